@@ -1,1 +1,2 @@
 //! The command line (in progress).
+pub mod simulate;

@@ -1,0 +1,1 @@
+//! `spherecal simulate` (in progress).
