@@ -1,1 +1,399 @@
-//! (in progress)
+//! Joint identification of hand-eye and kinematic errors, the paper's
+//! section 3.2 (eq. 10-19): one linearised update of the unknowns
+//! `ΔY = [ΔX; ΔP]` (6 hand-eye errors, `5·n` MDH errors).
+//!
+//! For a measurement `i` the base-frame centre is
+//! `X_i = bT_e(q_i) · eT_s · X_si` (eq. 10). To first order a hand-eye error
+//! `ΔX` (a twist in the sensor frame, `eT_s ← eT_s · exp(ΔX)`) and kinematic
+//! errors `ΔP` move it by
+//!
+//! ```text
+//! ΔX_i = R(bT_s,i) · P_i · ΔX + Q_i · J_i · ΔP          (eq. 12-16)
+//! P_i = [I | −[X_si]×]    (eq. 14; the rotation is that of bT_s = bT_e·eT_s,
+//!                           the corrected eq. 13 of NOTES.md)
+//! Q_i = [I | −[X_bi]×]    (eq. 16; J_i from kinematics::flange_jacobian)
+//! ```
+//!
+//! Two measurements of one station see one point, so for a pair `(i, j)`
+//! `X_i − X_j = [R_j·P_j − R_i·P_i,  Q_j·J_j − Q_i·J_i] · ΔY` (eq. 17, with
+//! the corrected second block). The pairs are stacked (eq. 18) and solved
+//! with a truncated SVD (eq. 19).
+//!
+//! **Column scaling.** Angle unknowns (rad) are multiplied by
+//! [`ANGLE_SCALE_MM`] before the SVD, so that every unknown is in mm of
+//! motion at a typical lever (1 mrad at 1 m = 1 mm). Singular values below
+//! `svd_tolerance × σ_max` of the scaled matrix are dropped. Unit-norm
+//! column scaling is not used: it would inflate the nearly-null columns of
+//! the rigid-motion parameters of joint 1 until they fit noise.
+
+use nalgebra::{DMatrix, DVector, Isometry3, Matrix3, Point3, Vector3};
+
+use super::error::IdentifyError;
+use super::geometry::{isometry_from_twist, skew};
+use super::handeye::Sighting;
+use super::kinematics::{PARAM_IS_ANGLE, PARAMS_PER_JOINT, Robot};
+
+/// Lever (mm per rad) applied to angle unknowns before the SVD: the arm's
+/// reach is ~1 m, so 1 mrad of a kinematic angle moves the tool ~1 mm.
+pub const ANGLE_SCALE_MM: f64 = 1000.0;
+
+/// Default relative SVD tolerance: singular values below this fraction of
+/// the largest are dropped. Chosen on simulated paper-like sessions (see
+/// README "Accuracy"): low enough to keep the weakly observed hand-eye
+/// rotation, high enough to drop the rigid-motion directions of joint 1.
+pub const DEFAULT_SVD_TOLERANCE: f64 = 1e-3;
+
+/// Labels of the six hand-eye unknowns (sensor frame; mm, rad).
+pub const HAND_EYE_LABELS: [&str; 6] = ["he_x", "he_y", "he_z", "he_rx", "he_ry", "he_rz"];
+
+/// How the measurements of a station are paired into eq. 17 rows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pairing {
+    /// The paper's: consecutive disjoint pairs (1,2), (3,4), (5,6) in file
+    /// order; an odd last measurement is paired with the first.
+    Disjoint,
+    /// Every pair `i < j`.
+    All,
+}
+
+impl Pairing {
+    /// The name written in the result's `solver.pairs`.
+    #[must_use]
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Disjoint => "disjoint",
+            Self::All => "all",
+        }
+    }
+
+    /// Parses `disjoint` or `all`.
+    #[must_use]
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "disjoint" => Some(Self::Disjoint),
+            "all" => Some(Self::All),
+            _ => None,
+        }
+    }
+
+    /// The index pairs for a station of `n` measurements.
+    #[must_use]
+    pub fn pairs(self, n: usize) -> Vec<(usize, usize)> {
+        match self {
+            Self::All => (0..n)
+                .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+                .collect(),
+            Self::Disjoint => {
+                let mut out: Vec<(usize, usize)> = (0..n / 2).map(|k| (2 * k, 2 * k + 1)).collect();
+                if n % 2 == 1 && n >= 3 {
+                    out.push((n - 1, 0));
+                }
+                out
+            }
+        }
+    }
+}
+
+/// One identify station: every sighting saw the same fixed point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Station {
+    /// Station id.
+    pub id: String,
+    /// Its sightings in file order.
+    pub sightings: Vec<Sighting>,
+}
+
+/// The current estimate: kinematic model and hand-eye.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Estimate {
+    /// Kinematic model.
+    pub robot: Robot,
+    /// `eT_s`.
+    pub flange_from_sensor: Isometry3<f64>,
+}
+
+impl Estimate {
+    /// The base-frame sphere centre of one sighting (eq. 10), mm.
+    #[must_use]
+    pub fn centre_in_base(&self, s: &Sighting) -> Vector3<f64> {
+        let base_from_sensor = self.robot.base_from_flange(&s.joints) * self.flange_from_sensor;
+        (base_from_sensor * Point3::from(s.centre_in_sensor)).coords
+    }
+
+    /// Base-frame centres of every station, grouped as `stations`.
+    #[must_use]
+    pub fn station_centres(&self, stations: &[Station]) -> Vec<Vec<Vector3<f64>>> {
+        stations
+            .iter()
+            .map(|st| st.sightings.iter().map(|s| self.centre_in_base(s)).collect())
+            .collect()
+    }
+
+    /// A copy with the update `ΔY = [ΔX; ΔP]` applied (mm, rad; unscaled).
+    #[must_use]
+    pub fn updated(&self, delta: &[f64]) -> Self {
+        let twist = [delta[0], delta[1], delta[2], delta[3], delta[4], delta[5]];
+        Self {
+            robot: self.robot.perturbed(&delta[6..]),
+            flange_from_sensor: self.flange_from_sensor * isometry_from_twist(&twist),
+        }
+    }
+}
+
+/// Label of unknown `k` of `ΔY` (`he_x`…, then `alpha1`, `a1`, …).
+#[must_use]
+pub fn unknown_label(k: usize) -> String {
+    if k < 6 {
+        HAND_EYE_LABELS[k].to_string()
+    } else {
+        Robot::param_label(k - 6)
+    }
+}
+
+/// Whether unknown `k` of `ΔY` is an angle (rad).
+#[must_use]
+pub fn unknown_is_angle(k: usize) -> bool {
+    if k < 6 {
+        k >= 3
+    } else {
+        PARAM_IS_ANGLE[(k - 6) % PARAMS_PER_JOINT]
+    }
+}
+
+/// The 3 × (6 + 5n) sensitivity `A_i` of one sighting's base-frame centre
+/// to `ΔY` (the bracket of eq. 17 for one measurement), and the centre.
+#[must_use]
+pub fn sensitivity(est: &Estimate, s: &Sighting) -> (Vector3<f64>, DMatrix<f64>) {
+    let (base_from_flange, jac) = est.robot.flange_jacobian(&s.joints);
+    let base_from_sensor = base_from_flange * est.flange_from_sensor;
+    let x_b = (base_from_sensor * Point3::from(s.centre_in_sensor)).coords;
+    let r_bs: Matrix3<f64> = base_from_sensor.rotation.to_rotation_matrix().into_inner();
+    let n = 6 + jac.ncols();
+    let mut a = DMatrix::zeros(3, n);
+    // Hand-eye block: R_bs · [I | −[X_s]×]   (eq. 13-14)
+    a.fixed_view_mut::<3, 3>(0, 0).copy_from(&r_bs);
+    a.fixed_view_mut::<3, 3>(0, 3)
+        .copy_from(&(-(r_bs * skew(&s.centre_in_sensor))));
+    // Kinematic block: Q_i · J_i = [I | −[X_b]×] · J_i   (eq. 15-16)
+    let mut q = nalgebra::Matrix3x6::zeros();
+    q.fixed_view_mut::<3, 3>(0, 0).copy_from(&Matrix3::identity());
+    q.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew(&x_b)));
+    let qj = q * jac;
+    a.view_mut((0, 6), (3, n - 6)).copy_from(&qj);
+    (x_b, a)
+}
+
+/// Settings of the paper's update.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PaperOptions {
+    /// Pairing of the measurements of a station.
+    pub pairing: Pairing,
+    /// Relative SVD tolerance (fraction of σ_max).
+    pub svd_tolerance: f64,
+}
+
+impl Default for PaperOptions {
+    fn default() -> Self {
+        Self {
+            pairing: Pairing::Disjoint,
+            svd_tolerance: DEFAULT_SVD_TOLERANCE,
+        }
+    }
+}
+
+/// What one update saw and did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UpdateInfo {
+    /// Singular values of the column-scaled `U`, descending.
+    pub singular_values: Vec<f64>,
+    /// How many were kept (above `svd_tolerance × σ_max`).
+    pub kept: usize,
+    /// Rows of `U` (3 per pair).
+    pub rows: usize,
+    /// The update `ΔY` (mm, rad).
+    pub delta: Vec<f64>,
+    /// The dropped directions, each as its dominant unknowns, e.g.
+    /// `"+0.71·d6 −0.71·he_z"`, strongest first.
+    pub dropped: Vec<String>,
+}
+
+/// Eq. 17-19: builds `U ΔY = V` over all pairs of all stations and solves
+/// it with the truncated SVD. Returns the update and what it saw.
+///
+/// # Errors
+/// [`IdentifyError::NotEnoughData`] when no station yields a pair,
+/// [`IdentifyError::InvalidOption`] for a tolerance outside (0, 1).
+pub fn paper_update(
+    est: &Estimate,
+    stations: &[Station],
+    options: &PaperOptions,
+) -> Result<UpdateInfo, IdentifyError> {
+    if !(options.svd_tolerance > 0.0 && options.svd_tolerance < 1.0) {
+        return Err(IdentifyError::InvalidOption(format!(
+            "svd tolerance must be in (0, 1), got {}",
+            options.svd_tolerance
+        )));
+    }
+    let n_unknowns = 6 + est.robot.n_params();
+    let mut blocks: Vec<(DMatrix<f64>, Vector3<f64>)> = Vec::new();
+    for st in stations {
+        let sens: Vec<(Vector3<f64>, DMatrix<f64>)> =
+            st.sightings.iter().map(|s| sensitivity(est, s)).collect();
+        for (i, j) in options.pairing.pairs(sens.len()) {
+            let u = &sens[j].1 - &sens[i].1;
+            let v = sens[i].0 - sens[j].0;
+            blocks.push((u, v));
+        }
+    }
+    if blocks.is_empty() {
+        return Err(IdentifyError::NotEnoughData {
+            detail: format!(
+                "{} identify station(s), none with 2 or more measurements",
+                stations.len()
+            ),
+        });
+    }
+    let rows = 3 * blocks.len();
+    let mut u = DMatrix::zeros(rows, n_unknowns);
+    let mut v = DVector::zeros(rows);
+    for (k, (bu, bv)) in blocks.iter().enumerate() {
+        u.view_mut((3 * k, 0), (3, n_unknowns)).copy_from(bu);
+        v.fixed_rows_mut::<3>(3 * k).copy_from(bv);
+    }
+    // Column scaling: unknown_scaled = scale · unknown.
+    let scale: Vec<f64> = (0..n_unknowns)
+        .map(|k| if unknown_is_angle(k) { ANGLE_SCALE_MM } else { 1.0 })
+        .collect();
+    for (c, s) in scale.iter().enumerate() {
+        u.column_mut(c).scale_mut(1.0 / s);
+    }
+    let (scaled_delta, singular_values, kept, dropped_dirs) =
+        truncated_solve(u, &v, options.svd_tolerance);
+    let delta: Vec<f64> = scaled_delta
+        .iter()
+        .zip(&scale)
+        .map(|(d, s)| d / s)
+        .collect();
+    let dropped = dropped_dirs.iter().map(|d| describe_direction(d)).collect();
+    Ok(UpdateInfo {
+        singular_values,
+        kept,
+        rows,
+        delta,
+        dropped,
+    })
+}
+
+/// Truncated-SVD least squares (eq. 19): `x = E · S⁺ · Fᵀ · v`, keeping
+/// singular values ≥ `tol · σ_max`. Also returns the singular values
+/// (descending, padded with zeros to the column count), the number kept
+/// and the dropped right singular vectors.
+fn truncated_solve(
+    u: DMatrix<f64>,
+    v: &DVector<f64>,
+    tol: f64,
+) -> (Vec<f64>, Vec<f64>, usize, Vec<Vec<f64>>) {
+    let ncols = u.ncols();
+    // Thin SVD of a tall matrix: min(rows, cols) singular values.
+    let svd = u.svd(true, true);
+    let (Some(left), Some(right_t)) = (svd.u, svd.v_t) else {
+        return (vec![0.0; ncols], vec![0.0; ncols], 0, Vec::new());
+    };
+    let sv = svd.singular_values;
+    let mut order: Vec<usize> = (0..sv.len()).collect();
+    order.sort_by(|a, b| sv[*b].total_cmp(&sv[*a]));
+    let smax = order.first().map_or(0.0, |&k| sv[k]);
+    let mut x = DVector::zeros(ncols);
+    let mut kept = 0;
+    let mut dropped = Vec::new();
+    for &k in &order {
+        let row = right_t.row(k);
+        if smax > 0.0 && sv[k] >= tol * smax {
+            let coef = left.column(k).dot(v) / sv[k];
+            x += row.transpose() * coef;
+            kept += 1;
+        } else {
+            dropped.push(row.iter().copied().collect());
+        }
+    }
+    // Directions beyond the rank of a short matrix are dropped too: the
+    // thin SVD has no vector for them; they are the complement.
+    let mut values: Vec<f64> = order.iter().map(|&k| sv[k]).collect();
+    values.resize(ncols, 0.0);
+    (x.iter().copied().collect(), values, kept, dropped)
+}
+
+/// A direction of `ΔY` (scaled space) as its dominant unknowns.
+fn describe_direction(d: &[f64]) -> String {
+    /// Components smaller than this are left out of the description.
+    const SHOWN: f64 = 0.2;
+    let mut parts: Vec<(usize, f64)> = d
+        .iter()
+        .copied()
+        .enumerate()
+        .filter(|(_, c)| c.abs() >= SHOWN)
+        .collect();
+    parts.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+    // Make the largest component positive so the sign is canonical.
+    let sign = parts.first().map_or(1.0, |p| p.1.signum());
+    parts
+        .iter()
+        .map(|(k, c)| format!("{:+.2}·{}", c * sign, unknown_label(*k)))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pairings() {
+        assert_eq!(Pairing::Disjoint.pairs(6), vec![(0, 1), (2, 3), (4, 5)]);
+        assert_eq!(Pairing::Disjoint.pairs(5), vec![(0, 1), (2, 3), (4, 0)]);
+        assert_eq!(Pairing::Disjoint.pairs(2), vec![(0, 1)]);
+        assert_eq!(Pairing::All.pairs(4).len(), 6);
+    }
+
+    #[test]
+    fn sensitivity_matches_finite_differences() {
+        let robot = crate::engine::kinematics::irb2400().robot;
+        let est = Estimate {
+            robot,
+            flange_from_sensor: isometry_from_twist(&[-7.4, -1.0, 287.8, 3.1, 0.02, 0.5]),
+        };
+        let s = Sighting {
+            id: "x".into(),
+            joints: vec![12.5, 20.1, -3.4, 40.0, 35.2, -10.0],
+            centre_in_sensor: Vector3::new(12.2, -1.3, 2.4),
+        };
+        let (x0, a) = sensitivity(&est, &s);
+        let n = a.ncols();
+        for k in 0..n {
+            let h = 1e-6;
+            let mut d = vec![0.0; n];
+            d[k] = h;
+            let xp = est.updated(&d).centre_in_base(&s);
+            d[k] = -h;
+            let xm = est.updated(&d).centre_in_base(&s);
+            let numeric = (xp - xm) / (2.0 * h);
+            let analytic = a.column(k);
+            let err = (numeric - analytic).norm();
+            assert!(err < 1e-5 * (1.0 + analytic.norm()), "{}: {err}", unknown_label(k));
+        }
+        assert!((x0 - est.centre_in_base(&s)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn truncated_solve_drops_null_direction() {
+        // Two identical columns: the difference direction is null.
+        let u = DMatrix::from_row_slice(3, 2, &[1.0, 1.0, 2.0, 2.0, 0.0, 0.0]);
+        let v = DVector::from_row_slice(&[2.0, 4.0, 0.0]);
+        let (x, sv, kept, dropped) = truncated_solve(u, &v, 1e-6);
+        assert_eq!(kept, 1);
+        assert_eq!(dropped.len(), 1);
+        assert!(sv[1].abs() < 1e-12);
+        // Minimum-norm solution splits equally.
+        assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] - 1.0).abs() < 1e-12);
+    }
+}
