@@ -30,3 +30,13 @@
 
 pub mod cli;
 pub mod engine;
+
+#[cfg(feature = "gui")]
+pub mod app;
+
+/// The demo session embedded in the binary (`sessions/demo-irb2400.json`):
+/// what the workbench opens when started without a file.
+pub const DEMO_SESSION_JSON: &str = include_str!("../sessions/demo-irb2400.json");
+
+/// File name shown for the embedded demo session.
+pub const DEMO_SESSION_NAME: &str = "demo-irb2400.json";

@@ -1,1 +1,47 @@
-fn main() {}
+//! `spherecal`: parse the command line, then start the workbench or run a
+//! command. All work is in the library.
+
+use std::process::ExitCode;
+
+use clap::Parser;
+use spherecal::cli::{self, Cli, CliError, Command};
+
+fn main() -> ExitCode {
+    let parsed = Cli::parse();
+    let outcome = match parsed.command {
+        Some(Command::Calibrate(args)) => cli::calibrate_command(&args),
+        Some(Command::Simulate(args)) => {
+            cli::simulate::run(&args).map_err(|e| CliError::input(format!("{e:#}")))
+        }
+        Some(Command::Gui(args)) => gui(args.session, args.result),
+        None => gui(None, None),
+    };
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", e.message);
+            ExitCode::from(u8::try_from(e.status).unwrap_or(1))
+        }
+    }
+}
+
+#[cfg(feature = "gui")]
+fn gui(
+    session: Option<std::path::PathBuf>,
+    result: Option<std::path::PathBuf>,
+) -> Result<(), CliError> {
+    spherecal::app::run(session, result).map_err(CliError::internal)
+}
+
+#[cfg(not(feature = "gui"))]
+fn gui(
+    _session: Option<std::path::PathBuf>,
+    _result: Option<std::path::PathBuf>,
+) -> Result<(), CliError> {
+    // Built without the workbench: show what the command line offers.
+    let _ = <Cli as clap::CommandFactory>::command().print_help();
+    println!();
+    Err(CliError::input(
+        "this build has no workbench (built without the `gui` feature); use `spherecal calibrate SESSION --out RESULT`",
+    ))
+}

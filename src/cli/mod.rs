@@ -1,2 +1,201 @@
-//! The command line (in progress).
+//! The command line: `spherecal calibrate | simulate | gui`. A thin caller
+//! of the engine; it prints, the engine does not.
+//!
+//! Exit status (FORMAT.md "Command line contract"): 0 on success, 2 on bad
+//! input with one `error:` line on stderr naming the file, the measurement
+//! and the problem, 1 on an internal failure. A result file is written
+//! atomically or not at all.
+
 pub mod simulate;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::{Args, Parser, Subcommand};
+
+use crate::engine::calibrate::{self, Control, HandEyeSource, Method, Options};
+use crate::engine::error::{CalibrationError, FileError};
+use crate::engine::identify::Pairing;
+use crate::engine::report;
+use crate::engine::session;
+
+/// spherecal: calibrate a robot-mounted laser-stripe sensor (hand-eye and
+/// kinematic errors) against a reference sphere.
+#[derive(Debug, Parser)]
+#[command(name = "spherecal", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do; without a command the workbench opens on the demo session.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run the whole calibration headless and write the result file.
+    Calibrate(CalibrateArgs),
+    /// Write a simulated session with a known truth (for tests, demos and what-if studies).
+    Simulate(simulate::SimulateArgs),
+    /// Open the workbench, optionally on a session file.
+    Gui(GuiArgs),
+}
+
+/// `spherecal gui`.
+#[derive(Debug, Args)]
+pub struct GuiArgs {
+    /// Session file to open (default: the embedded demo session).
+    pub session: Option<PathBuf>,
+    /// A result file to review beside the session (no solver run).
+    #[arg(long)]
+    pub result: Option<PathBuf>,
+}
+
+/// `spherecal calibrate`.
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    /// Session file (FORMAT.md `spherecal-session`).
+    pub session: PathBuf,
+    /// Where to write the result file (FORMAT.md `spherecal-result`).
+    #[arg(long, short)]
+    pub out: PathBuf,
+    /// Identification method: `paper` (the paper's section 3.2).
+    #[arg(long, default_value = "paper", value_parser = parse_method)]
+    pub method: Method,
+    /// Stop when ε falls to this (mm); default: the session's `solver.threshold` (0.15).
+    #[arg(long)]
+    pub threshold: Option<f64>,
+    /// Most updates; default: the session's `solver.max_iterations` (20).
+    #[arg(long)]
+    pub max_iterations: Option<usize>,
+    /// Relative SVD tolerance of the paper's method (fraction of the largest singular value).
+    #[arg(long, default_value_t = crate::engine::identify::DEFAULT_SVD_TOLERANCE)]
+    pub svd_tolerance: f64,
+    /// Pairing of a station's measurements: `disjoint` (the paper's (1,2),(3,4),(5,6)) or `all`.
+    #[arg(long, default_value = "disjoint", value_parser = parse_pairing)]
+    pub pairs: Pairing,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+fn parse_method(s: &str) -> Result<Method, String> {
+    Method::parse(s).ok_or_else(|| {
+        let names: Vec<&str> = Method::ALL.iter().map(|m| m.as_str()).collect();
+        format!("unknown method `{s}`, expected one of: {}", names.join(", "))
+    })
+}
+
+fn parse_pairing(s: &str) -> Result<Pairing, String> {
+    Pairing::parse(s).ok_or_else(|| format!("unknown pairing `{s}`, expected `disjoint` or `all`"))
+}
+
+/// A failure of a command, with its exit status.
+#[derive(Debug)]
+pub struct CliError {
+    /// 2 for bad input, 1 for an internal failure.
+    pub status: i32,
+    /// One line, without the `error: ` prefix.
+    pub message: String,
+}
+
+impl CliError {
+    /// Bad input (exit 2).
+    #[must_use]
+    pub fn input(message: impl Into<String>) -> Self {
+        Self {
+            status: 2,
+            message: message.into(),
+        }
+    }
+
+    /// Internal failure (exit 1).
+    #[must_use]
+    pub fn internal(message: impl Into<String>) -> Self {
+        Self {
+            status: 1,
+            message: message.into(),
+        }
+    }
+
+    /// From a file error: I/O on reading is input, on writing internal.
+    #[must_use]
+    pub fn from_file(e: &FileError, reading: bool) -> Self {
+        let message = e.to_string();
+        match e {
+            FileError::Invalid { .. } => Self::input(message),
+            FileError::Io { .. } if reading => Self::input(message),
+            FileError::Io { .. } => Self::internal(message),
+        }
+    }
+
+    /// From a calibration error of the session at `path`.
+    #[must_use]
+    pub fn from_calibration(e: &CalibrationError, path: &Path) -> Self {
+        let message = format!("{e} ({})", path.display());
+        if e.is_input_error() {
+            Self::input(message)
+        } else {
+            Self::internal(message)
+        }
+    }
+}
+
+/// `spherecal calibrate`: load, calibrate, write the result atomically,
+/// print a summary.
+///
+/// # Errors
+/// [`CliError`] with status 2 for bad input, 1 for internal failures.
+pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
+    let started = Instant::now();
+    let session = session::load_session(&args.session).map_err(|e| CliError::from_file(&e, true))?;
+    let mut options = Options::from_session(&session);
+    options.method = args.method;
+    if let Some(t) = args.threshold {
+        options.threshold = t;
+    }
+    if let Some(n) = args.max_iterations {
+        options.max_iterations = n;
+    }
+    options.paper.svd_tolerance = args.svd_tolerance;
+    options.paper.pairing = args.pairs;
+    let prepared = calibrate::prepare(&session).map_err(|e| CliError::from_calibration(&e, &args.session))?;
+    let quiet = args.quiet;
+    let mut on_progress = |p: &calibrate::Progress| {
+        if !quiet {
+            println!("  ε after {:>2} update(s): {:.4} mm", p.updates, p.epsilon);
+        }
+        Control::Continue
+    };
+    if !quiet {
+        println!("session {:?}: {} measurements", session.name, session.measurements.len());
+        for (id, w) in &prepared.warnings {
+            println!("  warning: measurement {id}: {w}");
+        }
+        match &prepared.hand_eye_source {
+            HandEyeSource::File => println!("initial hand-eye: from the session file"),
+            HandEyeSource::Computed(h) => println!(
+                "initial hand-eye (eq. 6-9): rotation residual {:.4} mm, translation residual {:.4} mm",
+                h.rotation_residual, h.translation_residual
+            ),
+        }
+        println!(
+            "identification: method {}, threshold {} mm, at most {} update(s)",
+            options.method.as_str(),
+            options.threshold,
+            options.max_iterations
+        );
+    }
+    let cal = calibrate::run(&session, &prepared, &options, &mut on_progress)
+        .map_err(|e| CliError::from_calibration(&e, &args.session))?;
+    let result = report::result_file(&session, &prepared, &cal);
+    session::save_result(&result, &args.out).map_err(|e| CliError::from_file(&e, false))?;
+    if !quiet {
+        print!("{}", report::summary(&session, &cal));
+        println!(
+            "wrote {} ({:.0} ms)",
+            args.out.display(),
+            started.elapsed().as_secs_f64() * 1e3
+        );
+    }
+    Ok(())
+}

@@ -13,6 +13,7 @@
 //! | Fig. 2 (the loop) and the whole pipeline | [`calibrate`] |
 
 pub mod calibrate;
+pub mod report;
 pub mod error;
 pub mod geometry;
 pub mod handeye;

@@ -1,0 +1,1 @@
+//! Result file and summary (in progress).
