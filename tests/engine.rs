@@ -1,0 +1,169 @@
+//! The paper's method end to end against simulated ground truth: the
+//! estimators must recover the truth exactly without noise and come within
+//! a stated factor of the noise floor with it.
+
+use spherecal::engine::calibrate::{self, Options, Prepared};
+use spherecal::engine::evaluate;
+use spherecal::engine::kinematics::Robot;
+use spherecal::engine::model::{Session, Use};
+use spherecal::engine::simulate::{self, SimConfig, Truth};
+
+fn simulate(config: &SimConfig) -> (Session, Truth) {
+    simulate::simulate(config).expect("simulation")
+}
+
+/// Noise-free: every noise source off and stripes written at full precision.
+fn noise_free(seed: u64) -> SimConfig {
+    SimConfig {
+        seed,
+        joint_noise: 0.0,
+        stripe_noise: 0.0,
+        centre_noise: 0.0,
+        tracker_noise: 0.0,
+        cut_jitter: 3.0,
+        stripe_decimals: 12,
+        ..SimConfig::default()
+    }
+}
+
+fn run(session: &Session, threshold: f64, max_iterations: usize) -> (Prepared, calibrate::Calibration) {
+    let mut options = Options::from_session(session);
+    options.threshold = threshold;
+    options.max_iterations = max_iterations;
+    calibrate::calibrate(session, &options).expect("calibration")
+}
+
+/// True distances between validate stations against those the calibrated
+/// model measures, every k-th pose pair.
+fn max_distance_error(session: &Session, prepared: &Prepared, truth: &Truth, robot: &Robot, he: &nalgebra::Isometry3<f64>) -> f64 {
+    evaluate::validation_errors(session, prepared, truth, robot, he)
+        .iter()
+        .fold(0.0_f64, |m, e| m.max(e.abs()))
+}
+
+#[test]
+fn noise_free_stripe_session_is_recovered_exactly() {
+    let (session, truth) = simulate(&noise_free(11));
+    let (prepared, cal) = run(&session, 0.0, 30);
+    // The noise-free sphere centres are exact.
+    for (m, p) in session.measurements.iter().zip(&prepared.measurements) {
+        let t = truth.measurement(&m.id).unwrap();
+        let d = (p.centre_in_sensor - nalgebra::Vector3::from(t.sensor_centre)).norm();
+        assert!(d < 1e-6, "{}: sensor centre off by {d}", m.id);
+    }
+    assert!(cal.epsilon_after() < 1e-6, "ε after = {}", cal.epsilon_after());
+    let err = max_distance_error(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
+    assert!(err < 1e-6, "validation distances off by {err} mm");
+    // Before calibration the nominal model is far off.
+    let before = max_distance_error(&session, &prepared, &truth, &session.robot, &prepared.hand_eye_initial);
+    assert!(before > 0.3, "{before}");
+}
+
+#[test]
+fn noise_free_initial_hand_eye_from_true_model_is_exact() {
+    // With the nominal model replaced by the truth, eq. 6-9 see exact flange
+    // poses, so the initial hand-eye equals the true one.
+    let (mut session, truth) = simulate(&noise_free(12));
+    session.robot = truth.true_robot();
+    let prepared = calibrate::prepare(&session).unwrap();
+    let he = prepared.hand_eye_initial;
+    let t = truth.true_hand_eye();
+    assert!(he.rotation.angle_to(&t.rotation) < 1e-9);
+    assert!((he.translation.vector - t.translation.vector).norm() < 1e-6);
+}
+
+#[test]
+fn noise_free_centres_session_is_recovered_exactly() {
+    let config = SimConfig {
+        centres: true,
+        ..noise_free(13)
+    };
+    let (session, truth) = simulate(&config);
+    let (prepared, cal) = run(&session, 0.0, 30);
+    let err = max_distance_error(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
+    assert!(err < 1e-6, "validation distances off by {err} mm");
+}
+
+#[test]
+fn noisy_sessions_reach_near_the_noise_floor() {
+    // Five seeds of the paper-like session (joint noise 0.003°, stripe
+    // noise 0.02 mm): the calibrated validation std must be within 3× the
+    // floor and at least 10× better than before.
+    let mut ratios = Vec::new();
+    for seed in 1..=5 {
+        let (session, truth) = simulate(&SimConfig {
+            seed,
+            ..SimConfig::default()
+        });
+        let (prepared, cal) = run(&session, session.solver.threshold, session.solver.max_iterations);
+        let score = evaluate::score(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
+        eprintln!(
+            "seed {seed}: before {:.4} after {:.4} floor {:.4} (ratio {:.2}, improvement {:.1}x)",
+            score.before.std,
+            score.after.std,
+            score.floor.std,
+            score.ratio_to_floor(),
+            score.improvement()
+        );
+        assert!(score.ratio_to_floor() < 3.0, "seed {seed}: {score:?}");
+        assert!(score.improvement() > 10.0, "seed {seed}: {score:?}");
+        ratios.push(score.ratio_to_floor());
+    }
+    let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
+    assert!(mean < 2.5, "mean ratio to floor {mean}");
+}
+
+#[test]
+fn epsilon_series_follows_the_loop_of_format_md() {
+    let (session, _) = simulate(&SimConfig {
+        seed: 3,
+        ..SimConfig::default()
+    });
+    // A threshold above the starting ε: one entry, no update.
+    let prepared = calibrate::prepare(&session).unwrap();
+    let mut options = Options::from_session(&session);
+    options.threshold = 1e6;
+    let cal = calibrate::run(&session, &prepared, &options, &mut |_| calibrate::Control::Continue).unwrap();
+    assert_eq!(cal.iterations.len(), 1);
+    assert!(cal.last_update.is_none());
+    // Threshold 0 with a bound of 4: exactly 4 updates, 5 entries.
+    options.threshold = 0.0;
+    options.max_iterations = 4;
+    let mut seen = Vec::new();
+    let cal = calibrate::run(&session, &prepared, &options, &mut |p| {
+        seen.push((p.updates, p.epsilon));
+        calibrate::Control::Continue
+    })
+    .unwrap();
+    assert_eq!(cal.iterations.len(), 5);
+    assert_eq!(seen.len(), 5);
+    assert_eq!(seen[4].0, 4);
+    assert!((seen[4].1 - cal.epsilon_after()).abs() < 1e-15);
+    assert!(cal.epsilon_after() < cal.epsilon_before());
+    assert!(matches!(cal.stop, calibrate::StopReason::IterationLimit { updates: 4, .. }));
+}
+
+#[test]
+fn cancel_stops_the_loop() {
+    let (session, _) = simulate(&SimConfig::default());
+    let prepared = calibrate::prepare(&session).unwrap();
+    let mut options = Options::from_session(&session);
+    options.threshold = 0.0;
+    let err = calibrate::run(&session, &prepared, &options, &mut |p| {
+        if p.updates >= 2 {
+            calibrate::Control::Cancel
+        } else {
+            calibrate::Control::Continue
+        }
+    })
+    .unwrap_err();
+    assert!(err.to_string().contains("cancelled"), "{err}");
+}
+
+#[test]
+fn too_little_identify_data_is_explained() {
+    let (mut session, _) = simulate(&SimConfig::default());
+    session.measurements.retain(|m| m.usage != Use::Identify);
+    let err = calibrate::calibrate(&session, &Options::from_session(&session)).unwrap_err();
+    assert!(err.to_string().contains("identify station"), "{err}");
+}
