@@ -15,6 +15,7 @@
 pub mod calibrate;
 pub mod report;
 pub mod error;
+pub mod evaluate;
 pub mod geometry;
 pub mod handeye;
 pub mod identify;
