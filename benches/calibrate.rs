@@ -1,1 +1,40 @@
-fn main() {}
+//! Whole-calibration benchmarks on the embedded demo session: centres
+//! from the stripes plus the initial hand-eye (`prepare`), and the
+//! identification loop (`run`) of each method.
+
+use std::path::Path;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use spherecal::engine::calibrate::{self, Control, Method, Options};
+use spherecal::engine::session::parse_session;
+
+fn demo() -> spherecal::engine::model::Session {
+    parse_session(spherecal::DEMO_SESSION_JSON, Path::new(spherecal::DEMO_SESSION_NAME))
+        .expect("the embedded demo session loads")
+}
+
+fn bench(c: &mut Criterion) {
+    let session = demo();
+    let mut group = c.benchmark_group("demo_session");
+    group.bench_function("prepare (stripe fits + initial hand-eye)", |b| {
+        b.iter(|| calibrate::prepare(&session).expect("prepare"));
+    });
+    let prepared = calibrate::prepare(&session).expect("prepare");
+    for method in Method::ALL {
+        let mut options = Options::from_session(&session);
+        options.method = method;
+        group.bench_function(format!("identify, method {}", method.as_str()), |b| {
+            b.iter(|| {
+                calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue)
+                    .expect("run")
+            });
+        });
+    }
+    group.bench_function("whole calibration, default options", |b| {
+        b.iter(|| calibrate::calibrate(&session, &Options::from_session(&session)).expect("calibrate"));
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
