@@ -1,0 +1,192 @@
+//! The command-line contract of FORMAT.md, on the real binary: exit 0 and
+//! a result file on success; exit 2, one `error:` line naming file and
+//! measurement, and no file on bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn spherecal() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_spherecal"))
+}
+
+fn demo_path(dir: &Path) -> PathBuf {
+    let p = dir.join("demo.json");
+    std::fs::write(&p, spherecal::DEMO_SESSION_JSON).unwrap();
+    p
+}
+
+/// Runs `calibrate` and returns (status, stdout, stderr).
+fn calibrate(session: &Path, out: &Path) -> (i32, String, String) {
+    let o = spherecal()
+        .args(["calibrate"])
+        .arg(session)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn calibrate_demo_writes_a_result_that_loads() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = demo_path(dir.path());
+    let out = dir.path().join("result.json");
+    let (status, stdout, stderr) = calibrate(&session, &out);
+    assert_eq!(status, 0, "{stderr}");
+    assert!(stdout.contains("ε after  0 update(s)"), "{stdout}");
+    assert!(stdout.contains("validation"), "{stdout}");
+    let result = spherecal::engine::session::load_result(&out).unwrap();
+    assert!(result.epsilon_after < result.epsilon_before);
+    let v = result.validation.expect("the demo has validate stations");
+    assert!(
+        v.after.std * 10.0 < v.before.std,
+        "{:?} → {:?}",
+        v.before,
+        v.after
+    );
+    assert_eq!(files_in(dir.path()), vec!["demo.json", "result.json"]);
+}
+
+/// Writes `text` as a session, runs calibrate, expects exit 2 with one
+/// `error:` line containing every `needle`, and no result file.
+fn expect_input_error(text: &str, needles: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let session = dir.path().join("bad.json");
+    std::fs::write(&session, text).unwrap();
+    let out = dir.path().join("result.json");
+    let (status, _stdout, stderr) = calibrate(&session, &out);
+    assert_eq!(status, 2, "stderr: {stderr}");
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "one line expected: {stderr}");
+    assert!(lines[0].starts_with("error: "), "{stderr}");
+    assert!(lines[0].contains("bad.json"), "names the file: {stderr}");
+    for n in needles {
+        assert!(lines[0].contains(n), "expected {n:?} in: {stderr}");
+    }
+    assert_eq!(
+        files_in(dir.path()),
+        vec!["bad.json"],
+        "no result file, no temp file"
+    );
+}
+
+fn demo_value() -> serde_json::Value {
+    serde_json::from_str(spherecal::DEMO_SESSION_JSON).unwrap()
+}
+
+#[test]
+fn bad_inputs_exit_2_with_one_line_and_no_file() {
+    // Invalid JSON.
+    expect_input_error("{ \"format\": ", &[]);
+    // NaN is not JSON.
+    let text = demo_value()
+        .to_string()
+        .replacen("\"diameter\":38.1", "\"diameter\":NaN", 1);
+    assert!(text.contains("NaN"));
+    expect_input_error(&text, &[]);
+    // Unknown key in a measurement.
+    let mut v = demo_value();
+    v["measurements"][12]["colour"] = serde_json::json!("red");
+    let id = v["measurements"][12]["id"].as_str().unwrap().to_string();
+    expect_input_error(&v.to_string(), &[&id, "colour"]);
+    // Wrong count of joints.
+    let mut v = demo_value();
+    v["measurements"][20]["joints"] = serde_json::json!([1.0, 2.0, 3.0]);
+    let id = v["measurements"][20]["id"].as_str().unwrap().to_string();
+    expect_input_error(&v.to_string(), &[&id]);
+    // A stripe too short to fit.
+    let mut v = demo_value();
+    v["measurements"][15]["stripe"]["points"] =
+        serde_json::json!([[0.0, 1.0], [1.0, 2.0], [2.0, 2.5]]);
+    let id = v["measurements"][15]["id"].as_str().unwrap().to_string();
+    expect_input_error(&v.to_string(), &[&id, "5"]);
+    // Translations that cannot determine the hand-eye: all at one pose.
+    let mut v = demo_value();
+    let first = v["measurements"][0]["joints"].clone();
+    for k in 0..v["measurements"].as_array().unwrap().len() {
+        if v["measurements"][k]["use"] == "translation" {
+            v["measurements"][k]["joints"] = first.clone();
+        }
+    }
+    expect_input_error(&v.to_string(), &["collinear"]);
+}
+
+#[test]
+fn unreadable_file_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.json");
+    let (status, _, stderr) = calibrate(&dir.path().join("missing.json"), &out);
+    assert_eq!(status, 2, "{stderr}");
+    assert!(
+        stderr.starts_with("error: ") && stderr.contains("missing.json"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn unwritable_output_exits_1_and_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = demo_path(dir.path());
+    // The output's folder does not exist: an internal (I/O) failure.
+    let out = dir.path().join("no-such-dir").join("r.json");
+    let (status, _, stderr) = calibrate(&session, &out);
+    assert_eq!(status, 1, "{stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    assert_eq!(files_in(dir.path()), vec!["demo.json"]);
+}
+
+#[test]
+fn help_is_available_for_every_command() {
+    for args in [
+        vec!["--help"],
+        vec!["calibrate", "--help"],
+        vec!["simulate", "--help"],
+    ] {
+        let o = spherecal().args(&args).output().unwrap();
+        assert!(o.status.success(), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&o.stdout).contains("Usage"),
+            "{args:?}"
+        );
+    }
+}
+
+#[test]
+fn simulate_is_deterministic_and_calibrates() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str| {
+        let s = dir.path().join(format!("{name}.json"));
+        let t = dir.path().join(format!("{name}.truth.json"));
+        let o = spherecal()
+            .args(["simulate", "--seed", "5", "--out"])
+            .arg(&s)
+            .arg("--truth")
+            .arg(&t)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        (std::fs::read(&s).unwrap(), std::fs::read(&t).unwrap(), s)
+    };
+    let (a, ta, path) = run("a");
+    let (b, tb, _) = run("b");
+    assert_eq!(a, b, "same seed, same session");
+    assert_eq!(ta, tb, "same seed, same truth");
+    let out = dir.path().join("r.json");
+    let (status, _, stderr) = calibrate(&path, &out);
+    assert_eq!(status, 0, "{stderr}");
+}
