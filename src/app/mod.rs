@@ -1,12 +1,71 @@
-//! The egui workbench (being built; see issue "The workbench").
+//! The workbench: an egui desktop app for the whole calibration, from
+//! loading a session to exporting the result. It calls the same engine
+//! functions as the command line; nothing here computes a calibration.
+//!
+//! Layout of the code (STYLE.md habit 5):
+//!
+//! - [`state`]: what the app knows ([`state::AppState`], changed only by
+//!   commands and job messages) and the form fields widgets edit;
+//! - [`commands`]: what the panels ask for;
+//! - [`workbench`]: applies commands, starts jobs, drains their messages;
+//! - [`jobs`] and [`work`]: named background threads and the engine calls
+//!   they make (load and fit, solve, save, export);
+//! - [`view`]: view models built from engine outputs (a run and a reviewed
+//!   result file both go through the FORMAT.md result);
+//! - [`export`]: the export files;
+//! - [`panels`]: one module per panel or view, each a `*_ui` function.
+//!
+//! Layout of the window, for an operator at 1366×768: the load and solver
+//! panel on the left, the Session, Stripe, Centres and Results views in the
+//! middle, a status bar at the bottom.
 
-/// Opens the workbench window.
+pub mod commands;
+pub mod export;
+pub mod jobs;
+pub mod panels;
+pub mod state;
+pub mod view;
+pub mod work;
+pub mod workbench;
+
+use std::path::PathBuf;
+
+pub use workbench::WorkbenchApp;
+
+/// The one line printed when the workbench cannot open a window.
+pub const NO_DISPLAY_HINT: &str =
+    "to calibrate without a display run `spherecal calibrate SESSION --out RESULT`";
+
+/// Opens the workbench window on `session` (default: the embedded demo
+/// session) and, when given, `result` for review beside it. Blocks until
+/// the window closes.
 ///
 /// # Errors
-/// Always, until the workbench lands.
-pub fn run(
-    _session: Option<std::path::PathBuf>,
-    _result: Option<std::path::PathBuf>,
-) -> Result<(), String> {
-    Err("the workbench is not built yet; use `spherecal calibrate`".into())
+/// No display (neither `DISPLAY` nor `WAYLAND_DISPLAY` set) or a window
+/// that could not be created: one line pointing to `spherecal calibrate`.
+pub fn run(session: Option<PathBuf>, result: Option<PathBuf>) -> Result<(), String> {
+    if std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none() {
+        return Err(format!(
+            "no display (DISPLAY and WAYLAND_DISPLAY are unset); {NO_DISPLAY_HINT}"
+        ));
+    }
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("spherecal workbench")
+            .with_app_id("spherecal")
+            .with_inner_size([1366.0, 768.0])
+            .with_min_inner_size([960.0, 600.0])
+            .with_drag_and_drop(true),
+        ..Default::default()
+    };
+    eframe::run_native(
+        "spherecal",
+        options,
+        Box::new(move |cc| {
+            Ok(Box::new(WorkbenchApp::from_storage(
+                cc.storage, session, result,
+            )))
+        }),
+    )
+    .map_err(|e| format!("could not open the workbench window ({e}); {NO_DISPLAY_HINT}"))
 }

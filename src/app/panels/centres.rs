@@ -1,0 +1,408 @@
+//! The Centres view: sphere centres in the base frame by station, before
+//! and after calibration, in a 3D view the operator can orbit (an
+//! orthographic camera drawn with the egui painter) and in the three plane
+//! projections. Clicking a centre selects its measurement.
+
+use egui::{Color32, Pos2, Rect, RichText, Sense, Stroke, Vec2};
+use egui_plot::{Legend, MarkerShape, Plot, PlotPoints, Points};
+
+use super::{AFTER, BEFORE, station_colour};
+use crate::app::commands::Command;
+use crate::app::state::{AppState, Camera, CentresForm, Forms};
+use crate::app::view::{CentrePoint, CentreSet};
+
+/// A click selects the nearest centre within this many points of the pointer.
+const PICK_RADIUS: f32 = 10.0;
+
+/// One drawn marker: where, which measurement, before or after.
+struct Marker {
+    pos: [f64; 3],
+    index: Option<usize>,
+    station: usize,
+    after: bool,
+}
+
+/// The Centres view.
+pub fn centres_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    let set = match (&state.result, &state.loaded) {
+        (Some(r), _) => &r.centres,
+        (None, Some(l)) => match &l.before {
+            Ok(set) => set,
+            Err(e) => {
+                ui.label(RichText::new(format!("No centres: {e}")).color(super::BAD));
+                return;
+            }
+        },
+        (None, None) => {
+            ui.label("No session open.");
+            return;
+        }
+    };
+    let has_after = set.points.iter().any(|p| p.after.is_some());
+    options_ui(ui, &mut forms.centres, has_after, set);
+    let markers = markers(set, &forms.centres);
+    let selected = state.selected;
+    let size = ui.available_size();
+    ui.horizontal(|ui| {
+        let w3d = (size.x * 0.55).max(200.0);
+        ui.vertical(|ui| {
+            ui.set_width(w3d);
+            ui.label(
+                RichText::new("3D (drag to orbit, scroll to zoom, click to select)")
+                    .small()
+                    .weak(),
+            );
+            let h = (size.y - 24.0).max(150.0);
+            if let Some(i) = orbit_ui(
+                ui,
+                Vec2::new(w3d, h),
+                &markers,
+                set,
+                &mut forms.centres.camera,
+                selected,
+            ) {
+                commands.push(Command::Select(i));
+            }
+        });
+        ui.vertical(|ui| {
+            let h = ((size.y - 3.0 * 22.0) / 3.0).max(100.0);
+            for (k, (a, b, name)) in [
+                (0, 1, "top view: x–y"),
+                (0, 2, "side view: x–z"),
+                (1, 2, "front view: y–z"),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                ui.label(RichText::new(name).small().weak());
+                if let Some(i) = projection_ui(ui, k, (a, b), h, &markers, set, selected) {
+                    commands.push(Command::Select(i));
+                }
+            }
+        });
+    });
+}
+
+fn options_ui(ui: &mut egui::Ui, f: &mut CentresForm, has_after: bool, set: &CentreSet) {
+    ui.horizontal_wrapped(|ui| {
+        ui.checkbox(
+            &mut f.show_before,
+            RichText::new("○ before (nominal)").color(BEFORE),
+        );
+        ui.add_enabled_ui(has_after, |ui| {
+            ui.checkbox(
+                &mut f.show_after,
+                RichText::new("● after (calibrated)").color(AFTER),
+            )
+            .on_disabled_hover_text("run the solver first");
+        });
+        ui.checkbox(
+            &mut f.relative,
+            "deviations from the station mean, magnified",
+        )
+        .on_hover_text(
+            "each centre is drawn at its station's mean plus its deviation times the factor",
+        );
+        ui.add_enabled_ui(f.relative, |ui| {
+            let l = ui.label("×");
+            ui.add(
+                egui::DragValue::new(&mut f.magnify)
+                    .range(1.0..=2000.0)
+                    .speed(1.0),
+            )
+            .labelled_by(l.id);
+        });
+        if ui.button("Reset view").clicked() {
+            f.camera = Camera::default();
+        }
+        ui.separator();
+        for (k, s) in set.stations.iter().enumerate() {
+            ui.label(RichText::new(format!("■ {s}")).color(station_colour(k)));
+        }
+    });
+}
+
+fn markers(set: &CentreSet, f: &CentresForm) -> Vec<Marker> {
+    let mut out = Vec::new();
+    let place = |p: [f64; 3], own_mean: [f64; 3], anchor: [f64; 3]| -> [f64; 3] {
+        if f.relative {
+            let k = f64::from(f.magnify);
+            [
+                anchor[0] + k * (p[0] - own_mean[0]),
+                anchor[1] + k * (p[1] - own_mean[1]),
+                anchor[2] + k * (p[2] - own_mean[2]),
+            ]
+        } else {
+            p
+        }
+    };
+    for p in &set.points {
+        let s = set.station_index(&p.station);
+        let (mean_before, mean_after) = set.means.get(s).copied().unwrap_or(([0.0; 3], [0.0; 3]));
+        if f.show_before {
+            out.push(Marker {
+                pos: place(p.before, mean_before, mean_before),
+                index: p.index,
+                station: s,
+                after: false,
+            });
+        }
+        if f.show_after
+            && let Some(a) = p.after
+        {
+            out.push(Marker {
+                pos: place(a, mean_after, mean_before),
+                index: p.index,
+                station: s,
+                after: true,
+            });
+        }
+    }
+    out
+}
+
+/// The orthographic orbit view. Returns the measurement clicked.
+fn orbit_ui(
+    ui: &mut egui::Ui,
+    size: Vec2,
+    markers: &[Marker],
+    set: &CentreSet,
+    cam: &mut Camera,
+    selected: Option<usize>,
+) -> Option<usize> {
+    let (response, painter) = ui.allocate_painter(size, Sense::click_and_drag());
+    let response = response.on_hover_text("sphere centres in the robot base frame");
+    let rect = response.rect;
+    painter.rect_filled(rect, 4.0, ui.visuals().extreme_bg_color);
+    if response.dragged() {
+        let d = response.drag_delta();
+        cam.yaw += d.x * 0.01;
+        cam.pitch = (cam.pitch + d.y * 0.01).clamp(-1.55, 1.55);
+    }
+    if response.hovered() {
+        let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+        if scroll != 0.0 {
+            cam.zoom = (cam.zoom * (scroll * 0.002).exp()).clamp(0.1, 50.0);
+        }
+    }
+    if markers.is_empty() {
+        painter.text(
+            rect.center(),
+            egui::Align2::CENTER_CENTER,
+            "nothing to show",
+            egui::FontId::proportional(16.0),
+            Color32::GRAY,
+        );
+        return None;
+    }
+    // Fit: centre of the bounding box, scale so its half-diagonal fills the view.
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for m in markers {
+        for k in 0..3 {
+            lo[k] = lo[k].min(m.pos[k]);
+            hi[k] = hi[k].max(m.pos[k]);
+        }
+    }
+    let centre = [
+        (lo[0] + hi[0]) / 2.0,
+        (lo[1] + hi[1]) / 2.0,
+        (lo[2] + hi[2]) / 2.0,
+    ];
+    let half = (0..3)
+        .map(|k| (hi[k] - lo[k]) / 2.0)
+        .map(|d| d * d)
+        .sum::<f64>()
+        .sqrt()
+        .max(1e-6);
+    let scale = f64::from(rect.width().min(rect.height())) * 0.45 / half * f64::from(cam.zoom);
+    let (sy, cy) = f64::from(cam.yaw).sin_cos();
+    let (sp, cp) = f64::from(cam.pitch).sin_cos();
+    // View: rotate about z by yaw, then tilt about the screen x axis by pitch;
+    // screen right = rotated x, screen up = z·cos(pitch) − depth·sin(pitch).
+    let project = |p: [f64; 3]| -> (Pos2, f64) {
+        let (x, y, z) = (p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]);
+        let xr = cy * x - sy * y;
+        let yr = sy * x + cy * y;
+        let up = z * cp - yr * sp;
+        let depth = yr * cp + z * sp;
+        (
+            Pos2::new(
+                rect.center().x + (xr * scale) as f32,
+                rect.center().y - (up * scale) as f32,
+            ),
+            depth,
+        )
+    };
+    let mut drawn: Vec<(Pos2, f64, &Marker)> = markers
+        .iter()
+        .map(|m| {
+            let (p, d) = project(m.pos);
+            (p, d, m)
+        })
+        .collect();
+    drawn.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let painter = painter.with_clip_rect(rect);
+    for (p, _, m) in &drawn {
+        let colour = station_colour(m.station);
+        if m.after {
+            painter.circle_filled(*p, 4.0, colour);
+        } else {
+            painter.circle_stroke(*p, 4.5, Stroke::new(1.5, colour));
+        }
+        if m.index.is_some() && m.index == selected {
+            painter.circle_stroke(*p, 8.0, Stroke::new(2.0, ui.visuals().strong_text_color()));
+        }
+    }
+    for (k, s) in set.stations.iter().enumerate() {
+        if let Some((mean, _)) = set.means.get(k) {
+            let (p, _) = project(*mean);
+            painter.text(
+                p + Vec2::new(10.0, -10.0),
+                egui::Align2::LEFT_BOTTOM,
+                s,
+                egui::FontId::proportional(13.0),
+                station_colour(k),
+            );
+        }
+    }
+    axes_triad(&painter, rect, cy, sy, cp, sp);
+    let hit = |pointer: Pos2| -> Option<&Marker> {
+        drawn
+            .iter()
+            .map(|(p, _, m)| (p.distance(pointer), *m))
+            .filter(|(d, _)| *d <= PICK_RADIUS)
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, m)| m)
+    };
+    if let Some(pointer) = response.hover_pos()
+        && let Some(m) = hit(pointer)
+    {
+        let label = tooltip(set, m);
+        painter.text(
+            pointer + Vec2::new(12.0, 12.0),
+            egui::Align2::LEFT_TOP,
+            label,
+            egui::FontId::proportional(13.0),
+            ui.visuals().strong_text_color(),
+        );
+    }
+    if response.clicked() {
+        return response
+            .interact_pointer_pos()
+            .and_then(hit)
+            .and_then(|m| m.index);
+    }
+    None
+}
+
+fn tooltip(set: &CentreSet, m: &Marker) -> String {
+    let p: Option<&CentrePoint> = m
+        .index
+        .and_then(|i| set.points.iter().find(|p| p.index == Some(i)));
+    let id = p.map_or("?", |p| p.id.as_str());
+    let station = set.stations.get(m.station).map_or("?", String::as_str);
+    format!(
+        "{id} ({station}, {})",
+        if m.after { "after" } else { "before" }
+    )
+}
+
+/// x (red), y (green), z (blue) in the lower left corner.
+fn axes_triad(painter: &egui::Painter, rect: Rect, cy: f64, sy: f64, cp: f64, sp: f64) {
+    let origin = rect.left_bottom() + Vec2::new(40.0, -40.0);
+    let axes = [
+        ([1.0, 0.0, 0.0], Color32::from_rgb(220, 60, 60), "x"),
+        ([0.0, 1.0, 0.0], Color32::from_rgb(60, 180, 60), "y"),
+        ([0.0, 0.0, 1.0], Color32::from_rgb(70, 110, 230), "z"),
+    ];
+    for (v, colour, name) in axes {
+        let xr = cy * v[0] - sy * v[1];
+        let yr = sy * v[0] + cy * v[1];
+        let up = v[2] * cp - yr * sp;
+        let tip = origin + Vec2::new((xr * 28.0) as f32, -(up * 28.0) as f32);
+        painter.line_segment([origin, tip], Stroke::new(2.0, colour));
+        painter.text(
+            tip,
+            egui::Align2::CENTER_CENTER,
+            name,
+            egui::FontId::proportional(12.0),
+            colour,
+        );
+    }
+}
+
+/// One plane projection. Returns the measurement clicked.
+fn projection_ui(
+    ui: &mut egui::Ui,
+    k: usize,
+    (a, b): (usize, usize),
+    height: f32,
+    markers: &[Marker],
+    set: &CentreSet,
+    selected: Option<usize>,
+) -> Option<usize> {
+    const AXES: [&str; 3] = ["x (mm)", "y (mm)", "z (mm)"];
+    let response = Plot::new(("projection", k))
+        .data_aspect(1.0)
+        .height(height)
+        .x_axis_label(AXES[a])
+        .y_axis_label(AXES[b])
+        .legend(Legend::default())
+        .show(ui, |p| {
+            for (s, name) in set.stations.iter().enumerate() {
+                let colour = station_colour(s);
+                for after in [false, true] {
+                    let pts: Vec<[f64; 2]> = markers
+                        .iter()
+                        .filter(|m| m.station == s && m.after == after)
+                        .map(|m| [m.pos[a], m.pos[b]])
+                        .collect();
+                    if pts.is_empty() {
+                        continue;
+                    }
+                    p.points(
+                        Points::new(name.clone(), PlotPoints::from(pts))
+                            .color(colour)
+                            .filled(after)
+                            .shape(MarkerShape::Circle)
+                            .radius(if after { 3.0 } else { 4.0 }),
+                    );
+                }
+            }
+            if let Some(sel) = selected {
+                let pts: Vec<[f64; 2]> = markers
+                    .iter()
+                    .filter(|m| m.index == Some(sel))
+                    .map(|m| [m.pos[a], m.pos[b]])
+                    .collect();
+                p.points(
+                    Points::new("selected", PlotPoints::from(pts))
+                        .shape(MarkerShape::Circle)
+                        .filled(false)
+                        .radius(8.0)
+                        .color(p.ctx().global_style().visuals.strong_text_color()),
+                );
+            }
+            let clicked = p.response().clicked();
+            let pointer = p.response().interact_pointer_pos();
+            match (clicked, pointer) {
+                (true, Some(pointer)) => markers
+                    .iter()
+                    .map(|m| {
+                        let s = p.screen_from_plot(egui_plot::PlotPoint::new(m.pos[a], m.pos[b]));
+                        (s.distance(pointer), m.index)
+                    })
+                    .filter(|(d, _)| *d <= PICK_RADIUS)
+                    .min_by(|x, y| x.0.total_cmp(&y.0))
+                    .and_then(|(_, i)| i),
+                _ => None,
+            }
+        });
+    response.inner
+}

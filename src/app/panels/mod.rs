@@ -1,0 +1,118 @@
+//! The panels and views, one module each. Every `*_ui` function reads the
+//! state, draws, and pushes [`Command`]s; form fields are edited in place.
+//! Shared widgets and colours live here.
+
+pub mod centres;
+pub mod results;
+pub mod session;
+pub mod side;
+pub mod status;
+pub mod stripe;
+
+use egui::{Color32, RichText};
+
+use super::commands::Command;
+use super::state::{AppState, Forms, Tab};
+
+/// Colour of "before calibration" series (nominal model, initial hand-eye).
+pub const BEFORE: Color32 = Color32::from_rgb(230, 120, 40);
+/// Colour of "after calibration" series.
+pub const AFTER: Color32 = Color32::from_rgb(40, 150, 230);
+/// Colour of rejected stripe points and errors.
+pub const BAD: Color32 = Color32::from_rgb(225, 60, 60);
+/// Colour of warnings.
+pub const WARN: Color32 = Color32::from_rgb(230, 170, 40);
+/// Colour of things marked not identifiable.
+pub const MUTED: Color32 = Color32::from_rgb(150, 150, 150);
+
+/// A distinct colour for station number `k`.
+#[must_use]
+pub fn station_colour(k: usize) -> Color32 {
+    const PALETTE: [Color32; 10] = [
+        Color32::from_rgb(31, 119, 180),
+        Color32::from_rgb(255, 127, 14),
+        Color32::from_rgb(44, 160, 44),
+        Color32::from_rgb(214, 39, 40),
+        Color32::from_rgb(148, 103, 189),
+        Color32::from_rgb(140, 86, 75),
+        Color32::from_rgb(227, 119, 194),
+        Color32::from_rgb(188, 189, 34),
+        Color32::from_rgb(23, 190, 207),
+        Color32::from_rgb(127, 127, 127),
+    ];
+    PALETTE[k % PALETTE.len()]
+}
+
+/// A one-line text field with a visible label tied to it (screen readers
+/// and the UI tests find it by that label).
+pub fn labelled_field(
+    ui: &mut egui::Ui,
+    label: &str,
+    text: &mut String,
+    hint: &str,
+    width: f32,
+) -> egui::Response {
+    let l = ui.label(label);
+    ui.add(
+        egui::TextEdit::singleline(text)
+            .hint_text(hint)
+            .desired_width(width),
+    )
+    .labelled_by(l.id)
+}
+
+/// The row of view tabs.
+pub fn tabs_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mut Vec<Command>) {
+    ui.horizontal(|ui| {
+        for tab in Tab::ALL {
+            let mut text = RichText::new(tab.label()).size(16.0);
+            if forms.tab == tab {
+                text = text.strong();
+            }
+            if ui.selectable_label(forms.tab == tab, text).clicked() {
+                commands.push(Command::ShowTab(tab));
+            }
+        }
+        ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+            if let Some(l) = &state.loaded {
+                ui.label(RichText::new(&l.session.name).weak());
+            }
+        });
+    });
+}
+
+/// A dimmed overlay while files are dragged over the window.
+pub fn drop_overlay_ui(ctx: &egui::Context) {
+    let hovering = ctx.input(|i| !i.raw.hovered_files.is_empty());
+    if !hovering {
+        return;
+    }
+    let painter = ctx.layer_painter(egui::LayerId::new(
+        egui::Order::Foreground,
+        egui::Id::unique("drop"),
+    ));
+    let rect = ctx.content_rect();
+    painter.rect_filled(rect, 0.0, Color32::from_black_alpha(160));
+    painter.text(
+        rect.center(),
+        egui::Align2::CENTER_CENTER,
+        "Drop a session or result file to open it",
+        egui::FontId::proportional(24.0),
+        Color32::WHITE,
+    );
+}
+
+/// `before → after` ratio as text, e.g. "3.3× lower".
+#[must_use]
+pub fn ratio_text(before: f64, after: f64) -> String {
+    if after > 0.0 && before > 0.0 {
+        let r = before / after;
+        if r >= 1.0 {
+            format!("{r:.1}× lower")
+        } else {
+            format!("{:.1}× higher", 1.0 / r)
+        }
+    } else {
+        String::new()
+    }
+}

@@ -1,0 +1,536 @@
+//! The Results view: the headline figures in large type, the paper's
+//! Fig. 5 (within-station centre distances, before and after, per pair)
+//! and Fig. 6 (reference-distance errors, before and after, per distance),
+//! ε per iteration, the singular values with the truncation line, the
+//! hand-eye before and after, the Table 1 view of the joint errors with
+//! the non-identifiable ones marked, and the export buttons.
+
+use egui::{Rect, RichText};
+use egui_plot::{
+    HLine, Legend, Line, LineStyle, MarkerShape, Plot, PlotPoint, PlotPoints, Points, Text, VLine,
+};
+
+use super::side::epsilon_plot_ui;
+use super::{AFTER, BAD, BEFORE, MUTED, WARN, labelled_field, ratio_text};
+use crate::app::commands::Command;
+use crate::app::state::{AppState, DialogPurpose, ExportKind, Forms};
+use crate::app::view::{HandEyeView, ResultOrigin, ResultView};
+use crate::engine::identify::HAND_EYE_LABELS;
+use crate::engine::kinematics::{PARAM_NAMES, PARAMS_PER_JOINT};
+
+/// Height of each of the four plots, points.
+const PLOT_HEIGHT: f32 = 230.0;
+
+/// The Results view. Returns the screen rectangle of the headline and the
+/// plots (what "Plots PNG" saves).
+pub fn results_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) -> Option<Rect> {
+    let Some(view) = &state.result else {
+        ui.add_space(20.0);
+        ui.label(RichText::new("No result yet.").size(18.0));
+        ui.label("Press ▶ Run in the solver panel on the left, or open a result file (path field or Open…) to review it beside its session.");
+        return None;
+    };
+    let mut plots_rect = None;
+    egui::ScrollArea::vertical()
+        .auto_shrink([false, false])
+        .show(ui, |ui| {
+            origin_ui(ui, view);
+            let top = ui.cursor().min;
+            headline_ui(ui, view);
+            export_ui(ui, state, forms, commands);
+            ui.add_space(4.0);
+            let bottom = plots_ui(ui, view);
+            plots_rect = Some(Rect::from_min_max(
+                top,
+                egui::pos2(ui.max_rect().right(), bottom),
+            ));
+            ui.add_space(8.0);
+            tables_ui(ui, view);
+        });
+    plots_rect
+}
+
+fn origin_ui(ui: &mut egui::Ui, view: &ResultView) {
+    let text = match &view.origin {
+        ResultOrigin::Run { seconds, excluded } => {
+            let left_out = if *excluded > 0 {
+                format!(", {excluded} measurement(s) left out")
+            } else {
+                String::new()
+            };
+            format!(
+                "Run of session \"{}\" in this window ({seconds:.2} s{left_out}), method {}.",
+                view.file.session, view.method
+            )
+        }
+        ResultOrigin::Review(path) => format!(
+            "Reviewing {} (session \"{}\", method {}): shown as it was computed, the solver was not run.",
+            path.display(),
+            view.file.session,
+            view.method
+        ),
+    };
+    ui.label(RichText::new(text).weak());
+    if let Some(stop) = &view.stop_reason {
+        ui.label(RichText::new(stop).small());
+    }
+    for n in &view.notes {
+        ui.label(RichText::new(format!("note: {n}")).color(WARN));
+    }
+}
+
+/// Validation std and max before → after in large type, with the ratio.
+fn headline_ui(ui: &mut egui::Ui, view: &ResultView) {
+    egui::Frame::group(ui.style()).show(ui, |ui| {
+        ui.set_width(ui.available_width());
+        match &view.headline {
+            Some(h) => {
+                ui.label(RichText::new(&h.what).strong());
+                let (b, a) = (h.stats.before, h.stats.after);
+                ui.horizontal_wrapped(|ui| {
+                    big(ui, format!("std {:.3} → {:.3} mm", b.std, a.std));
+                    ui.label(RichText::new(ratio_text(b.std, a.std)).size(16.0).color(AFTER));
+                    ui.add_space(24.0);
+                    big(ui, format!("max {:.3} → {:.3} mm", b.max, a.max));
+                    ui.label(RichText::new(ratio_text(b.max, a.max)).size(16.0).color(AFTER));
+                });
+            }
+            None => {
+                ui.label(RichText::new("No validate measurements in this session: accuracy is not checked.").color(WARN));
+            }
+        }
+        let w = &view.within_stats;
+        ui.label(format!(
+            "{} stations, centre distances (true value 0): std {:.3} → {:.3} mm, max {:.3} → {:.3} mm · ε {:.4} → {:.4} mm",
+            view.within_of,
+            w.before.std,
+            w.after.std,
+            w.before.max,
+            w.after.max,
+            view.file.epsilon_before,
+            view.file.epsilon_after
+        ));
+    });
+}
+
+fn big(ui: &mut egui::Ui, text: String) {
+    ui.label(RichText::new(text).size(28.0).strong());
+}
+
+fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mut Vec<Command>) {
+    ui.horizontal_wrapped(|ui| {
+        labelled_field(
+            ui,
+            "Export to folder",
+            &mut forms.export_dir,
+            "/path/to/folder",
+            220.0,
+        );
+        if ui
+            .button("Browse…")
+            .on_hover_text("choose the folder with the desktop's dialog")
+            .clicked()
+        {
+            commands.push(Command::Browse(DialogPurpose::ExportFolder));
+        }
+        ui.separator();
+        for kind in ExportKind::ALL {
+            let enabled = kind != ExportKind::PlotsPng || !state.busy.screenshot;
+            if ui
+                .add_enabled(enabled, egui::Button::new(kind.label()))
+                .on_hover_text(export_hint(kind))
+                .clicked()
+            {
+                commands.push(Command::Export(kind));
+            }
+        }
+    });
+}
+
+fn export_hint(kind: ExportKind) -> &'static str {
+    match kind {
+        ExportKind::ResultJson => {
+            "the result file of FORMAT.md (what `spherecal calibrate` writes)"
+        }
+        ExportKind::CentresCsv => {
+            "every sphere centre: sensor frame, base frame before and after (mm)"
+        }
+        ExportKind::DistancesCsv => {
+            "reference-distance errors and within-station distances, before and after (mm)"
+        }
+        ExportKind::PlotsPng => "an image of the figures on this page",
+    }
+}
+
+/// The four plots, two by two. Returns the bottom edge.
+fn plots_ui(ui: &mut egui::Ui, view: &ResultView) -> f32 {
+    ui.columns(2, |cols| {
+        cols[0].label(
+            RichText::new(format!(
+                "Centre distances within {} stations, per pair (cf. paper Fig. 5)",
+                view.within_of
+            ))
+            .strong(),
+        );
+        fig5_ui(&mut cols[0], view);
+        cols[1].label(
+            RichText::new("Reference-distance errors, measured − reference (cf. paper Fig. 6)")
+                .strong(),
+        );
+        fig6_ui(&mut cols[1], view);
+    });
+    ui.columns(2, |cols| {
+        cols[0].label(RichText::new("ε per iteration (paper eq. 20)").strong());
+        epsilon_plot_ui(
+            &mut cols[0],
+            "result_epsilon",
+            &view.epsilons,
+            view.threshold,
+            PLOT_HEIGHT,
+        );
+        cols[1].label(RichText::new("Singular values of the last update").strong());
+        singular_ui(&mut cols[1], view);
+    });
+    ui.min_rect().bottom()
+}
+
+fn before_after_series(p: &mut egui_plot::PlotUi<'_>, before: Vec<[f64; 2]>, after: Vec<[f64; 2]>) {
+    p.line(
+        Line::new("before (nominal)", PlotPoints::from(before.clone()))
+            .color(BEFORE)
+            .width(1.0),
+    );
+    p.points(
+        Points::new("before (nominal)", PlotPoints::from(before))
+            .color(BEFORE)
+            .shape(MarkerShape::Square)
+            .radius(3.0),
+    );
+    p.line(
+        Line::new("after (calibrated)", PlotPoints::from(after.clone()))
+            .color(AFTER)
+            .width(1.0),
+    );
+    p.points(
+        Points::new("after (calibrated)", PlotPoints::from(after))
+            .color(AFTER)
+            .shape(MarkerShape::Circle)
+            .radius(3.0),
+    );
+}
+
+fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
+    let before: Vec<[f64; 2]> = view
+        .within
+        .iter()
+        .enumerate()
+        .map(|(k, p)| [(k + 1) as f64, p.before])
+        .collect();
+    let after: Vec<[f64; 2]> = view
+        .within
+        .iter()
+        .enumerate()
+        .map(|(k, p)| [(k + 1) as f64, p.after])
+        .collect();
+    let top = view
+        .within
+        .iter()
+        .map(|p| p.before.max(p.after))
+        .fold(0.0, f64::max);
+    let within = &view.within;
+    Plot::new("fig5")
+        .height(PLOT_HEIGHT)
+        .x_axis_label("pair (station by station)")
+        .y_axis_label("distance (mm)")
+        .include_y(0.0)
+        .include_y(top * 1.15)
+        .legend(Legend::default())
+        .label_formatter(move |pos| match pos {
+            egui_plot::HoverPosition::NearDataPoint {
+                index, position, ..
+            } => within.get(*index).map(|p| {
+                format!(
+                    "{}: {} – {}\n{:.4} mm",
+                    p.station, p.ids.0, p.ids.1, position.y
+                )
+            }),
+            egui_plot::HoverPosition::Elsewhere { .. } => None,
+        })
+        .show(ui, |p| {
+            // Station boundaries and names.
+            let mut start = 0;
+            for k in 1..=within.len() {
+                if k == within.len() || within[k].station != within[start].station {
+                    let mid = (start + k + 1) as f64 / 2.0;
+                    p.text(
+                        Text::new(
+                            "station",
+                            PlotPoint::new(mid, top * 1.1),
+                            within[start].station.as_str(),
+                        )
+                        .color(MUTED),
+                    );
+                    if k < within.len() {
+                        p.vline(
+                            VLine::new("station boundary", k as f64 + 0.5)
+                                .color(MUTED)
+                                .style(LineStyle::dotted_dense()),
+                        );
+                    }
+                    start = k;
+                }
+            }
+            before_after_series(p, before, after);
+        });
+}
+
+fn fig6_ui(ui: &mut egui::Ui, view: &ResultView) {
+    if view.distances.is_empty() {
+        ui.allocate_ui(egui::vec2(ui.available_width(), PLOT_HEIGHT), |ui| {
+            ui.label(RichText::new("No reference distances in this session.").color(MUTED));
+        });
+        return;
+    }
+    let before: Vec<[f64; 2]> = view
+        .distances
+        .iter()
+        .enumerate()
+        .map(|(k, d)| [(k + 1) as f64, d.error_before()])
+        .collect();
+    let after: Vec<[f64; 2]> = view
+        .distances
+        .iter()
+        .enumerate()
+        .map(|(k, d)| [(k + 1) as f64, d.error_after()])
+        .collect();
+    let distances = &view.distances;
+    Plot::new("fig6")
+        .height(PLOT_HEIGHT)
+        .x_axis_label("distance")
+        .y_axis_label("error (mm)")
+        .legend(Legend::default())
+        .label_formatter(move |pos| match pos {
+            egui_plot::HoverPosition::NearDataPoint {
+                index, position, ..
+            } => distances.get(*index).map(|d| {
+                format!(
+                    "{} → {}, pose {}: reference {:.3} mm\nerror {:+.4} mm",
+                    d.from, d.to, d.pose, d.reference, position.y
+                )
+            }),
+            egui_plot::HoverPosition::Elsewhere { .. } => None,
+        })
+        .show(ui, |p| {
+            p.hline(HLine::new("zero", 0.0).color(MUTED).width(1.0));
+            before_after_series(p, before, after);
+        });
+}
+
+fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
+    let values: Vec<(usize, f64)> = view
+        .singular_values
+        .iter()
+        .copied()
+        .enumerate()
+        .filter(|(_, s)| *s > 0.0)
+        .collect();
+    if values.is_empty() {
+        ui.allocate_ui(egui::vec2(ui.available_width(), PLOT_HEIGHT), |ui| {
+            ui.label(
+                RichText::new("No update was made: ε started below the threshold.").color(MUTED),
+            );
+        });
+        return;
+    }
+    let smax = values.iter().map(|v| v.1).fold(0.0, f64::max);
+    let cut = view.svd_tolerance.map(|t| t * smax);
+    let (kept, dropped): (Vec<(usize, f64)>, Vec<(usize, f64)>) = values
+        .iter()
+        .partition(|(k, s)| view.kept.map_or(cut.is_none_or(|c| *s >= c), |n| *k < n));
+    let pts = |v: &[(usize, f64)]| -> Vec<[f64; 2]> {
+        v.iter()
+            .map(|(k, s)| [(*k + 1) as f64, s.log10()])
+            .collect()
+    };
+    let zeros = view.singular_values.len() - values.len();
+    Plot::new("singular")
+        .height(if zeros > 0 {
+            PLOT_HEIGHT - 18.0
+        } else {
+            PLOT_HEIGHT
+        })
+        .x_axis_label("index")
+        .y_axis_label("σ (log scale)")
+        .y_axis_formatter(|mark, _| format!("1e{:.0}", mark.value))
+        .legend(Legend::default())
+        .show(ui, |p| {
+            p.points(
+                Points::new("kept", PlotPoints::from(pts(&kept)))
+                    .color(AFTER)
+                    .radius(3.5),
+            );
+            if !dropped.is_empty() {
+                p.points(
+                    Points::new("dropped", PlotPoints::from(pts(&dropped)))
+                        .color(BAD)
+                        .shape(MarkerShape::Cross)
+                        .radius(5.0),
+                );
+            }
+            if let Some(c) = cut {
+                p.hline(
+                    HLine::new("truncation (tolerance × σ_max)", c.log10())
+                        .color(BEFORE)
+                        .style(LineStyle::dashed_loose()),
+                );
+            }
+        });
+    if zeros > 0 {
+        ui.label(
+            RichText::new(format!(
+                "{zeros} singular value(s) are 0 (not drawn on the log scale)"
+            ))
+            .small()
+            .weak(),
+        );
+    }
+}
+
+fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
+    ui.columns(2, |cols| {
+        hand_eye_ui(&mut cols[0], view);
+        joint_errors_ui(&mut cols[1], view);
+    });
+    if !view.dropped.is_empty() {
+        ui.add_space(6.0);
+        egui::CollapsingHeader::new(format!(
+            "Directions the SVD dropped ({})",
+            view.dropped.len()
+        ))
+        .show(ui, |ui| {
+            for d in &view.dropped {
+                ui.monospace(d);
+            }
+        });
+    }
+}
+
+fn marked_cell(ui: &mut egui::Ui, view: &ResultView, label: &str, text: String) {
+    if let Some(why) = view.marked.get(label) {
+        ui.label(RichText::new(format!("{text} †")).color(MUTED))
+            .on_hover_text(format!("{label} is not identifiable from this data: {why}"));
+    } else {
+        ui.label(text);
+    }
+}
+
+fn hand_eye_ui(ui: &mut egui::Ui, view: &ResultView) {
+    ui.label(RichText::new("Hand-eye eT_s (sensor to flange)").strong());
+    let (b, a): (&HandEyeView, &HandEyeView) = (&view.hand_eye_before, &view.hand_eye_after);
+    egui::Grid::new("hand_eye")
+        .striped(true)
+        .num_columns(4)
+        .show(ui, |ui| {
+            for t in ["", "initial", "calibrated", "change"] {
+                ui.strong(t);
+            }
+            ui.end_row();
+            let rows: [(&str, f64, f64, &str); 6] = [
+                (
+                    "x (mm)",
+                    b.translation[0],
+                    a.translation[0],
+                    HAND_EYE_LABELS[0],
+                ),
+                (
+                    "y (mm)",
+                    b.translation[1],
+                    a.translation[1],
+                    HAND_EYE_LABELS[1],
+                ),
+                (
+                    "z (mm)",
+                    b.translation[2],
+                    a.translation[2],
+                    HAND_EYE_LABELS[2],
+                ),
+                ("roll (deg)", b.rpy_deg[0], a.rpy_deg[0], HAND_EYE_LABELS[3]),
+                (
+                    "pitch (deg)",
+                    b.rpy_deg[1],
+                    a.rpy_deg[1],
+                    HAND_EYE_LABELS[4],
+                ),
+                ("yaw (deg)", b.rpy_deg[2], a.rpy_deg[2], HAND_EYE_LABELS[5]),
+            ];
+            for (name, before, after, label) in rows {
+                ui.label(name);
+                ui.label(format!("{before:.4}"));
+                marked_cell(ui, view, label, format!("{after:.4}"));
+                ui.label(format!("{:+.4}", after - before));
+                ui.end_row();
+            }
+        });
+    ui.label(
+        RichText::new(format!(
+            "rotation changed by {:.4}°",
+            view.hand_eye_rotation_change_deg
+        ))
+        .small(),
+    );
+    egui::CollapsingHeader::new("matrices").show(ui, |ui| {
+        for (title, m) in [("initial", &b.rows), ("calibrated", &a.rows)] {
+            ui.label(title);
+            for r in m {
+                ui.monospace(format!(
+                    "{:>10.5} {:>10.5} {:>10.5} {:>10.3}",
+                    r[0], r[1], r[2], r[3]
+                ));
+            }
+        }
+    });
+}
+
+fn joint_errors_ui(ui: &mut egui::Ui, view: &ResultView) {
+    ui.label(RichText::new("Joint errors, calibrated − nominal (cf. paper Table 1)").strong());
+    const HEADER: [&str; PARAMS_PER_JOINT + 1] = [
+        "joint",
+        "Δα (deg)",
+        "Δa (mm)",
+        "Δβ (deg)",
+        "Δθ (deg)",
+        "Δd (mm)",
+    ];
+    egui::Grid::new("joint_errors")
+        .striped(true)
+        .num_columns(HEADER.len())
+        .show(ui, |ui| {
+            for h in HEADER {
+                ui.strong(h);
+            }
+            ui.end_row();
+            for (j, e) in view.joint_errors.iter().enumerate() {
+                ui.label(format!("{}", j + 1));
+                for (p, name) in PARAM_NAMES.iter().enumerate() {
+                    let label = format!("{name}{}", j + 1);
+                    marked_cell(ui, view, &label, format!("{:+.4}", e.get(p)));
+                }
+                ui.end_row();
+            }
+        });
+    if !view.marked.is_empty() {
+        ui.label(
+            RichText::new(format!(
+                "† not identifiable from this data ({} parameter(s)): they lie in a direction the SVD dropped (or the method held them fixed), so the value is not a measurement of the robot. Hover a value for the direction.",
+                view.marked.len()
+            ))
+            .small()
+            .color(MUTED),
+        );
+    }
+}

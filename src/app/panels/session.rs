@@ -1,0 +1,359 @@
+//! The Session view: the table of measurements (id, station, use, side,
+//! points, fit RMS, cut angle, warnings), filters and grouping, include or
+//! leave out, and "Save as" of the session without the left-out ones.
+
+use egui::{Color32, RichText};
+use egui_extras::{Column, TableBuilder};
+
+use super::{BAD, MUTED, WARN, labelled_field};
+use crate::app::commands::Command;
+use crate::app::state::{AppState, DialogPurpose, Fit, Forms, Grouping, LoadedSession};
+use crate::engine::model::Use;
+
+/// A row of the table: a group header or a measurement.
+enum Row {
+    /// Group title; `Some(station)` for a station group (with a checkbox).
+    Header(String, Option<String>),
+    /// Index into the session's measurements.
+    Item(usize),
+}
+
+/// The Session view.
+pub fn session_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    let Some(loaded) = &state.loaded else {
+        ui.label("No session open: type a path on the left, press Open…, or drop a file here.");
+        return;
+    };
+    filters_ui(ui, loaded, forms, commands);
+    let n = loaded.session.measurements.len();
+    let excluded = state.excluded_count();
+    ui.horizontal_wrapped(|ui| {
+        ui.label(format!("{n} measurements in {} stations.", loaded.station_ids().len()));
+        if excluded > 0 {
+            ui.label(
+                RichText::new(format!(
+                    "{excluded} left out: the solver skips them; the opened file is unchanged until you save a copy."
+                ))
+                .color(WARN),
+            );
+        } else {
+            ui.label(RichText::new("Untick a measurement to leave it out of the solver.").weak());
+        }
+    });
+    save_ui(ui, state, forms, commands);
+    ui.separator();
+    table_ui(ui, state, loaded, forms, commands);
+}
+
+fn filters_ui(
+    ui: &mut egui::Ui,
+    loaded: &LoadedSession,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Station");
+        egui::ComboBox::from_id_salt("filter_station")
+            .selected_text(forms.filter_station.clone().unwrap_or_else(|| "all".into()))
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut forms.filter_station, None, "all");
+                for s in loaded.station_ids() {
+                    let text = s.clone();
+                    ui.selectable_value(&mut forms.filter_station, Some(s), text);
+                }
+            })
+            .response
+            .on_hover_text("show one station only");
+        ui.label("Use");
+        egui::ComboBox::from_id_salt("filter_use")
+            .selected_text(forms.filter_use.map_or("all", Use::as_str))
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut forms.filter_use, None, "all");
+                for u in Use::ALL {
+                    ui.selectable_value(&mut forms.filter_use, Some(u), u.as_str());
+                }
+            })
+            .response
+            .on_hover_text("show one use only");
+        ui.label("Group by");
+        egui::ComboBox::from_id_salt("group")
+            .selected_text(forms.group.label())
+            .show_ui(ui, |ui| {
+                for g in Grouping::ALL {
+                    ui.selectable_value(&mut forms.group, g, g.label());
+                }
+            })
+            .response
+            .on_hover_text("group the rows");
+        if ui
+            .button("Use all")
+            .on_hover_text("include every measurement again")
+            .clicked()
+        {
+            commands.push(Command::IncludeAll);
+        }
+    });
+}
+
+fn save_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mut Vec<Command>) {
+    ui.horizontal(|ui| {
+        let width = (ui.available_width() - 230.0).max(160.0);
+        let field = labelled_field(
+            ui,
+            "Save as",
+            &mut forms.save_path,
+            "/path/to/edited-session.json",
+            width,
+        );
+        let replace = state
+            .confirm_overwrite
+            .as_ref()
+            .is_some_and(|p| p.as_os_str() == forms.save_path.trim());
+        if ui
+            .button("Browse…")
+            .on_hover_text("choose the file with the desktop's dialog")
+            .clicked()
+        {
+            commands.push(Command::Browse(DialogPurpose::SaveSession));
+        }
+        let label = if replace { "Replace" } else { "Save" };
+        let save = ui
+            .add_enabled(!state.busy.saving, egui::Button::new(label))
+            .on_hover_text("write the session without the left-out measurements (atomic write)");
+        let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+        if save.clicked() || entered {
+            commands.push(Command::SaveSession);
+        }
+    });
+}
+
+fn rows(state: &AppState, loaded: &LoadedSession, forms: &Forms) -> Vec<Row> {
+    let ms = &loaded.session.measurements;
+    let mut out = Vec::new();
+    let mut current: Option<String> = None;
+    for i in state.visible_rows(forms) {
+        let key = match forms.group {
+            Grouping::None => None,
+            Grouping::Station => Some(ms[i].station.clone()),
+            Grouping::Use => Some(ms[i].usage.as_str().to_string()),
+        };
+        if key.is_some() && key != current {
+            let k = key.clone().unwrap_or_default();
+            let members: Vec<&crate::engine::model::Measurement> = ms
+                .iter()
+                .filter(|m| match forms.group {
+                    Grouping::Station => m.station == k,
+                    _ => m.usage.as_str() == k,
+                })
+                .collect();
+            let used = members
+                .iter()
+                .filter(|m| !state.excluded.contains(&m.id))
+                .count();
+            let (title, station) = match forms.group {
+                Grouping::Station => (
+                    format!("station {k}: {} measurements, {used} used", members.len()),
+                    Some(k),
+                ),
+                _ => (
+                    format!("{k}: {} measurements, {used} used", members.len()),
+                    None,
+                ),
+            };
+            out.push(Row::Header(title, station));
+            current = key;
+        }
+        out.push(Row::Item(i));
+    }
+    out
+}
+
+fn table_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    loaded: &LoadedSession,
+    forms: &Forms,
+    commands: &mut Vec<Command>,
+) {
+    let rows = rows(state, loaded, forms);
+    let selected_row = state.selected.and_then(|s| {
+        rows.iter()
+            .position(|r| matches!(r, Row::Item(i) if *i == s))
+    });
+    let ms = &loaded.session.measurements;
+    // Scroll to the selection once each time it changes (arrow keys).
+    let moved_id = egui::Id::unique("session_table_scrolled_to");
+    let last: Option<Option<usize>> = ui.data(|d| d.get_temp(moved_id));
+    let scroll = selected_row.filter(|_| last != Some(state.selected));
+    ui.data_mut(|d| d.insert_temp(moved_id, state.selected));
+    let mut table = TableBuilder::new(ui)
+        .striped(true)
+        .sense(egui::Sense::click())
+        .cell_layout(egui::Layout::left_to_right(egui::Align::Center))
+        .column(Column::initial(90.0).at_least(70.0))
+        .column(Column::initial(60.0))
+        .column(Column::initial(80.0))
+        .column(Column::initial(40.0))
+        .column(Column::initial(55.0))
+        .column(Column::initial(95.0))
+        .column(Column::initial(95.0))
+        .column(Column::remainder().at_least(120.0).clip(true))
+        .min_scrolled_height(0.0);
+    if let Some(row) = scroll {
+        table = table.scroll_to_row(row, None);
+    }
+    table
+        .header(22.0, |mut h| {
+            for title in [
+                "use · id",
+                "station",
+                "use",
+                "side",
+                "points",
+                "fit RMS (mm)",
+                "cut angle (°)",
+                "warnings",
+            ] {
+                h.col(|ui| {
+                    ui.strong(title);
+                });
+            }
+        })
+        .body(|body| {
+            body.rows(22.0, rows.len(), |mut row| match &rows[row.index()] {
+                Row::Header(title, station) => {
+                    row.col(|ui| {
+                        if let Some(s) = station {
+                            let all = ms
+                                .iter()
+                                .filter(|m| m.station == *s)
+                                .all(|m| !state.excluded.contains(&m.id));
+                            let mut v = all;
+                            if ui
+                                .checkbox(&mut v, "all")
+                                .on_hover_text(format!("use every measurement of station {s}"))
+                                .changed()
+                            {
+                                commands.push(Command::SetStationIncluded {
+                                    station: s.clone(),
+                                    included: v,
+                                });
+                            }
+                        }
+                    });
+                    row.col(|ui| {
+                        ui.add(egui::Label::new(RichText::new(title).strong()).extend());
+                    });
+                    for _ in 0..6 {
+                        row.col(|_| {});
+                    }
+                }
+                Row::Item(i) => {
+                    let i = *i;
+                    row.set_selected(state.selected == Some(i));
+                    item_row(&mut row, state, loaded, i, commands);
+                    let r = row.response();
+                    if r.double_clicked() {
+                        commands.push(Command::Inspect(i));
+                    } else if r.clicked() {
+                        commands.push(Command::Select(i));
+                    }
+                }
+            });
+        });
+}
+
+fn item_row(
+    row: &mut egui_extras::TableRow<'_, '_>,
+    state: &AppState,
+    loaded: &LoadedSession,
+    i: usize,
+    commands: &mut Vec<Command>,
+) {
+    let m = &loaded.session.measurements[i];
+    let used = !state.excluded.contains(&m.id);
+    let dim = |t: String| {
+        if used {
+            RichText::new(t)
+        } else {
+            RichText::new(t).color(MUTED).strikethrough()
+        }
+    };
+    row.col(|ui| {
+        let mut v = used;
+        if ui
+            .checkbox(&mut v, dim(m.id.clone()))
+            .on_hover_text(format!("use measurement {} in the solver", m.id))
+            .changed()
+        {
+            commands.push(Command::SetIncluded {
+                id: m.id.clone(),
+                included: v,
+            });
+        }
+    });
+    row.col(|ui| {
+        ui.label(dim(m.station.clone()));
+    });
+    row.col(|ui| {
+        ui.label(dim(m.usage.as_str().to_string()));
+    });
+    row.col(|ui| {
+        ui.label(dim(format!("{:+}", m.side)));
+    });
+    row.col(|ui| {
+        ui.label(dim(loaded
+            .points(i)
+            .map_or_else(|| "—".into(), |n| n.to_string())));
+    });
+    let fit = &loaded.fits[i];
+    match fit {
+        Fit::GivenCentre => {
+            row.col(|ui| {
+                ui.label(dim("given centre".into()));
+            });
+            row.col(|ui| {
+                ui.label(dim("—".into()));
+            });
+            row.col(|_| {});
+        }
+        Fit::Failed(e) => {
+            row.col(|ui| {
+                ui.label(RichText::new("fit failed").color(BAD))
+                    .on_hover_text(e);
+            });
+            row.col(|ui| {
+                ui.label("—");
+            });
+            row.col(|ui| {
+                ui.label(RichText::new(e).color(BAD)).on_hover_text(e);
+            });
+        }
+        Fit::Stripe(s) => {
+            row.col(|ui| {
+                ui.label(dim(format!("{:.4}", s.fit.rms)));
+            });
+            row.col(|ui| {
+                ui.label(dim(format!("{:+.1}", s.sphere.cut_angle_deg)));
+            });
+            row.col(|ui| {
+                if let Some(first) = s.warnings.first() {
+                    let text = if s.warnings.len() > 1 {
+                        format!("({}) {first}", s.warnings.len())
+                    } else {
+                        first.clone()
+                    };
+                    ui.label(RichText::new(text).color(WARN))
+                        .on_hover_text(s.warnings.join("\n"));
+                } else {
+                    ui.label(RichText::new("ok").color(Color32::from_rgb(90, 170, 90)));
+                }
+            });
+        }
+    }
+}

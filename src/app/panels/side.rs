@@ -1,0 +1,309 @@
+//! The left panel: load a session or result (path field, native dialog,
+//! demo, recent files, the error of a file that did not load) and the
+//! solver (settings, Run, Cancel, live ε).
+
+use egui::{RichText, Vec2};
+use egui_plot::{HLine, Line, Plot, PlotPoints, Points};
+
+use crate::engine::calibrate::Method;
+use crate::engine::identify::Pairing;
+
+use super::{AFTER, BAD, BEFORE, labelled_field};
+use crate::app::commands::Command;
+use crate::app::state::{AppState, DialogPurpose, Forms};
+use crate::app::workbench::NO_DIALOG;
+
+/// The whole left panel.
+pub fn side_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    egui::ScrollArea::vertical()
+        .auto_shrink([false, false])
+        .show(ui, |ui| {
+            ui.add_space(4.0);
+            load_ui(ui, state, forms, commands);
+            ui.separator();
+            solver_ui(ui, state, forms, commands);
+        });
+}
+
+/// Loading: the current session, the path field with Open…, the demo, the
+/// recent files and the error of the last file that did not load.
+pub fn load_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    ui.heading("Session");
+    match &state.loaded {
+        Some(l) => {
+            ui.label(RichText::new(&l.session.name).strong());
+            ui.label(RichText::new(l.source.label()).small().weak())
+                .on_hover_text(l.source.label());
+            let n = l.session.measurements.len();
+            ui.label(format!(
+                "{n} measurements, {} stations, sphere Ø {} mm",
+                l.station_ids().len(),
+                l.session.sphere_diameter
+            ));
+        }
+        None => {
+            ui.label(RichText::new("no session open").weak());
+        }
+    }
+    if let Some(notice) = &state.notice {
+        egui::Frame::group(ui.style())
+            .stroke(egui::Stroke::new(1.5, BAD))
+            .show(ui, |ui| {
+                ui.label(RichText::new(&notice.title).strong().color(BAD));
+                ui.label(&notice.body);
+                if ui.button("Dismiss").clicked() {
+                    commands.push(Command::DismissNotice);
+                }
+            });
+    }
+    ui.add_space(4.0);
+    let width = ui.available_width();
+    let field = ui
+        .vertical(|ui| {
+            labelled_field(
+                ui,
+                "Session or result file",
+                &mut forms.open_path,
+                "/path/to/session.json",
+                width,
+            )
+        })
+        .inner;
+    let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+    ui.horizontal(|ui| {
+        if ui
+            .button("Open path")
+            .on_hover_text("open the file typed above")
+            .clicked()
+            || entered
+        {
+            commands.push(Command::OpenPath(forms.open_path.trim().into()));
+        }
+        let dialog = ui
+            .add_enabled(!state.busy.dialog, egui::Button::new("Open…"))
+            .on_hover_text("choose a file with the desktop's file dialog");
+        if dialog.clicked() {
+            commands.push(Command::Browse(DialogPurpose::Open));
+        }
+        if ui
+            .button("Demo")
+            .on_hover_text("the demo session built into the program")
+            .clicked()
+        {
+            commands.push(Command::OpenDemo);
+        }
+    });
+    if state.dialog_empty {
+        ui.label(RichText::new(NO_DIALOG).small().weak());
+    }
+    ui.label(
+        RichText::new("or drop a file onto the window")
+            .small()
+            .weak(),
+    );
+    if !state.prefs.recent.is_empty() {
+        egui::CollapsingHeader::new("Recent files")
+            .default_open(true)
+            .show(ui, |ui| {
+                for p in &state.prefs.recent {
+                    let name = p.file_name().map_or_else(
+                        || p.display().to_string(),
+                        |n| n.to_string_lossy().into_owned(),
+                    );
+                    if ui
+                        .add(egui::Button::new(name).truncate())
+                        .on_hover_text(p.display().to_string())
+                        .clicked()
+                    {
+                        commands.push(Command::OpenPath(p.clone()));
+                    }
+                }
+                if ui.small_button("Clear list").clicked() {
+                    commands.push(Command::ClearRecent);
+                }
+            });
+    }
+}
+
+/// The solver: settings, Run and Cancel, progress and the live ε plot.
+pub fn solver_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    ui.heading("Solver");
+    let running = state.run.is_some();
+    ui.add_enabled_ui(!running, |ui| settings_ui(ui, forms));
+    ui.add_space(6.0);
+    let can_run = !running && state.loaded.as_ref().is_some_and(|l| l.before.is_ok());
+    ui.horizontal(|ui| {
+        let run = ui.add_enabled(
+            can_run,
+            egui::Button::new(RichText::new("▶ Run").size(18.0).strong())
+                .min_size(Vec2::new(110.0, 32.0)),
+        );
+        if run
+            .on_hover_text("calibrate the session with these settings")
+            .clicked()
+        {
+            commands.push(Command::Run);
+        }
+        let cancel = ui.add_enabled(
+            running && !state.run.as_ref().is_some_and(|r| r.cancelling),
+            egui::Button::new(RichText::new("Cancel").size(16.0)).min_size(Vec2::new(80.0, 32.0)),
+        );
+        if cancel
+            .on_hover_text("stop the solver at its next iteration")
+            .clicked()
+        {
+            commands.push(Command::Cancel);
+        }
+    });
+    if let Some(l) = &state.loaded
+        && let Err(e) = &l.before
+    {
+        ui.label(RichText::new(format!("cannot run: {e}")).color(BAD).small());
+    }
+    let excluded = state.excluded_count();
+    if excluded > 0 && !running {
+        ui.label(RichText::new(format!("{excluded} measurement(s) will be left out")).small());
+    }
+    if let Some(run) = &state.run {
+        ui.horizontal(|ui| {
+            ui.spinner();
+            let updates = run.epsilons.len().saturating_sub(1);
+            match run.epsilons.last() {
+                Some(eps) => ui.label(format!(
+                    "update {updates} of ≤ {}: ε = {eps:.4} mm",
+                    run.max_iterations
+                )),
+                None => ui.label("preparing: stripe fits and initial hand-eye…"),
+            };
+        });
+        epsilon_plot_ui(
+            ui,
+            "live_epsilon",
+            &run.epsilons,
+            Some(run.threshold),
+            150.0,
+        );
+    } else if let Some(result) = &state.result {
+        ui.label(RichText::new("ε of the result on show").small().weak());
+        epsilon_plot_ui(
+            ui,
+            "last_epsilon",
+            &result.epsilons,
+            result.threshold,
+            150.0,
+        );
+        if let Some(stop) = &result.stop_reason {
+            ui.label(RichText::new(stop).small());
+        }
+    }
+}
+
+/// Method, pairing, threshold, iteration bound, SVD tolerance.
+fn settings_ui(ui: &mut egui::Ui, forms: &mut Forms) {
+    let s = &mut forms.solver;
+    egui::Grid::new("solver_settings")
+        .num_columns(2)
+        .spacing([8.0, 6.0])
+        .show(ui, |ui| {
+            ui.label("Method");
+            egui::ComboBox::from_id_salt("method")
+                .selected_text(s.method.as_str())
+                .show_ui(ui, |ui| {
+                    for m in Method::ALL {
+                        ui.selectable_value(&mut s.method, m, m.as_str());
+                    }
+                })
+                .response
+                .on_hover_text("identification method");
+            ui.end_row();
+            ui.label("Pairs");
+            egui::ComboBox::from_id_salt("pairing")
+                .selected_text(s.pairing.as_str())
+                .show_ui(ui, |ui| {
+                    for p in [Pairing::Disjoint, Pairing::All] {
+                        ui.selectable_value(&mut s.pairing, p, p.as_str());
+                    }
+                })
+                .response
+                .on_hover_text("pairs of a station's measurements: disjoint (1,2),(3,4),… as in the paper, or all");
+            ui.end_row();
+            let l = ui.label("Threshold");
+            ui.add(
+                egui::DragValue::new(&mut s.threshold)
+                    .range(0.0..=10.0)
+                    .speed(0.001)
+                    .max_decimals(4)
+                    .suffix(" mm"),
+            )
+            .labelled_by(l.id)
+            .on_hover_text("stop when ε falls to this");
+            ui.end_row();
+            let l = ui.label("Max iterations");
+            ui.add(egui::DragValue::new(&mut s.max_iterations).range(1..=500).speed(0.2))
+                .labelled_by(l.id);
+            ui.end_row();
+            let l = ui.label("SVD tolerance");
+            ui.add(
+                egui::DragValue::new(&mut s.svd_tolerance)
+                    .range(1e-12..=0.5)
+                    .speed(1e-5)
+                    .custom_formatter(|v, _| format!("{v:.1e}"))
+                    .custom_parser(|t| t.trim().parse::<f64>().ok()),
+            )
+            .labelled_by(l.id)
+            .on_hover_text("singular values below this fraction of the largest are dropped (truncated SVD)");
+            ui.end_row();
+        });
+}
+
+/// ε per update, with the threshold.
+pub fn epsilon_plot_ui(
+    ui: &mut egui::Ui,
+    id: &str,
+    epsilons: &[f64],
+    threshold: Option<f64>,
+    height: f32,
+) {
+    let pts: Vec<[f64; 2]> = epsilons
+        .iter()
+        .enumerate()
+        .map(|(k, e)| [k as f64, *e])
+        .collect();
+    Plot::new(id)
+        .height(height)
+        .x_axis_label("update")
+        .y_axis_label("ε (mm)")
+        .include_y(0.0)
+        .include_x(0.0)
+        .allow_scroll(false)
+        .show(ui, |p| {
+            p.line(
+                Line::new("ε", PlotPoints::from(pts.clone()))
+                    .color(AFTER)
+                    .width(2.0),
+            );
+            p.points(
+                Points::new("ε points", PlotPoints::from(pts))
+                    .color(AFTER)
+                    .radius(3.0),
+            );
+            if let Some(t) = threshold {
+                p.hline(HLine::new("threshold", t).color(BEFORE));
+            }
+        });
+}

@@ -1,0 +1,260 @@
+//! The Stripe view: the selected measurement's stripe points and fitted
+//! circle in the laser plane (equal axes, mm), the rejected points marked,
+//! and the residuals. The arrow keys step through the table's order.
+
+use std::f64::consts::TAU;
+
+use egui::RichText;
+use egui_plot::{HLine, Legend, Line, LineStyle, MarkerShape, Plot, PlotPoints, Points};
+
+use super::{AFTER, BAD, BEFORE, MUTED, WARN};
+use crate::app::commands::Command;
+use crate::app::state::{AppState, Fit, Forms};
+use crate::engine::model::Observation;
+use crate::engine::stripe::StripeResult;
+
+/// Points on the drawn circle.
+const CIRCLE_SEGMENTS: usize = 256;
+
+/// The Stripe view.
+pub fn stripe_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mut Vec<Command>) {
+    let Some(loaded) = &state.loaded else {
+        ui.label("No session open.");
+        return;
+    };
+    let rows = state.visible_rows(forms);
+    let Some(i) = state
+        .selected
+        .filter(|&i| i < loaded.session.measurements.len())
+    else {
+        ui.label("Select a measurement in the Session view.");
+        return;
+    };
+    let m = &loaded.session.measurements[i];
+    ui.horizontal(|ui| {
+        let pos = rows.iter().position(|&r| r == i);
+        if ui
+            .add_enabled(pos.is_some_and(|p| p > 0), egui::Button::new("◀ Previous"))
+            .clicked()
+        {
+            commands.push(Command::Step(-1));
+        }
+        egui::ComboBox::from_id_salt("stripe_measurement")
+            .selected_text(RichText::new(&m.id).strong())
+            .height(400.0)
+            .show_ui(ui, |ui| {
+                for &r in &rows {
+                    let other = &loaded.session.measurements[r];
+                    if ui
+                        .selectable_label(
+                            r == i,
+                            format!("{} ({}, {})", other.id, other.station, other.usage.as_str()),
+                        )
+                        .clicked()
+                    {
+                        commands.push(Command::Select(r));
+                    }
+                }
+            })
+            .response
+            .on_hover_text("measurement");
+        if ui
+            .add_enabled(
+                pos.is_some_and(|p| p + 1 < rows.len()),
+                egui::Button::new("Next ▶"),
+            )
+            .clicked()
+        {
+            commands.push(Command::Step(1));
+        }
+        let used = !state.excluded.contains(&m.id);
+        let mut v = used;
+        if ui.checkbox(&mut v, "use in solver").changed() {
+            commands.push(Command::SetIncluded {
+                id: m.id.clone(),
+                included: v,
+            });
+        }
+        ui.label(RichText::new("arrow keys: previous / next").small().weak());
+    });
+    ui.label(format!(
+        "station {}, use {}, side {:+}, joints [{}] deg",
+        m.station,
+        m.usage.as_str(),
+        m.side,
+        m.joints
+            .iter()
+            .map(|q| format!("{q:.2}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    ));
+    match (&loaded.fits[i], &m.observation) {
+        (Fit::GivenCentre, Observation::Centre(c)) => {
+            ui.add_space(10.0);
+            ui.label(format!(
+                "This measurement gives its sphere centre directly: ({:.3}, {:.3}, {:.3}) mm in the sensor frame. There is no stripe to show.",
+                c.x, c.y, c.z
+            ));
+        }
+        (Fit::Failed(e), Observation::Stripe(points)) => {
+            ui.label(RichText::new(format!("The circle fit failed: {e}")).color(BAD));
+            plots_ui(ui, points, None);
+        }
+        (Fit::Stripe(s), Observation::Stripe(points)) => {
+            facts_ui(ui, s, loaded.session.sphere_radius());
+            plots_ui(ui, points, Some(s));
+        }
+        _ => {}
+    }
+}
+
+fn facts_ui(ui: &mut egui::Ui, s: &StripeResult, sphere_radius: f64) {
+    let f = &s.fit;
+    let c = &s.sphere.centre_in_sensor;
+    ui.horizontal_wrapped(|ui| {
+        ui.label(format!(
+            "points {} used, {} rejected · circle centre ({:.3}, {:.3}) mm · r = {:.3} ± {:.3} mm (R = {:.3} mm, r/R = {:.3}) · RMS {:.4} mm · arc {:.0}° · cut angle {:+.1}°",
+            f.used(),
+            f.rejected(),
+            f.centre[0],
+            f.centre[1],
+            f.radius,
+            f.radius_std(),
+            sphere_radius,
+            s.sphere.r_over_r,
+            f.rms,
+            f.arc_span_deg,
+            s.sphere.cut_angle_deg
+        ));
+    });
+    ui.label(format!(
+        "sphere centre in the sensor frame: ({:.3}, {:.3}, {:.3}) mm{}",
+        c.x,
+        c.y,
+        c.z,
+        if s.sphere.on_plane {
+            " (taken on the laser plane)"
+        } else {
+            ""
+        }
+    ));
+    for w in &s.warnings {
+        ui.label(RichText::new(format!("warning: {w}")).color(WARN));
+    }
+}
+
+fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) {
+    let inlier = |k: usize| fit.is_none_or(|s| s.fit.inlier.get(k).copied().unwrap_or(true));
+    let kept: Vec<[f64; 2]> = points
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| inlier(*k))
+        .map(|(_, p)| *p)
+        .collect();
+    let rejected: Vec<[f64; 2]> = points
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| !inlier(*k))
+        .map(|(_, p)| *p)
+        .collect();
+    let height = ui.available_height().max(200.0);
+    let width = ui.available_width();
+    ui.horizontal(|ui| {
+        ui.vertical(|ui| {
+            ui.set_width(width * 0.58);
+            ui.label(RichText::new("Stripe in the laser plane (sensor x = 0)").strong());
+            Plot::new("stripe_plot")
+                .data_aspect(1.0)
+                .height(height - 24.0)
+                .x_axis_label("y (mm)")
+                .y_axis_label("z (mm)")
+                .legend(Legend::default())
+                .show(ui, |p| {
+                    if let Some(s) = fit {
+                        let [yc, zc] = s.fit.centre;
+                        let r = s.fit.radius;
+                        let circle: Vec<[f64; 2]> = (0..=CIRCLE_SEGMENTS)
+                            .map(|k| {
+                                let a = TAU * k as f64 / CIRCLE_SEGMENTS as f64;
+                                [yc + r * a.cos(), zc + r * a.sin()]
+                            })
+                            .collect();
+                        p.line(
+                            Line::new("fitted circle", PlotPoints::from(circle))
+                                .color(BEFORE)
+                                .style(LineStyle::dashed_loose())
+                                .width(1.5),
+                        );
+                        p.points(
+                            Points::new("circle centre", PlotPoints::from(vec![[yc, zc]]))
+                                .shape(MarkerShape::Plus)
+                                .radius(6.0)
+                                .color(BEFORE),
+                        );
+                    }
+                    p.points(
+                        Points::new("stripe points", PlotPoints::from(kept))
+                            .color(AFTER)
+                            .radius(2.5),
+                    );
+                    if !rejected.is_empty() {
+                        p.points(
+                            Points::new("rejected", PlotPoints::from(rejected))
+                                .shape(MarkerShape::Cross)
+                                .color(BAD)
+                                .radius(6.0),
+                        );
+                    }
+                });
+        });
+        ui.vertical(|ui| {
+            ui.label(RichText::new("Residuals |p − c| − r").strong());
+            let Some(s) = fit else {
+                ui.label(RichText::new("no fit").color(MUTED));
+                return;
+            };
+            let um = |k: usize| s.fit.residuals.get(k).copied().unwrap_or(0.0) * 1000.0;
+            let used: Vec<[f64; 2]> = (0..points.len())
+                .filter(|&k| inlier(k))
+                .map(|k| [k as f64, um(k)])
+                .collect();
+            let out: Vec<[f64; 2]> = (0..points.len())
+                .filter(|&k| !inlier(k))
+                .map(|k| [k as f64, um(k)])
+                .collect();
+            let rms = s.fit.rms * 1000.0;
+            Plot::new("residual_plot")
+                .height(height - 24.0)
+                .x_axis_label("point")
+                .y_axis_label("residual (µm)")
+                .legend(Legend::default())
+                .show(ui, |p| {
+                    p.points(
+                        Points::new("used", PlotPoints::from(used))
+                            .color(AFTER)
+                            .radius(2.5)
+                            .stems(0.0),
+                    );
+                    if !out.is_empty() {
+                        p.points(
+                            Points::new("rejected", PlotPoints::from(out))
+                                .shape(MarkerShape::Cross)
+                                .color(BAD)
+                                .radius(5.0)
+                                .stems(0.0),
+                        );
+                    }
+                    p.hline(
+                        HLine::new("± RMS", rms)
+                            .color(MUTED)
+                            .style(LineStyle::dashed_dense()),
+                    );
+                    p.hline(
+                        HLine::new("± RMS", -rms)
+                            .color(MUTED)
+                            .style(LineStyle::dashed_dense()),
+                    );
+                });
+        });
+    });
+}

@@ -1,0 +1,561 @@
+//! What the workbench knows: the loaded session with its per-measurement
+//! fits, the run in progress, the result on show and the messages for the
+//! operator ([`AppState`], changed only by commands and job messages), and
+//! the form fields the widgets edit directly ([`Forms`]).
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use crate::engine::calibrate::{Method, Options};
+use crate::engine::identify::{DEFAULT_SVD_TOLERANCE, Pairing, PaperOptions};
+use crate::engine::model::{Session, Use};
+use crate::engine::stripe::StripeResult;
+
+use super::view::{CentreSet, ResultView};
+
+/// How many recent files the start list keeps.
+pub const RECENT_MAX: usize = 8;
+
+/// Where a session came from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Source {
+    /// The demo session embedded in the binary.
+    Demo,
+    /// A file on disk.
+    File(PathBuf),
+}
+
+impl Source {
+    /// The file, when there is one.
+    #[must_use]
+    pub fn path(&self) -> Option<&Path> {
+        match self {
+            Self::Demo => None,
+            Self::File(p) => Some(p),
+        }
+    }
+
+    /// A short name for people: the file name, or the demo's.
+    #[must_use]
+    pub fn label(&self) -> String {
+        match self {
+            Self::Demo => format!("{} (embedded demo)", crate::DEMO_SESSION_NAME),
+            Self::File(p) => p.display().to_string(),
+        }
+    }
+
+    /// The file stem used to name derived files (`<stem>-edited.json`, …).
+    #[must_use]
+    pub fn stem(&self) -> String {
+        let name = match self {
+            Self::Demo => Path::new(crate::DEMO_SESSION_NAME),
+            Self::File(p) => p.as_path(),
+        };
+        name.file_stem().map_or_else(
+            || "session".to_string(),
+            |s| s.to_string_lossy().into_owned(),
+        )
+    }
+}
+
+/// What the load job found out about one measurement (for the session
+/// table and the stripe view).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Fit {
+    /// The measurement gives its centre directly: nothing to fit.
+    GivenCentre,
+    /// The stripe's circle fit and sphere centre.
+    Stripe(Box<StripeResult>),
+    /// The stripe could not be fitted: the engine's message.
+    Failed(String),
+}
+
+impl Fit {
+    /// The stripe result, when the fit worked.
+    #[must_use]
+    pub fn stripe(&self) -> Option<&StripeResult> {
+        match self {
+            Self::Stripe(s) => Some(s),
+            _ => None,
+        }
+    }
+}
+
+/// A session as the workbench holds it.
+#[derive(Debug, Clone)]
+pub struct LoadedSession {
+    /// The validated session, as loaded (nothing left out).
+    pub session: Session,
+    /// Where it came from.
+    pub source: Source,
+    /// One per measurement, session order.
+    pub fits: Vec<Fit>,
+    /// Sphere centres in the base frame with the nominal model and the
+    /// initial hand-eye, or why they cannot be computed (a failed stripe, a
+    /// pose set that does not determine the hand-eye).
+    pub before: Result<CentreSet, String>,
+}
+
+impl LoadedSession {
+    /// Number of stripe points of measurement `i` (`None` for a given centre).
+    #[must_use]
+    pub fn points(&self, i: usize) -> Option<usize> {
+        match &self.session.measurements.get(i)?.observation {
+            crate::engine::model::Observation::Stripe(p) => Some(p.len()),
+            crate::engine::model::Observation::Centre(_) => None,
+        }
+    }
+
+    /// Station ids in order of first appearance (all uses).
+    #[must_use]
+    pub fn station_ids(&self) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        for m in &self.session.measurements {
+            if !out.contains(&m.station) {
+                out.push(m.station.clone());
+            }
+        }
+        out
+    }
+}
+
+/// The solver settings as the form edits them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverForm {
+    /// Identification method.
+    pub method: Method,
+    /// Pairing of a station's measurements (paper's method).
+    pub pairing: Pairing,
+    /// Stop when ε ≤ this, mm.
+    pub threshold: f64,
+    /// Most updates.
+    pub max_iterations: usize,
+    /// Relative SVD truncation tolerance (fraction of σ_max).
+    pub svd_tolerance: f64,
+}
+
+impl Default for SolverForm {
+    fn default() -> Self {
+        Self {
+            method: Method::ALL[0],
+            pairing: Pairing::Disjoint,
+            threshold: crate::engine::model::DEFAULT_THRESHOLD,
+            max_iterations: crate::engine::model::DEFAULT_MAX_ITERATIONS,
+            svd_tolerance: DEFAULT_SVD_TOLERANCE,
+        }
+    }
+}
+
+impl SolverForm {
+    /// The session's settings (threshold and iteration bound from its file).
+    #[must_use]
+    pub fn from_session(session: &Session) -> Self {
+        let o = Options::from_session(session);
+        Self {
+            method: o.method,
+            pairing: o.paper.pairing,
+            threshold: o.threshold,
+            max_iterations: o.max_iterations,
+            svd_tolerance: o.paper.svd_tolerance,
+        }
+    }
+
+    /// The engine options these settings stand for.
+    #[must_use]
+    pub fn options(&self, session: &Session) -> Options {
+        let mut o = Options::from_session(session);
+        o.method = self.method;
+        o.threshold = self.threshold;
+        o.max_iterations = self.max_iterations;
+        o.paper = PaperOptions {
+            pairing: self.pairing,
+            svd_tolerance: self.svd_tolerance,
+        };
+        o
+    }
+}
+
+/// A run on the background thread.
+#[derive(Debug, Clone)]
+pub struct RunState {
+    /// ε after 0, 1, … updates as reported so far, mm.
+    pub epsilons: Vec<f64>,
+    /// Threshold of this run, mm.
+    pub threshold: f64,
+    /// Iteration bound of this run.
+    pub max_iterations: usize,
+    /// Set to ask the solver to stop at its next ε.
+    pub cancel: Arc<AtomicBool>,
+    /// True once Cancel was pressed.
+    pub cancelling: bool,
+    /// When the run started.
+    pub started: Instant,
+    /// Measurements left out of this run.
+    pub excluded: usize,
+}
+
+/// How serious a status line is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Level {
+    /// Plain information.
+    Info,
+    /// Something to look at.
+    Warning,
+    /// Something failed.
+    Error,
+}
+
+/// The line in the status bar.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Status {
+    /// What happened.
+    pub text: String,
+    /// How serious.
+    pub level: Level,
+}
+
+/// An error shown in the window until dismissed (a file that did not
+/// load, a save that was refused).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Notice {
+    /// One line: what failed, e.g. "Could not open session.json".
+    pub title: String,
+    /// The engine's message, naming file and measurement.
+    pub body: String,
+}
+
+/// What a file dialog is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DialogPurpose {
+    /// Open a session or result file.
+    Open,
+    /// Choose where to save the edited session.
+    SaveSession,
+    /// Choose the export folder.
+    ExportFolder,
+}
+
+/// Things to export from the Results view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExportKind {
+    /// The FORMAT.md result file.
+    ResultJson,
+    /// Every sphere centre, before and after, CSV.
+    CentresCsv,
+    /// Reference-distance and within-station distance errors, CSV.
+    DistancesCsv,
+    /// The Results view's plots as an image.
+    PlotsPng,
+}
+
+impl ExportKind {
+    /// All kinds, in the order of the export buttons.
+    pub const ALL: [Self; 4] = [
+        Self::ResultJson,
+        Self::CentresCsv,
+        Self::DistancesCsv,
+        Self::PlotsPng,
+    ];
+
+    /// The button text.
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::ResultJson => "Result JSON",
+            Self::CentresCsv => "Centres CSV",
+            Self::DistancesCsv => "Distances CSV",
+            Self::PlotsPng => "Plots PNG",
+        }
+    }
+
+    /// The file name for a session stem.
+    #[must_use]
+    pub fn file_name(self, stem: &str) -> String {
+        match self {
+            Self::ResultJson => format!("{stem}-result.json"),
+            Self::CentresCsv => format!("{stem}-centres.csv"),
+            Self::DistancesCsv => format!("{stem}-distances.csv"),
+            Self::PlotsPng => format!("{stem}-plots.png"),
+        }
+    }
+}
+
+/// The central views.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tab {
+    /// The measurement table.
+    Session,
+    /// One stripe and its circle.
+    Stripe,
+    /// Sphere centres in the base frame.
+    Centres,
+    /// Plots and tables of a result.
+    Results,
+}
+
+impl Tab {
+    /// All tabs, in display order.
+    pub const ALL: [Self; 4] = [Self::Session, Self::Stripe, Self::Centres, Self::Results];
+
+    /// The tab's title.
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Session => "Session",
+            Self::Stripe => "Stripe",
+            Self::Centres => "Centres",
+            Self::Results => "Results",
+        }
+    }
+}
+
+/// How the session table groups its rows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Grouping {
+    /// File order.
+    None,
+    /// By station, stations in order of first appearance.
+    Station,
+    /// By use (translation, rotation, identify, validate).
+    Use,
+}
+
+impl Grouping {
+    /// All groupings.
+    pub const ALL: [Self; 3] = [Self::None, Self::Station, Self::Use];
+
+    /// Display text.
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::None => "file order",
+            Self::Station => "station",
+            Self::Use => "use",
+        }
+    }
+}
+
+/// The camera of the 3D centres view (orthographic, orbiting the centres).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Camera {
+    /// Rotation about the base z axis, rad.
+    pub yaw: f32,
+    /// Elevation above the base xy plane, rad.
+    pub pitch: f32,
+    /// Zoom factor (1 = fit all).
+    pub zoom: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Self {
+            yaw: -0.6,
+            pitch: 0.5,
+            zoom: 1.0,
+        }
+    }
+}
+
+/// Display options of the centres view.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CentresForm {
+    /// Draw the centres before calibration.
+    pub show_before: bool,
+    /// Draw the centres after calibration.
+    pub show_after: bool,
+    /// Draw each centre's deviation from its station mean magnified by
+    /// `magnify`, placed at the station mean.
+    pub relative: bool,
+    /// Magnification of the deviations in relative mode.
+    pub magnify: f32,
+    /// The orbit camera.
+    pub camera: Camera,
+}
+
+impl Default for CentresForm {
+    fn default() -> Self {
+        Self {
+            show_before: true,
+            show_after: true,
+            relative: true,
+            magnify: 50.0,
+            camera: Camera::default(),
+        }
+    }
+}
+
+/// Fields the widgets edit in place: text fields, filters, settings of
+/// the next run, view options.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Forms {
+    /// The current tab.
+    pub tab: Tab,
+    /// The path field of the load panel.
+    pub open_path: String,
+    /// Where "Save as" writes the edited session.
+    pub save_path: String,
+    /// The export folder.
+    pub export_dir: String,
+    /// Session table: only this station.
+    pub filter_station: Option<String>,
+    /// Session table: only this use.
+    pub filter_use: Option<Use>,
+    /// Session table grouping.
+    pub group: Grouping,
+    /// Settings of the next run.
+    pub solver: SolverForm,
+    /// Centres view options.
+    pub centres: CentresForm,
+}
+
+impl Default for Forms {
+    fn default() -> Self {
+        Self {
+            tab: Tab::Session,
+            open_path: String::new(),
+            save_path: String::new(),
+            export_dir: String::new(),
+            filter_station: None,
+            filter_use: None,
+            group: Grouping::None,
+            solver: SolverForm::default(),
+            centres: CentresForm::default(),
+        }
+    }
+}
+
+/// What lasts across runs of the program (eframe storage).
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Prefs {
+    /// Recently opened session and result files, newest first.
+    pub recent: Vec<PathBuf>,
+    /// The folder of the last file opened or saved.
+    pub last_folder: Option<PathBuf>,
+    /// The last export folder.
+    pub export_folder: Option<PathBuf>,
+}
+
+impl Prefs {
+    /// Puts `path` first in the recent list (once), trimmed to [`RECENT_MAX`].
+    pub fn remember(&mut self, path: &Path) {
+        self.recent.retain(|p| p != path);
+        self.recent.insert(0, path.to_path_buf());
+        self.recent.truncate(RECENT_MAX);
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            self.last_folder = Some(dir.to_path_buf());
+        }
+    }
+}
+
+/// Background work the frame loop waits on (to show it and to know when
+/// the app is idle).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Busy {
+    /// A session or result file is being read.
+    pub loading: bool,
+    /// A file dialog is open.
+    pub dialog: bool,
+    /// The edited session is being written.
+    pub saving: bool,
+    /// Exports being written.
+    pub exporting: usize,
+    /// A window screenshot for the plots PNG is awaited.
+    pub screenshot: bool,
+}
+
+/// Everything the workbench shows. Changed only by commands and job
+/// messages; the `*_ui` functions read it.
+#[derive(Debug, Default)]
+pub struct AppState {
+    /// The open session, if any.
+    pub loaded: Option<LoadedSession>,
+    /// Ids of the measurements left out of the solver and of "Save as".
+    pub excluded: BTreeSet<String>,
+    /// Index of the selected measurement in `loaded.session.measurements`.
+    pub selected: Option<usize>,
+    /// The run in progress.
+    pub run: Option<RunState>,
+    /// The result on show (from a run or a reviewed file).
+    pub result: Option<ResultView>,
+    /// The status line.
+    pub status: Option<Status>,
+    /// An error shown until dismissed.
+    pub notice: Option<Notice>,
+    /// The last file dialog returned nothing (cancelled or unavailable).
+    pub dialog_empty: bool,
+    /// "Save as" would overwrite this existing file: a second click confirms.
+    pub confirm_overwrite: Option<PathBuf>,
+    /// Background work in flight.
+    pub busy: Busy,
+    /// What lasts across runs.
+    pub prefs: Prefs,
+    /// A result file to open once the session given with it has loaded.
+    pub pending_result: Option<PathBuf>,
+}
+
+impl AppState {
+    /// Sets the status line.
+    pub fn say(&mut self, level: Level, text: impl Into<String>) {
+        self.status = Some(Status {
+            text: text.into(),
+            level,
+        });
+    }
+
+    /// True while any background work is in flight.
+    #[must_use]
+    pub fn is_busy(&self) -> bool {
+        self.run.is_some()
+            || self.busy.loading
+            || self.busy.dialog
+            || self.busy.saving
+            || self.busy.exporting > 0
+            || self.busy.screenshot
+    }
+
+    /// Indices of the measurements the session table shows, in its order
+    /// (filtered, then grouped).
+    #[must_use]
+    pub fn visible_rows(&self, forms: &Forms) -> Vec<usize> {
+        let Some(loaded) = &self.loaded else {
+            return Vec::new();
+        };
+        let ms = &loaded.session.measurements;
+        let mut rows: Vec<usize> = (0..ms.len())
+            .filter(|&i| {
+                forms
+                    .filter_station
+                    .as_ref()
+                    .is_none_or(|s| *s == ms[i].station)
+                    && forms.filter_use.is_none_or(|u| u == ms[i].usage)
+            })
+            .collect();
+        match forms.group {
+            Grouping::None => {}
+            Grouping::Station => {
+                let order = loaded.station_ids();
+                rows.sort_by_key(|&i| order.iter().position(|s| *s == ms[i].station));
+            }
+            Grouping::Use => rows.sort_by_key(|&i| ms[i].usage),
+        }
+        rows
+    }
+
+    /// Number of measurements left out that exist in the loaded session.
+    #[must_use]
+    pub fn excluded_count(&self) -> usize {
+        self.loaded.as_ref().map_or(0, |l| {
+            l.session
+                .measurements
+                .iter()
+                .filter(|m| self.excluded.contains(&m.id))
+                .count()
+        })
+    }
+}

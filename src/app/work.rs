@@ -1,0 +1,212 @@
+//! The work the jobs do, as plain functions of engine calls (no egui):
+//! open a file, fit its stripes, run the calibration, save the session
+//! without the left-out measurements. Each runs on a job thread.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use crate::engine::calibrate::{self, Control, Options, Progress};
+use crate::engine::error::{CalibrationError, FileError, IdentifyError};
+use crate::engine::identify::Estimate;
+use crate::engine::model::{Observation, Session};
+use crate::engine::report;
+use crate::engine::session::{
+    RESULT_FORMAT, ResultFile, parse_result, parse_session, session_to_json, write_atomic,
+};
+use crate::engine::stripe::centre_from_stripe;
+
+use super::jobs::{LoadFailure, RunFailure};
+use super::state::{Fit, LoadedSession, Source};
+use super::view::{CentrePoint, CentreSet, ResultOrigin, ResultView};
+
+/// What a file turned out to be.
+#[derive(Debug)]
+pub enum Opened {
+    /// A session, analysed.
+    Session(Box<LoadedSession>),
+    /// A result file, checked.
+    Result(Box<ResultFile>),
+}
+
+/// The embedded demo session, analysed.
+///
+/// # Errors
+/// Only if the embedded text were broken (a build error in practice).
+pub fn open_demo() -> Result<LoadedSession, LoadFailure> {
+    let name = Path::new(crate::DEMO_SESSION_NAME);
+    let session = parse_session(crate::DEMO_SESSION_JSON, name).map_err(|e| LoadFailure {
+        what: crate::DEMO_SESSION_NAME.to_string(),
+        message: e.to_string(),
+    })?;
+    Ok(analyse(session, Source::Demo))
+}
+
+/// Reads `path` and, by its `format` key, loads it as a result file or
+/// as a session (anything else goes to the session loader, whose message
+/// then says what is wrong).
+///
+/// # Errors
+/// The file cannot be read or breaks a FORMAT.md rule; the message names
+/// the file and, where it applies, the measurement.
+pub fn open_path(path: &Path) -> Result<Opened, LoadFailure> {
+    let fail = |e: &FileError| LoadFailure {
+        what: path.display().to_string(),
+        message: e.to_string(),
+    };
+    let text = std::fs::read_to_string(path).map_err(|source| {
+        fail(&FileError::Io {
+            action: "reading",
+            path: path.to_path_buf(),
+            source,
+        })
+    })?;
+    let is_result = serde_json::from_str::<serde_json::Value>(&text)
+        .ok()
+        .and_then(|v| {
+            v.get("format")
+                .and_then(|f| f.as_str())
+                .map(|f| f == RESULT_FORMAT)
+        })
+        .unwrap_or(false);
+    if is_result {
+        let result = parse_result(&text, path).map_err(|e| fail(&e))?;
+        Ok(Opened::Result(Box::new(result)))
+    } else {
+        let session = parse_session(&text, path).map_err(|e| fail(&e))?;
+        Ok(Opened::Session(Box::new(analyse(
+            session,
+            Source::File(path.to_path_buf()),
+        ))))
+    }
+}
+
+/// Fits every stripe (for the table and the stripe view) and computes the
+/// centres before calibration (nominal model, initial hand-eye).
+#[must_use]
+pub fn analyse(session: Session, source: Source) -> LoadedSession {
+    let radius = session.sphere_radius();
+    let fits = session
+        .measurements
+        .iter()
+        .map(|m| match &m.observation {
+            Observation::Centre(_) => Fit::GivenCentre,
+            Observation::Stripe(points) => match centre_from_stripe(points, radius, m.side) {
+                Ok(r) => Fit::Stripe(Box::new(r)),
+                Err(e) => Fit::Failed(e.to_string()),
+            },
+        })
+        .collect();
+    let before = calibrate::prepare(&session)
+        .map(|prepared| {
+            let start = Estimate {
+                robot: session.robot.clone(),
+                flange_from_sensor: prepared.hand_eye_initial,
+            };
+            let points = session
+                .measurements
+                .iter()
+                .enumerate()
+                .map(|(i, m)| CentrePoint {
+                    id: m.id.clone(),
+                    station: m.station.clone(),
+                    usage: m.usage.as_str().to_string(),
+                    index: Some(i),
+                    before: start.centre_in_base(&prepared.sighting(&session, i)).into(),
+                    after: None,
+                })
+                .collect();
+            CentreSet::new(points)
+        })
+        .map_err(|e| e.to_string());
+    LoadedSession {
+        session,
+        source,
+        fits,
+        before,
+    }
+}
+
+/// The session without the `excluded` measurements, checked against every
+/// FORMAT.md rule by a round trip through the file format (what a saved
+/// file would load as). The name is kept.
+///
+/// # Errors
+/// Leaving these measurements out breaks a rule: the loader's message.
+pub fn without(session: &Session, excluded: &BTreeSet<String>) -> Result<Session, String> {
+    let mut kept = session.clone();
+    kept.measurements.retain(|m| !excluded.contains(&m.id));
+    let left_out = session.measurements.len() - kept.measurements.len();
+    if left_out == 0 {
+        return Ok(kept);
+    }
+    let label = PathBuf::from(format!(
+        "{} without {left_out} left-out measurement(s)",
+        session.name
+    ));
+    let mut checked = parse_session(&session_to_json(&kept), &label).map_err(|e| e.to_string())?;
+    checked.name.clone_from(&session.name);
+    Ok(checked)
+}
+
+/// Writes the session without the `excluded` measurements to `path`
+/// (atomically). Returns how many measurements the file holds.
+///
+/// # Errors
+/// The edited session breaks a rule, or the file cannot be written.
+pub fn save_without(
+    session: &Session,
+    excluded: &BTreeSet<String>,
+    path: &Path,
+) -> Result<usize, String> {
+    let kept = without(session, excluded).map_err(|e| {
+        format!("not saved: the session without the left-out measurements is not valid: {e}")
+    })?;
+    write_atomic(path, session_to_json(&kept).as_bytes()).map_err(|e| e.to_string())?;
+    Ok(kept.measurements.len())
+}
+
+/// The whole calibration of `session` without the `excluded`
+/// measurements: prepare, run (reporting every ε, stopping when `cancel`
+/// is set), and the result file and its view.
+///
+/// # Errors
+/// [`RunFailure::Cancelled`] after a cancel, [`RunFailure::Failed`] with
+/// the engine's message otherwise.
+pub fn calibrate_session(
+    session: &Session,
+    excluded: &BTreeSet<String>,
+    options: &Options,
+    cancel: &AtomicBool,
+    on_progress: &mut dyn FnMut(&Progress) -> bool,
+) -> Result<ResultView, RunFailure> {
+    let started = Instant::now();
+    let kept = without(session, excluded).map_err(|e| {
+        RunFailure::Failed(format!(
+            "the session without the left-out measurements is not valid: {e}"
+        ))
+    })?;
+    let failed = |e: CalibrationError| match e {
+        CalibrationError::Identify(IdentifyError::Cancelled { iterations }) => {
+            RunFailure::Cancelled(iterations)
+        }
+        other => RunFailure::Failed(other.to_string()),
+    };
+    let prepared = calibrate::prepare(&kept).map_err(failed)?;
+    let cal = calibrate::run(&kept, &prepared, options, &mut |p| {
+        let delivered = on_progress(p);
+        if cancel.load(Ordering::Relaxed) || !delivered {
+            Control::Cancel
+        } else {
+            Control::Continue
+        }
+    })
+    .map_err(failed)?;
+    let file = report::result_file(&kept, &prepared, &cal);
+    let origin = ResultOrigin::Run {
+        seconds: started.elapsed().as_secs_f64(),
+        excluded: session.measurements.len() - kept.measurements.len(),
+    };
+    Ok(ResultView::new(file, origin, Some(session)))
+}

@@ -1,0 +1,769 @@
+//! The workbench: owns the state, the forms and the job runner. Each frame
+//! it drains the job messages, draws the panels (which push commands) and
+//! then applies the commands, starting jobs for anything slow.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use super::commands::Command;
+use super::export;
+use super::jobs::{JobMessage, Jobs, LoadFailure, RunFailure};
+use super::panels;
+use super::state::{
+    AppState, DialogPurpose, ExportKind, Forms, Level, LoadedSession, Notice, Prefs, RunState,
+    SolverForm, Tab,
+};
+use super::view::ResultOrigin;
+use super::work::{self, Opened};
+
+/// Key of the preferences in eframe's storage (JSON text).
+pub const PREFS_KEY: &str = "spherecal.prefs";
+
+/// What the status line says when a file dialog returned nothing.
+pub const NO_DIALOG: &str = "no file chosen — or no file dialog is available on this machine (no desktop portal); type the path instead";
+
+/// The workbench application (also driven directly by the UI tests).
+pub struct WorkbenchApp {
+    state: AppState,
+    forms: Forms,
+    jobs: Jobs,
+    /// Commands queued before the first frame (the start-up file).
+    startup: Vec<Command>,
+    /// Screen rectangle of the Results view's plots in the last frame.
+    plots_rect: Option<egui::Rect>,
+    /// Where the awaited screenshot's PNG goes.
+    png_target: Option<PathBuf>,
+    /// Whether [`install_fonts`] has run.
+    fonts_installed: bool,
+}
+
+/// Adds the default monospace font (Hack) as a fallback of the
+/// proportional family: egui's default proportional font has no arrows
+/// (→) or geometric shapes (▶ ● ○ ■), which the workbench uses.
+pub fn install_fonts(ctx: &egui::Context) {
+    let mut fonts = egui::FontDefinitions::default();
+    if fonts.font_data.contains_key("Hack")
+        && let Some(list) = fonts.families.get_mut(&egui::FontFamily::Proportional)
+        && !list.iter().any(|f| f == "Hack")
+    {
+        list.push("Hack".to_string());
+    }
+    ctx.set_fonts(fonts);
+}
+
+impl WorkbenchApp {
+    /// A workbench that opens `session` (else the demo) on its first frame
+    /// and then `result` for review, with remembered `prefs`.
+    #[must_use]
+    pub fn new(prefs: Prefs, session: Option<PathBuf>, result: Option<PathBuf>) -> Self {
+        let mut forms = Forms::default();
+        let export_dir = prefs
+            .export_folder
+            .clone()
+            .or_else(|| prefs.last_folder.clone())
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_default();
+        forms.export_dir = export_dir.display().to_string();
+        let state = AppState {
+            prefs,
+            pending_result: result,
+            ..AppState::default()
+        };
+        let startup = vec![session.map_or(Command::OpenDemo, Command::OpenPath)];
+        Self {
+            state,
+            forms,
+            jobs: Jobs::default(),
+            startup,
+            plots_rect: None,
+            png_target: None,
+            fonts_installed: false,
+        }
+    }
+
+    /// A workbench with the preferences kept in eframe's storage.
+    #[must_use]
+    pub fn from_storage(
+        storage: Option<&dyn eframe::Storage>,
+        session: Option<PathBuf>,
+        result: Option<PathBuf>,
+    ) -> Self {
+        let prefs = storage
+            .and_then(|s| s.get_string(PREFS_KEY))
+            .and_then(|text| serde_json::from_str(&text).ok())
+            .unwrap_or_default();
+        Self::new(prefs, session, result)
+    }
+
+    /// The state, for tests and the shell.
+    #[must_use]
+    pub fn state(&self) -> &AppState {
+        &self.state
+    }
+
+    /// The form fields, for tests.
+    #[must_use]
+    pub fn forms(&self) -> &Forms {
+        &self.forms
+    }
+
+    /// The form fields, for tests that set them directly.
+    pub fn forms_mut(&mut self) -> &mut Forms {
+        &mut self.forms
+    }
+
+    /// True while background work is in flight (or the start-up file has
+    /// not been asked for yet).
+    #[must_use]
+    pub fn is_busy(&self) -> bool {
+        !self.startup.is_empty() || self.state.is_busy() || self.state.pending_result.is_some()
+    }
+
+    /// Applies a command as if a panel had pushed it (for tests).
+    pub fn command(&mut self, ctx: &egui::Context, command: Command) {
+        self.apply(ctx, command);
+    }
+
+    /// One frame: drain job messages, draw everything, apply the commands.
+    pub fn show(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        if !self.fonts_installed {
+            // Takes effect at once: nothing has been laid out yet this pass.
+            install_fonts(&ctx);
+            self.fonts_installed = true;
+        }
+        for c in std::mem::take(&mut self.startup) {
+            self.apply(&ctx, c);
+        }
+        for message in self.jobs.drain() {
+            self.on_message(&ctx, message);
+        }
+        let mut commands = Vec::new();
+        self.input_commands(&ctx, &mut commands);
+        egui::Panel::bottom("status").show(ui, |ui| panels::status::status_ui(ui, &self.state));
+        egui::Panel::left("side")
+            .resizable(true)
+            .default_size(290.0)
+            .size_range(240.0..=420.0)
+            .show(ui, |ui| {
+                panels::side::side_ui(ui, &self.state, &mut self.forms, &mut commands);
+            });
+        egui::CentralPanel::default().show(ui, |ui| {
+            panels::tabs_ui(ui, &self.state, &self.forms, &mut commands);
+            ui.separator();
+            match self.forms.tab {
+                Tab::Session => {
+                    panels::session::session_ui(ui, &self.state, &mut self.forms, &mut commands);
+                }
+                Tab::Stripe => {
+                    panels::stripe::stripe_ui(ui, &self.state, &self.forms, &mut commands)
+                }
+                Tab::Centres => {
+                    panels::centres::centres_ui(ui, &self.state, &mut self.forms, &mut commands);
+                }
+                Tab::Results => {
+                    self.plots_rect = panels::results::results_ui(
+                        ui,
+                        &self.state,
+                        &mut self.forms,
+                        &mut commands,
+                    );
+                }
+            }
+        });
+        panels::drop_overlay_ui(&ctx);
+        for c in commands {
+            self.apply(&ctx, c);
+        }
+    }
+
+    /// Dropped files and the arrow keys.
+    fn input_commands(&self, ctx: &egui::Context, commands: &mut Vec<Command>) {
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .collect()
+        });
+        if let Some(p) = dropped.into_iter().next() {
+            commands.push(Command::OpenPath(p));
+        }
+        let stepping = matches!(self.forms.tab, Tab::Session | Tab::Stripe)
+            && ctx.memory(|m| m.focused().is_none());
+        if stepping {
+            let (down, up) = ctx.input(|i| {
+                (
+                    i.key_pressed(egui::Key::ArrowDown) || i.key_pressed(egui::Key::ArrowRight),
+                    i.key_pressed(egui::Key::ArrowUp) || i.key_pressed(egui::Key::ArrowLeft),
+                )
+            });
+            if down {
+                commands.push(Command::Step(1));
+            }
+            if up {
+                commands.push(Command::Step(-1));
+            }
+        }
+    }
+
+    /// Starts a job, or reports why it could not start.
+    fn spawn(
+        &mut self,
+        ctx: &egui::Context,
+        name: &str,
+        work: impl FnOnce(&super::jobs::Reporter) + Send + 'static,
+    ) -> bool {
+        match self.jobs.spawn(name, ctx, work) {
+            Ok(()) => true,
+            Err(e) => {
+                self.state.say(Level::Error, e);
+                false
+            }
+        }
+    }
+
+    fn apply(&mut self, ctx: &egui::Context, command: Command) {
+        match command {
+            Command::OpenDemo => {
+                self.state.busy.loading = true;
+                self.state.say(Level::Info, "opening the demo session…");
+                let started = self.spawn(ctx, "load", |rep| {
+                    rep.send(match work::open_demo() {
+                        Ok(l) => JobMessage::SessionLoaded(Box::new(l)),
+                        Err(e) => JobMessage::LoadFailed(e),
+                    });
+                });
+                self.state.busy.loading = started;
+            }
+            Command::OpenPath(path) => self.open_path(ctx, path),
+            Command::Browse(purpose) => self.browse(ctx, purpose),
+            Command::ShowTab(tab) => self.forms.tab = tab,
+            Command::Select(i) => self.state.selected = Some(i),
+            Command::Inspect(i) => {
+                self.state.selected = Some(i);
+                self.forms.tab = Tab::Stripe;
+            }
+            Command::Step(delta) => self.step(delta),
+            Command::SetIncluded { id, included } => {
+                if included {
+                    self.state.excluded.remove(&id);
+                } else {
+                    self.state.excluded.insert(id);
+                }
+                self.say_excluded();
+            }
+            Command::SetStationIncluded { station, included } => {
+                if let Some(l) = &self.state.loaded {
+                    for m in l
+                        .session
+                        .measurements
+                        .iter()
+                        .filter(|m| m.station == station)
+                    {
+                        if included {
+                            self.state.excluded.remove(&m.id);
+                        } else {
+                            self.state.excluded.insert(m.id.clone());
+                        }
+                    }
+                }
+                self.say_excluded();
+            }
+            Command::IncludeAll => {
+                self.state.excluded.clear();
+                self.say_excluded();
+            }
+            Command::SaveSession => self.save_session(ctx, false),
+            Command::Run => self.run(ctx),
+            Command::Cancel => {
+                if let Some(run) = &mut self.state.run {
+                    run.cancel.store(true, Ordering::Relaxed);
+                    run.cancelling = true;
+                    self.state.say(Level::Info, "cancelling the run…");
+                }
+            }
+            Command::Export(kind) => self.export(ctx, kind),
+            Command::DismissNotice => self.state.notice = None,
+            Command::ClearRecent => self.state.prefs.recent.clear(),
+        }
+    }
+
+    fn say_excluded(&mut self) {
+        let n = self.state.excluded_count();
+        if n == 0 {
+            self.state.say(Level::Info, "every measurement is used");
+        } else {
+            self.state.say(
+                Level::Info,
+                format!("{n} measurement(s) left out: the next run skips them; Save as… keeps the choice"),
+            );
+        }
+    }
+
+    fn open_path(&mut self, ctx: &egui::Context, path: PathBuf) {
+        if path.as_os_str().is_empty() {
+            self.state.say(
+                Level::Warning,
+                "type the path of a session or result file first",
+            );
+            return;
+        }
+        self.forms.open_path = path.display().to_string();
+        self.state
+            .say(Level::Info, format!("opening {}…", path.display()));
+        let session = self.state.loaded.as_ref().map(|l| l.session.clone());
+        let started = self.spawn(ctx, "load", move |rep| {
+            rep.send(match work::open_path(&path) {
+                Ok(Opened::Session(l)) => JobMessage::SessionLoaded(l),
+                Ok(Opened::Result(file)) => {
+                    let view = super::view::ResultView::new(
+                        *file,
+                        ResultOrigin::Review(path.clone()),
+                        session.as_ref(),
+                    );
+                    JobMessage::ResultLoaded {
+                        path,
+                        view: Box::new(view),
+                    }
+                }
+                Err(e) => JobMessage::LoadFailed(e),
+            });
+        });
+        self.state.busy.loading = started;
+    }
+
+    fn browse(&mut self, ctx: &egui::Context, purpose: DialogPurpose) {
+        if self.state.busy.dialog {
+            return;
+        }
+        let folder = match purpose {
+            DialogPurpose::ExportFolder => Some(PathBuf::from(self.forms.export_dir.trim())),
+            _ => self.state.prefs.last_folder.clone(),
+        };
+        let file_name = Path::new(self.forms.save_path.trim())
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned());
+        let started = self.spawn(ctx, "file-dialog", move |rep| {
+            let mut dialog = rfd::FileDialog::new();
+            if let Some(dir) = folder.filter(|d| d.is_dir()) {
+                dialog = dialog.set_directory(dir);
+            }
+            let path = match purpose {
+                DialogPurpose::Open => dialog
+                    .add_filter("spherecal session or result", &["json"])
+                    .pick_file(),
+                DialogPurpose::SaveSession => {
+                    let dialog = dialog.add_filter("spherecal session", &["json"]);
+                    match file_name {
+                        Some(n) => dialog.set_file_name(n),
+                        None => dialog,
+                    }
+                    .save_file()
+                }
+                DialogPurpose::ExportFolder => dialog.pick_folder(),
+            };
+            rep.send(JobMessage::Dialog { purpose, path });
+        });
+        self.state.busy.dialog = started;
+        if started {
+            self.state.say(Level::Info, "waiting for the file dialog…");
+        }
+    }
+
+    fn step(&mut self, delta: i32) {
+        let rows = self.state.visible_rows(&self.forms);
+        if rows.is_empty() {
+            return;
+        }
+        let pos = self
+            .state
+            .selected
+            .and_then(|s| rows.iter().position(|&r| r == s));
+        let next = match pos {
+            None => 0,
+            Some(p) => {
+                let last = rows.len() - 1;
+                if delta < 0 {
+                    p.saturating_sub(delta.unsigned_abs() as usize)
+                } else {
+                    (p + delta.unsigned_abs() as usize).min(last)
+                }
+            }
+        };
+        self.state.selected = Some(rows[next]);
+    }
+
+    fn save_session(&mut self, ctx: &egui::Context, confirmed: bool) {
+        let Some(loaded) = &self.state.loaded else {
+            self.state.say(Level::Warning, "no session to save");
+            return;
+        };
+        let text = self.forms.save_path.trim();
+        if text.is_empty() {
+            self.state
+                .say(Level::Warning, "type where to save the session first");
+            return;
+        }
+        let path = PathBuf::from(text);
+        let confirmed = confirmed || self.state.confirm_overwrite.as_ref() == Some(&path);
+        if path.exists() && !confirmed {
+            let opened = loaded.source.path() == Some(path.as_path());
+            self.state.say(
+                Level::Warning,
+                format!(
+                    "{} exists{}: press Save again to replace it",
+                    path.display(),
+                    if opened {
+                        " (it is the opened session file)"
+                    } else {
+                        ""
+                    }
+                ),
+            );
+            self.state.confirm_overwrite = Some(path);
+            return;
+        }
+        self.state.confirm_overwrite = None;
+        let session = loaded.session.clone();
+        let excluded = self.state.excluded.clone();
+        let started = self.spawn(ctx, "save", move |rep| {
+            let outcome = work::save_without(&session, &excluded, &path);
+            rep.send(JobMessage::Saved { path, outcome });
+        });
+        self.state.busy.saving = started;
+    }
+
+    fn run(&mut self, ctx: &egui::Context) {
+        if self.state.run.is_some() {
+            return;
+        }
+        let Some(loaded) = &self.state.loaded else {
+            self.state.say(Level::Warning, "open a session first");
+            return;
+        };
+        let session = loaded.session.clone();
+        let options = self.forms.solver.options(&session);
+        let excluded = self.state.excluded.clone();
+        let cancel = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&cancel);
+        let n_excluded = self.state.excluded_count();
+        let started = self.spawn(ctx, "solver", move |rep| {
+            let outcome = work::calibrate_session(&session, &excluded, &options, &flag, &mut |p| {
+                rep.send(JobMessage::Progress(*p))
+            });
+            rep.send(JobMessage::RunFinished(outcome.map(Box::new)));
+        });
+        if started {
+            self.state.run = Some(RunState {
+                epsilons: Vec::new(),
+                threshold: options.threshold,
+                max_iterations: options.max_iterations,
+                cancel,
+                cancelling: false,
+                started: Instant::now(),
+                excluded: n_excluded,
+            });
+            self.state.say(Level::Info, "running the calibration…");
+        }
+    }
+
+    fn export(&mut self, ctx: &egui::Context, kind: ExportKind) {
+        let Some(view) = &self.state.result else {
+            self.state.say(
+                Level::Warning,
+                "nothing to export: run the solver or open a result first",
+            );
+            return;
+        };
+        let dir = PathBuf::from(self.forms.export_dir.trim());
+        if !dir.is_dir() {
+            self.state.notice = Some(Notice {
+                title: "Nothing exported".to_string(),
+                body: format!("the export folder {} does not exist", dir.display()),
+            });
+            return;
+        }
+        self.state.prefs.export_folder = Some(dir.clone());
+        let stem = match &self.state.loaded {
+            Some(l) => l.source.stem(),
+            None => "result".to_string(),
+        };
+        let path = dir.join(kind.file_name(&stem));
+        if kind == ExportKind::PlotsPng {
+            if self.state.busy.screenshot {
+                return;
+            }
+            self.forms.tab = Tab::Results;
+            self.png_target = Some(path);
+            self.state.busy.screenshot = true;
+            let rep = self.jobs.reporter(ctx);
+            ctx.request_screenshot(move |image| {
+                rep.send(JobMessage::Screenshot(image));
+            });
+            self.state
+                .say(Level::Info, "taking a screenshot of the plots…");
+            return;
+        }
+        let view = view.clone();
+        let started = self.spawn(ctx, "export", move |rep| {
+            let outcome = export::write_text(kind, &view, &path);
+            rep.send(JobMessage::Exported {
+                kind,
+                path,
+                outcome,
+            });
+        });
+        if started {
+            self.state.busy.exporting += 1;
+        }
+    }
+
+    fn on_message(&mut self, ctx: &egui::Context, message: JobMessage) {
+        match message {
+            JobMessage::SessionLoaded(loaded) => self.on_session(ctx, *loaded),
+            JobMessage::ResultLoaded { path, view } => {
+                self.state.busy.loading = false;
+                self.state.prefs.remember(&path);
+                let notes = view.notes.join("; ");
+                self.state.result = Some(*view);
+                self.forms.tab = Tab::Results;
+                if notes.is_empty() {
+                    self.state.say(
+                        Level::Info,
+                        format!(
+                            "reviewing {} as it was computed (the solver was not run)",
+                            path.display()
+                        ),
+                    );
+                } else {
+                    self.state.say(
+                        Level::Warning,
+                        format!("reviewing {}: {notes}", path.display()),
+                    );
+                }
+            }
+            JobMessage::LoadFailed(LoadFailure { what, message }) => {
+                self.state.busy.loading = false;
+                self.state
+                    .say(Level::Error, format!("could not open {what}"));
+                self.state.notice = Some(Notice {
+                    title: format!("Could not open {what}"),
+                    body: message,
+                });
+                if let Some(p) = self.state.pending_result.take() {
+                    self.open_path(ctx, p);
+                }
+            }
+            JobMessage::Progress(p) => {
+                if let Some(run) = &mut self.state.run {
+                    run.epsilons.truncate(p.updates);
+                    run.epsilons.push(p.epsilon);
+                }
+            }
+            JobMessage::RunFinished(outcome) => {
+                // A run whose session was replaced meanwhile is forgotten.
+                let Some(run) = self.state.run.take() else {
+                    return;
+                };
+                match outcome {
+                    Ok(view) => {
+                        let stop = view.stop_reason.clone().unwrap_or_default();
+                        let seconds = run.started.elapsed().as_secs_f64();
+                        self.state.result = Some(*view);
+                        self.forms.tab = Tab::Results;
+                        self.state
+                            .say(Level::Info, format!("calibrated in {seconds:.2} s: {stop}"));
+                    }
+                    Err(RunFailure::Cancelled(n)) => self.state.say(
+                        Level::Warning,
+                        format!("run cancelled after {n} update(s); nothing was changed"),
+                    ),
+                    Err(RunFailure::Failed(message)) => {
+                        self.state.say(Level::Error, "the calibration failed");
+                        self.state.notice = Some(Notice {
+                            title: "The calibration failed".to_string(),
+                            body: message,
+                        });
+                    }
+                }
+            }
+            JobMessage::Dialog { purpose, path } => {
+                self.state.busy.dialog = false;
+                self.state.dialog_empty = path.is_none();
+                let Some(path) = path else {
+                    self.state.say(Level::Warning, NO_DIALOG);
+                    return;
+                };
+                match purpose {
+                    DialogPurpose::Open => self.open_path(ctx, path),
+                    DialogPurpose::SaveSession => {
+                        self.forms.save_path = path.display().to_string();
+                        // The dialog has asked about replacing a file already.
+                        self.save_session(ctx, true);
+                    }
+                    DialogPurpose::ExportFolder => {
+                        self.forms.export_dir = path.display().to_string();
+                        self.state
+                            .say(Level::Info, format!("exports go to {}", path.display()));
+                    }
+                }
+            }
+            JobMessage::Saved { path, outcome } => {
+                self.state.busy.saving = false;
+                match outcome {
+                    Ok(n) => {
+                        self.state.prefs.remember(&path);
+                        self.state.say(
+                            Level::Info,
+                            format!(
+                                "saved {n} measurements to {} (atomic write)",
+                                path.display()
+                            ),
+                        );
+                    }
+                    Err(message) => {
+                        self.state.say(Level::Error, "the session was not saved");
+                        self.state.notice = Some(Notice {
+                            title: format!("Could not save {}", path.display()),
+                            body: message,
+                        });
+                    }
+                }
+            }
+            JobMessage::Screenshot(image) => self.on_screenshot(ctx, &image),
+            JobMessage::Exported {
+                kind,
+                path,
+                outcome,
+            } => {
+                self.state.busy.exporting = self.state.busy.exporting.saturating_sub(1);
+                match outcome {
+                    Ok(()) => self.state.say(
+                        Level::Info,
+                        format!("exported {} to {}", kind.label(), path.display()),
+                    ),
+                    Err(message) => {
+                        self.state
+                            .say(Level::Error, format!("{} not exported", kind.label()));
+                        self.state.notice = Some(Notice {
+                            title: format!("Could not export {}", kind.label()),
+                            body: message,
+                        });
+                    }
+                }
+            }
+        }
+    }
+
+    fn on_session(&mut self, ctx: &egui::Context, loaded: LoadedSession) {
+        self.state.busy.loading = false;
+        if let Some(run) = self.state.run.take() {
+            // The run was of the previous session: stop it, forget it.
+            run.cancel.store(true, Ordering::Relaxed);
+        }
+        if let Some(p) = loaded.source.path() {
+            self.state.prefs.remember(p);
+            self.forms.open_path = p.display().to_string();
+        }
+        let dir = loaded
+            .source
+            .path()
+            .and_then(Path::parent)
+            .map(Path::to_path_buf)
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_default();
+        self.forms.save_path = dir
+            .join(format!("{}-edited.json", loaded.source.stem()))
+            .display()
+            .to_string();
+        self.forms.solver = SolverForm::from_session(&loaded.session);
+        self.forms.filter_station = None;
+        self.forms.filter_use = None;
+        if self.forms.tab == Tab::Results {
+            self.forms.tab = Tab::Session;
+        }
+        self.state.excluded.clear();
+        self.state.confirm_overwrite = None;
+        self.state.selected = (!loaded.session.measurements.is_empty()).then_some(0);
+        self.state.result = None;
+        self.state.notice = None;
+        let failed = loaded
+            .fits
+            .iter()
+            .filter(|f| matches!(f, super::state::Fit::Failed(_)))
+            .count();
+        let warned = loaded
+            .fits
+            .iter()
+            .filter(|f| f.stripe().is_some_and(|s| !s.warnings.is_empty()))
+            .count();
+        let mut text = format!(
+            "opened {}: {} measurements",
+            loaded.session.name,
+            loaded.session.measurements.len()
+        );
+        let mut level = Level::Info;
+        if warned > 0 {
+            text.push_str(&format!(", {warned} with stripe warnings"));
+        }
+        if failed > 0 {
+            text.push_str(&format!(", {failed} stripe(s) could not be fitted"));
+            level = Level::Warning;
+        }
+        if let Err(e) = &loaded.before {
+            text.push_str(&format!("; the solver cannot run: {e}"));
+            level = Level::Warning;
+        }
+        self.state.say(level, text);
+        self.state.loaded = Some(loaded);
+        if let Some(p) = self.state.pending_result.take() {
+            self.open_path(ctx, p);
+        }
+    }
+
+    fn on_screenshot(&mut self, ctx: &egui::Context, image: &Arc<egui::ColorImage>) {
+        self.state.busy.screenshot = false;
+        let (Some(path), Some(rect)) = (self.png_target.take(), self.plots_rect) else {
+            self.state.say(
+                Level::Warning,
+                "the plots were not on screen: no PNG written",
+            );
+            return;
+        };
+        let ppp = ctx.pixels_per_point();
+        let px = |v: f32| (v * ppp).round().max(0.0) as usize;
+        let crop = [
+            px(rect.min.x),
+            px(rect.min.y),
+            px(rect.width()),
+            px(rect.height()),
+        ];
+        let image = Arc::clone(image);
+        let started = self.spawn(ctx, "export", move |rep| {
+            let outcome = export::write_png(&image, crop, &path);
+            rep.send(JobMessage::Exported {
+                kind: ExportKind::PlotsPng,
+                path,
+                outcome,
+            });
+        });
+        if started {
+            self.state.busy.exporting += 1;
+        }
+    }
+}
+
+impl eframe::App for WorkbenchApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.show(ui);
+    }
+
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        if let Ok(text) = serde_json::to_string(&self.state.prefs) {
+            storage.set_string(PREFS_KEY, text);
+        }
+    }
+}

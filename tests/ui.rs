@@ -1,0 +1,373 @@
+//! UI tests: egui_kittest drives the real workbench (no display, no GPU).
+//! Widgets are found by their labels, clicked, and the app's state and
+//! shown text are checked against the engine run headless.
+
+#![cfg(feature = "gui")]
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use std::path::Path;
+use std::time::Duration;
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::{NodeT as _, Queryable as _};
+use spherecal::app::WorkbenchApp;
+use spherecal::app::state::{Prefs, Tab};
+use spherecal::engine::calibrate::{Options, calibrate};
+use spherecal::engine::session::parse_session;
+
+/// Frames to wait for background work (with a short sleep each): generous
+/// for a loaded CI machine; a run of the demo takes well under a second.
+const MAX_FRAMES: usize = 6000;
+
+fn harness(app: WorkbenchApp) -> Harness<'static, WorkbenchApp> {
+    Harness::builder()
+        .with_size(egui::vec2(1366.0, 768.0))
+        .build_ui_state(|ui, app: &mut WorkbenchApp| app.show(ui), app)
+}
+
+/// Steps frames until no background work is in flight, then settles.
+fn settle(h: &mut Harness<'_, WorkbenchApp>) {
+    for _ in 0..MAX_FRAMES {
+        h.step();
+        if !h.state().is_busy() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert!(!h.state().is_busy(), "background work did not finish");
+    h.run();
+}
+
+fn demo_app() -> Harness<'static, WorkbenchApp> {
+    let mut h = harness(WorkbenchApp::new(Prefs::default(), None, None));
+    settle(&mut h);
+    assert!(
+        h.state().state().loaded.is_some(),
+        "the demo session did not load"
+    );
+    h
+}
+
+/// The text of every label that starts with `prefix`.
+fn labels_starting(h: &Harness<'_, WorkbenchApp>, prefix: &str) -> Vec<String> {
+    h.query_all_by_label_contains(prefix)
+        .filter_map(|n| n.accesskit_node().label())
+        .filter(|l| l.starts_with(prefix))
+        .collect()
+}
+
+/// The numbers in `text`, in order (accepts a leading sign and decimals).
+fn numbers(text: &str) -> Vec<f64> {
+    text.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+        .filter_map(|t| t.parse::<f64>().ok())
+        .collect()
+}
+
+#[test]
+fn demo_loads_select_run_and_headline_matches_engine() {
+    let mut h = demo_app();
+    let session = parse_session(
+        spherecal::DEMO_SESSION_JSON,
+        Path::new(spherecal::DEMO_SESSION_NAME),
+    )
+    .expect("demo session parses");
+
+    // Select a measurement: the Stripe view's Next button, then an arrow key.
+    h.get_by_label("Stripe").click();
+    h.run();
+    h.get_by_label("Next ▶").click();
+    h.run();
+    assert_eq!(h.state().state().selected, Some(1));
+    h.key_press(egui::Key::ArrowDown);
+    h.run();
+    assert_eq!(h.state().state().selected, Some(2));
+    assert_eq!(h.state().forms().tab, Tab::Stripe);
+    let id = &session.measurements[2].id;
+    assert!(
+        h.query_by_label_contains(id).is_some(),
+        "the stripe view names {id}"
+    );
+
+    // Run the solver to the end.
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    assert_eq!(
+        h.state().forms().tab,
+        Tab::Results,
+        "a finished run shows the results"
+    );
+
+    // The engine's own answer on the same session and settings.
+    let (_, cal) =
+        calibrate(&session, &Options::from_session(&session)).expect("engine calibrates the demo");
+    let v = cal.validation.expect("the demo has validate measurements");
+
+    // Read the after-std from the headline: "std <before> → <after> mm".
+    let std_lines = labels_starting(&h, "std ");
+    assert_eq!(
+        std_lines.len(),
+        1,
+        "one headline std line, got {std_lines:?}"
+    );
+    let n = numbers(&std_lines[0]);
+    assert_eq!(n.len(), 2, "before and after in {:?}", std_lines[0]);
+    assert!(
+        (n[0] - v.before.std).abs() < 6e-4,
+        "before std {} vs engine {}",
+        n[0],
+        v.before.std
+    );
+    assert!(
+        (n[1] - v.after.std).abs() < 6e-4,
+        "after std {} vs engine {}",
+        n[1],
+        v.after.std
+    );
+    let max_lines = labels_starting(&h, "max ");
+    let m = numbers(&max_lines[0]);
+    assert!(
+        (m[1] - v.after.max).abs() < 6e-4,
+        "after max {} vs engine {}",
+        m[1],
+        v.after.max
+    );
+
+    // The view model holds exactly the engine's figures.
+    let view = h
+        .state()
+        .state()
+        .result
+        .as_ref()
+        .expect("a result is shown");
+    assert_eq!(view.epsilons, cal.iterations);
+    assert!(
+        view.headline
+            .as_ref()
+            .is_some_and(|hl| hl.stats.after == v.after)
+    );
+}
+
+#[test]
+fn bad_file_shows_its_error_and_the_app_stays_usable() {
+    let mut h = demo_app();
+    // The demo with a stripe cut to 3 points: a load error naming the measurement.
+    let mut doc: serde_json::Value =
+        serde_json::from_str(spherecal::DEMO_SESSION_JSON).expect("demo is JSON");
+    let bad_id = doc["measurements"][2]["id"]
+        .as_str()
+        .expect("id")
+        .to_string();
+    let points = doc["measurements"][2]["stripe"]["points"]
+        .as_array()
+        .expect("stripe")
+        .clone();
+    doc["measurements"][2]["stripe"]["points"] = serde_json::Value::Array(points[..3].to_vec());
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("broken-session.json");
+    std::fs::write(&path, serde_json::to_string(&doc).expect("json")).expect("write");
+
+    h.get_by_label("Session or result file").click();
+    h.run();
+    h.get_by_label("Session or result file")
+        .type_text(&path.display().to_string());
+    h.run();
+    h.get_by_label("Open path").click();
+    settle(&mut h);
+
+    let notice = h.state().state().notice.clone().expect("an error is shown");
+    assert!(notice.title.contains("broken-session.json"), "{notice:?}");
+    assert!(
+        notice.body.contains(&bad_id),
+        "the message names measurement {bad_id}: {notice:?}"
+    );
+    assert!(
+        h.query_by_label(&notice.body).is_some(),
+        "the message is shown in the window"
+    );
+    // The demo is still open and the app still works.
+    assert_eq!(
+        h.state()
+            .state()
+            .loaded
+            .as_ref()
+            .map(|l| l.session.name.clone()),
+        Some(session_name())
+    );
+    h.get_by_label("Dismiss").click();
+    h.run();
+    assert!(h.state().state().notice.is_none());
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    assert!(
+        h.state().state().result.is_some(),
+        "a run still works after the error"
+    );
+}
+
+fn session_name() -> String {
+    parse_session(
+        spherecal::DEMO_SESSION_JSON,
+        Path::new(spherecal::DEMO_SESSION_NAME),
+    )
+    .expect("demo parses")
+    .name
+}
+
+#[test]
+fn cancel_stops_a_run() {
+    let mut h = demo_app();
+    // A run that cannot converge: threshold 0, many iterations.
+    h.state_mut().forms_mut().solver.threshold = 0.0;
+    h.state_mut().forms_mut().solver.max_iterations = 500;
+    h.get_by_label("▶ Run").click();
+    h.step();
+    // Wait for the first ε, then press Cancel.
+    for _ in 0..MAX_FRAMES {
+        h.step();
+        if h.state()
+            .state()
+            .run
+            .as_ref()
+            .is_some_and(|r| !r.epsilons.is_empty())
+        {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    assert!(h.state().state().run.is_some(), "the run was still going");
+    h.get_by_label("Cancel").click();
+    settle(&mut h);
+    let state = h.state().state();
+    assert!(state.run.is_none());
+    assert!(state.result.is_none(), "a cancelled run shows no result");
+    let status = state
+        .status
+        .as_ref()
+        .map(|s| s.text.clone())
+        .unwrap_or_default();
+    assert!(status.contains("cancelled"), "status: {status}");
+}
+
+#[test]
+fn left_out_measurements_are_saved_and_a_bad_exclusion_is_refused() {
+    let mut h = demo_app();
+    let session = parse_session(
+        spherecal::DEMO_SESSION_JSON,
+        Path::new(spherecal::DEMO_SESSION_NAME),
+    )
+    .expect("demo parses");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let target = dir.path().join("demo-edited.json");
+    // Show the validate measurements only, then leave out the last one by
+    // unticking its checkbox.
+    let last = session.measurements.last().expect("measurements");
+    assert_eq!(last.usage, spherecal::engine::model::Use::Validate);
+    h.state_mut().forms_mut().filter_use = Some(spherecal::engine::model::Use::Validate);
+    h.run();
+    h.get_by_label(&last.id).click();
+    h.run();
+    assert!(h.state().state().excluded.contains(&last.id));
+    h.state_mut().forms_mut().save_path = target.display().to_string();
+    h.get_by_label("Save").click();
+    settle(&mut h);
+    let saved = spherecal::engine::session::load_session(&target).expect("the saved file loads");
+    assert_eq!(saved.measurements.len(), session.measurements.len() - 1);
+    assert!(saved.measurements.iter().all(|m| m.id != last.id));
+
+    // Leaving out every rotation measurement breaks a FORMAT rule: refused.
+    let rotation_station = session
+        .measurements
+        .iter()
+        .find(|m| m.usage == spherecal::engine::model::Use::Rotation)
+        .expect("rotation")
+        .station
+        .clone();
+    let ctx = h.ctx.clone();
+    for m in session
+        .measurements
+        .iter()
+        .filter(|m| m.station == rotation_station)
+    {
+        h.state_mut().command(
+            &ctx,
+            spherecal::app::commands::Command::SetIncluded {
+                id: m.id.clone(),
+                included: false,
+            },
+        );
+    }
+    let other = dir.path().join("broken.json");
+    h.state_mut().forms_mut().save_path = other.display().to_string();
+    h.get_by_label("Save").click();
+    settle(&mut h);
+    assert!(
+        !other.exists(),
+        "a session that breaks a rule is not written"
+    );
+    let notice = h
+        .state()
+        .state()
+        .notice
+        .clone()
+        .expect("the refusal is shown");
+    assert!(notice.body.contains("not valid"), "{notice:?}");
+}
+
+#[test]
+fn a_result_file_is_reviewed_without_running_the_solver() {
+    let mut h = demo_app();
+    let session = parse_session(
+        spherecal::DEMO_SESSION_JSON,
+        Path::new(spherecal::DEMO_SESSION_NAME),
+    )
+    .expect("demo parses");
+    let (prepared, cal) =
+        calibrate(&session, &Options::from_session(&session)).expect("calibrates");
+    let file = spherecal::engine::report::result_file(&session, &prepared, &cal);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("demo-result.json");
+    spherecal::engine::session::save_result(&file, &path).expect("saves");
+
+    h.get_by_label("Session or result file").click();
+    h.run();
+    h.get_by_label("Session or result file")
+        .type_text(&path.display().to_string());
+    h.run();
+    h.get_by_label("Open path").click();
+    settle(&mut h);
+    let view = h
+        .state()
+        .state()
+        .result
+        .as_ref()
+        .expect("the result is shown");
+    assert!(matches!(
+        view.origin,
+        spherecal::app::view::ResultOrigin::Review(_)
+    ));
+    assert!(
+        view.notes.is_empty(),
+        "the result matches the open session: {:?}",
+        view.notes
+    );
+    assert_eq!(h.state().forms().tab, Tab::Results);
+    let v = cal.validation.expect("validation");
+    let n = numbers(&labels_starting(&h, "std ")[0]);
+    assert!((n[1] - v.after.std).abs() < 6e-4);
+    assert!(
+        h.query_by_label_contains("the solver was not run")
+            .is_some(),
+        "the view says it is a review"
+    );
+}
+
+#[test]
+fn zz_debug_labels() {
+    let mut h = demo_app();
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    for n in h.root().children_recursive() {
+        let a = n.accesskit_node();
+        println!("{:?} {:?} {:?}", a.role(), a.label(), a.value());
+    }
+}
