@@ -45,6 +45,14 @@ pub enum StripeError {
         /// `(r − R)/R` in percent.
         excess_pct: f64,
     },
+    /// The sphere radius, the side or the fitted circle handed to the
+    /// sphere-centre computation is unusable (radius not finite and
+    /// positive, side not ±1).
+    #[error("invalid sphere-centre input: {detail}")]
+    InvalidInput {
+        /// What is wrong, with the value.
+        detail: String,
+    },
 }
 
 /// A session or result file could not be read or written.
