@@ -1,1 +1,314 @@
-//! `spherecal simulate` (in progress).
+//! `spherecal simulate`: writes a seeded simulated session (FORMAT.md) and
+//! its ground truth (`spherecal-truth`), both atomically, and prints one
+//! summary line. A thin caller of [`crate::engine::simulate`].
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::ValueEnum;
+
+use crate::engine::model::Use;
+use crate::engine::session;
+use crate::engine::simulate::{
+    self, ErrorModel, InitialHandEye, RobotChoice, SideChoice, SimConfig,
+};
+
+/// Robot preset (`--robot`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RobotArg {
+    /// ABB IRB 2400/16, the paper's robot.
+    Irb2400,
+    /// ABB IRB 120.
+    Irb120,
+    /// Universal Robots UR5e.
+    Ur5e,
+}
+
+impl From<RobotArg> for RobotChoice {
+    fn from(r: RobotArg) -> Self {
+        match r {
+            RobotArg::Irb2400 => Self::Irb2400,
+            RobotArg::Irb120 => Self::Irb120,
+            RobotArg::Ur5e => Self::Ur5e,
+        }
+    }
+}
+
+/// Kinematic error model (`--errors`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ErrorsArg {
+    /// The paper's Table 1.
+    Table1,
+    /// Gaussian: σ 0.1° for angles, 0.3 mm for lengths (times --error-scale).
+    Random,
+    /// The true robot is the nominal one.
+    None,
+}
+
+impl From<ErrorsArg> for ErrorModel {
+    fn from(e: ErrorsArg) -> Self {
+        match e {
+            ErrorsArg::Table1 => Self::Table1,
+            ErrorsArg::Random => Self::Random,
+            ErrorsArg::None => Self::None,
+        }
+    }
+}
+
+/// Side of the laser plane (`--side`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SideArg {
+    /// Both sides, about half each.
+    Mixed,
+    /// Every centre at sensor x > 0.
+    Plus,
+    /// Every centre at sensor x < 0.
+    Minus,
+}
+
+impl From<SideArg> for SideChoice {
+    fn from(s: SideArg) -> Self {
+        match s {
+            SideArg::Mixed => Self::Mixed,
+            SideArg::Plus => Self::Plus,
+            SideArg::Minus => Self::Minus,
+        }
+    }
+}
+
+/// `spherecal simulate`: a simulated session with a known truth, for tests,
+/// demos and what-if studies. Defaults give the paper-like demo.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SimulateArgs {
+    /// Where to write the session file (FORMAT.md `spherecal-session`).
+    #[arg(long, short)]
+    pub out: PathBuf,
+    /// Where to write the truth file (default: the session path with
+    /// `.json` replaced by `.truth.json`).
+    #[arg(long)]
+    pub truth: Option<PathBuf>,
+    /// Seed of every random choice; the same arguments give byte-identical files.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Robot preset (nominal model, joint limits, station box).
+    #[arg(long, value_enum, default_value_t = RobotArg::Irb2400)]
+    pub robot: RobotArg,
+    /// Kinematic errors of the true robot.
+    #[arg(long, value_enum, default_value_t = ErrorsArg::Table1)]
+    pub errors: ErrorsArg,
+    /// Multiplies the kinematic errors (table1 and random).
+    #[arg(long, default_value_t = 1.0)]
+    pub error_scale: f64,
+    /// Number of identify stations (P1..), 6 poses each by default.
+    #[arg(long, default_value_t = 9)]
+    pub identify_stations: usize,
+    /// Number of validate stations (V1..); consecutive ones get a reference distance.
+    #[arg(long, default_value_t = 10)]
+    pub validate_stations: usize,
+    /// Measurements per identify or validate station.
+    #[arg(long, default_value_t = 6)]
+    pub poses: usize,
+    /// σ of the joint reading noise, degrees.
+    #[arg(long, default_value_t = 0.003)]
+    pub joint_noise: f64,
+    /// σ of the stripe point noise on each coordinate, mm.
+    #[arg(long, default_value_t = 0.02)]
+    pub stripe_noise: f64,
+    /// Fraction (0..1) of stripe points made outliers, displaced 0.3-3 mm.
+    #[arg(long, default_value_t = 0.0)]
+    pub outliers: f64,
+    /// Side of the laser plane the sphere centres lie on.
+    #[arg(long, value_enum, default_value_t = SideArg::Mixed)]
+    pub side: SideArg,
+    /// Write sphere centres (sensor frame) instead of stripes.
+    #[arg(long)]
+    pub centres: bool,
+    /// σ of the centre noise on each coordinate with --centres, mm.
+    #[arg(long, default_value_t = 0.01)]
+    pub centre_noise: f64,
+    /// σ of the laser-tracker reference distances, mm.
+    #[arg(long, default_value_t = 0.01)]
+    pub tracker_noise: f64,
+    /// Session name (default: "simulated <robot>, seed <seed>").
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Write the paper's initial hand-eye into the session (default: none,
+    /// the engine computes it from the translation and rotation measurements).
+    #[arg(long)]
+    pub with_hand_eye: bool,
+}
+
+impl SimulateArgs {
+    /// The engine configuration: [`SimConfig::default`] with these options.
+    #[must_use]
+    pub fn to_config(&self) -> SimConfig {
+        SimConfig {
+            seed: self.seed,
+            name: self.name.clone(),
+            robot: self.robot.into(),
+            errors: self.errors.into(),
+            error_scale: self.error_scale,
+            initial_hand_eye: if self.with_hand_eye {
+                InitialHandEye::Paper
+            } else {
+                InitialHandEye::None
+            },
+            n_identify: self.identify_stations,
+            n_validate: self.validate_stations,
+            poses_per_station: self.poses,
+            joint_noise: self.joint_noise,
+            stripe_noise: self.stripe_noise,
+            outlier_fraction: self.outliers,
+            centres: self.centres,
+            centre_noise: self.centre_noise,
+            side: self.side.into(),
+            tracker_noise: self.tracker_noise,
+            ..SimConfig::default()
+        }
+    }
+
+    /// The truth file path: `--truth`, else the session path with `.json`
+    /// replaced by `.truth.json` (appended when it has no `.json`).
+    #[must_use]
+    pub fn truth_path(&self) -> PathBuf {
+        self.truth
+            .clone()
+            .unwrap_or_else(|| default_truth_path(&self.out))
+    }
+}
+
+fn default_truth_path(out: &Path) -> PathBuf {
+    let name = out
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let stem = name.strip_suffix(".json").unwrap_or(&name);
+    out.with_file_name(format!("{stem}.truth.json"))
+}
+
+/// Runs `spherecal simulate`: simulates, writes the truth and then the
+/// session (each atomically: a temporary file renamed into place), and
+/// prints one summary line.
+///
+/// # Errors
+/// A setting out of range or an unreachable station (the engine's
+/// message), the two paths being the same file, or a file that cannot be
+/// written (naming it).
+pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let truth_path = args.truth_path();
+    if truth_path == args.out {
+        anyhow::bail!(
+            "the session and the truth would both be written to {}; give --truth another path",
+            args.out.display()
+        );
+    }
+    let config = args.to_config();
+    let (session, truth) = simulate::simulate(&config)?;
+    session::write_atomic(&truth_path, simulate::truth_to_json(&truth).as_bytes())?;
+    session::write_atomic(&args.out, session::session_to_json(&session).as_bytes())?;
+    let count = |usage: Use| session.with_use(usage).count();
+    println!(
+        "simulated {} (seed {}): {} measurements ({} translation, {} rotation, {} identify, {} validate), {} reference distances -> {}, truth {} ({:.0} ms)",
+        session.robot.name,
+        config.seed,
+        session.measurements.len(),
+        count(Use::Translation),
+        count(Use::Rotation),
+        count(Use::Identify),
+        count(Use::Validate),
+        session.reference_distances.len(),
+        args.out.display(),
+        truth_path.display(),
+        started.elapsed().as_secs_f64() * 1e3,
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::expect_used)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Debug, Parser)]
+    struct Wrapper {
+        #[command(flatten)]
+        args: SimulateArgs,
+    }
+
+    fn parse(extra: &[&str]) -> SimulateArgs {
+        let mut argv = vec!["simulate", "--out", "dir/s.json"];
+        argv.extend_from_slice(extra);
+        Wrapper::try_parse_from(argv).unwrap().args
+    }
+
+    #[test]
+    fn defaults_are_the_engine_defaults() {
+        let args = parse(&[]);
+        assert_eq!(args.to_config(), SimConfig::default());
+        assert_eq!(args.truth_path(), PathBuf::from("dir/s.truth.json"));
+    }
+
+    #[test]
+    fn options_reach_the_config() {
+        let args = parse(&[
+            "--seed",
+            "7",
+            "--robot",
+            "ur5e",
+            "--errors",
+            "random",
+            "--error-scale",
+            "2",
+            "--identify-stations",
+            "4",
+            "--validate-stations",
+            "3",
+            "--poses",
+            "5",
+            "--joint-noise",
+            "0.01",
+            "--stripe-noise",
+            "0.05",
+            "--outliers",
+            "0.1",
+            "--side",
+            "plus",
+            "--centres",
+            "--centre-noise",
+            "0.02",
+            "--tracker-noise",
+            "0.03",
+            "--name",
+            "cell 3",
+            "--with-hand-eye",
+            "--truth",
+            "t.json",
+        ]);
+        let c = args.to_config();
+        assert_eq!(c.seed, 7);
+        assert_eq!(c.robot, RobotChoice::Ur5e);
+        assert_eq!(c.errors, ErrorModel::Random);
+        assert_eq!(c.error_scale, 2.0);
+        assert_eq!((c.n_identify, c.n_validate, c.poses_per_station), (4, 3, 5));
+        assert_eq!(
+            (c.joint_noise, c.stripe_noise, c.outlier_fraction),
+            (0.01, 0.05, 0.1)
+        );
+        assert_eq!(c.side, SideChoice::Plus);
+        assert!(c.centres);
+        assert_eq!((c.centre_noise, c.tracker_noise), (0.02, 0.03));
+        assert_eq!(c.name.as_deref(), Some("cell 3"));
+        assert_eq!(c.initial_hand_eye, InitialHandEye::Paper);
+        assert_eq!(args.truth_path(), PathBuf::from("t.json"));
+    }
+
+    #[test]
+    fn truth_path_without_json_extension() {
+        assert_eq!(
+            default_truth_path(Path::new("a/run")),
+            PathBuf::from("a/run.truth.json")
+        );
+    }
+}
