@@ -270,12 +270,10 @@ impl Robot {
             let (pose, jac) = self.joint_jacobian(&q);
             let err = pose_error(&pose, target);
             if err.fixed_rows::<3>(0).norm() < 1e-9 && err.fixed_rows::<3>(3).norm() < 1e-11 {
-                if let Some(lim) = limits {
-                    if q.iter().zip(lim).any(|(v, l)| *v < l.min || *v > l.max) {
-                        return None;
-                    }
-                }
-                return Some(q);
+                let outside = limits.is_some_and(|lim| {
+                    q.iter().zip(lim).any(|(v, l)| *v < l.min || *v > l.max)
+                });
+                return if outside { None } else { Some(q) };
             }
             // Weight rotation rows by a length so both parts matter.
             const ROT_WEIGHT: f64 = 1000.0;
