@@ -95,7 +95,10 @@ impl FileError {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum HandEyeError {
     /// Fewer translation measurements than eq. 6-7 need.
-    #[error("the initial rotation (eq. 6-7) needs at least 3 translation measurements, the session has {found}{}", list_ids(ids))]
+    #[error(
+        "the initial rotation (eq. 6-7) needs at least 3 translation measurements, the session has {found}{}",
+        list_ids(ids)
+    )]
     TooFewTranslations {
         /// Measurements found.
         found: usize,
@@ -111,7 +114,10 @@ pub enum HandEyeError {
         ratio: f64,
     },
     /// Fewer rotation measurements than eq. 8-9 need.
-    #[error("the initial translation (eq. 8-9) needs at least 2 rotation measurements, the session has {found}{}", list_ids(ids))]
+    #[error(
+        "the initial translation (eq. 8-9) needs at least 2 rotation measurements, the session has {found}{}",
+        list_ids(ids)
+    )]
     TooFewRotations {
         /// Measurements found.
         found: usize,
@@ -148,7 +154,9 @@ fn list_ids(ids: &[String]) -> String {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum IdentifyError {
     /// No identify station has two measurements.
-    #[error("identification needs at least one identify station with 2 or more measurements; {detail}")]
+    #[error(
+        "identification needs at least one identify station with 2 or more measurements; {detail}"
+    )]
     NotEnoughData {
         /// What was found.
         detail: String,
@@ -196,7 +204,10 @@ impl CalibrationError {
     pub fn is_input_error(&self) -> bool {
         match self {
             Self::Stripe { .. } | Self::HandEye(_) => true,
-            Self::Identify(e) => matches!(e, IdentifyError::NotEnoughData { .. } | IdentifyError::InvalidOption(_)),
+            Self::Identify(e) => matches!(
+                e,
+                IdentifyError::NotEnoughData { .. } | IdentifyError::InvalidOption(_)
+            ),
         }
     }
 }
