@@ -9,8 +9,11 @@ use spherecal::engine::calibrate::{self, Control, Method, Options};
 use spherecal::engine::session::parse_session;
 
 fn demo() -> spherecal::engine::model::Session {
-    parse_session(spherecal::DEMO_SESSION_JSON, Path::new(spherecal::DEMO_SESSION_NAME))
-        .expect("the embedded demo session loads")
+    parse_session(
+        spherecal::DEMO_SESSION_JSON,
+        Path::new(spherecal::DEMO_SESSION_NAME),
+    )
+    .expect("the embedded demo session loads")
 }
 
 fn bench(c: &mut Criterion) {
@@ -31,7 +34,9 @@ fn bench(c: &mut Criterion) {
         });
     }
     group.bench_function("whole calibration, default options", |b| {
-        b.iter(|| calibrate::calibrate(&session, &Options::from_session(&session)).expect("calibrate"));
+        b.iter(|| {
+            calibrate::calibrate(&session, &Options::from_session(&session)).expect("calibrate")
+        });
     });
     group.finish();
 }

@@ -26,7 +26,11 @@ fn noise_free(seed: u64) -> SimConfig {
     }
 }
 
-fn run(session: &Session, threshold: f64, max_iterations: usize) -> (Prepared, calibrate::Calibration) {
+fn run(
+    session: &Session,
+    threshold: f64,
+    max_iterations: usize,
+) -> (Prepared, calibrate::Calibration) {
     let mut options = Options::from_session(session);
     options.threshold = threshold;
     options.max_iterations = max_iterations;
@@ -35,7 +39,13 @@ fn run(session: &Session, threshold: f64, max_iterations: usize) -> (Prepared, c
 
 /// True distances between validate stations against those the calibrated
 /// model measures, every k-th pose pair.
-fn max_distance_error(session: &Session, prepared: &Prepared, truth: &Truth, robot: &Robot, he: &nalgebra::Isometry3<f64>) -> f64 {
+fn max_distance_error(
+    session: &Session,
+    prepared: &Prepared,
+    truth: &Truth,
+    robot: &Robot,
+    he: &nalgebra::Isometry3<f64>,
+) -> f64 {
     evaluate::validation_errors(session, prepared, truth, robot, he)
         .iter()
         .fold(0.0_f64, |m, e| m.max(e.abs()))
@@ -51,11 +61,21 @@ fn noise_free_stripe_session_is_recovered_exactly() {
         let d = (p.centre_in_sensor - nalgebra::Vector3::from(t.sensor_centre)).norm();
         assert!(d < 1e-6, "{}: sensor centre off by {d}", m.id);
     }
-    assert!(cal.epsilon_after() < 1e-6, "ε after = {}", cal.epsilon_after());
+    assert!(
+        cal.epsilon_after() < 1e-6,
+        "ε after = {}",
+        cal.epsilon_after()
+    );
     let err = max_distance_error(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
     assert!(err < 1e-6, "validation distances off by {err} mm");
     // Before calibration the nominal model is far off.
-    let before = max_distance_error(&session, &prepared, &truth, &session.robot, &prepared.hand_eye_initial);
+    let before = max_distance_error(
+        &session,
+        &prepared,
+        &truth,
+        &session.robot,
+        &prepared.hand_eye_initial,
+    );
     assert!(before > 0.3, "{before}");
 }
 
@@ -95,7 +115,11 @@ fn noisy_sessions_reach_near_the_noise_floor() {
             seed,
             ..SimConfig::default()
         });
-        let (prepared, cal) = run(&session, session.solver.threshold, session.solver.max_iterations);
+        let (prepared, cal) = run(
+            &session,
+            session.solver.threshold,
+            session.solver.max_iterations,
+        );
         let score = evaluate::score(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
         eprintln!(
             "seed {seed}: before {:.4} after {:.4} floor {:.4} (ratio {:.2}, improvement {:.1}x)",
@@ -123,7 +147,10 @@ fn epsilon_series_follows_the_loop_of_format_md() {
     let prepared = calibrate::prepare(&session).unwrap();
     let mut options = Options::from_session(&session);
     options.threshold = 1e6;
-    let cal = calibrate::run(&session, &prepared, &options, &mut |_| calibrate::Control::Continue).unwrap();
+    let cal = calibrate::run(&session, &prepared, &options, &mut |_| {
+        calibrate::Control::Continue
+    })
+    .unwrap();
     assert_eq!(cal.iterations.len(), 1);
     assert!(cal.last_update.is_none());
     // Threshold 0 with a bound of 4: exactly 4 updates, 5 entries.
@@ -140,7 +167,10 @@ fn epsilon_series_follows_the_loop_of_format_md() {
     assert_eq!(seen[4].0, 4);
     assert!((seen[4].1 - cal.epsilon_after()).abs() < 1e-15);
     assert!(cal.epsilon_after() < cal.epsilon_before());
-    assert!(matches!(cal.stop, calibrate::StopReason::IterationLimit { updates: 4, .. }));
+    assert!(matches!(
+        cal.stop,
+        calibrate::StopReason::IterationLimit { updates: 4, .. }
+    ));
 }
 
 #[test]

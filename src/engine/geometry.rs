@@ -98,7 +98,10 @@ pub fn isometry_from_twist(twist: &[f64; 6]) -> Isometry3<f64> {
 pub fn rot_x(angle: f64) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::identity(),
-        UnitQuaternion::from_rotation_matrix(&Rotation3::from_axis_angle(&Vector3::x_axis(), angle)),
+        UnitQuaternion::from_rotation_matrix(&Rotation3::from_axis_angle(
+            &Vector3::x_axis(),
+            angle,
+        )),
     )
 }
 
@@ -107,7 +110,10 @@ pub fn rot_x(angle: f64) -> Isometry3<f64> {
 pub fn rot_y(angle: f64) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::identity(),
-        UnitQuaternion::from_rotation_matrix(&Rotation3::from_axis_angle(&Vector3::y_axis(), angle)),
+        UnitQuaternion::from_rotation_matrix(&Rotation3::from_axis_angle(
+            &Vector3::y_axis(),
+            angle,
+        )),
     )
 }
 
@@ -116,7 +122,10 @@ pub fn rot_y(angle: f64) -> Isometry3<f64> {
 pub fn rot_z(angle: f64) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::identity(),
-        UnitQuaternion::from_rotation_matrix(&Rotation3::from_axis_angle(&Vector3::z_axis(), angle)),
+        UnitQuaternion::from_rotation_matrix(&Rotation3::from_axis_angle(
+            &Vector3::z_axis(),
+            angle,
+        )),
     )
 }
 
@@ -148,13 +157,22 @@ mod tests {
     fn rejects_reflection_and_skew() {
         let mut rows = rows_from_isometry(&Isometry3::identity());
         rows[0][0] = -1.0;
-        assert!(matches!(isometry_from_rows(&rows), Err(MatrixError::Reflection(_))));
+        assert!(matches!(
+            isometry_from_rows(&rows),
+            Err(MatrixError::Reflection(_))
+        ));
         let mut rows = rows_from_isometry(&Isometry3::identity());
         rows[0][1] = 0.01;
-        assert!(matches!(isometry_from_rows(&rows), Err(MatrixError::NotOrthonormal(_))));
+        assert!(matches!(
+            isometry_from_rows(&rows),
+            Err(MatrixError::NotOrthonormal(_))
+        ));
         let mut rows = rows_from_isometry(&Isometry3::identity());
         rows[3][0] = 1.0;
-        assert!(matches!(isometry_from_rows(&rows), Err(MatrixError::LastRow(..))));
+        assert!(matches!(
+            isometry_from_rows(&rows),
+            Err(MatrixError::LastRow(..))
+        ));
     }
 
     #[test]

@@ -250,7 +250,13 @@ mod tests {
     use crate::engine::kinematics::irb2400;
 
     /// Sightings of `station` from flange poses (exact, no noise).
-    fn sight(robot: &Robot, he: &Isometry3<f64>, station: &Vector3<f64>, q: &[f64], id: &str) -> Sighting {
+    fn sight(
+        robot: &Robot,
+        he: &Isometry3<f64>,
+        station: &Vector3<f64>,
+        q: &[f64],
+        id: &str,
+    ) -> Sighting {
         let base_from_sensor = robot.base_from_flange(q) * he;
         let c = base_from_sensor.inverse() * nalgebra::Point3::from(*station);
         Sighting {
@@ -264,18 +270,29 @@ mod tests {
     fn exact_on_noise_free_data() {
         let preset = irb2400();
         let robot = preset.robot;
-        let he = isometry_from_twist(&[-7.4, -1.0, 287.8, 0.02, -0.03, 0.5]) * crate::engine::geometry::rot_x(std::f64::consts::PI);
+        let he = isometry_from_twist(&[-7.4, -1.0, 287.8, 0.02, -0.03, 0.5])
+            * crate::engine::geometry::rot_x(std::f64::consts::PI);
         let q0 = [0.0, 20.0, 20.0, 0.0, 45.0, 0.0];
         let flange0 = robot.base_from_flange(&q0);
         let station = (flange0 * he * nalgebra::Point3::new(12.0, 1.0, -2.0)).coords;
         // Translations: same flange orientation, moved 20 mm three ways.
         let mut trans = Vec::new();
-        for (k, d) in [[0.0, 0.0, 0.0], [20.0, 0.0, 0.0], [0.0, 20.0, 0.0], [0.0, 0.0, 15.0]].iter().enumerate() {
+        for (k, d) in [
+            [0.0, 0.0, 0.0],
+            [20.0, 0.0, 0.0],
+            [0.0, 20.0, 0.0],
+            [0.0, 0.0, 15.0],
+        ]
+        .iter()
+        .enumerate()
+        {
             let target = Isometry3::from_parts(
                 Translation3::from(flange0.translation.vector + Vector3::from(*d)),
                 flange0.rotation,
             );
-            let q = robot.inverse_kinematics(&target, &q0, Some(&preset.limits)).unwrap();
+            let q = robot
+                .inverse_kinematics(&target, &q0, Some(&preset.limits))
+                .unwrap();
             trans.push(sight(&robot, &he, &station, &q, &format!("t{k}")));
         }
         let rots: Vec<Sighting> = [
@@ -293,13 +310,19 @@ mod tests {
             let wanted = flange.rotation * (he.rotation * Vector3::new(-12.0, 0.5, 1.0));
             let t = station - wanted - flange.rotation * he.translation.vector;
             let target = Isometry3::from_parts(Translation3::from(t), flange.rotation);
-            let q = robot.inverse_kinematics(&target, q, Some(&preset.limits)).unwrap();
+            let q = robot
+                .inverse_kinematics(&target, q, Some(&preset.limits))
+                .unwrap();
             sight(&robot, &he, &station, &q, &format!("r{k}"))
         })
         .collect();
         let est = initial_hand_eye(&robot, &trans, &rots).unwrap();
         let e = est.flange_from_sensor;
-        assert!(e.rotation.angle_to(&he.rotation) < 1e-9, "{}", e.rotation.angle_to(&he.rotation));
+        assert!(
+            e.rotation.angle_to(&he.rotation) < 1e-9,
+            "{}",
+            e.rotation.angle_to(&he.rotation)
+        );
         assert!((e.translation.vector - he.translation.vector).norm() < 1e-6);
         assert!(est.rotation_residual < 1e-9 && est.translation_residual < 1e-6);
         assert!(est.translation_orientation_drift_deg < 1e-6);
@@ -315,13 +338,27 @@ mod tests {
             centre_in_sensor: Vector3::from(c),
         };
         // Same joints: zero robot displacement → no spread.
-        let err = initial_rotation(&robot, &[s("a", [0.0; 3]), s("b", [1.0, 0.0, 0.0]), s("c", [2.0, 0.0, 0.0])])
-            .unwrap_err();
+        let err = initial_rotation(
+            &robot,
+            &[
+                s("a", [0.0; 3]),
+                s("b", [1.0, 0.0, 0.0]),
+                s("c", [2.0, 0.0, 0.0]),
+            ],
+        )
+        .unwrap_err();
         let msg = err.to_string();
-        assert!(matches!(err, HandEyeError::CollinearTranslations { .. }), "{msg}");
+        assert!(
+            matches!(err, HandEyeError::CollinearTranslations { .. }),
+            "{msg}"
+        );
         assert!(msg.contains("a, b, c"), "{msg}");
-        let err = initial_rotation(&robot, &[s("a", [0.0; 3]), s("b", [1.0, 0.0, 0.0])]).unwrap_err();
-        assert!(matches!(err, HandEyeError::TooFewTranslations { found: 2, .. }));
+        let err =
+            initial_rotation(&robot, &[s("a", [0.0; 3]), s("b", [1.0, 0.0, 0.0])]).unwrap_err();
+        assert!(matches!(
+            err,
+            HandEyeError::TooFewTranslations { found: 2, .. }
+        ));
     }
 
     #[test]
@@ -335,7 +372,10 @@ mod tests {
         let err = initial_translation(
             &robot,
             &UnitQuaternion::identity(),
-            &[s("r1", [0.0, 20.0, 20.0, 0.0, 45.0, 0.0]), s("r2", [0.0, 20.0, 20.0, 0.0, 45.0, 2.0])],
+            &[
+                s("r1", [0.0, 20.0, 20.0, 0.0, 45.0, 0.0]),
+                s("r2", [0.0, 20.0, 20.0, 0.0, 45.0, 2.0]),
+            ],
         )
         .unwrap_err();
         assert!(err.to_string().contains("r1, r2"), "{err}");

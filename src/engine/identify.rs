@@ -125,7 +125,12 @@ impl Estimate {
     pub fn station_centres(&self, stations: &[Station]) -> Vec<Vec<Vector3<f64>>> {
         stations
             .iter()
-            .map(|st| st.sightings.iter().map(|s| self.centre_in_base(s)).collect())
+            .map(|st| {
+                st.sightings
+                    .iter()
+                    .map(|s| self.centre_in_base(s))
+                    .collect()
+            })
             .collect()
     }
 
@@ -176,7 +181,8 @@ pub fn sensitivity(est: &Estimate, s: &Sighting) -> (Vector3<f64>, DMatrix<f64>)
         .copy_from(&(-(r_bs * skew(&s.centre_in_sensor))));
     // Kinematic block: Q_i · J_i = [I | −[X_b]×] · J_i   (eq. 15-16)
     let mut q = nalgebra::Matrix3x6::zeros();
-    q.fixed_view_mut::<3, 3>(0, 0).copy_from(&Matrix3::identity());
+    q.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&Matrix3::identity());
     q.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew(&x_b)));
     let qj = q * jac;
     a.view_mut((0, 6), (3, n - 6)).copy_from(&qj);
@@ -262,7 +268,13 @@ pub fn paper_update(
     }
     // Column scaling: unknown_scaled = scale · unknown.
     let scale: Vec<f64> = (0..n_unknowns)
-        .map(|k| if unknown_is_angle(k) { ANGLE_SCALE_MM } else { 1.0 })
+        .map(|k| {
+            if unknown_is_angle(k) {
+                ANGLE_SCALE_MM
+            } else {
+                1.0
+            }
+        })
         .collect();
     for (c, s) in scale.iter().enumerate() {
         u.column_mut(c).scale_mut(1.0 / s);
@@ -379,7 +391,11 @@ mod tests {
             let numeric = (xp - xm) / (2.0 * h);
             let analytic = a.column(k);
             let err = (numeric - analytic).norm();
-            assert!(err < 1e-5 * (1.0 + analytic.norm()), "{}: {err}", unknown_label(k));
+            assert!(
+                err < 1e-5 * (1.0 + analytic.norm()),
+                "{}: {err}",
+                unknown_label(k)
+            );
         }
         assert!((x0 - est.centre_in_base(&s)).norm() < 1e-12);
     }

@@ -172,7 +172,12 @@ impl Robot {
     /// A copy with `delta` (rad, mm) added to the parameter vector.
     #[must_use]
     pub fn perturbed(&self, delta: &[f64]) -> Self {
-        let p: Vec<f64> = self.params().iter().zip(delta).map(|(p, d)| p + d).collect();
+        let p: Vec<f64> = self
+            .params()
+            .iter()
+            .zip(delta)
+            .map(|(p, d)| p + d)
+            .collect();
         self.with_params(&p)
     }
 
@@ -189,7 +194,11 @@ impl Robot {
     /// Label of parameter `k` of the parameter vector, e.g. `"theta3"`.
     #[must_use]
     pub fn param_label(k: usize) -> String {
-        format!("{}{}", PARAM_NAMES[k % PARAMS_PER_JOINT], k / PARAMS_PER_JOINT + 1)
+        format!(
+            "{}{}",
+            PARAM_NAMES[k % PARAMS_PER_JOINT],
+            k / PARAMS_PER_JOINT + 1
+        )
     }
 
     /// Forward kinematics: the flange pose in the base frame, `bT_e(q)`,
@@ -270,9 +279,8 @@ impl Robot {
             let (pose, jac) = self.joint_jacobian(&q);
             let err = pose_error(&pose, target);
             if err.fixed_rows::<3>(0).norm() < 1e-9 && err.fixed_rows::<3>(3).norm() < 1e-11 {
-                let outside = limits.is_some_and(|lim| {
-                    q.iter().zip(lim).any(|(v, l)| *v < l.min || *v > l.max)
-                });
+                let outside = limits
+                    .is_some_and(|lim| q.iter().zip(lim).any(|(v, l)| *v < l.min || *v > l.max));
                 return if outside { None } else { Some(q) };
             }
             // Weight rotation rows by a length so both parts matter.
@@ -469,7 +477,11 @@ mod tests {
 
     #[test]
     fn irb120_zero_pose() {
-        let p = irb120().robot.base_from_flange(&[0.0; 6]).translation.vector;
+        let p = irb120()
+            .robot
+            .base_from_flange(&[0.0; 6])
+            .translation
+            .vector;
         assert!((p - Vector3::new(374.0, 0.0, 630.0)).norm() < 1e-9, "{p}");
     }
 
@@ -488,7 +500,10 @@ mod tests {
     fn irb2400_joint2_rotates_arm_forward() {
         // +q2 leans the lower arm forward: the wrist moves along +x, down.
         let robot = irb2400().robot;
-        let p = robot.base_from_flange(&[0.0, 10.0, 0.0, 0.0, 0.0, 0.0]).translation.vector;
+        let p = robot
+            .base_from_flange(&[0.0, 10.0, 0.0, 0.0, 0.0, 0.0])
+            .translation
+            .vector;
         assert!(p.x > 940.0 && p.z < 1455.0, "{p}");
     }
 
@@ -523,7 +538,8 @@ mod tests {
         // Non-zero beta and offsets so every column is exercised.
         robot.joints[2].beta = 0.7;
         robot.joints[4].a = -0.7;
-        robot.base = super::super::geometry::isometry_from_twist(&[5.0, -3.0, 2.0, 0.01, 0.02, -0.03]);
+        robot.base =
+            super::super::geometry::isometry_from_twist(&[5.0, -3.0, 2.0, 0.01, 0.02, -0.03]);
         robot.flange = super::super::geometry::isometry_from_twist(&[1.0, 2.0, 3.0, 0.1, 0.0, 0.2]);
         for q in [
             [0.0; 6],
@@ -551,7 +567,11 @@ mod tests {
             + Vector3::new(twist[3], twist[4], twist[5]).cross(&x0.coords);
         let actual = robot.perturbed(&dp).base_from_flange(&q) * point;
         // Second-order remainder: |dp|² × lever ~ (1e-4)² × 1e3 mm scale.
-        assert!((actual.coords - predicted).norm() < 2e-3, "{}", (actual.coords - predicted).norm());
+        assert!(
+            (actual.coords - predicted).norm() < 2e-3,
+            "{}",
+            (actual.coords - predicted).norm()
+        );
     }
 
     #[test]

@@ -232,7 +232,10 @@ mod tests {
         let st = |id: &str, xs: &[f64]| StationCentres {
             station: id.into(),
             before: xs.iter().map(|x| Vector3::new(*x, 0.0, 0.0)).collect(),
-            after: xs.iter().map(|x| Vector3::new(*x + 0.5, 0.0, 0.0)).collect(),
+            after: xs
+                .iter()
+                .map(|x| Vector3::new(*x + 0.5, 0.0, 0.0))
+                .collect(),
         };
         let stations = vec![st("V1", &[0.0, 0.1, 0.2]), st("V2", &[100.0, 100.0])];
         let refs = vec![ReferenceDistance {
