@@ -18,6 +18,9 @@ use crate::app::view::{HandEyeView, ResultOrigin, ResultView};
 use crate::engine::identify::HAND_EYE_LABELS;
 use crate::engine::kinematics::{PARAM_NAMES, PARAMS_PER_JOINT};
 
+/// Singular values with their index.
+type Indexed = Vec<(usize, f64)>;
+
 /// Height of each of the four plots, points.
 const PLOT_HEIGHT: f32 = 230.0;
 
@@ -349,7 +352,7 @@ fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
     }
     let smax = values.iter().map(|v| v.1).fold(0.0, f64::max);
     let cut = view.svd_tolerance.map(|t| t * smax);
-    let (kept, dropped): (Vec<(usize, f64)>, Vec<(usize, f64)>) = values
+    let (kept, dropped): (Indexed, Indexed) = values
         .iter()
         .partition(|(k, s)| view.kept.map_or(cut.is_none_or(|c| *s >= c), |n| *k < n));
     let pts = |v: &[(usize, f64)]| -> Vec<[f64; 2]> {
