@@ -11,18 +11,24 @@ use serde_json::{Map, Value, json};
 use super::error::{CalibrationError, IdentifyError};
 use super::handeye::{InitialHandEye, Sighting, initial_hand_eye};
 use super::identify::{
-    Estimate, PaperOptions, Pairing, Station, UpdateInfo, paper_update, unknown_label,
+    Estimate, Pairing, PaperOptions, Station, UpdateInfo, paper_update, unknown_label,
 };
 use super::kinematics::Robot;
 use super::model::{Observation, Session, Use};
 use super::stripe::{StripeResult, centre_from_stripe};
-use super::validate::{BeforeAfter, StationCentres, Stats, Validation, epsilon, validation, within_station_distances};
+use super::validate::{
+    BeforeAfter, StationCentres, Stats, Validation, epsilon, validation, within_station_distances,
+};
 
 /// Identification method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
     /// The paper's: paired differences, truncated SVD (section 3.2).
     Paper,
+    /// Maximum likelihood: station centres as unknowns, noise-model
+    /// weighting, identifiable set by pivoted QR, prior, robust loss
+    /// ([`super::ml`]).
+    Ml,
 }
 
 impl Method {
@@ -31,6 +37,7 @@ impl Method {
     pub fn as_str(self) -> &'static str {
         match self {
             Self::Paper => "paper",
+            Self::Ml => "ml",
         }
     }
 
@@ -39,12 +46,13 @@ impl Method {
     pub fn parse(s: &str) -> Option<Self> {
         match s {
             "paper" => Some(Self::Paper),
+            "ml" => Some(Self::Ml),
             _ => None,
         }
     }
 
     /// Every method, the default first.
-    pub const ALL: [Self; 1] = [Self::Paper];
+    pub const ALL: [Self; 2] = [Self::Paper, Self::Ml];
 }
 
 /// Everything that steers a run.
@@ -58,6 +66,8 @@ pub struct Options {
     pub max_iterations: usize,
     /// Settings of the paper's update.
     pub paper: PaperOptions,
+    /// Settings of the `ml` method.
+    pub ml: super::ml::MlOptions,
 }
 
 impl Options {
@@ -69,6 +79,7 @@ impl Options {
             threshold: session.solver.threshold,
             max_iterations: session.solver.max_iterations,
             paper: PaperOptions::default(),
+            ml: super::ml::MlOptions::default(),
         }
     }
 }
@@ -246,6 +257,18 @@ pub enum StopReason {
         /// off at the noise of the data, not that more updates would help.
         last_change: f64,
     },
+    /// The solver itself converged with ε above the threshold (`ml`: an
+    /// LM step lowered the cost by a negligible amount, or none could).
+    SolverConverged {
+        /// Final ε, mm.
+        epsilon: f64,
+        /// Threshold, mm.
+        threshold: f64,
+        /// Updates made.
+        updates: usize,
+        /// Relative cost decrease of the last step (0 when none was possible).
+        relative_change: f64,
+    },
 }
 
 /// Below this change of ε (mm) over one update the loop is said to have
@@ -281,6 +304,14 @@ impl StopReason {
                     "stopped on the iteration bound: ε = {epsilon:.4} mm > threshold {threshold:.4} mm after {updates} update(s); {why}"
                 )
             }
+            Self::SolverConverged {
+                epsilon,
+                threshold,
+                updates,
+                relative_change,
+            } => format!(
+                "converged: the maximum-likelihood solve reached its optimum (last relative cost change {relative_change:.1e}) after {updates} update(s); ε = {epsilon:.4} mm is above the threshold {threshold:.4} mm, which is below what the noise of this data allows"
+            ),
         }
     }
 
@@ -290,6 +321,7 @@ impl StopReason {
         match self {
             Self::Converged { .. } => "threshold",
             Self::IterationLimit { .. } => "max_iterations",
+            Self::SolverConverged { .. } => "converged",
         }
     }
 }
@@ -381,6 +413,9 @@ pub fn run(
         }
         .into());
     }
+    if options.method == Method::Ml {
+        return super::ml::run(session, prepared, options, progress);
+    }
     let start = Estimate {
         robot: session.robot.clone(),
         flange_from_sensor: prepared.hand_eye_initial,
@@ -401,7 +436,7 @@ pub fn run(
     while eps > options.threshold && iterations.len() - 1 < options.max_iterations {
         let updates = iterations.len();
         let info = match options.method {
-            Method::Paper => paper_update(&est, &stations, &options.paper)?,
+            Method::Paper | Method::Ml => paper_update(&est, &stations, &options.paper)?,
         };
         if info.delta.iter().any(|d| !d.is_finite()) {
             return Err(IdentifyError::NonFinite { iteration: updates }.into());
@@ -441,12 +476,21 @@ pub fn run(
             last_change,
         }
     };
-    Ok(finish(session, prepared, options, &start, est, iterations, stop, last_update))
+    Ok(finish(
+        session,
+        prepared,
+        options,
+        &start,
+        est,
+        iterations,
+        stop,
+        last_update,
+    ))
 }
 
 /// The centres, statistics and solver block of a finished run.
 #[allow(clippy::too_many_arguments)]
-fn finish(
+pub(crate) fn finish(
     session: &Session,
     prepared: &Prepared,
     options: &Options,
@@ -483,7 +527,10 @@ fn finish(
     let identify = grouped(Use::Identify);
     let identify_within = BeforeAfter {
         before: Stats::of(&within_station_distances(
-            &identify.iter().map(|s| s.before.clone()).collect::<Vec<_>>(),
+            &identify
+                .iter()
+                .map(|s| s.before.clone())
+                .collect::<Vec<_>>(),
         )),
         after: Stats::of(&within_station_distances(
             &identify.iter().map(|s| s.after.clone()).collect::<Vec<_>>(),
@@ -513,7 +560,11 @@ fn finish(
 }
 
 /// The result file's `solver` block for the paper's method.
-fn solver_block(options: &Options, stop: &StopReason, last: Option<&UpdateInfo>) -> Map<String, Value> {
+fn solver_block(
+    options: &Options,
+    stop: &StopReason,
+    last: Option<&UpdateInfo>,
+) -> Map<String, Value> {
     let mut m = Map::new();
     m.insert("method".into(), json!(options.method.as_str()));
     m.insert("pairs".into(), json!(options.paper.pairing.as_str()));
@@ -546,7 +597,10 @@ fn solver_block(options: &Options, stop: &StopReason, last: Option<&UpdateInfo>)
 ///
 /// # Errors
 /// As [`prepare`] and [`run`].
-pub fn calibrate(session: &Session, options: &Options) -> Result<(Prepared, Calibration), CalibrationError> {
+pub fn calibrate(
+    session: &Session,
+    options: &Options,
+) -> Result<(Prepared, Calibration), CalibrationError> {
     let prepared = prepare(session)?;
     let cal = run(session, &prepared, options, &mut |_| Control::Continue)?;
     Ok((prepared, cal))

@@ -13,14 +13,15 @@
 //! | Fig. 2 (the loop) and the whole pipeline | [`calibrate`] |
 
 pub mod calibrate;
-pub mod report;
 pub mod error;
 pub mod evaluate;
 pub mod geometry;
 pub mod handeye;
 pub mod identify;
 pub mod kinematics;
+pub mod ml;
 pub mod model;
+pub mod report;
 pub mod session;
 pub mod simulate;
 pub mod stripe;
