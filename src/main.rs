@@ -14,6 +14,7 @@ fn main() -> ExitCode {
             cli::simulate::run(&args).map_err(|e| CliError::input(format!("{e:#}")))
         }
         Some(Command::Gui(args)) => gui(args.session, args.result),
+        Some(Command::Evaluate(args)) => cli::evaluate::run(&args),
         None => gui(None, None),
     };
     match outcome {

@@ -6,6 +6,7 @@
 //! and the problem, 1 on an internal failure. A result file is written
 //! atomically or not at all.
 
+pub mod evaluate;
 pub mod simulate;
 
 use std::path::{Path, PathBuf};
@@ -16,6 +17,7 @@ use clap::{Args, Parser, Subcommand};
 use crate::engine::calibrate::{self, Control, HandEyeSource, Method, Options};
 use crate::engine::error::{CalibrationError, FileError};
 use crate::engine::identify::Pairing;
+use crate::engine::ml::{self, Loss, MlOptions, MlReport};
 use crate::engine::report;
 use crate::engine::session;
 
@@ -36,8 +38,10 @@ pub enum Command {
     Calibrate(CalibrateArgs),
     /// Write a simulated session with a known truth (for tests, demos and what-if studies).
     Simulate(simulate::SimulateArgs),
-    /// Open the workbench, optionally on a session file.
+        /// Open the workbench, optionally on a session file.
     Gui(GuiArgs),
+    /// Compare the paper's method, `ml` and the noise floor on simulated scenarios (README evidence).
+    Evaluate(evaluate::EvaluateArgs),
 }
 
 /// `spherecal gui`.
@@ -58,9 +62,15 @@ pub struct CalibrateArgs {
     /// Where to write the result file (FORMAT.md `spherecal-result`).
     #[arg(long, short)]
     pub out: PathBuf,
-    /// Identification method: `paper` (the paper's section 3.2).
+        /// Identification method: `paper` (the paper's section 3.2) or `ml` (maximum likelihood).
     #[arg(long, default_value = "paper", value_parser = parse_method)]
     pub method: Method,
+    /// Leave these measurements out (comma-separated ids), e.g. the outliers `ml` listed.
+    #[arg(long, value_delimiter = ',')]
+    pub exclude: Vec<String>,
+    /// Settings of the `ml` method.
+    #[command(flatten)]
+    pub ml: MlArgs,
     /// Stop when ε falls to this (mm); default: the session's `solver.threshold` (0.15).
     #[arg(long)]
     pub threshold: Option<f64>,
@@ -78,10 +88,72 @@ pub struct CalibrateArgs {
     pub quiet: bool,
 }
 
+/// Settings of the `ml` method (defaults: [`MlOptions::default`]).
+#[derive(Debug, Args)]
+pub struct MlArgs {
+    /// ml: σ of the joint readings, deg (default 0.003).
+    #[arg(long)]
+    pub joint_sigma: Option<f64>,
+    /// ml: σ of a centre given in the session, mm (default 0.01).
+    #[arg(long)]
+    pub centre_sigma: Option<f64>,
+    /// ml: floor of each principal σ of a stripe centre's covariance, mm (default 0.002).
+    #[arg(long)]
+    pub sensor_sigma_floor: Option<f64>,
+    /// ml: no prior on the kinematic deviations.
+    #[arg(long)]
+    pub no_prior: bool,
+    /// ml: prior σ of angle deviations, deg (default 0.2).
+    #[arg(long)]
+    pub prior_angle: Option<f64>,
+    /// ml: prior σ of length deviations, mm (default 0.5).
+    #[arg(long)]
+    pub prior_length: Option<f64>,
+    /// ml: robust loss, `squared`, `huber` or `cauchy` (default huber).
+    #[arg(long, value_parser = parse_loss)]
+    pub loss: Option<Loss>,
+    /// ml: robust loss scale, σ of the whitened residual norm (default 3.37, the 99 % point of χ(3)).
+    #[arg(long)]
+    pub loss_scale: Option<f64>,
+    /// ml: relative pivot tolerance of the identifiability QR (default 1e-7).
+    #[arg(long)]
+    pub rank_tolerance: Option<f64>,
+    /// ml: skip the leave-one-station-out cross-validation.
+    #[arg(long)]
+    pub no_cross_validation: bool,
+}
+
+impl MlArgs {
+    /// The options these flags give, the rest at their defaults.
+    #[must_use]
+    pub fn options(&self) -> MlOptions {
+        let d = MlOptions::default();
+        MlOptions {
+            joint_sigma_deg: self.joint_sigma.unwrap_or(d.joint_sigma_deg),
+            centre_sigma: self.centre_sigma.unwrap_or(d.centre_sigma),
+            sensor_sigma_floor: self.sensor_sigma_floor.unwrap_or(d.sensor_sigma_floor),
+            prior: d.prior && !self.no_prior,
+            prior_angle_deg: self.prior_angle.unwrap_or(d.prior_angle_deg),
+            prior_length: self.prior_length.unwrap_or(d.prior_length),
+            loss: self.loss.unwrap_or(d.loss),
+            loss_scale: self.loss_scale.unwrap_or(d.loss_scale),
+            rank_tolerance: self.rank_tolerance.unwrap_or(d.rank_tolerance),
+            cross_validation: d.cross_validation && !self.no_cross_validation,
+        }
+    }
+}
+
+fn parse_loss(s: &str) -> Result<Loss, String> {
+    Loss::parse(s).ok_or_else(|| format!("unknown loss `{s}`, expected `squared`, `huber` or `cauchy`"))
+}
+
 fn parse_method(s: &str) -> Result<Method, String> {
     Method::parse(s).ok_or_else(|| {
         let names: Vec<&str> = Method::ALL.iter().map(|m| m.as_str()).collect();
-        format!("unknown method `{s}`, expected one of: {}", names.join(", "))
+        format!(
+            "unknown method `{s}`, expected one of: {}",
+            names.join(", ")
+        )
     })
 }
 
@@ -147,8 +219,16 @@ impl CliError {
 /// [`CliError`] with status 2 for bad input, 1 for internal failures.
 pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     let started = Instant::now();
-    let session = session::load_session(&args.session).map_err(|e| CliError::from_file(&e, true))?;
+        let session =
+        session::load_session(&args.session).map_err(|e| CliError::from_file(&e, true))?;
+    let session = if args.exclude.is_empty() {
+        session
+    } else {
+        ml::exclude_measurements(&session, &args.exclude)
+            .map_err(|e| CliError::input(format!("{e} ({})", args.session.display())))?
+    };
     let mut options = Options::from_session(&session);
+    options.ml = args.ml.options();
     options.method = args.method;
     if let Some(t) = args.threshold {
         options.threshold = t;
@@ -158,7 +238,8 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     }
     options.paper.svd_tolerance = args.svd_tolerance;
     options.paper.pairing = args.pairs;
-    let prepared = calibrate::prepare(&session).map_err(|e| CliError::from_calibration(&e, &args.session))?;
+    let prepared =
+        calibrate::prepare(&session).map_err(|e| CliError::from_calibration(&e, &args.session))?;
     let quiet = args.quiet;
     let mut on_progress = |p: &calibrate::Progress| {
         if !quiet {
@@ -167,7 +248,11 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
         Control::Continue
     };
     if !quiet {
-        println!("session {:?}: {} measurements", session.name, session.measurements.len());
+        println!(
+            "session {:?}: {} measurements",
+            session.name,
+            session.measurements.len()
+        );
         for (id, w) in &prepared.warnings {
             println!("  warning: measurement {id}: {w}");
         }
@@ -190,7 +275,10 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     let result = report::result_file(&session, &prepared, &cal);
     session::save_result(&result, &args.out).map_err(|e| CliError::from_file(&e, false))?;
     if !quiet {
-        print!("{}", report::summary(&session, &cal));
+                print!("{}", report::summary(&session, &cal));
+        if let Some(r) = MlReport::from_solver_block(&cal.solver) {
+            print!("{}", r.summary());
+        }
         println!(
             "wrote {} ({:.0} ms)",
             args.out.display(),
