@@ -263,11 +263,11 @@ fn left_out_measurements_are_saved_and_a_bad_exclusion_is_refused() {
     .expect("demo parses");
     let dir = tempfile::tempdir().expect("temp dir");
     let target = dir.path().join("demo-edited.json");
-    // Show the validate measurements only, then leave out the last one by
-    // unticking its checkbox.
+    // Show the last measurement's station only, then leave the measurement
+    // out by unticking its checkbox.
     let last = session.measurements.last().expect("measurements");
     assert_eq!(last.usage, spherecal::engine::model::Use::Validate);
-    h.state_mut().forms_mut().filter_use = Some(spherecal::engine::model::Use::Validate);
+    h.state_mut().forms_mut().filter_station = Some(last.station.clone());
     h.run();
     h.get_by_label(&last.id).click();
     h.run();
@@ -364,5 +364,38 @@ fn a_result_file_is_reviewed_without_running_the_solver() {
             .count()
             > 0,
         "the view says it is a review"
+    );
+}
+
+#[test]
+fn exports_are_written_to_the_chosen_folder() {
+    let mut h = demo_app();
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    let dir = tempfile::tempdir().expect("temp dir");
+    h.state_mut().forms_mut().export_dir = dir.path().display().to_string();
+    for button in ["Result JSON", "Centres CSV", "Distances CSV"] {
+        h.get_by_label(button).click();
+        settle(&mut h);
+    }
+    let stem = "demo-irb2400";
+    let result =
+        spherecal::engine::session::load_result(&dir.path().join(format!("{stem}-result.json")))
+            .expect("the exported result loads");
+    let shown = h.state().state().result.as_ref().expect("result");
+    assert_eq!(result, shown.file, "the export is the result on show");
+    let centres =
+        std::fs::read_to_string(dir.path().join(format!("{stem}-centres.csv"))).expect("centres");
+    assert_eq!(centres.lines().count(), 1 + shown.file.centres.len());
+    let distances = std::fs::read_to_string(dir.path().join(format!("{stem}-distances.csv")))
+        .expect("distances");
+    assert_eq!(
+        distances.lines().count(),
+        1 + shown.distances.len() + shown.within.len()
+    );
+    assert_eq!(
+        h.state().state().prefs.export_folder.as_deref(),
+        Some(dir.path()),
+        "the folder is remembered"
     );
 }

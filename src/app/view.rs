@@ -101,7 +101,7 @@ pub struct CentrePoint {
 }
 
 /// The centres of the centres view, grouped by station.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct CentreSet {
     /// Every centre.
     pub points: Vec<CentrePoint>,
@@ -109,6 +109,31 @@ pub struct CentreSet {
     pub stations: Vec<String>,
     /// Per station (same order): mean before and mean after (or before), mm.
     pub means: Vec<([f64; 3], [f64; 3])>,
+    /// A magnification of the deviations from the station means that
+    /// makes the largest one about a quarter of the smallest distance
+    /// between stations (1-2-5 steps, 1 to 1000).
+    pub suggested_magnify: f32,
+}
+
+/// Largest deviation drawn, as a fraction of the closest station spacing.
+const DEVIATION_SHARE: f64 = 0.25;
+
+/// The largest 1-2-5 step at or below `x`, within 1..=1000.
+fn step_125(x: f64) -> f32 {
+    if !(x.is_finite() && x > 1.0) {
+        return 1.0;
+    }
+    let x = x.min(1000.0);
+    let decade = 10f64.powf(x.log10().floor());
+    let m = x / decade;
+    let step = if m >= 5.0 {
+        5.0
+    } else if m >= 2.0 {
+        2.0
+    } else {
+        1.0
+    };
+    (step * decade) as f32
 }
 
 impl CentreSet {
@@ -121,7 +146,7 @@ impl CentreSet {
                 stations.push(p.station.clone());
             }
         }
-        let means = stations
+        let means: Vec<([f64; 3], [f64; 3])> = stations
             .iter()
             .map(|s| {
                 let mine: Vec<&CentrePoint> = points.iter().filter(|p| p.station == *s).collect();
@@ -134,10 +159,31 @@ impl CentreSet {
                 (mean(&|p| p.before), mean(&|p| p.after.unwrap_or(p.before)))
             })
             .collect();
+        let dist = |a: &[f64; 3], b: &[f64; 3]| (Vector3::from(*a) - Vector3::from(*b)).norm();
+        let mut spread = 0.0_f64;
+        for p in &points {
+            let (mb, ma) = means[stations.iter().position(|s| *s == p.station).unwrap_or(0)];
+            spread = spread.max(dist(&p.before, &mb));
+            if let Some(a) = &p.after {
+                spread = spread.max(dist(a, &ma));
+            }
+        }
+        let mut separation = f64::INFINITY;
+        for (i, a) in means.iter().enumerate() {
+            for b in &means[i + 1..] {
+                separation = separation.min(dist(&a.0, &b.0));
+            }
+        }
+        let suggested_magnify = if spread > 0.0 && separation.is_finite() {
+            step_125(DEVIATION_SHARE * separation / spread)
+        } else {
+            1.0
+        };
         Self {
             points,
             stations,
             means,
+            suggested_magnify,
         }
     }
 
@@ -416,6 +462,14 @@ pub fn marked_parameters(dropped: &[String], fixed: &[String]) -> BTreeMap<Strin
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn magnification_steps() {
+        assert!((step_125(0.3) - 1.0).abs() < 1e-6);
+        assert!((step_125(7.9) - 5.0).abs() < 1e-6);
+        assert!((step_125(23.0) - 20.0).abs() < 1e-6);
+        assert!((step_125(1e9) - 1000.0).abs() < 1e-3);
+    }
 
     #[test]
     fn marks_large_coefficients_only() {

@@ -18,6 +18,10 @@ use super::state::{
 use super::view::ResultOrigin;
 use super::work::{self, Opened};
 
+/// How long to wait for the window's screenshot for a plots PNG: a frame
+/// takes milliseconds; a backend that cannot take one never answers.
+const SCREENSHOT_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(5);
+
 /// Key of the preferences in eframe's storage (JSON text).
 pub const PREFS_KEY: &str = "spherecal.prefs";
 
@@ -33,8 +37,8 @@ pub struct WorkbenchApp {
     startup: Vec<Command>,
     /// Screen rectangle of the Results view's plots in the last frame.
     plots_rect: Option<egui::Rect>,
-    /// Where the awaited screenshot's PNG goes.
-    png_target: Option<PathBuf>,
+    /// Where the awaited screenshot's PNG goes, and since when.
+    png_target: Option<(PathBuf, Instant)>,
     /// Whether [`install_fonts`] has run.
     fonts_installed: bool,
 }
@@ -140,6 +144,7 @@ impl WorkbenchApp {
         for message in self.jobs.drain() {
             self.on_message(&ctx, message);
         }
+        self.screenshot_timeout(&ctx);
         let mut commands = Vec::new();
         self.input_commands(&ctx, &mut commands);
         egui::Panel::bottom("status").show(ui, |ui| panels::status::status_ui(ui, &self.state));
@@ -176,6 +181,24 @@ impl WorkbenchApp {
         panels::drop_overlay_ui(&ctx);
         for c in commands {
             self.apply(&ctx, c);
+        }
+    }
+
+    /// Gives up on a window screenshot that never came (a backend that
+    /// cannot take one), so that the export stays usable.
+    fn screenshot_timeout(&mut self, ctx: &egui::Context) {
+        let Some((_, since)) = &self.png_target else {
+            return;
+        };
+        if since.elapsed() >= SCREENSHOT_TIMEOUT {
+            self.png_target = None;
+            self.state.busy.screenshot = false;
+            self.state.say(
+                Level::Warning,
+                "no screenshot came from the window system: no PNG written",
+            );
+        } else {
+            ctx.request_repaint_after(SCREENSHOT_TIMEOUT);
         }
     }
 
@@ -497,7 +520,7 @@ impl WorkbenchApp {
                 return;
             }
             self.forms.tab = Tab::Results;
-            self.png_target = Some(path);
+            self.png_target = Some((path, Instant::now()));
             self.state.busy.screenshot = true;
             let rep = self.jobs.reporter(ctx);
             ctx.request_screenshot(move |image| {
@@ -528,6 +551,7 @@ impl WorkbenchApp {
                 self.state.busy.loading = false;
                 self.state.prefs.remember(&path);
                 let notes = view.notes.join("; ");
+                self.forms.centres.magnify = view.centres.suggested_magnify;
                 self.state.result = Some(*view);
                 self.forms.tab = Tab::Results;
                 if notes.is_empty() {
@@ -572,6 +596,7 @@ impl WorkbenchApp {
                     Ok(view) => {
                         let stop = view.stop_reason.clone().unwrap_or_default();
                         let seconds = run.started.elapsed().as_secs_f64();
+                        self.forms.centres.magnify = view.centres.suggested_magnify;
                         self.state.result = Some(*view);
                         self.forms.tab = Tab::Results;
                         self.state
@@ -718,6 +743,9 @@ impl WorkbenchApp {
             level = Level::Warning;
         }
         self.state.say(level, text);
+        if let Ok(set) = &loaded.before {
+            self.forms.centres.magnify = set.suggested_magnify;
+        }
         self.state.loaded = Some(loaded);
         if let Some(p) = self.state.pending_result.take() {
             self.open_path(ctx, p);
@@ -726,7 +754,7 @@ impl WorkbenchApp {
 
     fn on_screenshot(&mut self, ctx: &egui::Context, image: &Arc<egui::ColorImage>) {
         self.state.busy.screenshot = false;
-        let (Some(path), Some(rect)) = (self.png_target.take(), self.plots_rect) else {
+        let (Some((path, _)), Some(rect)) = (self.png_target.take(), self.plots_rect) else {
             self.state.say(
                 Level::Warning,
                 "the plots were not on screen: no PNG written",

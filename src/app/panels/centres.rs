@@ -4,7 +4,7 @@
 //! projections. Clicking a centre selects its measurement.
 
 use egui::{Color32, Pos2, Rect, RichText, Sense, Stroke, Vec2};
-use egui_plot::{Legend, MarkerShape, Plot, PlotPoints, Points};
+use egui_plot::{MarkerShape, Plot, PlotPoints, Points};
 
 use super::{AFTER, BEFORE, station_colour};
 use crate::app::commands::Command;
@@ -353,7 +353,6 @@ fn projection_ui(
         .height(height)
         .x_axis_label(AXES[a])
         .y_axis_label(AXES[b])
-        .legend(Legend::default())
         .show(ui, |p| {
             for (s, name) in set.stations.iter().enumerate() {
                 let colour = station_colour(s);
@@ -382,7 +381,7 @@ fn projection_ui(
                     .map(|m| [m.pos[a], m.pos[b]])
                     .collect();
                 p.points(
-                    Points::new("selected", PlotPoints::from(pts))
+                    Points::new("", PlotPoints::from(pts))
                         .shape(MarkerShape::Circle)
                         .filled(false)
                         .radius(8.0)

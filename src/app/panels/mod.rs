@@ -116,3 +116,16 @@ pub fn ratio_text(before: f64, after: f64) -> String {
         String::new()
     }
 }
+
+/// The label of a log-scale tick at `log10(v) = exponent`: `v` with two
+/// significant digits.
+#[must_use]
+pub fn log_tick(exponent: f64) -> String {
+    let v = 10f64.powf(exponent);
+    if (1e-3..1e4).contains(&v) {
+        let digits = (1.0 - v.log10().floor()).max(0.0) as usize;
+        format!("{v:.digits$}")
+    } else {
+        format!("{v:.1e}")
+    }
+}

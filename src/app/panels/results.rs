@@ -180,11 +180,13 @@ fn plots_ui(ui: &mut egui::Ui, view: &ResultView) -> f32 {
             ))
             .strong(),
         );
+        key_ui(&mut cols[0]);
         fig5_ui(&mut cols[0], view);
         cols[1].label(
             RichText::new("Reference-distance errors, measured − reference (cf. paper Fig. 6)")
                 .strong(),
         );
+        key_ui(&mut cols[1]);
         fig6_ui(&mut cols[1], view);
     });
     ui.columns(2, |cols| {
@@ -200,6 +202,19 @@ fn plots_ui(ui: &mut egui::Ui, view: &ResultView) -> f32 {
         singular_ui(&mut cols[1], view);
     });
     ui.min_rect().bottom()
+}
+
+/// The colour key of the before/after plots (their legends would cover
+/// the data).
+fn key_ui(ui: &mut egui::Ui) {
+    ui.horizontal(|ui| {
+        ui.label(
+            RichText::new("■ before (nominal model, initial hand-eye)")
+                .color(BEFORE)
+                .small(),
+        );
+        ui.label(RichText::new("● after (calibrated)").color(AFTER).small());
+    });
 }
 
 fn before_after_series(p: &mut egui_plot::PlotUi<'_>, before: Vec<[f64; 2]>, after: Vec<[f64; 2]>) {
@@ -252,7 +267,6 @@ fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
         .y_axis_label("distance (mm)")
         .include_y(0.0)
         .include_y(top * 1.15)
-        .legend(Legend::default())
         .label_formatter(move |pos| match pos {
             egui_plot::HoverPosition::NearDataPoint {
                 index, position, ..
@@ -272,7 +286,7 @@ fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
                     let mid = (start + k + 1) as f64 / 2.0;
                     p.text(
                         Text::new(
-                            "station",
+                            "",
                             PlotPoint::new(mid, top * 1.1),
                             within[start].station.as_str(),
                         )
@@ -280,7 +294,7 @@ fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
                     );
                     if k < within.len() {
                         p.vline(
-                            VLine::new("station boundary", k as f64 + 0.5)
+                            VLine::new("", k as f64 + 0.5)
                                 .color(MUTED)
                                 .style(LineStyle::dotted_dense()),
                         );
@@ -316,7 +330,6 @@ fn fig6_ui(ui: &mut egui::Ui, view: &ResultView) {
         .height(PLOT_HEIGHT)
         .x_axis_label("distance")
         .y_axis_label("error (mm)")
-        .legend(Legend::default())
         .label_formatter(move |pos| match pos {
             egui_plot::HoverPosition::NearDataPoint {
                 index, position, ..
@@ -329,7 +342,7 @@ fn fig6_ui(ui: &mut egui::Ui, view: &ResultView) {
             egui_plot::HoverPosition::Elsewhere { .. } => None,
         })
         .show(ui, |p| {
-            p.hline(HLine::new("zero", 0.0).color(MUTED).width(1.0));
+            p.hline(HLine::new("", 0.0).color(MUTED).width(1.0));
             before_after_series(p, before, after);
         });
 }
@@ -369,8 +382,8 @@ fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
         })
         .x_axis_label("index")
         .y_axis_label("σ (log scale)")
-        .y_axis_formatter(|mark, _| format!("1e{:.0}", mark.value))
-        .legend(Legend::default())
+        .y_axis_formatter(|mark, _| super::log_tick(mark.value))
+        .legend(Legend::default().position(egui_plot::Corner::LeftBottom))
         .show(ui, |p| {
             p.points(
                 Points::new("kept", PlotPoints::from(pts(&kept)))

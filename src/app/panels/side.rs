@@ -271,7 +271,11 @@ fn settings_ui(ui: &mut egui::Ui, forms: &mut Forms) {
         });
 }
 
-/// ε per update, with the threshold.
+/// ε is drawn on a log scale; values below this (mm) are drawn at it.
+const EPSILON_FLOOR_MM: f64 = 1e-9;
+
+/// ε per update on a log scale (it falls by orders of magnitude), with
+/// the threshold.
 pub fn epsilon_plot_ui(
     ui: &mut egui::Ui,
     id: &str,
@@ -279,31 +283,40 @@ pub fn epsilon_plot_ui(
     threshold: Option<f64>,
     height: f32,
 ) {
+    let log = |v: f64| v.max(EPSILON_FLOOR_MM).log10();
     let pts: Vec<[f64; 2]> = epsilons
         .iter()
         .enumerate()
-        .map(|(k, e)| [k as f64, *e])
+        .map(|(k, e)| [k as f64, log(*e)])
         .collect();
     Plot::new(id)
         .height(height)
         .x_axis_label("update")
-        .y_axis_label("ε (mm)")
-        .include_y(0.0)
+        .y_axis_label("ε (mm, log)")
+        .y_axis_formatter(|mark, _| super::log_tick(mark.value))
+        .label_formatter(|pos| match pos {
+            egui_plot::HoverPosition::NearDataPoint { position, .. } => Some(format!(
+                "update {}: ε = {:.4} mm",
+                position.x.round(),
+                10f64.powf(position.y)
+            )),
+            egui_plot::HoverPosition::Elsewhere { .. } => None,
+        })
         .include_x(0.0)
         .allow_scroll(false)
         .show(ui, |p| {
             p.line(
-                Line::new("ε", PlotPoints::from(pts.clone()))
+                Line::new("", PlotPoints::from(pts.clone()))
                     .color(AFTER)
                     .width(2.0),
             );
             p.points(
-                Points::new("ε points", PlotPoints::from(pts))
+                Points::new("ε", PlotPoints::from(pts))
                     .color(AFTER)
                     .radius(3.0),
             );
             if let Some(t) = threshold {
-                p.hline(HLine::new("threshold", t).color(BEFORE));
+                p.hline(HLine::new("threshold", log(t)).color(BEFORE));
             }
         });
 }
