@@ -127,9 +127,6 @@ const STEP_TOL_MM: f64 = 1e-9;
 /// LM steps in one update of the loop. From the nominal model LM takes
 /// 5-10 steps; 100 only guards against a pathological session.
 const MAX_LM_STEPS: usize = 100;
-/// LM steps allowed per leave-one-station-out refit: it starts at the full
-/// solution, one station away, and converges in 2-4 steps.
-const CV_MAX_STEPS: usize = 8;
 /// Columns of the identifiability QR whose norms agree to this relative
 /// amount are a tie; the lower index (hand-eye first, then base to flange)
 /// is kept.
@@ -473,6 +470,24 @@ struct State {
     centres: Vec<Vector3<f64>>,
 }
 
+/// Which measurement rows a linearisation takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Rows {
+    /// Every measurement and the prior.
+    All,
+    /// Only the measurements of one station (no prior).
+    Only(usize),
+}
+
+impl Rows {
+    fn includes(self, station: usize) -> bool {
+        match self {
+            Self::All => true,
+            Self::Only(s) => s == station,
+        }
+    }
+}
+
 /// The linearised problem at a state.
 struct Linear {
     /// `JᵀWJ` over [estimated parameters (scaled); centres].
@@ -567,12 +582,11 @@ impl Problem {
         &prior.whiten * dev
     }
 
-    /// Robust cost at `state`, leaving out station `skip`.
-    fn cost(&self, state: &State, skip: Option<usize>) -> f64 {
+    /// Robust cost at `state`.
+    fn cost(&self, state: &State) -> f64 {
         let data: f64 = self
             .obs
             .iter()
-            .filter(|o| Some(o.station) != skip)
             .map(|o| {
                 self.loss
                     .rho(self.residual(o, state).norm(), self.loss_scale)
@@ -595,15 +609,15 @@ impl Problem {
     }
 
     /// Gauss-Newton matrix, gradient and cost at `state` (IRLS weights from
-    /// the current residuals), leaving out station `skip`.
-    fn linearize(&self, state: &State, skip: Option<usize>) -> Linear {
+    /// the current residuals), over the rows `rows` selects.
+    fn linearize(&self, state: &State, rows: Rows) -> Linear {
         let k = self.estimated.len();
         let n = self.dim();
         let mut h = DMatrix::zeros(n, n);
         let mut g = DVector::zeros(n);
         let mut cost = 0.0;
         for o in &self.obs {
-            if Some(o.station) == skip {
+            if !rows.includes(o.station) {
                 continue;
             }
             let (r, jp) = self.obs_jacobian(o, state);
@@ -628,7 +642,7 @@ impl Problem {
             let gc = jc.transpose() * r * w;
             g.fixed_rows_mut::<3>(c0).add_assign(&gc);
         }
-        if let Some(prior) = &self.prior {
+        if let (Some(prior), false) = (&self.prior, matches!(rows, Rows::Only(_))) {
             let r = self.prior_residual(state);
             // Jacobian of the prior rows in the scaled slots.
             let mut jp = DMatrix::zeros(r.len(), k);
@@ -640,14 +654,6 @@ impl Problem {
             hpp += &jpt * &jp;
             g.rows_mut(0, k).add_assign(&(&jpt * &r));
             cost += 0.5 * r.norm_squared();
-        }
-        if let Some(s) = skip {
-            // The left-out station has no rows: pin its centre.
-            let c0 = k + 3 * s;
-            for d in 0..3 {
-                h[(c0 + d, c0 + d)] = 1.0;
-                g[c0 + d] = 0.0;
-            }
         }
         Linear { h, g, cost }
     }
@@ -673,8 +679,8 @@ impl Problem {
     /// One Levenberg-Marquardt step from `state`: retries with more
     /// damping until the cost falls. `None` when no damping lowers it
     /// (the state is at the optimum to numerical precision).
-    fn lm_step(&self, state: &State, lambda: &mut f64, skip: Option<usize>) -> Option<LmStep> {
-        let lin = self.linearize(state, skip);
+    fn lm_step(&self, state: &State, lambda: &mut f64) -> Option<LmStep> {
+        let lin = self.linearize(state, Rows::All);
         let n = self.dim();
         let dmax = (0..n).map(|i| lin.h[(i, i)]).fold(0.0_f64, f64::max);
         let floor = (dmax * DIAG_FLOOR_REL).max(f64::MIN_POSITIVE);
@@ -687,7 +693,7 @@ impl Problem {
                 let step = -chol.solve(&lin.g);
                 if step.iter().all(|v| v.is_finite()) {
                     let trial = self.apply(state, &step);
-                    let cost = self.cost(&trial, skip);
+                    let cost = self.cost(&trial);
                     if cost.is_finite() && cost < lin.cost {
                         let used = *lambda;
                         *lambda = (*lambda * LAMBDA_DOWN).max(LAMBDA_MIN);
@@ -706,22 +712,63 @@ impl Problem {
         None
     }
 
-    /// Runs LM from `state` for at most `max_steps` accepted steps.
-    fn solve(&self, mut state: State, max_steps: usize, skip: Option<usize>) -> State {
-        let mut lambda = LAMBDA_START;
-        for _ in 0..max_steps {
-            match self.lm_step(&state, &mut lambda, skip) {
-                Some(step) => {
-                    let done = step.converged();
-                    state = step.state;
-                    if done {
-                        break;
-                    }
-                }
-                None => break,
+    /// Leave-one-station-out cross-validation at the solution `state`.
+    /// Each refit without station `s` is one Gauss-Newton step from the
+    /// full solution with the station's rows removed,
+    /// `δ = −(H − H_s)⁻¹ · (g − g_s)`: dropping one station of many moves
+    /// the parameters by a fraction of their σ, well inside the linear
+    /// regime, so one step is the refit to second order (and costs one
+    /// factorisation instead of a whole LM run per station). The model
+    /// refitted without `s` then predicts the within-station distances
+    /// of `s`, whose true value is zero.
+    fn cross_validate(&self, state: &State) -> CrossValidation {
+        let k = self.estimated.len();
+        let full = self.linearize(state, Rows::All);
+        let mut rows = Vec::new();
+        let (mut sum, mut count) = (0.0, 0_usize);
+        for (s, id) in self.stations.iter().enumerate() {
+            let own = self.linearize(state, Rows::Only(s));
+            let mut h = &full.h - &own.h;
+            let mut g = &full.g - &own.g;
+            // The left-out station has no rows: pin its centre.
+            let c0 = k + 3 * s;
+            for d in 0..3 {
+                h[(c0 + d, c0 + d)] = 1.0;
+                g[c0 + d] = 0.0;
             }
+            let refit = match h.cholesky() {
+                Some(chol) => self.apply(state, &(-chol.solve(&g))),
+                None => state.clone(),
+            };
+            let centres: Vec<Vector3<f64>> = self
+                .obs
+                .iter()
+                .filter(|o| o.station == s)
+                .map(|o| refit.est.centre_in_base(&o.sighting))
+                .collect();
+            let (mut ss, mut n) = (0.0, 0_usize);
+            for i in 0..centres.len() {
+                for j in i + 1..centres.len() {
+                    ss += (centres[i] - centres[j]).norm_squared();
+                    n += 1;
+                }
+            }
+            sum += ss;
+            count += n;
+            rows.push(CrossStation {
+                station: id.clone(),
+                pairs: n,
+                rms: if n > 0 { (ss / n as f64).sqrt() } else { 0.0 },
+            });
         }
-        state
+        CrossValidation {
+            stations: rows,
+            rms: if count > 0 {
+                (sum / count as f64).sqrt()
+            } else {
+                0.0
+            },
+        }
     }
 }
 
@@ -1142,7 +1189,7 @@ impl MlSolver {
     fn update(&mut self, epsilon: &dyn Fn(&Estimate) -> f64) -> StepOutcome {
         let mut taken = 0;
         while taken < MAX_LM_STEPS {
-            let Some(step) = self.problem.lm_step(&self.state, &mut self.lambda, None) else {
+            let Some(step) = self.problem.lm_step(&self.state, &mut self.lambda) else {
                 return if taken == 0 {
                     StepOutcome::Stuck
                 } else {
@@ -1295,7 +1342,7 @@ pub struct DistanceStd {
     pub mean: f64,
     /// Largest total σ, mm.
     pub max: f64,
-        /// RMS of the total σ, mm: the expected RMS error of these distances
+    /// RMS of the total σ, mm: the expected RMS error of these distances
     /// (compare with a measured `rms`).
     pub rms: f64,
     /// Expected sample standard deviation of the errors over this set of
@@ -1569,7 +1616,7 @@ fn distance_std(
     if pairs.is_empty() {
         return out;
     }
-        let mut sum_sq = 0.0;
+    let mut sum_sq = 0.0;
     let mut grads: Vec<DVector<f64>> = Vec::with_capacity(pairs.len());
     let mut noise = 0.0;
     for ((sa, ca), (sb, cb)) in pairs {
@@ -1584,7 +1631,7 @@ fn distance_std(
         let grad = DMatrix::from_row_slice(1, 3, u.as_slice()) * (aa - ab);
         let g = restricted(&grad, problem);
         let var_p = (g.transpose() * cov * &g)[(0, 0)].max(0.0);
-                let var_n = (u.transpose() * (ca + cb) * u)[(0, 0)].max(0.0);
+        let var_n = (u.transpose() * (ca + cb) * u)[(0, 0)].max(0.0);
         noise += var_n;
         grads.push(g);
         let total = (var_p + var_n).sqrt();
@@ -1594,7 +1641,7 @@ fn distance_std(
         out.parameter_mean += var_p.sqrt();
         out.parameter_max = out.parameter_max.max(var_p.sqrt());
     }
-        let n = pairs.len() as f64;
+    let n = pairs.len() as f64;
     out.mean /= n;
     out.parameter_mean /= n;
     out.rms = (sum_sq / n).sqrt();
@@ -1603,7 +1650,10 @@ fn distance_std(
     let m = grads.len();
     if m >= 2 {
         let mf = m as f64;
-        let mean_grad = grads.iter().fold(DVector::zeros(cov.nrows()), |acc, g| acc + g) / mf;
+        let mean_grad = grads
+            .iter()
+            .fold(DVector::zeros(cov.nrows()), |acc, g| acc + g)
+            / mf;
         let spread: f64 = grads
             .iter()
             .map(|g| {
@@ -1629,7 +1679,7 @@ fn diagnostics(
     let state = &solver.state;
     let mo = &options.ml;
     let k = problem.estimated.len();
-    let lin = problem.linearize(state, None);
+    let lin = problem.linearize(state, Rows::All);
     let full_inv = lin
         .h
         .clone()
@@ -1789,41 +1839,8 @@ fn diagnostics(
         (!vpairs.is_empty()).then(|| distance_std(problem, &state.est, &cov_scaled, &vpairs));
     let predicted_identify = distance_std(problem, &state.est, &cov_scaled, &ipairs);
     // Leave-one-station-out.
-    let cross_validation = (mo.cross_validation && problem.stations.len() >= 2).then(|| {
-        let mut rows = Vec::new();
-        let (mut sum, mut count) = (0.0, 0_usize);
-        for (s, id) in problem.stations.iter().enumerate() {
-            let refit = problem.solve(state.clone(), CV_MAX_STEPS, Some(s));
-            let centres: Vec<Vector3<f64>> = problem
-                .obs
-                .iter()
-                .filter(|o| o.station == s)
-                .map(|o| refit.est.centre_in_base(&o.sighting))
-                .collect();
-            let (mut ss, mut n) = (0.0, 0_usize);
-            for i in 0..centres.len() {
-                for j in i + 1..centres.len() {
-                    ss += (centres[i] - centres[j]).norm_squared();
-                    n += 1;
-                }
-            }
-            sum += ss;
-            count += n;
-            rows.push(CrossStation {
-                station: id.clone(),
-                pairs: n,
-                rms: if n > 0 { (ss / n as f64).sqrt() } else { 0.0 },
-            });
-        }
-        CrossValidation {
-            stations: rows,
-            rms: if count > 0 {
-                (sum / count as f64).sqrt()
-            } else {
-                0.0
-            },
-        }
-    });
+    let cross_validation =
+        (mo.cross_validation && problem.stations.len() >= 2).then(|| problem.cross_validate(state));
     let ident = &solver.ident;
     MlReport {
         method: "ml".into(),
