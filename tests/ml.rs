@@ -4,6 +4,10 @@
 //! IRB 2400; outliers are listed and excluding them restores accuracy;
 //! the predicted uncertainty matches what the truth shows.
 
+// The helpers below are test code too: a panic is a test failure with a
+// message (clippy.toml allows this only inside `#[test]` functions).
+#![allow(clippy::expect_used)]
+
 use spherecal::cli::evaluate;
 use spherecal::engine::calibrate::{self, Calibration, Control, Method, Options, Prepared};
 use spherecal::engine::evaluate::{TruthScore, score, validation_errors};
@@ -29,7 +33,12 @@ fn report(cal: &Calibration) -> MlReport {
     MlReport::from_solver_block(&cal.solver).expect("an ml solver block")
 }
 
-fn truth_score(session: &Session, prepared: &Prepared, truth: &Truth, cal: &Calibration) -> TruthScore {
+fn truth_score(
+    session: &Session,
+    prepared: &Prepared,
+    truth: &Truth,
+    cal: &Calibration,
+) -> TruthScore {
     score(session, prepared, truth, &cal.calibrated, &cal.hand_eye)
 }
 
@@ -55,9 +64,22 @@ fn noise_free_session_is_recovered_exactly() {
     let errors = validation_errors(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
     let worst = errors.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
     assert!(worst < 1e-6, "validation distances off by {worst} mm");
-    assert!(cal.epsilon_after() < 1e-6, "ε after = {}", cal.epsilon_after());
-    let before = validation_errors(&session, &prepared, &truth, &session.robot, &prepared.hand_eye_initial);
-    assert!(before.iter().any(|e| e.abs() > 0.3), "the nominal model should be far off");
+    assert!(
+        cal.epsilon_after() < 1e-6,
+        "ε after = {}",
+        cal.epsilon_after()
+    );
+    let before = validation_errors(
+        &session,
+        &prepared,
+        &truth,
+        &session.robot,
+        &prepared.hand_eye_initial,
+    );
+    assert!(
+        before.iter().any(|e| e.abs() > 0.3),
+        "the nominal model should be far off"
+    );
     assert_eq!(cal.stop.code(), "converged", "{}", cal.stop.describe());
 }
 
@@ -86,13 +108,20 @@ fn noisy_sessions_reach_near_the_floor_and_beat_the_paper() {
         );
         // Never worse than the paper by more than a small margin: the
         // validation std of 54 distances itself scatters by ~10 %.
-        assert!(m.after.std < 1.1 * p.after.std, "seed {seed}: ml {m:?} paper {p:?}");
+        assert!(
+            m.after.std < 1.1 * p.after.std,
+            "seed {seed}: ml {m:?} paper {p:?}"
+        );
         assert!(m.improvement() > 10.0, "seed {seed}: {m:?}");
         ratios.push(m.ratio_to_floor());
         paper_ratios.push(p.ratio_to_floor());
     }
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-    assert!(mean(&ratios) <= 1.3, "ml mean ratio to floor {}", mean(&ratios));
+    assert!(
+        mean(&ratios) <= 1.3,
+        "ml mean ratio to floor {}",
+        mean(&ratios)
+    );
     assert!(mean(&ratios) < mean(&paper_ratios));
 }
 
@@ -104,20 +133,40 @@ fn identifiability_names_the_redundancies_of_the_irb2400() {
     // NOTES.md: joint 1 is a rigid motion of everything; d6 and theta6
     // overlap the hand-eye; d2, d3 lie on parallel axes; Hayati's beta is
     // redundant wherever consecutive axes are not parallel.
-    for fixed in ["alpha1", "a1", "beta1", "theta1", "d1", "d2", "beta2", "beta4", "beta5", "beta6", "theta6", "d6"] {
-        assert!(r.fixed.iter().any(|f| f == fixed), "{fixed} not fixed: {:?}", r.fixed);
+    for fixed in [
+        "alpha1", "a1", "beta1", "theta1", "d1", "d2", "beta2", "beta4", "beta5", "beta6",
+        "theta6", "d6",
+    ] {
+        assert!(
+            r.fixed.iter().any(|f| f == fixed),
+            "{fixed} not fixed: {:?}",
+            r.fixed
+        );
     }
     assert_eq!(r.estimated.len(), 24, "{:?}", r.estimated);
     assert_eq!(r.estimated.len() + r.fixed.len(), 36);
     let has = |needle: &str| r.inseparable.iter().any(|s| s.starts_with(needle));
-    assert!(has("alpha1, a1, beta1, theta1, d1: no effect"), "{:#?}", r.inseparable);
+    assert!(
+        has("alpha1, a1, beta1, theta1, d1: no effect"),
+        "{:#?}",
+        r.inseparable
+    );
     assert!(has("d6 ~ he_z"), "{:#?}", r.inseparable);
     assert!(has("theta6 ~ he_rz"), "{:#?}", r.inseparable);
     assert!(has("d2 ~ d3"), "{:#?}", r.inseparable);
     // A clean gap between what is kept and what is fixed.
-    let kept_min = r.identifiability.pivots[..24].iter().map(|p| p.relative).fold(1.0, f64::min);
-    let fixed_max = r.identifiability.pivots[24..].iter().map(|p| p.relative).fold(0.0, f64::max);
-    assert!(kept_min > 1e-4 && fixed_max < 1e-12, "{kept_min} {fixed_max}");
+    let kept_min = r.identifiability.pivots[..24]
+        .iter()
+        .map(|p| p.relative)
+        .fold(1.0, f64::min);
+    let fixed_max = r.identifiability.pivots[24..]
+        .iter()
+        .map(|p| p.relative)
+        .fold(0.0, f64::max);
+    assert!(
+        kept_min > 1e-4 && fixed_max < 1e-12,
+        "{kept_min} {fixed_max}"
+    );
     // The covariance covers exactly the estimated parameters.
     assert_eq!(r.covariance.labels, r.estimated);
     assert_eq!(r.covariance.matrix.len(), 24);
@@ -138,7 +187,11 @@ fn an_outlier_is_listed_and_excluding_it_restores_accuracy() {
     let (clean, truth) = simulate(&config);
     let (prepared, cal) = run(&clean, &ml_options(&clean));
     let clean_std = truth_score(&clean, &prepared, &truth, &cal).after.std;
-    assert!(report(&cal).outliers.is_empty(), "{:?}", report(&cal).outliers);
+    assert!(
+        report(&cal).outliers.is_empty(),
+        "{:?}",
+        report(&cal).outliers
+    );
 
     let mut spoiled = clean.clone();
     let bad = spoiled
@@ -158,8 +211,15 @@ fn an_outlier_is_listed_and_excluding_it_restores_accuracy() {
     assert_eq!(r.outliers.len(), 1, "{:?}", r.outliers);
     let o = &r.outliers[0];
     assert_eq!(o.measurement, bad_id);
-    assert!(o.sigma > r.outlier_limit_sigma && o.residual_mm > 1.0, "{o:?}");
-    assert!(o.reason.contains("mm") && o.reason.contains("σ"), "{}", o.reason);
+    assert!(
+        o.sigma > r.outlier_limit_sigma && o.residual_mm > 1.0,
+        "{o:?}"
+    );
+    assert!(
+        o.reason.contains("mm") && o.reason.contains("σ"),
+        "{}",
+        o.reason
+    );
     let spoiled_std = truth_score(&spoiled, &prepared, &truth, &cal).after.std;
     let paper_std = truth_score(&spoiled, &prepared, &truth, &paper).after.std;
     eprintln!("clean {clean_std:.4}, with outlier: ml {spoiled_std:.4}, paper {paper_std:.4}");
@@ -172,7 +232,10 @@ fn an_outlier_is_listed_and_excluding_it_restores_accuracy() {
     let rerun_std = truth_score(&rerun, &prepared, &truth, &cal).after.std;
     eprintln!("after excluding {bad_id}: {rerun_std:.4}");
     assert!(report(&cal).outliers.is_empty());
-    assert!(rerun_std < 1.1 * clean_std, "{rerun_std} vs clean {clean_std}");
+    assert!(
+        rerun_std < 1.1 * clean_std,
+        "{rerun_std} vs clean {clean_std}"
+    );
 }
 
 #[test]
@@ -187,7 +250,9 @@ fn excluding_checks_the_format_rules() {
         .map(|m| m.id.clone())
         .collect();
     let err = ml::exclude_measurements(&session, &p1[1..]).unwrap_err();
-    assert!(matches!(&err, ExcludeError::StationTooSmall { station, remaining: 1, .. } if station == "P1"));
+    assert!(
+        matches!(&err, ExcludeError::StationTooSmall { station, remaining: 1, .. } if station == "P1")
+    );
     assert!(err.to_string().contains("identify station P1"), "{err}");
     assert!(ml::exclude_measurements(&session, &p1[2..]).is_ok());
     let v1: Vec<String> = session
@@ -220,19 +285,37 @@ fn predicted_uncertainty_matches_the_truth() {
             s.after.rms,
             p.rms,
             r.cross_validation.as_ref().map_or(0.0, |c| c.rms),
-            cal.validation.as_ref().map_or(0.0, |v| v.within_station.after.rms)
+            cal.validation
+                .as_ref()
+                .map_or(0.0, |v| v.within_station.after.rms)
         );
         assert!(p.centred > 0.0 && p.rms >= p.centred && p.max >= p.mean);
         predicted += p.centred;
         measured += s.after.std;
         cv += r.cross_validation.as_ref().expect("cross-validation").rms;
-        within += cal.validation.as_ref().expect("validation").within_station.after.rms;
-        assert!(r.variance_factor > 0.5 && r.variance_factor < 2.0, "{}", r.variance_factor);
+        within += cal
+            .validation
+            .as_ref()
+            .expect("validation")
+            .within_station
+            .after
+            .rms;
+        assert!(
+            r.variance_factor > 0.5 && r.variance_factor < 2.0,
+            "{}",
+            r.variance_factor
+        );
     }
     let ratio = predicted / measured;
-    assert!((0.5..2.0).contains(&ratio), "predicted/measured validation std {ratio}");
+    assert!(
+        (0.5..2.0).contains(&ratio),
+        "predicted/measured validation std {ratio}"
+    );
     let ratio = cv / within;
-    assert!((0.5..2.0).contains(&ratio), "cross-validation/within-station {ratio}");
+    assert!(
+        (0.5..2.0).contains(&ratio),
+        "cross-validation/within-station {ratio}"
+    );
 }
 
 #[test]
@@ -245,7 +328,8 @@ fn the_loop_of_format_md_holds_for_ml() {
     let mut options = ml_options(&session);
     // A threshold above the starting ε: one entry, no update.
     options.threshold = 1e6;
-    let cal = calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue).expect("run");
+    let cal =
+        calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue).expect("run");
     assert_eq!(cal.iterations.len(), 1);
     assert_eq!(cal.stop.code(), "threshold");
     // Threshold 0: one update (a complete LM solve), then LM has converged.
@@ -265,7 +349,8 @@ fn the_loop_of_format_md_holds_for_ml() {
     assert!((r.iterations.last().map_or(0.0, |i| i.epsilon) - cal.epsilon_after()).abs() < 1e-12);
     // No update allowed: the start is reported, with its diagnostics.
     options.max_iterations = 0;
-    let cal = calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue).expect("run");
+    let cal =
+        calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue).expect("run");
     assert_eq!(cal.iterations.len(), 1);
     assert_eq!(cal.stop.code(), "max_iterations");
     // Cancel.
@@ -274,8 +359,12 @@ fn the_loop_of_format_md_holds_for_ml() {
     assert!(err.to_string().contains("cancelled"), "{err}");
     // Bad options are input errors.
     options.ml.joint_sigma_deg = -1.0;
-    let err = calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue).unwrap_err();
-    assert!(err.is_input_error() && err.to_string().contains("joint sigma"), "{err}");
+    let err =
+        calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue).unwrap_err();
+    assert!(
+        err.is_input_error() && err.to_string().contains("joint sigma"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -38,7 +38,7 @@ pub enum Command {
     Calibrate(CalibrateArgs),
     /// Write a simulated session with a known truth (for tests, demos and what-if studies).
     Simulate(simulate::SimulateArgs),
-        /// Open the workbench, optionally on a session file.
+    /// Open the workbench, optionally on a session file.
     Gui(GuiArgs),
     /// Compare the paper's method, `ml` and the noise floor on simulated scenarios (README evidence).
     Evaluate(evaluate::EvaluateArgs),
@@ -62,7 +62,7 @@ pub struct CalibrateArgs {
     /// Where to write the result file (FORMAT.md `spherecal-result`).
     #[arg(long, short)]
     pub out: PathBuf,
-        /// Identification method: `paper` (the paper's section 3.2) or `ml` (maximum likelihood).
+    /// Identification method: `paper` (the paper's section 3.2) or `ml` (maximum likelihood).
     #[arg(long, default_value = "paper", value_parser = parse_method)]
     pub method: Method,
     /// Leave these measurements out (comma-separated ids), e.g. the outliers `ml` listed.
@@ -144,7 +144,8 @@ impl MlArgs {
 }
 
 fn parse_loss(s: &str) -> Result<Loss, String> {
-    Loss::parse(s).ok_or_else(|| format!("unknown loss `{s}`, expected `squared`, `huber` or `cauchy`"))
+    Loss::parse(s)
+        .ok_or_else(|| format!("unknown loss `{s}`, expected `squared`, `huber` or `cauchy`"))
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {
@@ -219,7 +220,7 @@ impl CliError {
 /// [`CliError`] with status 2 for bad input, 1 for internal failures.
 pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     let started = Instant::now();
-        let session =
+    let session =
         session::load_session(&args.session).map_err(|e| CliError::from_file(&e, true))?;
     let session = if args.exclude.is_empty() {
         session
@@ -275,7 +276,7 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     let result = report::result_file(&session, &prepared, &cal);
     session::save_result(&result, &args.out).map_err(|e| CliError::from_file(&e, false))?;
     if !quiet {
-                print!("{}", report::summary(&session, &cal));
+        print!("{}", report::summary(&session, &cal));
         if let Some(r) = MlReport::from_solver_block(&cal.solver) {
             print!("{}", r.summary());
         }

@@ -1602,12 +1602,15 @@ fn restricted(a: &DMatrix<f64>, problem: &Problem) -> DVector<f64> {
     )
 }
 
+/// A sighting with its base-frame centre covariance (mm²).
+type NoisySighting = (Sighting, Matrix3<f64>);
+
 /// Predicted σ of the distances between pairs of sightings.
 fn distance_std(
     problem: &Problem,
     est: &Estimate,
     cov: &DMatrix<f64>,
-    pairs: &[((Sighting, Matrix3<f64>), (Sighting, Matrix3<f64>))],
+    pairs: &[(NoisySighting, NoisySighting)],
 ) -> DistanceStd {
     let mut out = DistanceStd {
         pairs: pairs.len(),
@@ -1806,7 +1809,7 @@ fn diagnostics(
     let dof = (3 * problem.obs.len()).saturating_sub(problem.dim()).max(1);
     let variance_factor = chi2 / dof as f64;
     // Predicted distance σ.
-    let noisy = |i: usize| -> (Sighting, Matrix3<f64>) {
+    let noisy = |i: usize| -> NoisySighting {
         let s = prepared.sighting(session, i);
         let cov = base_covariance(
             &state.est,
