@@ -219,6 +219,13 @@ pub struct ResultView {
     pub dropped: Vec<String>,
     /// `solver.fixed`: parameters a method held fixed.
     pub fixed: Vec<String>,
+    /// `solver.estimated`: parameters a method estimated (when it says).
+    pub estimated: Vec<String>,
+    /// `solver.inseparable` and `solver.strong_correlations`: what the
+    /// method says about parameters the data cannot tell apart.
+    pub caveats: Vec<String>,
+    /// Every entry of the `solver` block as text (values as compact JSON).
+    pub solver_entries: Vec<(String, String)>,
     /// Parameter labels (`theta1`, `he_z`, …) not identifiable from this
     /// data, each with why.
     pub marked: BTreeMap<String, String>,
@@ -276,6 +283,23 @@ impl ResultView {
         let dropped = texts("dropped_directions");
         let fixed = texts("fixed");
         let marked = marked_parameters(&dropped, &fixed);
+        let estimated = texts("estimated");
+        let mut caveats = texts("inseparable");
+        caveats.extend(
+            texts("strong_correlations")
+                .into_iter()
+                .map(|c| format!("strongly correlated: {c}")),
+        );
+        let solver_entries = solver
+            .iter()
+            .map(|(k, v)| {
+                let text = match v {
+                    Value::String(t) => t.clone(),
+                    other => other.to_string(),
+                };
+                (k.clone(), text)
+            })
+            .collect();
 
         let mut notes = Vec::new();
         let index_of = |id: &str| -> Option<usize> {
@@ -370,6 +394,9 @@ impl ResultView {
                 .and_then(|k| usize::try_from(k).ok()),
             dropped,
             fixed,
+            estimated,
+            caveats,
+            solver_entries,
             marked,
             hand_eye_before: HandEyeView::new(&file.hand_eye_initial),
             hand_eye_after: HandEyeView::new(&file.hand_eye),

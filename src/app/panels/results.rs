@@ -18,6 +18,10 @@ use crate::app::view::{HandEyeView, ResultOrigin, ResultView};
 use crate::engine::identify::HAND_EYE_LABELS;
 use crate::engine::kinematics::{PARAM_NAMES, PARAMS_PER_JOINT};
 
+/// Longest solver-block value shown in full (longer ones are cut, the
+/// whole value is in the tooltip and the exported JSON).
+const SOLVER_ENTRY_CHARS: usize = 300;
+
 /// Singular values with their index.
 type Indexed = Vec<(usize, f64)>;
 
@@ -43,9 +47,9 @@ pub fn results_ui(
         .auto_shrink([false, false])
         .show(ui, |ui| {
             origin_ui(ui, view);
+            export_ui(ui, state, forms, commands);
             let top = ui.cursor().min;
             headline_ui(ui, view);
-            export_ui(ui, state, forms, commands);
             ui.add_space(4.0);
             let bottom = plots_ui(ui, view);
             plots_rect = Some(Rect::from_min_max(
@@ -198,7 +202,12 @@ fn plots_ui(ui: &mut egui::Ui, view: &ResultView) -> f32 {
             view.threshold,
             PLOT_HEIGHT,
         );
-        cols[1].label(RichText::new("Singular values of the last update").strong());
+        let title = if view.singular_values.is_empty() && !view.fixed.is_empty() {
+            "Identifiable set"
+        } else {
+            "Singular values of the last update"
+        };
+        cols[1].label(RichText::new(title).strong());
         singular_ui(&mut cols[1], view);
     });
     ui.min_rect().bottom()
@@ -357,9 +366,14 @@ fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
         .collect();
     if values.is_empty() {
         ui.allocate_ui(egui::vec2(ui.available_width(), PLOT_HEIGHT), |ui| {
-            ui.label(
-                RichText::new("No update was made: ε started below the threshold.").color(MUTED),
-            );
+            if view.fixed.is_empty() && view.estimated.is_empty() {
+                ui.label(
+                    RichText::new("No update was made: ε started below the threshold.")
+                        .color(MUTED),
+                );
+            } else {
+                identifiable_set_ui(ui, view);
+            }
         });
         return;
     }
@@ -417,6 +431,26 @@ fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
     }
 }
 
+/// What a method that chooses its identifiable set (rather than truncating
+/// an SVD) estimated and held fixed.
+fn identifiable_set_ui(ui: &mut egui::Ui, view: &ResultView) {
+    ui.label(format!(
+        "Method {} estimated {} parameter(s) and held {} fixed (not identifiable from centre distances):",
+        view.method,
+        view.estimated.len(),
+        view.fixed.len()
+    ));
+    egui::ScrollArea::vertical()
+        .id_salt("identifiable_set")
+        .max_height(PLOT_HEIGHT - 30.0)
+        .show(ui, |ui| {
+            ui.label(RichText::new(format!("fixed: {}", view.fixed.join(", "))).color(MUTED));
+            for c in &view.caveats {
+                ui.label(RichText::new(c).small());
+            }
+        });
+}
+
 fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
     ui.columns(2, |cols| {
         hand_eye_ui(&mut cols[0], view);
@@ -434,6 +468,24 @@ fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
             }
         });
     }
+    egui::CollapsingHeader::new("Solver block of the result (all entries)").show(ui, |ui| {
+        egui::Grid::new("solver_entries")
+            .striped(true)
+            .num_columns(2)
+            .show(ui, |ui| {
+                for (k, v) in &view.solver_entries {
+                    ui.monospace(k);
+                    let short: String = v.chars().take(SOLVER_ENTRY_CHARS).collect();
+                    let shown = if short.len() < v.len() {
+                        format!("{short}…")
+                    } else {
+                        short
+                    };
+                    ui.add(egui::Label::new(shown).wrap()).on_hover_text(v);
+                    ui.end_row();
+                }
+            });
+    });
 }
 
 fn marked_cell(ui: &mut egui::Ui, view: &ResultView, label: &str, text: String) {

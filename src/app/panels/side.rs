@@ -231,16 +231,20 @@ fn settings_ui(ui: &mut egui::Ui, forms: &mut Forms) {
                 .response
                 .on_hover_text("identification method");
             ui.end_row();
+            let paper = s.method == Method::Paper;
             ui.label("Pairs");
-            egui::ComboBox::from_id_salt("pairing")
-                .selected_text(s.pairing.as_str())
-                .show_ui(ui, |ui| {
-                    for p in [Pairing::Disjoint, Pairing::All] {
-                        ui.selectable_value(&mut s.pairing, p, p.as_str());
-                    }
-                })
-                .response
-                .on_hover_text("pairs of a station's measurements: disjoint (1,2),(3,4),… as in the paper, or all");
+            ui.add_enabled_ui(paper, |ui| {
+                egui::ComboBox::from_id_salt("pairing")
+                    .selected_text(s.pairing.as_str())
+                    .show_ui(ui, |ui| {
+                        for p in [Pairing::Disjoint, Pairing::All] {
+                            ui.selectable_value(&mut s.pairing, p, p.as_str());
+                        }
+                    })
+                    .response
+                    .on_hover_text("pairs of a station's measurements: disjoint (1,2),(3,4),… as in the paper, or all")
+                    .on_disabled_hover_text("used by the paper's method only");
+            });
             ui.end_row();
             let l = ui.label("Threshold");
             ui.add(
@@ -258,7 +262,8 @@ fn settings_ui(ui: &mut egui::Ui, forms: &mut Forms) {
                 .labelled_by(l.id);
             ui.end_row();
             let l = ui.label("SVD tolerance");
-            ui.add(
+            ui.add_enabled(
+                paper,
                 egui::DragValue::new(&mut s.svd_tolerance)
                     .range(1e-12..=0.5)
                     .speed(1e-5)
@@ -266,7 +271,8 @@ fn settings_ui(ui: &mut egui::Ui, forms: &mut Forms) {
                     .custom_parser(|t| t.trim().parse::<f64>().ok()),
             )
             .labelled_by(l.id)
-            .on_hover_text("singular values below this fraction of the largest are dropped (truncated SVD)");
+            .on_hover_text("singular values below this fraction of the largest are dropped (truncated SVD)")
+            .on_disabled_hover_text("used by the paper's method only");
             ui.end_row();
         });
 }
