@@ -399,3 +399,47 @@ fn exports_are_written_to_the_chosen_folder() {
         "the folder is remembered"
     );
 }
+
+#[test]
+fn clicking_a_centre_in_the_3d_view_selects_its_measurement() {
+    let mut h = demo_app();
+    h.get_by_label("Centres").click();
+    h.run();
+    let rect = h
+        .get_by_label(spherecal::app::panels::centres::ORBIT_LABEL)
+        .rect();
+    let positions = {
+        let app = h.state();
+        let set = app
+            .state()
+            .loaded
+            .as_ref()
+            .and_then(|l| l.before.as_ref().ok())
+            .expect("centres before calibration");
+        spherecal::app::panels::centres::orbit_positions(set, &app.forms().centres, rect)
+    };
+    // A centre well inside the view that no other centre covers: a click on
+    // it picks the nearest marker, itself.
+    let (pos, index) = positions
+        .iter()
+        .filter(|(p, i)| i.is_some() && rect.shrink(20.0).contains(*p))
+        .find(|(p, i)| {
+            positions
+                .iter()
+                .all(|(q, j)| j == i || p.distance(*q) > 2.0)
+        })
+        .copied()
+        .expect("an isolated centre");
+    let index = index.expect("measurement index");
+    assert_ne!(h.state().state().selected, Some(index));
+    for pressed in [true, false] {
+        h.event(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+    }
+    h.run();
+    assert_eq!(h.state().state().selected, Some(index));
+}

@@ -457,8 +457,8 @@ impl Prefs {
 /// the app is idle).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Busy {
-    /// A session or result file is being read.
-    pub loading: bool,
+    /// Session or result files being read.
+    pub loading: usize,
     /// A file dialog is open.
     pub dialog: bool,
     /// The edited session is being written.
@@ -512,7 +512,7 @@ impl AppState {
     #[must_use]
     pub fn is_busy(&self) -> bool {
         self.run.is_some()
-            || self.busy.loading
+            || self.busy.loading > 0
             || self.busy.dialog
             || self.busy.saving
             || self.busy.exporting > 0

@@ -251,7 +251,6 @@ impl WorkbenchApp {
     fn apply(&mut self, ctx: &egui::Context, command: Command) {
         match command {
             Command::OpenDemo => {
-                self.state.busy.loading = true;
                 self.state.say(Level::Info, "opening the demo session…");
                 let started = self.spawn(ctx, "load", |rep| {
                     rep.send(match work::open_demo() {
@@ -259,7 +258,9 @@ impl WorkbenchApp {
                         Err(e) => JobMessage::LoadFailed(e),
                     });
                 });
-                self.state.busy.loading = started;
+                if started {
+                    self.state.busy.loading += 1;
+                }
             }
             Command::OpenPath(path) => self.open_path(ctx, path),
             Command::Browse(purpose) => self.browse(ctx, purpose),
@@ -355,7 +356,9 @@ impl WorkbenchApp {
                 Err(e) => JobMessage::LoadFailed(e),
             });
         });
-        self.state.busy.loading = started;
+        if started {
+            self.state.busy.loading += 1;
+        }
     }
 
     fn browse(&mut self, ctx: &egui::Context, purpose: DialogPurpose) {
@@ -548,7 +551,7 @@ impl WorkbenchApp {
         match message {
             JobMessage::SessionLoaded(loaded) => self.on_session(ctx, *loaded),
             JobMessage::ResultLoaded { path, view } => {
-                self.state.busy.loading = false;
+                self.state.busy.loading = self.state.busy.loading.saturating_sub(1);
                 self.state.prefs.remember(&path);
                 let notes = view.notes.join("; ");
                 self.forms.centres.magnify = view.centres.suggested_magnify;
@@ -570,7 +573,7 @@ impl WorkbenchApp {
                 }
             }
             JobMessage::LoadFailed(LoadFailure { what, message }) => {
-                self.state.busy.loading = false;
+                self.state.busy.loading = self.state.busy.loading.saturating_sub(1);
                 self.state
                     .say(Level::Error, format!("could not open {what}"));
                 self.state.notice = Some(Notice {
@@ -684,7 +687,7 @@ impl WorkbenchApp {
     }
 
     fn on_session(&mut self, ctx: &egui::Context, loaded: LoadedSession) {
-        self.state.busy.loading = false;
+        self.state.busy.loading = self.state.busy.loading.saturating_sub(1);
         if let Some(run) = self.state.run.take() {
             // The run was of the previous session: stop it, forget it.
             run.cancel.store(true, Ordering::Relaxed);

@@ -166,6 +166,96 @@ fn markers(set: &CentreSet, f: &CentresForm) -> Vec<Marker> {
     out
 }
 
+/// The accessible name of the 3D view.
+pub const ORBIT_LABEL: &str = "3D view of the sphere centres";
+
+/// The orthographic camera of the orbit view, fitted to the markers.
+struct Orbit {
+    centre: [f64; 3],
+    scale: f64,
+    screen_centre: Pos2,
+    cy: f64,
+    sy: f64,
+    cp: f64,
+    sp: f64,
+}
+
+impl Orbit {
+    /// Centre of the markers' bounding box in the middle of `rect`, its
+    /// half-diagonal filling 45 % of the shorter side (times the zoom).
+    fn fit(markers: &[Marker], cam: &Camera, rect: Rect) -> Self {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for m in markers {
+            for k in 0..3 {
+                lo[k] = lo[k].min(m.pos[k]);
+                hi[k] = hi[k].max(m.pos[k]);
+            }
+        }
+        let centre = [
+            (lo[0] + hi[0]) / 2.0,
+            (lo[1] + hi[1]) / 2.0,
+            (lo[2] + hi[2]) / 2.0,
+        ];
+        let half = (0..3)
+            .map(|k| (hi[k] - lo[k]) / 2.0)
+            .map(|d| d * d)
+            .sum::<f64>()
+            .sqrt()
+            .max(1e-6);
+        let (sy, cy) = f64::from(cam.yaw).sin_cos();
+        let (sp, cp) = f64::from(cam.pitch).sin_cos();
+        Self {
+            centre,
+            scale: f64::from(rect.width().min(rect.height())) * 0.45 / half * f64::from(cam.zoom),
+            screen_centre: rect.center(),
+            cy,
+            sy,
+            cp,
+            sp,
+        }
+    }
+
+    /// Screen position and depth of a base-frame point. The view rotates
+    /// about z by the yaw, then tilts about the screen x axis by the pitch:
+    /// screen right = rotated x, screen up = z·cos(pitch) − depth·sin(pitch).
+    fn project(&self, p: [f64; 3]) -> (Pos2, f64) {
+        let (x, y, z) = (
+            p[0] - self.centre[0],
+            p[1] - self.centre[1],
+            p[2] - self.centre[2],
+        );
+        let xr = self.cy * x - self.sy * y;
+        let yr = self.sy * x + self.cy * y;
+        let up = z * self.cp - yr * self.sp;
+        let depth = yr * self.cp + z * self.sp;
+        (
+            Pos2::new(
+                self.screen_centre.x + (xr * self.scale) as f32,
+                self.screen_centre.y - (up * self.scale) as f32,
+            ),
+            depth,
+        )
+    }
+}
+
+/// Where the 3D view in `rect` draws each centre: screen position and
+/// measurement index (before and after markers alike). For tests and tools
+/// that need to point at a centre.
+#[must_use]
+pub fn orbit_positions(
+    set: &CentreSet,
+    form: &CentresForm,
+    rect: Rect,
+) -> Vec<(Pos2, Option<usize>)> {
+    let markers = markers(set, form);
+    let view = Orbit::fit(&markers, &form.camera, rect);
+    markers
+        .iter()
+        .map(|m| (view.project(m.pos).0, m.index))
+        .collect()
+}
+
 /// The orthographic orbit view. Returns the measurement clicked.
 fn orbit_ui(
     ui: &mut egui::Ui,
@@ -176,6 +266,7 @@ fn orbit_ui(
     selected: Option<usize>,
 ) -> Option<usize> {
     let (response, painter) = ui.allocate_painter(size, Sense::click_and_drag());
+    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, ORBIT_LABEL));
     let response = response.on_hover_text("sphere centres in the robot base frame");
     let rect = response.rect;
     painter.rect_filled(rect, 4.0, ui.visuals().extreme_bg_color);
@@ -200,45 +291,9 @@ fn orbit_ui(
         );
         return None;
     }
-    // Fit: centre of the bounding box, scale so its half-diagonal fills the view.
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for m in markers {
-        for k in 0..3 {
-            lo[k] = lo[k].min(m.pos[k]);
-            hi[k] = hi[k].max(m.pos[k]);
-        }
-    }
-    let centre = [
-        (lo[0] + hi[0]) / 2.0,
-        (lo[1] + hi[1]) / 2.0,
-        (lo[2] + hi[2]) / 2.0,
-    ];
-    let half = (0..3)
-        .map(|k| (hi[k] - lo[k]) / 2.0)
-        .map(|d| d * d)
-        .sum::<f64>()
-        .sqrt()
-        .max(1e-6);
-    let scale = f64::from(rect.width().min(rect.height())) * 0.45 / half * f64::from(cam.zoom);
-    let (sy, cy) = f64::from(cam.yaw).sin_cos();
-    let (sp, cp) = f64::from(cam.pitch).sin_cos();
-    // View: rotate about z by yaw, then tilt about the screen x axis by pitch;
-    // screen right = rotated x, screen up = z·cos(pitch) − depth·sin(pitch).
-    let project = |p: [f64; 3]| -> (Pos2, f64) {
-        let (x, y, z) = (p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]);
-        let xr = cy * x - sy * y;
-        let yr = sy * x + cy * y;
-        let up = z * cp - yr * sp;
-        let depth = yr * cp + z * sp;
-        (
-            Pos2::new(
-                rect.center().x + (xr * scale) as f32,
-                rect.center().y - (up * scale) as f32,
-            ),
-            depth,
-        )
-    };
+    let view = Orbit::fit(markers, cam, rect);
+    let project = |p: [f64; 3]| view.project(p);
+    let (cy, sy, cp, sp) = (view.cy, view.sy, view.cp, view.sp);
     let mut drawn: Vec<(Pos2, f64, &Marker)> = markers
         .iter()
         .map(|m| {

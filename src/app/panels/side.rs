@@ -146,7 +146,9 @@ pub fn solver_ui(
     let running = state.run.is_some();
     ui.add_enabled_ui(!running, |ui| settings_ui(ui, forms));
     ui.add_space(6.0);
-    let can_run = !running && state.loaded.as_ref().is_some_and(|l| l.before.is_ok());
+    // A session whose stripes do not all fit can still run once the
+    // failing measurements are left out: the run reports what fails.
+    let can_run = !running && state.loaded.is_some();
     ui.horizontal(|ui| {
         let run = ui.add_enabled(
             can_run,
@@ -173,7 +175,13 @@ pub fn solver_ui(
     if let Some(l) = &state.loaded
         && let Err(e) = &l.before
     {
-        ui.label(RichText::new(format!("cannot run: {e}")).color(BAD).small());
+        ui.label(
+            RichText::new(format!(
+                "the whole session cannot be prepared: {e}; leave out what fails"
+            ))
+            .color(BAD)
+            .small(),
+        );
     }
     let excluded = state.excluded_count();
     if excluded > 0 && !running {
