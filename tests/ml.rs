@@ -220,6 +220,7 @@ fn an_outlier_is_listed_and_excluding_it_restores_accuracy() {
         "{}",
         o.reason
     );
+    eprintln!("outlier {}: {}", o.measurement, o.reason);
     let spoiled_std = truth_score(&spoiled, &prepared, &truth, &cal).after.std;
     let paper_std = truth_score(&spoiled, &prepared, &truth, &paper).after.std;
     eprintln!("clean {clean_std:.4}, with outlier: ml {spoiled_std:.4}, paper {paper_std:.4}");
