@@ -2,11 +2,20 @@
 //! estimators must recover the truth exactly without noise and come within
 //! a stated factor of the noise floor with it.
 
-use spherecal::engine::calibrate::{self, Options, Prepared};
+use spherecal::engine::calibrate::{self, Method, Options, Prepared};
 use spherecal::engine::evaluate;
 use spherecal::engine::kinematics::Robot;
 use spherecal::engine::model::{Session, Use};
 use spherecal::engine::simulate::{self, SimConfig, Truth};
+
+/// The paper's method: these tests are its baseline (the `ml` method,
+/// the default, has its own in `tests/ml.rs`).
+fn paper_options(session: &Session) -> Options {
+    Options {
+        method: Method::Paper,
+        ..Options::from_session(session)
+    }
+}
 
 fn simulate(config: &SimConfig) -> (Session, Truth) {
     simulate::simulate(config).expect("simulation")
@@ -31,7 +40,7 @@ fn run(
     threshold: f64,
     max_iterations: usize,
 ) -> (Prepared, calibrate::Calibration) {
-    let mut options = Options::from_session(session);
+    let mut options = paper_options(session);
     options.threshold = threshold;
     options.max_iterations = max_iterations;
     calibrate::calibrate(session, &options).expect("calibration")
@@ -145,7 +154,7 @@ fn epsilon_series_follows_the_loop_of_format_md() {
     });
     // A threshold above the starting ε: one entry, no update.
     let prepared = calibrate::prepare(&session).unwrap();
-    let mut options = Options::from_session(&session);
+    let mut options = paper_options(&session);
     options.threshold = 1e6;
     let cal = calibrate::run(&session, &prepared, &options, &mut |_| {
         calibrate::Control::Continue
@@ -177,7 +186,7 @@ fn epsilon_series_follows_the_loop_of_format_md() {
 fn cancel_stops_the_loop() {
     let (session, _) = simulate(&SimConfig::default());
     let prepared = calibrate::prepare(&session).unwrap();
-    let mut options = Options::from_session(&session);
+    let mut options = paper_options(&session);
     options.threshold = 0.0;
     let err = calibrate::run(&session, &prepared, &options, &mut |p| {
         if p.updates >= 2 {
@@ -194,6 +203,6 @@ fn cancel_stops_the_loop() {
 fn too_little_identify_data_is_explained() {
     let (mut session, _) = simulate(&SimConfig::default());
     session.measurements.retain(|m| m.usage != Use::Identify);
-    let err = calibrate::calibrate(&session, &Options::from_session(&session)).unwrap_err();
+    let err = calibrate::calibrate(&session, &paper_options(&session)).unwrap_err();
     assert!(err.to_string().contains("identify station"), "{err}");
 }

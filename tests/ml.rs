@@ -25,6 +25,13 @@ fn ml_options(session: &Session) -> Options {
     o
 }
 
+/// The paper's method, the baseline `ml` is compared with.
+fn paper_options(session: &Session) -> Options {
+    let mut o = Options::from_session(session);
+    o.method = Method::Paper;
+    o
+}
+
 fn run(session: &Session, options: &Options) -> (Prepared, Calibration) {
     calibrate::calibrate(session, options).expect("calibration")
 }
@@ -94,7 +101,7 @@ fn noisy_sessions_reach_near_the_floor_and_beat_the_paper() {
             seed,
             ..SimConfig::default()
         });
-        let (prepared, paper) = run(&session, &Options::from_session(&session));
+        let (prepared, paper) = run(&session, &paper_options(&session));
         let (_, ml) = run(&session, &ml_options(&session));
         let p = truth_score(&session, &prepared, &truth, &paper);
         let m = truth_score(&session, &prepared, &truth, &ml);
@@ -203,9 +210,9 @@ fn an_outlier_is_listed_and_excluding_it_restores_accuracy() {
     if let Observation::Centre(c) = &mut spoiled.measurements[bad].observation {
         c.x += 2.0;
     }
-    let mut paper_options = Options::from_session(&spoiled);
-    paper_options.threshold = 0.0;
-    let (prepared, paper) = run(&spoiled, &paper_options);
+    let mut paper = paper_options(&spoiled);
+    paper.threshold = 0.0;
+    let (prepared, paper) = run(&spoiled, &paper);
     let (_, cal) = run(&spoiled, &ml_options(&spoiled));
     let r = report(&cal);
     assert_eq!(r.outliers.len(), 1, "{:?}", r.outliers);

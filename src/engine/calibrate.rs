@@ -52,7 +52,7 @@ impl Method {
     }
 
     /// Every method, the default first.
-    pub const ALL: [Self; 2] = [Self::Paper, Self::Ml];
+    pub const ALL: [Self; 2] = [Self::Ml, Self::Paper];
 }
 
 /// Everything that steers a run.
@@ -72,10 +72,12 @@ pub struct Options {
 
 impl Options {
     /// Defaults, with threshold and iteration bound from the session file.
+    /// The method is `ml`: over five simulated scenarios it comes nearer the
+    /// noise floor than the paper's method in every one (README, Evidence).
     #[must_use]
     pub fn from_session(session: &Session) -> Self {
         Self {
-            method: Method::Paper,
+            method: Method::Ml,
             threshold: session.solver.threshold,
             max_iterations: session.solver.max_iterations,
             paper: PaperOptions::default(),
