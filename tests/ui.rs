@@ -221,25 +221,11 @@ fn session_name() -> String {
 #[test]
 fn cancel_stops_a_run() {
     let mut h = demo_app();
-    // A run that cannot converge: threshold 0, many iterations.
-    h.state_mut().forms_mut().solver.threshold = 0.0;
-    h.state_mut().forms_mut().solver.max_iterations = 500;
+    // Press Run, then Cancel: the harness runs one frame per queued event,
+    // so Cancel lands microseconds after the solver thread starts, long
+    // before it has fitted the stripes and reported its first ε (where it
+    // checks the flag).
     h.get_by_label("▶ Run").click();
-    h.step();
-    // Wait for the first ε, then press Cancel.
-    for _ in 0..MAX_FRAMES {
-        h.step();
-        if h.state()
-            .state()
-            .run
-            .as_ref()
-            .is_some_and(|r| !r.epsilons.is_empty())
-        {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    assert!(h.state().state().run.is_some(), "the run was still going");
     h.get_by_label("Cancel").click();
     settle(&mut h);
     let state = h.state().state();

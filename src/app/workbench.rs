@@ -130,6 +130,20 @@ impl WorkbenchApp {
         self.apply(ctx, command);
     }
 
+    /// The non-drawing part of a frame: the start-up commands, the job
+    /// messages, the screenshot timeout. Also run while the window is
+    /// hidden (eframe's `logic`), so that a long run never waits on a full
+    /// channel.
+    pub fn pump(&mut self, ctx: &egui::Context) {
+        for c in std::mem::take(&mut self.startup) {
+            self.apply(ctx, c);
+        }
+        for message in self.jobs.drain() {
+            self.on_message(ctx, message);
+        }
+        self.screenshot_timeout(ctx);
+    }
+
     /// One frame: drain job messages, draw everything, apply the commands.
     pub fn show(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
@@ -138,13 +152,7 @@ impl WorkbenchApp {
             install_fonts(&ctx);
             self.fonts_installed = true;
         }
-        for c in std::mem::take(&mut self.startup) {
-            self.apply(&ctx, c);
-        }
-        for message in self.jobs.drain() {
-            self.on_message(&ctx, message);
-        }
-        self.screenshot_timeout(&ctx);
+        self.pump(&ctx);
         let mut commands = Vec::new();
         self.input_commands(&ctx, &mut commands);
         egui::Panel::bottom("status").show(ui, |ui| panels::status::status_ui(ui, &self.state));
@@ -788,6 +796,10 @@ impl WorkbenchApp {
 }
 
 impl eframe::App for WorkbenchApp {
+    fn logic(&mut self, ctx: &egui::Context, _frame: &mut eframe::Frame) {
+        self.pump(ctx);
+    }
+
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.show(ui);
     }
