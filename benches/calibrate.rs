@@ -2,6 +2,9 @@
 //! from the stripes plus the initial hand-eye (`prepare`), and the
 //! identification loop (`run`) of each method.
 
+// A benchmark aborts on data it cannot load: there is nothing to recover.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};

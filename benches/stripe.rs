@@ -1,6 +1,7 @@
 //! Benchmark of the stripe circle fit: one 60-point arc over 110° with
 //! 0.02 mm noise at the paper's 40° cut of a 38.1 mm sphere (a typical
 //! stripe of the demo calibration), reported in points per second.
+
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use std::hint::black_box;

@@ -2,6 +2,9 @@
 //! a result file on success; exit 2, one `error:` line naming file and
 //! measurement, and no file on bad input.
 
+// Test helpers may panic: a panic is a test failure with its message.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

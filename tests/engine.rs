@@ -2,6 +2,9 @@
 //! estimators must recover the truth exactly without noise and come within
 //! a stated factor of the noise floor with it.
 
+// Test helpers may panic: a panic is a test failure with its message.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use spherecal::engine::calibrate::{self, Method, Options, Prepared};
 use spherecal::engine::evaluate;
 use spherecal::engine::kinematics::Robot;

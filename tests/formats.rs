@@ -534,12 +534,12 @@ fn every_invalid_fixture_fails_with_its_message() {
                         "{name}: message does not end with the path: {text}"
                     ));
                 }
-                if let Some(id) = measurement {
-                    if !text.starts_with(&format!("measurement {id}: ")) {
-                        failures.push(format!(
-                            "{name}: message does not start with the measurement: {text}"
-                        ));
-                    }
+                if let Some(id) = measurement
+                    && !text.starts_with(&format!("measurement {id}: "))
+                {
+                    failures.push(format!(
+                        "{name}: message does not start with the measurement: {text}"
+                    ));
                 }
             }
         }
