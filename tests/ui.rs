@@ -12,7 +12,7 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
 use spherecal::app::state::{Prefs, Tab};
-use spherecal::engine::calibrate::{Options, calibrate};
+use spherecal::engine::calibrate::{Method, Options, calibrate};
 use spherecal::engine::session::parse_session;
 
 /// Frames to wait for background work (with a short sleep each): generous
@@ -221,11 +221,24 @@ fn session_name() -> String {
 #[test]
 fn cancel_stops_a_run() {
     let mut h = demo_app();
-    // Press Run, then Cancel: the harness runs one frame per queued event,
-    // so Cancel lands microseconds after the solver thread starts, long
-    // before it has fitted the stripes and reported its first ε (where it
-    // checks the flag).
+    // A run that only Cancel can end: the paper's method with threshold 0
+    // and an iteration bound of a million updates (hours of work). The
+    // solver checks the cancel flag at every ε, so whenever Cancel lands
+    // the run stops within one update; without a working Cancel, `settle`
+    // gives up and the test fails.
+    {
+        let solver = &mut h.state_mut().forms_mut().solver;
+        solver.method = Method::Paper;
+        solver.threshold = 0.0;
+        solver.max_iterations = 1_000_000;
+    }
     h.get_by_label("▶ Run").click();
+    // Let the run get going (the window repaints while it works).
+    for _ in 0..10 {
+        h.step();
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert!(h.state().is_busy(), "the long run is under way");
     h.get_by_label("Cancel").click();
     settle(&mut h);
     let state = h.state().state();
