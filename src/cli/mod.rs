@@ -7,6 +7,7 @@
 //! atomically or not at all.
 
 pub mod evaluate;
+pub mod import;
 pub mod simulate;
 
 use std::path::{Path, PathBuf};
@@ -42,6 +43,8 @@ pub enum Command {
     Gui(GuiArgs),
     /// Compare the paper's method, `ml` and the noise floor on simulated scenarios (README evidence).
     Evaluate(evaluate::EvaluateArgs),
+    /// Build a session file from a joint log CSV and stripe profile files (mm, deg in the session; units of the inputs chosen by flags).
+    Import(import::ImportArgs),
 }
 
 /// `spherecal gui`.

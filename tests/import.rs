@@ -1,0 +1,488 @@
+//! `spherecal import` against a simulated session: its joints and stripes
+//! written as CSV files must import back to the same measurements and
+//! calibrate; the flange-pose check must pass correct poses in all four
+//! conventions and flag unit and joint-order mistakes with the right hint.
+
+// Test helpers may panic: a panic is a test failure with its message.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::fmt::Write as _;
+use std::fs;
+use std::path::Path;
+
+use spherecal::engine::calibrate::{self, Options};
+use spherecal::engine::import::{
+    self, AngleUnit, ColumnMap, DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention,
+    ImportError, ImportSpec, LengthUnit, ProfileSource, RobotSource,
+};
+use spherecal::engine::kinematics;
+use spherecal::engine::model::{Observation, Session};
+use spherecal::engine::simulate::{self, SimConfig};
+
+const CONVENTIONS: [FlangeConvention; 4] = [
+    FlangeConvention::AbbQuaternion,
+    FlangeConvention::KukaAbc,
+    FlangeConvention::FanucWpr,
+    FlangeConvention::UrRotationVector,
+];
+
+/// How the test log is written.
+struct LogOptions {
+    /// Joints written in radians.
+    radians: bool,
+    /// Write joint 2's value under `j3` and joint 3's under `j2`.
+    swap_23: bool,
+    /// Flange poses in this convention (from the nominal FK of the true joints).
+    flange: Option<FlangeConvention>,
+    /// Use semicolons as separators.
+    semicolon: bool,
+}
+
+const PLAIN: LogOptions = LogOptions {
+    radians: false,
+    swap_23: false,
+    flange: None,
+    semicolon: false,
+};
+
+fn simulated() -> Session {
+    simulate::simulate(&SimConfig::default()).unwrap().0
+}
+
+/// Writes `log.csv` and `profiles/<id>.csv` for the session into `dir`.
+fn write_files(session: &Session, dir: &Path, o: &LogOptions) {
+    let sep = if o.semicolon { ";" } else { "," };
+    let nominal = kinematics::irb2400().robot;
+    let mut text = String::from("# joint log written by tests/import.rs\n");
+    let mut header = vec![
+        "id", "station", "use", "side", "j1", "j2", "j3", "j4", "j5", "j6",
+    ]
+    .into_iter()
+    .map(String::from)
+    .collect::<Vec<_>>();
+    if let Some(c) = o.flange {
+        header.extend(c.default_columns());
+    }
+    writeln!(text, "{}", header.join(sep)).unwrap();
+    let profiles = dir.join("profiles");
+    fs::create_dir_all(&profiles).unwrap();
+    for m in &session.measurements {
+        let mut fields = vec![
+            m.id.clone(),
+            m.station.clone(),
+            m.usage.as_str().to_string(),
+            format!("{}", m.side),
+        ];
+        let mut q = m.joints.clone();
+        if o.swap_23 {
+            q.swap(1, 2);
+        }
+        for v in &q {
+            let v = if o.radians { v.to_radians() } else { *v };
+            fields.push(format!("{v:?}"));
+        }
+        if let Some(c) = o.flange {
+            let pose = nominal.base_from_flange(&m.joints);
+            fields.extend(c.values_from_pose(&pose).iter().map(|v| format!("{v:?}")));
+        }
+        writeln!(text, "{}", fields.join(sep)).unwrap();
+        let Observation::Stripe(points) = &m.observation else {
+            panic!("simulated default has stripes");
+        };
+        let mut p = String::from("y,z\n");
+        for [y, z] in points {
+            writeln!(p, "{y:?},{z:?}").unwrap();
+        }
+        fs::write(profiles.join(format!("{}.csv", m.id)), p).unwrap();
+    }
+    fs::write(dir.join("log.csv"), text).unwrap();
+}
+
+fn spec(dir: &Path, o: &LogOptions) -> ImportSpec {
+    ImportSpec {
+        joint_log: dir.join("log.csv"),
+        columns: ColumnMap {
+            id: "id".into(),
+            station: "station".into(),
+            usage: "use".into(),
+            side: Some("side".into()),
+            joints: (1..=6).map(|k| format!("J{k}")).collect(),
+        },
+        joint_unit: AngleUnit::Deg,
+        profiles: ProfileSource::Folder(dir.join("profiles")),
+        profile_unit: LengthUnit::Mm,
+        robot: RobotSource::Preset("irb2400".into()),
+        sphere_diameter: DEFAULT_SPHERE_DIAMETER,
+        name: Some("imported".into()),
+        flange: o.flange.map(FlangeCheck::new),
+    }
+}
+
+fn assert_same_measurements(a: &Session, b: &Session) {
+    assert_eq!(a.measurements.len(), b.measurements.len());
+    for (x, y) in a.measurements.iter().zip(&b.measurements) {
+        assert_eq!(x.id, y.id);
+        assert_eq!(x.station, y.station);
+        assert_eq!(x.usage, y.usage);
+        assert_eq!(x.side, y.side, "{}", x.id);
+        for (p, q) in x.joints.iter().zip(&y.joints) {
+            assert!((p - q).abs() < 1e-9, "{}: joint {p} vs {q}", x.id);
+        }
+        assert_eq!(x.observation, y.observation, "{}", x.id);
+    }
+}
+
+#[test]
+fn simulated_session_round_trips_and_calibrates() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let (session, checks) = import::import(&spec(dir.path(), &PLAIN)).unwrap();
+    assert!(checks.is_empty());
+    assert_same_measurements(&original, &session);
+    assert_eq!(session.robot, kinematics::irb2400().robot);
+    let (_, cal) = calibrate::calibrate(&session, &Options::from_session(&session)).unwrap();
+    assert!(
+        cal.epsilon_after() < cal.epsilon_before(),
+        "ε {} -> {}",
+        cal.epsilon_before(),
+        cal.epsilon_after()
+    );
+}
+
+#[test]
+fn radians_semicolons_and_micrometres_convert() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    let o = LogOptions {
+        radians: true,
+        semicolon: true,
+        ..PLAIN
+    };
+    write_files(&original, dir.path(), &o);
+    // Rewrite the profiles in µm.
+    for m in &original.measurements {
+        let Observation::Stripe(points) = &m.observation else {
+            unreachable!()
+        };
+        let mut p = String::from("\"y\",\"z\"\n");
+        for [y, z] in points {
+            writeln!(p, "{:?},{:?}", y * 1000.0, z * 1000.0).unwrap();
+        }
+        fs::write(dir.path().join("profiles").join(format!("{}.csv", m.id)), p).unwrap();
+    }
+    let mut s = spec(dir.path(), &o);
+    s.joint_unit = AngleUnit::Rad;
+    s.profile_unit = LengthUnit::Um;
+    let (session, _) = import::import(&s).unwrap();
+    for (x, y) in original.measurements.iter().zip(&session.measurements) {
+        for (p, q) in x.joints.iter().zip(&y.joints) {
+            assert!((p - q).abs() < 1e-9, "{}: joint {p} vs {q}", x.id);
+        }
+        let (Observation::Stripe(a), Observation::Stripe(b)) = (&x.observation, &y.observation)
+        else {
+            unreachable!()
+        };
+        for (p, q) in a.iter().zip(b) {
+            assert!((p[0] - q[0]).abs() < 1e-9 && (p[1] - q[1]).abs() < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn single_profile_file_with_pose_column() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let mut all = String::from("pose,y,z\n");
+    for m in &original.measurements {
+        let Observation::Stripe(points) = &m.observation else {
+            unreachable!()
+        };
+        for [y, z] in points {
+            writeln!(all, "{},{y:?},{z:?}", m.id).unwrap();
+        }
+    }
+    let file = dir.path().join("stripes.csv");
+    fs::write(&file, all).unwrap();
+    let mut s = spec(dir.path(), &PLAIN);
+    s.profiles = ProfileSource::File {
+        path: file,
+        pose_column: "pose".into(),
+    };
+    let (session, _) = import::import(&s).unwrap();
+    assert_same_measurements(&original, &session);
+}
+
+#[test]
+fn correct_flange_poses_pass_in_every_convention() {
+    let original = simulated();
+    for c in CONVENTIONS {
+        let dir = tempfile::tempdir().unwrap();
+        let o = LogOptions {
+            flange: Some(c),
+            ..PLAIN
+        };
+        write_files(&original, dir.path(), &o);
+        let (_, checks) = import::import(&spec(dir.path(), &o)).unwrap();
+        assert_eq!(checks.len(), original.measurements.len());
+        for ch in &checks {
+            assert!(
+                !ch.flagged && ch.position_error_mm < 1e-6 && ch.rotation_error_deg < 1e-6,
+                "{c:?}: {ch:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn conventions_match_their_definitions() {
+    // KUKA A=90: Rz(90); Fanuc W=90: Rx(90); UR rz=π/2: Rz(90) and metres.
+    let rz = nalgebra::UnitQuaternion::from_axis_angle(
+        &nalgebra::Vector3::z_axis(),
+        std::f64::consts::FRAC_PI_2,
+    );
+    let rx = nalgebra::UnitQuaternion::from_axis_angle(
+        &nalgebra::Vector3::x_axis(),
+        std::f64::consts::FRAC_PI_2,
+    );
+    let k = FlangeConvention::KukaAbc
+        .pose_from_values(&[1.0, 2.0, 3.0, 90.0, 0.0, 0.0])
+        .unwrap();
+    assert!(k.rotation.angle_to(&rz) < 1e-12);
+    let f = FlangeConvention::FanucWpr
+        .pose_from_values(&[1.0, 2.0, 3.0, 90.0, 0.0, 0.0])
+        .unwrap();
+    assert!(f.rotation.angle_to(&rx) < 1e-12);
+    let u = FlangeConvention::UrRotationVector
+        .pose_from_values(&[0.001, 0.002, 0.003, 0.0, 0.0, std::f64::consts::FRAC_PI_2])
+        .unwrap();
+    assert!(u.rotation.angle_to(&rz) < 1e-12);
+    assert!((u.translation.vector - nalgebra::Vector3::new(1.0, 2.0, 3.0)).norm() < 1e-12);
+    let a = FlangeConvention::AbbQuaternion
+        .pose_from_values(&[1.0, 2.0, 3.0, rx.w, rx.i, rx.j, rx.k])
+        .unwrap();
+    assert!(a.rotation.angle_to(&rx) < 1e-12);
+}
+
+#[test]
+fn radians_declared_degrees_are_flagged_with_the_unit_hint() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    let o = LogOptions {
+        radians: true,
+        flange: Some(FlangeConvention::KukaAbc),
+        ..PLAIN
+    };
+    write_files(&original, dir.path(), &o);
+    let (_, checks) = import::import(&spec(dir.path(), &o)).unwrap();
+    for ch in &checks {
+        assert!(ch.flagged, "{ch:?}");
+        assert!(
+            ch.hint.contains("--joint-unit rad"),
+            "{}: {}",
+            ch.id,
+            ch.hint
+        );
+    }
+}
+
+#[test]
+fn swapped_joint_columns_are_flagged_with_the_swap_hint() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    let o = LogOptions {
+        swap_23: true,
+        flange: Some(FlangeConvention::AbbQuaternion),
+        ..PLAIN
+    };
+    write_files(&original, dir.path(), &o);
+    let (_, checks) = import::import(&spec(dir.path(), &o)).unwrap();
+    // Where joints 2 and 3 read nearly the same, a swap is invisible.
+    let visible: Vec<_> = checks
+        .iter()
+        .zip(&original.measurements)
+        .filter(|(_, m)| (m.joints[1] - m.joints[2]).abs() > 1.0)
+        .map(|(c, _)| c)
+        .collect();
+    assert!(visible.len() > checks.len() / 2, "{}", visible.len());
+    for ch in visible {
+        assert!(ch.flagged, "{ch:?}");
+        assert!(
+            ch.hint.contains("joint columns 2 and 3 look swapped"),
+            "{}: {}",
+            ch.id,
+            ch.hint
+        );
+    }
+}
+
+#[test]
+fn wrong_robot_is_flagged() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    let o = LogOptions {
+        flange: Some(FlangeConvention::FanucWpr),
+        ..PLAIN
+    };
+    write_files(&original, dir.path(), &o);
+    let mut s = spec(dir.path(), &o);
+    s.robot = RobotSource::Preset("irb120".into());
+    let (_, checks) = import::import(&s).unwrap();
+    assert!(checks.iter().all(|c| c.flagged));
+    assert!(
+        checks
+            .iter()
+            .any(|c| c.hint == "wrong robot model or base frame?")
+    );
+}
+
+#[test]
+fn missing_profile_names_the_pose() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let id = &original.measurements[7].id;
+    fs::remove_file(dir.path().join("profiles").join(format!("{id}.csv"))).unwrap();
+    let e = import::import(&spec(dir.path(), &PLAIN)).unwrap_err();
+    assert!(matches!(e, ImportError::MissingProfile { .. }), "{e:?}");
+    let msg = e.to_string();
+    assert!(msg.contains(&format!("pose {id}:")), "{msg}");
+    assert!(msg.contains(&format!("{id}.csv")), "{msg}");
+}
+
+#[test]
+fn malformed_number_names_file_line_and_column() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let log = dir.path().join("log.csv");
+    let text = fs::read_to_string(&log).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    // Line 5 of the file: comment, header, then the third data row.
+    let mut fields: Vec<String> = lines[4].split(',').map(String::from).collect();
+    fields[6] = "12,5x".replace(',', ".");
+    lines[4] = fields.join(",");
+    fs::write(&log, lines.join("\n")).unwrap();
+    let msg = import::import(&spec(dir.path(), &PLAIN))
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("line 5"), "{msg}");
+    assert!(msg.contains("column `j3`"), "{msg}");
+    assert!(msg.contains("12.5x"), "{msg}");
+    assert!(msg.contains("log.csv"), "{msg}");
+
+    // The same in a profile file.
+    let id = &original.measurements[0].id;
+    let p = dir.path().join("profiles").join(format!("{id}.csv"));
+    fs::write(&p, "y,z\n1.0,2.0\n1.5,abc\n").unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    fs::write(&p, "y,z\n1.0,2.0\n1.5,abc\n").unwrap();
+    let msg = import::import(&spec(dir.path(), &PLAIN))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("line 3") && msg.contains("column `z`") && msg.contains(&format!("{id}.csv")),
+        "{msg}"
+    );
+}
+
+#[test]
+fn session_rules_are_the_loaders() {
+    // A stripe of 3 points breaks FORMAT.md's "at least 5 points".
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let id = &original.measurements[2].id;
+    fs::write(
+        dir.path().join("profiles").join(format!("{id}.csv")),
+        "y,z\n1,2\n2,3\n3,4\n",
+    )
+    .unwrap();
+    let e = import::import(&spec(dir.path(), &PLAIN)).unwrap_err();
+    assert!(matches!(e, ImportError::Session(_)), "{e:?}");
+    assert!(e.to_string().contains(id.as_str()), "{e}");
+}
+
+#[test]
+fn preview_shows_mapped_rows_in_degrees() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    let o = LogOptions {
+        radians: true,
+        ..PLAIN
+    };
+    write_files(&original, dir.path(), &o);
+    let mut s = spec(dir.path(), &o);
+    s.joint_unit = AngleUnit::Rad;
+    let text = import::preview(&s, 2).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 4, "{text}");
+    assert!(
+        lines[0].contains("rad") && lines[0].contains("deg"),
+        "{text}"
+    );
+    let m = &original.measurements[1];
+    assert!(lines[3].starts_with(m.id.as_str()), "{text}");
+    assert!(lines[3].contains(&format!("{:.4}", m.joints[1])), "{text}");
+}
+
+#[test]
+fn cli_writes_the_session_and_reports_flags() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    let o = LogOptions {
+        swap_23: true,
+        flange: Some(FlangeConvention::UrRotationVector),
+        ..PLAIN
+    };
+    write_files(&original, dir.path(), &o);
+    let out = dir.path().join("session.json");
+    let bin = env!("CARGO_BIN_EXE_spherecal");
+    let run = std::process::Command::new(bin)
+        .args(["import", "--joints"])
+        .arg(dir.path().join("log.csv"))
+        .arg("--profiles")
+        .arg(dir.path().join("profiles"))
+        .args([
+            "--robot",
+            "irb2400",
+            "--map",
+            "side=side",
+            "--flange-poses",
+            "UR",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{run:?}");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    let first = &original.measurements[0].id;
+    assert!(
+        stdout.contains(&format!("flagged pose {first}:")) && stdout.contains("look swapped"),
+        "{stdout}"
+    );
+    assert!(out.is_file());
+
+    // Bad input: one `error:` line, exit 2, nothing written.
+    let out2 = dir.path().join("none.json");
+    let run = std::process::Command::new(bin)
+        .args(["import", "--joints"])
+        .arg(dir.path().join("missing.csv"))
+        .arg("--profiles")
+        .arg(dir.path().join("profiles"))
+        .args(["--robot", "irb2400"])
+        .arg("--out")
+        .arg(&out2)
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(2), "{run:?}");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.starts_with("error:") && stderr.contains("missing.csv"),
+        "{stderr}"
+    );
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(!out2.exists());
+}
