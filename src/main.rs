@@ -15,6 +15,7 @@ fn main() -> ExitCode {
         }
         Some(Command::Gui(args)) => gui(args.session, args.result),
         Some(Command::Evaluate(args)) => cli::evaluate::run(&args),
+        Some(Command::ExportModel(args)) => cli::export_model::run(&args),
         Some(Command::Import(args)) => cli::import::run(&args),
         None => gui(None, None),
     };

@@ -7,6 +7,7 @@
 //! atomically or not at all.
 
 pub mod evaluate;
+pub mod export_model;
 pub mod import;
 pub mod simulate;
 
@@ -43,6 +44,8 @@ pub enum Command {
     Gui(GuiArgs),
     /// Compare the paper's method, `ml` and the noise floor on simulated scenarios (README evidence).
     Evaluate(evaluate::EvaluateArgs),
+    /// Write the calibrated model of a result file as JSON (the session `robot` block), CSV (MDH table) or URDF.
+    ExportModel(export_model::ExportModelArgs),
     /// Build a session file from a joint log CSV and stripe profile files (mm, deg in the session; units of the inputs chosen by flags).
     Import(import::ImportArgs),
 }

@@ -22,6 +22,7 @@ pub mod import;
 pub mod kinematics;
 pub mod ml;
 pub mod model;
+pub mod model_export;
 pub mod report;
 pub mod session;
 pub mod simulate;
