@@ -115,6 +115,7 @@ fn spec(dir: &Path, o: &LogOptions) -> ImportSpec {
         sphere_diameter: DEFAULT_SPHERE_DIAMETER,
         name: Some("imported".into()),
         flange: o.flange.map(FlangeCheck::new),
+        references: None,
     }
 }
 
@@ -485,4 +486,65 @@ fn cli_writes_the_session_and_reports_flags() {
     );
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
     assert!(!out2.exists());
+}
+
+/// Writes the session's reference distances as `references.csv`.
+fn write_references(session: &Session, dir: &Path) -> std::path::PathBuf {
+    let mut text = String::from("from,to,distance\n");
+    for r in &session.reference_distances {
+        writeln!(text, "{},{},{}", r.from, r.to, r.distance).unwrap();
+    }
+    let path = dir.join("references.csv");
+    fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn reference_distances_import_and_validate() {
+    let original = simulated();
+    assert!(!original.reference_distances.is_empty());
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let mut s = spec(dir.path(), &PLAIN);
+    s.references = Some(write_references(&original, dir.path()));
+    let (session, _) = import::import(&s).unwrap();
+    assert_eq!(session.reference_distances, original.reference_distances);
+    let (_, cal) = calibrate::calibrate(&session, &Options::from_session(&session)).unwrap();
+    let v = cal.validation.as_ref().expect("validation with references");
+    assert_eq!(v.distances.len(), {
+        let (_, c) = calibrate::calibrate(&original, &Options::from_session(&original)).unwrap();
+        c.validation.unwrap().distances.len()
+    });
+}
+
+#[test]
+fn bad_reference_rows_name_file_and_line() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let path = dir.path().join("references.csv");
+    let mut s = spec(dir.path(), &PLAIN);
+    s.references = Some(path.clone());
+    for (body, expect) in [
+        (
+            "from,to,distance\nV1,V2,-3\n",
+            "line 2: distance -3 mm is not positive",
+        ),
+        (
+            "from,to,distance\nV1,V2,abc\n",
+            "line 2: column `distance`: `abc`",
+        ),
+        ("from,to\nV1,V2\n", "no column `distance`"),
+        ("from,to,distance\n", "no reference distances"),
+        ("from,to,distance\nV1,V1,10\n", "from and to are both `V1`"),
+    ] {
+        fs::write(&path, body).unwrap();
+        let msg = import::import(&s).unwrap_err().to_string();
+        assert!(msg.contains(expect), "{body:?}: {msg}");
+        assert!(msg.contains("references.csv"), "{msg}");
+    }
+    // A station the session does not have is the loader's error.
+    fs::write(&path, "from,to,distance\nV1,Q9,100\n").unwrap();
+    let msg = import::import(&s).unwrap_err().to_string();
+    assert!(msg.contains("Q9"), "{msg}");
 }

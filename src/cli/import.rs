@@ -62,6 +62,9 @@ pub struct ImportArgs {
     /// Flange-pose rotation tolerance, deg.
     #[arg(long, default_value_t = DEFAULT_ROTATION_TOLERANCE_DEG)]
     pub rotation_tolerance: f64,
+    /// Laser-tracker reference distances between validate stations: a CSV with columns from, to, distance (mm).
+    #[arg(long)]
+    pub references: Option<PathBuf>,
     /// Print the first N rows with the mapping applied and exit without writing.
     #[arg(long)]
     pub preview: Option<usize>,
@@ -156,6 +159,7 @@ pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
         sphere_diameter: args.sphere_diameter,
         name: args.name.clone(),
         flange,
+        references: args.references.clone(),
     })
 }
 
@@ -178,6 +182,12 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
     let (session, checks) = import::import(&spec).map_err(|e| input(&e))?;
     let text = session::session_to_json(&session);
     session::write_atomic(out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
+    if !session.reference_distances.is_empty() {
+        println!(
+            "{} reference distances between validate stations",
+            session.reference_distances.len()
+        );
+    }
     println!(
         "imported {} measurements at {} stations into {}",
         session.measurements.len(),

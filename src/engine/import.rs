@@ -22,7 +22,7 @@ use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 use super::error::FileError;
 use super::kinematics::{self, Robot};
-use super::model::{Measurement, Observation, Session, SolverSettings, Use};
+use super::model::{Measurement, Observation, ReferenceDistance, Session, SolverSettings, Use};
 use super::session::{parse_result, parse_session, session_to_json};
 
 /// Default sphere diameter, mm: the 1.5 inch sphere of the paper.
@@ -337,6 +337,9 @@ pub struct ImportSpec {
     pub name: Option<String>,
     /// Optional flange-pose check.
     pub flange: Option<FlangeCheck>,
+    /// Optional laser-tracker reference distances: a CSV with columns
+    /// `from`, `to`, `distance` (station ids, mm).
+    pub references: Option<PathBuf>,
 }
 
 /// The flange-pose check of one pose.
@@ -763,11 +766,58 @@ pub fn import(spec: &ImportSpec) -> Result<(Session, Vec<PoseCheck>), ImportErro
         hand_eye: None,
         solver: SolverSettings::default(),
         solver_given: false,
-        reference_distances: Vec::new(),
+        reference_distances: match &spec.references {
+            Some(path) => read_references(path)?,
+            None => Vec::new(),
+        },
         measurements,
     };
     let session = parse_session(&session_to_json(&session), &spec.joint_log)?;
     Ok((session, checks))
+}
+
+/// The reference distances of a CSV with columns `from`, `to`, `distance`
+/// (mm). Whether the stations exist and have validate measurements is
+/// the session loader's check.
+///
+/// # Errors
+/// Unreadable file, missing column, a distance that is not a positive
+/// finite number, an empty station id or no rows at all.
+pub fn read_references(path: &Path) -> Result<Vec<ReferenceDistance>, ImportError> {
+    let csv = Csv::read(path)?;
+    let from = csv.column("from")?;
+    let to = csv.column("to")?;
+    let distance = csv.column("distance")?;
+    let mut out = Vec::with_capacity(csv.rows.len());
+    for (line, row) in &csv.rows {
+        let d = csv.number(*line, row, distance)?;
+        let fail = |message: String| ImportError::Csv {
+            path: path.to_path_buf(),
+            line: *line,
+            message,
+        };
+        if d <= 0.0 {
+            return Err(fail(format!("distance {d} mm is not positive")));
+        }
+        if row[from].is_empty() || row[to].is_empty() {
+            return Err(fail("empty station id".into()));
+        }
+        if row[from] == row[to] {
+            return Err(fail(format!("from and to are both `{}`", row[from])));
+        }
+        out.push(ReferenceDistance {
+            from: row[from].clone(),
+            to: row[to].clone(),
+            distance: d,
+        });
+    }
+    if out.is_empty() {
+        return Err(ImportError::File {
+            path: path.to_path_buf(),
+            message: "no reference distances (only a header)".into(),
+        });
+    }
+    Ok(out)
 }
 
 /// Position (mm) and rotation (deg) mismatch of FK at `q_deg` and `pose`.
