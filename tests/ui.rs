@@ -13,6 +13,7 @@ use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
 use spherecal::app::state::{Prefs, Tab};
 use spherecal::engine::calibrate::{Method, Options, calibrate};
+use spherecal::engine::model_export::{self, ModelFormat};
 use spherecal::engine::session::parse_session;
 
 /// Frames to wait for background work (with a short sleep each): generous
@@ -373,7 +374,14 @@ fn exports_are_written_to_the_chosen_folder() {
     settle(&mut h);
     let dir = tempfile::tempdir().expect("temp dir");
     h.state_mut().forms_mut().export_dir = dir.path().display().to_string();
-    for button in ["Result JSON", "Centres CSV", "Distances CSV"] {
+    for button in [
+        "Result JSON",
+        "Centres CSV",
+        "Distances CSV",
+        "Model JSON",
+        "Model CSV",
+        "Model URDF",
+    ] {
         h.get_by_label(button).click();
         settle(&mut h);
     }
@@ -392,6 +400,17 @@ fn exports_are_written_to_the_chosen_folder() {
         distances.lines().count(),
         1 + shown.distances.len() + shown.within.len()
     );
+    for (ext, format) in [
+        ("json", ModelFormat::Json),
+        ("csv", ModelFormat::Csv),
+        ("urdf", ModelFormat::Urdf),
+    ] {
+        let written = std::fs::read_to_string(dir.path().join(format!("{stem}-model.{ext}")))
+            .expect("model file");
+        let source = format!("a workbench run of {}", shown.file.session);
+        let expected = model_export::export(&shown.file, format, &source).expect("exports");
+        assert_eq!(written, expected, "the {ext} model is the engine's export");
+    }
     assert_eq!(
         h.state().state().prefs.export_folder.as_deref(),
         Some(dir.path()),

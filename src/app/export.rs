@@ -1,15 +1,17 @@
 //! Export files of a result: the FORMAT.md result JSON, CSV of the centres
-//! and of the distance errors, and a PNG of the plots (cropped from a
-//! window screenshot). Every file is written atomically by the engine's
+//! and of the distance errors, a PNG of the plots (cropped from a window
+//! screenshot), and the calibrated model (JSON robot block, MDH CSV, URDF
+//! fragment, as `spherecal export-model`). Every file is written atomically by the engine's
 //! [`write_atomic`]. Runs on a job thread.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
+use crate::engine::model_export::{self, ModelFormat};
 use crate::engine::session::{result_to_json, write_atomic};
 
 use super::state::ExportKind;
-use super::view::ResultView;
+use super::view::{ResultOrigin, ResultView};
 
 /// CSV of every sphere centre: sensor frame and base frame before and
 /// after, mm.
@@ -94,6 +96,19 @@ pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<()
         ExportKind::CentresCsv => centres_csv(view),
         ExportKind::DistancesCsv => distances_csv(view),
         ExportKind::PlotsPng => return Err("a PNG is written from a screenshot".to_string()),
+        ExportKind::ModelJson | ExportKind::ModelCsv | ExportKind::ModelUrdf => {
+            let format = match kind {
+                ExportKind::ModelJson => ModelFormat::Json,
+                ExportKind::ModelCsv => ModelFormat::Csv,
+                _ => ModelFormat::Urdf,
+            };
+            let source = match &view.origin {
+                ResultOrigin::Review(p) => p.display().to_string(),
+                ResultOrigin::Run { .. } => format!("a workbench run of {}", view.file.session),
+            };
+            model_export::export(&view.file, format, &source)
+                .map_err(|e| format!("the model cannot be exported: {e}"))?
+        }
     };
     write_atomic(path, text.as_bytes()).map_err(|e| e.to_string())
 }

@@ -251,15 +251,24 @@ pub enum ExportKind {
     DistancesCsv,
     /// The Results view's plots as an image.
     PlotsPng,
+    /// The calibrated model as the FORMAT.md `robot` block (deg, mm).
+    ModelJson,
+    /// The calibrated MDH table and matrices, CSV (deg, mm).
+    ModelCsv,
+    /// A URDF fragment with the calibrated joint origins (m, rad).
+    ModelUrdf,
 }
 
 impl ExportKind {
     /// All kinds, in the order of the export buttons.
-    pub const ALL: [Self; 4] = [
+    pub const ALL: [Self; 7] = [
         Self::ResultJson,
         Self::CentresCsv,
         Self::DistancesCsv,
         Self::PlotsPng,
+        Self::ModelJson,
+        Self::ModelCsv,
+        Self::ModelUrdf,
     ];
 
     /// The button text.
@@ -270,6 +279,9 @@ impl ExportKind {
             Self::CentresCsv => "Centres CSV",
             Self::DistancesCsv => "Distances CSV",
             Self::PlotsPng => "Plots PNG",
+            Self::ModelJson => "Model JSON",
+            Self::ModelCsv => "Model CSV",
+            Self::ModelUrdf => "Model URDF",
         }
     }
 
@@ -281,6 +293,9 @@ impl ExportKind {
             Self::CentresCsv => format!("{stem}-centres.csv"),
             Self::DistancesCsv => format!("{stem}-distances.csv"),
             Self::PlotsPng => format!("{stem}-plots.png"),
+            Self::ModelJson => format!("{stem}-model.json"),
+            Self::ModelCsv => format!("{stem}-model.csv"),
+            Self::ModelUrdf => format!("{stem}-model.urdf"),
         }
     }
 }

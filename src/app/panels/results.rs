@@ -171,6 +171,15 @@ fn export_hint(kind: ExportKind) -> &'static str {
             "reference-distance errors and within-station distances, before and after (mm)"
         }
         ExportKind::PlotsPng => "an image of the figures on this page",
+        ExportKind::ModelJson => {
+            "the calibrated robot as the FORMAT.md robot block (deg, mm), pasteable into a session"
+        }
+        ExportKind::ModelCsv => {
+            "the calibrated MDH table with the deltas, then base, flange and hand-eye matrices (deg, mm)"
+        }
+        ExportKind::ModelUrdf => {
+            "a URDF fragment with the calibrated joint origins and the sensor link (m, rad), for ROS"
+        }
     }
 }
 
