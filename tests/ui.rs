@@ -461,3 +461,176 @@ fn clicking_a_centre_in_the_3d_view_selects_its_measurement() {
     h.run();
     assert_eq!(h.state().state().selected, Some(index));
 }
+
+/// Writes the demo session's poses as a KUKA-style joint log (`Pose`,
+/// `Sphere`, `Use`, `Side`, `A1`..`A6`) and one profile CSV per pose.
+fn write_import_files(dir: &Path) -> spherecal::engine::model::Session {
+    use std::fmt::Write as _;
+    let session = parse_session(
+        spherecal::DEMO_SESSION_JSON,
+        Path::new(spherecal::DEMO_SESSION_NAME),
+    )
+    .expect("demo parses");
+    let profiles = dir.join("profiles");
+    std::fs::create_dir_all(&profiles).expect("profiles folder");
+    let mut log = String::from("Pose,Sphere,Use,Side,A1,A2,A3,A4,A5,A6\n");
+    for m in &session.measurements {
+        write!(
+            log,
+            "{},{},{},{}",
+            m.id,
+            m.station,
+            m.usage.as_str(),
+            m.side
+        )
+        .unwrap();
+        for q in &m.joints {
+            write!(log, ",{q}").unwrap();
+        }
+        log.push('\n');
+        let spherecal::engine::model::Observation::Stripe(points) = &m.observation else {
+            panic!("the demo has stripes");
+        };
+        let mut p = String::from("y,z\n");
+        for [y, z] in points {
+            writeln!(p, "{y},{z}").unwrap();
+        }
+        std::fs::write(profiles.join(format!("{}.csv", m.id)), p).expect("profile");
+    }
+    std::fs::write(dir.join("joints.csv"), log).expect("log");
+    let mut refs = String::from("from,to,distance\n");
+    for r in &session.reference_distances {
+        writeln!(refs, "{},{},{}", r.from, r.to, r.distance).unwrap();
+    }
+    std::fs::write(dir.join("references.csv"), refs).expect("references");
+    session
+}
+
+fn type_into(h: &mut Harness<'_, WorkbenchApp>, label: &str, text: &str) {
+    h.get_by_label(label).click();
+    h.run();
+    h.get_by_label(label).type_text(text);
+    h.run();
+}
+
+#[test]
+fn the_import_wizard_guesses_the_mapping_previews_and_opens_the_session() {
+    let mut h = demo_app();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let original = write_import_files(dir.path());
+    h.get_by_label("Import").click();
+    h.run();
+    assert_eq!(h.state().forms().tab, Tab::Import);
+    let joints = dir.path().join("joints.csv");
+    type_into(&mut h, "Joint log CSV", &joints.display().to_string());
+    let profiles = dir.path().join("profiles");
+    type_into(&mut h, "Stripe profiles", &profiles.display().to_string());
+    let refs = dir.path().join("references.csv");
+    type_into(
+        &mut h,
+        "Reference distances CSV",
+        &refs.display().to_string(),
+    );
+
+    // The default mapping (id, station, j1…) does not fit this header.
+    h.get_by_label("Preview").click();
+    settle(&mut h);
+    let preview = h.state().state().import.preview.clone().expect("preview");
+    assert!(
+        preview
+            .as_ref()
+            .is_err_and(|e| e.contains("no column `id`")),
+        "{preview:?}"
+    );
+    assert!(
+        h.query_all_by_label_contains("not in the header").count() > 0,
+        "the unmatched columns are named"
+    );
+
+    h.get_by_label("Guess mapping").click();
+    settle(&mut h);
+    let form = &h.state().forms().import;
+    assert_eq!(form.id_column, "Pose");
+    assert_eq!(form.side_column, "Side");
+    assert_eq!(form.joint_columns[5], "A6");
+    let preview = h.state().state().import.preview.clone().expect("preview");
+    let text = preview.expect("the preview works with the guessed mapping");
+    let first = &original.measurements[0];
+    assert!(text.contains(&first.id), "{text}");
+    assert!(
+        h.query_all_by_label_contains(&format!("{:.4}", first.joints[1]))
+            .count()
+            > 0,
+        "the preview shows joint 2 of the first pose"
+    );
+
+    h.get_by_label("Import and open").click();
+    settle(&mut h);
+    let loaded = h.state().state().loaded.as_ref().expect("a session");
+    assert!(matches!(
+        loaded.source,
+        spherecal::app::state::Source::Imported(_)
+    ));
+    assert_eq!(
+        loaded.session.measurements.len(),
+        original.measurements.len()
+    );
+    assert_eq!(
+        loaded.session.reference_distances,
+        original.reference_distances
+    );
+    for (a, b) in loaded
+        .session
+        .measurements
+        .iter()
+        .zip(&original.measurements)
+    {
+        assert_eq!((&a.id, &a.station, a.side), (&b.id, &b.station, b.side));
+        assert_eq!(a.joints, b.joints);
+    }
+    assert_eq!(h.state().forms().tab, Tab::Session);
+    assert!(
+        h.state().forms().save_path.ends_with("joints.json"),
+        "Save as proposes a session beside the joint log: {}",
+        h.state().forms().save_path
+    );
+}
+
+#[test]
+fn a_failed_import_names_the_pose_and_keeps_the_open_session() {
+    let mut h = demo_app();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let original = write_import_files(dir.path());
+    let gone = &original.measurements[3].id;
+    std::fs::remove_file(dir.path().join("profiles").join(format!("{gone}.csv"))).expect("remove");
+    let before = session_name();
+    {
+        let form = &mut h.state_mut().forms_mut().import;
+        form.joints = dir.path().join("joints.csv").display().to_string();
+        form.profiles = dir.path().join("profiles").display().to_string();
+    }
+    h.get_by_label("Import").click();
+    h.run();
+    h.get_by_label("Guess mapping").click();
+    settle(&mut h);
+    h.get_by_label("Import and open").click();
+    settle(&mut h);
+    let outcome = h.state().state().import.outcome.clone().expect("outcome");
+    let message = outcome.expect_err("the import fails");
+    assert!(message.contains(&format!("pose {gone}")), "{message}");
+    assert!(
+        h.query_all_by_label_contains(&format!("pose {gone}"))
+            .count()
+            > 0,
+        "the message is on screen"
+    );
+    let name = &h
+        .state()
+        .state()
+        .loaded
+        .as_ref()
+        .expect("session")
+        .session
+        .name;
+    assert_eq!(*name, before, "the open session is kept");
+}

@@ -53,4 +53,12 @@ pub enum Command {
     DismissNotice,
     /// Empty the recent-files list.
     ClearRecent,
+    /// Read the joint log's header, guess the mapping and preview the
+    /// first rows.
+    ImportPreview {
+        /// Overwrite the mapping fields with the guesses from the header.
+        guess: bool,
+    },
+    /// Build the session from the import form and open it.
+    ImportRun,
 }

@@ -9,9 +9,11 @@ use std::sync::Arc;
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
 
 use crate::engine::calibrate::Progress;
+use crate::engine::import::PoseCheck;
 
 use super::state::{DialogPurpose, ExportKind, LoadedSession};
 use super::view::ResultView;
+use super::wizard::ImportForm;
 
 /// Messages a job may have in flight before it waits for the UI to drain
 /// them: far more than a run's ε reports (one per update), so the solver
@@ -62,6 +64,17 @@ pub enum JobMessage {
     },
     /// The window's pixels for a plots PNG arrived.
     Screenshot(Arc<egui::ColorImage>),
+    /// The import wizard's joint log was read: its header and the preview.
+    ImportPreviewed {
+        /// The header, empty when it could not be read.
+        header: Vec<String>,
+        /// The form with the mapping guessed from the header, when asked.
+        guessed: Option<Box<ImportForm>>,
+        /// The mapped rows, or the engine's message.
+        preview: Result<String, String>,
+    },
+    /// The import wizard built a session, or why not.
+    Imported(Result<Imported, String>),
     /// An export file was written, or why not.
     Exported {
         /// What was exported.
@@ -71,6 +84,15 @@ pub enum JobMessage {
         /// Success or the error message.
         outcome: Result<(), String>,
     },
+}
+
+/// The outcome of an import job.
+#[derive(Debug)]
+pub struct Imported {
+    /// The session, analysed like an opened file.
+    pub loaded: Box<LoadedSession>,
+    /// The flange-pose checks (empty without a check).
+    pub checks: Vec<PoseCheck>,
 }
 
 /// A file that could not be opened: which, and the engine's message.

@@ -13,6 +13,7 @@
 //! - [`view`]: view models built from engine outputs (a run and a reviewed
 //!   result file both go through the FORMAT.md result);
 //! - [`export`]: the export files;
+//! - [`wizard`]: the import wizard's form and the engine spec it builds;
 //! - [`panels`]: one module per panel or view, each a `*_ui` function.
 //!
 //! Layout of the window, for an operator at 1366×768: the load and solver
@@ -25,6 +26,7 @@ pub mod jobs;
 pub mod panels;
 pub mod state;
 pub mod view;
+pub mod wizard;
 pub mod work;
 pub mod workbench;
 

@@ -17,6 +17,7 @@ use crate::engine::model::{Session, Use};
 use crate::engine::stripe::StripeResult;
 
 use super::view::{CentreSet, ResultView};
+use super::wizard::{ImportForm, ImportView};
 
 /// How many recent files the start list keeps.
 pub const RECENT_MAX: usize = 8;
@@ -28,6 +29,8 @@ pub enum Source {
     Demo,
     /// A file on disk.
     File(PathBuf),
+    /// Built by the import wizard from this joint log; not saved yet.
+    Imported(PathBuf),
 }
 
 impl Source {
@@ -35,8 +38,18 @@ impl Source {
     #[must_use]
     pub fn path(&self) -> Option<&Path> {
         match self {
-            Self::Demo => None,
+            Self::Demo | Self::Imported(_) => None,
             Self::File(p) => Some(p),
+        }
+    }
+
+    /// The folder derived files go to by default: the session file's or
+    /// the joint log's.
+    #[must_use]
+    pub fn folder(&self) -> Option<&Path> {
+        match self {
+            Self::Demo => None,
+            Self::File(p) | Self::Imported(p) => p.parent(),
         }
     }
 
@@ -46,6 +59,7 @@ impl Source {
         match self {
             Self::Demo => format!("{} (embedded demo)", crate::DEMO_SESSION_NAME),
             Self::File(p) => p.display().to_string(),
+            Self::Imported(p) => format!("imported from {} (not saved yet)", p.display()),
         }
     }
 
@@ -54,7 +68,7 @@ impl Source {
     pub fn stem(&self) -> String {
         let name = match self {
             Self::Demo => Path::new(crate::DEMO_SESSION_NAME),
-            Self::File(p) => p.as_path(),
+            Self::File(p) | Self::Imported(p) => p.as_path(),
         };
         name.file_stem().map_or_else(
             || "session".to_string(),
@@ -238,6 +252,12 @@ pub enum DialogPurpose {
     SaveSession,
     /// Choose the export folder.
     ExportFolder,
+    /// Import wizard: the joint log CSV.
+    ImportJoints,
+    /// Import wizard: the profiles folder (or file, as the form says).
+    ImportProfiles,
+    /// Import wizard: the reference distances CSV.
+    ImportReferences,
 }
 
 /// Things to export from the Results view.
@@ -311,11 +331,19 @@ pub enum Tab {
     Centres,
     /// Plots and tables of a result.
     Results,
+    /// The import wizard: joint log and profiles to a session.
+    Import,
 }
 
 impl Tab {
     /// All tabs, in display order.
-    pub const ALL: [Self; 4] = [Self::Session, Self::Stripe, Self::Centres, Self::Results];
+    pub const ALL: [Self; 5] = [
+        Self::Session,
+        Self::Stripe,
+        Self::Centres,
+        Self::Results,
+        Self::Import,
+    ];
 
     /// The tab's title.
     #[must_use]
@@ -325,6 +353,7 @@ impl Tab {
             Self::Stripe => "Stripe",
             Self::Centres => "Centres",
             Self::Results => "Results",
+            Self::Import => "Import",
         }
     }
 }
@@ -426,6 +455,8 @@ pub struct Forms {
     pub solver: SolverForm,
     /// Centres view options.
     pub centres: CentresForm,
+    /// The import wizard's fields.
+    pub import: ImportForm,
 }
 
 impl Default for Forms {
@@ -440,6 +471,7 @@ impl Default for Forms {
             group: Grouping::None,
             solver: SolverForm::default(),
             centres: CentresForm::default(),
+            import: ImportForm::default(),
         }
     }
 }
@@ -482,6 +514,8 @@ pub struct Busy {
     pub exporting: usize,
     /// A window screenshot for the plots PNG is awaited.
     pub screenshot: bool,
+    /// Import previews or imports in flight.
+    pub importing: usize,
 }
 
 /// Everything the workbench shows. Changed only by commands and job
@@ -512,6 +546,8 @@ pub struct AppState {
     pub prefs: Prefs,
     /// A result file to open once the session given with it has loaded.
     pub pending_result: Option<PathBuf>,
+    /// What the import wizard shows (header, preview, flange checks).
+    pub import: ImportView,
 }
 
 impl AppState {
@@ -532,6 +568,7 @@ impl AppState {
             || self.busy.saving
             || self.busy.exporting > 0
             || self.busy.screenshot
+            || self.busy.importing > 0
     }
 
     /// Indices of the measurements the session table shows, in its order

@@ -10,6 +10,7 @@ use std::time::Instant;
 use crate::engine::calibrate::{self, Control, Options, Progress};
 use crate::engine::error::{CalibrationError, FileError, IdentifyError};
 use crate::engine::identify::Estimate;
+use crate::engine::import;
 use crate::engine::model::{Observation, Session};
 use crate::engine::report;
 use crate::engine::session::{
@@ -17,9 +18,10 @@ use crate::engine::session::{
 };
 use crate::engine::stripe::centre_from_stripe;
 
-use super::jobs::{LoadFailure, RunFailure};
+use super::jobs::{Imported, LoadFailure, RunFailure};
 use super::state::{Fit, LoadedSession, Source};
 use super::view::{CentrePoint, CentreSet, ResultOrigin, ResultView};
+use super::wizard::{ImportForm, PREVIEW_ROWS};
 
 /// What a file turned out to be.
 #[derive(Debug)]
@@ -209,4 +211,45 @@ pub fn calibrate_session(
         excluded: session.measurements.len() - kept.measurements.len(),
     };
     Ok(ResultView::new(file, origin, Some(session)))
+}
+
+/// The import wizard's preview: the joint log's header, the form with the
+/// mapping guessed from it (when `guess`), and the first rows mapped.
+pub fn import_preview(
+    mut form: ImportForm,
+    guess: bool,
+) -> (Vec<String>, Option<Box<ImportForm>>, Result<String, String>) {
+    if form.joints.trim().is_empty() {
+        return (
+            Vec::new(),
+            None,
+            Err("choose the joint log CSV first".into()),
+        );
+    }
+    let header = match import::header(Path::new(form.joints.trim())) {
+        Ok(h) => h,
+        Err(e) => return (Vec::new(), None, Err(e.to_string())),
+    };
+    if guess {
+        form.guess_mapping(&header);
+    }
+    let preview = form
+        .spec()
+        .and_then(|spec| import::preview(&spec, PREVIEW_ROWS).map_err(|e| e.to_string()));
+    (header, guess.then(|| Box::new(form)), preview)
+}
+
+/// Runs the import of the wizard's form and analyses the session like an
+/// opened file.
+///
+/// # Errors
+/// The form is incomplete or the engine's import failed: its message,
+/// naming the file, line, column or pose id.
+pub fn import_session(form: &ImportForm) -> Result<Imported, String> {
+    let spec = form.spec()?;
+    let (session, checks) = import::import(&spec).map_err(|e| e.to_string())?;
+    Ok(Imported {
+        loaded: Box::new(analyse(session, Source::Imported(spec.joint_log))),
+        checks,
+    })
 }

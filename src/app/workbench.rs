@@ -13,9 +13,10 @@ use super::jobs::{JobMessage, Jobs, LoadFailure, RunFailure};
 use super::panels;
 use super::state::{
     AppState, DialogPurpose, ExportKind, Forms, Level, LoadedSession, Notice, Prefs, RunState,
-    SolverForm, Tab,
+    SolverForm, Source, Tab,
 };
 use super::view::ResultOrigin;
+use super::wizard::ProfilesKind;
 use super::work::{self, Opened};
 
 /// How long to wait for the window's screenshot for a plots PNG: a frame
@@ -184,6 +185,9 @@ impl WorkbenchApp {
                         &mut commands,
                     );
                 }
+                Tab::Import => {
+                    panels::import::import_ui(ui, &self.state, &mut self.forms, &mut commands);
+                }
             }
         });
         panels::drop_overlay_ui(&ctx);
@@ -320,6 +324,39 @@ impl WorkbenchApp {
             Command::Export(kind) => self.export(ctx, kind),
             Command::DismissNotice => self.state.notice = None,
             Command::ClearRecent => self.state.prefs.recent.clear(),
+            Command::ImportPreview { guess } => self.import_preview(ctx, guess),
+            Command::ImportRun => self.import_run(ctx),
+        }
+    }
+
+    fn import_preview(&mut self, ctx: &egui::Context, guess: bool) {
+        let form = self.forms.import.clone();
+        let started = self.spawn(ctx, "import", move |rep| {
+            let (header, guessed, preview) = work::import_preview(form, guess);
+            rep.send(JobMessage::ImportPreviewed {
+                header,
+                guessed,
+                preview,
+            });
+        });
+        if started {
+            self.state.busy.importing += 1;
+        }
+    }
+
+    fn import_run(&mut self, ctx: &egui::Context) {
+        let form = self.forms.import.clone();
+        if let Err(e) = form.spec() {
+            self.state.import.outcome = Some(Err(e.clone()));
+            self.state.say(Level::Warning, e);
+            return;
+        }
+        self.state.say(Level::Info, "importing…");
+        let started = self.spawn(ctx, "import", move |rep| {
+            rep.send(JobMessage::Imported(work::import_session(&form)));
+        });
+        if started {
+            self.state.busy.importing += 1;
         }
     }
 
@@ -375,8 +412,16 @@ impl WorkbenchApp {
         }
         let folder = match purpose {
             DialogPurpose::ExportFolder => Some(PathBuf::from(self.forms.export_dir.trim())),
+            DialogPurpose::ImportProfiles | DialogPurpose::ImportReferences => {
+                Path::new(self.forms.import.joints.trim())
+                    .parent()
+                    .map(Path::to_path_buf)
+                    .filter(|d| !d.as_os_str().is_empty())
+                    .or_else(|| self.state.prefs.last_folder.clone())
+            }
             _ => self.state.prefs.last_folder.clone(),
         };
+        let profiles_folder = self.forms.import.profiles_kind == ProfilesKind::Folder;
         let file_name = Path::new(self.forms.save_path.trim())
             .file_name()
             .map(|n| n.to_string_lossy().into_owned());
@@ -398,6 +443,13 @@ impl WorkbenchApp {
                     .save_file()
                 }
                 DialogPurpose::ExportFolder => dialog.pick_folder(),
+                DialogPurpose::ImportJoints | DialogPurpose::ImportReferences => {
+                    dialog.add_filter("CSV", &["csv", "txt"]).pick_file()
+                }
+                DialogPurpose::ImportProfiles if profiles_folder => dialog.pick_folder(),
+                DialogPurpose::ImportProfiles => {
+                    dialog.add_filter("CSV", &["csv", "txt"]).pick_file()
+                }
             };
             rep.send(JobMessage::Dialog { purpose, path });
         });
@@ -645,6 +697,16 @@ impl WorkbenchApp {
                         self.state
                             .say(Level::Info, format!("exports go to {}", path.display()));
                     }
+                    DialogPurpose::ImportJoints => {
+                        self.forms.import.joints = path.display().to_string();
+                        self.import_preview(ctx, true);
+                    }
+                    DialogPurpose::ImportProfiles => {
+                        self.forms.import.profiles = path.display().to_string();
+                    }
+                    DialogPurpose::ImportReferences => {
+                        self.forms.import.references = path.display().to_string();
+                    }
                 }
             }
             JobMessage::Saved { path, outcome } => {
@@ -670,6 +732,69 @@ impl WorkbenchApp {
                 }
             }
             JobMessage::Screenshot(image) => self.on_screenshot(ctx, &image),
+            JobMessage::ImportPreviewed {
+                header,
+                guessed,
+                preview,
+            } => {
+                self.state.busy.importing = self.state.busy.importing.saturating_sub(1);
+                if let Some(form) = guessed {
+                    let f = &mut self.forms.import;
+                    f.id_column = form.id_column;
+                    f.station_column = form.station_column;
+                    f.use_column = form.use_column;
+                    f.side_column = form.side_column;
+                    f.joint_columns = form.joint_columns;
+                }
+                self.state.import.header = header;
+                match &preview {
+                    Ok(_) => self
+                        .state
+                        .say(Level::Info, "preview of the mapped rows below"),
+                    Err(e) => self.state.say(Level::Warning, format!("preview: {e}")),
+                }
+                self.state.import.preview = Some(preview);
+            }
+            JobMessage::Imported(outcome) => {
+                self.state.busy.importing = self.state.busy.importing.saturating_sub(1);
+                match outcome {
+                    Ok(imported) => {
+                        let flagged = imported.checks.iter().filter(|c| c.flagged).count();
+                        let n = imported.loaded.session.measurements.len();
+                        let refs = imported.loaded.session.reference_distances.len();
+                        let mut line =
+                            format!("imported {n} measurements and {refs} reference distances");
+                        if !imported.checks.is_empty() {
+                            line.push_str(&format!(
+                                "; flange poses: {} checked, {flagged} flagged",
+                                imported.checks.len()
+                            ));
+                        }
+                        self.state.import.checks = imported.checks;
+                        self.state.import.outcome = Some(Ok(line.clone()));
+                        self.on_session(ctx, *imported.loaded);
+                        self.forms.tab = if flagged > 0 {
+                            Tab::Import
+                        } else {
+                            Tab::Session
+                        };
+                        let level = if flagged > 0 {
+                            Level::Warning
+                        } else {
+                            Level::Info
+                        };
+                        self.state.say(
+                            level,
+                            format!("{line}: not saved yet, use Save as… on the Session view"),
+                        );
+                    }
+                    Err(message) => {
+                        self.state.say(Level::Error, "the import failed");
+                        self.state.import.checks.clear();
+                        self.state.import.outcome = Some(Err(message));
+                    }
+                }
+            }
             JobMessage::Exported {
                 kind,
                 path,
@@ -706,15 +831,15 @@ impl WorkbenchApp {
         }
         let dir = loaded
             .source
-            .path()
-            .and_then(Path::parent)
+            .folder()
             .map(Path::to_path_buf)
             .or_else(|| std::env::current_dir().ok())
             .unwrap_or_default();
-        self.forms.save_path = dir
-            .join(format!("{}-edited.json", loaded.source.stem()))
-            .display()
-            .to_string();
+        let file_name = match loaded.source {
+            Source::Imported(_) => format!("{}.json", loaded.source.stem()),
+            _ => format!("{}-edited.json", loaded.source.stem()),
+        };
+        self.forms.save_path = dir.join(file_name).display().to_string();
         self.forms.solver = SolverForm::from_session(&loaded.session);
         self.forms.filter_station = None;
         self.forms.filter_use = None;

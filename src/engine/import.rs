@@ -573,6 +573,14 @@ pub fn load_robot(source: &RobotSource) -> Result<Robot, ImportError> {
     }
 }
 
+/// The column names of a CSV file's header (for a mapping form).
+///
+/// # Errors
+/// The file cannot be read or has no header row.
+pub fn header(path: &Path) -> Result<Vec<String>, ImportError> {
+    Ok(Csv::read(path)?.header)
+}
+
 /// The first `rows` rows of the joint log with the mapping applied, as a
 /// text table: id, station, use, side and the joints converted to deg (the
 /// declared unit in the header).

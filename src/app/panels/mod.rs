@@ -3,6 +3,7 @@
 //! Shared widgets and colours live here.
 
 pub mod centres;
+pub mod import;
 pub mod results;
 pub mod session;
 pub mod side;

@@ -1,0 +1,399 @@
+//! The Import view: a wizard that turns a joint log CSV and stripe profile
+//! files into a session (the engine's [`crate::engine::import`], as
+//! `spherecal import`). Three steps on one page: files, robot and units,
+//! column mapping with a preview of the first rows; then Import opens the
+//! session and lists the flange-pose checks.
+
+use egui::RichText;
+
+use super::{BAD, WARN, labelled_field};
+use crate::app::commands::Command;
+use crate::app::state::{AppState, DialogPurpose, Forms};
+use crate::app::wizard::{CONVENTIONS, ImportForm, ProfilesKind};
+use crate::engine::import::{AngleUnit, LengthUnit};
+use crate::engine::kinematics;
+
+/// Width of the path fields, points.
+const PATH_WIDTH: f32 = 420.0;
+/// Width of a column-name field, points.
+const COLUMN_WIDTH: f32 = 90.0;
+
+/// The whole Import view.
+pub fn import_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    egui::ScrollArea::vertical()
+        .auto_shrink([false, false])
+        .show(ui, |ui| {
+            ui.heading("Import a joint log and stripe profiles");
+            ui.label(
+                RichText::new(
+                    "One row of the joint log per pose (id, station, use, joints); one CSV of y,z points per pose, \
+                     or one file with a pose column. The session is checked by the same rules as a session file.",
+                )
+                .weak(),
+            );
+            ui.add_space(6.0);
+            let busy = state.busy.importing > 0 || state.busy.dialog;
+            files_ui(ui, busy, &mut forms.import, commands);
+            ui.separator();
+            robot_ui(ui, &mut forms.import);
+            ui.separator();
+            mapping_ui(ui, state, &mut forms.import);
+            ui.separator();
+            flange_ui(ui, &mut forms.import);
+            ui.separator();
+            ui.horizontal(|ui| {
+                if ui
+                    .add_enabled(!busy, egui::Button::new("Preview"))
+                    .on_hover_text("read the header and show the first rows with this mapping")
+                    .clicked()
+                {
+                    commands.push(Command::ImportPreview { guess: false });
+                }
+                if ui
+                    .add_enabled(!busy, egui::Button::new("Guess mapping"))
+                    .on_hover_text("fill the column names from the header where they are obvious")
+                    .clicked()
+                {
+                    commands.push(Command::ImportPreview { guess: true });
+                }
+                let import = ui
+                    .add_enabled(
+                        !busy,
+                        egui::Button::new(RichText::new("Import and open").strong().size(16.0)),
+                    )
+                    .on_hover_text("build the session and open it (save it with Save as… afterwards)");
+                if import.clicked() {
+                    commands.push(Command::ImportRun);
+                }
+                if state.busy.importing > 0 {
+                    ui.spinner();
+                }
+            });
+            outcome_ui(ui, state);
+        });
+}
+
+fn files_ui(ui: &mut egui::Ui, busy: bool, f: &mut ImportForm, commands: &mut Vec<Command>) {
+    ui.label(RichText::new("1 · Files").strong());
+    egui::Grid::new("import_files")
+        .num_columns(3)
+        .spacing([8.0, 6.0])
+        .show(ui, |ui| {
+            path_row(
+                ui,
+                "Joint log CSV",
+                &mut f.joints,
+                "/path/to/joints.csv",
+                busy,
+                DialogPurpose::ImportJoints,
+                commands,
+            );
+            let hint = match f.profiles_kind {
+                ProfilesKind::Folder => "/path/to/profiles/ (one <id>.csv each)",
+                ProfilesKind::File => "/path/to/profiles.csv (with a pose column)",
+            };
+            path_row(
+                ui,
+                "Stripe profiles",
+                &mut f.profiles,
+                hint,
+                busy,
+                DialogPurpose::ImportProfiles,
+                commands,
+            );
+            ui.label("");
+            ui.horizontal(|ui| {
+                ui.radio_value(
+                    &mut f.profiles_kind,
+                    ProfilesKind::Folder,
+                    "a folder of <id>.csv",
+                );
+                ui.radio_value(&mut f.profiles_kind, ProfilesKind::File, "one file");
+                let l = ui.label("pose column");
+                ui.add_enabled(
+                    f.profiles_kind == ProfilesKind::File,
+                    egui::TextEdit::singleline(&mut f.pose_column).desired_width(COLUMN_WIDTH),
+                )
+                .labelled_by(l.id);
+            });
+            ui.end_row();
+            path_row(
+                ui,
+                "Reference distances CSV",
+                &mut f.references,
+                "optional: from,to,distance (mm), from the laser tracker",
+                busy,
+                DialogPurpose::ImportReferences,
+                commands,
+            );
+        });
+}
+
+fn path_row(
+    ui: &mut egui::Ui,
+    label: &str,
+    text: &mut String,
+    hint: &str,
+    busy: bool,
+    purpose: DialogPurpose,
+    commands: &mut Vec<Command>,
+) {
+    let l = ui.label(label);
+    ui.add(
+        egui::TextEdit::singleline(text)
+            .hint_text(hint)
+            .desired_width(PATH_WIDTH),
+    )
+    .labelled_by(l.id);
+    if ui
+        .add_enabled(!busy, egui::Button::new("Browse…"))
+        .on_hover_text(format!(
+            "choose the {} with the desktop's dialog",
+            label.to_lowercase()
+        ))
+        .clicked()
+    {
+        commands.push(Command::Browse(purpose));
+    }
+    ui.end_row();
+}
+
+fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
+    ui.label(RichText::new("2 · Robot, units, sphere").strong());
+    egui::Grid::new("import_robot")
+        .num_columns(2)
+        .spacing([8.0, 6.0])
+        .show(ui, |ui| {
+            let l = ui.label("Nominal robot");
+            ui.horizontal(|ui| {
+                let from_file = !f.robot_file.trim().is_empty();
+                ui.add_enabled_ui(!from_file, |ui| {
+                    egui::ComboBox::from_id_salt("import_robot_preset")
+                        .selected_text(&f.robot_preset)
+                        .show_ui(ui, |ui| {
+                            for p in kinematics::presets() {
+                                ui.selectable_value(
+                                    &mut f.robot_preset,
+                                    p.key.to_string(),
+                                    format!("{} ({})", p.key, p.robot.name),
+                                );
+                            }
+                        })
+                        .response
+                        .labelled_by(l.id);
+                });
+                labelled_field(
+                    ui,
+                    "or robot file",
+                    &mut f.robot_file,
+                    "a session or result file with the robot block",
+                    260.0,
+                );
+            });
+            ui.end_row();
+            ui.label("Joint unit");
+            ui.horizontal(|ui| {
+                for u in [AngleUnit::Deg, AngleUnit::Rad] {
+                    ui.radio_value(&mut f.joint_unit, u, u.as_str());
+                }
+            });
+            ui.end_row();
+            ui.label("Profile unit");
+            ui.horizontal(|ui| {
+                for u in [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M] {
+                    ui.radio_value(&mut f.profile_unit, u, u.as_str());
+                }
+            });
+            ui.end_row();
+            let l = ui.label("Sphere diameter");
+            ui.add(
+                egui::DragValue::new(&mut f.sphere_diameter)
+                    .range(1.0..=500.0)
+                    .speed(0.01)
+                    .max_decimals(4)
+                    .suffix(" mm"),
+            )
+            .labelled_by(l.id);
+            ui.end_row();
+            let l = ui.label("Session name");
+            ui.add(
+                egui::TextEdit::singleline(&mut f.name)
+                    .hint_text("default: the joint log's file name")
+                    .desired_width(PATH_WIDTH),
+            )
+            .labelled_by(l.id);
+            ui.end_row();
+        });
+}
+
+fn mapping_ui(ui: &mut egui::Ui, state: &AppState, f: &mut ImportForm) {
+    ui.label(RichText::new("3 · Columns of the joint log").strong());
+    if state.import.header.is_empty() {
+        ui.label(
+            RichText::new("Preview reads the header; Guess mapping fills the fields from it.")
+                .weak(),
+        );
+    } else {
+        ui.label(format!("Header: {}", state.import.header.join(", ")));
+    }
+    let header = &state.import.header;
+    ui.horizontal_wrapped(|ui| {
+        column_field(ui, "id", &mut f.id_column, header);
+        column_field(ui, "station", &mut f.station_column, header);
+        column_field(ui, "use", &mut f.use_column, header);
+        column_field(ui, "side", &mut f.side_column, header);
+    });
+    ui.horizontal_wrapped(|ui| {
+        for (k, c) in f.joint_columns.iter_mut().enumerate() {
+            column_field(ui, &format!("joint {}", k + 1), c, header);
+        }
+    });
+    let missing: Vec<&str> = [&f.id_column, &f.station_column, &f.use_column]
+        .into_iter()
+        .chain(&f.joint_columns)
+        .chain(std::iter::once(&f.side_column).filter(|s| !s.trim().is_empty()))
+        .map(|s| s.trim())
+        .filter(|c| !header.is_empty() && !header.iter().any(|h| h.eq_ignore_ascii_case(c)))
+        .collect();
+    if !missing.is_empty() {
+        ui.label(RichText::new(format!("not in the header: {}", missing.join(", "))).color(WARN));
+    }
+    if let Some(preview) = &state.import.preview {
+        match preview {
+            Ok(text) => {
+                egui::ScrollArea::horizontal()
+                    .id_salt("import_preview")
+                    .show(ui, |ui| {
+                        ui.label(RichText::new(text).monospace());
+                    });
+            }
+            Err(e) => {
+                ui.label(RichText::new(format!("Preview failed: {e}")).color(BAD));
+            }
+        }
+    }
+}
+
+/// A column-name field with a menu of the header's names.
+fn column_field(ui: &mut egui::Ui, label: &str, value: &mut String, header: &[String]) {
+    let l = ui.label(label);
+    ui.add(egui::TextEdit::singleline(value).desired_width(COLUMN_WIDTH))
+        .labelled_by(l.id);
+    if !header.is_empty() {
+        egui::ComboBox::from_id_salt(("import_column", label))
+            .selected_text("")
+            .width(18.0)
+            .show_ui(ui, |ui| {
+                if label == "side" {
+                    ui.selectable_value(value, String::new(), "(none: every side +1)");
+                }
+                for h in header {
+                    ui.selectable_value(value, h.clone(), h);
+                }
+            })
+            .response
+            .on_hover_text(format!("choose the {label} column from the header"));
+    }
+    ui.add_space(8.0);
+}
+
+fn flange_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
+    ui.label(RichText::new("4 · Flange poses from the controller (optional)").strong());
+    ui.horizontal(|ui| {
+        let text = f
+            .flange
+            .and_then(|c| CONVENTIONS.iter().find(|(k, _)| *k == c))
+            .map_or("no check", |(_, l)| l);
+        egui::ComboBox::from_id_salt("import_flange")
+            .selected_text(text)
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut f.flange, None, "no check");
+                for (c, l) in CONVENTIONS {
+                    ui.selectable_value(&mut f.flange, Some(c), l);
+                }
+            })
+            .response
+            .on_hover_text(
+                "compare the controller's flange poses with the nominal model's forward kinematics",
+            );
+        if let Some(c) = f.flange {
+            labelled_field(
+                ui,
+                "columns",
+                &mut f.flange_columns,
+                &c.default_columns().join(","),
+                180.0,
+            );
+            let l = ui.label("tolerance");
+            ui.add(
+                egui::DragValue::new(&mut f.tolerance_mm)
+                    .range(0.01..=100.0)
+                    .speed(0.05)
+                    .suffix(" mm"),
+            )
+            .labelled_by(l.id);
+            ui.add(
+                egui::DragValue::new(&mut f.tolerance_deg)
+                    .range(0.01..=45.0)
+                    .speed(0.01)
+                    .suffix(" deg"),
+            );
+        }
+    });
+}
+
+fn outcome_ui(ui: &mut egui::Ui, state: &AppState) {
+    let view = &state.import;
+    match &view.outcome {
+        Some(Ok(line)) => {
+            ui.label(RichText::new(line).strong());
+        }
+        Some(Err(e)) => {
+            egui::Frame::group(ui.style())
+                .stroke(egui::Stroke::new(1.5, BAD))
+                .show(ui, |ui| {
+                    ui.label(RichText::new("The import failed").strong().color(BAD));
+                    ui.label(e);
+                });
+        }
+        None => {}
+    }
+    let flagged: Vec<_> = view.checks.iter().filter(|c| c.flagged).collect();
+    if view.checks.is_empty() {
+        return;
+    }
+    let worst = view
+        .checks
+        .iter()
+        .map(|c| c.position_error_mm)
+        .fold(0.0_f64, f64::max);
+    ui.label(format!(
+        "Flange poses: {} checked, {} flagged, largest position mismatch {worst:.3} mm",
+        view.checks.len(),
+        flagged.len()
+    ));
+    if flagged.is_empty() {
+        return;
+    }
+    egui::Grid::new("import_flagged")
+        .striped(true)
+        .num_columns(4)
+        .show(ui, |ui| {
+            for h in ["pose", "position (mm)", "rotation (deg)", "likely cause"] {
+                ui.label(RichText::new(h).strong());
+            }
+            ui.end_row();
+            for c in flagged {
+                ui.label(RichText::new(&c.id).color(WARN));
+                ui.label(format!("{:.3}", c.position_error_mm));
+                ui.label(format!("{:.3}", c.rotation_error_deg));
+                ui.label(&c.hint);
+                ui.end_row();
+            }
+        });
+}

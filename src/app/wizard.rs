@@ -1,0 +1,295 @@
+//! The import wizard's form: what the operator chose (files, robot, units,
+//! column mapping, flange-pose check) and the engine's [`ImportSpec`] it
+//! stands for. The import itself is [`crate::engine::import`], the same
+//! function `spherecal import` calls.
+
+use std::path::PathBuf;
+
+use crate::engine::import::{
+    AngleUnit, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
+    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit, PoseCheck,
+    ProfileSource, RobotSource,
+};
+
+/// Rows the preview shows.
+pub const PREVIEW_ROWS: usize = 8;
+
+/// Number of joint columns of the mapping (the presets are all 6-axis; a
+/// robot file with another count is reported by the engine).
+pub const JOINTS: usize = 6;
+
+/// Where the stripe profiles are, as the form chooses it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProfilesKind {
+    /// A folder of `<id>.csv` files.
+    Folder,
+    /// One CSV with a pose column.
+    File,
+}
+
+/// The four flange-pose conventions with their labels.
+pub const CONVENTIONS: [(FlangeConvention, &str); 4] = [
+    (
+        FlangeConvention::AbbQuaternion,
+        "ABB (x y z mm, quaternion)",
+    ),
+    (FlangeConvention::KukaAbc, "KUKA (x y z mm, A B C deg)"),
+    (FlangeConvention::FanucWpr, "FANUC (x y z mm, W P R deg)"),
+    (
+        FlangeConvention::UrRotationVector,
+        "UR (x y z m, rotation vector rad)",
+    ),
+];
+
+/// The import wizard's fields.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImportForm {
+    /// The joint log CSV.
+    pub joints: String,
+    /// Folder or file of the stripe profiles.
+    pub profiles: String,
+    /// Whether `profiles` is a folder or one file.
+    pub profiles_kind: ProfilesKind,
+    /// Pose-id column of a single profile file.
+    pub pose_column: String,
+    /// Optional reference distances CSV (`from,to,distance`, mm).
+    pub references: String,
+    /// Robot preset key, used when `robot_file` is empty.
+    pub robot_preset: String,
+    /// A session or result file whose robot block is the nominal model.
+    pub robot_file: String,
+    /// Unit of the joint columns.
+    pub joint_unit: AngleUnit,
+    /// Unit of the profile coordinates.
+    pub profile_unit: LengthUnit,
+    /// Sphere diameter, mm.
+    pub sphere_diameter: f64,
+    /// Session name (empty: the joint log's file name).
+    pub name: String,
+    /// Column of the measurement id.
+    pub id_column: String,
+    /// Column of the station id.
+    pub station_column: String,
+    /// Column of the use.
+    pub use_column: String,
+    /// Column of the side (empty: none, every side +1).
+    pub side_column: String,
+    /// Columns of joints 1..6.
+    pub joint_columns: Vec<String>,
+    /// Check the flange poses in this convention.
+    pub flange: Option<FlangeConvention>,
+    /// The flange-pose columns, comma separated (empty: the convention's
+    /// defaults).
+    pub flange_columns: String,
+    /// Position tolerance of the flange check, mm.
+    pub tolerance_mm: f64,
+    /// Rotation tolerance of the flange check, deg.
+    pub tolerance_deg: f64,
+}
+
+impl Default for ImportForm {
+    fn default() -> Self {
+        Self {
+            joints: String::new(),
+            profiles: String::new(),
+            profiles_kind: ProfilesKind::Folder,
+            pose_column: "pose".into(),
+            references: String::new(),
+            robot_preset: "irb2400".into(),
+            robot_file: String::new(),
+            joint_unit: AngleUnit::Deg,
+            profile_unit: LengthUnit::Mm,
+            sphere_diameter: DEFAULT_SPHERE_DIAMETER,
+            name: String::new(),
+            id_column: "id".into(),
+            station_column: "station".into(),
+            use_column: "use".into(),
+            side_column: String::new(),
+            joint_columns: (1..=JOINTS).map(|k| format!("j{k}")).collect(),
+            flange: None,
+            flange_columns: String::new(),
+            tolerance_mm: DEFAULT_POSITION_TOLERANCE_MM,
+            tolerance_deg: DEFAULT_ROTATION_TOLERANCE_DEG,
+        }
+    }
+}
+
+impl ImportForm {
+    /// The engine's spec, or what is missing.
+    ///
+    /// # Errors
+    /// No joint log or profiles chosen, a non-positive sphere diameter or
+    /// tolerance: a sentence for the operator.
+    pub fn spec(&self) -> Result<ImportSpec, String> {
+        let joints = self.joints.trim();
+        if joints.is_empty() {
+            return Err("choose the joint log CSV first".into());
+        }
+        let profiles = self.profiles.trim();
+        if profiles.is_empty() {
+            return Err("choose the stripe profiles (a folder or one file) first".into());
+        }
+        if !(self.sphere_diameter.is_finite() && self.sphere_diameter > 0.0) {
+            return Err(format!(
+                "the sphere diameter {} mm is not positive",
+                self.sphere_diameter
+            ));
+        }
+        if !(self.tolerance_mm > 0.0 && self.tolerance_deg > 0.0) {
+            return Err("the flange-check tolerances must be positive".into());
+        }
+        let profiles = match self.profiles_kind {
+            ProfilesKind::Folder => ProfileSource::Folder(PathBuf::from(profiles)),
+            ProfilesKind::File => ProfileSource::File {
+                path: PathBuf::from(profiles),
+                pose_column: self.pose_column.trim().to_string(),
+            },
+        };
+        let robot = if self.robot_file.trim().is_empty() {
+            RobotSource::Preset(self.robot_preset.clone())
+        } else {
+            RobotSource::File(PathBuf::from(self.robot_file.trim()))
+        };
+        let side = self.side_column.trim();
+        let flange = self.flange.map(|convention| {
+            let mut check = FlangeCheck::new(convention);
+            let columns: Vec<String> = self
+                .flange_columns
+                .split(',')
+                .map(|c| c.trim().to_string())
+                .filter(|c| !c.is_empty())
+                .collect();
+            if !columns.is_empty() {
+                check.columns = columns;
+            }
+            check.tolerance_mm = self.tolerance_mm;
+            check.tolerance_deg = self.tolerance_deg;
+            check
+        });
+        let name = self.name.trim();
+        let references = self.references.trim();
+        Ok(ImportSpec {
+            joint_log: PathBuf::from(joints),
+            columns: ColumnMap {
+                id: self.id_column.trim().to_string(),
+                station: self.station_column.trim().to_string(),
+                usage: self.use_column.trim().to_string(),
+                side: (!side.is_empty()).then(|| side.to_string()),
+                joints: self
+                    .joint_columns
+                    .iter()
+                    .map(|c| c.trim().to_string())
+                    .collect(),
+            },
+            joint_unit: self.joint_unit,
+            profiles,
+            profile_unit: self.profile_unit,
+            robot,
+            sphere_diameter: self.sphere_diameter,
+            name: (!name.is_empty()).then(|| name.to_string()),
+            flange,
+            references: (!references.is_empty()).then(|| PathBuf::from(references)),
+        })
+    }
+
+    /// Fills the mapping from a joint log's header where a column's name
+    /// is an obvious match (case-insensitive: `id`/`pose`, `station`/
+    /// `sphere`, `use`, `side`, `j1`/`a1`/`joint1`/`q1`…), leaving the
+    /// other fields as they are. Returns how many fields it set.
+    pub fn guess_mapping(&mut self, header: &[String]) -> usize {
+        let find = |names: &[String]| -> Option<String> {
+            header
+                .iter()
+                .find(|h| names.iter().any(|n| h.eq_ignore_ascii_case(n)))
+                .cloned()
+        };
+        let words = |list: &[&str]| -> Vec<String> { list.iter().map(|s| (*s).into()).collect() };
+        let mut set = 0;
+        let mut assign = |field: &mut String, found: Option<String>| {
+            if let Some(f) = found {
+                *field = f;
+                set += 1;
+            }
+        };
+        assign(
+            &mut self.id_column,
+            find(&words(&["id", "pose", "pose_id", "measurement"])),
+        );
+        assign(
+            &mut self.station_column,
+            find(&words(&["station", "sphere", "station_id"])),
+        );
+        assign(
+            &mut self.use_column,
+            find(&words(&["use", "usage", "group"])),
+        );
+        assign(&mut self.side_column, find(&words(&["side"])));
+        let joints_found: Vec<Option<String>> = (1..=JOINTS)
+            .map(|k| {
+                find(&[
+                    format!("j{k}"),
+                    format!("a{k}"),
+                    format!("joint{k}"),
+                    format!("joint_{k}"),
+                    format!("axis{k}"),
+                ])
+            })
+            .collect();
+        for (slot, found) in self.joint_columns.iter_mut().zip(joints_found) {
+            assign(slot, found);
+        }
+        set
+    }
+}
+
+/// What the wizard shows besides its form.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ImportView {
+    /// The joint log's header, once read.
+    pub header: Vec<String>,
+    /// The preview text (mapped rows), or why it failed.
+    pub preview: Option<Result<String, String>>,
+    /// The flange-pose checks of the last import.
+    pub checks: Vec<PoseCheck>,
+    /// The last import's outcome in one line, or its error.
+    pub outcome: Option<Result<String, String>>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mapping_is_guessed_from_a_kuka_style_header() {
+        let mut f = ImportForm::default();
+        let header: Vec<String> = ["Pose", "Sphere", "Use", "A1", "A2", "A3", "A4", "A5", "A6"]
+            .iter()
+            .map(|s| (*s).to_string())
+            .collect();
+        assert_eq!(f.guess_mapping(&header), 9);
+        assert_eq!(f.id_column, "Pose");
+        assert_eq!(f.station_column, "Sphere");
+        assert_eq!(f.joint_columns[5], "A6");
+        assert!(f.side_column.is_empty(), "no side column in the header");
+    }
+
+    #[test]
+    fn spec_needs_the_files_and_carries_the_choices() {
+        let mut f = ImportForm::default();
+        assert!(f.spec().unwrap_err().contains("joint log"));
+        f.joints = "log.csv".into();
+        assert!(f.spec().unwrap_err().contains("profiles"));
+        f.profiles = "p.csv".into();
+        f.profiles_kind = ProfilesKind::File;
+        f.side_column = "side".into();
+        f.flange = Some(FlangeConvention::KukaAbc);
+        f.references = " refs.csv ".into();
+        let s = f.spec().unwrap();
+        assert_eq!(s.columns.side.as_deref(), Some("side"));
+        assert_eq!(s.flange.unwrap().columns.len(), 6);
+        assert_eq!(s.references, Some(PathBuf::from("refs.csv")));
+        assert!(matches!(s.profiles, ProfileSource::File { .. }));
+        f.sphere_diameter = 0.0;
+        assert!(f.spec().unwrap_err().contains("diameter"));
+    }
+}
