@@ -18,6 +18,7 @@ pub mod evaluate;
 pub mod geometry;
 pub mod handeye;
 pub mod identify;
+pub mod ik;
 pub mod import;
 pub mod kinematics;
 pub mod ml;

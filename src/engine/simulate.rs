@@ -44,11 +44,11 @@ use std::collections::HashSet;
 use std::f64::consts::PI;
 use std::fmt;
 use std::marker::PhantomData;
+use std::ops::ControlFlow;
 use std::path::Path;
 
 use nalgebra::{
-    Isometry3, Matrix3, Matrix6, Point3, Rotation3, Translation3, Unit, UnitQuaternion, Vector3,
-    Vector6,
+    Isometry3, Matrix3, Point3, Rotation3, Translation3, Unit, UnitQuaternion, Vector3,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -58,7 +58,8 @@ use serde::ser::SerializeMap;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use super::error::FileError;
-use super::geometry::{MatrixError, isometry_from_rows, rot_x, rot_y, rows_from_isometry, trans};
+use super::geometry::{MatrixError, isometry_from_rows, rows_from_isometry};
+use super::ik::{Chain, DOF, wrap_deg};
 use super::kinematics::{self, Joint, JointLimit, Robot};
 use super::model::{
     DEFAULT_MAX_ITERATIONS, DEFAULT_THRESHOLD, Measurement, Observation, ReferenceDistance,
@@ -1152,257 +1153,10 @@ fn station_sides(rng: &mut ChaCha8Rng, n: usize, choice: SideChoice) -> Vec<i8> 
     }
 }
 
-/// Joints of the arms this simulator plans for (every preset has 6).
-const DOF: usize = 6;
-/// IK iteration bound: from a family start a reachable target converges in
-/// ~6-12 iterations (steps are capped at [`IK_MAX_STEP`]).
-const IK_MAX_ITER: usize = 60;
-/// After this many iterations a start still more than [`IK_FAR_MM`] or
-/// [`IK_FAR_RAD`] off is abandoned: it is heading for a limit or a
-/// singularity, and the next start is cheaper than waiting.
-const IK_GIVE_UP_ITER: usize = 20;
-/// See [`IK_GIVE_UP_ITER`], mm.
-const IK_FAR_MM: f64 = 1.0;
-/// See [`IK_GIVE_UP_ITER`], rad.
-const IK_FAR_RAD: f64 = 0.02;
-/// Largest joint step per iteration (rad), to stay in one basin.
-const IK_MAX_STEP: f64 = 0.3;
-/// Rotation error rows are weighted by this length (mm per rad, ~the
-/// sensor stand-off) so position and orientation matter alike.
-const IK_ROT_WEIGHT: f64 = 300.0;
-/// Convergence: flange position error, mm (ground truth must hold to
-/// 1e-6 mm; 1e-9 is ~10⁴ ulp of a 1 m coordinate).
-const IK_POSITION_TOLERANCE: f64 = 1e-9;
-/// Convergence: flange rotation error, rad (1e-11 rad moves the sphere,
-/// ~300 mm out, by 3e-9 mm).
-const IK_ROTATION_TOLERANCE: f64 = 1e-11;
-/// Damping of the normal equations (mm²): negligible beside `JᵀJ`
-/// (~10⁴-10⁶ mm²) away from singularities, bounded steps near them.
-const IK_DAMPING: f64 = 1e-6;
 /// The sphere seen through the reference forward kinematics
 /// ([`Robot::base_from_flange`]) must agree with the station to this
-/// (mm): a guard on the fast chain below.
+/// (mm): a guard on the fast [`Chain`].
 const IK_CHECK_TOLERANCE: f64 = 1e-7;
-
-/// The true model prepared for repeated inverse kinematics: the same MDH
-/// product as [`Robot::base_from_flange`], with each joint's fixed part
-/// `Rx(alpha)·Tx(a)·Ry(beta)` precomputed, and the geometric Jacobian of
-/// the flange (6 columns, not the 30 of the parameter Jacobian).
-struct Chain {
-    base: Isometry3<f64>,
-    fixed: [Isometry3<f64>; DOF],
-    /// Per joint: zero offset theta (deg) and offset d (mm).
-    theta_d: [(f64, f64); DOF],
-    flange: Isometry3<f64>,
-    /// Whether the wrist is `alpha5 = 90°, alpha6 = −90°` with small betas
-    /// (every preset), so [`Self::wrist_starts`] can solve it.
-    euler_wrist: bool,
-    /// Whether, moreover, the wrist axes nearly meet (`a5`, `d5`, `a6`
-    /// small: the ABB arms, not the UR5e), so the wrist centre depends on
-    /// joints 1-3 only and [`Self::arm_for_wrist`] can place it.
-    spherical_wrist: bool,
-}
-
-/// `Rz(angle_deg) · Tz(d)`, the moving part of an MDH link.
-fn joint_motion(angle_deg: f64, d: f64) -> Isometry3<f64> {
-    Isometry3::from_parts(
-        Translation3::new(0.0, 0.0, d),
-        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle_deg.to_radians()),
-    )
-}
-
-/// Largest deviation (deg) of the wrist twists and betas from the Euler
-/// wrist for which [`Chain::wrist_starts`] still gives a useful start.
-const EULER_WRIST_TOLERANCE: f64 = 2.0;
-
-/// Two arm solutions closer than this on every joint (deg) are the same.
-const SAME_ARM_DEG: f64 = 1.0;
-/// Largest wrist offset (mm) for which the wrist counts as spherical: the
-/// true models' offsets are below 1 mm, the UR5e's are ~100 mm.
-const SPHERICAL_WRIST_TOLERANCE: f64 = 5.0;
-/// The wrist centre is placed to this (mm) before the full solve: the
-/// start only needs to be in the basin, the full solve polishes.
-const WRIST_CENTRE_TOLERANCE: f64 = 0.01;
-
-impl Chain {
-    fn new(robot: &Robot) -> Option<Self> {
-        if robot.dof() != DOF {
-            return None;
-        }
-        let mut fixed = [Isometry3::identity(); DOF];
-        let mut theta_d = [(0.0, 0.0); DOF];
-        for (i, j) in robot.joints.iter().enumerate() {
-            fixed[i] =
-                rot_x(j.alpha.to_radians()) * trans(j.a, 0.0, 0.0) * rot_y(j.beta.to_radians());
-            theta_d[i] = (j.theta, j.d);
-        }
-        let j = &robot.joints;
-        let euler_wrist = (j[4].alpha - 90.0).abs() < EULER_WRIST_TOLERANCE
-            && (j[5].alpha + 90.0).abs() < EULER_WRIST_TOLERANCE
-            && j[4].beta.abs() < EULER_WRIST_TOLERANCE
-            && j[5].beta.abs() < EULER_WRIST_TOLERANCE;
-        let spherical_wrist = euler_wrist
-            && j[4].a.abs() < SPHERICAL_WRIST_TOLERANCE
-            && j[4].d.abs() < SPHERICAL_WRIST_TOLERANCE
-            && j[5].a.abs() < SPHERICAL_WRIST_TOLERANCE;
-        Some(Self {
-            base: robot.base,
-            fixed,
-            theta_d,
-            flange: robot.flange,
-            euler_wrist,
-            spherical_wrist,
-        })
-    }
-
-    /// Flange pose and geometric Jacobian for readings `q` (deg): column
-    /// `i` is `[z_i × (p − o_i); z_i]` (mm/rad of the flange origin `p`,
-    /// rad/rad), base frame.
-    fn pose_and_jacobian(&self, q: &[f64; DOF]) -> (Isometry3<f64>, Matrix6<f64>) {
-        let mut t = self.base;
-        let mut axes = [(Vector3::zeros(), Vector3::zeros()); DOF];
-        for i in 0..DOF {
-            t *= self.fixed[i];
-            axes[i] = (t.rotation * Vector3::z(), t.translation.vector);
-            let (theta, d) = self.theta_d[i];
-            t *= joint_motion(q[i] + theta, d);
-        }
-        let pose = t * self.flange;
-        let p = pose.translation.vector;
-        let mut jac = Matrix6::zeros();
-        for (i, (z, o)) in axes.iter().enumerate() {
-            let v = z.cross(&(p - o));
-            jac.fixed_view_mut::<3, 1>(0, i).copy_from(&v);
-            jac.fixed_view_mut::<3, 1>(3, i).copy_from(z);
-        }
-        (pose, jac)
-    }
-
-    /// The wrist centre target for a flange target: the origin of the
-    /// frame before the last joint's `Tz(d6)`, with the flange transform
-    /// removed (on a spherical wrist it depends on joints 1-3 only).
-    fn wrist_centre_target(&self, target: &Isometry3<f64>) -> Vector3<f64> {
-        let d6 = self.theta_d[DOF - 1].1;
-        (target * self.flange.inverse() * trans(0.0, 0.0, -d6))
-            .translation
-            .vector
-    }
-
-    /// Joints 1-3 (deg) that put the spherical wrist's centre at `centre`,
-    /// by damped Gauss-Newton from `arm`; `None` when out of reach.
-    fn arm_for_wrist(&self, arm: [f64; 3], centre: &Vector3<f64>) -> Option<[f64; 3]> {
-        let mut q = arm;
-        let d4 = self.theta_d[3].1;
-        for _ in 0..IK_MAX_ITER {
-            let mut t = self.base;
-            let mut axes = [(Vector3::zeros(), Vector3::zeros()); 3];
-            for i in 0..3 {
-                t *= self.fixed[i];
-                axes[i] = (t.rotation * Vector3::z(), t.translation.vector);
-                let (theta, d) = self.theta_d[i];
-                t *= joint_motion(q[i] + theta, d);
-            }
-            let w = (t * self.fixed[3] * trans(0.0, 0.0, d4)).translation.vector;
-            let err = centre - w;
-            if err.norm() < WRIST_CENTRE_TOLERANCE {
-                return Some(q);
-            }
-            let jac = Matrix3::from_columns(&axes.map(|(z, o)| z.cross(&(w - o))));
-            let normal = jac.transpose() * jac + Matrix3::identity() * IK_DAMPING;
-            let step = normal.cholesky()?.solve(&(jac.transpose() * err));
-            let largest = step.amax();
-            let scale = if largest > IK_MAX_STEP {
-                IK_MAX_STEP / largest
-            } else {
-                1.0
-            };
-            for (qi, s) in q.iter_mut().zip(step.iter()) {
-                *qi += (s * scale).to_degrees();
-            }
-        }
-        None
-    }
-
-    /// IK starts for an arm guess `(q1, q2, q3)` (deg): the two wrist
-    /// solutions (`q5` of either sign) that give exactly the target
-    /// rotation for that arm. The wrist of every preset is
-    /// `Rz(q4') · Rx(90°) · Rz(q5') · Rx(−90°) · Rz(q6') = Rz(q4') · Ry(−q5') · Rz(q6')`
-    /// (primes: plus `theta`), a z-y-z Euler decomposition; a robot without
-    /// that wrist gets the arm guess with a zero wrist.
-    fn wrist_starts(&self, arm: [f64; 3], target: &Isometry3<f64>) -> [[f64; DOF]; 2] {
-        let (t4, t5, t6) = (self.theta_d[3].0, self.theta_d[4].0, self.theta_d[5].0);
-        if !self.euler_wrist {
-            return [[arm[0], arm[1], arm[2], 0.0, 0.0, 0.0]; 2];
-        }
-        let mut t = self.base;
-        for (i, q) in arm.iter().enumerate() {
-            let (theta, d) = self.theta_d[i];
-            t *= self.fixed[i] * joint_motion(*q + theta, d);
-        }
-        t *= self.fixed[3];
-        let m = (t.rotation.inverse() * target.rotation * self.flange.rotation.inverse())
-            .to_rotation_matrix();
-        let b = m[(0, 2)].hypot(m[(1, 2)]).atan2(m[(2, 2)]).to_degrees();
-        let a = m[(1, 2)].atan2(m[(0, 2)]).to_degrees();
-        let c = m[(2, 1)].atan2(-m[(2, 0)]).to_degrees();
-        [
-            [arm[0], arm[1], arm[2], a - t4, -b - t5, c - t6],
-            [
-                arm[0],
-                arm[1],
-                arm[2],
-                a + 180.0 - t4,
-                b - t5,
-                c + 180.0 - t6,
-            ],
-        ]
-    }
-
-    /// Damped Gauss-Newton from `start` (deg) to the flange pose `target`;
-    /// `None` when it does not converge (limits are the caller's check).
-    fn inverse_kinematics(
-        &self,
-        target: &Isometry3<f64>,
-        start: &[f64; DOF],
-    ) -> Option<[f64; DOF]> {
-        let mut q = *start;
-        for iter in 0..IK_MAX_ITER {
-            let (pose, jac) = self.pose_and_jacobian(&q);
-            let dp = target.translation.vector - pose.translation.vector;
-            let dr = (target.rotation * pose.rotation.inverse()).scaled_axis();
-            if dp.norm() < IK_POSITION_TOLERANCE && dr.norm() < IK_ROTATION_TOLERANCE {
-                return Some(q);
-            }
-            if iter >= IK_GIVE_UP_ITER && (dp.norm() > IK_FAR_MM || dr.norm() > IK_FAR_RAD) {
-                return None;
-            }
-            let mut a = jac;
-            for r in 3..6 {
-                a.row_mut(r).scale_mut(IK_ROT_WEIGHT);
-            }
-            let e = Vector6::new(
-                dp.x,
-                dp.y,
-                dp.z,
-                dr.x * IK_ROT_WEIGHT,
-                dr.y * IK_ROT_WEIGHT,
-                dr.z * IK_ROT_WEIGHT,
-            );
-            let normal = a.transpose() * a + Matrix6::identity() * IK_DAMPING;
-            let step = normal.cholesky()?.solve(&(a.transpose() * e));
-            let largest = step.amax();
-            let scale = if largest > IK_MAX_STEP {
-                IK_MAX_STEP / largest
-            } else {
-                1.0
-            };
-            for (qi, s) in q.iter_mut().zip(step.iter()) {
-                *qi += (s * scale).to_degrees();
-            }
-        }
-        None
-    }
-}
 
 /// One planned pose before noise.
 #[derive(Debug, Clone)]
@@ -1528,36 +1282,12 @@ impl Planner<'_> {
             return Some(q);
         }
         let guesses = self.arm_guesses(&target);
-        let centre = self.chain.wrist_centre_target(&target);
-        let mut arms_tried: Vec<[f64; 3]> = Vec::new();
-        for guess in guesses {
-            let arm = if self.chain.spherical_wrist {
-                match self.chain.arm_for_wrist(guess, &centre) {
-                    Some(arm) => arm,
-                    None => continue,
-                }
-            } else {
-                guess
-            };
-            // Different guesses often reach the same arm solution.
-            let seen_before = arms_tried.iter().any(|t| {
-                t.iter()
-                    .zip(&arm)
-                    .all(|(a, b)| wrap_deg(a - b).abs() < SAME_ARM_DEG)
-            });
-            if seen_before {
-                continue;
-            }
-            arms_tried.push(arm);
-            let mut wrists = self.chain.wrist_starts(arm, &target);
-            if self.wrist_dislike(&wrists[1]) < self.wrist_dislike(&wrists[0]) {
-                wrists.swap(0, 1);
-            }
-            if let Some(q) = wrists.iter().find_map(attempt) {
-                return Some(q);
-            }
-        }
-        None
+        let dislike = |q: &[f64; DOF]| self.wrist_dislike(q);
+        self.chain
+            .search(&target, &guesses, &dislike, |start| match attempt(start) {
+                Some(q) => ControlFlow::Break(q),
+                None => ControlFlow::Continue(()),
+            })
     }
 
     /// `n` poses seeing `station` from random orientations in the cone.
@@ -1729,12 +1459,6 @@ fn unreachable(id: &str, station: &Vector3<f64>) -> SimError {
         position: [station.x, station.y, station.z],
         attempts: MAX_POSE_ATTEMPTS,
     }
-}
-
-/// `v` moved by whole turns into (−180, 180].
-fn wrap_deg(v: f64) -> f64 {
-    let w = v - 360.0 * (v / 360.0).round();
-    if w <= -180.0 { w + 360.0 } else { w }
 }
 
 /// Identify stations: a 3×3 Latin square of x, y, z levels (jittered),
@@ -2116,52 +1840,6 @@ mod tests {
         // r = 14.59 mm, ±55°, 0.5 mm: 28.0 mm of arc, 57 points.
         let r = 19.05 * 40f64.to_radians().cos();
         assert_eq!(stripe_point_count(r, 55.0, 0.5), 57);
-    }
-
-    #[test]
-    fn chain_matches_reference_kinematics() {
-        let mut robot = kinematics::irb2400().robot;
-        for (j, e) in robot.joints.iter_mut().zip(table1_errors()) {
-            j.alpha += e.alpha;
-            j.a += e.a;
-            j.beta += e.beta;
-            j.theta += e.theta;
-            j.d += e.d;
-        }
-        let chain = Chain::new(&robot).unwrap();
-        let q = [12.5, 20.1, -3.4, 40.0, 35.2, -10.0];
-        let (pose, jac) = chain.pose_and_jacobian(&q);
-        let reference = robot.base_from_flange(&q);
-        assert!((pose.translation.vector - reference.translation.vector).norm() < 1e-9);
-        assert!(pose.rotation.angle_to(&reference.rotation) < 1e-12);
-        // Jacobian columns against central differences (per rad).
-        let h = 1e-6_f64;
-        for i in 0..DOF {
-            let mut qp = q;
-            qp[i] += h.to_degrees();
-            let mut qm = q;
-            qm[i] -= h.to_degrees();
-            let (pp, _) = chain.pose_and_jacobian(&qp);
-            let (pm, _) = chain.pose_and_jacobian(&qm);
-            let v = (pp.translation.vector - pm.translation.vector) / (2.0 * h);
-            let col = jac.column(i);
-            assert!(
-                (v - Vector3::new(col[0], col[1], col[2])).norm() < 1e-4,
-                "joint {i}"
-            );
-        }
-        // IK from a wrist start returns the pose.
-        let target = reference;
-        let arm = chain
-            .arm_for_wrist([10.0, 15.0, 0.0], &chain.wrist_centre_target(&target))
-            .unwrap();
-        let solved = chain
-            .wrist_starts(arm, &target)
-            .iter()
-            .find_map(|s| chain.inverse_kinematics(&target, s))
-            .unwrap();
-        let back = robot.base_from_flange(&solved);
-        assert!((back.translation.vector - target.translation.vector).norm() < 1e-8);
     }
 
     #[test]
