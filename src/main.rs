@@ -17,6 +17,7 @@ fn main() -> ExitCode {
         Some(Command::Evaluate(args)) => cli::evaluate::run(&args),
         Some(Command::ExportModel(args)) => cli::export_model::run(&args),
         Some(Command::Import(args)) => cli::import::run(&args),
+        Some(Command::Plan(args)) => cli::plan::run(&args),
         None => gui(None, None),
     };
     match outcome {

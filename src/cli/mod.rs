@@ -9,6 +9,7 @@
 pub mod evaluate;
 pub mod export_model;
 pub mod import;
+pub mod plan;
 pub mod simulate;
 
 use std::path::{Path, PathBuf};
@@ -48,6 +49,8 @@ pub enum Command {
     ExportModel(export_model::ExportModelArgs),
     /// Build a session file from a joint log CSV and stripe profile files (mm, deg in the session; units of the inputs chosen by flags).
     Import(import::ImportArgs),
+    /// Plan the poses to teach (translation, rotation, identify and validate groups) for a robot, a rough sphere position and a hand-eye guess; export CSV and RAPID.
+    Plan(plan::PlanArgs),
 }
 
 /// `spherecal gui`.

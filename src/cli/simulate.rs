@@ -1,13 +1,20 @@
 //! `spherecal simulate`: writes a seeded simulated session (FORMAT.md) and
 //! its ground truth (`spherecal-truth`), both atomically, and prints one
-//! summary line. A thin caller of [`crate::engine::simulate`].
+//! summary line. With `--plan` the poses come from a plan CSV
+//! (`spherecal plan --csv`) instead of the simulator's own generation;
+//! with `--csv-out DIR` it also writes the joint log, stripe profiles and
+//! reference distances that `spherecal import` reads. A thin caller of
+//! [`crate::engine::simulate`].
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use anyhow::Context as _;
 use clap::ValueEnum;
 
-use crate::engine::model::Use;
+use crate::engine::kinematics;
+use crate::engine::model::{Session, Use};
+use crate::engine::plan;
 use crate::engine::session;
 use crate::engine::simulate::{
     self, ErrorModel, InitialHandEye, RobotChoice, SideChoice, SimConfig,
@@ -136,6 +143,18 @@ pub struct SimulateArgs {
     /// the engine computes it from the translation and rotation measurements).
     #[arg(long)]
     pub with_hand_eye: bool,
+    /// Sphere diameter, mm.
+    #[arg(long, default_value_t = 38.1)]
+    pub diameter: f64,
+    /// Simulate the poses of a plan CSV (`spherecal plan --csv`) on the --robot preset with --errors, instead of generating poses: the robot goes to the plan's joints, the sphere stands where it then sees the planned centres on average.
+    #[arg(long)]
+    pub plan: Option<PathBuf>,
+    /// With --plan: the true hand-eye, a JSON 4x4 (rows, mm) or a session/result file's `hand_eye` (default: the paper's calibrated hand-eye, the paper's guess error applied to its initial one).
+    #[arg(long, requires = "plan")]
+    pub hand_eye: Option<PathBuf>,
+    /// Also write what `spherecal import` reads: DIR/joints.csv (joint log with the nominal ABB flange pose), DIR/profiles/<id>.csv (y,z mm) and DIR/references.csv (from,to,distance mm).
+    #[arg(long)]
+    pub csv_out: Option<PathBuf>,
 }
 
 impl SimulateArgs {
@@ -163,6 +182,7 @@ impl SimulateArgs {
             centre_noise: self.centre_noise,
             side: self.side.into(),
             tracker_noise: self.tracker_noise,
+            diameter: self.diameter,
             ..SimConfig::default()
         }
     }
@@ -175,6 +195,23 @@ impl SimulateArgs {
             .clone()
             .unwrap_or_else(|| default_truth_path(&self.out))
     }
+}
+
+/// Writes the import inputs of `session` into `dir` (created if needed),
+/// each file atomically.
+fn write_import_files(session: &Session, dir: &Path) -> anyhow::Result<()> {
+    let files = simulate::import_files(session)?;
+    let profiles = dir.join("profiles");
+    std::fs::create_dir_all(&profiles)
+        .with_context(|| format!("creating {} failed", profiles.display()))?;
+    session::write_atomic(&dir.join("joints.csv"), files.joints_csv.as_bytes())?;
+    for (id, text) in &files.profiles {
+        session::write_atomic(&profiles.join(format!("{id}.csv")), text.as_bytes())?;
+    }
+    if let Some(text) = &files.references_csv {
+        session::write_atomic(&dir.join("references.csv"), text.as_bytes())?;
+    }
+    Ok(())
 }
 
 fn default_truth_path(out: &Path) -> PathBuf {
@@ -204,7 +241,29 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         );
     }
     let config = args.to_config();
-    let (session, truth) = simulate::simulate(&config)?;
+    let (session, truth) = match &args.plan {
+        None => simulate::simulate(&config)?,
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("reading failed ({})", path.display()))?;
+            let poses = plan::read_plan_csv(&text)
+                .map_err(|e| anyhow::anyhow!("{e} ({})", path.display()))?;
+            let nominal = kinematics::preset(config.robot.key())
+                .map(|p| p.robot)
+                .ok_or_else(|| anyhow::anyhow!("unknown robot {}", config.robot.key()))?;
+            let hand_eye = match &args.hand_eye {
+                Some(he) => {
+                    super::plan::read_hand_eye(he).map_err(|e| anyhow::anyhow!(e.message))?
+                }
+                None => simulate::paper_hand_eye(),
+            };
+            simulate::simulate_plan(&config, &nominal, &hand_eye, &poses)
+                .map_err(|e| anyhow::anyhow!("{e} ({})", path.display()))?
+        }
+    };
+    if let Some(dir) = &args.csv_out {
+        write_import_files(&session, dir)?;
+    }
     session::write_atomic(&truth_path, simulate::truth_to_json(&truth).as_bytes())?;
     session::write_atomic(&args.out, session::session_to_json(&session).as_bytes())?;
     let count = |usage: Use| session.with_use(usage).count();

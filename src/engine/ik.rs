@@ -100,6 +100,9 @@ pub struct Chain {
     spherical_wrist: bool,
 }
 
+/// A joint axis in the base frame: direction and a point on it (mm).
+type Axis = (Vector3<f64>, Vector3<f64>);
+
 /// `Rz(angle_deg) · Tz(d)`, the moving part of an MDH link.
 fn joint_motion(angle_deg: f64, d: f64) -> Isometry3<f64> {
     Isometry3::from_parts(
@@ -206,7 +209,7 @@ impl Chain {
     }
 
     /// The wrist centre (base frame, mm) for arm joints `arm` (deg).
-    fn wrist_centre(&self, arm: &[f64; 3]) -> (Vector3<f64>, [(Vector3<f64>, Vector3<f64>); 3]) {
+    fn wrist_centre(&self, arm: &[f64; 3]) -> (Vector3<f64>, [Axis; 3]) {
         let mut t = self.base;
         let mut axes = [(Vector3::zeros(), Vector3::zeros()); 3];
         for i in 0..3 {

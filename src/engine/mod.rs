@@ -24,6 +24,7 @@ pub mod kinematics;
 pub mod ml;
 pub mod model;
 pub mod model_export;
+pub mod plan;
 pub mod report;
 pub mod session;
 pub mod simulate;

@@ -270,7 +270,7 @@ impl Workspace {
         }
     }
 
-    fn lerp(&self, f: [f64; 3]) -> Vector3<f64> {
+    pub(crate) fn lerp(&self, f: [f64; 3]) -> Vector3<f64> {
         Vector3::from_fn(|i, _| self.min[i] + f[i] * (self.max[i] - self.min[i]))
     }
 
@@ -435,6 +435,23 @@ pub enum SimError {
         position: [f64; 3],
         /// Orientations tried.
         attempts: usize,
+    },
+    /// A pose of a plan does not see the sphere on the true robot: the
+    /// sphere centre falls outside the usable cut of the laser plane.
+    #[error(
+        "pose {id}: on the true robot the sphere centre lies at sensor x = {x:.2} mm, outside the usable cut on side {side:+} ({lo:.2} to {hi:.2} mm from the laser plane); the true robot or hand-eye is too far from the plan's (smaller --error-scale, or the plan's robot and hand-eye)"
+    )]
+    PlanMiss {
+        /// Measurement id.
+        id: String,
+        /// Sensor-frame x of the sphere centre, mm.
+        x: f64,
+        /// The planned side, +1 or −1.
+        side: i8,
+        /// Smallest usable `|x|`, mm.
+        lo: f64,
+        /// Largest usable `|x|`, mm.
+        hi: f64,
     },
 }
 
@@ -691,7 +708,7 @@ impl Truth {
 /// A rigid transform from 4×4 rows, taking the nearest rotation of the 3×3
 /// block. For rows that pass [`isometry_from_rows`] the result is identical
 /// to it (same conversion); it never fails, so accessors need no `Result`.
-fn rigid_from_rows(rows: &[[f64; 4]; 4]) -> Isometry3<f64> {
+pub(crate) fn rigid_from_rows(rows: &[[f64; 4]; 4]) -> Isometry3<f64> {
     let r = Matrix3::from_fn(|i, j| rows[i][j]);
     Isometry3::from_parts(
         Translation3::new(rows[0][3], rows[1][3], rows[2][3]),
@@ -699,7 +716,7 @@ fn rigid_from_rows(rows: &[[f64; 4]; 4]) -> Isometry3<f64> {
     )
 }
 
-fn round_to(value: f64, decimals: i32) -> f64 {
+pub(crate) fn round_to(value: f64, decimals: i32) -> f64 {
     let scale = 10f64.powi(decimals);
     (value * scale).round() / scale
 }
@@ -852,7 +869,7 @@ pub fn load_truth(path: &Path) -> Result<Truth, FileError> {
 }
 
 /// One ChaCha8 stream of the seed (see "Randomness" in the module docs).
-fn stream(seed: u64, id: u64) -> ChaCha8Rng {
+pub(crate) fn stream(seed: u64, id: u64) -> ChaCha8Rng {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(id);
     rng
@@ -866,7 +883,7 @@ const STREAM_ERRORS: u64 = 1;
 const STREAM_NOISE: u64 = 2;
 
 /// Uniform in `[lo, hi)`; never panics and always draws one number.
-fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
+pub(crate) fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
     lo + (hi - lo) * rng.random::<f64>()
 }
 
@@ -1053,7 +1070,7 @@ fn validate_config(c: &SimConfig) -> Result<(), SimError> {
 
 /// Points on an arc of radius `r` (mm), half-angle `half_angle_deg`, one
 /// every `spacing` mm.
-fn stripe_point_count(r: f64, half_angle_deg: f64, spacing: f64) -> usize {
+pub(crate) fn stripe_point_count(r: f64, half_angle_deg: f64, spacing: f64) -> usize {
     let arc = 2.0 * half_angle_deg.to_radians() * r;
     // Truncation intended: whole points that fit on the arc.
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
@@ -1096,7 +1113,11 @@ fn kinematic_errors(c: &SimConfig, dof: usize, rng: &mut ChaCha8Rng) -> Vec<Join
 
 /// A unit vector uniformly distributed (by solid angle) within `cone` rad
 /// of `axis`.
-fn direction_in_cone(rng: &mut ChaCha8Rng, axis: &Vector3<f64>, cone: f64) -> Vector3<f64> {
+pub(crate) fn direction_in_cone(
+    rng: &mut ChaCha8Rng,
+    axis: &Vector3<f64>,
+    cone: f64,
+) -> Vector3<f64> {
     let cos_t = 1.0 - rng.random::<f64>() * (1.0 - cone.cos());
     let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
     let phi = 2.0 * PI * rng.random::<f64>();
@@ -1118,7 +1139,7 @@ fn perpendiculars(axis: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
 
 /// The rotation whose z axis is `approach` (unit), turned by `roll` rad
 /// about it.
-fn rotation_from_approach(approach: &Vector3<f64>, roll: f64) -> UnitQuaternion<f64> {
+pub(crate) fn rotation_from_approach(approach: &Vector3<f64>, roll: f64) -> UnitQuaternion<f64> {
     let (e1, e2) = perpendiculars(approach);
     let x = e1 * roll.cos() + e2 * roll.sin();
     let y = approach.cross(&x);
@@ -1126,7 +1147,11 @@ fn rotation_from_approach(approach: &Vector3<f64>, roll: f64) -> UnitQuaternion<
 }
 
 /// A random flange orientation: approach in the cone, uniform roll.
-fn random_orientation(rng: &mut ChaCha8Rng, mean: &Vector3<f64>, cone: f64) -> UnitQuaternion<f64> {
+pub(crate) fn random_orientation(
+    rng: &mut ChaCha8Rng,
+    mean: &Vector3<f64>,
+    cone: f64,
+) -> UnitQuaternion<f64> {
     let approach = direction_in_cone(rng, mean, cone);
     let roll = 2.0 * PI * rng.random::<f64>();
     rotation_from_approach(&approach, roll)
@@ -1439,8 +1464,17 @@ impl Planner<'_> {
 /// in 10..160, away from the stretched-arm singularity at 0 and from
 /// folding onto itself).
 fn planning_limits(choice: RobotChoice, limits: &[JointLimit]) -> Vec<JointLimit> {
+    cell_limits(choice.key(), limits)
+}
+
+/// The joint limits a cell would plan within for the preset `key`: the
+/// preset's `limits`, with the UR5e narrowed as the simulator narrows it
+/// (upper arm above the horizontal, elbow up and bent); other robots keep
+/// `limits` unchanged.
+#[must_use]
+pub fn cell_limits(key: &str, limits: &[JointLimit]) -> Vec<JointLimit> {
     let mut out = limits.to_vec();
-    if choice == RobotChoice::Ur5e && out.len() >= 3 {
+    if key == RobotChoice::Ur5e.key() && out.len() >= 3 {
         out[1] = JointLimit {
             min: -150.0,
             max: -10.0,
@@ -1463,7 +1497,11 @@ fn unreachable(id: &str, station: &Vector3<f64>) -> SimError {
 
 /// Identify stations: a 3×3 Latin square of x, y, z levels (jittered),
 /// then uniform in the box.
-fn identify_stations(rng: &mut ChaCha8Rng, w: &Workspace, n: usize) -> Vec<Vector3<f64>> {
+pub(crate) fn identify_stations(
+    rng: &mut ChaCha8Rng,
+    w: &Workspace,
+    n: usize,
+) -> Vec<Vector3<f64>> {
     (0..n)
         .map(|k| {
             if k < 9 {
@@ -1483,7 +1521,11 @@ fn identify_stations(rng: &mut ChaCha8Rng, w: &Workspace, n: usize) -> Vec<Vecto
 
 /// Validate stations: uniform in the box, each far enough from the one
 /// before (long reference distances).
-fn validate_stations(rng: &mut ChaCha8Rng, w: &Workspace, n: usize) -> Vec<Vector3<f64>> {
+pub(crate) fn validate_stations(
+    rng: &mut ChaCha8Rng,
+    w: &Workspace,
+    n: usize,
+) -> Vec<Vector3<f64>> {
     let min_gap = MIN_STATION_SEPARATION * w.diagonal();
     let mut out: Vec<Vector3<f64>> = Vec::with_capacity(n);
     for _ in 0..n {
@@ -1653,17 +1695,21 @@ fn record(
 }
 
 /// Tracker distances between consecutive validate stations (`V1 → V2`,
-/// `V2 → V3`, …): true distance plus tracker noise, and the true ones.
+/// `V2 → V3`, …, in the order given): true distance plus tracker noise,
+/// and the true ones.
 fn reference_distances(
     config: &SimConfig,
-    validate: &[Vector3<f64>],
+    validate: &[(String, Vector3<f64>)],
     rng: &mut ChaCha8Rng,
 ) -> (Vec<ReferenceDistance>, Vec<TrueDistance>) {
     let mut reference = Vec::new();
     let mut truth = Vec::new();
-    for k in 1..validate.len() {
-        let (from, to) = (format!("V{k}"), format!("V{}", k + 1));
-        let distance = (validate[k] - validate[k - 1]).norm();
+    for pair in validate.windows(2) {
+        let [(from, a), (to, b)] = pair else {
+            continue;
+        };
+        let (from, to) = (from.clone(), to.clone());
+        let distance = (b - a).norm();
         let measured = distance + config.tracker_noise * normal(rng);
         reference.push(ReferenceDistance {
             from: from.clone(),
@@ -1729,8 +1775,14 @@ pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
         1
     };
     let (measurements, truths) = record(config, &plan.poses, default_side, &mut rng_noise);
+    let validate: Vec<(String, Vector3<f64>)> = plan
+        .validate
+        .iter()
+        .enumerate()
+        .map(|(k, p)| (format!("V{}", k + 1), *p))
+        .collect();
     let (reference_distances, true_distances) =
-        reference_distances(config, &plan.validate, &mut rng_noise);
+        reference_distances(config, &validate, &mut rng_noise);
 
     let name = config
         .name
@@ -1781,6 +1833,332 @@ pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
         measurements: OrderedMap(truths),
     };
     Ok((session, truth))
+}
+
+/// Smallest cut angle (deg) at which a pose of a plan still counts as
+/// seeing the sphere on the true robot: below it the centre is within
+/// `R · sin 5°` ≈ 1.7 mm of the laser plane and its side is a guess.
+const PLAN_MIN_CUT_DEG: f64 = 5.0;
+/// Largest usable cut angle (deg): beyond it the stripe circle radius
+/// falls under `R · cos 80°` ≈ 3.3 mm and `t = sqrt(R² − r²)` loses all
+/// precision (shared/paper/NOTES.md, "The cut angle matters").
+const PLAN_MAX_CUT_DEG: f64 = 80.0;
+
+/// One commanded pose of a measurement plan (e.g. [`plan`](super::plan)'s
+/// CSV), for [`simulate_plan`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanPose {
+    /// Measurement id, unique in the plan.
+    pub id: String,
+    /// Station id (the sphere's place).
+    pub station: String,
+    /// FORMAT.md `use`.
+    pub usage: Use,
+    /// Planned side of the laser plane, +1 or −1.
+    pub side: i8,
+    /// Commanded joint readings, deg: the robot goes exactly there.
+    pub joints: Vec<f64>,
+    /// Where the plan expects the sphere centre in the sensor frame (mm),
+    /// under its nominal model and hand-eye guess.
+    pub centre_in_sensor: [f64; 3],
+}
+
+/// Simulates a plan's poses on a true robot: what a cell records when the
+/// controller drives the **nominal** model's joint targets of `poses`.
+///
+/// - The true robot is `nominal` plus `config`'s kinematic errors (error
+///   stream of `config.seed`), the true hand-eye is `flange_from_sensor`.
+///   `config.robot`, the workspace and the pose settings are not used.
+/// - The robot reaches the commanded joints exactly (they are the actual
+///   joints of the truth); the readings get `joint_noise`.
+/// - Each station's sphere is where the true robot sees the planned
+///   sensor-frame centres on average (the mean over the station's poses of
+///   `true_fk(q) · flange_from_sensor · centre_in_sensor`): the operator
+///   put the sphere where the robot actually looks. Each pose then sees it
+///   at its own sensor-frame centre, which differs from the planned one by
+///   the true robot's error; that centre must stay within the usable cut
+///   ([`SimError::PlanMiss`]).
+/// - Stripes (or centres), noise and the reference distances between
+///   consecutive validate stations (in order of first appearance) are made
+///   as in [`simulate`]; measurement ids are the plan's.
+///
+/// # Errors
+/// [`SimError::InvalidConfig`] for a bad setting, a robot that is not
+/// 6-axis, a malformed pose (side, joint count, duplicate id),
+/// [`SimError::PlanMiss`] when a pose does not see the sphere.
+pub fn simulate_plan(
+    config: &SimConfig,
+    nominal: &Robot,
+    flange_from_sensor: &Isometry3<f64>,
+    poses: &[PlanPose],
+) -> Result<(Session, Truth), SimError> {
+    let count = |usage: Use| poses.iter().filter(|p| p.usage == usage).count();
+    let mut per_station: Vec<(String, usize)> = Vec::new();
+    for p in poses {
+        match per_station.iter_mut().find(|(s, _)| *s == p.station) {
+            Some((_, n)) => *n += 1,
+            None => per_station.push((p.station.clone(), 1)),
+        }
+    }
+    let smallest_station = poses
+        .iter()
+        .filter(|p| matches!(p.usage, Use::Identify | Use::Validate))
+        .filter_map(|p| per_station.iter().find(|(s, _)| *s == p.station))
+        .map(|(_, n)| *n)
+        .min()
+        .unwrap_or(2);
+    let mut echoed = SimConfig {
+        n_translation: count(Use::Translation),
+        n_rotation: count(Use::Rotation),
+        n_identify: count_stations(poses, Use::Identify),
+        n_validate: count_stations(poses, Use::Validate),
+        poses_per_station: smallest_station,
+        workspace: None,
+        ..config.clone()
+    };
+    validate_config(&echoed)?;
+    let dof = nominal.dof();
+    check(dof == DOF, || {
+        format!(
+            "the simulator drives 6-axis arms, {} has {dof} joints",
+            nominal.name
+        )
+    })?;
+    check(!poses.is_empty(), || "the plan has no poses".to_owned())?;
+    let mut ids = HashSet::new();
+    for p in poses {
+        check(ids.insert(p.id.as_str()), || {
+            format!("pose id {} is given twice", p.id)
+        })?;
+        check(p.joints.len() == dof, || {
+            format!(
+                "pose {}: {} joint values, the robot has {dof}",
+                p.id,
+                p.joints.len()
+            )
+        })?;
+        check(p.joints.iter().all(|v| v.is_finite()), || {
+            format!("pose {}: a joint value is not finite", p.id)
+        })?;
+        check(p.side == 1 || p.side == -1, || {
+            format!("pose {}: side must be +1 or -1, found {}", p.id, p.side)
+        })?;
+        check(p.centre_in_sensor.iter().all(|v| v.is_finite()), || {
+            format!("pose {}: the planned centre is not finite", p.id)
+        })?;
+    }
+    let mut rng_errors = stream(config.seed, STREAM_ERRORS);
+    let mut rng_noise = stream(config.seed, STREAM_NOISE);
+    let errors = kinematic_errors(config, dof, &mut rng_errors);
+    let mut true_robot = nominal.clone();
+    for (joint, e) in true_robot.joints.iter_mut().zip(&errors) {
+        joint.alpha += e.alpha;
+        joint.a += e.a;
+        joint.beta += e.beta;
+        joint.theta += e.theta;
+        joint.d += e.d;
+    }
+    let base_from_sensor = |q: &[f64]| true_robot.base_from_flange(q) * flange_from_sensor;
+    // Each station: the mean of where the true robot sees the planned centres.
+    let stations: Vec<(String, Vector3<f64>)> = per_station
+        .iter()
+        .map(|(id, n)| {
+            let sum: Vector3<f64> = poses
+                .iter()
+                .filter(|p| p.station == *id)
+                .map(|p| (base_from_sensor(&p.joints) * Point3::from(p.centre_in_sensor)).coords)
+                .sum();
+            (id.clone(), sum / *n as f64)
+        })
+        .collect();
+    let radius = config.diameter / 2.0;
+    let (lo, hi) = (
+        radius * PLAN_MIN_CUT_DEG.to_radians().sin(),
+        radius * PLAN_MAX_CUT_DEG.to_radians().sin(),
+    );
+    let mut simulated = Vec::with_capacity(poses.len());
+    for p in poses {
+        let station = stations
+            .iter()
+            .find(|(id, _)| *id == p.station)
+            .map_or_else(Vector3::zeros, |(_, c)| *c);
+        let centre = base_from_sensor(&p.joints)
+            .inverse_transform_point(&Point3::from(station))
+            .coords;
+        let x = centre.x * f64::from(p.side);
+        if !(lo..=hi).contains(&x) {
+            return Err(SimError::PlanMiss {
+                id: p.id.clone(),
+                x: centre.x,
+                side: p.side,
+                lo,
+                hi,
+            });
+        }
+        let mut joints = [0.0; DOF];
+        joints.copy_from_slice(&p.joints);
+        simulated.push(Pose {
+            station: p.station.clone(),
+            usage: p.usage,
+            side: p.side,
+            joints,
+            centre_in_sensor: centre,
+        });
+    }
+    let default_side = 1;
+    let (mut measurements, mut truths) = record(config, &simulated, default_side, &mut rng_noise);
+    for ((m, t), p) in measurements.iter_mut().zip(truths.iter_mut()).zip(poses) {
+        m.id.clone_from(&p.id);
+        t.0.clone_from(&p.id);
+    }
+    let validate: Vec<(String, Vector3<f64>)> = stations
+        .iter()
+        .filter(|(id, _)| {
+            poses
+                .iter()
+                .any(|p| p.station == *id && p.usage == Use::Validate)
+        })
+        .cloned()
+        .collect();
+    let (reference_distances, true_distances) =
+        reference_distances(config, &validate, &mut rng_noise);
+    let name = config
+        .name
+        .clone()
+        .unwrap_or_else(|| format!("simulated plan, {}, seed {}", nominal.name, config.seed));
+    let hand_eye = match config.initial_hand_eye {
+        InitialHandEye::None => None,
+        InitialHandEye::Paper => Some(paper_initial_hand_eye()),
+        InitialHandEye::Truth => Some(*flange_from_sensor),
+    };
+    let session = Session {
+        name: name.clone(),
+        name_given: true,
+        robot: nominal.clone(),
+        base_given: nominal.base != Isometry3::identity(),
+        flange_given: nominal.flange != Isometry3::identity(),
+        sphere_diameter: config.diameter,
+        default_side,
+        sensor_given: true,
+        hand_eye,
+        solver: SolverSettings {
+            threshold: config.threshold,
+            max_iterations: config.max_iterations,
+        },
+        solver_given: true,
+        reference_distances,
+        measurements,
+    };
+    echoed.name = Some(name.clone());
+    let truth = Truth {
+        format: TRUTH_FORMAT.to_owned(),
+        version: TRUTH_VERSION,
+        session: name,
+        config: echoed,
+        robot: TruthRobot::from_robot(&true_robot),
+        nominal: TruthRobot::from_robot(nominal),
+        joint_errors: errors,
+        hand_eye: rows_from_isometry(flange_from_sensor),
+        stations: OrderedMap(
+            stations
+                .iter()
+                .map(|(id, p)| (id.clone(), [p.x, p.y, p.z]))
+                .collect(),
+        ),
+        true_distances,
+        measurements: OrderedMap(truths),
+    };
+    Ok((session, truth))
+}
+
+/// Number of distinct stations with measurements of `usage`.
+fn count_stations(poses: &[PlanPose], usage: Use) -> usize {
+    let mut seen: Vec<&str> = Vec::new();
+    for p in poses.iter().filter(|p| p.usage == usage) {
+        if !seen.contains(&p.station.as_str()) {
+            seen.push(&p.station);
+        }
+    }
+    seen.len()
+}
+
+/// The inputs of `spherecal import` for a simulated stripe session, as a
+/// real cell would leave them (see [`import_files`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImportFiles {
+    /// The joint log: `id,station,use,side,j1..jn,x,y,z,q1,q2,q3,q4`.
+    pub joints_csv: String,
+    /// One stripe profile per measurement: `(id, "y,z" CSV text)`, mm.
+    pub profiles: Vec<(String, String)>,
+    /// `from,to,distance` (mm) of the reference distances; `None` when the
+    /// session has none.
+    pub references_csv: Option<String>,
+}
+
+/// The import inputs of a session with stripes: the joint log with the
+/// flange pose the controller reports (ABB `x,y,z` in mm and the unit
+/// quaternion `q1..q4` = w, x, y, z), computed by the **nominal** forward
+/// kinematics of the recorded joints, as a real controller computes it;
+/// a `y,z` profile per measurement; the reference distances. Numbers are
+/// written with enough decimals to round-trip the session (joints 1e-9°,
+/// profile points as in the session).
+///
+/// # Errors
+/// [`SimError::InvalidConfig`] when a measurement is a centre (the import
+/// reads stripes only).
+pub fn import_files(session: &Session) -> Result<ImportFiles, SimError> {
+    use std::fmt::Write as _;
+    let n = session.robot.dof();
+    let mut joints_csv = String::from("id,station,use,side");
+    for k in 1..=n {
+        let _ = write!(joints_csv, ",j{k}");
+    }
+    joints_csv.push_str(",x,y,z,q1,q2,q3,q4\n");
+    let mut profiles = Vec::with_capacity(session.measurements.len());
+    for m in &session.measurements {
+        let Observation::Stripe(points) = &m.observation else {
+            return Err(SimError::InvalidConfig(format!(
+                "measurement {} is a sphere centre; the import reads stripe profiles (simulate without --centres)",
+                m.id
+            )));
+        };
+        let _ = write!(
+            joints_csv,
+            "{},{},{},{}",
+            m.id,
+            m.station,
+            m.usage.as_str(),
+            m.side
+        );
+        for q in &m.joints {
+            let _ = write!(joints_csv, ",{q}");
+        }
+        let pose = session.robot.base_from_flange(&m.joints);
+        let t = pose.translation.vector;
+        let r = pose.rotation;
+        let _ = writeln!(
+            joints_csv,
+            ",{:.6},{:.6},{:.6},{:.12},{:.12},{:.12},{:.12}",
+            t.x, t.y, t.z, r.w, r.i, r.j, r.k
+        );
+        let mut text = String::from("y,z\n");
+        for [y, z] in points {
+            let _ = writeln!(text, "{y},{z}");
+        }
+        profiles.push((m.id.clone(), text));
+    }
+    let references_csv = (!session.reference_distances.is_empty()).then(|| {
+        let mut text = String::from("from,to,distance\n");
+        for r in &session.reference_distances {
+            let _ = writeln!(text, "{},{},{}", r.from, r.to, r.distance);
+        }
+        text
+    });
+    Ok(ImportFiles {
+        joints_csv,
+        profiles,
+        references_csv,
+    })
 }
 
 #[cfg(test)]

@@ -1,0 +1,432 @@
+//! `spherecal plan`: the poses to teach for a calibration, from a robot, a
+//! rough sphere position and the sensor's hand-eye guess; optionally the
+//! plan's predicted accuracy by simulation, and its exports (the joint log
+//! CSV that `spherecal import` reads, controller programs). A thin caller
+//! of [`crate::engine::plan`]; every file is written atomically.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use nalgebra::Isometry3;
+use serde_json::Value;
+
+use super::CliError;
+use crate::engine::calibrate::Control;
+use crate::engine::geometry::isometry_from_rows;
+use crate::engine::import::{self, RobotSource};
+use crate::engine::kinematics::{self, JointLimit};
+use crate::engine::plan::{
+    self, Controller, PlanConfig, PlanError, PredictConfig, Selection, StationLayout,
+};
+use crate::engine::session;
+use crate::engine::simulate;
+
+/// `spherecal plan`.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// Robot: a preset key (irb2400, irb120, ur5e) or a session/result file whose `robot` block is the nominal model.
+    #[arg(long, default_value = "irb2400")]
+    pub robot: String,
+    /// Joint limits, deg, `min:max` per joint, comma-separated (default: the preset's; a robot from a file needs them unless it is named like a preset).
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub limits: Vec<String>,
+    /// Rough sphere position `x,y,z` (mm, base frame): station P0 and the middle of the station box.
+    #[arg(long, value_parser = parse_triple, allow_hyphen_values = true)]
+    pub sphere: [f64; 3],
+    /// Hand-eye guess: a JSON file with a 4x4 matrix (rows, mm) or a session/result file with `hand_eye` (default: the paper's initial hand-eye).
+    #[arg(long)]
+    pub hand_eye: Option<PathBuf>,
+    /// Sphere diameter, mm.
+    #[arg(long, default_value_t = 38.1)]
+    pub diameter: f64,
+    /// Translation poses at P0 (0, or at least 3).
+    #[arg(long, default_value_t = 4)]
+    pub translations: usize,
+    /// Rotation poses at P0 (0, or at least 2).
+    #[arg(long, default_value_t = 6)]
+    pub rotations: usize,
+    /// Identify stations (in the station box).
+    #[arg(long, default_value_t = 9)]
+    pub identify_stations: usize,
+    /// Poses per identify station.
+    #[arg(long, default_value_t = 6)]
+    pub identify_poses: usize,
+    /// Validate stations (in the station box); consecutive ones get a reference distance.
+    #[arg(long, default_value_t = 10)]
+    pub validate_stations: usize,
+    /// Poses per validate station.
+    #[arg(long, default_value_t = 6)]
+    pub validate_poses: usize,
+    /// Station box `dx,dy,dz` (mm, base axes) centred on --sphere (default: the preset's simulator box, e.g. 400,600,450 for the IRB 2400; 300 mm cube otherwise).
+    #[arg(long, value_parser = parse_triple)]
+    pub box_size: Option<[f64; 3]>,
+    /// Explicit stations instead of the box: a CSV with columns use (identify|validate), x, y, z (mm, base frame).
+    #[arg(long)]
+    pub stations: Option<PathBuf>,
+    /// Cut angle, deg: the laser plane cuts the sphere with its centre at sensor x = ±R·sin(angle).
+    #[arg(long, default_value_t = plan::DEFAULT_CUT_ANGLE_DEG)]
+    pub angle: f64,
+    /// Half-angle of the cone of approach directions, deg.
+    #[arg(long, default_value_t = plan::DEFAULT_CONE_DEG)]
+    pub cone: f64,
+    /// Flange orientations drawn per station (each with every IK branch and both sides).
+    #[arg(long, default_value_t = plan::DEFAULT_CANDIDATES)]
+    pub candidates: usize,
+    /// Choose identify poses at random instead of D-optimally (the baseline).
+    #[arg(long)]
+    pub random: bool,
+    /// Seed of every random choice; the same arguments give the same plan.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Write the plan as a joint log CSV (the layout `spherecal import` reads, with the ABB flange pose).
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// Write the plan as an ABB RAPID module (MODULE SpherecalPlan).
+    #[arg(long)]
+    pub rapid: Option<PathBuf>,
+    /// Write a controller program: `KEY=FILE` (keys: rapid); may be repeated.
+    #[arg(long)]
+    pub program: Vec<String>,
+    /// Predict the calibrated accuracy from N simulated calibrations (random kinematic errors, default noise, ml); 0 skips.
+    #[arg(long, default_value_t = PredictConfig::default().runs)]
+    pub predict: usize,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+fn parse_triple(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("`{s}`: {e}; expected three numbers x,y,z"))?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|a| a.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err(format!("`{s}`: expected three finite numbers x,y,z")),
+    }
+}
+
+fn parse_limits(items: &[String], dof: usize) -> Result<Vec<JointLimit>, CliError> {
+    if items.len() != dof {
+        return Err(CliError::input(format!(
+            "--limits has {} entries, the robot has {dof} joints",
+            items.len()
+        )));
+    }
+    items
+        .iter()
+        .map(|item| {
+            let parsed = item.split_once(':').and_then(|(a, b)| {
+                Some(JointLimit {
+                    min: a.trim().parse().ok()?,
+                    max: b.trim().parse().ok()?,
+                })
+            });
+            parsed.ok_or_else(|| {
+                CliError::input(format!("--limits entry `{item}` is not min:max (deg)"))
+            })
+        })
+        .collect()
+}
+
+/// A hand-eye `flange_from_sensor` from a JSON file: a bare 4×4 array of
+/// rows, or an object with a `hand_eye` 4×4 (a session or result file).
+///
+/// # Errors
+/// [`CliError`] (status 2) naming the file and what is wrong.
+pub fn read_hand_eye(path: &Path) -> Result<Isometry3<f64>, CliError> {
+    let fail = |m: String| CliError::input(format!("hand-eye: {m} ({})", path.display()));
+    let text = std::fs::read_to_string(path).map_err(|e| fail(format!("reading failed: {e}")))?;
+    let value: Value = serde_json::from_str(&text).map_err(|e| fail(e.to_string()))?;
+    let matrix = match &value {
+        Value::Object(map) => map
+            .get("hand_eye")
+            .cloned()
+            .ok_or_else(|| fail("the file has no `hand_eye`".to_owned()))?,
+        other => other.clone(),
+    };
+    let rows: [[f64; 4]; 4] = serde_json::from_value(matrix)
+        .map_err(|e| fail(format!("expected a 4x4 matrix of numbers: {e}")))?;
+    isometry_from_rows(&rows).map_err(|e| fail(e.to_string()))
+}
+
+/// Explicit stations from a CSV with columns `use`, `x`, `y`, `z`.
+fn read_stations(path: &Path) -> Result<StationLayout, CliError> {
+    let fail =
+        |line: usize, m: String| CliError::input(format!("line {line}: {m} ({})", path.display()));
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError::input(format!("reading failed: {e} ({})", path.display())))?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let Some((hl, header)) = lines.next() else {
+        return Err(fail(1, "no header row".to_owned()));
+    };
+    let header: Vec<String> = header
+        .split(',')
+        .map(|h| h.trim().to_ascii_lowercase())
+        .collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| fail(hl, format!("no column `{name}`")))
+    };
+    let (u, x, y, z) = (col("use")?, col("x")?, col("y")?, col("z")?);
+    let (mut identify, mut validate) = (Vec::new(), Vec::new());
+    for (line, l) in lines {
+        let f: Vec<&str> = l.split(',').map(str::trim).collect();
+        if f.len() != header.len() {
+            return Err(fail(
+                line,
+                format!("{} fields, the header has {}", f.len(), header.len()),
+            ));
+        }
+        let num = |c: usize| {
+            f[c].parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| fail(line, format!("`{}` is not a finite number", f[c])))
+        };
+        let p = [num(x)?, num(y)?, num(z)?];
+        match f[u] {
+            "identify" => identify.push(p),
+            "validate" => validate.push(p),
+            other => {
+                return Err(fail(
+                    line,
+                    format!("use `{other}` is not identify or validate"),
+                ));
+            }
+        }
+    }
+    Ok(StationLayout::Explicit { identify, validate })
+}
+
+/// The engine configuration of these flags.
+///
+/// # Errors
+/// [`CliError`] (status 2) for an unknown robot, bad limits, an unreadable
+/// hand-eye or stations file.
+pub fn config(args: &PlanArgs) -> Result<PlanConfig, CliError> {
+    let mut config = match kinematics::preset(&args.robot) {
+        Some(preset) => PlanConfig::for_preset(&preset, args.sphere),
+        None => {
+            let path = PathBuf::from(&args.robot);
+            let robot = import::load_robot(&RobotSource::File(path))
+                .map_err(|e| CliError::input(e.to_string()))?;
+            let named = kinematics::presets()
+                .into_iter()
+                .find(|p| p.robot.name == robot.name);
+            let limits = if !args.limits.is_empty() {
+                parse_limits(&args.limits, robot.dof())?
+            } else if let Some(p) = &named {
+                simulate::cell_limits(p.key, &p.limits)
+            } else {
+                return Err(CliError::input(format!(
+                    "robot {} from {} is not a preset: give its joint limits with --limits min:max,... (deg)",
+                    robot.name, args.robot
+                )));
+            };
+            PlanConfig::new(robot, limits, args.sphere)
+        }
+    };
+    if !args.limits.is_empty() {
+        config.limits = parse_limits(&args.limits, config.robot.dof())?;
+    }
+    if let Some(path) = &args.hand_eye {
+        config.flange_from_sensor = read_hand_eye(path)?;
+    }
+    config.diameter = args.diameter;
+    config.n_translation = args.translations;
+    config.n_rotation = args.rotations;
+    config.n_identify = args.identify_stations;
+    config.identify_poses = args.identify_poses;
+    config.n_validate = args.validate_stations;
+    config.validate_poses = args.validate_poses;
+    if let Some(size) = args.box_size {
+        config.stations = StationLayout::Box { size };
+    }
+    if let Some(path) = &args.stations {
+        config.stations = read_stations(path)?;
+    }
+    config.cut_angle = args.angle;
+    config.cone_angle = args.cone;
+    config.candidates = args.candidates;
+    config.seed = args.seed;
+    config.selection = if args.random {
+        Selection::Random
+    } else {
+        Selection::DOptimal
+    };
+    Ok(config)
+}
+
+fn plan_error(e: &PlanError) -> CliError {
+    match e {
+        PlanError::Analysis(_) => CliError::internal(e.to_string()),
+        _ => CliError::input(e.to_string()),
+    }
+}
+
+fn write(path: &Path, text: &str) -> Result<(), CliError> {
+    session::write_atomic(path, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))
+}
+
+/// Runs `spherecal plan`.
+///
+/// # Errors
+/// [`CliError`] with status 2 for bad input or an impossible request
+/// (unreachable sphere, too few reachable poses, collinear translations),
+/// 1 when a file cannot be written.
+pub fn run(args: &PlanArgs) -> Result<(), CliError> {
+    let started = Instant::now();
+    let mut programs: Vec<(Controller, PathBuf)> = Vec::new();
+    if let Some(path) = &args.rapid {
+        programs.push((Controller::AbbRapid, path.clone()));
+    }
+    for item in &args.program {
+        let parsed = item
+            .split_once('=')
+            .and_then(|(k, f)| Some((Controller::parse(k.trim())?, PathBuf::from(f.trim()))));
+        let Some(p) = parsed else {
+            let keys: Vec<&str> = Controller::ALL.iter().map(|c| c.key()).collect();
+            return Err(CliError::input(format!(
+                "--program `{item}` is not KEY=FILE with KEY one of: {}",
+                keys.join(", ")
+            )));
+        };
+        programs.push(p);
+    }
+    let config = config(args)?;
+    let quiet = args.quiet;
+    let made = plan::plan(&config, &mut |_| Control::Continue).map_err(|e| plan_error(&e))?;
+    let planned_ms = started.elapsed().as_secs_f64() * 1e3;
+    if !quiet {
+        print!("{}", plan::summary(&made));
+        println!("  planned in {planned_ms:.0} ms");
+    }
+    if args.predict > 0 {
+        let predict = PredictConfig {
+            runs: args.predict,
+            seed: args.seed,
+            ..PredictConfig::default()
+        };
+        let t = Instant::now();
+        let p = plan::predict(&made, &predict, &mut |_, _| Control::Continue)
+            .map_err(|e| plan_error(&e))?;
+        if !quiet {
+            println!(
+                "  predicted validation std after calibration (ml, {} simulated robots with random errors σ {}°/{} mm, joint noise {}°, stripe noise {} mm): {:.4} ± {:.4} mm",
+                p.runs.len(),
+                simulate::RANDOM_ANGLE_SIGMA_DEG,
+                simulate::RANDOM_LENGTH_SIGMA_MM,
+                predict.joint_noise,
+                predict.stripe_noise,
+                p.after_mean,
+                p.after_spread
+            );
+            println!(
+                "    before {:.3} mm; noise floor {:.4} mm; after / floor {:.2} ({:.0} ms)",
+                p.before_mean,
+                p.floor_mean,
+                p.ratio_mean,
+                t.elapsed().as_secs_f64() * 1e3
+            );
+        }
+    }
+    if let Some(path) = &args.csv {
+        write(path, &plan::plan_csv(&made))?;
+        if !quiet {
+            println!("wrote {} (joint log CSV)", path.display());
+        }
+    }
+    for (controller, path) in &programs {
+        write(path, &controller.render(&made))?;
+        if !quiet {
+            println!("wrote {} ({} program)", path.display(), controller.key());
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::expect_used)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Debug, Parser)]
+    struct Wrapper {
+        #[command(flatten)]
+        args: PlanArgs,
+    }
+
+    fn parse(extra: &[&str]) -> PlanArgs {
+        let mut argv = vec!["plan"];
+        argv.extend_from_slice(extra);
+        Wrapper::try_parse_from(argv).unwrap().args
+    }
+
+    #[test]
+    fn flags_reach_the_config() {
+        let args = parse(&[
+            "--sphere",
+            "-525,0,125.5",
+            "--robot",
+            "ur5e",
+            "--identify-stations",
+            "4",
+            "--identify-poses",
+            "5",
+            "--validate-stations",
+            "3",
+            "--validate-poses",
+            "2",
+            "--angle",
+            "35",
+            "--box-size",
+            "100,200,300",
+            "--seed",
+            "9",
+            "--random",
+            "--limits",
+            "-360:360,-150:-10,10:160,-360:360,-360:360,-360:360",
+        ]);
+        let c = config(&args).unwrap();
+        assert_eq!(c.sphere, [-525.0, 0.0, 125.5]);
+        assert_eq!(c.robot.name, "Universal Robots UR5e");
+        assert_eq!((c.n_identify, c.identify_poses), (4, 5));
+        assert_eq!((c.n_validate, c.validate_poses), (3, 2));
+        assert_eq!(c.cut_angle, 35.0);
+        assert_eq!(c.seed, 9);
+        assert_eq!(c.selection, Selection::Random);
+        assert_eq!(
+            c.stations,
+            StationLayout::Box {
+                size: [100.0, 200.0, 300.0]
+            }
+        );
+        assert_eq!(
+            c.limits[1],
+            JointLimit {
+                min: -150.0,
+                max: -10.0
+            }
+        );
+    }
+
+    #[test]
+    fn bad_flags_are_input_errors() {
+        assert!(parse_triple("1,2").is_err());
+        assert!(parse_triple("1,x,3").is_err());
+        let args = parse(&["--sphere", "1,2,3", "--limits", "0:1,2"]);
+        assert_eq!(config(&args).unwrap_err().status, 2);
+        let args = parse(&["--sphere", "1,2,3", "--robot", "no-such-robot.json"]);
+        assert_eq!(config(&args).unwrap_err().status, 2);
+    }
+}
