@@ -18,6 +18,7 @@ fn main() -> ExitCode {
         Some(Command::ExportModel(args)) => cli::export_model::run(&args),
         Some(Command::Import(args)) => cli::import::run(&args),
         Some(Command::Plan(args)) => cli::plan::run(&args),
+        Some(Command::Report(args)) => cli::html_report::run(&args),
         None => gui(None, None),
     };
     match outcome {

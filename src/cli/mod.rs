@@ -8,6 +8,7 @@
 
 pub mod evaluate;
 pub mod export_model;
+pub mod html_report;
 pub mod import;
 pub mod plan;
 pub mod simulate;
@@ -51,6 +52,8 @@ pub enum Command {
     Import(import::ImportArgs),
     /// Plan the poses to teach (translation, rotation, identify and validate groups) for a robot, a rough sphere position and a hand-eye guess; export CSV and RAPID.
     Plan(plan::PlanArgs),
+    /// Write a self-contained HTML report (figures as inline SVG): calibrates the session first, or reports `--result` as it is.
+    Report(html_report::ReportArgs),
 }
 
 /// `spherecal gui`.

@@ -1,0 +1,111 @@
+//! `spherecal report`: the self-contained HTML report of a calibration
+//! ([`crate::engine::html_report`]). The module is `html_report` because
+//! `cli` already imports the engine's result-file module as `report`.
+//! Without `--result` the session is calibrated first, as `spherecal
+//! calibrate` does with its defaults (the session's threshold and iteration
+//! bound); with `--result` that result is reported as it is, after checking
+//! that it belongs to the session.
+
+use std::path::PathBuf;
+use std::time::{Instant, SystemTime};
+
+use clap::Args;
+
+use super::{CliError, parse_method};
+use crate::engine::calibrate::{self, Control, Method, Options};
+use crate::engine::error::FileError;
+use crate::engine::html_report::{self, ReportInput, ReportMeta};
+use crate::engine::{report, session};
+
+/// `spherecal report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Session file (FORMAT.md `spherecal-session`); its SHA-256 is in the report.
+    pub session: PathBuf,
+    /// A result file of this session to report as it is (no solver run); without it the session is calibrated first.
+    #[arg(long)]
+    pub result: Option<PathBuf>,
+    /// Where to write the HTML report (one file: inline CSS and SVG, no script, no external resource).
+    #[arg(long, short)]
+    pub out: PathBuf,
+    /// Method of the calibration run when no `--result` is given: `ml` (default) or `paper`.
+    #[arg(long, default_value = "ml", value_parser = parse_method)]
+    pub method: Method,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Loads the session (and result), calibrates when needed, renders the
+/// report and writes it atomically.
+///
+/// # Errors
+/// [`CliError`] with status 2 for bad input (unreadable or invalid files,
+/// a result of another session, a session that cannot be calibrated), 1
+/// when the report cannot be written.
+pub fn run(args: &ReportArgs) -> Result<(), CliError> {
+    let started = Instant::now();
+    let bytes = std::fs::read(&args.session).map_err(|source| {
+        CliError::from_file(
+            &FileError::Io {
+                action: "reading",
+                path: args.session.clone(),
+                source,
+            },
+            true,
+        )
+    })?;
+    let text = std::str::from_utf8(&bytes).map_err(|e| {
+        CliError::input(format!(
+            "the file is not UTF-8 text ({e}) ({})",
+            args.session.display()
+        ))
+    })?;
+    let session =
+        session::parse_session(text, &args.session).map_err(|e| CliError::from_file(&e, true))?;
+    let prepared =
+        calibrate::prepare(&session).map_err(|e| CliError::from_calibration(&e, &args.session))?;
+    let result = match &args.result {
+        Some(path) => {
+            let result = session::load_result(path).map_err(|e| CliError::from_file(&e, true))?;
+            html_report::check_result(&session, &result, Some(&prepared)).map_err(|e| {
+                CliError::input(format!(
+                    "{} does not belong to {}: {e}",
+                    path.display(),
+                    args.session.display()
+                ))
+            })?;
+            result
+        }
+        None => {
+            let mut options = Options::from_session(&session);
+            options.method = args.method;
+            let cal = calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue)
+                .map_err(|e| CliError::from_calibration(&e, &args.session))?;
+            report::result_file(&session, &prepared, &cal)
+        }
+    };
+    let meta = ReportMeta::new(args.session.display().to_string(), SystemTime::now());
+    let html = html_report::render(&ReportInput {
+        session: &session,
+        session_bytes: &bytes,
+        result: &result,
+        prepared: Some(&prepared),
+        meta: &meta,
+    });
+    session::write_atomic(&args.out, html.as_bytes())
+        .map_err(|e| CliError::from_file(&e, false))?;
+    if !args.quiet {
+        let how = match &args.result {
+            Some(_) => "the given result".to_string(),
+            None => format!("a run of method {}", args.method.as_str()),
+        };
+        println!(
+            "wrote {} ({:.0} KB, {how}, {:.0} ms)",
+            args.out.display(),
+            html.len() as f64 / 1024.0,
+            started.elapsed().as_secs_f64() * 1e3
+        );
+    }
+    Ok(())
+}
