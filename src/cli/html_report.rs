@@ -86,6 +86,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         }
     };
     let meta = ReportMeta::new(args.session.display().to_string(), SystemTime::now());
+    let rendering = Instant::now();
     let html = html_report::render(&ReportInput {
         session: &session,
         session_bytes: &bytes,
@@ -93,6 +94,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         prepared: Some(&prepared),
         meta: &meta,
     });
+    let render_ms = rendering.elapsed().as_secs_f64() * 1e3;
     session::write_atomic(&args.out, html.as_bytes())
         .map_err(|e| CliError::from_file(&e, false))?;
     if !args.quiet {
@@ -101,7 +103,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
             None => format!("a run of method {}", args.method.as_str()),
         };
         println!(
-            "wrote {} ({:.0} KB, {how}, {:.0} ms)",
+            "wrote {} ({:.0} KB, {how}; {:.0} ms in all, {render_ms:.1} ms of it rendering)",
             args.out.display(),
             html.len() as f64 / 1024.0,
             started.elapsed().as_secs_f64() * 1e3

@@ -362,7 +362,7 @@ table.small{font-size:12px}
 td.key{font-family:ui-monospace,'DejaVu Sans Mono',Menlo,Consolas,monospace;white-space:nowrap}
 pre{font-size:12px;margin:4px 0;background:#f7f7f7;padding:6px 8px;overflow-x:auto}
 .headline{border:1px solid #ccc;border-radius:6px;padding:10px 14px;margin:8px 0}
-.big{font-size:26px;font-weight:600;margin-right:28px;white-space:nowrap}
+.big{display:inline-block;font-size:26px;font-weight:600;margin-right:28px;white-space:nowrap}
 .ratio{color:#1f6fae;font-size:16px;font-weight:normal;margin-left:4px}
 .warn{background:#fff4e0;border-left:4px solid #e6aa28;padding:6px 10px;margin:8px 0}
 .muted,.marked{color:var(--muted)}

@@ -550,7 +550,7 @@ mod tests {
         assert!(svg.contains("after &amp; done") && svg.contains("P&lt;1&gt;"));
         assert!(!svg.contains("<b>") && !svg.contains("P<1>"));
         // The negative point is left out on the log axis: two circles.
-        assert_eq!(svg.matches("a3 3 0 1 0").count(), 2);
+        assert_eq!(svg.matches("a3 3 0 1 0 6 0a").count(), 2);
         assert!(svg.contains("<polyline") && svg.contains("stroke-dasharray=\"6 4\""));
         assert!(!svg.contains("NaN") && !svg.contains("inf"));
     }
