@@ -214,6 +214,17 @@ fn the_report_is_a_function_of_its_input() {
 }
 
 #[test]
+fn a_saved_and_reloaded_result_gives_the_same_report() {
+    // The workbench reports a run, the command line a result file: the
+    // same figures either way.
+    let text = spherecal::DEMO_SESSION_JSON;
+    let (s, r) = calibrated(text, Method::Ml);
+    let reloaded =
+        session::parse_result(&session::result_to_json(&r), Path::new("r.json")).unwrap();
+    assert_eq!(render(text, &s, &r), render(text, &s, &reloaded));
+}
+
+#[test]
 fn no_external_resource_and_no_script() {
     let (_, _, html) = demo_report(Method::Paper);
     let lower = html.to_ascii_lowercase();

@@ -329,9 +329,11 @@ fn the_report_renders_in_headless_chromium() {
         );
     }
     eprintln!(
-        "chromium: DOM {:.2} s, screenshot {:.2} s, PDF {:.2} s ({pages} pages)",
+        "chromium: DOM {:.2} s, screenshot {:.2} s ({} before-colour px, {} after-colour px, ink {ink:.3}), PDF {:.2} s ({pages} pages)",
         t_dom.as_secs_f64(),
         t_shot.as_secs_f64(),
+        counts[0],
+        counts[1],
         t_pdf.as_secs_f64()
     );
 }

@@ -445,6 +445,14 @@ pub fn render(plot: &Plot) -> String {
                     y - 3.0
                 );
             }
+            Some(Marker::Cross) => {
+                let _ = write!(
+                    s,
+                    r#"<path d="M{:.1} {:.1}l6 6m0 -6l-6 6" fill="none" stroke="{colour}" stroke-width="1.5"/>"#,
+                    x + 5.0,
+                    y - 3.0
+                );
+            }
             _ => {
                 let dash = if dashed {
                     r#" stroke-dasharray="4 3""#
