@@ -19,6 +19,7 @@ fn main() -> ExitCode {
         Some(Command::Import(args)) => cli::import::run(&args),
         Some(Command::Plan(args)) => cli::plan::run(&args),
         Some(Command::Report(args)) => cli::html_report::run(&args),
+        Some(Command::History(args)) => cli::history::run(&args),
         None => gui(None, None),
     };
     match outcome {

@@ -8,6 +8,7 @@
 
 pub mod evaluate;
 pub mod export_model;
+pub mod history;
 pub mod html_report;
 pub mod import;
 pub mod plan;
@@ -54,6 +55,8 @@ pub enum Command {
     Plan(plan::PlanArgs),
     /// Write a self-contained HTML report (figures as inline SVG): calibrates the session first, or reports `--result` as it is.
     Report(html_report::ReportArgs),
+    /// Library of a folder of sessions and results: per robot the drift of the hand-eye and kinematic deviations over time, jumps beyond k combined σ flagged.
+    History(history::HistoryArgs),
 }
 
 /// `spherecal gui`.

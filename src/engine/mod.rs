@@ -17,6 +17,7 @@ pub mod error;
 pub mod evaluate;
 pub mod geometry;
 pub mod handeye;
+pub mod history;
 pub mod html_report;
 pub mod identify;
 pub mod ik;
