@@ -762,3 +762,29 @@ fn command_line_prints_the_library_drift_and_jumps() {
     assert_eq!(status, 2);
     assert!(err.contains("positive"), "{err}");
 }
+
+#[test]
+fn the_example_library_shows_its_two_events() {
+    // sessions/history (make.sh): three repeats, a sensor remount on
+    // 2026-04-13, a joint-3 zero change on 2026-05-11.
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("sessions/history");
+    let library = history::scan(&folder).unwrap();
+    assert!(library.problems.is_empty(), "{:?}", library.problems);
+    assert_eq!(library.entries.len(), 5);
+    assert!(library.entries.iter().all(|e| {
+        e.date_source == DateSource::SessionName && e.paired_by == Some(history::PairedBy::FileName)
+    }));
+    let d = irb_drift(&library);
+    let jumps: Vec<(String, &str)> = d
+        .jumps()
+        .map(|c| (date(&library, c.to), c.parameter.as_str()))
+        .collect();
+    assert_eq!(
+        jumps,
+        [
+            ("2026-04-13".to_string(), "hand_eye.x"),
+            ("2026-04-13".to_string(), "hand_eye.y"),
+            ("2026-05-11".to_string(), "theta3"),
+        ]
+    );
+}
