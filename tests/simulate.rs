@@ -505,3 +505,87 @@ fn load_truth_names_the_file_on_error() {
         Err(simulate::TruthError::Version(2))
     ));
 }
+
+#[test]
+fn simulating_its_own_poses_as_a_plan_reproduces_a_session() {
+    // The poses of a simulated session, run as a plan on the same true
+    // robot (same seed: same kinematic errors and noise stream), give the
+    // same recordings: simulate_plan and simulate share one model of the cell.
+    let config = small(61, RobotChoice::Irb2400);
+    let (session, truth) = simulate(&config);
+    let poses: Vec<simulate::PlanPose> = session
+        .measurements
+        .iter()
+        .map(|m| {
+            let t = truth.measurement(&m.id).unwrap();
+            simulate::PlanPose {
+                id: m.id.clone(),
+                station: m.station.clone(),
+                usage: m.usage,
+                side: m.side,
+                joints: t.joints_actual.clone(),
+                centre_in_sensor: t.sensor_centre,
+            }
+        })
+        .collect();
+    let (again, again_truth) = simulate::simulate_plan(
+        &config,
+        &truth.nominal_robot(),
+        &truth.true_hand_eye(),
+        &poses,
+        simulate::PlanExecution::AsPlanned,
+    )
+    .unwrap();
+    assert_eq!(again.measurements.len(), session.measurements.len());
+    for (a, b) in again.measurements.iter().zip(&session.measurements) {
+        assert_eq!(
+            (&a.id, &a.station, a.usage, a.side),
+            (&b.id, &b.station, b.usage, b.side)
+        );
+        assert_eq!(a.joints, b.joints, "{}", a.id);
+        let (Observation::Stripe(pa), Observation::Stripe(pb)) = (&a.observation, &b.observation)
+        else {
+            panic!("{}: stripes expected", a.id);
+        };
+        assert_eq!(pa.len(), pb.len(), "{}", a.id);
+        for (p, q) in pa.iter().zip(pb) {
+            // Rounded to 1e-4 mm: a centre that moved by 1e-12 mm can
+            // round the other way.
+            assert!((p[0] - q[0]).abs() <= 1.0001e-4 && (p[1] - q[1]).abs() <= 1.0001e-4);
+        }
+    }
+    for (id, p) in truth.stations.iter() {
+        let q = again_truth.station(id).unwrap();
+        assert!((Vector3::from(*p) - q).norm() < 1e-9, "{id}");
+    }
+    assert_eq!(
+        again.reference_distances.len(),
+        session.reference_distances.len()
+    );
+    for (a, b) in again
+        .reference_distances
+        .iter()
+        .zip(&session.reference_distances)
+    {
+        assert_eq!((&a.from, &a.to), (&b.from, &b.to));
+        assert!((a.distance - b.distance).abs() < 1e-8);
+    }
+    // The import inputs: a joint log with the nominal ABB flange pose.
+    let files = simulate::import_files(&again).unwrap();
+    let mut lines = files.joints_csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("id,station,use,side,j1,j2,j3,j4,j5,j6,x,y,z,q1,q2,q3,q4")
+    );
+    assert_eq!(lines.count(), again.measurements.len());
+    assert_eq!(files.profiles.len(), again.measurements.len());
+    assert!(files.profiles[0].1.starts_with("y,z\n"));
+    let refs = files.references_csv.unwrap();
+    assert!(refs.starts_with("from,to,distance\n"));
+    // A centres session has no stripes to write.
+    let (centres, _) = simulate(&SimConfig {
+        centres: true,
+        ..small(62, RobotChoice::Irb2400)
+    });
+    assert!(simulate::import_files(&centres).is_err());
+}

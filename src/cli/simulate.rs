@@ -17,7 +17,7 @@ use crate::engine::model::{Session, Use};
 use crate::engine::plan;
 use crate::engine::session;
 use crate::engine::simulate::{
-    self, ErrorModel, InitialHandEye, RobotChoice, SideChoice, SimConfig,
+    self, ErrorModel, InitialHandEye, PlanExecution, RobotChoice, SideChoice, SimConfig,
 };
 
 /// Robot preset (`--robot`).
@@ -152,6 +152,9 @@ pub struct SimulateArgs {
     /// With --plan: the true hand-eye, a JSON 4x4 (rows, mm) or a session/result file's `hand_eye` (default: the paper's calibrated hand-eye, the paper's guess error applied to its initial one).
     #[arg(long, requires = "plan")]
     pub hand_eye: Option<PathBuf>,
+    /// With --plan: touch every pose up as when teaching (the smallest joint change that puts the sphere at the planned sensor-frame centre on the true robot) instead of running the plan's joints as written.
+    #[arg(long, requires = "plan")]
+    pub touch_up: bool,
     /// Also write what `spherecal import` reads: DIR/joints.csv (joint log with the nominal ABB flange pose), DIR/profiles/<id>.csv (y,z mm) and DIR/references.csv (from,to,distance mm).
     #[arg(long)]
     pub csv_out: Option<PathBuf>,
@@ -257,7 +260,12 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
                 }
                 None => simulate::paper_hand_eye(),
             };
-            simulate::simulate_plan(&config, &nominal, &hand_eye, &poses)
+            let execution = if args.touch_up {
+                PlanExecution::TouchUp
+            } else {
+                PlanExecution::AsPlanned
+            };
+            simulate::simulate_plan(&config, &nominal, &hand_eye, &poses, execution)
                 .map_err(|e| anyhow::anyhow!("{e} ({})", path.display()))?
         }
     };

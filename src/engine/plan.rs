@@ -98,7 +98,7 @@ use super::kinematics::{JointLimit, Preset, Robot};
 use super::ml::{self, MlOptions, MlReport};
 use super::model::{Measurement, Observation, ReferenceDistance, Session, SolverSettings, Use};
 use super::simulate::{
-    self, ErrorModel, InitialHandEye, PlanPose, RobotChoice, SimConfig, Workspace,
+    self, ErrorModel, InitialHandEye, PlanExecution, PlanPose, RobotChoice, SimConfig, Workspace,
 };
 
 /// Default cut angle, deg: the paper's "about ±40°" (section 4.1), where
@@ -149,6 +149,9 @@ const TRANSLATION_TRIES_PER_CANDIDATE: usize = 4;
 /// A translation pose must stay within this (deg, every joint) of the
 /// previous one: the same IK branch, a pure flange translation.
 const TRANSLATION_SAME_BRANCH_DEG: f64 = 20.0;
+/// Bound on the 2-opt passes over one group: each pass strictly shortens
+/// the path, and a group of tens of poses settles in a handful.
+const MAX_TWO_OPT_PASSES: usize = 100;
 /// Two rotation poses differ in orientation by at least this (deg), as in
 /// the simulator, so eq. 8-9 get distinct rows.
 const MIN_ROTATION_SEPARATION_DEG: f64 = 15.0;
@@ -1984,10 +1987,21 @@ impl Metric<'_> {
             .unwrap_or(b)
     }
 
-    /// `max_i w_i·|a_i − b_i|`, `b` at its nearest equivalents.
+    /// `max_i w_i·|a_i − b_i|`, the difference taken modulo a turn on
+    /// joints whose range spans one. Symmetric, as 2-opt needs (the
+    /// nearest equivalent *within the limits* is not: 150° to −170° on a
+    /// ±200° axis is 40° one way and 320° the other).
     fn distance(&self, a: &[f64; DOF], b: &[f64; DOF]) -> f64 {
         (0..DOF)
-            .map(|i| self.weights[i] * (self.nearest(i, a[i], b[i]) - a[i]).abs())
+            .map(|i| {
+                let l = self.limits[i];
+                let d = if l.max - l.min >= 360.0 {
+                    wrap_deg(a[i] - b[i])
+                } else {
+                    a[i] - b[i]
+                };
+                self.weights[i] * d.abs()
+            })
             .fold(0.0, f64::max)
     }
 
@@ -2050,8 +2064,10 @@ impl Metric<'_> {
             }
         };
         let mut improved = true;
-        while improved {
+        let mut passes = 0;
+        while improved && passes < MAX_TWO_OPT_PASSES {
             improved = false;
+            passes += 1;
             for i in 0..n - 1 {
                 for j in i + 1..n {
                     let prev = before(&path, i);
@@ -2144,6 +2160,8 @@ pub struct PredictConfig {
     pub stripe_noise: f64,
     /// σ of the laser-tracker reference distances, mm.
     pub tracker_noise: f64,
+    /// Whether the poses run as planned or are touched up.
+    pub execution: PlanExecution,
 }
 
 impl Default for PredictConfig {
@@ -2159,6 +2177,7 @@ impl Default for PredictConfig {
             joint_noise: sim.joint_noise,
             stripe_noise: sim.stripe_noise,
             tracker_noise: sim.tracker_noise,
+            execution: PlanExecution::AsPlanned,
         }
     }
 }
@@ -2258,7 +2277,7 @@ pub fn predict(
             ..SimConfig::default()
         };
         let (mut session, truth) =
-            simulate::simulate_plan(&sim, &plan.robot, &truth_hand_eye, &poses)
+            simulate::simulate_plan(&sim, &plan.robot, &truth_hand_eye, &poses, config.execution)
                 .map_err(|e| fail(e.to_string()))?;
         if !hand_eye_groups {
             session.hand_eye = Some(plan.flange_from_sensor);

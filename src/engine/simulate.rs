@@ -439,7 +439,7 @@ pub enum SimError {
     /// A pose of a plan does not see the sphere on the true robot: the
     /// sphere centre falls outside the usable cut of the laser plane.
     #[error(
-        "pose {id}: on the true robot the sphere centre lies at sensor x = {x:.2} mm, outside the usable cut on side {side:+} ({lo:.2} to {hi:.2} mm from the laser plane); the true robot or hand-eye is too far from the plan's (smaller --error-scale, or the plan's robot and hand-eye)"
+        "pose {id}: on the true robot the sphere centre lies at sensor x = {x:.2} mm, outside the usable cut on side {side:+} ({lo:.2} to {hi:.2} mm from the laser plane); the true robot or hand-eye is too far from the plan's nominal ones: touch the poses up (--touch-up), use smaller errors (--errors random, --error-scale), or the plan's robot and hand-eye"
     )]
     PlanMiss {
         /// Measurement id.
@@ -1870,7 +1870,9 @@ pub struct PlanPose {
 ///   stream of `config.seed`), the true hand-eye is `flange_from_sensor`.
 ///   `config.robot`, the workspace and the pose settings are not used.
 /// - The robot reaches the commanded joints exactly (they are the actual
-///   joints of the truth); the readings get `joint_noise`.
+///   joints of the truth), or, with [`PlanExecution::TouchUp`], the
+///   nearest joints that see the sphere at the planned centre; the
+///   readings get `joint_noise`.
 /// - Each station's sphere is where the true robot sees the planned
 ///   sensor-frame centres on average (the mean over the station's poses of
 ///   `true_fk(q) · flange_from_sensor · centre_in_sensor`): the operator
@@ -1891,6 +1893,7 @@ pub fn simulate_plan(
     nominal: &Robot,
     flange_from_sensor: &Isometry3<f64>,
     poses: &[PlanPose],
+    execution: PlanExecution,
 ) -> Result<(Session, Truth), SimError> {
     let count = |usage: Use| poses.iter().filter(|p| p.usage == usage).count();
     let mut per_station: Vec<(String, usize)> = Vec::new();
@@ -1976,13 +1979,31 @@ pub fn simulate_plan(
         radius * PLAN_MIN_CUT_DEG.to_radians().sin(),
         radius * PLAN_MAX_CUT_DEG.to_radians().sin(),
     );
+    let chain = Chain::new(&true_robot)
+        .ok_or_else(|| SimError::InvalidConfig(format!("{} is not a 6-axis arm", nominal.name)))?;
     let mut simulated = Vec::with_capacity(poses.len());
     for p in poses {
         let station = stations
             .iter()
             .find(|(id, _)| *id == p.station)
             .map_or_else(Vector3::zeros, |(_, c)| *c);
-        let centre = base_from_sensor(&p.joints)
+        let mut joints = [0.0; DOF];
+        joints.copy_from_slice(&p.joints);
+        if execution == PlanExecution::TouchUp {
+            let planned = Vector3::from(p.centre_in_sensor);
+            joints = touch_up(&chain, flange_from_sensor, &joints, &planned, &station)
+                .filter(|q| {
+                    let seen = base_from_sensor(q) * Point3::from(planned);
+                    (seen.coords - station).norm() < IK_CHECK_TOLERANCE
+                })
+                .ok_or_else(|| {
+                    SimError::InvalidConfig(format!(
+                        "pose {}: the touch-up found no joints that see the sphere at the planned centre",
+                        p.id
+                    ))
+                })?;
+        }
+        let centre = base_from_sensor(&joints)
             .inverse_transform_point(&Point3::from(station))
             .coords;
         let x = centre.x * f64::from(p.side);
@@ -1995,8 +2016,6 @@ pub fn simulate_plan(
                 hi,
             });
         }
-        let mut joints = [0.0; DOF];
-        joints.copy_from_slice(&p.joints);
         simulated.push(Pose {
             station: p.station.clone(),
             usage: p.usage,
@@ -2069,6 +2088,60 @@ pub fn simulate_plan(
         measurements: OrderedMap(truths),
     };
     Ok((session, truth))
+}
+
+/// How the cell executes a plan in [`simulate_plan`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PlanExecution {
+    /// The robot goes to the plan's joints exactly (a program of joint
+    /// targets run as written); each pose sees the sphere wherever the
+    /// true robot's error puts it, within the usable cut or
+    /// [`SimError::PlanMiss`].
+    #[default]
+    AsPlanned,
+    /// Each pose is touched up, as when teaching (the paper's teach mode):
+    /// the smallest joint change (least squares in joint space) that puts
+    /// the sphere at the planned sensor-frame centre on the true robot.
+    /// The recorded joints are the touched-up ones.
+    TouchUp,
+}
+
+/// Touch-up iteration bound: from the plan's joints the correction is a
+/// fraction of a degree and Gauss-Newton converges in 3-5 steps.
+const TOUCH_UP_MAX_ITER: usize = 30;
+/// Touch-up convergence, mm (as the IK's position tolerance).
+const TOUCH_UP_TOLERANCE_MM: f64 = 1e-9;
+
+/// The joints nearest `start` (deg, least-norm Gauss-Newton steps) at
+/// which `chain` sees `station` (base, mm) at `centre` (sensor, mm).
+fn touch_up(
+    chain: &Chain,
+    flange_from_sensor: &Isometry3<f64>,
+    start: &[f64; DOF],
+    centre: &Vector3<f64>,
+    station: &Vector3<f64>,
+) -> Option<[f64; DOF]> {
+    let in_flange = (flange_from_sensor * Point3::from(*centre)).coords;
+    let mut q = *start;
+    for _ in 0..TOUCH_UP_MAX_ITER {
+        let (pose, jac) = chain.pose_and_jacobian(&q);
+        let point = (pose * Point3::from(in_flange)).coords;
+        let r = point - station;
+        if r.norm() < TOUCH_UP_TOLERANCE_MM {
+            return Some(q);
+        }
+        // Velocity of the point: v + ω × (point − flange origin).
+        let lever = point - pose.translation.vector;
+        let jp = nalgebra::Matrix3x6::from_fn(|i, j| {
+            let w = Vector3::new(jac[(3, j)], jac[(4, j)], jac[(5, j)]);
+            jac[(i, j)] + w.cross(&lever)[i]
+        });
+        let step = jp.transpose() * (jp * jp.transpose()).try_inverse()? * (-r);
+        for (qi, s) in q.iter_mut().zip(step.iter()) {
+            *qi += s.to_degrees();
+        }
+    }
+    None
 }
 
 /// Number of distinct stations with measurements of `usage`.
