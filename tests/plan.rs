@@ -599,3 +599,121 @@ fn predicted_accuracy_agrees_with_an_independent_simulation() {
     let cancelled = plan::predict(plan, &PredictConfig::default(), &mut |_, _| Control::Cancel);
     assert_eq!(cancelled, Err(PlanError::Cancelled));
 }
+
+/// Runs the real binary; returns (status, stdout, stderr).
+fn spherecal(args: &[&str]) -> (i32, String, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_spherecal"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn plan_then_simulate_import_and_calibrate_on_the_command_line() {
+    // The walkthrough: plan → simulate --plan --csv-out → import
+    // (joint log, profiles, references) → calibrate → result file.
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let small = [
+        "--identify-stations",
+        "4",
+        "--validate-stations",
+        "3",
+        "--validate-poses",
+        "4",
+        "--candidates",
+        "8",
+    ];
+    let mut args = vec!["plan", "--sphere", "1050,0,475", "--predict", "1"];
+    args.extend(small);
+    let (csv, rapid) = (p("plan.csv"), p("plan.mod"));
+    args.extend(["--csv", &csv, "--rapid", &rapid]);
+    let (status, out, err) = spherecal(&args);
+    assert_eq!(status, 0, "{err}");
+    for needle in [
+        "4 translation, 6 rotation",
+        "reachable candidates",
+        "ln det",
+        "cannot identify",
+        "path:",
+        "predicted validation std after calibration",
+    ] {
+        assert!(out.contains(needle), "`{needle}` missing from:\n{out}");
+    }
+    assert!(
+        std::fs::read_to_string(&rapid)
+            .unwrap()
+            .starts_with("MODULE SpherecalPlan")
+    );
+    let data = p("data");
+    let (status, _, err) = spherecal(&[
+        "simulate",
+        "--plan",
+        &csv,
+        "--errors",
+        "random",
+        "--seed",
+        "3",
+        "--out",
+        &p("sim.json"),
+        "--csv-out",
+        &data,
+    ]);
+    assert_eq!(status, 0, "{err}");
+    let session = p("S.json");
+    let (status, out, err) = spherecal(&[
+        "import",
+        "--joints",
+        &format!("{data}/joints.csv"),
+        "--profiles",
+        &format!("{data}/profiles"),
+        "--references",
+        &format!("{data}/references.csv"),
+        "--robot",
+        "irb2400",
+        "--flange-poses",
+        "ABB",
+        "--map",
+        "side=side",
+        "-o",
+        &session,
+    ]);
+    assert_eq!(status, 0, "{err}");
+    assert!(out.contains("0 flagged"), "{out}");
+    let result = p("R.json");
+    let (status, out, err) = spherecal(&["calibrate", &session, "--out", &result]);
+    assert_eq!(status, 0, "{err}");
+    assert!(out.contains("validation"), "{out}");
+    let r = session::load_result(Path::new(&result)).unwrap();
+    let v = r.validation.expect("validate stations were planned");
+    assert!(
+        v.after.std * 3.0 < v.before.std,
+        "{:?} → {:?}",
+        v.before,
+        v.after
+    );
+
+    // A sphere out of reach: exit 2, one `error:` line, no file.
+    let far = p("far.csv");
+    let (status, out, err) = spherecal(&[
+        "plan",
+        "--sphere",
+        "5000,0,0",
+        "--candidates",
+        "2",
+        "--csv",
+        &far,
+    ]);
+    assert_eq!(status, 2, "{out}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("error: station P0 at [5000.0, 0.0, 0.0] mm"),
+        "{err}"
+    );
+    assert!(!Path::new(&far).exists());
+}

@@ -1,0 +1,306 @@
+//! A plan's exports: the joint log CSV that `spherecal import` reads (and
+//! `spherecal simulate --plan` reads back), and robot programs behind
+//! [`Controller`], one `render` arm per controller.
+
+use std::fmt::Write as _;
+
+use nalgebra::{Isometry3, Vector3};
+
+use super::{Plan, PlanError};
+use crate::engine::model::Use;
+use crate::engine::simulate::PlanPose;
+
+/// The flange pose as an ABB controller reports it: `x, y, z` (mm) and the
+/// unit quaternion `q1..q4 = w, x, y, z` with `w ≥ 0`.
+fn abb_pose(pose: &Isometry3<f64>) -> [f64; 7] {
+    let t = pose.translation.vector;
+    let q = pose.rotation.into_inner();
+    let q = if q.w < 0.0 { -q } else { q };
+    [t.x, t.y, t.z, q.w, q.i, q.j, q.k]
+}
+
+/// The plan as a joint log CSV that `spherecal import` reads: header
+/// `id,station,use,side,j1..jn,x,y,z,q1,q2,q3,q4` (joints deg; the nominal
+/// model's ABB flange pose, mm and quaternion w, x, y, z, so that
+/// `--flange-poses ABB` checks it), then `sphere_x,sphere_y,sphere_z` (the
+/// station, base frame, mm) and `centre_x,centre_y,centre_z` (the planned
+/// sensor-frame centre, mm), which the import ignores. `#` lines before
+/// the header describe the plan.
+#[must_use]
+pub fn plan_csv(plan: &Plan) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "# spherecal plan: {}, {} poses, sphere diameter {} mm, cut angle ±{}°",
+        plan.robot.name,
+        plan.poses.len(),
+        plan.diameter,
+        plan.cut_angle
+    );
+    let _ = writeln!(
+        out,
+        "# joints in deg; x,y,z,q1..q4: nominal flange pose (mm, ABB quaternion w,x,y,z); sphere_*: station (base, mm); centre_*: planned sphere centre (sensor, mm)"
+    );
+    let mut header = String::from("id,station,use,side");
+    for k in 1..=plan.robot.dof() {
+        let _ = write!(header, ",j{k}");
+    }
+    header.push_str(",x,y,z,q1,q2,q3,q4,sphere_x,sphere_y,sphere_z,centre_x,centre_y,centre_z");
+    let _ = writeln!(out, "{header}");
+    for p in &plan.poses {
+        let _ = write!(
+            out,
+            "{},{},{},{}",
+            p.id,
+            p.station,
+            p.usage.as_str(),
+            p.side
+        );
+        for q in &p.joints {
+            let _ = write!(out, ",{q:.9}");
+        }
+        let f = abb_pose(&p.base_from_flange);
+        let _ = write!(
+            out,
+            ",{:.6},{:.6},{:.6},{:.12},{:.12},{:.12},{:.12}",
+            f[0], f[1], f[2], f[3], f[4], f[5], f[6]
+        );
+        let s = plan
+            .station(&p.station)
+            .map_or_else(Vector3::zeros, |s| s.position);
+        let c = p.centre_in_sensor;
+        let _ = writeln!(
+            out,
+            ",{:.6},{:.6},{:.6},{:.9},{:.9},{:.9}",
+            s.x, s.y, s.z, c.x, c.y, c.z
+        );
+    }
+    out
+}
+
+/// Reads the poses of a plan CSV ([`plan_csv`]'s layout; columns found by
+/// name, case-insensitively; `#` and blank lines skipped) for
+/// [`simulate::simulate_plan`]. The joint columns are `j1`, `j2`, … as
+/// many as the header has.
+///
+/// # Errors
+/// [`PlanError::Csv`] naming the line and the column.
+pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPose>, PlanError> {
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let Some((header_line, header)) = lines.next() else {
+        return Err(PlanError::Csv {
+            line: 1,
+            message: "no header row".to_owned(),
+        });
+    };
+    let header: Vec<String> = header
+        .split(',')
+        .map(|h| h.trim().to_ascii_lowercase())
+        .collect();
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| PlanError::Csv {
+                line: header_line,
+                message: format!("no column `{name}` (the header has: {})", header.join(", ")),
+            })
+    };
+    let (id, station, usage, side) = (
+        column("id")?,
+        column("station")?,
+        column("use")?,
+        column("side")?,
+    );
+    let joints: Vec<usize> = (1..)
+        .map_while(|k| header.iter().position(|h| *h == format!("j{k}")))
+        .collect();
+    let centre = [
+        column("centre_x")?,
+        column("centre_y")?,
+        column("centre_z")?,
+    ];
+    let mut out = Vec::new();
+    for (line, l) in lines {
+        let fields: Vec<&str> = l.split(',').map(str::trim).collect();
+        let fail = |message: String| PlanError::Csv { line, message };
+        if fields.len() != header.len() {
+            return Err(fail(format!(
+                "{} fields, the header has {}",
+                fields.len(),
+                header.len()
+            )));
+        }
+        let number = |c: usize| -> Result<f64, PlanError> {
+            fields[c]
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    fail(format!(
+                        "column `{}`: `{}` is not a finite number",
+                        header[c], fields[c]
+                    ))
+                })
+        };
+        let usage = Use::parse(fields[usage]).ok_or_else(|| {
+            fail(format!(
+                "`{}` is not translation, rotation, identify or validate",
+                fields[usage]
+            ))
+        })?;
+        let side = match fields[side] {
+            "1" | "+1" => 1,
+            "-1" => -1,
+            other => return Err(fail(format!("side `{other}` is not +1 or -1"))),
+        };
+        out.push(PlanPose {
+            id: fields[id].to_owned(),
+            station: fields[station].to_owned(),
+            usage,
+            side,
+            joints: joints
+                .iter()
+                .map(|&c| number(c))
+                .collect::<Result<_, _>>()?,
+            centre_in_sensor: [number(centre[0])?, number(centre[1])?, number(centre[2])?],
+        });
+    }
+    if out.is_empty() {
+        return Err(PlanError::Csv {
+            line: header_line,
+            message: "no poses after the header".to_owned(),
+        });
+    }
+    Ok(out)
+}
+
+/// A robot controller a plan can be exported to as a program. To add one
+/// (KUKA KRL, URScript, Fanuc TP): a variant here, its [`Self::key`],
+/// [`Self::extension`] and a `render` arm writing the program from
+/// [`Plan::poses`] (joint targets in deg, in plan order; ids and stations
+/// for comments), then list it in [`Self::ALL`]; the command line's
+/// `--program KEY=FILE` picks it up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Controller {
+    /// ABB IRC5 / OmniCore: a RAPID module of `jointtarget`s and
+    /// `MoveAbsJ`.
+    AbbRapid,
+}
+
+impl Controller {
+    /// Every controller.
+    pub const ALL: [Self; 1] = [Self::AbbRapid];
+
+    /// The command-line key.
+    #[must_use]
+    pub fn key(self) -> &'static str {
+        match self {
+            Self::AbbRapid => "rapid",
+        }
+    }
+
+    /// The usual file extension.
+    #[must_use]
+    pub fn extension(self) -> &'static str {
+        match self {
+            Self::AbbRapid => "mod",
+        }
+    }
+
+    /// Parses a key.
+    #[must_use]
+    pub fn parse(key: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|c| c.key() == key)
+    }
+
+    /// The program text.
+    #[must_use]
+    pub fn render(self, plan: &Plan) -> String {
+        match self {
+            Self::AbbRapid => rapid_module(plan),
+        }
+    }
+}
+
+/// RAPID module name of the export.
+pub const RAPID_MODULE: &str = "SpherecalPlan";
+
+/// The plan as an ABB RAPID module: one `CONST jointtarget jt_<id>` per
+/// pose (joints deg to 4 decimals, external axes unused `9E9`), and a
+/// `main` that visits them in plan order with `MoveAbsJ … fine, tool0`,
+/// stops with a message when the sphere has to be moved to the next
+/// station, and calls the `Measure` hook at every pose (edit it to trigger
+/// the sensor and log the joints). Plain ASCII (controllers read
+/// ISO-8859-1).
+#[must_use]
+pub fn rapid_module(plan: &Plan) -> String {
+    let mut out = String::new();
+    let _ = writeln!(out, "MODULE {RAPID_MODULE}");
+    let _ = writeln!(
+        out,
+        "    ! Generated by spherecal plan: {}, {} poses at {} stations.",
+        plan.robot.name,
+        plan.poses.len(),
+        plan.stations.len()
+    );
+    let _ = writeln!(
+        out,
+        "    ! Sphere diameter {} mm, laser plane at +/-{} deg on the sphere. Joint targets in deg.",
+        plan.diameter, plan.cut_angle
+    );
+    for s in &plan.stations {
+        let _ = writeln!(
+            out,
+            "    ! Station {}: sphere at [{:.1}, {:.1}, {:.1}] mm (base frame).",
+            s.id, s.position.x, s.position.y, s.position.z
+        );
+    }
+    let _ = writeln!(out);
+    let _ = writeln!(out, "    PERS speeddata vPlan := [200, 100, 5000, 1000];");
+    for p in &plan.poses {
+        let joints: Vec<String> = p.joints.iter().map(|q| format!("{q:.4}")).collect();
+        let _ = writeln!(
+            out,
+            "    CONST jointtarget jt_{} := [[{}], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]]; ! station {}, {}, side {:+}",
+            p.id,
+            joints.join(", "),
+            p.station,
+            p.usage.as_str(),
+            p.side
+        );
+    }
+    let _ = writeln!(out);
+    let _ = writeln!(out, "    PROC main()");
+    let mut station = "";
+    for p in &plan.poses {
+        if p.station != station {
+            station = &p.station;
+            let _ = writeln!(out, "        ! --- station {station} ---");
+            let _ = writeln!(
+                out,
+                "        TPWrite \"Place the sphere at station {station}, then press Start\";"
+            );
+            let _ = writeln!(out, "        Stop;");
+        }
+        let _ = writeln!(out, "        MoveAbsJ jt_{}, vPlan, fine, tool0;", p.id);
+        let _ = writeln!(out, "        Measure \"{}\", \"{}\";", p.id, p.station);
+    }
+    let _ = writeln!(out, "    ENDPROC");
+    let _ = writeln!(out);
+    let _ = writeln!(out, "    PROC Measure(string id, string station)");
+    let _ = writeln!(
+        out,
+        "        ! Hook: trigger the laser-stripe sensor here and log id, station and CJointT() (e.g. SetDO, WaitDI)."
+    );
+    let _ = writeln!(out, "        WaitTime 0.5;");
+    let _ = writeln!(out, "    ENDPROC");
+    let _ = writeln!(out, "ENDMODULE");
+    out.chars()
+        .map(|c| if c.is_ascii() { c } else { '?' })
+        .collect()
+}

@@ -1,0 +1,351 @@
+//! Choosing the poses: the D-optimal criterion of the identify poses
+//! (information of the `ml` model with the station centres eliminated,
+//! plus `ml`'s prior), its greedy maximisation with exchange passes, the
+//! random baseline, the spread of the validate poses and the rotation
+//! group's criterion (see the parent module's docs).
+
+use nalgebra::{Cholesky, DMatrix, Dyn, Matrix3};
+use rand_chacha::ChaCha8Rng;
+
+use super::{Candidate, Planner, Site, joint_gap, side_quota, unknown_scale};
+use crate::engine::identify::unknown_is_angle;
+use crate::engine::kinematics::Robot;
+use crate::engine::ml::MlOptions;
+
+/// Weak prior σ of the hand-eye translation in the criterion, mm: only
+/// ranks the first, still singular selection steps (`ml` has no hand-eye
+/// prior; 10 mm is far wider than any hand-eye guess error).
+const HAND_EYE_PRIOR_MM: f64 = 10.0;
+
+/// Weak prior σ of the hand-eye rotation in the criterion, deg.
+const HAND_EYE_PRIOR_DEG: f64 = 10.0;
+
+/// Exchange passes after the greedy selection; each pass tries every
+/// chosen identify pose against every candidate of its station and side.
+/// Two passes catch nearly all of the gain in trials (a third swaps
+/// nothing on the presets).
+pub(super) const EXCHANGE_PASSES: usize = 3;
+
+/// A swap must raise `ln det` by at least this to count (numerical noise
+/// of a ~30 × 30 Cholesky is ~1e-12).
+const EXCHANGE_MIN_GAIN: f64 = 1e-9;
+
+/// Ridge added to eq. 8's normal matrix when ranking rotation poses.
+const ROTATION_RIDGE: f64 = 1e-6;
+
+/// The prior information (scaled units) of the estimated parameters:
+/// `ml`'s prior on the kinematic deviations, a weak one on the hand-eye.
+pub(super) fn prior_information(estimated: &[usize]) -> DMatrix<f64> {
+    let ml = MlOptions::default();
+    let diagonal: Vec<f64> = estimated
+        .iter()
+        .map(|&k| {
+            let sigma = match (k < 6, unknown_is_angle(k)) {
+                (true, false) => HAND_EYE_PRIOR_MM,
+                (true, true) => HAND_EYE_PRIOR_DEG.to_radians(),
+                (false, false) => ml.prior_length,
+                (false, true) => ml.prior_angle_deg.to_radians(),
+            } * unknown_scale(k);
+            1.0 / (sigma * sigma)
+        })
+        .collect();
+    DMatrix::from_diagonal(&nalgebra::DVector::from_vec(diagonal))
+}
+
+/// The information one identify candidate carries: its scaled sensitivity
+/// to the estimated parameters and the inverse covariance of its
+/// base-frame centre.
+#[derive(Debug, Clone)]
+pub(super) struct Info {
+    /// 3 × K.
+    pub(super) a: DMatrix<f64>,
+    /// Inverse covariance, mm⁻².
+    pub(super) w: Matrix3<f64>,
+}
+
+/// Accumulated information of one station: `H = Σ AᵀWA`, `B = Σ AᵀW`,
+/// `C = Σ W`; the station centre eliminated, `M_s = H − B·C⁻¹·Bᵀ`.
+#[derive(Debug, Clone)]
+pub(super) struct StationInfo {
+    h: DMatrix<f64>,
+    b: DMatrix<f64>,
+    c: Matrix3<f64>,
+    n: usize,
+}
+
+impl StationInfo {
+    fn new(k: usize) -> Self {
+        Self {
+            h: DMatrix::zeros(k, k),
+            b: DMatrix::zeros(k, 3),
+            c: Matrix3::zeros(),
+            n: 0,
+        }
+    }
+
+    pub(super) fn of(infos: &[Info], chosen: &[usize], k: usize) -> Self {
+        let mut s = Self::new(k);
+        for &i in chosen {
+            s.add(&infos[i]);
+        }
+        s
+    }
+
+    fn add(&mut self, info: &Info) {
+        let w = dm3(&info.w);
+        let atw = info.a.transpose() * &w;
+        self.h += &atw * &info.a;
+        self.b += atw;
+        self.c += info.w;
+        self.n += 1;
+    }
+
+    /// `M_s`, K × K.
+    pub(super) fn schur(&self) -> DMatrix<f64> {
+        match self.c.try_inverse() {
+            Some(ci) if self.n >= 2 => &self.h - &self.b * dm3(&ci) * self.b.transpose(),
+            _ => DMatrix::zeros(self.h.nrows(), self.h.ncols()),
+        }
+    }
+
+    /// `ln det(M + ΔM) − ln det(M)` for adding `info`, with `chol` the
+    /// Cholesky factor of `M`: `ΔM = Eᵀ·V·E` with `E = A − C⁻¹Bᵀ` and
+    /// `V = (W⁻¹ + C⁻¹)⁻¹` (the new sighting against the station's centre
+    /// as the others fix it), by the matrix determinant lemma. Zero for a
+    /// station with no sighting yet (one sighting only fixes its centre).
+    fn gain(&self, info: &Info, chol: &Cholesky<f64, Dyn>) -> f64 {
+        let Some(ci) = self.c.try_inverse() else {
+            return 0.0;
+        };
+        let Some(wi) = info.w.try_inverse() else {
+            return 0.0;
+        };
+        let e = &info.a - dm3(&ci) * self.b.transpose();
+        // F = L⁻¹·Eᵀ, G = FᵀF = E·M⁻¹·Eᵀ.
+        let mut f = e.transpose();
+        chol.l_dirty().solve_lower_triangular_mut(&mut f);
+        let g = f.transpose() * &f;
+        let v_inv = wi + ci;
+        let total = v_inv + Matrix3::from_fn(|i, j| g[(i, j)]);
+        match (total.cholesky(), v_inv.cholesky()) {
+            (Some(t), Some(v)) => log_det3(&t) - log_det3(&v),
+            _ => 0.0,
+        }
+    }
+}
+
+fn dm3(m: &Matrix3<f64>) -> DMatrix<f64> {
+    DMatrix::from_fn(3, 3, |i, j| m[(i, j)])
+}
+
+fn log_det3(c: &nalgebra::Cholesky<f64, nalgebra::U3>) -> f64 {
+    2.0 * (0..3).map(|i| c.l_dirty()[(i, i)].ln()).sum::<f64>()
+}
+
+fn log_det(chol: &Cholesky<f64, Dyn>) -> f64 {
+    let l = chol.l_dirty();
+    2.0 * (0..l.nrows()).map(|i| l[(i, i)].ln()).sum::<f64>()
+}
+
+/// `ln det(prior + Σ_s M_s)` of a selection `(site, chosen)`.
+pub(super) fn criterion(
+    prior: &DMatrix<f64>,
+    infos: &[Vec<Info>],
+    selection: &[(usize, Vec<usize>)],
+) -> Option<f64> {
+    let k = prior.nrows();
+    let mut m = prior.clone();
+    for (site, chosen) in selection {
+        m += StationInfo::of(&infos[*site], chosen, k).schur();
+    }
+    m.cholesky().map(|c| log_det(&c))
+}
+
+/// A seeded random selection of `n` poses per identify station, sides
+/// balanced as in the greedy selection.
+pub(super) fn random_selection(
+    sites: &[Site],
+    identify: &[usize],
+    n: usize,
+    rng: &mut ChaCha8Rng,
+) -> Vec<(usize, Vec<usize>)> {
+    identify
+        .iter()
+        .map(|&k| {
+            let mut chosen = Vec::with_capacity(n);
+            for side in [1_i8, -1] {
+                let of_side: Vec<usize> = (0..sites[k].candidates.len())
+                    .filter(|&i| sites[k].candidates[i].side == side)
+                    .collect();
+                let quota = side_quota(n, side).min(of_side.len());
+                for j in rand::seq::index::sample(rng, of_side.len(), quota).into_vec() {
+                    chosen.push(of_side[j]);
+                }
+            }
+            (k, chosen)
+        })
+        .collect()
+}
+
+/// Greedy D-optimal selection with exchange passes (module docs).
+pub(super) fn greedy_selection(
+    planner: &Planner<'_>,
+    sites: &[Site],
+    identify: &[usize],
+    infos: &[Vec<Info>],
+    prior: &DMatrix<f64>,
+) -> Vec<(usize, Vec<usize>)> {
+    let n = planner.config.identify_poses;
+    let k = prior.nrows();
+    let mut chosen: Vec<Vec<usize>> = identify
+        .iter()
+        .map(|&s| planner.first_pose(&sites[s]).into_iter().collect())
+        .collect();
+    let mut stations: Vec<StationInfo> = identify
+        .iter()
+        .zip(&chosen)
+        .map(|(&s, c)| StationInfo::of(&infos[s], c, k))
+        .collect();
+    let mut m = prior.clone();
+    for st in &stations {
+        m += st.schur();
+    }
+    let side_ok = |site: &Site, chosen: &[usize], cand: usize| {
+        let side = site.candidates[cand].side;
+        let used = chosen
+            .iter()
+            .filter(|&&i| site.candidates[i].side == side)
+            .count();
+        !chosen.contains(&cand) && used < side_quota(n, side)
+    };
+    // Greedy additions.
+    while let Some(chol) = m.clone().cholesky() {
+        let mut best: Option<(f64, usize, usize)> = None;
+        for (slot, &s) in identify.iter().enumerate() {
+            if chosen[slot].len() >= n {
+                continue;
+            }
+            for (cand, info) in infos[s].iter().enumerate() {
+                if !side_ok(&sites[s], &chosen[slot], cand) {
+                    continue;
+                }
+                let g = stations[slot].gain(info, &chol);
+                if best.is_none_or(|(b, _, _)| g > b) {
+                    best = Some((g, slot, cand));
+                }
+            }
+        }
+        let Some((_, slot, cand)) = best else {
+            break;
+        };
+        let s = identify[slot];
+        m -= stations[slot].schur();
+        stations[slot].add(&infos[s][cand]);
+        m += stations[slot].schur();
+        chosen[slot].push(cand);
+    }
+    // Exchange passes: swap a chosen pose for a better one of its side.
+    for _ in 0..EXCHANGE_PASSES {
+        let mut swapped = false;
+        for (slot, &s) in identify.iter().enumerate() {
+            for pos in 0..chosen[slot].len() {
+                let Some(current) = m.clone().cholesky().map(|c| log_det(&c)) else {
+                    continue;
+                };
+                let removed = chosen[slot][pos];
+                let mut rest = chosen[slot].clone();
+                rest.remove(pos);
+                let without = StationInfo::of(&infos[s], &rest, k);
+                let without_schur = without.schur();
+                let m_without = &m - stations[slot].schur() + &without_schur;
+                let Some(chol) = m_without.clone().cholesky() else {
+                    continue;
+                };
+                let base = log_det(&chol);
+                let side = sites[s].candidates[removed].side;
+                let mut best: Option<(f64, usize)> = None;
+                for (cand, info) in infos[s].iter().enumerate() {
+                    if sites[s].candidates[cand].side != side || chosen[slot].contains(&cand) {
+                        continue;
+                    }
+                    let value = base + without.gain(info, &chol);
+                    if best.is_none_or(|(b, _)| value > b) {
+                        best = Some((value, cand));
+                    }
+                }
+                if let Some((value, cand)) = best
+                    && value > current + EXCHANGE_MIN_GAIN
+                {
+                    let mut updated = without;
+                    updated.add(&infos[s][cand]);
+                    m = m_without - without_schur + updated.schur();
+                    chosen[slot][pos] = cand;
+                    stations[slot] = updated;
+                    swapped = true;
+                }
+            }
+        }
+        if !swapped {
+            break;
+        }
+    }
+    identify.iter().copied().zip(chosen).collect()
+}
+
+/// Validate poses: farthest point in flange orientation, sides balanced,
+/// from the candidate closest to the mean approach.
+pub(super) fn spread_selection(planner: &Planner<'_>, site: &Site, n: usize) -> Vec<usize> {
+    let mut chosen: Vec<usize> = planner.first_pose(site).into_iter().collect();
+    while chosen.len() < n {
+        let mut best: Option<(f64, usize)> = None;
+        for (i, c) in site.candidates.iter().enumerate() {
+            let used = chosen
+                .iter()
+                .filter(|&&j| site.candidates[j].side == c.side)
+                .count();
+            if chosen.contains(&i) || used >= side_quota(n, c.side) {
+                continue;
+            }
+            let nearest = chosen
+                .iter()
+                .map(|&j| {
+                    let other = &site.candidates[j];
+                    // Same orientation on another branch still differs in joints.
+                    other.rotation.angle_to(&c.rotation)
+                        + joint_gap(&other.joints, &c.joints).to_radians() * 1e-3
+                })
+                .fold(f64::INFINITY, f64::min);
+            if best.is_none_or(|(b, _)| nearest > b) {
+                best = Some((nearest, i));
+            }
+        }
+        match best {
+            Some((_, i)) => chosen.push(i),
+            None => break,
+        }
+    }
+    chosen
+}
+
+/// `ln det(N + ε·I)` of eq. 8's normal matrix `N = Σ_{i<j} (R_i − R_j)ᵀ(R_i − R_j)`
+/// over the flange rotations of `set` (nominal model).
+pub(super) fn rotation_criterion(robot: &Robot, set: &[&Candidate]) -> f64 {
+    let rotations: Vec<Matrix3<f64>> = set
+        .iter()
+        .map(|c| {
+            robot
+                .base_from_flange(&c.joints)
+                .rotation
+                .to_rotation_matrix()
+                .into_inner()
+        })
+        .collect();
+    let mut n = Matrix3::identity() * ROTATION_RIDGE;
+    for i in 0..rotations.len() {
+        for j in i + 1..rotations.len() {
+            let d = rotations[i] - rotations[j];
+            n += d.transpose() * d;
+        }
+    }
+    n.determinant().max(f64::MIN_POSITIVE).ln()
+}
