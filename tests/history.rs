@@ -788,3 +788,110 @@ fn the_example_library_shows_its_two_events() {
         ]
     );
 }
+
+/// A copy of the first calibration under another date, its `ml` solver
+/// block edited by `edit`.
+fn edited(date: &str, edit: impl Fn(&mut serde_json::Map<String, serde_json::Value>)) -> Cal {
+    let base = &calibrations()[0];
+    let name = format!("IRB2400 cell 3, {date}");
+    let mut result = base.result.clone();
+    result.session.clone_from(&name);
+    edit(&mut result.solver);
+    Cal {
+        stem: format!("edited-{date}"),
+        session: Session {
+            name,
+            ..base.session.clone()
+        },
+        result,
+    }
+}
+
+#[test]
+fn variance_factor_prior_and_fixed_sets_are_respected() {
+    use serde_json::{Value, json};
+    let dir = tempfile::tempdir().unwrap();
+    let theta3_std = |block: &serde_json::Map<String, Value>| {
+        block["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["parameter"] == "theta3")
+            .unwrap()["std"]
+            .as_f64()
+            .unwrap()
+    };
+    let reported = theta3_std(&calibrations()[0].result.solver);
+    // 1. As calibrated.
+    write_pair(dir.path(), &edited("2026-01-01", |_| {}));
+    // 2. An optimistic noise model (variance factor 4): every σ doubles.
+    //    theta3's σ also made 0.15° (≥ half the 0.2° prior): prior-held.
+    write_pair(
+        dir.path(),
+        &edited("2026-02-01", |b| {
+            b.insert("variance_factor".into(), json!(4.0));
+            for p in b["parameters"].as_array_mut().unwrap() {
+                if p["parameter"] == "theta3" {
+                    p["std"] = json!(0.15);
+                }
+            }
+        }),
+    );
+    // 3. d4 fixed (d4 ~ a3): d4 is then not comparable, a3 carries
+    //    something else, theta3 is unaffected.
+    write_pair(
+        dir.path(),
+        &edited("2026-03-01", |b| {
+            let strip = |v: &mut Value| {
+                v.as_array_mut().unwrap().retain(|x| x != "d4");
+            };
+            strip(b.get_mut("estimated").unwrap());
+            b["fixed"].as_array_mut().unwrap().push(json!("d4"));
+            b["inseparable"]
+                .as_array_mut()
+                .unwrap()
+                .push(json!("d4 ~ a3: d4 +1 mm is undone by a3 -1.000 mm"));
+        }),
+    );
+    let library = history::scan(dir.path()).unwrap();
+    let e = &library.entries;
+    assert_eq!(
+        e[0].sigma_scale,
+        1.0_f64.max(e[0].variance_factor.unwrap()).sqrt()
+    );
+    assert_eq!(e[1].sigma_scale, 2.0);
+    let s0 = e[0].param("hand_eye.x").unwrap().sigma.unwrap();
+    let s1 = e[1].param("hand_eye.x").unwrap().sigma.unwrap();
+    assert!(
+        (s1 / s0 - 2.0 / e[0].sigma_scale).abs() < 1e-12,
+        "{s0} {s1}"
+    );
+    let t1 = e[1].param("theta3").unwrap();
+    assert!(t1.prior_held);
+    assert_eq!(t1.sigma, Some(0.3));
+    assert!(!e[0].param("theta3").unwrap().prior_held);
+    assert!(
+        (e[0].param("theta3").unwrap().sigma.unwrap() - reported * e[0].sigma_scale).abs() < 1e-15
+    );
+    assert_eq!(e[2].param("d4").unwrap().status, Status::Fixed);
+
+    let d = irb_drift(&library);
+    let check = |to: usize, p: &str| {
+        d.checks
+            .iter()
+            .find(|c| c.to == to && c.parameter == p)
+            .unwrap_or_else(|| panic!("no check of {p} into entry {to}"))
+    };
+    // Same data: nothing moves, the prior-held one is said to be weak.
+    let c = check(1, "theta3");
+    assert_eq!(c.verdict, Verdict::Steady);
+    assert!(c.notes.iter().any(|n| n.contains("prior")), "{:?}", c.notes);
+    let reason = |c: &history::JumpCheck| match &c.verdict {
+        Verdict::NotChecked(r) => r.clone(),
+        v => panic!("{}: {v:?}", c.parameter),
+    };
+    assert!(reason(check(2, "d4")).contains("fixed in the other"));
+    assert!(reason(check(2, "a3")).contains("fixed different parameters (d4)"));
+    assert_eq!(check(2, "theta3").verdict, Verdict::Steady);
+    assert_eq!(check(2, "hand_eye.x").verdict, Verdict::Steady);
+}
