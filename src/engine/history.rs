@@ -1843,14 +1843,18 @@ fn drift_notes(library: &Library, entries: &[usize], reference: &[Joint]) -> Vec
             entries.len()
         ));
     }
-    for w in entries.windows(2) {
-        let (a, b) = (&library.entries[w[0]], &library.entries[w[1]]);
-        if a.date == b.date {
-            notes.push(format!(
-                "two results share the date {}: their order is by file path",
-                a.date
-            ));
-        }
+    let mut shared: Vec<String> = entries
+        .windows(2)
+        .map(|w| (&library.entries[w[0]], &library.entries[w[1]]))
+        .filter(|(a, b)| a.date == b.date)
+        .map(|(a, _)| a.date.to_string())
+        .collect();
+    shared.dedup();
+    if !shared.is_empty() {
+        notes.push(format!(
+            "several results share a date ({}): among themselves they are in file path order",
+            shared.join(", ")
+        ));
     }
     notes
 }
