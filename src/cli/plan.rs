@@ -17,7 +17,7 @@ use crate::engine::geometry::isometry_from_rows;
 use crate::engine::import::{self, RobotSource};
 use crate::engine::kinematics::{self, JointLimit};
 use crate::engine::plan::{
-    self, Controller, PlanConfig, PlanError, PredictConfig, Selection, StationLayout,
+    self, Controller, PlanConfig, PlanError, PlanStage, PredictConfig, Selection, StationLayout,
 };
 use crate::engine::session;
 use crate::engine::simulate;
@@ -304,11 +304,37 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     }
     let config = config(args)?;
     let quiet = args.quiet;
-    let made = plan::plan(&config, &mut |_| Control::Continue).map_err(|e| plan_error(&e))?;
-    let planned_ms = started.elapsed().as_secs_f64() * 1e3;
+    // When each stage began, for the timing line.
+    let mut marks: Vec<(&str, Instant)> = vec![("candidates", Instant::now())];
+    let made = plan::plan(&config, &mut |stage| {
+        let name = match stage {
+            PlanStage::Candidates { .. } => None,
+            PlanStage::Analysis => Some("identifiability"),
+            PlanStage::Selection => Some("selection"),
+            PlanStage::Ordering => Some("ordering and report"),
+        };
+        if let Some(name) = name {
+            marks.push((name, Instant::now()));
+        }
+        Control::Continue
+    })
+    .map_err(|e| plan_error(&e))?;
+    let end = Instant::now();
     if !quiet {
         print!("{}", plan::summary(&made));
-        println!("  planned in {planned_ms:.0} ms");
+        let stages: Vec<String> = marks
+            .iter()
+            .enumerate()
+            .map(|(k, (name, at))| {
+                let next = marks.get(k + 1).map_or(end, |m| m.1);
+                format!("{name} {:.0}", (next - *at).as_secs_f64() * 1e3)
+            })
+            .collect();
+        println!(
+            "  planned in {:.0} ms ({} ms)",
+            (end - started).as_secs_f64() * 1e3,
+            stages.join(", ")
+        );
     }
     if args.predict > 0 {
         let predict = PredictConfig {
