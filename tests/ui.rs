@@ -381,6 +381,7 @@ fn exports_are_written_to_the_chosen_folder() {
         "Model JSON",
         "Model CSV",
         "Model URDF",
+        "Report HTML",
     ] {
         h.get_by_label(button).click();
         settle(&mut h);
@@ -411,6 +412,19 @@ fn exports_are_written_to_the_chosen_folder() {
         let expected = model_export::export(&shown.file, format, &source).expect("exports");
         assert_eq!(written, expected, "the {ext} model is the engine's export");
     }
+    let report =
+        std::fs::read_to_string(dir.path().join(format!("{stem}-report.html"))).expect("report");
+    let sha = spherecal::engine::html_report::sha256_hex(spherecal::DEMO_SESSION_JSON.as_bytes());
+    assert!(report.starts_with("<!DOCTYPE html>"));
+    assert!(
+        report.contains(&sha),
+        "the report carries the session's SHA-256"
+    );
+    assert!(report.contains(&shown.file.session));
+    assert!(
+        report.matches("<svg").count() >= 3,
+        "figures are inline SVG"
+    );
     assert_eq!(
         h.state().state().prefs.export_folder.as_deref(),
         Some(dir.path()),
@@ -633,4 +647,139 @@ fn a_failed_import_names_the_pose_and_keeps_the_open_session() {
         .session
         .name;
     assert_eq!(*name, before, "the open session is kept");
+}
+
+#[test]
+fn the_history_view_scans_the_example_library_and_flags_its_jumps() {
+    let mut h = demo_app();
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("sessions/history");
+    h.get_by_label("History").click();
+    h.run();
+    type_into(&mut h, "Library folder", &folder.display().to_string());
+    h.get_by_label("Scan").click();
+    settle(&mut h);
+    let view = &h.state().state().history;
+    let library = view
+        .library
+        .as_ref()
+        .expect("scanned")
+        .as_ref()
+        .expect("the library loads");
+    assert_eq!(library.entries.len(), 5);
+    assert!(library.problems.is_empty(), "{:?}", library.problems);
+    let drift = view
+        .drift
+        .as_ref()
+        .expect("a drift")
+        .as_ref()
+        .expect("the drift of the one robot");
+    let mut jumped: Vec<&str> = drift.jumps().map(|j| j.parameter.as_str()).collect();
+    jumped.sort_unstable();
+    assert_eq!(jumped, ["hand_eye.x", "hand_eye.y", "theta3"]);
+    assert!(
+        h.query_all_by_label_contains("3 jump(s) flagged").count() > 0,
+        "the jumps are announced"
+    );
+    // Untick the last calibration: the theta3 jump (2026-05-11) goes.
+    let last = library.entries.last().expect("entries").path.clone();
+    let name = last
+        .file_name()
+        .expect("name")
+        .to_string_lossy()
+        .into_owned();
+    h.get_by_label(&name).click();
+    h.run();
+    assert!(h.state().forms().history.unselected.contains(&last));
+    let drift = h
+        .state()
+        .state()
+        .history
+        .drift
+        .clone()
+        .expect("drift")
+        .expect("ok");
+    let mut jumped: Vec<String> = drift.jumps().map(|j| j.parameter.clone()).collect();
+    jumped.sort_unstable();
+    assert_eq!(jumped, ["hand_eye.x", "hand_eye.y"]);
+    assert_eq!(drift.entries.len(), 4);
+}
+
+#[test]
+fn a_missing_library_folder_is_reported() {
+    let mut h = demo_app();
+    h.get_by_label("History").click();
+    h.run();
+    type_into(&mut h, "Library folder", "/no/such/folder");
+    h.get_by_label("Scan").click();
+    settle(&mut h);
+    let outcome = h.state().state().history.library.as_ref().expect("scanned");
+    let message = outcome.as_ref().expect_err("fails");
+    assert!(message.contains("/no/such/folder"), "{message}");
+    assert!(h.query_all_by_label_contains("Could not scan").count() > 0);
+}
+
+#[test]
+fn a_plan_is_made_exported_simulated_and_calibrated() {
+    use spherecal::app::state::Source;
+    use spherecal::engine::plan;
+    let mut h = demo_app();
+    h.get_by_label("Plan").click();
+    h.run();
+    assert_eq!(h.state().forms().tab, Tab::Plan);
+    {
+        let f = &mut h.state_mut().forms_mut().plan;
+        f.n_identify = 3;
+        f.identify_poses = 4;
+        f.n_validate = 2;
+        f.validate_poses = 3;
+        f.candidates = 8;
+        f.predict_runs = 1;
+    }
+    h.get_by_label("Make plan").click();
+    settle(&mut h);
+    let outcome = h
+        .state()
+        .state()
+        .plan
+        .outcome
+        .clone()
+        .expect("planned")
+        .expect("a plan");
+    let n = outcome.plan.poses.len();
+    assert_eq!(n, 4 + 6 + 3 * 4 + 2 * 3);
+    let prediction = outcome.prediction.expect("asked for").expect("predicted");
+    assert!(prediction.after_mean > 0.0 && prediction.after_mean < prediction.before_mean);
+    assert!(
+        h.query_all_by_label_contains("Predicted validation std after")
+            .count()
+            > 0
+    );
+
+    let dir = tempfile::tempdir().expect("temp dir");
+    h.state_mut().forms_mut().export_dir = dir.path().display().to_string();
+    h.get_by_label("Plan CSV").click();
+    settle(&mut h);
+    h.get_by_label("RAPID module").click();
+    settle(&mut h);
+    let csv = std::fs::read_to_string(dir.path().join("plan-irb2400.csv")).expect("csv");
+    let poses = plan::read_plan_csv(&csv).expect("the CSV reads back");
+    assert_eq!(poses.len(), n);
+    let rapid = std::fs::read_to_string(dir.path().join("plan-irb2400.mod")).expect("rapid");
+    assert!(rapid.contains("MODULE"), "{rapid}");
+    assert!(
+        rapid.matches("jointtarget").count() >= n,
+        "one jointtarget per pose"
+    );
+
+    h.get_by_label("Simulate and open").click();
+    settle(&mut h);
+    let notice = h.state().state().notice.clone();
+    assert!(notice.is_none(), "{notice:?}");
+    let loaded = h.state().state().loaded.as_ref().expect("a session");
+    assert_eq!(loaded.source, Source::Simulated);
+    assert_eq!(loaded.session.measurements.len(), n);
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    let result = h.state().state().result.as_ref().expect("calibrated");
+    assert!(result.file.epsilon_after < result.file.epsilon_before);
 }

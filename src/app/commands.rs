@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use super::state::{DialogPurpose, ExportKind, Tab};
+use super::state::{DialogPurpose, ExportKind, PlanExport, Tab};
 
 /// A request from the UI.
 #[derive(Debug, Clone, PartialEq)]
@@ -61,4 +61,16 @@ pub enum Command {
     },
     /// Build the session from the import form and open it.
     ImportRun,
+    /// Scan the History form's folder.
+    HistoryScan,
+    /// Recompute the drift after the robot, the ticks or `k` changed.
+    HistoryDrift,
+    /// Make a plan with the Plan form's settings (and predict it).
+    PlanMake,
+    /// Stop the planning job.
+    PlanCancel,
+    /// Write the plan into the export folder.
+    PlanExport(PlanExport),
+    /// Simulate a session of the plan and open it.
+    PlanSimulate,
 }

@@ -1,12 +1,15 @@
 //! Export files of a result: the FORMAT.md result JSON, CSV of the centres
 //! and of the distance errors, a PNG of the plots (cropped from a window
-//! screenshot), and the calibrated model (JSON robot block, MDH CSV, URDF
+//! screenshot), the self-contained HTML report, and the calibrated model (JSON robot block, MDH CSV, URDF
 //! fragment, as `spherecal export-model`). Every file is written atomically by the engine's
 //! [`write_atomic`]. Runs on a job thread.
 
 use std::fmt::Write as _;
 use std::path::Path;
+use std::time::SystemTime;
 
+use crate::engine::html_report::{self, ReportInput, ReportMeta};
+use crate::engine::model::Session;
 use crate::engine::model_export::{self, ModelFormat};
 use crate::engine::session::{result_to_json, write_atomic};
 
@@ -96,6 +99,7 @@ pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<()
         ExportKind::CentresCsv => centres_csv(view),
         ExportKind::DistancesCsv => distances_csv(view),
         ExportKind::PlotsPng => return Err("a PNG is written from a screenshot".to_string()),
+        ExportKind::ReportHtml => return Err("a report needs its session".to_string()),
         ExportKind::ModelJson | ExportKind::ModelCsv | ExportKind::ModelUrdf => {
             let format = match kind {
                 ExportKind::ModelJson => ModelFormat::Json,
@@ -111,6 +115,33 @@ pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<()
         }
     };
     write_atomic(path, text.as_bytes()).map_err(|e| e.to_string())
+}
+
+/// Writes the HTML report of `view` against its session atomically (the
+/// engine's [`html_report::render`], as `spherecal report --result`).
+/// `bytes` are the session file's bytes (for the SHA-256) and `label`
+/// names it in the report.
+///
+/// # Errors
+/// The result is not of this session, or the file cannot be written.
+pub fn write_report(
+    view: &ResultView,
+    session: &Session,
+    bytes: &[u8],
+    label: &str,
+    path: &Path,
+) -> Result<(), String> {
+    html_report::check_result(session, &view.file, None)
+        .map_err(|e| format!("the report was not written: {e}"))?;
+    let meta = ReportMeta::new(label, SystemTime::now());
+    let html = html_report::render(&ReportInput {
+        session,
+        session_bytes: bytes,
+        result: &view.file,
+        prepared: None,
+        meta: &meta,
+    });
+    write_atomic(path, html.as_bytes()).map_err(|e| e.to_string())
 }
 
 /// Crops `image` to `rect` (physical pixels: min x, min y, width, height)

@@ -9,9 +9,11 @@ use std::sync::Arc;
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
 
 use crate::engine::calibrate::Progress;
+use crate::engine::history::Library;
 use crate::engine::import::PoseCheck;
 
-use super::state::{DialogPurpose, ExportKind, LoadedSession};
+use super::planner::PlanEvent;
+use super::state::{DialogPurpose, ExportKind, LoadedSession, PlanExport};
 use super::view::ResultView;
 use super::wizard::ImportForm;
 
@@ -75,6 +77,26 @@ pub enum JobMessage {
     },
     /// The import wizard built a session, or why not.
     Imported(Result<Imported, String>),
+    /// The planning job's progress or result.
+    Plan(PlanEvent),
+    /// A plan file was written, or why not.
+    PlanWritten {
+        /// What was written.
+        kind: PlanExport,
+        /// Target file.
+        path: PathBuf,
+        /// Success or the error message.
+        outcome: Result<(), String>,
+    },
+    /// A session simulated from the plan, or why not.
+    PlanSimulated(Result<Box<LoadedSession>, String>),
+    /// A library folder was scanned, or why not.
+    Scanned {
+        /// The folder.
+        folder: PathBuf,
+        /// The library or the engine's message.
+        outcome: Result<Box<Library>, String>,
+    },
     /// An export file was written, or why not.
     Exported {
         /// What was exported.

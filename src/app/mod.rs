@@ -14,6 +14,7 @@
 //!   result file both go through the FORMAT.md result);
 //! - [`export`]: the export files;
 //! - [`wizard`]: the import wizard's form and the engine spec it builds;
+//! - [`planner`]: the Plan view's form and the planning job;
 //! - [`panels`]: one module per panel or view, each a `*_ui` function.
 //!
 //! Layout of the window, for an operator at 1366×768: the load and solver
@@ -24,6 +25,7 @@ pub mod commands;
 pub mod export;
 pub mod jobs;
 pub mod panels;
+pub mod planner;
 pub mod state;
 pub mod view;
 pub mod wizard;

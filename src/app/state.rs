@@ -16,8 +16,10 @@ use crate::engine::identify::{DEFAULT_SVD_TOLERANCE, Pairing, PaperOptions};
 use crate::engine::model::{Session, Use};
 use crate::engine::stripe::StripeResult;
 
+use super::planner::{PlanForm, PlanOutcome};
 use super::view::{CentreSet, ResultView};
 use super::wizard::{ImportForm, ImportView};
+use crate::engine::history::{DEFAULT_K, Drift, Library};
 
 /// How many recent files the start list keeps.
 pub const RECENT_MAX: usize = 8;
@@ -31,6 +33,8 @@ pub enum Source {
     File(PathBuf),
     /// Built by the import wizard from this joint log; not saved yet.
     Imported(PathBuf),
+    /// Simulated from the Plan view's plan; not saved yet.
+    Simulated,
 }
 
 impl Source {
@@ -38,7 +42,7 @@ impl Source {
     #[must_use]
     pub fn path(&self) -> Option<&Path> {
         match self {
-            Self::Demo | Self::Imported(_) => None,
+            Self::Demo | Self::Imported(_) | Self::Simulated => None,
             Self::File(p) => Some(p),
         }
     }
@@ -48,7 +52,7 @@ impl Source {
     #[must_use]
     pub fn folder(&self) -> Option<&Path> {
         match self {
-            Self::Demo => None,
+            Self::Demo | Self::Simulated => None,
             Self::File(p) | Self::Imported(p) => p.parent(),
         }
     }
@@ -60,6 +64,7 @@ impl Source {
             Self::Demo => format!("{} (embedded demo)", crate::DEMO_SESSION_NAME),
             Self::File(p) => p.display().to_string(),
             Self::Imported(p) => format!("imported from {} (not saved yet)", p.display()),
+            Self::Simulated => "simulated from the plan (not saved yet)".to_string(),
         }
     }
 
@@ -68,6 +73,7 @@ impl Source {
     pub fn stem(&self) -> String {
         let name = match self {
             Self::Demo => Path::new(crate::DEMO_SESSION_NAME),
+            Self::Simulated => Path::new("plan-simulated"),
             Self::File(p) | Self::Imported(p) => p.as_path(),
         };
         name.file_stem().map_or_else(
@@ -107,6 +113,9 @@ pub struct LoadedSession {
     pub session: Session,
     /// Where it came from.
     pub source: Source,
+    /// The file's bytes as read (for the report's SHA-256); for an
+    /// imported session, the FORMAT.md text Save as would write.
+    pub bytes: Vec<u8>,
     /// One per measurement, session order.
     pub fits: Vec<Fit>,
     /// Sphere centres in the base frame with the nominal model and the
@@ -258,6 +267,37 @@ pub enum DialogPurpose {
     ImportProfiles,
     /// Import wizard: the reference distances CSV.
     ImportReferences,
+    /// History: the library folder.
+    HistoryFolder,
+}
+
+/// What the Plan view writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlanExport {
+    /// The plan as the joint-log CSV `spherecal import` reads.
+    Csv,
+    /// An ABB RAPID module of joint targets.
+    Rapid,
+}
+
+impl PlanExport {
+    /// The button text.
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Csv => "Plan CSV",
+            Self::Rapid => "RAPID module",
+        }
+    }
+
+    /// The file name for a robot key.
+    #[must_use]
+    pub fn file_name(self, robot: &str) -> String {
+        match self {
+            Self::Csv => format!("plan-{robot}.csv"),
+            Self::Rapid => format!("plan-{robot}.mod"),
+        }
+    }
 }
 
 /// Things to export from the Results view.
@@ -277,11 +317,14 @@ pub enum ExportKind {
     ModelCsv,
     /// A URDF fragment with the calibrated joint origins (m, rad).
     ModelUrdf,
+    /// The self-contained HTML report (inline SVG figures).
+    ReportHtml,
 }
 
 impl ExportKind {
     /// All kinds, in the order of the export buttons.
-    pub const ALL: [Self; 7] = [
+    pub const ALL: [Self; 8] = [
+        Self::ReportHtml,
         Self::ResultJson,
         Self::CentresCsv,
         Self::DistancesCsv,
@@ -302,6 +345,7 @@ impl ExportKind {
             Self::ModelJson => "Model JSON",
             Self::ModelCsv => "Model CSV",
             Self::ModelUrdf => "Model URDF",
+            Self::ReportHtml => "Report HTML",
         }
     }
 
@@ -316,6 +360,7 @@ impl ExportKind {
             Self::ModelJson => format!("{stem}-model.json"),
             Self::ModelCsv => format!("{stem}-model.csv"),
             Self::ModelUrdf => format!("{stem}-model.urdf"),
+            Self::ReportHtml => format!("{stem}-report.html"),
         }
     }
 }
@@ -333,16 +378,22 @@ pub enum Tab {
     Results,
     /// The import wizard: joint log and profiles to a session.
     Import,
+    /// The library of past results and the drift of one robot.
+    History,
+    /// The pose planner.
+    Plan,
 }
 
 impl Tab {
     /// All tabs, in display order.
-    pub const ALL: [Self; 5] = [
+    pub const ALL: [Self; 7] = [
         Self::Session,
         Self::Stripe,
         Self::Centres,
         Self::Results,
+        Self::Plan,
         Self::Import,
+        Self::History,
     ];
 
     /// The tab's title.
@@ -354,6 +405,8 @@ impl Tab {
             Self::Centres => "Centres",
             Self::Results => "Results",
             Self::Import => "Import",
+            Self::History => "History",
+            Self::Plan => "Plan",
         }
     }
 }
@@ -457,6 +510,10 @@ pub struct Forms {
     pub centres: CentresForm,
     /// The import wizard's fields.
     pub import: ImportForm,
+    /// The History view's fields.
+    pub history: HistoryForm,
+    /// The Plan view's fields.
+    pub plan: PlanForm,
 }
 
 impl Default for Forms {
@@ -472,8 +529,60 @@ impl Default for Forms {
             solver: SolverForm::default(),
             centres: CentresForm::default(),
             import: ImportForm::default(),
+            history: HistoryForm::default(),
+            plan: PlanForm::default(),
         }
     }
+}
+
+/// What the Plan view shows.
+#[derive(Debug, Default)]
+pub struct PlanView {
+    /// The planning job's last stage, in words, while it runs.
+    pub progress: Option<String>,
+    /// Set to stop the planning job; `Some` while it runs.
+    pub cancel: Option<Arc<AtomicBool>>,
+    /// The last plan, or why planning failed.
+    pub outcome: Option<Result<PlanOutcome, String>>,
+    /// Plan files being written or a plan being simulated.
+    pub writing: usize,
+}
+
+/// The History view's fields.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HistoryForm {
+    /// The library folder.
+    pub folder: String,
+    /// The robot whose drift is shown.
+    pub robot: Option<String>,
+    /// Result files left out of the drift (unticked in the table).
+    pub unselected: BTreeSet<PathBuf>,
+    /// Flag a change beyond `k` combined σ.
+    pub k: f64,
+}
+
+impl Default for HistoryForm {
+    fn default() -> Self {
+        Self {
+            folder: String::new(),
+            robot: None,
+            unselected: BTreeSet::new(),
+            k: DEFAULT_K,
+        }
+    }
+}
+
+/// What the History view shows.
+#[derive(Debug, Clone, Default)]
+pub struct HistoryView {
+    /// The last scan, or why it failed.
+    pub library: Option<Result<Library, String>>,
+    /// The drift of the chosen robot over the ticked results, or why
+    /// there is none; computed from `drift_of`, the library with only the
+    /// ticked results.
+    pub drift: Option<Result<Drift, String>>,
+    /// The library the drift's entry indices refer to (the ticked results).
+    pub drift_of: Option<Library>,
 }
 
 /// What lasts across runs of the program (eframe storage).
@@ -486,6 +595,8 @@ pub struct Prefs {
     pub last_folder: Option<PathBuf>,
     /// The last export folder.
     pub export_folder: Option<PathBuf>,
+    /// The last library folder of the History view.
+    pub history_folder: Option<PathBuf>,
 }
 
 impl Prefs {
@@ -516,6 +627,8 @@ pub struct Busy {
     pub screenshot: bool,
     /// Import previews or imports in flight.
     pub importing: usize,
+    /// A library folder is being scanned.
+    pub scanning: bool,
 }
 
 /// Everything the workbench shows. Changed only by commands and job
@@ -548,6 +661,10 @@ pub struct AppState {
     pub pending_result: Option<PathBuf>,
     /// What the import wizard shows (header, preview, flange checks).
     pub import: ImportView,
+    /// The scanned library and the drift on show.
+    pub history: HistoryView,
+    /// The plan on show and the planning job.
+    pub plan: PlanView,
 }
 
 impl AppState {
@@ -569,6 +686,9 @@ impl AppState {
             || self.busy.exporting > 0
             || self.busy.screenshot
             || self.busy.importing > 0
+            || self.busy.scanning
+            || self.plan.cancel.is_some()
+            || self.plan.writing > 0
     }
 
     /// Indices of the measurements the session table shows, in its order

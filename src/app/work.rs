@@ -42,7 +42,9 @@ pub fn open_demo() -> Result<LoadedSession, LoadFailure> {
         what: crate::DEMO_SESSION_NAME.to_string(),
         message: e.to_string(),
     })?;
-    Ok(analyse(session, Source::Demo))
+    let mut loaded = analyse(session, Source::Demo);
+    loaded.bytes = crate::DEMO_SESSION_JSON.as_bytes().to_vec();
+    Ok(loaded)
 }
 
 /// Reads `path` and, by its `format` key, loads it as a result file or
@@ -77,10 +79,9 @@ pub fn open_path(path: &Path) -> Result<Opened, LoadFailure> {
         Ok(Opened::Result(Box::new(result)))
     } else {
         let session = parse_session(&text, path).map_err(|e| fail(&e))?;
-        Ok(Opened::Session(Box::new(analyse(
-            session,
-            Source::File(path.to_path_buf()),
-        ))))
+        let mut loaded = analyse(session, Source::File(path.to_path_buf()));
+        loaded.bytes = text.into_bytes();
+        Ok(Opened::Session(Box::new(loaded)))
     }
 }
 
@@ -123,6 +124,7 @@ pub fn analyse(session: Session, source: Source) -> LoadedSession {
         })
         .map_err(|e| e.to_string());
     LoadedSession {
+        bytes: session_to_json(&session).into_bytes(),
         session,
         source,
         fits,

@@ -11,13 +11,18 @@ use super::commands::Command;
 use super::export;
 use super::jobs::{JobMessage, Jobs, LoadFailure, RunFailure};
 use super::panels;
+use super::planner::{self, PlanEvent};
 use super::state::{
-    AppState, DialogPurpose, ExportKind, Forms, Level, LoadedSession, Notice, Prefs, RunState,
-    SolverForm, Source, Tab,
+    AppState, DialogPurpose, ExportKind, Forms, Level, LoadedSession, Notice, PlanExport, Prefs,
+    RunState, SolverForm, Source, Tab,
 };
 use super::view::ResultOrigin;
 use super::wizard::ProfilesKind;
 use super::work::{self, Opened};
+use crate::engine::geometry::isometry_from_rows;
+use crate::engine::history::{self, DriftOptions, HistoryError};
+use crate::engine::plan::{self, Controller, Plan};
+use crate::engine::session::write_atomic;
 
 /// How long to wait for the window's screenshot for a plots PNG: a frame
 /// takes milliseconds; a backend that cannot take one never answers.
@@ -71,6 +76,9 @@ impl WorkbenchApp {
             .or_else(|| std::env::current_dir().ok())
             .unwrap_or_default();
         forms.export_dir = export_dir.display().to_string();
+        if let Some(dir) = &prefs.history_folder {
+            forms.history.folder = dir.display().to_string();
+        }
         let state = AppState {
             prefs,
             pending_result: result,
@@ -187,6 +195,12 @@ impl WorkbenchApp {
                 }
                 Tab::Import => {
                     panels::import::import_ui(ui, &self.state, &mut self.forms, &mut commands);
+                }
+                Tab::Plan => {
+                    panels::plan::plan_ui(ui, &self.state, &mut self.forms, &mut commands);
+                }
+                Tab::History => {
+                    panels::history::history_ui(ui, &self.state, &mut self.forms, &mut commands);
                 }
             }
         });
@@ -326,7 +340,161 @@ impl WorkbenchApp {
             Command::ClearRecent => self.state.prefs.recent.clear(),
             Command::ImportPreview { guess } => self.import_preview(ctx, guess),
             Command::ImportRun => self.import_run(ctx),
+            Command::HistoryScan => self.history_scan(ctx),
+            Command::HistoryDrift => self.history_drift(),
+            Command::PlanMake => self.plan_make(ctx),
+            Command::PlanCancel => {
+                if let Some(c) = &self.state.plan.cancel {
+                    c.store(true, Ordering::Relaxed);
+                    self.state.plan.progress = Some("cancelling…".to_string());
+                }
+            }
+            Command::PlanExport(kind) => self.plan_export(ctx, kind),
+            Command::PlanSimulate => self.plan_simulate(ctx),
         }
+    }
+
+    fn plan_make(&mut self, ctx: &egui::Context) {
+        if self.state.plan.cancel.is_some() {
+            return;
+        }
+        let session_hand_eye = self
+            .state
+            .result
+            .as_ref()
+            .and_then(|v| isometry_from_rows(&v.file.hand_eye).ok())
+            .or_else(|| self.state.loaded.as_ref().and_then(|l| l.session.hand_eye));
+        let config = match self.forms.plan.config(session_hand_eye) {
+            Ok(c) => c,
+            Err(e) => {
+                self.state.plan.outcome = Some(Err(e.clone()));
+                self.state.say(Level::Warning, e);
+                return;
+            }
+        };
+        let runs = self.forms.plan.predict_runs;
+        let cancel = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&cancel);
+        let started = self.spawn(ctx, "plan", move |rep| {
+            let outcome = planner::make_plan(&config, runs, &flag, &mut |event| {
+                rep.send(JobMessage::Plan(event));
+            });
+            rep.send(JobMessage::Plan(PlanEvent::Finished(outcome)));
+        });
+        if started {
+            self.state.plan.cancel = Some(cancel);
+            self.state.plan.progress = Some("planning…".to_string());
+            self.state.say(Level::Info, "planning the poses…");
+        }
+    }
+
+    fn current_plan(&mut self) -> Option<Plan> {
+        match &self.state.plan.outcome {
+            Some(Ok(o)) => Some((*o.plan).clone()),
+            _ => {
+                self.state.say(Level::Warning, "make a plan first");
+                None
+            }
+        }
+    }
+
+    fn plan_export(&mut self, ctx: &egui::Context, kind: PlanExport) {
+        let Some(plan) = self.current_plan() else {
+            return;
+        };
+        let dir = PathBuf::from(self.forms.export_dir.trim());
+        if !dir.is_dir() {
+            self.state.notice = Some(Notice {
+                title: "Nothing exported".to_string(),
+                body: format!("the export folder {} does not exist", dir.display()),
+            });
+            return;
+        }
+        self.state.prefs.export_folder = Some(dir.clone());
+        let path = dir.join(kind.file_name(&self.forms.plan.robot));
+        let started = self.spawn(ctx, "export", move |rep| {
+            let text = match kind {
+                PlanExport::Csv => plan::plan_csv(&plan),
+                PlanExport::Rapid => Controller::AbbRapid.render(&plan),
+            };
+            let outcome = write_atomic(&path, text.as_bytes()).map_err(|e| e.to_string());
+            rep.send(JobMessage::PlanWritten {
+                kind,
+                path,
+                outcome,
+            });
+        });
+        if started {
+            self.state.plan.writing += 1;
+        }
+    }
+
+    fn plan_simulate(&mut self, ctx: &egui::Context) {
+        let Some(plan) = self.current_plan() else {
+            return;
+        };
+        let robot = self.forms.plan.robot.clone();
+        let seed = self.forms.plan.seed;
+        let started = self.spawn(ctx, "simulate", move |rep| {
+            let outcome = planner::simulate_plan(&plan, &robot, seed)
+                .map(|session| Box::new(work::analyse(session, Source::Simulated)));
+            rep.send(JobMessage::PlanSimulated(outcome));
+        });
+        if started {
+            self.state.plan.writing += 1;
+            self.state
+                .say(Level::Info, "simulating a session of the plan…");
+        }
+    }
+
+    fn history_scan(&mut self, ctx: &egui::Context) {
+        let text = self.forms.history.folder.trim();
+        if text.is_empty() {
+            self.state
+                .say(Level::Warning, "type or choose the library folder first");
+            return;
+        }
+        if self.state.busy.scanning {
+            return;
+        }
+        let folder = PathBuf::from(text);
+        self.state
+            .say(Level::Info, format!("scanning {}…", folder.display()));
+        let started = self.spawn(ctx, "history", move |rep| {
+            let outcome = history::scan(&folder)
+                .map(Box::new)
+                .map_err(|e| e.to_string());
+            rep.send(JobMessage::Scanned { folder, outcome });
+        });
+        self.state.busy.scanning = started;
+    }
+
+    /// The drift of the chosen robot over the ticked results (fast: no
+    /// file is read, a few hundred numbers are compared).
+    fn history_drift(&mut self) {
+        let view = &mut self.state.history;
+        view.drift = None;
+        view.drift_of = None;
+        let (Some(Ok(library)), Some(robot)) = (&view.library, &self.forms.history.robot) else {
+            return;
+        };
+        let mut ticked = library.clone();
+        ticked.sessions.clear();
+        ticked
+            .entries
+            .retain(|e| !self.forms.history.unselected.contains(&e.path));
+        let options = DriftOptions {
+            k: self.forms.history.k,
+            ..DriftOptions::default()
+        };
+        view.drift = Some(match history::drift(&ticked, robot, &options) {
+            Ok(d) => Ok(d),
+            Err(HistoryError::UnknownRobot { .. }) => Err(format!(
+                "no ticked result of {robot}: tick some in the table"
+            )),
+            Err(e) => Err(e.to_string()),
+        });
+        view.drift_of = Some(ticked);
     }
 
     fn import_preview(&mut self, ctx: &egui::Context, guess: bool) {
@@ -412,6 +580,12 @@ impl WorkbenchApp {
         }
         let folder = match purpose {
             DialogPurpose::ExportFolder => Some(PathBuf::from(self.forms.export_dir.trim())),
+            DialogPurpose::HistoryFolder => self
+                .state
+                .prefs
+                .history_folder
+                .clone()
+                .or_else(|| self.state.prefs.last_folder.clone()),
             DialogPurpose::ImportProfiles | DialogPurpose::ImportReferences => {
                 Path::new(self.forms.import.joints.trim())
                     .parent()
@@ -442,7 +616,7 @@ impl WorkbenchApp {
                     }
                     .save_file()
                 }
-                DialogPurpose::ExportFolder => dialog.pick_folder(),
+                DialogPurpose::ExportFolder | DialogPurpose::HistoryFolder => dialog.pick_folder(),
                 DialogPurpose::ImportJoints | DialogPurpose::ImportReferences => {
                     dialog.add_filter("CSV", &["csv", "txt"]).pick_file()
                 }
@@ -594,6 +768,28 @@ impl WorkbenchApp {
             return;
         }
         let view = view.clone();
+        if kind == ExportKind::ReportHtml {
+            let Some(loaded) = &self.state.loaded else {
+                self.state
+                    .say(Level::Warning, "a report needs the session: open it first");
+                return;
+            };
+            let session = loaded.session.clone();
+            let bytes = loaded.bytes.clone();
+            let label = loaded.source.label();
+            let started = self.spawn(ctx, "export", move |rep| {
+                let outcome = export::write_report(&view, &session, &bytes, &label, &path);
+                rep.send(JobMessage::Exported {
+                    kind,
+                    path,
+                    outcome,
+                });
+            });
+            if started {
+                self.state.busy.exporting += 1;
+            }
+            return;
+        }
         let started = self.spawn(ctx, "export", move |rep| {
             let outcome = export::write_text(kind, &view, &path);
             rep.send(JobMessage::Exported {
@@ -707,6 +903,10 @@ impl WorkbenchApp {
                     DialogPurpose::ImportReferences => {
                         self.forms.import.references = path.display().to_string();
                     }
+                    DialogPurpose::HistoryFolder => {
+                        self.forms.history.folder = path.display().to_string();
+                        self.history_scan(ctx);
+                    }
                 }
             }
             JobMessage::Saved { path, outcome } => {
@@ -754,6 +954,122 @@ impl WorkbenchApp {
                     Err(e) => self.state.say(Level::Warning, format!("preview: {e}")),
                 }
                 self.state.import.preview = Some(preview);
+            }
+            JobMessage::Plan(PlanEvent::Progress(text)) => {
+                if self.state.plan.cancel.is_some() {
+                    self.state.plan.progress = Some(text);
+                }
+            }
+            JobMessage::Plan(PlanEvent::Finished(outcome)) => {
+                self.state.plan.cancel = None;
+                self.state.plan.progress = None;
+                match &outcome {
+                    Ok(o) => {
+                        let line = match &o.prediction {
+                            Some(Ok(p)) => format!(
+                                "planned {} poses; predicted validation std after {:.3} ± {:.3} mm",
+                                o.plan.poses.len(),
+                                p.after_mean,
+                                p.after_spread
+                            ),
+                            Some(Err(e)) => {
+                                format!("planned {} poses; no prediction: {e}", o.plan.poses.len())
+                            }
+                            None => format!("planned {} poses", o.plan.poses.len()),
+                        };
+                        self.state.say(Level::Info, line);
+                    }
+                    Err(e) => self.state.say(Level::Warning, format!("no plan: {e}")),
+                }
+                self.state.plan.outcome = Some(outcome);
+            }
+            JobMessage::PlanWritten {
+                kind,
+                path,
+                outcome,
+            } => {
+                self.state.plan.writing = self.state.plan.writing.saturating_sub(1);
+                match outcome {
+                    Ok(()) => self.state.say(
+                        Level::Info,
+                        format!("wrote the {} to {}", kind.label(), path.display()),
+                    ),
+                    Err(message) => {
+                        self.state
+                            .say(Level::Error, format!("{} not written", kind.label()));
+                        self.state.notice = Some(Notice {
+                            title: format!("Could not write the {}", kind.label()),
+                            body: message,
+                        });
+                    }
+                }
+            }
+            JobMessage::PlanSimulated(outcome) => {
+                self.state.plan.writing = self.state.plan.writing.saturating_sub(1);
+                match outcome {
+                    Ok(loaded) => {
+                        self.on_session(ctx, *loaded);
+                        self.state.say(
+                            Level::Info,
+                            "opened a session simulated from the plan (not saved yet): press Run to calibrate it",
+                        );
+                    }
+                    Err(message) => {
+                        self.state
+                            .say(Level::Error, "the plan could not be simulated");
+                        self.state.notice = Some(Notice {
+                            title: "Could not simulate the plan".to_string(),
+                            body: message,
+                        });
+                    }
+                }
+            }
+            JobMessage::Scanned { folder, outcome } => {
+                self.state.busy.scanning = false;
+                match outcome {
+                    Ok(library) => {
+                        self.state.prefs.history_folder = Some(folder.clone());
+                        let robots = library.robots();
+                        let keep = self
+                            .forms
+                            .history
+                            .robot
+                            .as_ref()
+                            .is_some_and(|r| robots.iter().any(|(n, _)| n == r));
+                        if !keep {
+                            // The robot with the most results.
+                            self.forms.history.robot = robots
+                                .iter()
+                                .max_by_key(|(_, n)| *n)
+                                .map(|(name, _)| name.clone());
+                        }
+                        self.forms.history.unselected.clear();
+                        let problems = library.problems.len();
+                        let mut line = format!(
+                            "{}: {} results of {} robot(s), {} sessions",
+                            folder.display(),
+                            library.entries.len(),
+                            robots.len(),
+                            library.sessions.len()
+                        );
+                        if problems > 0 {
+                            line.push_str(&format!(", {problems} file(s) could not be used"));
+                        }
+                        let level = if problems > 0 {
+                            Level::Warning
+                        } else {
+                            Level::Info
+                        };
+                        self.state.say(level, line);
+                        self.state.history.library = Some(Ok(*library));
+                    }
+                    Err(message) => {
+                        self.state
+                            .say(Level::Error, "the library could not be scanned");
+                        self.state.history.library = Some(Err(message));
+                    }
+                }
+                self.history_drift();
             }
             JobMessage::Imported(outcome) => {
                 self.state.busy.importing = self.state.busy.importing.saturating_sub(1);

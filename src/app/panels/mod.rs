@@ -3,7 +3,9 @@
 //! Shared widgets and colours live here.
 
 pub mod centres;
+pub mod history;
 pub mod import;
+pub mod plan;
 pub mod results;
 pub mod session;
 pub mod side;

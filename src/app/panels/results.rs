@@ -171,6 +171,9 @@ fn export_hint(kind: ExportKind) -> &'static str {
             "reference-distance errors and within-station distances, before and after (mm)"
         }
         ExportKind::PlotsPng => "an image of the figures on this page",
+        ExportKind::ReportHtml => {
+            "one self-contained HTML file: provenance (SHA-256), settings, stripe quality, figures, hand-eye, joint errors, validation"
+        }
         ExportKind::ModelJson => {
             "the calibrated robot as the FORMAT.md robot block (deg, mm), pasteable into a session"
         }
