@@ -548,11 +548,16 @@ fn hand_eye_ui(ui: &mut egui::Ui, view: &ResultView) {
                 ),
                 ("yaw (deg)", b.rpy_deg[2], a.rpy_deg[2], HAND_EYE_LABELS[5]),
             ];
-            for (name, before, after, label) in rows {
+            for (k, (name, before, after, label)) in rows.into_iter().enumerate() {
                 ui.label(name);
                 ui.label(format!("{before:.4}"));
                 marked_cell(ui, view, label, format!("{after:.4}"));
-                ui.label(format!("{:+.4}", after - before));
+                let change = if k < 3 {
+                    after - before
+                } else {
+                    wrap_deg(after - before)
+                };
+                ui.label(format!("{change:+.4}"));
                 ui.end_row();
             }
         });
@@ -612,5 +617,27 @@ fn joint_errors_ui(ui: &mut egui::Ui, view: &ResultView) {
             .small()
             .color(MUTED),
         );
+    }
+}
+
+/// An angle difference wrapped to (−180°, 180°]: a roll near ±180° that
+/// crosses over is a change of a degree, not of 359°.
+#[must_use]
+pub fn wrap_deg(d: f64) -> f64 {
+    let w = (d + 180.0).rem_euclid(360.0) - 180.0;
+    if w == -180.0 { 180.0 } else { w }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wrap_deg;
+
+    #[test]
+    fn angle_changes_wrap_across_180() {
+        assert!((wrap_deg(358.9) - (-1.1)).abs() < 1e-9);
+        assert!((wrap_deg(-359.0) - 1.0).abs() < 1e-9);
+        assert!((wrap_deg(0.25) - 0.25).abs() < 1e-12);
+        assert_eq!(wrap_deg(180.0), 180.0);
+        assert_eq!(wrap_deg(-180.0), 180.0);
     }
 }
