@@ -418,14 +418,15 @@ fn preview_shows_mapped_rows_in_degrees() {
     s.joint_unit = AngleUnit::Rad;
     let text = import::preview(&s, 2).unwrap();
     let lines: Vec<&str> = text.lines().collect();
-    assert_eq!(lines.len(), 4, "{text}");
+    assert_eq!(lines.len(), 5, "{text}");
     assert!(
         lines[0].contains("rad") && lines[0].contains("deg"),
         "{text}"
     );
+    assert_eq!(lines[1], "side from column `side`");
     let m = &original.measurements[1];
-    assert!(lines[3].starts_with(m.id.as_str()), "{text}");
-    assert!(lines[3].contains(&format!("{:.4}", m.joints[1])), "{text}");
+    assert!(lines[4].starts_with(m.id.as_str()), "{text}");
+    assert!(lines[4].contains(&format!("{:.4}", m.joints[1])), "{text}");
 }
 
 #[test]
@@ -547,4 +548,26 @@ fn bad_reference_rows_name_file_and_line() {
     fs::write(&path, "from,to,distance\nV1,Q9,100\n").unwrap();
     let msg = import::import(&s).unwrap_err().to_string();
     assert!(msg.contains("Q9"), "{msg}");
+}
+
+#[test]
+fn a_side_column_is_read_without_a_mapping() {
+    let original = simulated();
+    assert!(
+        original.measurements.iter().any(|m| m.side == -1),
+        "the simulated session has both sides"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let mut s = spec(dir.path(), &PLAIN);
+    s.columns.side = None;
+    let (session, _) = import::import(&s).unwrap();
+    for (a, b) in session.measurements.iter().zip(&original.measurements) {
+        assert_eq!(a.side, b.side, "{}", a.id);
+    }
+    assert!(
+        import::preview(&s, 2)
+            .unwrap()
+            .contains("side from column `side`")
+    );
 }

@@ -678,8 +678,6 @@ fn plan_then_simulate_import_and_calibrate_on_the_command_line() {
         "irb2400",
         "--flange-poses",
         "ABB",
-        "--map",
-        "side=side",
         "-o",
         &session,
     ]);

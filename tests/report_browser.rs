@@ -337,3 +337,131 @@ fn the_report_renders_in_headless_chromium() {
         t_pdf.as_secs_f64()
     );
 }
+
+/// Runs `spherecal` with `args`; panics with its stderr on failure.
+fn spherecal(args: &[&str]) -> String {
+    let o = Command::new(env!("CARGO_BIN_EXE_spherecal"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "spherecal {}: {}",
+        args.join(" "),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Issue 5's "done when", on the binary: a plan made by `spherecal plan`,
+/// simulated data written as a joint log and stripe profiles, imported
+/// through the CSV path, calibrated, reported, and the report rendered by
+/// the browser.
+#[test]
+fn plan_to_browser_rendered_report_through_the_csv_import() {
+    let Some(browser) = chromium_or_skip() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let (plan, data) = (p("plan.csv"), p("data"));
+    spherecal(&[
+        "plan",
+        "--robot",
+        "irb2400",
+        "--sphere",
+        "1050,0,475",
+        "--identify-stations",
+        "5",
+        "--validate-stations",
+        "4",
+        "--candidates",
+        "12",
+        "--predict",
+        "0",
+        "--csv",
+        &plan,
+        "-q",
+    ]);
+    spherecal(&[
+        "simulate",
+        "--plan",
+        &plan,
+        "--touch-up",
+        "--seed",
+        "7",
+        "--out",
+        &p("sim.json"),
+        "--csv-out",
+        &data,
+    ]);
+    let (session, result, report) = (p("cell.json"), p("cell.result.json"), p("cell.html"));
+    let out = spherecal(&[
+        "import",
+        "--joints",
+        &format!("{data}/joints.csv"),
+        "--profiles",
+        &format!("{data}/profiles"),
+        "--references",
+        &format!("{data}/references.csv"),
+        "--robot",
+        "irb2400",
+        "--flange-poses",
+        "ABB",
+        "--name",
+        "cell 3 from the plan, 2026-11-22",
+        "-o",
+        &session,
+    ]);
+    assert!(out.contains("0 flagged"), "{out}");
+    spherecal(&["calibrate", &session, "--out", &result]);
+    let r = spherecal::engine::session::load_result(Path::new(&result)).unwrap();
+    let v = r
+        .validation
+        .as_ref()
+        .expect("validate stations were planned");
+    assert!(
+        v.after.std * 10.0 < v.before.std,
+        "Table 1 errors are calibrated away: {:?} → {:?}",
+        v.before,
+        v.after
+    );
+    spherecal(&["report", &session, "--result", &result, "-o", &report]);
+
+    let url = format!("file://{report}");
+    let (dom, _) = run_chromium(&browser, dir.path(), "dom", &["--dump-dom".into()], &url);
+    let dom = String::from_utf8_lossy(&dom.stdout).into_owned();
+    assert!(dom.contains("cell 3 from the plan, 2026-11-22"));
+    let bytes = std::fs::read(&session).unwrap();
+    assert!(
+        dom.contains(&spherecal::engine::html_report::sha256_hex(&bytes)),
+        "the session's SHA-256 is on the page"
+    );
+    assert_eq!(dom.matches("<svg").count(), 3, "Fig. 5, Fig. 6 and ε");
+    assert!(
+        dom.contains(&format!("{:.3}", v.after.std)),
+        "the std after"
+    );
+    let shot = dir.path().join("shot.png");
+    run_chromium(
+        &browser,
+        dir.path(),
+        "shot",
+        &[
+            format!("--screenshot={}", shot.display()),
+            format!("--window-size={SHOT_WIDTH},{SHOT_HEIGHT}"),
+        ],
+        &url,
+    );
+    let img = image::open(&shot).unwrap().to_rgb8();
+    let near = |p: &image::Rgb<u8>, c: [u8; 3]| {
+        p.0.iter()
+            .zip(c)
+            .all(|(a, b)| a.abs_diff(b) <= COLOUR_TOLERANCE)
+    };
+    for colour in [BEFORE_COLOUR, AFTER_COLOUR] {
+        let c = hex_rgb(colour);
+        let n = img.pixels().filter(|p| near(p, c)).count();
+        assert!(n >= 200, "series colour {colour}: {n} px");
+    }
+}

@@ -41,7 +41,7 @@ pub struct ImportArgs {
     #[arg(long, default_value = "mm", value_parser = parse_length_unit)]
     pub profile_unit: LengthUnit,
     /// Column mapping, e.g. `id=Pose,station=Sphere,use=Use,side=Side,j1=A1,...`
-    /// (defaults: id, station, use, no side, j1..jn).
+    /// (defaults: id, station, use, side when the log has a `side` column, j1..jn).
     #[arg(long, value_delimiter = ',')]
     pub map: Vec<String>,
     /// Sphere diameter, mm.

@@ -25,6 +25,8 @@ use super::kinematics::{self, Robot};
 use super::model::{Measurement, Observation, ReferenceDistance, Session, SolverSettings, Use};
 use super::session::{parse_result, parse_session, session_to_json};
 
+/// The side column read when the mapping names none.
+pub const DEFAULT_SIDE_COLUMN: &str = "side";
 /// Default sphere diameter, mm: the 1.5 inch sphere of the paper.
 pub const DEFAULT_SPHERE_DIAMETER: f64 = 38.1;
 /// Default position tolerance of the flange-pose check, mm: a few mm, far
@@ -151,7 +153,8 @@ pub struct ColumnMap {
     pub station: String,
     /// Use (`translation`, `rotation`, `identify`, `validate`).
     pub usage: String,
-    /// Side (+1 or −1), when the log has one.
+    /// Side (+1 or −1). `None`: the column named [`DEFAULT_SIDE_COLUMN`]
+    /// when the log has one, else every side is +1.
     pub side: Option<String>,
     /// The joint columns, joint 1 first; one per robot joint.
     pub joints: Vec<String>,
@@ -524,12 +527,13 @@ fn log_columns(spec: &ImportSpec, log: &Csv, dof: usize) -> Result<LogColumns, I
         id: log.column(&spec.columns.id)?,
         station: log.column(&spec.columns.station)?,
         usage: log.column(&spec.columns.usage)?,
-        side: spec
-            .columns
-            .side
-            .as_ref()
-            .map(|s| log.column(s))
-            .transpose()?,
+        side: match &spec.columns.side {
+            Some(s) => Some(log.column(s)?),
+            None => log
+                .header
+                .iter()
+                .position(|h| h.eq_ignore_ascii_case(DEFAULT_SIDE_COLUMN)),
+        },
         joints: spec
             .columns
             .joints
@@ -601,6 +605,14 @@ pub fn preview(spec: &ImportSpec, rows: usize) -> Result<String, ImportError> {
         robot.name,
         spec.joint_unit.as_str()
     );
+    match cols.side {
+        Some(c) => {
+            let _ = writeln!(out, "side from column `{}`", log.header[c]);
+        }
+        None => {
+            let _ = writeln!(out, "no side column: every side is +1");
+        }
+    }
     let mut header = format!("{:<10} {:<8} {:<12} {:>4}", "id", "station", "use", "side");
     for (k, c) in spec.columns.joints.iter().enumerate() {
         let _ = write!(header, " {:>12}", format!("j{}={c}", k + 1));
