@@ -164,7 +164,7 @@ fn library_ui(
 /// Returns whether a tick changed.
 fn table_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) -> bool {
     let mut changed = false;
-    egui::ScrollArea::vertical()
+    egui::ScrollArea::both()
         .id_salt("history_table")
         .max_height(TABLE_HEIGHT)
         .show(ui, |ui| {
@@ -296,7 +296,9 @@ fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {
                             .map_or("–".into(), |c| format!("{c:.4} {}", j.unit.as_str())),
                     );
                     ui.label(j.ratio.map_or("–".into(), |r| format!("{r:.1}")));
-                    ui.label(j.notes.join("; "));
+                    let notes = j.notes.join("; ");
+                    ui.add(egui::Label::new(&notes).truncate())
+                        .on_hover_text(notes);
                     ui.end_row();
                 }
             });

@@ -330,7 +330,7 @@ fn map_ui(ui: &mut egui::Ui, plan: &Plan) {
         .data_aspect(1.0)
         .x_axis_label("x (mm)")
         .y_axis_label("y (mm)")
-        .legend(egui_plot::Legend::default())
+        .legend(egui_plot::Legend::default().position(egui_plot::Corner::LeftTop))
         .show(ui, |p| {
             p.points(
                 Points::new("robot base", PlotPoints::from(vec![[base.x, base.y]]))
