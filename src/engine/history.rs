@@ -301,18 +301,24 @@ impl Timestamp {
         })
     }
 
-    /// A file time as a UTC date and time; `None` before 1970.
+    /// A file time as a UTC date and time; `None` before 1970 or after
+    /// 9999 (the calendar is `humantime`'s RFC 3339 formatter).
     #[must_use]
     pub fn from_system_time(t: SystemTime) -> Option<Self> {
+        // humantime formats the years 1970..=9999 (it panics outside them).
+        const YEAR_10000: u64 = 253_402_300_800;
         let secs = t.duration_since(UNIX_EPOCH).ok()?.as_secs();
-        let days = i64::try_from(secs / 86_400).ok()?;
-        let rest = secs % 86_400;
-        let (year, month, day) = civil_from_days(days);
-        let hms = |v: u64| u32::try_from(v).unwrap_or(0);
-        Self::date(i32::try_from(year).ok()?, month, day)?.at(
-            hms(rest / 3600),
-            hms(rest % 3600 / 60),
-            hms(rest % 60),
+        if secs >= YEAR_10000 {
+            return None;
+        }
+        // `YYYY-MM-DDThh:mm:ssZ`
+        let text = humantime::format_rfc3339_seconds(t).to_string();
+        let field = |range: std::ops::Range<usize>| text.get(range)?.parse::<u32>().ok();
+        let year = i32::try_from(field(0..4)?).ok()?;
+        Self::date(year, field(5..7)?, field(8..10)?)?.at(
+            field(11..13)?,
+            field(14..16)?,
+            field(17..19)?,
         )
     }
 }
@@ -339,25 +345,6 @@ fn days_in_month(year: i32, month: u32) -> u32 {
         4 | 6 | 9 | 11 => 30,
         _ => 31,
     }
-}
-
-/// Days since 1970-01-01 to (year, month, day), proleptic Gregorian
-/// (H. Hinnant's `civil_from_days`).
-fn civil_from_days(days: i64) -> (i64, u32, u32) {
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z.rem_euclid(146_097);
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let day = doy - (153 * mp + 2) / 5 + 1;
-    let month = if mp < 10 { mp + 3 } else { mp - 9 };
-    let year = yoe + era * 400 + i64::from(month <= 2);
-    (
-        year,
-        u32::try_from(month).unwrap_or(1),
-        u32::try_from(day).unwrap_or(1),
-    )
 }
 
 /// Years accepted in a name: a four-digit number outside this range is a
