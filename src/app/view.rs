@@ -15,13 +15,6 @@ use crate::engine::model::{Session, Use};
 use crate::engine::session::ResultFile;
 use crate::engine::validate::{BeforeAfter, DistanceRecord, Stats, within_station_distances};
 
-/// A dropped SVD direction marks a parameter as not identifiable when its
-/// coefficient in the (unit) direction is at least this large: 0.3 is
-/// about a tenth of the direction's energy (0.3² ≈ 0.09), so the parameter
-/// takes a real share of the combination the data cannot see. The engine
-/// lists components from 0.2 upwards.
-pub const MARK_COEFFICIENT: f64 = 0.3;
-
 /// Where a result on show came from.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ResultOrigin {
@@ -282,7 +275,7 @@ impl ResultView {
         };
         let dropped = texts("dropped_directions");
         let fixed = texts("fixed");
-        let marked = marked_parameters(&dropped, &fixed);
+        let marked = crate::engine::html_report::identifiability_marks(solver);
         let estimated = texts("estimated");
         let mut caveats = texts("inseparable");
         caveats.extend(
@@ -460,32 +453,6 @@ fn within_pairs(points: &[CentrePoint], usage: Use) -> Vec<PairDistance> {
         .collect()
 }
 
-/// Parameters named with a coefficient of at least [`MARK_COEFFICIENT`] in
-/// a dropped direction (`"+0.71·d6 −0.71·he_z"`), and every fixed one.
-#[must_use]
-pub fn marked_parameters(dropped: &[String], fixed: &[String]) -> BTreeMap<String, String> {
-    let mut out = BTreeMap::new();
-    for direction in dropped {
-        for term in direction.split_whitespace() {
-            let Some((coef, label)) = term.split_once('·') else {
-                continue;
-            };
-            let coef = coef.replace('−', "-");
-            let Ok(c) = coef.parse::<f64>() else {
-                continue;
-            };
-            if c.abs() >= MARK_COEFFICIENT {
-                out.entry(label.to_string())
-                    .or_insert_with(|| format!("in the dropped SVD direction {direction}"));
-            }
-        }
-    }
-    for label in fixed {
-        out.insert(label.clone(), "held fixed by the method".to_string());
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -496,18 +463,5 @@ mod tests {
         assert!((step_125(7.9) - 5.0).abs() < 1e-6);
         assert!((step_125(23.0) - 20.0).abs() < 1e-6);
         assert!((step_125(1e9) - 1000.0).abs() < 1e-3);
-    }
-
-    #[test]
-    fn marks_large_coefficients_only() {
-        let m = marked_parameters(
-            &[
-                "+0.71·d6 −0.71·he_z".to_string(),
-                "+0.95·theta1 -0.25·a2".to_string(),
-            ],
-            &["beta3".to_string()],
-        );
-        let keys: Vec<&str> = m.keys().map(String::as_str).collect();
-        assert_eq!(keys, vec!["beta3", "d6", "he_z", "theta1"]);
     }
 }
