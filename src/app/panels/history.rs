@@ -164,6 +164,9 @@ fn library_ui(
 /// Returns whether a tick changed.
 fn table_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) -> bool {
     let mut changed = false;
+    // Solid scroll bars take their own space: a floating one would cover
+    // the last row's tick box.
+    ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
     egui::ScrollArea::both()
         .id_salt("history_table")
         .max_height(TABLE_HEIGHT)

@@ -75,6 +75,7 @@ pub fn import_ui(
                 }
             });
             outcome_ui(ui, state);
+            preview_ui(ui, state);
         });
 }
 
@@ -263,20 +264,6 @@ fn mapping_ui(ui: &mut egui::Ui, state: &AppState, f: &mut ImportForm) {
     if !missing.is_empty() {
         ui.label(RichText::new(format!("not in the header: {}", missing.join(", "))).color(WARN));
     }
-    if let Some(preview) = &state.import.preview {
-        match preview {
-            Ok(text) => {
-                egui::ScrollArea::horizontal()
-                    .id_salt("import_preview")
-                    .show(ui, |ui| {
-                        ui.label(RichText::new(text).monospace());
-                    });
-            }
-            Err(e) => {
-                ui.label(RichText::new(format!("Preview failed: {e}")).color(BAD));
-            }
-        }
-    }
 }
 
 /// A column-name field with a menu of the header's names.
@@ -345,6 +332,24 @@ fn flange_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
             );
         }
     });
+}
+
+/// The preview of the mapped rows, below the buttons.
+fn preview_ui(ui: &mut egui::Ui, state: &AppState) {
+    if let Some(preview) = &state.import.preview {
+        match preview {
+            Ok(text) => {
+                egui::ScrollArea::horizontal()
+                    .id_salt("import_preview")
+                    .show(ui, |ui| {
+                        ui.label(RichText::new(text).monospace());
+                    });
+            }
+            Err(e) => {
+                ui.label(RichText::new(format!("Preview failed: {e}")).color(BAD));
+            }
+        }
+    }
 }
 
 fn outcome_ui(ui: &mut egui::Ui, state: &AppState) {
