@@ -71,18 +71,11 @@ impl Default for PlanForm {
     }
 }
 
-/// The robot choice of a preset key.
-fn choice(key: &str) -> Option<RobotChoice> {
-    [RobotChoice::Irb2400, RobotChoice::Irb120, RobotChoice::Ur5e]
-        .into_iter()
-        .find(|c| c.key() == key)
-}
-
 /// A sphere position every preset reaches from both sides: the centre of
 /// its simulator workspace (base frame, mm).
 #[must_use]
 pub fn default_sphere(key: &str) -> [f64; 3] {
-    choice(key).map_or([1000.0, 0.0, 500.0], |c| {
+    RobotChoice::from_key(key).map_or([1000.0, 0.0, 500.0], |c| {
         let w = Workspace::for_robot(c);
         [0, 1, 2].map(|i| (w.min[i] + w.max[i]) / 2.0)
     })
@@ -100,7 +93,7 @@ impl PlanForm {
         let mut c = PlanConfig::for_preset(&preset, self.sphere);
         if self.hand_eye_from_session {
             c.flange_from_sensor = session_hand_eye.ok_or(
-                "the open session has no hand-eye: untick \"hand-eye from the open session\" to use the paper's initial one",
+                "no hand-eye in the result on show or the open session: untick \"hand-eye guess from the open calibration\" to use the paper's initial one",
             )?;
         }
         c.n_translation = self.n_translation;
@@ -206,7 +199,8 @@ pub fn stage_text(stage: PlanStage) -> String {
 /// The engine's message (a pose that would not see the sphere on the true
 /// robot, an unknown preset).
 pub fn simulate_plan(plan: &Plan, robot: &str, seed: u64) -> Result<Session, String> {
-    let robot_choice = choice(robot).ok_or_else(|| format!("unknown robot preset `{robot}`"))?;
+    let robot_choice =
+        RobotChoice::from_key(robot).ok_or_else(|| format!("unknown robot preset `{robot}`"))?;
     let config = SimConfig {
         robot: robot_choice,
         seed,

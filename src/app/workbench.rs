@@ -989,20 +989,7 @@ impl WorkbenchApp {
                 outcome,
             } => {
                 self.state.plan.writing = self.state.plan.writing.saturating_sub(1);
-                match outcome {
-                    Ok(()) => self.state.say(
-                        Level::Info,
-                        format!("wrote the {} to {}", kind.label(), path.display()),
-                    ),
-                    Err(message) => {
-                        self.state
-                            .say(Level::Error, format!("{} not written", kind.label()));
-                        self.state.notice = Some(Notice {
-                            title: format!("Could not write the {}", kind.label()),
-                            body: message,
-                        });
-                    }
-                }
+                self.say_written(kind.label(), &path, outcome);
             }
             JobMessage::PlanSimulated(outcome) => {
                 self.state.plan.writing = self.state.plan.writing.saturating_sub(1);
@@ -1117,20 +1104,23 @@ impl WorkbenchApp {
                 outcome,
             } => {
                 self.state.busy.exporting = self.state.busy.exporting.saturating_sub(1);
-                match outcome {
-                    Ok(()) => self.state.say(
-                        Level::Info,
-                        format!("exported {} to {}", kind.label(), path.display()),
-                    ),
-                    Err(message) => {
-                        self.state
-                            .say(Level::Error, format!("{} not exported", kind.label()));
-                        self.state.notice = Some(Notice {
-                            title: format!("Could not export {}", kind.label()),
-                            body: message,
-                        });
-                    }
-                }
+                self.say_written(kind.label(), &path, outcome);
+            }
+        }
+    }
+
+    /// The status line for a written file, or the notice of why not.
+    fn say_written(&mut self, what: &str, path: &Path, outcome: Result<(), String>) {
+        match outcome {
+            Ok(()) => self
+                .state
+                .say(Level::Info, format!("wrote {what} to {}", path.display())),
+            Err(message) => {
+                self.state.say(Level::Error, format!("{what} not written"));
+                self.state.notice = Some(Notice {
+                    title: format!("Could not write {what}"),
+                    body: message,
+                });
             }
         }
     }

@@ -298,9 +298,7 @@ impl PlanConfig {
             simulate::cell_limits(preset.key, &preset.limits),
             sphere,
         );
-        let choice = [RobotChoice::Irb2400, RobotChoice::Irb120, RobotChoice::Ur5e]
-            .into_iter()
-            .find(|c| c.key() == preset.key);
+        let choice = RobotChoice::from_key(preset.key);
         if let Some(choice) = choice {
             let w = Workspace::for_robot(choice);
             config.stations = StationLayout::Box {

@@ -168,6 +168,15 @@ pub enum RobotChoice {
 }
 
 impl RobotChoice {
+    /// Every preset.
+    pub const ALL: [Self; 3] = [Self::Irb2400, Self::Irb120, Self::Ur5e];
+
+    /// The choice whose [`Self::key`] is `key`.
+    #[must_use]
+    pub fn from_key(key: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|c| c.key() == key)
+    }
+
     /// The preset key of [`kinematics::preset`].
     #[must_use]
     pub fn key(self) -> &'static str {
