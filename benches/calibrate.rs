@@ -8,10 +8,10 @@
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use spherecal::engine::calibrate::{self, Control, Method, Options};
-use spherecal::engine::session::parse_session;
+use spherecal::engine::format::parse_session;
+use spherecal::engine::solve::{self, Control, Method, Options};
 
-fn demo() -> spherecal::engine::model::Session {
+fn demo() -> spherecal::engine::session::Session {
     parse_session(
         spherecal::DEMO_SESSION_JSON,
         Path::new(spherecal::DEMO_SESSION_NAME),
@@ -23,23 +23,20 @@ fn bench(c: &mut Criterion) {
     let session = demo();
     let mut group = c.benchmark_group("demo_session");
     group.bench_function("prepare (stripe fits + initial hand-eye)", |b| {
-        b.iter(|| calibrate::prepare(&session).expect("prepare"));
+        b.iter(|| solve::prepare(&session).expect("prepare"));
     });
-    let prepared = calibrate::prepare(&session).expect("prepare");
+    let prepared = solve::prepare(&session).expect("prepare");
     for method in Method::ALL {
         let mut options = Options::from_session(&session);
         options.method = method;
         group.bench_function(format!("identify, method {}", method.as_str()), |b| {
             b.iter(|| {
-                calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue)
-                    .expect("run")
+                solve::run(&session, &prepared, &options, &mut |_| Control::Continue).expect("run")
             });
         });
     }
     group.bench_function("whole calibration, default options", |b| {
-        b.iter(|| {
-            calibrate::calibrate(&session, &Options::from_session(&session)).expect("calibrate")
-        });
+        b.iter(|| solve::calibrate(&session, &Options::from_session(&session)).expect("calibrate"));
     });
     group.finish();
 }

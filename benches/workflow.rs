@@ -11,20 +11,20 @@ use std::path::Path;
 use std::time::{Duration, UNIX_EPOCH};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use spherecal::engine::calibrate::{self, Control, Options};
+use spherecal::engine::format::parse_session;
 use spherecal::engine::history::{self, DriftOptions};
-use spherecal::engine::html_report::{self, ReportInput, ReportMeta};
-use spherecal::engine::kinematics;
 use spherecal::engine::plan::{self, PlanConfig, PredictConfig};
-use spherecal::engine::report;
-use spherecal::engine::session::parse_session;
+use spherecal::engine::report::html::{self, ReportInput, ReportMeta};
+use spherecal::engine::report::summary;
+use spherecal::engine::robot;
+use spherecal::engine::solve::{self, Control, Options};
 
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("workflow");
     group.sample_size(10);
     group.measurement_time(Duration::from_secs(10));
 
-    let config = PlanConfig::for_preset(&kinematics::irb2400(), [1050.0, 0.0, 475.0]);
+    let config = PlanConfig::for_preset(&robot::irb2400(), [1050.0, 0.0, 475.0]);
     group.bench_function("plan, default IRB 2400 (124 poses)", |b| {
         b.iter(|| plan::plan(&config, &mut |_| Control::Continue).expect("plan"));
     });
@@ -42,13 +42,13 @@ fn bench(c: &mut Criterion) {
         Path::new(spherecal::DEMO_SESSION_NAME),
     )
     .expect("the embedded demo session loads");
-    let (prepared, cal) = calibrate::calibrate(&session, &Options::from_session(&session))
-        .expect("the demo calibrates");
-    let result = report::result_file(&session, &prepared, &cal);
+    let (prepared, cal) =
+        solve::calibrate(&session, &Options::from_session(&session)).expect("the demo calibrates");
+    let result = summary::result_file(&session, &prepared, &cal);
     let meta = ReportMeta::new("demo", UNIX_EPOCH + Duration::from_secs(1_795_132_800));
     group.bench_function("HTML report of the demo (render)", |b| {
         b.iter(|| {
-            html_report::render(&ReportInput {
+            html::render(&ReportInput {
                 session: &session,
                 session_bytes: spherecal::DEMO_SESSION_JSON.as_bytes(),
                 result: &result,

@@ -27,11 +27,11 @@ use std::path::PathBuf;
 
 use anyhow::Context as _;
 use nalgebra::Vector3;
-use spherecal::engine::calibrate::{self, Options};
-use spherecal::engine::model::{Observation, Session};
-use spherecal::engine::report;
-use spherecal::engine::session;
+use spherecal::engine::format;
+use spherecal::engine::report::summary;
+use spherecal::engine::session::{Observation, Session};
 use spherecal::engine::simulate::{self, SimConfig};
+use spherecal::engine::solve::{self, Options};
 
 /// Sensor displacement along its own y axis after the April remount, mm:
 /// large against the ~0.013 mm σ `ml` reports for the hand-eye x and y
@@ -148,12 +148,12 @@ fn main() -> anyhow::Result<()> {
         let stem = format!("cell3-{}", m.date);
         let session_path = folder.join(format!("{stem}.json"));
         let result_path = folder.join(format!("{stem}.result.json"));
-        session::save_session(&s, &session_path)?;
+        format::save_session(&s, &session_path)?;
         // Calibrate what the file holds, exactly as `spherecal calibrate` does.
-        let s = session::load_session(&session_path)?;
-        let (prepared, cal) = calibrate::calibrate(&s, &Options::from_session(&s))
+        let s = format::load_session(&session_path)?;
+        let (prepared, cal) = solve::calibrate(&s, &Options::from_session(&s))
             .with_context(|| session_path.display().to_string())?;
-        session::save_result(&report::result_file(&s, &prepared, &cal), &result_path)?;
+        format::save_result(&summary::result_file(&s, &prepared, &cal), &result_path)?;
         println!(
             "{}: validation std {:.4} mm -> {}",
             name,

@@ -16,7 +16,7 @@
 //!   Transforms are named `target_from_source`; `flange_from_sensor` is the
 //!   hand-eye `eT_s`.
 //! - **Units**: files hold millimetres and degrees. Inside the engine
-//!   lengths are mm and angles are radians, except [`engine::kinematics::Joint`]
+//!   lengths are mm and angles are radians, except [`engine::robot::Joint`]
 //!   and joint readings, which stay in degrees as in the files.
 //! - **Numbers**: `f64` throughout.
 //! - **The laser plane** is the sensor's `x = 0` plane; stripe points are

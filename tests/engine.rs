@@ -5,11 +5,11 @@
 // Test helpers may panic: a panic is a test failure with its message.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use spherecal::engine::calibrate::{self, Method, Options, Prepared};
 use spherecal::engine::evaluate;
-use spherecal::engine::kinematics::Robot;
-use spherecal::engine::model::{Session, Use};
+use spherecal::engine::robot::Robot;
+use spherecal::engine::session::{Session, Use};
 use spherecal::engine::simulate::{self, SimConfig, Truth};
+use spherecal::engine::solve::{self, Method, Options, Prepared};
 
 /// The paper's method: these tests are its baseline (the `ml` method,
 /// the default, has its own in `tests/ml.rs`).
@@ -38,15 +38,11 @@ fn noise_free(seed: u64) -> SimConfig {
     }
 }
 
-fn run(
-    session: &Session,
-    threshold: f64,
-    max_iterations: usize,
-) -> (Prepared, calibrate::Calibration) {
+fn run(session: &Session, threshold: f64, max_iterations: usize) -> (Prepared, solve::Calibration) {
     let mut options = paper_options(session);
     options.threshold = threshold;
     options.max_iterations = max_iterations;
-    calibrate::calibrate(session, &options).expect("calibration")
+    solve::calibrate(session, &options).expect("calibration")
 }
 
 /// True distances between validate stations against those the calibrated
@@ -97,7 +93,7 @@ fn noise_free_initial_hand_eye_from_true_model_is_exact() {
     // poses, so the initial hand-eye equals the true one.
     let (mut session, truth) = simulate(&noise_free(12));
     session.robot = truth.true_robot();
-    let prepared = calibrate::prepare(&session).unwrap();
+    let prepared = solve::prepare(&session).unwrap();
     let he = prepared.hand_eye_initial;
     let t = truth.true_hand_eye();
     assert!(he.rotation.angle_to(&t.rotation) < 1e-9);
@@ -156,11 +152,11 @@ fn epsilon_series_follows_the_loop_of_format_md() {
         ..SimConfig::default()
     });
     // A threshold above the starting ε: one entry, no update.
-    let prepared = calibrate::prepare(&session).unwrap();
+    let prepared = solve::prepare(&session).unwrap();
     let mut options = paper_options(&session);
     options.threshold = 1e6;
-    let cal = calibrate::run(&session, &prepared, &options, &mut |_| {
-        calibrate::Control::Continue
+    let cal = solve::run(&session, &prepared, &options, &mut |_| {
+        solve::Control::Continue
     })
     .unwrap();
     assert_eq!(cal.iterations.len(), 1);
@@ -169,9 +165,9 @@ fn epsilon_series_follows_the_loop_of_format_md() {
     options.threshold = 0.0;
     options.max_iterations = 4;
     let mut seen = Vec::new();
-    let cal = calibrate::run(&session, &prepared, &options, &mut |p| {
+    let cal = solve::run(&session, &prepared, &options, &mut |p| {
         seen.push((p.updates, p.epsilon));
-        calibrate::Control::Continue
+        solve::Control::Continue
     })
     .unwrap();
     assert_eq!(cal.iterations.len(), 5);
@@ -181,21 +177,21 @@ fn epsilon_series_follows_the_loop_of_format_md() {
     assert!(cal.epsilon_after() < cal.epsilon_before());
     assert!(matches!(
         cal.stop,
-        calibrate::StopReason::IterationLimit { updates: 4, .. }
+        solve::StopReason::IterationLimit { updates: 4, .. }
     ));
 }
 
 #[test]
 fn cancel_stops_the_loop() {
     let (session, _) = simulate(&SimConfig::default());
-    let prepared = calibrate::prepare(&session).unwrap();
+    let prepared = solve::prepare(&session).unwrap();
     let mut options = paper_options(&session);
     options.threshold = 0.0;
-    let err = calibrate::run(&session, &prepared, &options, &mut |p| {
+    let err = solve::run(&session, &prepared, &options, &mut |p| {
         if p.updates >= 2 {
-            calibrate::Control::Cancel
+            solve::Control::Cancel
         } else {
-            calibrate::Control::Continue
+            solve::Control::Continue
         }
     })
     .unwrap_err();
@@ -206,6 +202,6 @@ fn cancel_stops_the_loop() {
 fn too_little_identify_data_is_explained() {
     let (mut session, _) = simulate(&SimConfig::default());
     session.measurements.retain(|m| m.usage != Use::Identify);
-    let err = calibrate::calibrate(&session, &paper_options(&session)).unwrap_err();
+    let err = solve::calibrate(&session, &paper_options(&session)).unwrap_err();
     assert!(err.to_string().contains("identify station"), "{err}");
 }

@@ -14,12 +14,13 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use spherecal::engine::error::FileError;
-use spherecal::engine::model::{Observation, Session, Use};
-use spherecal::engine::session::{
-    MIN_STRIPE_POINTS, load_result, load_session, parse_result, parse_session, result_to_json,
-    save_result, save_session, session_to_json, write_atomic,
+use spherecal::engine::format::FileError;
+use spherecal::engine::format::{
+    load_result, load_session, parse_result, parse_session, result_to_json, save_result,
+    save_session, session_to_json, write_atomic,
 };
+use spherecal::engine::session::MIN_STRIPE_POINTS;
+use spherecal::engine::session::{Observation, Session, Use};
 
 fn data(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -16,15 +16,16 @@ use std::sync::OnceLock;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use nalgebra::Vector3;
-use spherecal::engine::calibrate::{self, Method, Options};
+use spherecal::engine::format::{self, ResultFile};
 use spherecal::engine::history::{
     self, DEFAULT_K, DateSource, Drift, DriftOptions, HAND_EYE_NAMES, Library, SeriesKind, Status,
     Timestamp, Verdict,
 };
-use spherecal::engine::model::{Observation, Session};
-use spherecal::engine::report;
-use spherecal::engine::session::{self, ResultFile};
-use spherecal::engine::simulate::{self, RobotChoice, SimConfig};
+use spherecal::engine::report::summary;
+use spherecal::engine::robot::RobotChoice;
+use spherecal::engine::session::{Observation, Session};
+use spherecal::engine::simulate::{self, SimConfig};
+use spherecal::engine::solve::{self, Method, Options};
 
 const IRB: &str = "ABB IRB 2400/16";
 /// The sensor moves this far along its own y axis (mm) on 2026-06-01.
@@ -79,8 +80,8 @@ fn calibrate(stem: &str, session: Session, method: Method) -> Cal {
     let mut options = Options::from_session(&session);
     options.method = method;
     options.ml.cross_validation = false;
-    let (prepared, cal) = calibrate::calibrate(&session, &options).expect("calibration");
-    let result = report::result_file(&session, &prepared, &cal);
+    let (prepared, cal) = solve::calibrate(&session, &options).expect("calibration");
+    let result = summary::result_file(&session, &prepared, &cal);
     Cal {
         stem: stem.to_string(),
         session,
@@ -132,8 +133,8 @@ fn write_pair(dir: &Path, cal: &Cal) -> (PathBuf, PathBuf) {
     fs::create_dir_all(dir).unwrap();
     let s = dir.join(format!("{}.json", cal.stem));
     let r = dir.join(format!("{}.result.json", cal.stem));
-    session::save_session(&cal.session, &s).unwrap();
-    session::save_result(&cal.result, &r).unwrap();
+    format::save_session(&cal.session, &s).unwrap();
+    format::save_result(&cal.result, &r).unwrap();
     (s, r)
 }
 
@@ -161,13 +162,10 @@ fn write_library(dir: &Path) {
     }
     // A result cut short, a session with a typo, JSON of other kinds, a
     // text file, a hidden folder and a folder nested too deep.
-    let good = session::result_to_json(&calibrations()[0].result);
+    let good = format::result_to_json(&calibrations()[0].result);
     fs::write(dir.join("broken.result.json"), &good[..good.len() / 2]).unwrap();
-    let bad_session = session::session_to_json(&calibrations()[0].session).replacen(
-        "\"sphere\"",
-        "\"spehre\"",
-        1,
-    );
+    let bad_session =
+        format::session_to_json(&calibrations()[0].session).replacen("\"sphere\"", "\"spehre\"", 1);
     fs::write(dir.join("typo.json"), bad_session).unwrap();
     fs::write(
         dir.join("notes.json"),

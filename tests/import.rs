@@ -10,14 +10,14 @@ use std::fmt::Write as _;
 use std::fs;
 use std::path::Path;
 
-use spherecal::engine::calibrate::{self, Options};
 use spherecal::engine::import::{
     self, AngleUnit, ColumnMap, DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention,
     ImportError, ImportSpec, LengthUnit, ProfileSource, RobotSource,
 };
-use spherecal::engine::kinematics;
-use spherecal::engine::model::{Observation, Session};
+use spherecal::engine::robot;
+use spherecal::engine::session::{Observation, Session};
 use spherecal::engine::simulate::{self, SimConfig};
+use spherecal::engine::solve::{self, Options};
 
 const CONVENTIONS: [FlangeConvention; 4] = [
     FlangeConvention::AbbQuaternion,
@@ -52,7 +52,7 @@ fn simulated() -> Session {
 /// Writes `log.csv` and `profiles/<id>.csv` for the session into `dir`.
 fn write_files(session: &Session, dir: &Path, o: &LogOptions) {
     let sep = if o.semicolon { ";" } else { "," };
-    let nominal = kinematics::irb2400().robot;
+    let nominal = robot::irb2400().robot;
     let mut text = String::from("# joint log written by tests/import.rs\n");
     let mut header = vec![
         "id", "station", "use", "side", "j1", "j2", "j3", "j4", "j5", "j6",
@@ -141,8 +141,8 @@ fn simulated_session_round_trips_and_calibrates() {
     let (session, checks) = import::import(&spec(dir.path(), &PLAIN)).unwrap();
     assert!(checks.is_empty());
     assert_same_measurements(&original, &session);
-    assert_eq!(session.robot, kinematics::irb2400().robot);
-    let (_, cal) = calibrate::calibrate(&session, &Options::from_session(&session)).unwrap();
+    assert_eq!(session.robot, robot::irb2400().robot);
+    let (_, cal) = solve::calibrate(&session, &Options::from_session(&session)).unwrap();
     assert!(
         cal.epsilon_after() < cal.epsilon_before(),
         "ε {} -> {}",
@@ -510,10 +510,10 @@ fn reference_distances_import_and_validate() {
     s.references = Some(write_references(&original, dir.path()));
     let (session, _) = import::import(&s).unwrap();
     assert_eq!(session.reference_distances, original.reference_distances);
-    let (_, cal) = calibrate::calibrate(&session, &Options::from_session(&session)).unwrap();
+    let (_, cal) = solve::calibrate(&session, &Options::from_session(&session)).unwrap();
     let v = cal.validation.as_ref().expect("validation with references");
     assert_eq!(v.distances.len(), {
-        let (_, c) = calibrate::calibrate(&original, &Options::from_session(&original)).unwrap();
+        let (_, c) = solve::calibrate(&original, &Options::from_session(&original)).unwrap();
         c.validation.unwrap().distances.len()
     });
 }

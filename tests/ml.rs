@@ -9,11 +9,11 @@
 #![allow(clippy::expect_used)]
 
 use spherecal::cli::evaluate;
-use spherecal::engine::calibrate::{self, Calibration, Control, Method, Options, Prepared};
 use spherecal::engine::evaluate::{TruthScore, score, validation_errors};
-use spherecal::engine::ml::{self, ExcludeError, MlReport};
-use spherecal::engine::model::{Observation, Session, Use};
+use spherecal::engine::session::{Observation, Session, Use};
 use spherecal::engine::simulate::{self, SimConfig, Truth};
+use spherecal::engine::solve::ml::{self, ExcludeError, MlReport};
+use spherecal::engine::solve::{self, Calibration, Control, Method, Options, Prepared};
 
 fn simulate(config: &SimConfig) -> (Session, Truth) {
     simulate::simulate(config).expect("simulation")
@@ -33,7 +33,7 @@ fn paper_options(session: &Session) -> Options {
 }
 
 fn run(session: &Session, options: &Options) -> (Prepared, Calibration) {
-    calibrate::calibrate(session, options).expect("calibration")
+    solve::calibrate(session, options).expect("calibration")
 }
 
 fn report(cal: &Calibration) -> MlReport {
@@ -332,18 +332,17 @@ fn the_loop_of_format_md_holds_for_ml() {
         seed: 3,
         ..SimConfig::default()
     });
-    let prepared = calibrate::prepare(&session).expect("prepare");
+    let prepared = solve::prepare(&session).expect("prepare");
     let mut options = ml_options(&session);
     // A threshold above the starting ε: one entry, no update.
     options.threshold = 1e6;
-    let cal =
-        calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue).expect("run");
+    let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue).expect("run");
     assert_eq!(cal.iterations.len(), 1);
     assert_eq!(cal.stop.code(), "threshold");
     // Threshold 0: one update (a complete LM solve), then LM has converged.
     options.threshold = 0.0;
     let mut seen = Vec::new();
-    let cal = calibrate::run(&session, &prepared, &options, &mut |p| {
+    let cal = solve::run(&session, &prepared, &options, &mut |p| {
         seen.push((p.updates, p.epsilon));
         Control::Continue
     })
@@ -357,18 +356,16 @@ fn the_loop_of_format_md_holds_for_ml() {
     assert!((r.iterations.last().map_or(0.0, |i| i.epsilon) - cal.epsilon_after()).abs() < 1e-12);
     // No update allowed: the start is reported, with its diagnostics.
     options.max_iterations = 0;
-    let cal =
-        calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue).expect("run");
+    let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue).expect("run");
     assert_eq!(cal.iterations.len(), 1);
     assert_eq!(cal.stop.code(), "max_iterations");
     // Cancel.
     options.max_iterations = 20;
-    let err = calibrate::run(&session, &prepared, &options, &mut |_| Control::Cancel).unwrap_err();
+    let err = solve::run(&session, &prepared, &options, &mut |_| Control::Cancel).unwrap_err();
     assert!(err.to_string().contains("cancelled"), "{err}");
     // Bad options are input errors.
     options.ml.joint_sigma_deg = -1.0;
-    let err =
-        calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue).unwrap_err();
+    let err = solve::run(&session, &prepared, &options, &mut |_| Control::Continue).unwrap_err();
     assert!(
         err.is_input_error() && err.to_string().contains("joint sigma"),
         "{err}"

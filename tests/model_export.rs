@@ -10,15 +10,15 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion};
-use spherecal::engine::kinematics::Robot;
-use spherecal::engine::model_export::{self, CSV_HEADER};
-use spherecal::engine::session::{self, ResultFile};
+use spherecal::engine::format::{self, ResultFile};
+use spherecal::engine::report::model::{self, CSV_HEADER};
+use spherecal::engine::robot::Robot;
 
 const RESULT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/v1/result.json");
 const BASE_SESSION: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/base.json");
 
 fn fixture() -> ResultFile {
-    session::load_result(Path::new(RESULT)).unwrap()
+    format::load_result(Path::new(RESULT)).unwrap()
 }
 
 /// Runs `export-model` and returns (status, stderr).
@@ -183,7 +183,7 @@ fn urdf_chain_reproduces_forward_kinematics() {
     check_urdf(&fixture(), Path::new(RESULT), dir.path());
     let locked = locked_result();
     let path = dir.path().join("locked.json");
-    session::save_result(&locked, &path).unwrap();
+    format::save_result(&locked, &path).unwrap();
     check_urdf(&locked, &path, dir.path());
 }
 
@@ -201,7 +201,7 @@ fn urdf_origin_is_exact_at_and_near_gimbal_lock() {
             Translation3::new(1.0, 2.0, 3.0),
             UnitQuaternion::from_rotation_matrix(&r),
         );
-        let (xyz, rpy) = model_export::urdf_origin(&iso);
+        let (xyz, rpy) = model::urdf_origin(&iso);
         assert_eq!(xyz, [0.001, 0.002, 0.003]);
         let back = Rotation3::from_euler_angles(rpy[0], rpy[1], rpy[2]);
         let err = (back.matrix() - r.matrix()).abs().max();
@@ -226,7 +226,7 @@ fn csv_reads_back_to_the_joints() {
         assert_eq!(v[6..11], [e.alpha, e.a, e.beta, e.theta, e.d], "row {line}");
     }
     let matrices: Vec<&str> = tables.next().unwrap().lines().collect();
-    assert_eq!(matrices[0], model_export::CSV_MATRIX_HEADER);
+    assert_eq!(matrices[0], model::CSV_MATRIX_HEADER);
     assert_eq!(matrices.len(), 13);
     for (k, (name, m)) in [
         ("base", result.robot.base),
@@ -258,7 +258,7 @@ fn json_is_a_session_robot_block() {
         serde_json::from_str(&std::fs::read_to_string(BASE_SESSION).unwrap()).unwrap();
     s["robot"] = block;
     let text = serde_json::to_string(&s).unwrap();
-    let loaded = session::parse_session(&text, Path::new("embedded.json")).unwrap();
+    let loaded = format::parse_session(&text, Path::new("embedded.json")).unwrap();
     let expected = result.robot.to_robot().unwrap();
     assert_eq!(loaded.robot.name, expected.name);
     assert_eq!(loaded.robot.joints, expected.joints);

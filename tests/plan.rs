@@ -13,26 +13,26 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use nalgebra::{Point3, Vector3};
-use spherecal::engine::calibrate::{self, Control, Method, Options};
 use spherecal::engine::evaluate;
+use spherecal::engine::format;
 use spherecal::engine::import::{
     self, AngleUnit, ColumnMap, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit,
     ProfileSource, RobotSource,
 };
-use spherecal::engine::kinematics;
-use spherecal::engine::model::{Session, Use};
 use spherecal::engine::plan::{
     self, Controller, Plan, PlanConfig, PlanError, PredictConfig, Selection, StationRole,
 };
-use spherecal::engine::report;
-use spherecal::engine::session;
+use spherecal::engine::report::summary;
+use spherecal::engine::robot;
+use spherecal::engine::session::{Session, Use};
 use spherecal::engine::simulate::{self, ErrorModel, PlanExecution, SimConfig, Truth};
+use spherecal::engine::solve::{self, Control, Method, Options};
 
 /// The paper's cell, scaled down so a debug build plans it in well under
 /// a second: 4 identify stations × 6 poses, 4 validate stations × 4 poses,
 /// 8 orientations per station.
 fn small_config(seed: u64) -> PlanConfig {
-    let mut c = PlanConfig::for_preset(&kinematics::irb2400(), [1050.0, 0.0, 475.0]);
+    let mut c = PlanConfig::for_preset(&robot::irb2400(), [1050.0, 0.0, 475.0]);
     c.n_identify = 4;
     c.identify_poses = 6;
     c.n_validate = 4;
@@ -378,13 +378,12 @@ fn simulated_data_from_a_plan_imports_through_the_csv_path_and_calibrates() {
         assert_eq!(a.observation, b.observation, "{}", a.id);
     }
     // Calibrate (default method, ml) and write the result.
-    let (prepared, cal) =
-        calibrate::calibrate(&imported, &Options::from_session(&imported)).unwrap();
+    let (prepared, cal) = solve::calibrate(&imported, &Options::from_session(&imported)).unwrap();
     assert_eq!(cal.options.method, Method::Ml);
-    let result = report::result_file(&imported, &prepared, &cal);
+    let result = summary::result_file(&imported, &prepared, &cal);
     let out = dir.path().join("R.json");
-    session::save_result(&result, &out).unwrap();
-    assert!(session::load_result(&out).is_ok());
+    format::save_result(&result, &out).unwrap();
+    assert!(format::load_result(&out).is_ok());
     let validation = cal.validation.as_ref().expect("validation block");
     assert_eq!(validation.distances.len(), 3 * 4);
     let score = evaluate::score(&imported, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
@@ -518,7 +517,7 @@ fn noise_free_simulation_of_a_plan_calibrates_to_the_truth() {
         options.threshold = 0.0;
         options.ml.prior = false;
         options.ml.cross_validation = false;
-        let (prepared, cal) = calibrate::calibrate(&session, &options).unwrap();
+        let (prepared, cal) = solve::calibrate(&session, &options).unwrap();
         let errors = evaluate::validation_errors(
             &session,
             &prepared,
@@ -573,7 +572,7 @@ fn predicted_accuracy_agrees_with_an_independent_simulation() {
         .unwrap();
         let mut options = Options::from_session(&session);
         options.ml.cross_validation = false;
-        let (prepared, cal) = calibrate::calibrate(&session, &options).unwrap();
+        let (prepared, cal) = solve::calibrate(&session, &options).unwrap();
         after.push(
             evaluate::score(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye)
                 .after
@@ -687,7 +686,7 @@ fn plan_then_simulate_import_and_calibrate_on_the_command_line() {
     let (status, out, err) = spherecal(&["calibrate", &session, "--out", &result]);
     assert_eq!(status, 0, "{err}");
     assert!(out.contains("validation"), "{out}");
-    let r = session::load_result(Path::new(&result)).unwrap();
+    let r = format::load_result(Path::new(&result)).unwrap();
     let v = r.validation.expect("validate stations were planned");
     assert!(
         v.after.std * 3.0 < v.before.std,

@@ -13,16 +13,17 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use serde_json::Value;
 use sha2::{Digest, Sha256};
-use spherecal::engine::calibrate::{self, Method, Options};
-use spherecal::engine::html_report::{
+use spherecal::engine::format::{self, ResultFile};
+use spherecal::engine::report::html::{
     self, ReportError, ReportInput, ReportMeta, check_result, excluded_measurements, format_utc,
     sha256_hex,
 };
-use spherecal::engine::identify::HAND_EYE_LABELS;
-use spherecal::engine::kinematics::PARAM_NAMES;
-use spherecal::engine::model::Session;
-use spherecal::engine::session::{self, ResultFile};
-use spherecal::engine::{ml, report};
+use spherecal::engine::report::summary;
+use spherecal::engine::robot::PARAM_NAMES;
+use spherecal::engine::session::Session;
+use spherecal::engine::solve::estimate::HAND_EYE_LABELS;
+use spherecal::engine::solve::ml;
+use spherecal::engine::solve::{self, Method, Options};
 
 /// 2023-11-14 22:13:20 UTC.
 const WHEN: u64 = 1_700_000_000;
@@ -41,17 +42,17 @@ fn demo_value() -> Value {
 
 /// Session text, parsed session and a result of `method`.
 fn calibrated(text: &str, method: Method) -> (Session, ResultFile) {
-    let session = session::parse_session(text, Path::new("test.json")).unwrap();
+    let session = format::parse_session(text, Path::new("test.json")).unwrap();
     let mut options = Options::from_session(&session);
     options.method = method;
-    let (prepared, cal) = calibrate::calibrate(&session, &options).unwrap();
-    let result = report::result_file(&session, &prepared, &cal);
+    let (prepared, cal) = solve::calibrate(&session, &options).unwrap();
+    let result = summary::result_file(&session, &prepared, &cal);
     (session, result)
 }
 
 fn render(text: &str, session: &Session, result: &ResultFile) -> String {
     let meta = ReportMeta::new("sessions/test.json", when());
-    html_report::render(&ReportInput {
+    html::render(&ReportInput {
         session,
         session_bytes: text.as_bytes(),
         result,
@@ -188,7 +189,7 @@ fn every_section_the_sha256_and_the_headline() {
             .count(),
         2
     );
-    assert!(html.contains(html_report::BEFORE_COLOUR) && html.contains(html_report::AFTER_COLOUR));
+    assert!(html.contains(html::BEFORE_COLOUR) && html.contains(html::AFTER_COLOUR));
     // ml: σ beside the estimates, the fixed set marked.
     assert!(html.contains("id=\"fixed\""));
     assert!(html.contains(" ± "));
@@ -219,8 +220,7 @@ fn a_saved_and_reloaded_result_gives_the_same_report() {
     // same figures either way.
     let text = spherecal::DEMO_SESSION_JSON;
     let (s, r) = calibrated(text, Method::Ml);
-    let reloaded =
-        session::parse_result(&session::result_to_json(&r), Path::new("r.json")).unwrap();
+    let reloaded = format::parse_result(&format::result_to_json(&r), Path::new("r.json")).unwrap();
     assert_eq!(render(text, &s, &r), render(text, &s, &reloaded));
 }
 
@@ -315,7 +315,7 @@ fn the_papers_method_marks_the_dropped_directions() {
     // Fig. 5, Fig. 6, ε and the singular values with the truncation line.
     assert_eq!(html.matches("<svg").count(), 4);
     assert!(html.contains("truncation"));
-    let marks = html_report::identifiability_marks(&result.solver);
+    let marks = html::identifiability_marks(&result.solver);
     assert!(!marks.is_empty() && marks.contains_key("theta1"));
     // Every mark of a joint or hand-eye parameter is a marked cell.
     let mut labels: Vec<String> = HAND_EYE_LABELS.iter().map(|l| l.to_string()).collect();
@@ -342,11 +342,11 @@ fn a_centre_session_has_no_stripe_fits() {
 fn a_result_must_belong_to_its_session() {
     let text = spherecal::DEMO_SESSION_JSON;
     let (demo, result) = calibrated(text, Method::Paper);
-    let prepared = calibrate::prepare(&demo).unwrap();
+    let prepared = solve::prepare(&demo).unwrap();
     assert_eq!(check_result(&demo, &result, Some(&prepared)), Ok(()));
     // Another session.
     let ur5e_text = std::fs::read_to_string(sessions_dir().join("ur5e.json")).unwrap();
-    let ur5e = session::parse_session(&ur5e_text, Path::new("ur5e.json")).unwrap();
+    let ur5e = format::parse_session(&ur5e_text, Path::new("ur5e.json")).unwrap();
     assert!(matches!(
         check_result(&ur5e, &result, None),
         Err(ReportError::OtherSession { .. })
@@ -382,10 +382,10 @@ fn a_result_must_belong_to_its_session() {
 #[test]
 fn measurements_left_out_are_listed() {
     let text = spherecal::DEMO_SESSION_JSON;
-    let demo = session::parse_session(text, Path::new("demo.json")).unwrap();
+    let demo = format::parse_session(text, Path::new("demo.json")).unwrap();
     let fewer = ml::exclude_measurements(&demo, &["c5".to_string(), "v7".to_string()]).unwrap();
-    let (prepared, cal) = calibrate::calibrate(&fewer, &Options::from_session(&fewer)).unwrap();
-    let result = report::result_file(&fewer, &prepared, &cal);
+    let (prepared, cal) = solve::calibrate(&fewer, &Options::from_session(&fewer)).unwrap();
+    let result = summary::result_file(&fewer, &prepared, &cal);
     // Reported against the full session: the ids are its own.
     assert_eq!(check_result(&demo, &result, None), Ok(()));
     assert_eq!(excluded_measurements(&demo, &result), ["c5", "v7"]);
@@ -486,7 +486,7 @@ fn cli_report_calibrates_or_reports_a_given_result() {
     assert!(stdout.contains("the given result"), "{stdout}");
     let html = std::fs::read_to_string(&out).unwrap();
     assert!(html.contains("<strong>paper</strong> method kept"));
-    let loaded = session::load_result(&result).unwrap();
+    let loaded = format::load_result(&result).unwrap();
     let v = loaded.validation.unwrap();
     assert!(html.contains(&format!("std {:.3} → {:.3} mm", v.before.std, v.after.std)));
 }

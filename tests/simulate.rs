@@ -10,11 +10,11 @@ use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, Point3, Vector3};
-use spherecal::engine::model::{Observation, Session, Use};
-use spherecal::engine::session;
-use spherecal::engine::simulate::{
-    self, ErrorModel, InitialHandEye, RobotChoice, SideChoice, SimConfig, Truth,
-};
+use spherecal::engine::cell::sensor;
+use spherecal::engine::format;
+use spherecal::engine::robot::{self, RobotChoice};
+use spherecal::engine::session::{Observation, Session, Use};
+use spherecal::engine::simulate::{self, ErrorModel, InitialHandEye, SideChoice, SimConfig, Truth};
 
 fn simulate(config: &SimConfig) -> (Session, Truth) {
     simulate::simulate(config).expect("simulation")
@@ -66,9 +66,9 @@ fn same_seed_same_files_other_seed_other_files() {
     let (s1, t1) = simulate(&small(21, RobotChoice::Irb2400));
     let (s2, t2) = simulate(&small(21, RobotChoice::Irb2400));
     let (s3, t3) = simulate(&small(22, RobotChoice::Irb2400));
-    assert_eq!(session::session_to_json(&s1), session::session_to_json(&s2));
+    assert_eq!(format::session_to_json(&s1), format::session_to_json(&s2));
     assert_eq!(simulate::truth_to_json(&t1), simulate::truth_to_json(&t2));
-    assert_ne!(session::session_to_json(&s1), session::session_to_json(&s3));
+    assert_ne!(format::session_to_json(&s1), format::session_to_json(&s3));
     assert_ne!(simulate::truth_to_json(&t1), simulate::truth_to_json(&t3));
 }
 
@@ -163,7 +163,7 @@ fn noise_free_session_matches_its_truth_exactly() {
     {
         assert!((t.alpha - n.alpha - e.alpha).abs() < 1e-12 && (t.d - n.d - e.d).abs() < 1e-12);
     }
-    assert_eq!(truth.joint_errors, simulate::table1_errors());
+    assert_eq!(truth.joint_errors, robot::table1_errors());
 }
 
 #[test]
@@ -382,8 +382,8 @@ fn every_preset_and_mode_passes_format_rules_and_loads() {
         );
         // The strict loader accepts the written file and reads back the
         // same measurements.
-        let text = session::session_to_json(&session);
-        let loaded = session::parse_session(&text, Path::new("simulated.json"))
+        let text = format::session_to_json(&session);
+        let loaded = format::parse_session(&text, Path::new("simulated.json"))
             .unwrap_or_else(|e| panic!("{:?}: {e}", config.robot));
         assert_eq!(
             loaded.measurements, session.measurements,
@@ -466,10 +466,10 @@ fn truth_file_has_the_shape_of_the_shared_example() {
 fn shared_example_truth_loads_and_agrees_with_our_conventions() {
     let truth = simulate::load_truth(&example_truth_path()).unwrap();
     assert_eq!(truth.config.errors, ErrorModel::Table1);
-    assert_eq!(truth.joint_errors, simulate::table1_errors());
+    assert_eq!(truth.joint_errors, robot::table1_errors());
     let robot = truth.true_robot();
     let hand_eye = truth.true_hand_eye();
-    let ours = simulate::paper_hand_eye();
+    let ours = sensor::paper_hand_eye();
     assert!(
         (hand_eye.to_homogeneous() - ours.to_homogeneous())
             .abs()

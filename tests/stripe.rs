@@ -9,7 +9,7 @@ use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use spherecal::engine::error::StripeError;
+use spherecal::engine::stripe::StripeError;
 use spherecal::engine::stripe::{
     CircleFit, MIN_POINTS, MIN_POINTS_TO_TRIM, RADIUS_TOLERANCE, centre_from_stripe, fit_circle,
     on_plane_x_variance, sphere_centre,

@@ -12,9 +12,9 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
 use spherecal::app::state::{Prefs, Tab};
-use spherecal::engine::calibrate::{Method, Options, calibrate};
-use spherecal::engine::model_export::{self, ModelFormat};
-use spherecal::engine::session::parse_session;
+use spherecal::engine::format::parse_session;
+use spherecal::engine::report::model::{self, ModelFormat};
+use spherecal::engine::solve::{Method, Options, calibrate};
 
 /// Frames to wait for background work (with a short sleep each): generous
 /// for a loaded CI machine; a run of the demo takes well under a second.
@@ -266,7 +266,7 @@ fn left_out_measurements_are_saved_and_a_bad_exclusion_is_refused() {
     // Show the last measurement's station only, then leave the measurement
     // out by unticking its checkbox.
     let last = session.measurements.last().expect("measurements");
-    assert_eq!(last.usage, spherecal::engine::model::Use::Validate);
+    assert_eq!(last.usage, spherecal::engine::session::Use::Validate);
     h.state_mut().forms_mut().filter_station = Some(last.station.clone());
     h.run();
     h.get_by_label(&last.id).click();
@@ -275,7 +275,7 @@ fn left_out_measurements_are_saved_and_a_bad_exclusion_is_refused() {
     h.state_mut().forms_mut().save_path = target.display().to_string();
     h.get_by_label("Save").click();
     settle(&mut h);
-    let saved = spherecal::engine::session::load_session(&target).expect("the saved file loads");
+    let saved = spherecal::engine::format::load_session(&target).expect("the saved file loads");
     assert_eq!(saved.measurements.len(), session.measurements.len() - 1);
     assert!(saved.measurements.iter().all(|m| m.id != last.id));
 
@@ -283,7 +283,7 @@ fn left_out_measurements_are_saved_and_a_bad_exclusion_is_refused() {
     let rotation_station = session
         .measurements
         .iter()
-        .find(|m| m.usage == spherecal::engine::model::Use::Rotation)
+        .find(|m| m.usage == spherecal::engine::session::Use::Rotation)
         .expect("rotation")
         .station
         .clone();
@@ -328,10 +328,10 @@ fn a_result_file_is_reviewed_without_running_the_solver() {
     .expect("demo parses");
     let (prepared, cal) =
         calibrate(&session, &Options::from_session(&session)).expect("calibrates");
-    let file = spherecal::engine::report::result_file(&session, &prepared, &cal);
+    let file = spherecal::engine::report::summary::result_file(&session, &prepared, &cal);
     let dir = tempfile::tempdir().expect("temp dir");
     let path = dir.path().join("demo-result.json");
-    spherecal::engine::session::save_result(&file, &path).expect("saves");
+    spherecal::engine::format::save_result(&file, &path).expect("saves");
 
     h.get_by_label("Session or result file").click();
     h.run();
@@ -388,7 +388,7 @@ fn exports_are_written_to_the_chosen_folder() {
     }
     let stem = "demo-irb2400";
     let result =
-        spherecal::engine::session::load_result(&dir.path().join(format!("{stem}-result.json")))
+        spherecal::engine::format::load_result(&dir.path().join(format!("{stem}-result.json")))
             .expect("the exported result loads");
     let shown = h.state().state().result.as_ref().expect("result");
     assert_eq!(result, shown.file, "the export is the result on show");
@@ -409,12 +409,12 @@ fn exports_are_written_to_the_chosen_folder() {
         let written = std::fs::read_to_string(dir.path().join(format!("{stem}-model.{ext}")))
             .expect("model file");
         let source = format!("a workbench run of {}", shown.file.session);
-        let expected = model_export::export(&shown.file, format, &source).expect("exports");
+        let expected = model::export(&shown.file, format, &source).expect("exports");
         assert_eq!(written, expected, "the {ext} model is the engine's export");
     }
     let report =
         std::fs::read_to_string(dir.path().join(format!("{stem}-report.html"))).expect("report");
-    let sha = spherecal::engine::html_report::sha256_hex(spherecal::DEMO_SESSION_JSON.as_bytes());
+    let sha = spherecal::engine::report::html::sha256_hex(spherecal::DEMO_SESSION_JSON.as_bytes());
     assert!(report.starts_with("<!DOCTYPE html>"));
     assert!(
         report.contains(&sha),
@@ -478,7 +478,7 @@ fn clicking_a_centre_in_the_3d_view_selects_its_measurement() {
 
 /// Writes the demo session's poses as a KUKA-style joint log (`Pose`,
 /// `Sphere`, `Use`, `Side`, `A1`..`A6`) and one profile CSV per pose.
-fn write_import_files(dir: &Path) -> spherecal::engine::model::Session {
+fn write_import_files(dir: &Path) -> spherecal::engine::session::Session {
     use std::fmt::Write as _;
     let session = parse_session(
         spherecal::DEMO_SESSION_JSON,
@@ -502,7 +502,7 @@ fn write_import_files(dir: &Path) -> spherecal::engine::model::Session {
             write!(log, ",{q}").unwrap();
         }
         log.push('\n');
-        let spherecal::engine::model::Observation::Stripe(points) = &m.observation else {
+        let spherecal::engine::session::Observation::Stripe(points) = &m.observation else {
             panic!("the demo has stripes");
         };
         let mut p = String::from("y,z\n");

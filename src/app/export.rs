@@ -8,10 +8,10 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::SystemTime;
 
-use crate::engine::html_report::{self, ReportInput, ReportMeta};
-use crate::engine::model::Session;
-use crate::engine::model_export::{self, ModelFormat};
-use crate::engine::session::{result_to_json, write_atomic};
+use crate::engine::format::{result_to_json, write_atomic};
+use crate::engine::report::html::{self, ReportInput, ReportMeta};
+use crate::engine::report::model::{self, ModelFormat};
+use crate::engine::session::Session;
 
 use super::state::ExportKind;
 use super::view::{ResultOrigin, ResultView};
@@ -110,7 +110,7 @@ pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<()
                 ResultOrigin::Review(p) => p.display().to_string(),
                 ResultOrigin::Run { .. } => format!("a workbench run of {}", view.file.session),
             };
-            model_export::export(&view.file, format, &source)
+            model::export(&view.file, format, &source)
                 .map_err(|e| format!("the model cannot be exported: {e}"))?
         }
     };
@@ -118,7 +118,7 @@ pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<()
 }
 
 /// Writes the HTML report of `view` against its session atomically (the
-/// engine's [`html_report::render`], as `spherecal report --result`).
+/// engine's [`html::render`], as `spherecal report --result`).
 /// `bytes` are the session file's bytes (for the SHA-256) and `label`
 /// names it in the report.
 ///
@@ -131,10 +131,10 @@ pub fn write_report(
     label: &str,
     path: &Path,
 ) -> Result<(), String> {
-    html_report::check_result(session, &view.file, None)
+    html::check_result(session, &view.file, None)
         .map_err(|e| format!("the report was not written: {e}"))?;
     let meta = ReportMeta::new(label, SystemTime::now());
-    let html = html_report::render(&ReportInput {
+    let html = html::render(&ReportInput {
         session,
         session_bytes: bytes,
         result: &view.file,

@@ -8,9 +8,9 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
 
-use crate::engine::calibrate::Progress;
 use crate::engine::history::Library;
 use crate::engine::import::PoseCheck;
+use crate::engine::solve::Progress;
 
 use super::planner::PlanEvent;
 use super::state::{DialogPurpose, ExportKind, LoadedSession, PlanExport};

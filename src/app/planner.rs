@@ -9,14 +9,16 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use nalgebra::Isometry3;
 
-use crate::engine::calibrate::Control;
-use crate::engine::kinematics;
-use crate::engine::model::Session;
+use crate::engine::cell::workspace::Workspace;
 use crate::engine::plan::{
     self, DEFAULT_CANDIDATES, DEFAULT_CUT_ANGLE_DEG, Plan, PlanConfig, PlanError, PlanStage,
     PredictConfig, Prediction,
 };
-use crate::engine::simulate::{self, PlanExecution, RobotChoice, SimConfig, Workspace};
+use crate::engine::robot;
+use crate::engine::robot::RobotChoice;
+use crate::engine::session::Session;
+use crate::engine::simulate::{self, PlanExecution, SimConfig};
+use crate::engine::solve::Control;
 
 /// The Plan view's fields.
 #[derive(Debug, Clone, PartialEq)]
@@ -88,7 +90,7 @@ impl PlanForm {
     /// # Errors
     /// An unknown preset, or the session hand-eye asked for but absent.
     pub fn config(&self, session_hand_eye: Option<Isometry3<f64>>) -> Result<PlanConfig, String> {
-        let preset = kinematics::preset(&self.robot)
+        let preset = robot::preset(&self.robot)
             .ok_or_else(|| format!("unknown robot preset `{}`", self.robot))?;
         let mut c = PlanConfig::for_preset(&preset, self.sphere);
         if self.hand_eye_from_session {

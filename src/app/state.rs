@@ -11,9 +11,9 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::engine::calibrate::{Method, Options};
-use crate::engine::identify::{DEFAULT_SVD_TOLERANCE, Pairing, PaperOptions};
-use crate::engine::model::{Session, Use};
+use crate::engine::session::{Session, Use};
+use crate::engine::solve::paper::{DEFAULT_SVD_TOLERANCE, Pairing, PaperOptions};
+use crate::engine::solve::{Method, Options};
 use crate::engine::stripe::StripeResult;
 
 use super::planner::{PlanForm, PlanOutcome};
@@ -129,8 +129,8 @@ impl LoadedSession {
     #[must_use]
     pub fn points(&self, i: usize) -> Option<usize> {
         match &self.session.measurements.get(i)?.observation {
-            crate::engine::model::Observation::Stripe(p) => Some(p.len()),
-            crate::engine::model::Observation::Centre(_) => None,
+            crate::engine::session::Observation::Stripe(p) => Some(p.len()),
+            crate::engine::session::Observation::Centre(_) => None,
         }
     }
 
@@ -167,8 +167,8 @@ impl Default for SolverForm {
         Self {
             method: Method::ALL[0],
             pairing: Pairing::Disjoint,
-            threshold: crate::engine::model::DEFAULT_THRESHOLD,
-            max_iterations: crate::engine::model::DEFAULT_MAX_ITERATIONS,
+            threshold: crate::engine::session::DEFAULT_THRESHOLD,
+            max_iterations: crate::engine::session::DEFAULT_MAX_ITERATIONS,
             svd_tolerance: DEFAULT_SVD_TOLERANCE,
         }
     }

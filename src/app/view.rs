@@ -9,10 +9,10 @@ use std::path::PathBuf;
 use nalgebra::Vector3;
 use serde_json::Value;
 
+use crate::engine::format::ResultFile;
 use crate::engine::geometry::{isometry_from_rows, rotation_angle_between};
-use crate::engine::kinematics::Joint;
-use crate::engine::model::{Session, Use};
-use crate::engine::session::ResultFile;
+use crate::engine::robot::Joint;
+use crate::engine::session::{Session, Use};
 use crate::engine::validate::{BeforeAfter, DistanceRecord, Stats, within_station_distances};
 
 /// Where a result on show came from.
@@ -275,7 +275,7 @@ impl ResultView {
         };
         let dropped = texts("dropped_directions");
         let fixed = texts("fixed");
-        let marked = crate::engine::html_report::identifiability_marks(solver);
+        let marked = crate::engine::report::html::identifiability_marks(solver);
         let estimated = texts("estimated");
         let mut caveats = texts("inseparable");
         caveats.extend(

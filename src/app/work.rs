@@ -7,15 +7,16 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use crate::engine::calibrate::{self, Control, Options, Progress};
-use crate::engine::error::{CalibrationError, FileError, IdentifyError};
-use crate::engine::identify::Estimate;
-use crate::engine::import;
-use crate::engine::model::{Observation, Session};
-use crate::engine::report;
-use crate::engine::session::{
+use crate::engine::format::FileError;
+use crate::engine::format::{
     RESULT_FORMAT, ResultFile, parse_result, parse_session, session_to_json, write_atomic,
 };
+use crate::engine::import;
+use crate::engine::report::summary;
+use crate::engine::session::{Observation, Session};
+use crate::engine::solve::estimate::Estimate;
+use crate::engine::solve::{self, Control, Options, Progress};
+use crate::engine::solve::{CalibrationError, IdentifyError};
 use crate::engine::stripe::centre_from_stripe;
 
 use super::jobs::{Imported, LoadFailure, RunFailure};
@@ -101,7 +102,7 @@ pub fn analyse(session: Session, source: Source) -> LoadedSession {
             },
         })
         .collect();
-    let before = calibrate::prepare(&session)
+    let before = solve::prepare(&session)
         .map(|prepared| {
             let start = Estimate {
                 robot: session.robot.clone(),
@@ -197,8 +198,8 @@ pub fn calibrate_session(
         }
         other => RunFailure::Failed(other.to_string()),
     };
-    let prepared = calibrate::prepare(&kept).map_err(failed)?;
-    let cal = calibrate::run(&kept, &prepared, options, &mut |p| {
+    let prepared = solve::prepare(&kept).map_err(failed)?;
+    let cal = solve::run(&kept, &prepared, options, &mut |p| {
         let delivered = on_progress(p);
         if cancel.load(Ordering::Relaxed) || !delivered {
             Control::Cancel
@@ -207,7 +208,7 @@ pub fn calibrate_session(
         }
     })
     .map_err(failed)?;
-    let file = report::result_file(&kept, &prepared, &cal);
+    let file = summary::result_file(&kept, &prepared, &cal);
     let origin = ResultOrigin::Run {
         seconds: started.elapsed().as_secs_f64(),
         excluded: session.measurements.len() - kept.measurements.len(),

@@ -19,10 +19,10 @@ use super::state::{
 use super::view::ResultOrigin;
 use super::wizard::ProfilesKind;
 use super::work::{self, Opened};
+use crate::engine::format::write_atomic;
 use crate::engine::geometry::isometry_from_rows;
 use crate::engine::history::{self, DriftOptions, HistoryError};
 use crate::engine::plan::{self, Controller, Plan};
-use crate::engine::session::write_atomic;
 
 /// How long to wait for the window's screenshot for a plots PNG: a frame
 /// takes milliseconds; a backend that cannot take one never answers.

@@ -22,9 +22,9 @@ use std::time::Instant;
 use clap::Args;
 
 use super::CliError;
-use crate::engine::calibrate::{self, Control, Method, Options};
 use crate::engine::evaluate;
 use crate::engine::simulate::{self, ErrorModel, SimConfig};
+use crate::engine::solve::{self, Control, Method, Options};
 
 /// `spherecal evaluate`.
 #[derive(Debug, Args)]
@@ -59,8 +59,8 @@ fn paper_like(seed: u64) -> SimConfig {
     }
 }
 
-/// Twice the Table 1 magnitude: [`simulate::RANDOM_ANGLE_SIGMA_DEG`] and
-/// [`simulate::RANDOM_LENGTH_SIGMA_MM`] are Table-1-sized at scale 1.
+/// Twice the Table 1 magnitude: [`simulate::config::RANDOM_ANGLE_SIGMA_DEG`] and
+/// [`simulate::config::RANDOM_LENGTH_SIGMA_MM`] are Table-1-sized at scale 1.
 const RANDOM_ERROR_SCALE: f64 = 2.0;
 /// The "stripe noise 0.05 mm".
 const HIGH_STRIPE_NOISE_MM: f64 = 0.05;
@@ -134,7 +134,7 @@ pub struct MethodRuns {
     pub std: Vec<f64>,
     /// `std / floor`, per seed.
     pub ratio: Vec<f64>,
-    /// Wall time of `calibrate::run`, ms, per seed.
+    /// Wall time of `solve::run`, ms, per seed.
     pub millis: Vec<f64>,
 }
 
@@ -196,12 +196,12 @@ pub fn run_scenario(scenario: &Scenario, seeds: u64) -> Result<ScenarioResult, S
         };
         let (session, truth) =
             simulate::simulate(&(scenario.config)(seed)).map_err(|e| fail("simulation", &e))?;
-        let prepared = calibrate::prepare(&session).map_err(|e| fail("prepare", &e))?;
+        let prepared = solve::prepare(&session).map_err(|e| fail("prepare", &e))?;
         for (method, runs) in [(Method::Paper, &mut out.paper), (Method::Ml, &mut out.ml)] {
             let mut options = Options::from_session(&session);
             options.method = method;
             let started = Instant::now();
-            let cal = calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue)
+            let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
                 .map_err(|e| fail(method.as_str(), &e))?;
             runs.millis.push(started.elapsed().as_secs_f64() * 1e3);
             let score =

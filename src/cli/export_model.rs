@@ -1,15 +1,15 @@
 //! `spherecal export-model`: writes the calibrated model of a result file
 //! as the FORMAT.md `robot` block (JSON), a CSV table of MDH parameters or
 //! a URDF fragment, atomically. A thin caller of
-//! [`crate::engine::model_export`].
+//! [`crate::engine::report::model`].
 
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 
 use super::CliError;
-use crate::engine::model_export::{self, ModelFormat};
-use crate::engine::session;
+use crate::engine::format;
+use crate::engine::report::model::{self, ModelFormat};
 
 /// Output format (`--format`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -51,11 +51,10 @@ pub struct ExportModelArgs {
 /// [`CliError`] with status 2 when the result file cannot be read or is
 /// not a valid result, 1 when the output cannot be written.
 pub fn run(args: &ExportModelArgs) -> Result<(), CliError> {
-    let result = session::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;
+    let result = format::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;
     let source = args.result.display().to_string();
-    let text = model_export::export(&result, args.format.into(), &source)
+    let text = model::export(&result, args.format.into(), &source)
         .map_err(|e| CliError::input(format!("{e} ({source})")))?;
-    session::write_atomic(&args.out, text.as_bytes())
-        .map_err(|e| CliError::from_file(&e, false))?;
+    format::write_atomic(&args.out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
     Ok(())
 }

@@ -6,10 +6,10 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+use crate::engine::format;
 use crate::engine::history::{
     self, DEFAULT_K, DEFAULT_TOP, Drift, DriftOptions, Entry, Library, Series, SeriesKind, Verdict,
 };
-use crate::engine::session;
 
 use super::CliError;
 
@@ -82,7 +82,7 @@ pub fn run(args: &HistoryArgs) -> Result<(), CliError> {
         print!("{}", drift_text(&library, d));
     }
     if let Some(path) = &args.csv {
-        session::write_atomic(path, history::drift_csv(&library, &drifts).as_bytes())
+        format::write_atomic(path, history::drift_csv(&library, &drifts).as_bytes())
             .map_err(|e| CliError::from_file(&e, false))?;
         println!("\nwrote {}", path.display());
     }

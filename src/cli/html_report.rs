@@ -1,5 +1,5 @@
 //! `spherecal report`: the self-contained HTML report of a calibration
-//! ([`crate::engine::html_report`]). The module is `html_report` because
+//! ([`crate::engine::report::html`]). The module is `html_report` because
 //! `cli` already imports the engine's result-file module as `report`.
 //! Without `--result` the session is calibrated first, as `spherecal
 //! calibrate` does with its defaults (the session's threshold and iteration
@@ -12,10 +12,10 @@ use std::time::{Instant, SystemTime};
 use clap::Args;
 
 use super::{CliError, parse_method};
-use crate::engine::calibrate::{self, Control, Method, Options};
-use crate::engine::error::FileError;
-use crate::engine::html_report::{self, ReportInput, ReportMeta};
-use crate::engine::{report, session};
+use crate::engine::format::{self, FileError};
+use crate::engine::report::html::{self, ReportInput, ReportMeta};
+use crate::engine::report::summary;
+use crate::engine::solve::{self, Control, Method, Options};
 
 /// `spherecal report`.
 #[derive(Debug, Args)]
@@ -62,13 +62,13 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         ))
     })?;
     let session =
-        session::parse_session(text, &args.session).map_err(|e| CliError::from_file(&e, true))?;
+        format::parse_session(text, &args.session).map_err(|e| CliError::from_file(&e, true))?;
     let prepared =
-        calibrate::prepare(&session).map_err(|e| CliError::from_calibration(&e, &args.session))?;
+        solve::prepare(&session).map_err(|e| CliError::from_calibration(&e, &args.session))?;
     let result = match &args.result {
         Some(path) => {
-            let result = session::load_result(path).map_err(|e| CliError::from_file(&e, true))?;
-            html_report::check_result(&session, &result, Some(&prepared)).map_err(|e| {
+            let result = format::load_result(path).map_err(|e| CliError::from_file(&e, true))?;
+            html::check_result(&session, &result, Some(&prepared)).map_err(|e| {
                 CliError::input(format!(
                     "{} does not belong to {}: {e}",
                     path.display(),
@@ -80,14 +80,14 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         None => {
             let mut options = Options::from_session(&session);
             options.method = args.method;
-            let cal = calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue)
+            let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
                 .map_err(|e| CliError::from_calibration(&e, &args.session))?;
-            report::result_file(&session, &prepared, &cal)
+            summary::result_file(&session, &prepared, &cal)
         }
     };
     let meta = ReportMeta::new(args.session.display().to_string(), SystemTime::now());
     let rendering = Instant::now();
-    let html = html_report::render(&ReportInput {
+    let html = html::render(&ReportInput {
         session: &session,
         session_bytes: &bytes,
         result: &result,
@@ -95,8 +95,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         meta: &meta,
     });
     let render_ms = rendering.elapsed().as_secs_f64() * 1e3;
-    session::write_atomic(&args.out, html.as_bytes())
-        .map_err(|e| CliError::from_file(&e, false))?;
+    format::write_atomic(&args.out, html.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
     if !args.quiet {
         let how = match &args.result {
             Some(_) => "the given result".to_string(),

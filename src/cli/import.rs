@@ -7,12 +7,12 @@ use std::path::PathBuf;
 
 use clap::Args;
 
+use crate::engine::format;
 use crate::engine::import::{
     self, AngleUnit, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
     DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportError, ImportSpec, LengthUnit,
     ProfileSource, RobotSource,
 };
-use crate::engine::session;
 
 use super::CliError;
 
@@ -180,8 +180,8 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         ));
     };
     let (session, checks) = import::import(&spec).map_err(|e| input(&e))?;
-    let text = session::session_to_json(&session);
-    session::write_atomic(out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
+    let text = format::session_to_json(&session);
+    format::write_atomic(out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
     if !session.reference_distances.is_empty() {
         println!(
             "{} reference distances between validate stations",

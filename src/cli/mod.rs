@@ -19,12 +19,13 @@ use std::time::Instant;
 
 use clap::{Args, Parser, Subcommand};
 
-use crate::engine::calibrate::{self, Control, HandEyeSource, Method, Options};
-use crate::engine::error::{CalibrationError, FileError};
-use crate::engine::identify::Pairing;
-use crate::engine::ml::{self, Loss, MlOptions, MlReport};
-use crate::engine::report;
-use crate::engine::session;
+use crate::engine::format;
+use crate::engine::format::FileError;
+use crate::engine::report::summary;
+use crate::engine::solve::CalibrationError;
+use crate::engine::solve::ml::{self, Loss, MlOptions, MlReport};
+use crate::engine::solve::paper::Pairing;
+use crate::engine::solve::{self, Control, HandEyeSource, Method, Options};
 
 /// spherecal: calibrate a robot-mounted laser-stripe sensor (hand-eye and
 /// kinematic errors) against a reference sphere.
@@ -93,7 +94,7 @@ pub struct CalibrateArgs {
     #[arg(long)]
     pub max_iterations: Option<usize>,
     /// Relative SVD tolerance of the paper's method (fraction of the largest singular value).
-    #[arg(long, default_value_t = crate::engine::identify::DEFAULT_SVD_TOLERANCE)]
+    #[arg(long, default_value_t = crate::engine::solve::paper::DEFAULT_SVD_TOLERANCE)]
     pub svd_tolerance: f64,
     /// Pairing of a station's measurements: `disjoint` (the paper's (1,2),(3,4),(5,6)) or `all`.
     #[arg(long, default_value = "disjoint", value_parser = parse_pairing)]
@@ -235,8 +236,7 @@ impl CliError {
 /// [`CliError`] with status 2 for bad input, 1 for internal failures.
 pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     let started = Instant::now();
-    let session =
-        session::load_session(&args.session).map_err(|e| CliError::from_file(&e, true))?;
+    let session = format::load_session(&args.session).map_err(|e| CliError::from_file(&e, true))?;
     let session = if args.exclude.is_empty() {
         session
     } else {
@@ -255,9 +255,9 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     options.paper.svd_tolerance = args.svd_tolerance;
     options.paper.pairing = args.pairs;
     let prepared =
-        calibrate::prepare(&session).map_err(|e| CliError::from_calibration(&e, &args.session))?;
+        solve::prepare(&session).map_err(|e| CliError::from_calibration(&e, &args.session))?;
     let quiet = args.quiet;
-    let mut on_progress = |p: &calibrate::Progress| {
+    let mut on_progress = |p: &solve::Progress| {
         if !quiet {
             println!("  ε after {:>2} update(s): {:.4} mm", p.updates, p.epsilon);
         }
@@ -286,12 +286,12 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
             options.max_iterations
         );
     }
-    let cal = calibrate::run(&session, &prepared, &options, &mut on_progress)
+    let cal = solve::run(&session, &prepared, &options, &mut on_progress)
         .map_err(|e| CliError::from_calibration(&e, &args.session))?;
-    let result = report::result_file(&session, &prepared, &cal);
-    session::save_result(&result, &args.out).map_err(|e| CliError::from_file(&e, false))?;
+    let result = summary::result_file(&session, &prepared, &cal);
+    format::save_result(&result, &args.out).map_err(|e| CliError::from_file(&e, false))?;
     if !quiet {
-        print!("{}", report::summary(&session, &cal));
+        print!("{}", summary::summary(&session, &cal));
         if let Some(r) = MlReport::from_solver_block(&cal.solver) {
             print!("{}", r.summary());
         }

@@ -12,15 +12,16 @@ use nalgebra::Isometry3;
 use serde_json::Value;
 
 use super::CliError;
-use crate::engine::calibrate::Control;
+use crate::engine::cell::workspace;
+use crate::engine::format;
 use crate::engine::geometry::isometry_from_rows;
 use crate::engine::import::{self, RobotSource};
-use crate::engine::kinematics::{self, JointLimit};
 use crate::engine::plan::{
     self, Controller, PlanConfig, PlanError, PlanStage, PredictConfig, Selection, StationLayout,
 };
-use crate::engine::session;
+use crate::engine::robot::{self, JointLimit};
 use crate::engine::simulate;
+use crate::engine::solve::Control;
 
 /// `spherecal plan`.
 #[derive(Debug, Args)]
@@ -213,19 +214,19 @@ fn read_stations(path: &Path) -> Result<StationLayout, CliError> {
 /// [`CliError`] (status 2) for an unknown robot, bad limits, an unreadable
 /// hand-eye or stations file.
 pub fn config(args: &PlanArgs) -> Result<PlanConfig, CliError> {
-    let mut config = match kinematics::preset(&args.robot) {
+    let mut config = match robot::preset(&args.robot) {
         Some(preset) => PlanConfig::for_preset(&preset, args.sphere),
         None => {
             let path = PathBuf::from(&args.robot);
             let robot = import::load_robot(&RobotSource::File(path))
                 .map_err(|e| CliError::input(e.to_string()))?;
-            let named = kinematics::presets()
+            let named = robot::presets()
                 .into_iter()
                 .find(|p| p.robot.name == robot.name);
             let limits = if !args.limits.is_empty() {
                 parse_limits(&args.limits, robot.dof())?
             } else if let Some(p) = &named {
-                simulate::cell_limits(p.key, &p.limits)
+                workspace::cell_limits(p.key, &p.limits)
             } else {
                 return Err(CliError::input(format!(
                     "robot {} from {} is not a preset: give its joint limits with --limits min:max,... (deg)",
@@ -274,7 +275,7 @@ fn plan_error(e: &PlanError) -> CliError {
 }
 
 fn write(path: &Path, text: &str) -> Result<(), CliError> {
-    session::write_atomic(path, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))
+    format::write_atomic(path, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))
 }
 
 /// Runs `spherecal plan`.
@@ -349,8 +350,8 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
             println!(
                 "  predicted validation std after calibration (ml, {} simulated robots with random errors σ {}°/{} mm, joint noise {}°, stripe noise {} mm): {:.4} ± {:.4} mm",
                 p.runs.len(),
-                simulate::RANDOM_ANGLE_SIGMA_DEG,
-                simulate::RANDOM_LENGTH_SIGMA_MM,
+                simulate::config::RANDOM_ANGLE_SIGMA_DEG,
+                simulate::config::RANDOM_LENGTH_SIGMA_MM,
                 predict.joint_noise,
                 predict.stripe_noise,
                 p.after_mean,

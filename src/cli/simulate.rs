@@ -12,12 +12,13 @@ use std::time::Instant;
 use anyhow::Context as _;
 use clap::ValueEnum;
 
-use crate::engine::kinematics;
-use crate::engine::model::{Session, Use};
+use crate::engine::cell::sensor;
+use crate::engine::format;
 use crate::engine::plan;
-use crate::engine::session;
+use crate::engine::robot::{self, RobotChoice};
+use crate::engine::session::{Session, Use};
 use crate::engine::simulate::{
-    self, ErrorModel, InitialHandEye, PlanExecution, RobotChoice, SideChoice, SimConfig,
+    self, ErrorModel, InitialHandEye, PlanExecution, SideChoice, SimConfig,
 };
 
 /// Robot preset (`--robot`).
@@ -207,12 +208,12 @@ fn write_import_files(session: &Session, dir: &Path) -> anyhow::Result<()> {
     let profiles = dir.join("profiles");
     std::fs::create_dir_all(&profiles)
         .with_context(|| format!("creating {} failed", profiles.display()))?;
-    session::write_atomic(&dir.join("joints.csv"), files.joints_csv.as_bytes())?;
+    format::write_atomic(&dir.join("joints.csv"), files.joints_csv.as_bytes())?;
     for (id, text) in &files.profiles {
-        session::write_atomic(&profiles.join(format!("{id}.csv")), text.as_bytes())?;
+        format::write_atomic(&profiles.join(format!("{id}.csv")), text.as_bytes())?;
     }
     if let Some(text) = &files.references_csv {
-        session::write_atomic(&dir.join("references.csv"), text.as_bytes())?;
+        format::write_atomic(&dir.join("references.csv"), text.as_bytes())?;
     }
     Ok(())
 }
@@ -251,14 +252,14 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
                 .with_context(|| format!("reading failed ({})", path.display()))?;
             let poses = plan::read_plan_csv(&text)
                 .map_err(|e| anyhow::anyhow!("{e} ({})", path.display()))?;
-            let nominal = kinematics::preset(config.robot.key())
+            let nominal = robot::preset(config.robot.key())
                 .map(|p| p.robot)
                 .ok_or_else(|| anyhow::anyhow!("unknown robot {}", config.robot.key()))?;
             let hand_eye = match &args.hand_eye {
                 Some(he) => {
                     super::plan::read_hand_eye(he).map_err(|e| anyhow::anyhow!(e.message))?
                 }
-                None => simulate::paper_hand_eye(),
+                None => sensor::paper_hand_eye(),
             };
             let execution = if args.touch_up {
                 PlanExecution::TouchUp
@@ -272,8 +273,8 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     if let Some(dir) = &args.csv_out {
         write_import_files(&session, dir)?;
     }
-    session::write_atomic(&truth_path, simulate::truth_to_json(&truth).as_bytes())?;
-    session::write_atomic(&args.out, session::session_to_json(&session).as_bytes())?;
+    format::write_atomic(&truth_path, simulate::truth_to_json(&truth).as_bytes())?;
+    format::write_atomic(&args.out, format::session_to_json(&session).as_bytes())?;
     let count = |usage: Use| session.with_use(usage).count();
     println!(
         "simulated {} (seed {}): {} measurements ({} translation, {} rotation, {} identify, {} validate), {} reference distances -> {}, truth {} ({:.0} ms)",

@@ -141,6 +141,25 @@ pub fn rotation_angle_between(a: &Isometry3<f64>, b: &Isometry3<f64>) -> f64 {
     a.rotation.angle_to(&b.rotation)
 }
 
+/// `v` (deg) moved by whole turns into (−180, 180].
+#[must_use]
+pub fn wrap_deg(v: f64) -> f64 {
+    let w = v - 360.0 * (v / 360.0).round();
+    if w <= -180.0 { w + 360.0 } else { w }
+}
+
+/// A rigid transform from 4×4 rows, taking the nearest rotation of the 3×3
+/// block. For rows that pass [`isometry_from_rows`] the result is identical
+/// to it (same conversion); it never fails, so accessors need no `Result`.
+#[must_use]
+pub fn rigid_from_rows(rows: &[[f64; 4]; 4]) -> Isometry3<f64> {
+    let r = Matrix3::from_fn(|i, j| rows[i][j]);
+    Isometry3::from_parts(
+        Translation3::new(rows[0][3], rows[1][3], rows[2][3]),
+        UnitQuaternion::from_matrix(&r),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -180,5 +199,13 @@ mod tests {
         let v = Vector3::new(1.0, 2.0, 3.0);
         let w = Vector3::new(-0.5, 4.0, 0.25);
         assert!((skew(&v) * w - v.cross(&w)).norm() < 1e-14);
+    }
+
+    #[test]
+    fn wraps_to_half_open_turn() {
+        assert_eq!(wrap_deg(190.0), -170.0);
+        assert_eq!(wrap_deg(-180.0), 180.0);
+        assert_eq!(wrap_deg(540.0), 180.0);
+        assert!((wrap_deg(-725.0) - -5.0).abs() < 1e-12);
     }
 }

@@ -14,8 +14,66 @@
 
 use nalgebra::{DMatrix, DVector, Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 
-use super::error::HandEyeError;
-use super::kinematics::Robot;
+use crate::engine::robot::Robot;
+
+/// The initial hand-eye (paper 3.1) cannot be determined from the data.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum HandEyeError {
+    /// Fewer translation measurements than eq. 6-7 need.
+    #[error(
+        "the initial rotation (eq. 6-7) needs at least 3 translation measurements, the session has {found}{}",
+        list_ids(ids)
+    )]
+    TooFewTranslations {
+        /// Measurements found.
+        found: usize,
+        /// Their ids.
+        ids: Vec<String>,
+    },
+    /// Translation displacements do not span a plane.
+    #[error("the translation displacements of {} are collinear (second singular value {ratio:.2e} of the first): the rotation about their common direction is undetermined; move the robot in two different directions", ids.join(", "))]
+    CollinearTranslations {
+        /// Measurement ids involved.
+        ids: Vec<String>,
+        /// σ2/σ1 of the displacement matrix.
+        ratio: f64,
+    },
+    /// Fewer rotation measurements than eq. 8-9 need.
+    #[error(
+        "the initial translation (eq. 8-9) needs at least 2 rotation measurements, the session has {found}{}",
+        list_ids(ids)
+    )]
+    TooFewRotations {
+        /// Measurements found.
+        found: usize,
+        /// Their ids.
+        ids: Vec<String>,
+    },
+    /// Orientations do not differ enough (or only about one axis).
+    #[error("the orientations of rotation measurements {} do not determine the translation (eq. 8-9): {detail}", ids.join(", "))]
+    RotationsTooSimilar {
+        /// Measurement ids involved.
+        ids: Vec<String>,
+        /// What was measured.
+        detail: String,
+    },
+    /// Translation or rotation measurements span more than one station.
+    #[error("all {usage} measurements must share one station, found stations {}", stations.join(", "))]
+    MixedStations {
+        /// "translation" or "rotation".
+        usage: &'static str,
+        /// The stations found.
+        stations: Vec<String>,
+    },
+}
+
+fn list_ids(ids: &[String]) -> String {
+    if ids.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", ids.join(", "))
+    }
+}
 
 /// Smallest ratio σ₂/σ₁ of the translation-displacement matrix accepted as
 /// "not collinear". Displacements of 15-20 mm in different directions give
@@ -247,7 +305,7 @@ pub fn initial_hand_eye(
 mod tests {
     use super::*;
     use crate::engine::geometry::isometry_from_twist;
-    use crate::engine::kinematics::irb2400;
+    use crate::engine::robot::irb2400;
 
     /// Sightings of `station` from flange poses (exact, no noise).
     fn sight(

@@ -1,35 +1,36 @@
 //! The headless calibration engine. It never imports egui, eframe or rfd;
 //! the command line and the workbench are two thin callers of it.
 //!
-//! Where each part of the paper lives:
+//! The units are listed in pipeline order; each uses only units above it.
 //!
-//! | paper | module |
+//! | unit | holds |
 //! |---|---|
-//! | eq. 1-2 (frames), MDH model, `J_i` of eq. 16 | [`kinematics`] |
-//! | eq. 21 (sphere centre from a stripe circle) | [`stripe`] |
-//! | eq. 3-9 (initial hand-eye) | [`handeye`] |
-//! | eq. 10-19 (joint identification, truncated SVD) | [`identify`] |
-//! | eq. 20 (ε) and the validation of section 4.3 | [`validate`] |
-//! | Fig. 2 (the loop) and the whole pipeline | [`calibrate`] |
+//! | [`geometry`], [`numeric`] | rigid transforms, twists, roll/pitch/yaw; rounding, medians |
+//! | [`robot`] | the MDH model, forward kinematics and Jacobians, presets, inverse kinematics |
+//! | [`session`] | the in-memory session every function takes |
+//! | [`stripe`] | circle fit of a stripe, the sphere centre (eq. 21) |
+//! | [`handeye`] | the initial hand-eye (eq. 3-9) |
+//! | [`validate`] | ε (eq. 20), statistics, Fig. 5 and 6 distances |
+//! | [`solve`] | the loop of Fig. 2 around the paper's update (eq. 10-19) or `ml` |
+//! | [`format`] | session and result files, atomic writes |
+//! | [`report`] | text summary, HTML report, model export |
+//! | [`cell`] | what the simulator and the planner share about a cell |
+//! | [`import`] | joint logs and profiles into a session |
+//! | [`simulate`], [`plan`], [`history`], [`evaluate`] | simulated sessions, pose plans, drift over time, method comparison |
 
-pub mod calibrate;
-pub mod error;
+pub mod cell;
 pub mod evaluate;
+pub mod format;
 pub mod geometry;
 pub mod handeye;
 pub mod history;
-pub mod html_report;
-pub mod identify;
-pub mod ik;
 pub mod import;
-pub mod kinematics;
-pub mod ml;
-pub mod model;
-pub mod model_export;
+pub mod numeric;
 pub mod plan;
 pub mod report;
+pub mod robot;
 pub mod session;
 pub mod simulate;
+pub mod solve;
 pub mod stripe;
-pub mod svg;
 pub mod validate;

@@ -46,11 +46,59 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::engine::error::StripeError;
+/// A circle fit or sphere-centre computation failed (one stripe).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StripeError {
+    /// Fewer points than a circle fit needs.
+    #[error("stripe has {found} points, at least {needed} are needed")]
+    TooFewPoints {
+        /// Points in the stripe.
+        found: usize,
+        /// Minimum (FORMAT.md: 5).
+        needed: usize,
+    },
+    /// A point is NaN or infinite.
+    #[error("stripe point {index} is not finite")]
+    NonFinite {
+        /// Index of the point.
+        index: usize,
+    },
+    /// The points do not determine a circle (collinear or coincident).
+    #[error("stripe points are collinear or coincident: no circle fits them")]
+    Degenerate,
+    /// After rejecting outliers too few points remain.
+    #[error("only {kept} of {total} stripe points remain after outlier rejection")]
+    TooManyOutliers {
+        /// Points kept.
+        kept: usize,
+        /// Points in the stripe.
+        total: usize,
+    },
+    /// Fitted radius larger than the sphere beyond the tolerance.
+    #[error(
+        "fitted stripe radius r = {r:.4} mm exceeds the sphere radius R = {sphere:.4} mm by {excess_pct:.2} % (tolerance 0.5 %)"
+    )]
+    RadiusTooLarge {
+        /// Fitted radius, mm.
+        r: f64,
+        /// Sphere radius, mm.
+        sphere: f64,
+        /// `(r − R)/R` in percent.
+        excess_pct: f64,
+    },
+    /// The sphere radius, the side or the fitted circle handed to the
+    /// sphere-centre computation is unusable (radius not finite and
+    /// positive, side not ±1).
+    #[error("invalid sphere-centre input: {detail}")]
+    InvalidInput {
+        /// What is wrong, with the value.
+        detail: String,
+    },
+}
 
-/// Fewest points a stripe may have (FORMAT.md: "A stripe needs at least 5
-/// points"): three determine a circle, two more give a residual check.
-pub const MIN_POINTS: usize = 5;
+/// Fewest points a stripe may have: the session rule
+/// [`MIN_STRIPE_POINTS`](crate::engine::session::MIN_STRIPE_POINTS).
+pub const MIN_POINTS: usize = crate::engine::session::MIN_STRIPE_POINTS;
 
 /// How far the fitted stripe radius `r` may exceed the sphere radius `R`, as
 /// a fraction of `R` (FORMAT.md: 0.5 %). Within it the centre is taken on the

@@ -6,7 +6,7 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use super::model::ReferenceDistance;
+use crate::engine::session::ReferenceDistance;
 
 /// FORMAT.md statistics of a list of errors `e`: `max |e|`, the sample
 /// standard deviation (divisor `n − 1`) and `sqrt(mean e²)`. All mm.

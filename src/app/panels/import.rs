@@ -11,7 +11,7 @@ use crate::app::commands::Command;
 use crate::app::state::{AppState, DialogPurpose, Forms};
 use crate::app::wizard::{CONVENTIONS, ImportForm, ProfilesKind};
 use crate::engine::import::{AngleUnit, LengthUnit};
-use crate::engine::kinematics;
+use crate::engine::robot;
 
 /// Width of the path fields, points.
 const PATH_WIDTH: f32 = 420.0;
@@ -177,7 +177,7 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
                     egui::ComboBox::from_id_salt("import_robot_preset")
                         .selected_text(&f.robot_preset)
                         .show_ui(ui, |ui| {
-                            for p in kinematics::presets() {
+                            for p in robot::presets() {
                                 ui.selectable_value(
                                     &mut f.robot_preset,
                                     p.key.to_string(),

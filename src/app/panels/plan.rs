@@ -11,9 +11,9 @@ use super::{AFTER, BAD, BEFORE, MUTED, labelled_field};
 use crate::app::commands::Command;
 use crate::app::planner::{PlanOutcome, default_sphere};
 use crate::app::state::{AppState, DialogPurpose, Forms, PlanExport};
-use crate::engine::kinematics;
-use crate::engine::model::Use;
 use crate::engine::plan::{Plan, StationRole};
+use crate::engine::robot;
+use crate::engine::session::Use;
 
 /// Width of the settings column, points.
 const FORM_WIDTH: f32 = 330.0;
@@ -77,7 +77,7 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
             egui::ComboBox::from_id_salt("plan_robot")
                 .selected_text(&f.robot)
                 .show_ui(ui, |ui| {
-                    for p in kinematics::presets() {
+                    for p in robot::presets() {
                         ui.selectable_value(
                             &mut f.robot,
                             p.key.to_string(),

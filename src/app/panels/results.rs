@@ -15,8 +15,8 @@ use super::{AFTER, BAD, BEFORE, MUTED, WARN, labelled_field, ratio_text};
 use crate::app::commands::Command;
 use crate::app::state::{AppState, DialogPurpose, ExportKind, Forms};
 use crate::app::view::{HandEyeView, ResultOrigin, ResultView};
-use crate::engine::identify::HAND_EYE_LABELS;
-use crate::engine::kinematics::{PARAM_NAMES, PARAMS_PER_JOINT};
+use crate::engine::robot::{PARAM_NAMES, PARAMS_PER_JOINT};
+use crate::engine::solve::estimate::HAND_EYE_LABELS;
 
 /// Longest solver-block value shown in full (longer ones are cut, the
 /// whole value is in the tooltip and the exported JSON).

@@ -8,7 +8,7 @@ use egui_extras::{Column, TableBuilder};
 use super::{BAD, MUTED, WARN, labelled_field};
 use crate::app::commands::Command;
 use crate::app::state::{AppState, DialogPurpose, Fit, Forms, Grouping, LoadedSession};
-use crate::engine::model::Use;
+use crate::engine::session::Use;
 
 /// A row of the table: a group header or a measurement.
 enum Row {
@@ -144,7 +144,7 @@ fn rows(state: &AppState, loaded: &LoadedSession, forms: &Forms) -> Vec<Row> {
         };
         if key.is_some() && key != current {
             let k = key.clone().unwrap_or_default();
-            let members: Vec<&crate::engine::model::Measurement> = ms
+            let members: Vec<&crate::engine::session::Measurement> = ms
                 .iter()
                 .filter(|m| match forms.group {
                     Grouping::Station => m.station == k,

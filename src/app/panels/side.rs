@@ -5,8 +5,8 @@
 use egui::{RichText, Vec2};
 use egui_plot::{HLine, Line, Plot, PlotPoints, Points};
 
-use crate::engine::calibrate::Method;
-use crate::engine::identify::Pairing;
+use crate::engine::solve::Method;
+use crate::engine::solve::paper::Pairing;
 
 use super::{AFTER, BAD, BEFORE, labelled_field};
 use crate::app::commands::Command;

@@ -10,7 +10,7 @@ use egui_plot::{HLine, Legend, Line, LineStyle, MarkerShape, Plot, PlotPoints, P
 use super::{AFTER, BAD, BEFORE, MUTED, WARN};
 use crate::app::commands::Command;
 use crate::app::state::{AppState, Fit, Forms};
-use crate::engine::model::Observation;
+use crate::engine::session::Observation;
 use crate::engine::stripe::StripeResult;
 
 /// Points on the drawn circle.

@@ -4,20 +4,12 @@
 
 use std::fmt::Write as _;
 
-use nalgebra::{Isometry3, Vector3};
+use nalgebra::Vector3;
 
 use super::{Plan, PlanError};
-use crate::engine::model::Use;
+use crate::engine::cell::joint_log::{self, Table};
+use crate::engine::session::Use;
 use crate::engine::simulate::PlanPose;
-
-/// The flange pose as an ABB controller reports it: `x, y, z` (mm) and the
-/// unit quaternion `q1..q4 = w, x, y, z` with `w ≥ 0`.
-fn abb_pose(pose: &Isometry3<f64>) -> [f64; 7] {
-    let t = pose.translation.vector;
-    let q = pose.rotation.into_inner();
-    let q = if q.w < 0.0 { -q } else { q };
-    [t.x, t.y, t.z, q.w, q.i, q.j, q.k]
-}
 
 /// The plan as a joint log CSV that `spherecal import` reads: header
 /// `id,station,use,side,j1..jn,x,y,z,q1,q2,q3,q4` (joints deg; the nominal
@@ -28,54 +20,50 @@ fn abb_pose(pose: &Isometry3<f64>) -> [f64; 7] {
 /// the header describe the plan.
 #[must_use]
 pub fn plan_csv(plan: &Plan) -> String {
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "# spherecal plan: {}, {} poses, sphere diameter {} mm, cut angle ±{}°",
-        plan.robot.name,
-        plan.poses.len(),
-        plan.diameter,
-        plan.cut_angle
-    );
-    let _ = writeln!(
-        out,
-        "# joints in deg; x,y,z,q1..q4: nominal flange pose (mm, ABB quaternion w,x,y,z); sphere_*: station (base, mm); centre_*: planned sphere centre (sensor, mm)"
-    );
-    let mut header = String::from("id,station,use,side");
-    for k in 1..=plan.robot.dof() {
-        let _ = write!(header, ",j{k}");
-    }
-    header.push_str(",x,y,z,q1,q2,q3,q4,sphere_x,sphere_y,sphere_z,centre_x,centre_y,centre_z");
-    let _ = writeln!(out, "{header}");
-    for p in &plan.poses {
-        let _ = write!(
-            out,
-            "{},{},{},{}",
-            p.id,
-            p.station,
-            p.usage.as_str(),
-            p.side
-        );
-        for q in &p.joints {
-            let _ = write!(out, ",{q:.9}");
-        }
-        let f = abb_pose(&p.base_from_flange);
-        let _ = write!(
-            out,
-            ",{:.6},{:.6},{:.6},{:.12},{:.12},{:.12},{:.12}",
-            f[0], f[1], f[2], f[3], f[4], f[5], f[6]
-        );
-        let s = plan
-            .station(&p.station)
-            .map_or_else(Vector3::zeros, |s| s.position);
-        let c = p.centre_in_sensor;
-        let _ = writeln!(
-            out,
-            ",{:.6},{:.6},{:.6},{:.9},{:.9},{:.9}",
-            s.x, s.y, s.z, c.x, c.y, c.z
-        );
-    }
-    out
+    let comments = [
+        format!(
+            "spherecal plan: {}, {} poses, sphere diameter {} mm, cut angle ±{}°",
+            plan.robot.name,
+            plan.poses.len(),
+            plan.diameter,
+            plan.cut_angle
+        ),
+        "joints in deg; x,y,z,q1..q4: nominal flange pose (mm, ABB quaternion w,x,y,z); sphere_*: station (base, mm); centre_*: planned sphere centre (sensor, mm)".to_string(),
+    ];
+    let rows: Vec<joint_log::Row> = plan
+        .poses
+        .iter()
+        .map(|p| {
+            let s = plan
+                .station(&p.station)
+                .map_or_else(Vector3::zeros, |s| s.position);
+            let c = p.centre_in_sensor;
+            joint_log::Row {
+                id: &p.id,
+                station: &p.station,
+                usage: p.usage,
+                side: p.side,
+                joints: &p.joints,
+                flange: p.base_from_flange,
+                extra: vec![
+                    format!("{:.6}", s.x),
+                    format!("{:.6}", s.y),
+                    format!("{:.6}", s.z),
+                    format!("{:.9}", c.x),
+                    format!("{:.9}", c.y),
+                    format!("{:.9}", c.z),
+                ],
+            }
+        })
+        .collect();
+    joint_log::write(
+        &comments,
+        plan.robot.dof(),
+        &[
+            "sphere_x", "sphere_y", "sphere_z", "centre_x", "centre_y", "centre_z",
+        ],
+        &rows,
+    )
 }
 
 /// Reads the poses of a plan CSV ([`plan_csv`]'s layout; columns found by
@@ -86,29 +74,17 @@ pub fn plan_csv(plan: &Plan) -> String {
 /// # Errors
 /// [`PlanError::Csv`] naming the line and the column.
 pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPose>, PlanError> {
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let Some((header_line, header)) = lines.next() else {
-        return Err(PlanError::Csv {
-            line: 1,
-            message: "no header row".to_owned(),
-        });
-    };
-    let header: Vec<String> = header
-        .split(',')
-        .map(|h| h.trim().to_ascii_lowercase())
-        .collect();
+    let table = Table::parse(text).map_err(|e| PlanError::Csv {
+        line: e.line,
+        message: e.message,
+    })?;
+    let header_line = table.header_line;
+    let header = &table.header;
     let column = |name: &str| {
-        header
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| PlanError::Csv {
-                line: header_line,
-                message: format!("no column `{name}` (the header has: {})", header.join(", ")),
-            })
+        table.column(name).ok_or_else(|| PlanError::Csv {
+            line: header_line,
+            message: table.no_column(name),
+        })
     };
     let (id, station, usage, side) = (
         column("id")?,
@@ -117,7 +93,7 @@ pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPose>, PlanError> {
         column("side")?,
     );
     let joints: Vec<usize> = (1..)
-        .map_while(|k| header.iter().position(|h| *h == format!("j{k}")))
+        .map_while(|k| table.column(&format!("j{k}")))
         .collect();
     let centre = [
         column("centre_x")?,
@@ -125,16 +101,9 @@ pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPose>, PlanError> {
         column("centre_z")?,
     ];
     let mut out = Vec::new();
-    for (line, l) in lines {
-        let fields: Vec<&str> = l.split(',').map(str::trim).collect();
+    for (line, fields) in &table.rows {
+        let line = *line;
         let fail = |message: String| PlanError::Csv { line, message };
-        if fields.len() != header.len() {
-            return Err(fail(format!(
-                "{} fields, the header has {}",
-                fields.len(),
-                header.len()
-            )));
-        }
         let number = |c: usize| -> Result<f64, PlanError> {
             fields[c]
                 .parse::<f64>()
@@ -147,13 +116,13 @@ pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPose>, PlanError> {
                     ))
                 })
         };
-        let usage = Use::parse(fields[usage]).ok_or_else(|| {
+        let usage = Use::parse(&fields[usage]).ok_or_else(|| {
             fail(format!(
                 "`{}` is not translation, rotation, identify or validate",
                 fields[usage]
             ))
         })?;
-        let side = match fields[side] {
+        let side = match fields[side].as_str() {
             "1" | "+1" => 1,
             "-1" => -1,
             other => return Err(fail(format!("side `{other}` is not +1 or -1"))),

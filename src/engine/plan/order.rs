@@ -6,9 +6,10 @@
 use nalgebra::Vector3;
 
 use super::{Candidate, Group, Site, StationRole};
-use crate::engine::ik::{DOF, wrap_deg};
-use crate::engine::kinematics::JointLimit;
-use crate::engine::model::Use;
+use crate::engine::geometry::wrap_deg;
+use crate::engine::robot::JointLimit;
+use crate::engine::robot::ik::DOF;
+use crate::engine::session::Use;
 
 /// Bound on the 2-opt passes over one group: each pass strictly shortens
 /// the path, and a group of tens of poses settles in a handful.

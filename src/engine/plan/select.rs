@@ -8,9 +8,9 @@ use nalgebra::{Cholesky, DMatrix, Dyn, Matrix3};
 use rand_chacha::ChaCha8Rng;
 
 use super::{Candidate, Planner, Site, joint_gap, side_quota, unknown_scale};
-use crate::engine::identify::unknown_is_angle;
-use crate::engine::kinematics::Robot;
-use crate::engine::ml::MlOptions;
+use crate::engine::robot::Robot;
+use crate::engine::solve::estimate::unknown_is_angle;
+use crate::engine::solve::ml::MlOptions;
 
 /// Weak prior σ of the hand-eye translation in the criterion, mm: only
 /// ranks the first, still singular selection steps (`ml` has no hand-eye

@@ -4,7 +4,7 @@
 //! **Model (paper eq. 1, 10).** Every identify measurement `i` of station
 //! `s` sees the sphere at `X_i = bT_e(q_i; p) · eT_s · X_si`; the station
 //! centre `c_s` (base frame) is an unknown like the hand-eye (6, a twist in
-//! the sensor frame as in [`identify`](super::identify)) and the kinematic
+//! the sensor frame as in [`identify`](crate::engine::solve::paper)) and the kinematic
 //! errors (`5·n`). The residual of a measurement is `e_i = X_i − c_s`, so
 //! every measurement is used once, with no pairing (eq. 17-18 difference
 //! pairs instead; their noise is correlated and the disjoint pairing of the
@@ -78,15 +78,17 @@ use nalgebra::{DMatrix, DVector, Matrix3, Matrix3x6, SymmetricEigen, Vector3};
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
-use super::calibrate::{
+use super::{CalibrationError, IdentifyError};
+use crate::engine::geometry::skew;
+use crate::engine::handeye::Sighting;
+use crate::engine::session::{Session, Use};
+use crate::engine::solve::estimate::{
+    ANGLE_SCALE_MM, Estimate, sensitivity, unknown_is_angle, unknown_label,
+};
+use crate::engine::solve::{
     Calibration, Control, Options, Prepared, PreparedMeasurement, Progress, StopReason,
 };
-use super::error::{CalibrationError, IdentifyError};
-use super::geometry::skew;
-use super::handeye::Sighting;
-use super::identify::{ANGLE_SCALE_MM, Estimate, sensitivity, unknown_is_angle, unknown_label};
-use super::model::{Session, Use};
-use super::validate::epsilon;
+use crate::engine::validate::epsilon;
 
 /// Default σ of the joint readings, deg: the repeatability-level noise of
 /// an industrial arm's encoders (the simulator's default is 0.003°).
@@ -841,14 +843,14 @@ fn sensitivity_at(est: &Estimate, s: &Sighting, point: &Vector3<f64>) -> DMatrix
 /// values close to the physical deviations, which is what a prior on them
 /// assumes; a different member would have to absorb e.g. a 0.76° `theta3`
 /// as `beta4` and 1.8 mm of `d4`.
-fn pivot_preference(robot: &super::kinematics::Robot, u: usize) -> f64 {
+fn pivot_preference(robot: &crate::engine::robot::Robot, u: usize) -> f64 {
     if u < 6 {
         return 1.0;
     }
     let k = u - 6;
     let (joint, which) = (
-        k / super::kinematics::PARAMS_PER_JOINT,
-        k % super::kinematics::PARAMS_PER_JOINT,
+        k / crate::engine::robot::PARAMS_PER_JOINT,
+        k % crate::engine::robot::PARAMS_PER_JOINT,
     );
     let n = robot.joints.len();
     let parallel_to_previous =
@@ -1236,7 +1238,7 @@ impl MlSolver {
 /// ε before any update; while ε > threshold, fewer than `max_iterations`
 /// updates were made and LM has not converged, one update (a complete LM
 /// solve) and ε again. `progress` sees every ε and may cancel. Called by
-/// [`calibrate::run`](super::calibrate::run) for [`Method::Ml`](super::calibrate::Method::Ml).
+/// [`solve::run`](crate::engine::solve::run) for [`Method::Ml`](crate::engine::solve::Method::Ml).
 ///
 /// # Errors
 /// A bad option, too little data, a non-finite step or a cancel.
@@ -1317,7 +1319,7 @@ pub fn run(
     };
     let report = diagnostics(session, prepared, options, &solver, &stop);
     let est = solver.state.est.clone();
-    let mut cal = super::calibrate::finish(
+    let mut cal = crate::engine::solve::finish(
         session, prepared, options, &start, est, iterations, stop, None,
     );
     cal.solver = report.to_solver_block();

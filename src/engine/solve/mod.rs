@@ -5,20 +5,86 @@
 //! [`prepare`] and [`run`]; `run` reports every ε through a callback that
 //! can cancel.
 
+pub mod estimate;
+pub mod ml;
+pub mod paper;
+
 use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 use serde_json::{Map, Value, json};
 
-use super::error::{CalibrationError, IdentifyError};
-use super::handeye::{InitialHandEye, Sighting, initial_hand_eye};
-use super::identify::{
-    Estimate, Pairing, PaperOptions, Station, UpdateInfo, paper_update, unknown_label,
-};
-use super::kinematics::Robot;
-use super::model::{Observation, Session, Use};
-use super::stripe::{StripeResult, centre_from_stripe};
-use super::validate::{
+use crate::engine::handeye::HandEyeError;
+use crate::engine::handeye::{InitialHandEye, Sighting, initial_hand_eye};
+use crate::engine::robot::Robot;
+use crate::engine::session::{Observation, Session, Use};
+use crate::engine::solve::estimate::{Estimate, Station, unknown_label};
+use crate::engine::solve::paper::{Pairing, PaperOptions, UpdateInfo, paper_update};
+use crate::engine::stripe::StripeError;
+use crate::engine::stripe::{StripeResult, centre_from_stripe};
+use crate::engine::validate::{
     BeforeAfter, StationCentres, Stats, Validation, epsilon, validation, within_station_distances,
 };
+
+/// The identification (paper 3.2 or the ML method) cannot run or failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum IdentifyError {
+    /// No identify station has two measurements.
+    #[error(
+        "identification needs at least one identify station with 2 or more measurements; {detail}"
+    )]
+    NotEnoughData {
+        /// What was found.
+        detail: String,
+    },
+    /// A number became non-finite during the solve.
+    #[error("the solver produced a non-finite value at iteration {iteration}")]
+    NonFinite {
+        /// Update number.
+        iteration: usize,
+    },
+    /// The user cancelled the run.
+    #[error("cancelled by the user after {iterations} update(s)")]
+    Cancelled {
+        /// Updates made before the cancel.
+        iterations: usize,
+    },
+    /// An option is out of range.
+    #[error("invalid solver option: {0}")]
+    InvalidOption(String),
+}
+
+/// Anything that stops a calibration of a loaded session.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CalibrationError {
+    /// One stripe could not give a sphere centre.
+    #[error("measurement {id}: {source}")]
+    Stripe {
+        /// Measurement id.
+        id: String,
+        /// The stripe problem.
+        source: StripeError,
+    },
+    /// The initial hand-eye could not be determined.
+    #[error(transparent)]
+    HandEye(#[from] HandEyeError),
+    /// The identification could not run.
+    #[error(transparent)]
+    Identify(#[from] IdentifyError),
+}
+
+impl CalibrationError {
+    /// True when the cause is the input data (exit status 2), false for an
+    /// internal failure or a cancel.
+    #[must_use]
+    pub fn is_input_error(&self) -> bool {
+        match self {
+            Self::Stripe { .. } | Self::HandEye(_) => true,
+            Self::Identify(e) => matches!(
+                e,
+                IdentifyError::NotEnoughData { .. } | IdentifyError::InvalidOption(_)
+            ),
+        }
+    }
+}
 
 /// Identification method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -27,7 +93,7 @@ pub enum Method {
     Paper,
     /// Maximum likelihood: station centres as unknowns, noise-model
     /// weighting, identifiable set by pivoted QR, prior, robust loss
-    /// ([`super::ml`]).
+    /// ([`crate::engine::solve::ml`]).
     Ml,
 }
 
@@ -67,7 +133,7 @@ pub struct Options {
     /// Settings of the paper's update.
     pub paper: PaperOptions,
     /// Settings of the `ml` method.
-    pub ml: super::ml::MlOptions,
+    pub ml: crate::engine::solve::ml::MlOptions,
 }
 
 impl Options {
@@ -81,7 +147,7 @@ impl Options {
             threshold: session.solver.threshold,
             max_iterations: session.solver.max_iterations,
             paper: PaperOptions::default(),
-            ml: super::ml::MlOptions::default(),
+            ml: crate::engine::solve::ml::MlOptions::default(),
         }
     }
 }
@@ -416,7 +482,7 @@ pub fn run(
         .into());
     }
     if options.method == Method::Ml {
-        return super::ml::run(session, prepared, options, progress);
+        return crate::engine::solve::ml::run(session, prepared, options, progress);
     }
     let start = Estimate {
         robot: session.robot.clone(),
@@ -575,7 +641,7 @@ fn solver_block(
         "column_scaling".into(),
         json!(format!(
             "angle unknowns × {} mm/rad before the SVD",
-            super::identify::ANGLE_SCALE_MM
+            crate::engine::solve::estimate::ANGLE_SCALE_MM
         )),
     );
     m.insert("threshold".into(), json!(options.threshold));

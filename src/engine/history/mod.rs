@@ -8,11 +8,11 @@
 //!
 //! [`scan`] walks a folder (subfolders to [`MAX_DEPTH`] levels; hidden
 //! entries such as `.git` or the temporary files of
-//! [`write_atomic`](super::session::write_atomic) and symbolic links to
+//! [`write_atomic`](crate::engine::format::write_atomic) and symbolic links to
 //! folders are skipped). Every `*.json` file is classified by its
 //! `"format"` key, not by its name: `spherecal-session` and
 //! `spherecal-result` files are loaded by the strict loaders of
-//! [`session`](super::session); JSON files of other formats (truth files,
+//! [`session`](crate::engine::format); JSON files of other formats (truth files,
 //! anything else) are listed as ignored. A file that cannot be read, is
 //! not JSON, or breaks a rule of its format is a [`Problem`] with its path
 //! and message, and the scan goes on. Only a folder that cannot be read at
@@ -112,12 +112,12 @@ use serde::Deserialize;
 use serde::de::IgnoredAny;
 use serde_json::{Map, Value};
 
-use super::error::FileError;
-use super::geometry::isometry_from_rows;
-use super::identify::{ANGLE_SCALE_MM, HAND_EYE_LABELS};
-use super::kinematics::{Joint, PARAM_IS_ANGLE, PARAMS_PER_JOINT, Robot};
-use super::session::{self, RESULT_FORMAT, ResultFile, SESSION_FORMAT};
-use super::validate::Stats;
+use crate::engine::format::FileError;
+use crate::engine::format::{self, RESULT_FORMAT, ResultFile, SESSION_FORMAT};
+use crate::engine::geometry::isometry_from_rows;
+use crate::engine::robot::{Joint, PARAM_IS_ANGLE, PARAMS_PER_JOINT, Robot};
+use crate::engine::solve::estimate::{ANGLE_SCALE_MM, HAND_EYE_LABELS};
+use crate::engine::validate::Stats;
 
 /// Deepest subfolder level [`scan`] enters (the folder itself is level 0).
 /// A library is a folder of cells, robots or dates; 8 levels is far beyond
@@ -939,7 +939,7 @@ fn read_file(path: &Path) -> Result<Found, String> {
     };
     match format.as_ref().and_then(Value::as_str) {
         Some(SESSION_FORMAT) => {
-            let s = session::parse_session(&text, path).map_err(|e| file_error_message(&e))?;
+            let s = format::parse_session(&text, path).map_err(|e| file_error_message(&e))?;
             Ok(Found::Session {
                 name: s.name,
                 robot: s.robot.name,
@@ -948,7 +948,7 @@ fn read_file(path: &Path) -> Result<Found, String> {
             })
         }
         Some(RESULT_FORMAT) => {
-            let result = session::parse_result(&text, path).map_err(|e| file_error_message(&e))?;
+            let result = format::parse_result(&text, path).map_err(|e| file_error_message(&e))?;
             Ok(Found::Result {
                 result: Box::new(result),
                 modified,

@@ -25,9 +25,9 @@ use std::fmt::Write as _;
 
 use nalgebra::{Isometry3, Rotation3};
 
-use super::geometry::{MatrixError, isometry_from_rows, rot_x, rot_y, rot_z, trans};
-use super::kinematics::{Joint, Robot};
-use super::session::ResultFile;
+use crate::engine::format::ResultFile;
+use crate::engine::geometry::{MatrixError, isometry_from_rows, rot_x, rot_y, rot_z, trans};
+use crate::engine::robot::{Joint, Robot};
 
 /// Millimetres per metre: file lengths are mm, URDF lengths are m.
 const MM_PER_M: f64 = 1000.0;
@@ -127,7 +127,7 @@ fn check(result: &ResultFile) -> Result<(), ExportError> {
                     "joint_errors"
                 };
                 return Err(ExportError::NotFinite {
-                    what: format!("{what}[{i}].{}", super::kinematics::PARAM_NAMES[k % 5]),
+                    what: format!("{what}[{i}].{}", crate::engine::robot::PARAM_NAMES[k % 5]),
                 });
             }
         }

@@ -1,5 +1,5 @@
 //! Small hand-written SVG plots for the HTML report
-//! ([`super::html_report`]): markers and lines on linear or log axes, with
+//! ([`crate::engine::report::html`]): markers and lines on linear or log axes, with
 //! ticks, axis labels (units in the label), a legend, horizontal rules
 //! (a threshold, zero) and labelled x bands (stations). No plotting crate:
 //! a report needs a few scatter plots, and inline SVG renders in every

@@ -33,7 +33,7 @@
 //!    drawn: approach (flange z) uniform in a cone of `cone_angle` about the
 //!    direction from the eye point to the station, uniform roll. For each
 //!    orientation and side, every IK branch of the nominal model
-//!    ([`Chain::solutions`](super::ik::Chain::solutions)) within the joint
+//!    ([`Chain::solutions`](crate::engine::robot::ik::Chain::solutions)) within the joint
 //!    limits and at least `min_wrist_angle` from the wrist singularity is a
 //!    candidate, kept only when the reference forward kinematics puts the
 //!    planned sensor-frame centre on the station (to 1e-6 mm).
@@ -87,17 +87,24 @@ use nalgebra::{DMatrix, Isometry3, Matrix3, Point3, Translation3, Unit, UnitQuat
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-use super::calibrate::{self, Control, HandEyeSource, Method, Options, Prepared};
-use super::evaluate;
-use super::handeye::{MIN_TRANSLATION_SPREAD, Sighting};
-use super::identify::{ANGLE_SCALE_MM, Estimate, sensitivity, unknown_is_angle, unknown_label};
-use super::ik::{Chain, DOF, wrap_deg};
-use super::kinematics::{JointLimit, Preset, Robot};
-use super::ml::{self, MlOptions, MlReport};
-use super::model::{Measurement, Observation, ReferenceDistance, Session, SolverSettings, Use};
-use super::simulate::{
-    self, ErrorModel, InitialHandEye, PlanExecution, PlanPose, RobotChoice, SimConfig, Workspace,
+use crate::engine::cell::workspace::{self, Workspace};
+use crate::engine::cell::{approach, random, sensor};
+use crate::engine::evaluate;
+use crate::engine::geometry::wrap_deg;
+use crate::engine::handeye::{MIN_TRANSLATION_SPREAD, Sighting};
+use crate::engine::robot::ik::{Chain, DOF};
+use crate::engine::robot::{JointLimit, Preset, Robot, RobotChoice};
+use crate::engine::session::{
+    Measurement, Observation, ReferenceDistance, Session, SolverSettings, Use,
 };
+use crate::engine::simulate::{
+    self, ErrorModel, InitialHandEye, PlanExecution, PlanPose, SimConfig,
+};
+use crate::engine::solve::estimate::{
+    ANGLE_SCALE_MM, Estimate, sensitivity, unknown_is_angle, unknown_label,
+};
+use crate::engine::solve::ml::{self, MlOptions, MlReport};
+use crate::engine::solve::{self, Control, HandEyeSource, Method, Options, Prepared};
 
 mod export;
 mod order;
@@ -259,7 +266,7 @@ impl PlanConfig {
             robot,
             limits,
             sphere,
-            flange_from_sensor: simulate::paper_initial_hand_eye(),
+            flange_from_sensor: sensor::paper_initial_hand_eye(),
             diameter: sim.diameter,
             n_translation: sim.n_translation,
             n_rotation: sim.n_rotation,
@@ -288,14 +295,14 @@ impl PlanConfig {
     }
 
     /// Defaults for a preset: [`Self::new`] with the limits a cell plans
-    /// within ([`simulate::cell_limits`]) and the simulator's station box
+    /// within ([`workspace::cell_limits`]) and the simulator's station box
     /// size for that robot ([`Workspace::for_robot`], e.g. 400 × 600 ×
     /// 450 mm for the IRB 2400).
     #[must_use]
     pub fn for_preset(preset: &Preset, sphere: [f64; 3]) -> Self {
         let mut config = Self::new(
             preset.robot.clone(),
-            simulate::cell_limits(preset.key, &preset.limits),
+            workspace::cell_limits(preset.key, &preset.limits),
             sphere,
         );
         let choice = RobotChoice::from_key(preset.key);
@@ -1089,8 +1096,8 @@ impl Planner<'_> {
                     eye: eye.into(),
                 };
                 (
-                    simulate::identify_stations(rng, &w, c.n_identify),
-                    simulate::validate_stations(rng, &w, c.n_validate),
+                    workspace::identify_stations(rng, &w, c.n_identify),
+                    workspace::validate_stations(rng, &w, c.n_validate),
                 )
             }
             StationLayout::Explicit { identify, validate } => (
@@ -1153,7 +1160,7 @@ impl Planner<'_> {
         let cone = c.cone_angle.to_radians();
         let mut out = Vec::new();
         for _ in 0..c.candidates {
-            let rotation = simulate::random_orientation(rng, &mean, cone);
+            let rotation = approach::random_orientation(rng, &mean, cone);
             for side in [1_i8, -1] {
                 let offset = self.offset(rng);
                 out.extend(self.candidates_at(
@@ -1176,8 +1183,8 @@ impl Planner<'_> {
         let [y, z] = self.config.centre_spread;
         Vector3::new(
             0.0,
-            simulate::uniform(rng, -y, y),
-            simulate::uniform(rng, -z, z),
+            random::uniform(rng, -y, y),
+            random::uniform(rng, -z, z),
         )
     }
 
@@ -1233,7 +1240,7 @@ impl Planner<'_> {
         let n = c.n_translation;
         let tries = c.candidates * TRANSLATION_TRIES_PER_CANDIDATE;
         for _ in 0..tries {
-            let rotation = simulate::random_orientation(rng, &mean, cone);
+            let rotation = approach::random_orientation(rng, &mean, cone);
             let phase = std::f64::consts::TAU * rng.random::<f64>();
             if n == 0 {
                 // Only a reference orientation for the rotation group: one
@@ -1316,12 +1323,12 @@ impl Planner<'_> {
         let draws = c.candidates.max(n) * 2;
         let mut pool: Vec<Candidate> = Vec::new();
         for k in 0..draws {
-            let axis = Unit::new_normalize(simulate::direction_in_cone(
+            let axis = Unit::new_normalize(approach::direction_in_cone(
                 rng,
                 &Vector3::z(),
                 std::f64::consts::PI,
             ));
-            let angle = simulate::uniform(rng, c.rotation_min, c.rotation_max).to_radians();
+            let angle = random::uniform(rng, c.rotation_min, c.rotation_max).to_radians();
             let rotation = reference * UnitQuaternion::from_axis_angle(&axis, angle);
             let side = if k % 2 == 0 { 1 } else { -1 };
             // One branch per orientation: the eq. 8 rows depend on the
@@ -1454,7 +1461,7 @@ impl Planner<'_> {
                 joints: cand.joints.to_vec(),
                 observation: Observation::Centre(cand.centre),
             });
-            prepared.push(calibrate::PreparedMeasurement {
+            prepared.push(solve::PreparedMeasurement {
                 index,
                 centre_in_sensor: cand.centre,
                 covariance: Some(self.sensor_covariance(cand.side)),
@@ -1507,7 +1514,7 @@ impl Planner<'_> {
                 ..MlOptions::default()
             },
         };
-        let cal = calibrate::run(session, prepared, &options, &mut |_| Control::Continue)
+        let cal = solve::run(session, prepared, &options, &mut |_| Control::Continue)
             .map_err(|e| PlanError::Analysis(e.to_string()))?;
         MlReport::from_solver_block(&cal.solver)
             .ok_or_else(|| PlanError::Analysis("ml gave no report".to_owned()))
@@ -1715,7 +1722,7 @@ pub struct Prediction {
 /// so that the default guess gives the paper's calibrated hand-eye.
 #[must_use]
 pub fn simulated_true_hand_eye(guess: &Isometry3<f64>) -> Isometry3<f64> {
-    guess * simulate::paper_initial_hand_eye().inverse() * simulate::paper_hand_eye()
+    guess * sensor::paper_initial_hand_eye().inverse() * sensor::paper_hand_eye()
 }
 
 /// Predicted calibrated accuracy of a plan: `runs` simulations of its
@@ -1781,8 +1788,8 @@ pub fn predict(
         }
         let mut options = Options::from_session(&session);
         options.ml.cross_validation = false;
-        let prepared = calibrate::prepare(&session).map_err(|e| fail(e.to_string()))?;
-        let cal = calibrate::run(&session, &prepared, &options, &mut |_| Control::Continue)
+        let prepared = solve::prepare(&session).map_err(|e| fail(e.to_string()))?;
+        let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
             .map_err(|e| fail(e.to_string()))?;
         let score = evaluate::score(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
         runs.push(RunScore {

@@ -1,6 +1,6 @@
 //! Multi-branch inverse kinematics of 6-axis arms, shared by the simulator
-//! ([`simulate`](super::simulate)) and the pose planner
-//! ([`plan`](super::plan)).
+//! ([`simulate`](crate::engine::simulate)) and the pose planner
+//! ([`plan`](crate::engine::plan)).
 //!
 //! [`Chain`] is a [`Robot`] prepared for many IK solves: the same MDH
 //! product as [`Robot::base_from_flange`] with each joint's fixed part
@@ -31,8 +31,8 @@ use std::ops::ControlFlow;
 
 use nalgebra::{Isometry3, Matrix3, Matrix6, Translation3, UnitQuaternion, Vector3, Vector6};
 
-use super::geometry::{rot_x, rot_y, trans};
 use super::kinematics::{JointLimit, Robot};
+use crate::engine::geometry::{rot_x, rot_y, trans, wrap_deg};
 
 /// Joints of the arms this module solves (every preset has 6).
 pub const DOF: usize = 6;
@@ -109,13 +109,6 @@ fn joint_motion(angle_deg: f64, d: f64) -> Isometry3<f64> {
         Translation3::new(0.0, 0.0, d),
         UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle_deg.to_radians()),
     )
-}
-
-/// `v` (deg) moved by whole turns into (−180, 180].
-#[must_use]
-pub fn wrap_deg(v: f64) -> f64 {
-    let w = v - 360.0 * (v / 360.0).round();
-    if w <= -180.0 { w + 360.0 } else { w }
 }
 
 /// Whether every reading of `q` (deg) lies within its limit (inclusive).
@@ -469,14 +462,14 @@ impl Chain {
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
     use super::*;
-    use crate::engine::kinematics;
+    use crate::engine::robot::presets as kinematics;
 
     fn perturbed_irb2400() -> Robot {
         let mut robot = kinematics::irb2400().robot;
         for (j, e) in robot
             .joints
             .iter_mut()
-            .zip(crate::engine::simulate::table1_errors())
+            .zip(crate::engine::robot::table1_errors())
         {
             j.alpha += e.alpha;
             j.a += e.a;

@@ -1,8 +1,8 @@
 //! The kinematic model of FORMAT.md: modified DH with Hayati's `beta`,
 //! forward kinematics (paper eq. 1-2), the Jacobian of the flange pose with
-//! respect to all `5·n` parameters (the `J_i` of paper eq. 16), numerical
-//! inverse kinematics (for the simulator and the pose planner) and robot
-//! presets.
+//! respect to all `5·n` parameters (the `J_i` of paper eq. 16) and a
+//! numerical inverse kinematics from one start (the multi-branch solver of
+//! the simulator and the planner is [`ik`](super::ik)).
 //!
 //! Link transform of joint `i` (FORMAT.md "Kinematic model"):
 //!
@@ -19,7 +19,7 @@
 use nalgebra::{DMatrix, DVector, Isometry3, Matrix6xX, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
 
-use super::geometry::{rot_x, rot_y, rot_z, trans};
+use crate::engine::geometry::{rot_x, rot_y, rot_z, trans};
 
 /// Number of kinematic parameters per joint.
 pub const PARAMS_PER_JOINT: usize = 5;
@@ -331,181 +331,10 @@ fn translation_twist(frame: &Isometry3<f64>, axis_local: &Vector3<f64>) -> Vecto
     Vector6::new(u.x, u.y, u.z, 0.0, 0.0, 0.0)
 }
 
-/// A named robot preset: nominal model and joint limits.
-#[derive(Debug, Clone)]
-pub struct Preset {
-    /// Short key used on the command line (`--robot irb2400`).
-    pub key: &'static str,
-    /// The nominal model.
-    pub robot: Robot,
-    /// Joint limits, deg.
-    pub limits: Vec<JointLimit>,
-}
-
-fn joint(alpha: f64, a: f64, beta: f64, theta: f64, d: f64) -> Joint {
-    Joint {
-        alpha,
-        a,
-        beta,
-        theta,
-        d,
-    }
-}
-
-fn limits(pairs: &[(f64, f64)]) -> Vec<JointLimit> {
-    pairs
-        .iter()
-        .map(|&(min, max)| JointLimit { min, max })
-        .collect()
-}
-
-/// ABB IRB 2400/16 in the FORMAT.md convention (the paper's robot). Values:
-/// FORMAT.md's table, which follows ABB's product specification (615 mm
-/// base height, 100 mm shoulder offset, 705 mm lower arm, 135 mm elbow
-/// offset, 755 mm upper arm, 85 mm flange). Limits: ABB product
-/// specification IRB 2400 (axis 1 ±180°, 2 −100/+110°, 3 −60/+65°,
-/// 4 ±200°, 5 ±120°, 6 ±400°).
-#[must_use]
-pub fn irb2400() -> Preset {
-    Preset {
-        key: "irb2400",
-        robot: Robot::new(
-            "ABB IRB 2400/16",
-            vec![
-                joint(0.0, 0.0, 0.0, 0.0, 615.0),
-                joint(-90.0, 100.0, 0.0, -90.0, 0.0),
-                joint(0.0, 705.0, 0.0, 0.0, 0.0),
-                joint(-90.0, 135.0, 0.0, 0.0, 755.0),
-                joint(90.0, 0.0, 0.0, 0.0, 0.0),
-                joint(-90.0, 0.0, 0.0, 0.0, 85.0),
-            ],
-        ),
-        limits: limits(&[
-            (-180.0, 180.0),
-            (-100.0, 110.0),
-            (-60.0, 65.0),
-            (-200.0, 200.0),
-            (-120.0, 120.0),
-            (-400.0, 400.0),
-        ]),
-    }
-}
-
-/// ABB IRB 120-3/0.6 in the same layout as the IRB 2400. Values: ABB
-/// product specification IRB 120 (290 mm base height, 270 mm lower arm,
-/// 70 mm elbow offset, 302 mm upper arm, 72 mm flange; no shoulder
-/// offset). Limits from the same document (axis 1 ±165°, 2 ±110°,
-/// 3 −110/+70°, 4 ±160°, 5 ±120°, 6 ±400°).
-#[must_use]
-pub fn irb120() -> Preset {
-    Preset {
-        key: "irb120",
-        robot: Robot::new(
-            "ABB IRB 120-3/0.6",
-            vec![
-                joint(0.0, 0.0, 0.0, 0.0, 290.0),
-                joint(-90.0, 0.0, 0.0, -90.0, 0.0),
-                joint(0.0, 270.0, 0.0, 0.0, 0.0),
-                joint(-90.0, 70.0, 0.0, 0.0, 302.0),
-                joint(90.0, 0.0, 0.0, 0.0, 0.0),
-                joint(-90.0, 0.0, 0.0, 0.0, 72.0),
-            ],
-        ),
-        limits: limits(&[
-            (-165.0, 165.0),
-            (-110.0, 110.0),
-            (-110.0, 70.0),
-            (-160.0, 160.0),
-            (-120.0, 120.0),
-            (-400.0, 400.0),
-        ]),
-    }
-}
-
-/// Universal Robots UR5e. Values: Universal Robots' published standard-DH
-/// table ("DH parameters for calculations of kinematics and dynamics":
-/// d1 = 162.5, a2 = −425, a3 = −392.2, d4 = 133.3, d5 = 99.7, d6 = 99.6 mm,
-/// alpha1 = 90°, alpha4 = 90°, alpha5 = −90°), converted to this modified
-/// convention: standard `(a_i, alpha_i)` become the `(a, alpha)` of joint
-/// `i+1`; `a_6 = alpha_6 = 0`, so the flange transform is the identity.
-/// Limits ±360° on every joint (UR e-Series user manual).
-#[must_use]
-pub fn ur5e() -> Preset {
-    Preset {
-        key: "ur5e",
-        robot: Robot::new(
-            "Universal Robots UR5e",
-            vec![
-                joint(0.0, 0.0, 0.0, 0.0, 162.5),
-                joint(90.0, 0.0, 0.0, 0.0, 0.0),
-                joint(0.0, -425.0, 0.0, 0.0, 0.0),
-                joint(0.0, -392.2, 0.0, 0.0, 133.3),
-                joint(90.0, 0.0, 0.0, 0.0, 99.7),
-                joint(-90.0, 0.0, 0.0, 0.0, 99.6),
-            ],
-        ),
-        limits: limits(&[(-360.0, 360.0); 6]),
-    }
-}
-
-/// Every preset, the paper's robot first.
-#[must_use]
-pub fn presets() -> Vec<Preset> {
-    vec![irb2400(), irb120(), ur5e()]
-}
-
-/// The preset with this key (`irb2400`, `irb120`, `ur5e`).
-#[must_use]
-pub fn preset(key: &str) -> Option<Preset> {
-    presets().into_iter().find(|p| p.key == key)
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::presets::{irb2400, ur5e};
     use super::*;
-
-    #[test]
-    fn irb2400_zero_pose() {
-        let robot = irb2400().robot;
-        let pose = robot.base_from_flange(&[0.0; 6]);
-        let p = pose.translation.vector;
-        assert!((p - Vector3::new(940.0, 0.0, 1455.0)).norm() < 1e-9, "{p}");
-        // Flange z along base +x, as in ABB's tool0 at the calibration pose.
-        let z = pose.rotation * Vector3::z();
-        assert!((z - Vector3::x()).norm() < 1e-12, "{z}");
-    }
-
-    #[test]
-    fn irb120_zero_pose() {
-        let p = irb120()
-            .robot
-            .base_from_flange(&[0.0; 6])
-            .translation
-            .vector;
-        assert!((p - Vector3::new(374.0, 0.0, 630.0)).norm() < 1e-9, "{p}");
-    }
-
-    #[test]
-    fn ur5e_zero_pose() {
-        // UR zero pose: arm stretched along −x; tool at (−817.2, −232.9, 62.8)
-        // per the standard-DH chain (x = a2 + a3, y = −(d4 + d6), z = d1 − d5).
-        let p = ur5e().robot.base_from_flange(&[0.0; 6]).translation.vector;
-        assert!(
-            (p - Vector3::new(-817.2, -232.9, 62.8)).norm() < 1e-9,
-            "{p}"
-        );
-    }
-
-    #[test]
-    fn irb2400_joint2_rotates_arm_forward() {
-        // +q2 leans the lower arm forward: the wrist moves along +x, down.
-        let robot = irb2400().robot;
-        let p = robot
-            .base_from_flange(&[0.0, 10.0, 0.0, 0.0, 0.0, 0.0])
-            .translation
-            .vector;
-        assert!(p.x > 940.0 && p.z < 1455.0, "{p}");
-    }
 
     fn finite_difference_check(robot: &Robot, q: &[f64]) {
         let (pose, jac) = robot.flange_jacobian(q);
@@ -539,8 +368,9 @@ mod tests {
         robot.joints[2].beta = 0.7;
         robot.joints[4].a = -0.7;
         robot.base =
-            super::super::geometry::isometry_from_twist(&[5.0, -3.0, 2.0, 0.01, 0.02, -0.03]);
-        robot.flange = super::super::geometry::isometry_from_twist(&[1.0, 2.0, 3.0, 0.1, 0.0, 0.2]);
+            crate::engine::geometry::isometry_from_twist(&[5.0, -3.0, 2.0, 0.01, 0.02, -0.03]);
+        robot.flange =
+            crate::engine::geometry::isometry_from_twist(&[1.0, 2.0, 3.0, 0.1, 0.0, 0.2]);
         for q in [
             [0.0; 6],
             [12.5, 20.1, -3.4, 40.0, 35.2, -10.0],

@@ -4,10 +4,10 @@
 
 use std::fmt::Write as _;
 
-use super::calibrate::{Calibration, Prepared};
-use super::geometry::rows_from_isometry;
-use super::model::Session;
-use super::session::{CentreRecord, IterationRecord, ResultFile, RobotRecord};
+use crate::engine::format::result::{CentreRecord, IterationRecord, ResultFile, RobotRecord};
+use crate::engine::geometry::rows_from_isometry;
+use crate::engine::session::Session;
+use crate::engine::solve::{Calibration, Prepared};
 
 /// The FORMAT.md result file of a run.
 #[must_use]

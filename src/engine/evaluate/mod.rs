@@ -7,11 +7,11 @@
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
-use super::calibrate::Prepared;
-use super::kinematics::Robot;
-use super::model::{Session, Use};
-use super::simulate::Truth;
-use super::validate::Stats;
+use crate::engine::robot::Robot;
+use crate::engine::session::{Session, Use};
+use crate::engine::simulate::Truth;
+use crate::engine::solve::Prepared;
+use crate::engine::validate::Stats;
 
 /// Validation distance errors `measured − true` (mm) of a model and
 /// hand-eye: for each reference distance `from → to` of the session, the

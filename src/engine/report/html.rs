@@ -1,5 +1,5 @@
 //! The self-contained HTML report of a calibration: one file with inline
-//! CSS and inline SVG figures ([`super::svg`]), no script and no external
+//! CSS and inline SVG figures ([`crate::engine::report::svg`]), no script and no external
 //! resource, printable on A4. It shows what the workbench's Results view
 //! shows, plus the provenance a report needs:
 //!
@@ -12,7 +12,7 @@
 //! - settings: every scalar of the result's `solver` block and where the
 //!   initial hand-eye came from;
 //! - stripe quality: fitted radii, arc spans, cut angles, fit RMS
-//!   distribution, trimmed points, warnings (from [`calibrate::prepare`]);
+//!   distribution, trimmed points, warnings (from [`solve::prepare`]);
 //! - the paper's Fig. 5 (within-station centre distances, per pair) and
 //!   Fig. 6 (reference-distance errors, per distance), before and after;
 //! - ε per update, and the singular values of the paper's method;
@@ -34,16 +34,16 @@ use std::time::{SystemTime, UNIX_EPOCH};
 use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
 
-use super::calibrate::{self, HandEyeSource, Prepared};
-use super::geometry::{isometry_from_rows, rotation_angle_between};
-use super::identify::HAND_EYE_LABELS;
-use super::kinematics::PARAM_NAMES;
-use super::ml::MlReport;
-use super::model::{Observation, Session, Use};
-use super::session::{CentreRecord, ResultFile};
-use super::stripe::{HIGH_RMS_MM, StripeResult};
-use super::svg::{self, Band, Marker, Plot, Rule, Series, escape};
-use super::validate::{BeforeAfter, Stats, within_station_distances};
+use crate::engine::format::result::{CentreRecord, ResultFile};
+use crate::engine::geometry::{isometry_from_rows, rotation_angle_between};
+use crate::engine::report::svg::{self, Band, Marker, Plot, Rule, Series, escape};
+use crate::engine::robot::PARAM_NAMES;
+use crate::engine::session::{Observation, Session, Use};
+use crate::engine::solve::estimate::HAND_EYE_LABELS;
+use crate::engine::solve::ml::MlReport;
+use crate::engine::solve::{self, HandEyeSource, Prepared};
+use crate::engine::stripe::{HIGH_RMS_MM, StripeResult};
+use crate::engine::validate::{BeforeAfter, Stats, within_station_distances};
 
 /// The version written in the report: this crate's.
 pub const SOFTWARE_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -109,7 +109,7 @@ pub struct ReportInput<'a> {
     /// The result to report.
     pub result: &'a ResultFile,
     /// The session's stripe fits and initial hand-eye, when the caller has
-    /// them; `None` recomputes them with [`calibrate::prepare`].
+    /// them; `None` recomputes them with [`solve::prepare`].
     pub prepared: Option<&'a Prepared>,
     /// File name, time and version.
     pub meta: &'a ReportMeta,
@@ -304,7 +304,7 @@ pub fn render(input: &ReportInput<'_>) -> String {
     let computed;
     let prepared: Result<&Prepared, String> = match input.prepared {
         Some(p) => Ok(p),
-        None => match calibrate::prepare(input.session) {
+        None => match solve::prepare(input.session) {
             Ok(p) => {
                 computed = p;
                 Ok(&computed)
@@ -1151,7 +1151,7 @@ fn figures(h: &mut String, ctx: &Ctx<'_>) {
             "<p id=\"fig6\" class=\"warn\">{why}: no Fig. 6 (reference-distance errors).</p>"
         );
     } else {
-        let pts = |f: fn(&super::validate::DistanceRecord) -> f64| -> Vec<[f64; 2]> {
+        let pts = |f: fn(&crate::engine::validate::DistanceRecord) -> f64| -> Vec<[f64; 2]> {
             distances
                 .iter()
                 .enumerate()
@@ -1163,8 +1163,8 @@ fn figures(h: &mut String, ctx: &Ctx<'_>) {
             x_label: "distance (reference pair, pose by pose)".into(),
             y_label: "error (mm)".into(),
             series: before_after_series(
-                pts(super::validate::DistanceRecord::error_before),
-                pts(super::validate::DistanceRecord::error_after),
+                pts(crate::engine::validate::DistanceRecord::error_before),
+                pts(crate::engine::validate::DistanceRecord::error_after),
             ),
             rules: vec![Rule {
                 y: 0.0,

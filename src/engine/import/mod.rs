@@ -20,10 +20,12 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
-use super::error::FileError;
-use super::kinematics::{self, Robot};
-use super::model::{Measurement, Observation, ReferenceDistance, Session, SolverSettings, Use};
-use super::session::{parse_result, parse_session, session_to_json};
+use crate::engine::format::FileError;
+use crate::engine::format::{parse_result, parse_session, session_to_json};
+use crate::engine::robot::{self, Robot};
+use crate::engine::session::{
+    Measurement, Observation, ReferenceDistance, Session, SolverSettings, Use,
+};
 
 /// The side column read when the mapping names none.
 pub const DEFAULT_SIDE_COLUMN: &str = "side";
@@ -138,7 +140,7 @@ pub enum ProfileSource {
 /// Where the nominal robot model comes from.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum RobotSource {
-    /// A preset key of [`kinematics::preset`] (`irb2400`, `irb120`, `ur5e`).
+    /// A preset key of [`robot::preset`] (`irb2400`, `irb120`, `ur5e`).
     Preset(String),
     /// The `robot` block of a session or result file.
     File(PathBuf),
@@ -551,8 +553,8 @@ fn log_columns(spec: &ImportSpec, log: &Csv, dof: usize) -> Result<LogColumns, I
 /// file that is neither a valid session nor a valid result file.
 pub fn load_robot(source: &RobotSource) -> Result<Robot, ImportError> {
     match source {
-        RobotSource::Preset(key) => kinematics::preset(key).map(|p| p.robot).ok_or_else(|| {
-            let keys: Vec<&str> = kinematics::presets().iter().map(|p| p.key).collect();
+        RobotSource::Preset(key) => robot::preset(key).map(|p| p.robot).ok_or_else(|| {
+            let keys: Vec<&str> = robot::presets().iter().map(|p| p.key).collect();
             ImportError::Spec(format!(
                 "unknown robot `{key}`, expected one of: {} or a session/result file",
                 keys.join(", ")

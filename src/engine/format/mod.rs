@@ -1,0 +1,57 @@
+//! The files of FORMAT.md: session and result files (strict loading that
+//! names every broken rule and where, exact pretty writing), and the atomic
+//! write every output of spherecal goes through.
+
+use std::path::PathBuf;
+
+pub mod atomic;
+mod json;
+pub mod result;
+pub mod session;
+
+pub use atomic::write_atomic;
+pub use result::{ResultFile, load_result, parse_result, result_to_json, save_result};
+pub use session::{load_session, parse_session, save_session, session_to_json};
+
+/// The `format` of a session file.
+pub const SESSION_FORMAT: &str = "spherecal-session";
+/// The `format` of a result file.
+pub const RESULT_FORMAT: &str = "spherecal-result";
+/// The file-format version this build reads and writes (session and result).
+pub const FORMAT_VERSION: u32 = 1;
+
+/// A session or result file could not be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum FileError {
+    /// The file could not be read or written at all.
+    #[error("{action} failed: {source} ({path})")]
+    Io {
+        /// "reading" or "writing".
+        action: &'static str,
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The file's content breaks a rule of FORMAT.md.
+    #[error("{}{message} ({path})", measurement.as_ref().map(|m| format!("measurement {m}: ")).unwrap_or_default())]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// Id of the offending measurement, when the problem is in one.
+        measurement: Option<String>,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl FileError {
+    /// The measurement id the error names, if any.
+    #[must_use]
+    pub fn measurement(&self) -> Option<&str> {
+        match self {
+            Self::Invalid { measurement, .. } => measurement.as_deref(),
+            Self::Io { .. } => None,
+        }
+    }
+}

@@ -1,0 +1,717 @@
+//! The session and result files of FORMAT.md (version 1): strict loading
+//! that enforces every session rule, pretty writing that round-trips
+//! exactly, and atomic saves.
+//!
+//! # Loading
+//!
+//! A file is checked in layers, so that every error says where it is:
+//!
+//! 1. the whole text as JSON: a syntax error (`NaN` and `Infinity`
+//!    included) reports line and column (a number beyond `f64` is reported
+//!    with its key in step 3);
+//! 2. the header: `format` and `version`, before anything else, so that a
+//!    result file or a newer version is named as such;
+//! 3. every JSON object of the session is deserialised into a private
+//!    struct with `deny_unknown_fields` whose fields stay raw JSON slices:
+//!    serde's derive rejects unknown keys and keys given twice; each field is
+//!    then parsed on its own under its key path (`robot.joints[3]`,
+//!    `stripe.points[2]`), so a message names the key and, for a problem in
+//!    a measurement, the measurement id. Positions are reported as line and
+//!    column of the whole file;
+//! 4. the rules that span measurements (unique ids, one station for all
+//!    translations and one for all rotations, enough measurements for the
+//!    initial hand-eye, identify stations of at least 2, reference distances
+//!    naming validate stations).
+//!
+//! Any JSON number is accepted where a number is expected: an integer where
+//! a float is stored, and an integer-valued float (`20.0`) where an integer
+//! is (`version`, `side`, `max_iterations`). Numbers are parsed exactly
+//! (serde_json's `float_roundtrip`) and written in the shortest form that
+//! reads back to the same `f64`.
+//!
+//! # Writing
+//!
+//! [`session_to_json`] writes only the keys the file had (the `*_given`
+//! flags of [`Session`]) plus any value that differs from its default, so a
+//! load → save round trip adds nothing. Arrays of numbers stay on one line
+//! (a stripe point, a matrix row, joint readings), and so do small objects
+//! of scalars (a joint, an iteration); other objects and nested arrays take
+//! one line per entry. Saves go through [`write_atomic`]: a crash or a
+//! full disk never leaves a partial file.
+//!
+//! 4×4 matrices are held as [`Isometry3`] (a unit quaternion), which cannot
+//! hold the file's 16 numbers bit for bit. The loader checks each matrix with
+//! [`isometry_from_rows`] and then settles its rotation on a quaternion, at
+//! most a few ulps away, that survives its own write and read unchanged, so a
+//! loaded session saves and reloads to an equal [`Session`]. (A transform
+//! computed in code may move by those few ulps on its first save.)
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use nalgebra::Isometry3;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use serde_json::value::RawValue;
+
+use super::FORMAT_VERSION;
+use super::json::{Ctx, join, keys_struct, prefix, present, read_text, render, render_lossy};
+use super::{FileError, SESSION_FORMAT, write_atomic};
+use crate::engine::geometry::rows_from_isometry;
+use crate::engine::robot::{Joint, Robot};
+use crate::engine::session::{
+    DEFAULT_MAX_ITERATIONS, DEFAULT_THRESHOLD, MIN_STRIPE_POINTS, Measurement, Observation,
+    ReferenceDistance, Session, SolverSettings, Use,
+};
+use crate::engine::stripe::StripeError;
+use nalgebra::Vector3;
+
+/// Largest `max_iterations` accepted: 2^53, the largest integer an `f64`
+/// (JSON number) holds exactly. Any real value is far below.
+const MAX_ITERATIONS_LIMIT: f64 = 9_007_199_254_740_992.0;
+
+/// Reads and validates a session file (FORMAT.md "Session file").
+///
+/// # Errors
+/// [`FileError::Io`] when the file cannot be read, [`FileError::Invalid`]
+/// naming the broken rule (and the measurement, when it is in one).
+pub fn load_session(path: &Path) -> Result<Session, FileError> {
+    let text = read_text(path)?;
+    parse_session(&text, path)
+}
+
+/// Parses and validates the text of a session file. `path` is used only in
+/// messages and for the default name (the file stem) when the file has no
+/// `name`.
+///
+/// # Errors
+/// [`FileError::Invalid`] naming the broken rule, the key path and, for a
+/// problem in a measurement, its id.
+pub fn parse_session(text: &str, path: &Path) -> Result<Session, FileError> {
+    let ctx = Ctx::new(text, path);
+    let top = ctx.document()?;
+    ctx.header(top, SESSION_FORMAT)?;
+    ctx.session(top)
+}
+
+/// The session as FORMAT.md version 1 JSON, pretty-printed, with a trailing
+/// newline. [`parse_session`] reads it back to an equal [`Session`] (for a
+/// session that itself came from [`parse_session`]; see the module doc on
+/// matrices).
+#[must_use]
+pub fn session_to_json(session: &Session) -> String {
+    render_lossy(&SessionOut::new(session))
+}
+
+/// Writes the session to `path` atomically (see [`write_atomic`]).
+///
+/// # Errors
+/// [`FileError::Io`] when the file cannot be written; the old file, if any,
+/// is then unchanged.
+pub fn save_session(session: &Session, path: &Path) -> Result<(), FileError> {
+    let text = render(&SessionOut::new(session), path)?;
+    write_atomic(path, text.as_bytes())
+}
+
+keys_struct!(SessionKeys, "a session object" {
+    #[allow(dead_code, reason = "checked by the header pass")]
+    format,
+    #[allow(dead_code, reason = "checked by the header pass")]
+    version,
+    name, robot, sphere, sensor, hand_eye, solver,
+    reference_distances, measurements,
+});
+keys_struct!(RobotKeys, "an object with name, joints and optionally base and flange" {
+    name, joints, base, flange,
+});
+keys_struct!(SphereKeys, "an object with diameter" { diameter });
+keys_struct!(SensorKeys, "an object with side" { side });
+keys_struct!(SolverKeys, "an object with threshold and max_iterations" {
+    threshold, max_iterations,
+});
+keys_struct!(ReferenceKeys, "an object with from, to and distance" { from, to, distance });
+keys_struct!(MeasurementKeys, "a measurement object" {
+    id, station, usage as "use", side, joints, stripe, centre,
+});
+keys_struct!(StripeKeys, "an object with points" { points });
+
+impl<'a> Ctx<'a> {
+    fn session(&self, top: &'a RawValue) -> Result<Session, FileError> {
+        let keys: SessionKeys = self.object(top, "", None)?;
+        let name_given = keys.name.is_some();
+        let name = match keys.name {
+            Some(raw) => self.parse::<String>(raw, "name", None)?,
+            None => self.path.file_stem().map_or_else(
+                || "session".to_owned(),
+                |s| s.to_string_lossy().into_owned(),
+            ),
+        };
+        let robot_raw = self.required(keys.robot, top, "", "robot", None)?;
+        let (robot, base_given, flange_given) = self.robot(robot_raw)?;
+        let sphere_diameter =
+            self.sphere(self.required(keys.sphere, top, "", "sphere", None)?)?;
+        let sensor_given = keys.sensor.is_some();
+        let default_side = match keys.sensor {
+            Some(raw) => {
+                let sensor: SensorKeys = self.object(raw, "sensor", None)?;
+                match sensor.side {
+                    Some(side) => self.side(side, "sensor.side", None)?,
+                    None => 1,
+                }
+            }
+            None => 1,
+        };
+        let hand_eye = match keys.hand_eye {
+            Some(raw) => Some(self.matrix(raw, "hand_eye")?),
+            None => None,
+        };
+        let solver_given = keys.solver.is_some();
+        let solver = match keys.solver {
+            Some(raw) => self.solver(raw)?,
+            None => SolverSettings::default(),
+        };
+        let measurements_raw = self.required(keys.measurements, top, "", "measurements", None)?;
+        let items: Vec<&'a RawValue> = self.parse(measurements_raw, "measurements", None)?;
+        let mut measurements = Vec::with_capacity(items.len());
+        let mut first_index: HashMap<String, usize> = HashMap::new();
+        for (index, raw) in items.into_iter().enumerate() {
+            let m = self.measurement(index, raw, robot.joints.len(), default_side)?;
+            if let Some(&first) = first_index.get(&m.id) {
+                return Err(self.invalid(
+                    Some(&m.id),
+                    format!(
+                        "id `{}` is used by measurements[{first}] and measurements[{index}]; ids must be unique{}",
+                        m.id,
+                        self.at(raw)
+                    ),
+                ));
+            }
+            first_index.insert(m.id.clone(), index);
+            measurements.push(m);
+        }
+        let mut session = Session {
+            name,
+            name_given,
+            robot,
+            base_given,
+            flange_given,
+            sphere_diameter,
+            default_side,
+            sensor_given,
+            hand_eye,
+            solver,
+            solver_given,
+            reference_distances: Vec::new(),
+            measurements,
+        };
+        if let Some(raw) = keys.reference_distances {
+            session.reference_distances = self.reference_distances(raw, &session)?;
+        }
+        self.check_uses(&session)?;
+        Ok(session)
+    }
+
+    fn robot(&self, raw: &'a RawValue) -> Result<(Robot, bool, bool), FileError> {
+        let keys: RobotKeys = self.object(raw, "robot", None)?;
+        let name: String = self.parse(
+            self.required(keys.name, raw, "robot", "name", None)?,
+            "robot.name",
+            None,
+        )?;
+        let joints_raw = self.required(keys.joints, raw, "robot", "joints", None)?;
+        let items: Vec<&'a RawValue> = self.parse(joints_raw, "robot.joints", None)?;
+        let joints = items
+            .into_iter()
+            .enumerate()
+            .map(|(i, item)| self.object::<Joint>(item, &format!("robot.joints[{i}]"), None))
+            .collect::<Result<Vec<_>, _>>()?;
+        if joints.is_empty() {
+            return Err(self.invalid(
+                None,
+                format!(
+                    "robot.joints is empty: at least one joint is needed{}",
+                    self.at(joints_raw)
+                ),
+            ));
+        }
+        let base = match keys.base {
+            Some(b) => Some(self.matrix(b, "robot.base")?),
+            None => None,
+        };
+        let flange = match keys.flange {
+            Some(f) => Some(self.matrix(f, "robot.flange")?),
+            None => None,
+        };
+        let robot = Robot {
+            name,
+            joints,
+            base: base.unwrap_or_else(Isometry3::identity),
+            flange: flange.unwrap_or_else(Isometry3::identity),
+        };
+        Ok((robot, base.is_some(), flange.is_some()))
+    }
+
+    fn sphere(&self, raw: &'a RawValue) -> Result<f64, FileError> {
+        let keys: SphereKeys = self.object(raw, "sphere", None)?;
+        let d_raw = self.required(keys.diameter, raw, "sphere", "diameter", None)?;
+        let diameter: f64 = self.parse(d_raw, "sphere.diameter", None)?;
+        if diameter > 0.0 && diameter.is_finite() {
+            Ok(diameter)
+        } else {
+            Err(self.invalid(
+                None,
+                format!(
+                    "sphere.diameter must be positive (mm), found {diameter}{}",
+                    self.at(d_raw)
+                ),
+            ))
+        }
+    }
+
+    fn solver(&self, raw: &'a RawValue) -> Result<SolverSettings, FileError> {
+        let keys: SolverKeys = self.object(raw, "solver", None)?;
+        let mut solver = SolverSettings::default();
+        if let Some(t_raw) = keys.threshold {
+            let threshold: f64 = self.parse(t_raw, "solver.threshold", None)?;
+            if !(threshold >= 0.0 && threshold.is_finite()) {
+                return Err(self.invalid(
+                    None,
+                    format!(
+                        "solver.threshold must be zero or positive (mm), found {threshold}{}",
+                        self.at(t_raw)
+                    ),
+                ));
+            }
+            solver.threshold = threshold;
+        }
+        if let Some(n_raw) = keys.max_iterations {
+            let n: f64 = self.parse(n_raw, "solver.max_iterations", None)?;
+            if !(n >= 0.0 && n.fract() == 0.0 && n <= MAX_ITERATIONS_LIMIT) {
+                return Err(self.invalid(
+                    None,
+                    format!(
+                        "solver.max_iterations must be a non-negative integer, found {n}{}",
+                        self.at(n_raw)
+                    ),
+                ));
+            }
+            // Exact: an integer in [0, 2^53].
+            solver.max_iterations = n as usize;
+        }
+        Ok(solver)
+    }
+
+    fn measurement(
+        &self,
+        index: usize,
+        raw: &'a RawValue,
+        robot_joints: usize,
+        default_side: i8,
+    ) -> Result<Measurement, FileError> {
+        // The id is picked out leniently first so that every later error,
+        // even a malformed key, can name the measurement.
+        let lenient_id = serde_json::from_str::<Value>(raw.get())
+            .ok()
+            .and_then(|v| v.get("id")?.as_str().map(str::to_owned))
+            .filter(|id| !id.is_empty());
+        let m = lenient_id.as_deref();
+        let scope = if m.is_some() {
+            String::new()
+        } else {
+            format!("measurements[{index}]")
+        };
+        let keys: MeasurementKeys = self.object(raw, &scope, m)?;
+
+        let id_raw = self.required(keys.id, raw, &scope, "id", m)?;
+        let id: String = self.parse(id_raw, &join(&scope, "id"), m)?;
+        if id.is_empty() {
+            return Err(self.invalid(
+                m,
+                format!(
+                    "{} must not be empty{}",
+                    join(&scope, "id"),
+                    self.at(id_raw)
+                ),
+            ));
+        }
+        let m = Some(id.as_str());
+
+        let station_raw = self.required(keys.station, raw, &scope, "station", m)?;
+        let station: String = self.parse(station_raw, &join(&scope, "station"), m)?;
+        if station.is_empty() {
+            return Err(self.invalid(
+                m,
+                format!(
+                    "{} must not be empty{}",
+                    join(&scope, "station"),
+                    self.at(station_raw)
+                ),
+            ));
+        }
+
+        let use_raw = self.required(keys.usage, raw, &scope, "use", m)?;
+        let use_text: String = self.parse(use_raw, &join(&scope, "use"), m)?;
+        let usage = Use::parse(&use_text).ok_or_else(|| {
+            self.invalid(
+                m,
+                format!(
+                    "{} must be one of translation, rotation, identify, validate; found \"{use_text}\"{}",
+                    join(&scope, "use"),
+                    self.at(use_raw)
+                ),
+            )
+        })?;
+
+        let side_given = match keys.side {
+            Some(s) => Some(self.side(s, &join(&scope, "side"), m)?),
+            None => None,
+        };
+
+        let joints_raw = self.required(keys.joints, raw, &scope, "joints", m)?;
+        let joints: Vec<f64> = self.array(joints_raw, &join(&scope, "joints"), m)?;
+        if joints.len() != robot_joints {
+            return Err(self.invalid(
+                m,
+                format!(
+                    "{} has {} readings, the robot has {robot_joints} joints{}",
+                    join(&scope, "joints"),
+                    joints.len(),
+                    self.at(joints_raw)
+                ),
+            ));
+        }
+
+        let observation = match (keys.stripe, keys.centre) {
+            (Some(_), Some(_)) => {
+                return Err(self.invalid(
+                    m,
+                    format!(
+                        "{}both `stripe` and `centre` are given; give exactly one{}",
+                        prefix(&scope),
+                        self.at(raw)
+                    ),
+                ));
+            }
+            (None, None) => {
+                return Err(self.invalid(
+                    m,
+                    format!(
+                        "{}neither `stripe` nor `centre` is given; give exactly one{}",
+                        prefix(&scope),
+                        self.at(raw)
+                    ),
+                ));
+            }
+            (Some(stripe_raw), None) => {
+                let stripe_key = join(&scope, "stripe");
+                let stripe: StripeKeys = self.object(stripe_raw, &stripe_key, m)?;
+                let points_raw =
+                    self.required(stripe.points, stripe_raw, &stripe_key, "points", m)?;
+                let points_key = join(&stripe_key, "points");
+                let items: Vec<&'a RawValue> = self.parse(points_raw, &points_key, m)?;
+                let points = items
+                    .into_iter()
+                    .enumerate()
+                    .map(|(i, item)| {
+                        self.numbers::<2>(item, &format!("{points_key}[{i}]"), " [y, z]", m)
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                if points.len() < MIN_STRIPE_POINTS {
+                    let problem = StripeError::TooFewPoints {
+                        found: points.len(),
+                        needed: MIN_STRIPE_POINTS,
+                    };
+                    return Err(self.invalid(
+                        m,
+                        format!("{}{problem}{}", prefix(&scope), self.at(points_raw)),
+                    ));
+                }
+                Observation::Stripe(points)
+            }
+            (None, Some(centre_raw)) => {
+                let c = self.numbers::<3>(centre_raw, &join(&scope, "centre"), " [x, y, z]", m)?;
+                Observation::Centre(Vector3::from(c))
+            }
+        };
+
+        Ok(Measurement {
+            id,
+            station,
+            usage,
+            side_given,
+            side: side_given.unwrap_or(default_side),
+            joints,
+            observation,
+        })
+    }
+
+    fn reference_distances(
+        &self,
+        raw: &'a RawValue,
+        session: &Session,
+    ) -> Result<Vec<ReferenceDistance>, FileError> {
+        let items: Vec<&'a RawValue> = self.parse(raw, "reference_distances", None)?;
+        let validate_stations = session.stations(Use::Validate);
+        let mut out = Vec::with_capacity(items.len());
+        for (i, item) in items.into_iter().enumerate() {
+            let key = format!("reference_distances[{i}]");
+            let keys: ReferenceKeys = self.object(item, &key, None)?;
+            let station = |field: &str, value: Option<&'a RawValue>| -> Result<String, FileError> {
+                let v_raw = self.required(value, item, &key, field, None)?;
+                let id: String = self.parse(v_raw, &join(&key, field), None)?;
+                if validate_stations.iter().any(|(s, _)| *s == id) {
+                    return Ok(id);
+                }
+                let other: Vec<&str> = session
+                    .measurements
+                    .iter()
+                    .filter(|m| m.station == id)
+                    .map(|m| m.usage.as_str())
+                    .collect();
+                let detail = match other.first() {
+                    Some(u) => format!(" (it has {u} measurements)"),
+                    None => " (no measurement has this station)".to_owned(),
+                };
+                Err(self.invalid(
+                    None,
+                    format!(
+                        "{}: station `{id}` has no validate measurements{detail}; reference distances may only name validate stations{}",
+                        join(&key, field),
+                        self.at(v_raw)
+                    ),
+                ))
+            };
+            let from = station("from", keys.from)?;
+            let to = station("to", keys.to)?;
+            if from == to {
+                return Err(self.invalid(
+                    None,
+                    format!(
+                        "{key}: from and to are the same station `{from}`{}",
+                        self.at(item)
+                    ),
+                ));
+            }
+            let d_raw = self.required(keys.distance, item, &key, "distance", None)?;
+            let distance: f64 = self.parse(d_raw, &join(&key, "distance"), None)?;
+            if !(distance > 0.0 && distance.is_finite()) {
+                return Err(self.invalid(
+                    None,
+                    format!(
+                        "{key}.distance must be positive (mm), found {distance}{}",
+                        self.at(d_raw)
+                    ),
+                ));
+            }
+            out.push(ReferenceDistance { from, to, distance });
+        }
+        Ok(out)
+    }
+
+    /// The rules of FORMAT.md `measurements[].use` and `station` that span
+    /// measurements. Whether the translations are collinear and the
+    /// rotations too similar is checked by the initial hand-eye itself.
+    fn check_uses(&self, session: &Session) -> Result<(), FileError> {
+        let ids = |indices: &[usize]| -> String {
+            indices
+                .iter()
+                .map(|&i| session.measurements[i].id.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        for usage in [Use::Translation, Use::Rotation] {
+            let stations = session.stations(usage);
+            if let [(first, first_ids), (second, second_ids), ..] = stations.as_slice() {
+                let offender = &session.measurements[second_ids[0]].id;
+                return Err(self.invalid(
+                    Some(offender),
+                    format!(
+                        "all {} measurements must share one station: {} at station {first}, {} at station {second}",
+                        usage.as_str(),
+                        ids(first_ids),
+                        ids(second_ids)
+                    ),
+                ));
+            }
+        }
+        if session.hand_eye.is_none() {
+            for (usage, needed, purpose) in [
+                (Use::Translation, 3, "the initial rotation (paper eq. 6-7)"),
+                (Use::Rotation, 2, "the initial translation (paper eq. 8-9)"),
+            ] {
+                let found: Vec<usize> = (0..session.measurements.len())
+                    .filter(|&i| session.measurements[i].usage == usage)
+                    .collect();
+                if found.len() < needed {
+                    let list = if found.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" ({})", ids(&found))
+                    };
+                    return Err(self.invalid(
+                        None,
+                        format!(
+                            "without `hand_eye`, {purpose} needs at least {needed} {} measurements; the session has {}{list}",
+                            usage.as_str(),
+                            found.len()
+                        ),
+                    ));
+                }
+            }
+        }
+        for (station, indices) in session.stations(Use::Identify) {
+            if indices.len() < 2 {
+                let id = &session.measurements[indices[0]].id;
+                return Err(self.invalid(
+                    Some(id),
+                    format!(
+                        "identify station {station} has only 1 measurement ({id}); an identify station needs at least 2"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Writing
+// ---------------------------------------------------------------------------
+
+#[derive(Serialize)]
+struct SessionOut<'a> {
+    format: &'static str,
+    version: u32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    name: Option<&'a str>,
+    robot: RobotOut<'a>,
+    sphere: SphereOut,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    sensor: Option<SensorOut>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    hand_eye: Option<[[f64; 4]; 4]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    solver: Option<SolverOut>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    reference_distances: Vec<ReferenceOut<'a>>,
+    measurements: Vec<MeasurementOut<'a>>,
+}
+
+#[derive(Serialize)]
+struct RobotOut<'a> {
+    name: &'a str,
+    joints: &'a [Joint],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    base: Option<[[f64; 4]; 4]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    flange: Option<[[f64; 4]; 4]>,
+}
+
+#[derive(Serialize)]
+struct SphereOut {
+    diameter: f64,
+}
+
+#[derive(Serialize)]
+struct SensorOut {
+    side: i8,
+}
+
+#[derive(Serialize)]
+struct SolverOut {
+    threshold: f64,
+    max_iterations: usize,
+}
+
+#[derive(Serialize)]
+struct ReferenceOut<'a> {
+    from: &'a str,
+    to: &'a str,
+    distance: f64,
+}
+
+#[derive(Serialize)]
+struct MeasurementOut<'a> {
+    id: &'a str,
+    station: &'a str,
+    #[serde(rename = "use")]
+    usage: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    side: Option<i8>,
+    joints: &'a [f64],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    stripe: Option<StripeOut<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    centre: Option<[f64; 3]>,
+}
+
+#[derive(Serialize)]
+struct StripeOut<'a> {
+    points: &'a [[f64; 2]],
+}
+
+impl<'a> SessionOut<'a> {
+    /// Keys the file had, plus any value that differs from its default (a
+    /// session built in code without the `*_given` flags loses nothing).
+    fn new(s: &'a Session) -> Self {
+        let matrix = |given: bool, iso: &Isometry3<f64>| {
+            (given || *iso != Isometry3::identity()).then(|| rows_from_isometry(iso))
+        };
+        Self {
+            format: SESSION_FORMAT,
+            version: FORMAT_VERSION,
+            name: s.name_given.then_some(s.name.as_str()),
+            robot: RobotOut {
+                name: &s.robot.name,
+                joints: &s.robot.joints,
+                base: matrix(s.base_given, &s.robot.base),
+                flange: matrix(s.flange_given, &s.robot.flange),
+            },
+            sphere: SphereOut {
+                diameter: s.sphere_diameter,
+            },
+            sensor: (s.sensor_given || s.default_side != 1).then_some(SensorOut {
+                side: s.default_side,
+            }),
+            hand_eye: s.hand_eye.as_ref().map(rows_from_isometry),
+            solver: (s.solver_given
+                || s.solver.threshold != DEFAULT_THRESHOLD
+                || s.solver.max_iterations != DEFAULT_MAX_ITERATIONS)
+                .then_some(SolverOut {
+                    threshold: s.solver.threshold,
+                    max_iterations: s.solver.max_iterations,
+                }),
+            reference_distances: s
+                .reference_distances
+                .iter()
+                .map(|r| ReferenceOut {
+                    from: &r.from,
+                    to: &r.to,
+                    distance: r.distance,
+                })
+                .collect(),
+            measurements: s
+                .measurements
+                .iter()
+                .map(|m| MeasurementOut {
+                    id: &m.id,
+                    station: &m.station,
+                    usage: m.usage.as_str(),
+                    // The effective side is kept even if the flags disagree.
+                    side: m
+                        .side_given
+                        .or((m.side != s.default_side).then_some(m.side)),
+                    joints: &m.joints,
+                    stripe: match &m.observation {
+                        Observation::Stripe(points) => Some(StripeOut { points }),
+                        Observation::Centre(_) => None,
+                    },
+                    centre: match &m.observation {
+                        Observation::Centre(c) => Some([c.x, c.y, c.z]),
+                        Observation::Stripe(_) => None,
+                    },
+                })
+                .collect(),
+        }
+    }
+}

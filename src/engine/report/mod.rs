@@ -1,0 +1,8 @@
+//! What people and other tools read of a calibration: the command line's
+//! text summary, the self-contained HTML report with its SVG figures, and
+//! the calibrated model as JSON, MDH CSV or URDF.
+
+pub mod html;
+pub mod model;
+pub mod summary;
+pub mod svg;
