@@ -11,11 +11,11 @@ use std::path::Path;
 use std::time::{Duration, UNIX_EPOCH};
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use spherecal::engine::format::ResultFile;
 use spherecal::engine::format::parse_session;
 use spherecal::engine::history::{self, DriftOptions};
 use spherecal::engine::plan::{self, PlanConfig, PredictConfig};
 use spherecal::engine::report::html::{self, ReportInput, ReportMeta};
-use spherecal::engine::report::summary;
 use spherecal::engine::robot;
 use spherecal::engine::solve::{self, Control, Options};
 
@@ -44,7 +44,7 @@ fn bench(c: &mut Criterion) {
     .expect("the embedded demo session loads");
     let (prepared, cal) =
         solve::calibrate(&session, &Options::from_session(&session)).expect("the demo calibrates");
-    let result = summary::result_file(&session, &prepared, &cal);
+    let result = ResultFile::from_calibration(&session, &cal);
     let meta = ReportMeta::new("demo", UNIX_EPOCH + Duration::from_secs(1_795_132_800));
     group.bench_function("HTML report of the demo (render)", |b| {
         b.iter(|| {

@@ -28,7 +28,6 @@ use std::path::PathBuf;
 use anyhow::Context as _;
 use nalgebra::Vector3;
 use spherecal::engine::format;
-use spherecal::engine::report::summary;
 use spherecal::engine::session::{Observation, Session};
 use spherecal::engine::simulate::{self, SimConfig};
 use spherecal::engine::solve::{self, Options};
@@ -151,9 +150,12 @@ fn main() -> anyhow::Result<()> {
         format::save_session(&s, &session_path)?;
         // Calibrate what the file holds, exactly as `spherecal calibrate` does.
         let s = format::load_session(&session_path)?;
-        let (prepared, cal) = solve::calibrate(&s, &Options::from_session(&s))
+        let (_, cal) = solve::calibrate(&s, &Options::from_session(&s))
             .with_context(|| session_path.display().to_string())?;
-        format::save_result(&summary::result_file(&s, &prepared, &cal), &result_path)?;
+        format::save_result(
+            &format::ResultFile::from_calibration(&s, &cal),
+            &result_path,
+        )?;
         println!(
             "{}: validation std {:.4} mm -> {}",
             name,

@@ -160,7 +160,11 @@ fn epsilon_series_follows_the_loop_of_format_md() {
     })
     .unwrap();
     assert_eq!(cal.iterations.len(), 1);
-    assert!(cal.last_update.is_none());
+    assert!(
+        cal.report
+            .paper()
+            .is_some_and(|p| p.kept_directions.is_none())
+    );
     // Threshold 0 with a bound of 4: exactly 4 updates, 5 entries.
     options.threshold = 0.0;
     options.max_iterations = 4;
@@ -187,15 +191,19 @@ fn cancel_stops_the_loop() {
     let prepared = solve::prepare(&session).unwrap();
     let mut options = paper_options(&session);
     options.threshold = 0.0;
-    let err = solve::run(&session, &prepared, &options, &mut |p| {
+    // A cancel is a stop reason (not an error): the run ends with the
+    // estimate reached so far.
+    let cal = solve::run(&session, &prepared, &options, &mut |p| {
         if p.updates >= 2 {
             solve::Control::Cancel
         } else {
             solve::Control::Continue
         }
     })
-    .unwrap_err();
-    assert!(err.to_string().contains("cancelled"), "{err}");
+    .unwrap();
+    let err = cal.stop.describe();
+    assert!(err.contains("cancelled"), "{err}");
+    assert_eq!(cal.iterations.len(), 3);
 }
 
 #[test]

@@ -108,8 +108,8 @@ fn v1_result_loads() {
     assert_eq!(r.session, "fixture: every key of session format version 1");
     assert_eq!(r.robot.joints.len(), 6);
     assert_eq!(r.joint_errors.len(), 6);
-    assert_eq!(r.solver["method"], "paper");
-    assert_eq!(r.solver["kept_directions"], 27);
+    assert_eq!(r.solver.method(), "paper");
+    assert_eq!(r.solver.paper().and_then(|p| p.kept_directions), Some(27));
     assert_eq!(r.iterations.len(), 3);
     assert_eq!(r.epsilon_before, r.iterations[0].epsilon);
     assert_eq!(r.epsilon_after, 0.149);
@@ -120,7 +120,15 @@ fn v1_result_loads() {
     assert_eq!(v.distances.len(), 2);
     assert_eq!(v.distances[1].pose, 1);
     assert_eq!(v.within_station.after.max, 0.31);
-    assert!(r.robot.to_robot().is_ok());
+    // The robot block is a usable model (its base and flange were checked on load).
+    assert!(
+        r.robot
+            .base_from_flange(&[0.0; 6])
+            .translation
+            .vector
+            .iter()
+            .all(|v| v.is_finite())
+    );
 }
 
 #[test]
@@ -707,7 +715,12 @@ fn result_rules_are_checked() {
         1,
     );
     assert_eq!(
-        parse_result(&extra, path).unwrap().solver["anything"]["goes"][1],
+        parse_result(&extra, path)
+            .unwrap()
+            .solver
+            .paper()
+            .unwrap()
+            .extra["anything"]["goes"][1],
         2
     );
 }

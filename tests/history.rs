@@ -21,10 +21,12 @@ use spherecal::engine::history::{
     self, DEFAULT_K, DateSource, Drift, DriftOptions, HAND_EYE_NAMES, Library, SeriesKind, Status,
     Timestamp, Verdict,
 };
-use spherecal::engine::report::summary;
 use spherecal::engine::robot::RobotChoice;
 use spherecal::engine::session::{Observation, Session};
 use spherecal::engine::simulate::{self, SimConfig};
+use spherecal::engine::solve::SolverReport;
+use spherecal::engine::solve::ml::identifiability::Partner;
+use spherecal::engine::solve::ml::{Inseparable, MlReport};
 use spherecal::engine::solve::{self, Method, Options};
 
 const IRB: &str = "ABB IRB 2400/16";
@@ -80,8 +82,8 @@ fn calibrate(stem: &str, session: Session, method: Method) -> Cal {
     let mut options = Options::from_session(&session);
     options.method = method;
     options.ml.cross_validation = false;
-    let (prepared, cal) = solve::calibrate(&session, &options).expect("calibration");
-    let result = summary::result_file(&session, &prepared, &cal);
+    let (_, cal) = solve::calibrate(&session, &options).expect("calibration");
+    let result = ResultFile::from_calibration(&session, &cal);
     Cal {
         stem: stem.to_string(),
         session,
@@ -787,14 +789,16 @@ fn the_example_library_shows_its_two_events() {
     );
 }
 
-/// A copy of the first calibration under another date, its `ml` solver
-/// block edited by `edit`.
-fn edited(date: &str, edit: impl Fn(&mut serde_json::Map<String, serde_json::Value>)) -> Cal {
+/// A copy of the first calibration under another date, its `ml` report
+/// edited by `edit`.
+fn edited(date: &str, edit: impl Fn(&mut MlReport)) -> Cal {
     let base = &calibrations()[0];
     let name = format!("IRB2400 cell 3, {date}");
     let mut result = base.result.clone();
     result.session.clone_from(&name);
-    edit(&mut result.solver);
+    if let SolverReport::Ml(report) = &mut result.solver {
+        edit(report);
+    }
     Cal {
         stem: format!("edited-{date}"),
         session: Session {
@@ -807,17 +811,16 @@ fn edited(date: &str, edit: impl Fn(&mut serde_json::Map<String, serde_json::Val
 
 #[test]
 fn variance_factor_prior_and_fixed_sets_are_respected() {
-    use serde_json::{Value, json};
     let dir = tempfile::tempdir().unwrap();
-    let theta3_std = |block: &serde_json::Map<String, Value>| {
-        block["parameters"]
-            .as_array()
+    let theta3_std = |report: &SolverReport| {
+        report
+            .ml()
             .unwrap()
+            .parameters
             .iter()
-            .find(|p| p["parameter"] == "theta3")
-            .unwrap()["std"]
-            .as_f64()
+            .find(|p| p.parameter == "theta3")
             .unwrap()
+            .std
     };
     let reported = theta3_std(&calibrations()[0].result.solver);
     // 1. As calibrated.
@@ -827,10 +830,10 @@ fn variance_factor_prior_and_fixed_sets_are_respected() {
     write_pair(
         dir.path(),
         &edited("2026-02-01", |b| {
-            b.insert("variance_factor".into(), json!(4.0));
-            for p in b["parameters"].as_array_mut().unwrap() {
-                if p["parameter"] == "theta3" {
-                    p["std"] = json!(0.15);
+            b.variance_factor = 4.0;
+            for p in &mut b.parameters {
+                if p.parameter == "theta3" {
+                    p.std = 0.15;
                 }
             }
         }),
@@ -840,15 +843,16 @@ fn variance_factor_prior_and_fixed_sets_are_respected() {
     write_pair(
         dir.path(),
         &edited("2026-03-01", |b| {
-            let strip = |v: &mut Value| {
-                v.as_array_mut().unwrap().retain(|x| x != "d4");
-            };
-            strip(b.get_mut("estimated").unwrap());
-            b["fixed"].as_array_mut().unwrap().push(json!("d4"));
-            b["inseparable"]
-                .as_array_mut()
-                .unwrap()
-                .push(json!("d4 ~ a3: d4 +1 mm is undone by a3 -1.000 mm"));
+            b.estimated.retain(|x| x != "d4");
+            b.fixed.push("d4".into());
+            b.inseparable.push(Inseparable::Combination {
+                fixed: "d4".into(),
+                partners: vec![Partner {
+                    parameter: "a3".into(),
+                    undo: -1.0,
+                }],
+                explained_pct: None,
+            });
         }),
     );
     let library = history::scan(dir.path()).unwrap();

@@ -10,9 +10,12 @@
 
 use spherecal::cli::evaluate;
 use spherecal::engine::evaluate::{TruthScore, score, validation_errors};
+use spherecal::engine::format::result::solver_block;
+use spherecal::engine::format::{self, ResultFile};
+use spherecal::engine::session::{self, ExcludeError};
 use spherecal::engine::session::{Observation, Session, Use};
 use spherecal::engine::simulate::{self, SimConfig, Truth};
-use spherecal::engine::solve::ml::{self, ExcludeError, MlReport};
+use spherecal::engine::solve::ml::MlReport;
 use spherecal::engine::solve::{self, Calibration, Control, Method, Options, Prepared};
 
 fn simulate(config: &SimConfig) -> (Session, Truth) {
@@ -37,7 +40,7 @@ fn run(session: &Session, options: &Options) -> (Prepared, Calibration) {
 }
 
 fn report(cal: &Calibration) -> MlReport {
-    MlReport::from_solver_block(&cal.solver).expect("an ml solver block")
+    cal.report.ml().expect("an ml report").clone()
 }
 
 fn truth_score(
@@ -152,7 +155,11 @@ fn identifiability_names_the_redundancies_of_the_irb2400() {
     }
     assert_eq!(r.estimated.len(), 24, "{:?}", r.estimated);
     assert_eq!(r.estimated.len() + r.fixed.len(), 36);
-    let has = |needle: &str| r.inseparable.iter().any(|s| s.starts_with(needle));
+    let has = |needle: &str| {
+        r.inseparable
+            .iter()
+            .any(|s| s.to_string().starts_with(needle))
+    };
     assert!(
         has("alpha1, a1, beta1, theta1, d1: no effect"),
         "{:#?}",
@@ -234,7 +241,8 @@ fn an_outlier_is_listed_and_excluding_it_restores_accuracy() {
     // The paper's method has no defence against it.
     assert!(paper_std > 1.5 * clean_std, "{paper_std} vs {clean_std}");
 
-    let rerun = ml::exclude_measurements(&spoiled, std::slice::from_ref(&bad_id)).expect("exclude");
+    let rerun =
+        session::exclude_measurements(&spoiled, std::slice::from_ref(&bad_id)).expect("exclude");
     assert_eq!(rerun.measurements.len(), spoiled.measurements.len() - 1);
     let (prepared, cal) = run(&rerun, &ml_options(&rerun));
     let rerun_std = truth_score(&rerun, &prepared, &truth, &cal).after.std;
@@ -249,7 +257,7 @@ fn an_outlier_is_listed_and_excluding_it_restores_accuracy() {
 #[test]
 fn excluding_checks_the_format_rules() {
     let (session, _) = simulate(&SimConfig::default());
-    let err = ml::exclude_measurements(&session, &["nope".into()]).unwrap_err();
+    let err = session::exclude_measurements(&session, &["nope".into()]).unwrap_err();
     assert_eq!(err, ExcludeError::UnknownId("nope".into()));
     let p1: Vec<String> = session
         .measurements
@@ -257,19 +265,19 @@ fn excluding_checks_the_format_rules() {
         .filter(|m| m.usage == Use::Identify && m.station == "P1")
         .map(|m| m.id.clone())
         .collect();
-    let err = ml::exclude_measurements(&session, &p1[1..]).unwrap_err();
+    let err = session::exclude_measurements(&session, &p1[1..]).unwrap_err();
     assert!(
         matches!(&err, ExcludeError::StationTooSmall { station, remaining: 1, .. } if station == "P1")
     );
     assert!(err.to_string().contains("identify station P1"), "{err}");
-    assert!(ml::exclude_measurements(&session, &p1[2..]).is_ok());
+    assert!(session::exclude_measurements(&session, &p1[2..]).is_ok());
     let v1: Vec<String> = session
         .measurements
         .iter()
         .filter(|m| m.usage == Use::Validate && m.station == "V1")
         .map(|m| m.id.clone())
         .collect();
-    let err = ml::exclude_measurements(&session, &v1).unwrap_err();
+    let err = session::exclude_measurements(&session, &v1).unwrap_err();
     assert!(err.to_string().contains("validate station V1"), "{err}");
 }
 
@@ -359,10 +367,13 @@ fn the_loop_of_format_md_holds_for_ml() {
     let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue).expect("run");
     assert_eq!(cal.iterations.len(), 1);
     assert_eq!(cal.stop.code(), "max_iterations");
-    // Cancel.
+    // Cancel: a stop reason, with the start reported and no diagnostics.
     options.max_iterations = 20;
-    let err = solve::run(&session, &prepared, &options, &mut |_| Control::Cancel).unwrap_err();
-    assert!(err.to_string().contains("cancelled"), "{err}");
+    let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Cancel).expect("run");
+    let err = cal.stop.describe();
+    assert!(err.contains("cancelled"), "{err}");
+    assert_eq!(cal.iterations.len(), 1);
+    assert!(report(&cal).parameters.is_empty());
     // Bad options are input errors.
     options.ml.joint_sigma_deg = -1.0;
     let err = solve::run(&session, &prepared, &options, &mut |_| Control::Continue).unwrap_err();
@@ -376,7 +387,8 @@ fn the_loop_of_format_md_holds_for_ml() {
 fn ml_result_block_round_trips_and_is_named() {
     let (session, _) = simulate(&SimConfig::default());
     let (_, cal) = run(&session, &ml_options(&session));
-    assert_eq!(cal.solver["method"], "ml");
+    let block = solver_block(&cal.report);
+    assert_eq!(block["method"], "ml");
     for key in [
         "noise_model",
         "prior",
@@ -393,10 +405,16 @@ fn ml_result_block_round_trips_and_is_named() {
         "iterations",
         "stop_reason",
     ] {
-        assert!(cal.solver.contains_key(key), "solver block lacks {key}");
+        assert!(block.contains_key(key), "solver block lacks {key}");
     }
     let r = report(&cal);
-    assert_eq!(MlReport::from_solver_block(&r.to_solver_block()), Some(r));
+    let file = ResultFile::from_calibration(&session, &cal);
+    let back = format::parse_result(
+        &format::result_to_json(&file),
+        std::path::Path::new("r.json"),
+    )
+    .unwrap();
+    assert_eq!(back.solver.ml(), Some(&r));
 }
 
 #[test]

@@ -22,7 +22,6 @@ use spherecal::engine::import::{
 use spherecal::engine::plan::{
     self, Controller, Plan, PlanConfig, PlanError, PredictConfig, Selection, StationRole,
 };
-use spherecal::engine::report::summary;
 use spherecal::engine::robot;
 use spherecal::engine::session::{Session, Use};
 use spherecal::engine::simulate::{self, ErrorModel, PlanExecution, SimConfig, Truth};
@@ -163,7 +162,11 @@ fn d_optimal_selection_beats_random_selections() {
     for p in ["theta1", "d1", "d6", "theta6"] {
         assert!(st.fixed.iter().any(|f| f == p), "{p} should be fixed");
     }
-    assert!(st.inseparable.iter().any(|s| s.starts_with("d6 ~ he_z")));
+    assert!(
+        st.inseparable
+            .iter()
+            .any(|s| s.to_string().starts_with("d6 ~ he_z"))
+    );
     assert!(st.condition.is_finite() && st.condition > 1.0);
 }
 
@@ -380,7 +383,7 @@ fn simulated_data_from_a_plan_imports_through_the_csv_path_and_calibrates() {
     // Calibrate (default method, ml) and write the result.
     let (prepared, cal) = solve::calibrate(&imported, &Options::from_session(&imported)).unwrap();
     assert_eq!(cal.options.method, Method::Ml);
-    let result = summary::result_file(&imported, &prepared, &cal);
+    let result = format::ResultFile::from_calibration(&imported, &cal);
     let out = dir.path().join("R.json");
     format::save_result(&result, &out).unwrap();
     assert!(format::load_result(&out).is_ok());

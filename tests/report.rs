@@ -14,15 +14,11 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 use serde_json::Value;
 use sha2::{Digest, Sha256};
 use spherecal::engine::format::{self, ResultFile};
-use spherecal::engine::report::html::{
-    self, ReportError, ReportInput, ReportMeta, check_result, excluded_measurements, format_utc,
-    sha256_hex,
-};
-use spherecal::engine::report::summary;
+use spherecal::engine::report::html::{self, ReportInput, ReportMeta, format_utc, sha256_hex};
+use spherecal::engine::result_view::{self, ReportError, check_result, excluded_measurements};
 use spherecal::engine::robot::PARAM_NAMES;
-use spherecal::engine::session::Session;
+use spherecal::engine::session::{self, Session};
 use spherecal::engine::solve::estimate::HAND_EYE_LABELS;
-use spherecal::engine::solve::ml;
 use spherecal::engine::solve::{self, Method, Options};
 
 /// 2023-11-14 22:13:20 UTC.
@@ -45,8 +41,8 @@ fn calibrated(text: &str, method: Method) -> (Session, ResultFile) {
     let session = format::parse_session(text, Path::new("test.json")).unwrap();
     let mut options = Options::from_session(&session);
     options.method = method;
-    let (prepared, cal) = solve::calibrate(&session, &options).unwrap();
-    let result = summary::result_file(&session, &prepared, &cal);
+    let (_, cal) = solve::calibrate(&session, &options).unwrap();
+    let result = ResultFile::from_calibration(&session, &cal);
     (session, result)
 }
 
@@ -315,7 +311,7 @@ fn the_papers_method_marks_the_dropped_directions() {
     // Fig. 5, Fig. 6, ε and the singular values with the truncation line.
     assert_eq!(html.matches("<svg").count(), 4);
     assert!(html.contains("truncation"));
-    let marks = html::identifiability_marks(&result.solver);
+    let marks = result_view::identifiability_marks(&result.solver);
     assert!(!marks.is_empty() && marks.contains_key("theta1"));
     // Every mark of a joint or hand-eye parameter is a marked cell.
     let mut labels: Vec<String> = HAND_EYE_LABELS.iter().map(|l| l.to_string()).collect();
@@ -383,9 +379,10 @@ fn a_result_must_belong_to_its_session() {
 fn measurements_left_out_are_listed() {
     let text = spherecal::DEMO_SESSION_JSON;
     let demo = format::parse_session(text, Path::new("demo.json")).unwrap();
-    let fewer = ml::exclude_measurements(&demo, &["c5".to_string(), "v7".to_string()]).unwrap();
-    let (prepared, cal) = solve::calibrate(&fewer, &Options::from_session(&fewer)).unwrap();
-    let result = summary::result_file(&fewer, &prepared, &cal);
+    let fewer =
+        session::exclude_measurements(&demo, &["c5".to_string(), "v7".to_string()]).unwrap();
+    let (_, cal) = solve::calibrate(&fewer, &Options::from_session(&fewer)).unwrap();
+    let result = ResultFile::from_calibration(&fewer, &cal);
     // Reported against the full session: the ids are its own.
     assert_eq!(check_result(&demo, &result, None), Ok(()));
     assert_eq!(excluded_measurements(&demo, &result), ["c5", "v7"]);

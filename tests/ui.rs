@@ -147,7 +147,8 @@ fn demo_loads_select_run_and_headline_matches_engine() {
         .expect("a result is shown");
     assert_eq!(view.epsilons, cal.iterations);
     assert!(
-        view.headline
+        view.shown
+            .headline
             .as_ref()
             .is_some_and(|hl| hl.stats.after == v.after)
     );
@@ -326,9 +327,8 @@ fn a_result_file_is_reviewed_without_running_the_solver() {
         Path::new(spherecal::DEMO_SESSION_NAME),
     )
     .expect("demo parses");
-    let (prepared, cal) =
-        calibrate(&session, &Options::from_session(&session)).expect("calibrates");
-    let file = spherecal::engine::report::summary::result_file(&session, &prepared, &cal);
+    let (_, cal) = calibrate(&session, &Options::from_session(&session)).expect("calibrates");
+    let file = spherecal::engine::format::ResultFile::from_calibration(&session, &cal);
     let dir = tempfile::tempdir().expect("temp dir");
     let path = dir.path().join("demo-result.json");
     spherecal::engine::format::save_result(&file, &path).expect("saves");
@@ -399,7 +399,7 @@ fn exports_are_written_to_the_chosen_folder() {
         .expect("distances");
     assert_eq!(
         distances.lines().count(),
-        1 + shown.distances.len() + shown.within.len()
+        1 + shown.shown.distances.len() + shown.shown.within.len()
     );
     for (ext, format) in [
         ("json", ModelFormat::Json),

@@ -11,9 +11,9 @@ use std::time::SystemTime;
 use crate::engine::format::{result_to_json, write_atomic};
 use crate::engine::report::html::{self, ReportInput, ReportMeta};
 use crate::engine::report::model::{self, ModelFormat};
-use crate::engine::session::Session;
+use crate::engine::result_view;
 
-use super::state::ExportKind;
+use super::state::{ExportKind, LoadedSession};
 use super::view::{ResultOrigin, ResultView};
 
 /// CSV of every sphere centre: sensor frame and base frame before and
@@ -29,7 +29,7 @@ pub fn centres_csv(view: &ResultView) -> String {
             "{},{},{}",
             csv_field(&c.measurement),
             csv_field(&c.station),
-            c.usage
+            c.usage.as_str()
         );
         for v in c.sensor.iter().chain(&c.before).chain(&c.after) {
             let _ = write!(s, ",{v}");
@@ -48,7 +48,7 @@ pub fn distances_csv(view: &ResultView) -> String {
     let mut s = String::from(
         "kind,from,to,pose,reference_mm,before_mm,after_mm,error_before_mm,error_after_mm\n",
     );
-    for d in &view.distances {
+    for d in &view.shown.distances {
         let _ = writeln!(
             s,
             "reference,{},{},{},{},{},{},{},{}",
@@ -62,7 +62,7 @@ pub fn distances_csv(view: &ResultView) -> String {
             d.error_after()
         );
     }
-    for p in &view.within {
+    for p in &view.shown.within {
         let _ = writeln!(
             s,
             "within_station,{},{},{}/{},0,{},{},{},{}",
@@ -118,27 +118,22 @@ pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<()
 }
 
 /// Writes the HTML report of `view` against its session atomically (the
-/// engine's [`html::render`], as `spherecal report --result`).
-/// `bytes` are the session file's bytes (for the SHA-256) and `label`
-/// names it in the report.
+/// engine's [`html::render`], as `spherecal report --result`), with the
+/// stripe fits made when the session was loaded.
 ///
 /// # Errors
 /// The result is not of this session, or the file cannot be written.
-pub fn write_report(
-    view: &ResultView,
-    session: &Session,
-    bytes: &[u8],
-    label: &str,
-    path: &Path,
-) -> Result<(), String> {
-    html::check_result(session, &view.file, None)
+pub fn write_report(view: &ResultView, loaded: &LoadedSession, path: &Path) -> Result<(), String> {
+    let session = &loaded.session;
+    result_view::check_result(session, &view.file, None)
         .map_err(|e| format!("the report was not written: {e}"))?;
-    let meta = ReportMeta::new(label, SystemTime::now());
+    let prepared = loaded.analysis.clone().prepared(session).ok();
+    let meta = ReportMeta::new(loaded.source.label(), SystemTime::now());
     let html = html::render(&ReportInput {
         session,
-        session_bytes: bytes,
+        session_bytes: &loaded.bytes,
         result: &view.file,
-        prepared: None,
+        prepared: prepared.as_ref(),
         meta: &meta,
     });
     write_atomic(path, html.as_bytes()).map_err(|e| e.to_string())

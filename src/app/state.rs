@@ -13,8 +13,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::engine::session::{Session, Use};
 use crate::engine::solve::paper::{DEFAULT_SVD_TOLERANCE, Pairing, PaperOptions};
-use crate::engine::solve::{Method, Options};
-use crate::engine::stripe::StripeResult;
+use crate::engine::solve::{Analysis, Method, Options};
+use crate::engine::stripe::{StripeError, StripeResult};
 
 use super::planner::{PlanForm, PlanOutcome};
 use super::view::{CentreSet, ResultView};
@@ -84,21 +84,21 @@ impl Source {
 }
 
 /// What the load job found out about one measurement (for the session
-/// table and the stripe view).
-#[derive(Debug, Clone, PartialEq)]
-pub enum Fit {
+/// table and the stripe view), borrowed from the session's analysis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Fit<'a> {
     /// The measurement gives its centre directly: nothing to fit.
     GivenCentre,
     /// The stripe's circle fit and sphere centre.
-    Stripe(Box<StripeResult>),
-    /// The stripe could not be fitted: the engine's message.
-    Failed(String),
+    Stripe(&'a StripeResult),
+    /// The stripe could not be fitted.
+    Failed(&'a StripeError),
 }
 
-impl Fit {
+impl<'a> Fit<'a> {
     /// The stripe result, when the fit worked.
     #[must_use]
-    pub fn stripe(&self) -> Option<&StripeResult> {
+    pub fn stripe(&self) -> Option<&'a StripeResult> {
         match self {
             Self::Stripe(s) => Some(s),
             _ => None,
@@ -116,8 +116,9 @@ pub struct LoadedSession {
     /// The file's bytes as read (for the report's SHA-256); for an
     /// imported session, the FORMAT.md text Save as would write.
     pub bytes: Vec<u8>,
-    /// One per measurement, session order.
-    pub fits: Vec<Fit>,
+    /// Every stripe fitted once, the initial hand-eye: what a run starts
+    /// from.
+    pub analysis: Analysis,
     /// Sphere centres in the base frame with the nominal model and the
     /// initial hand-eye, or why they cannot be computed (a failed stripe, a
     /// pose set that does not determine the hand-eye).
@@ -125,6 +126,16 @@ pub struct LoadedSession {
 }
 
 impl LoadedSession {
+    /// What the load job found out about measurement `i`.
+    #[must_use]
+    pub fn fit(&self, i: usize) -> Fit<'_> {
+        match self.analysis.measurements.get(i) {
+            Some(Ok(p)) => p.stripe.as_ref().map_or(Fit::GivenCentre, Fit::Stripe),
+            Some(Err(e)) => Fit::Failed(e),
+            None => Fit::GivenCentre,
+        }
+    }
+
     /// Number of stripe points of measurement `i` (`None` for a given centre).
     #[must_use]
     pub fn points(&self, i: usize) -> Option<usize> {

@@ -1,19 +1,18 @@
 //! View models built once, off the UI thread, from engine outputs: the
-//! [`ResultView`] of a result (from a run or a reviewed file alike, both go
-//! through the FORMAT.md [`ResultFile`]) and the [`CentreSet`] of the
-//! centres view. The `*_ui` functions only draw them.
+//! [`ResultView`] of a result (from a run or a reviewed file alike, both
+//! the typed [`ResultFile`]), around the engine's shared
+//! [`result_view`](crate::engine::result_view), and the [`CentreSet`] of
+//! the centres view. The `*_ui` functions only draw them.
 
-use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use nalgebra::Vector3;
 use serde_json::Value;
 
 use crate::engine::format::ResultFile;
-use crate::engine::geometry::{isometry_from_rows, rotation_angle_between};
-use crate::engine::robot::Joint;
-use crate::engine::session::{Session, Use};
-use crate::engine::validate::{BeforeAfter, DistanceRecord, Stats, within_station_distances};
+use crate::engine::format::result::solver_block;
+pub use crate::engine::result_view::{HandEyeView, ResultView as Shown};
+use crate::engine::session::Session;
 
 /// Where a result on show came from.
 #[derive(Debug, Clone, PartialEq)]
@@ -27,53 +26,6 @@ pub enum ResultOrigin {
     },
     /// A result file opened for review (no solver run).
     Review(PathBuf),
-}
-
-/// The hand-eye `eT_s` in readable form.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HandEyeView {
-    /// The 4×4 matrix (mm), row-major.
-    pub rows: [[f64; 4]; 4],
-    /// Translation, mm.
-    pub translation: [f64; 3],
-    /// Roll, pitch, yaw (rotations about x, y, z), deg.
-    pub rpy_deg: [f64; 3],
-}
-
-impl HandEyeView {
-    fn new(rows: &[[f64; 4]; 4]) -> Self {
-        let rpy = isometry_from_rows(rows).map_or([0.0; 3], |iso| {
-            let (r, p, y) = iso.rotation.euler_angles();
-            [r.to_degrees(), p.to_degrees(), y.to_degrees()]
-        });
-        Self {
-            rows: *rows,
-            translation: [rows[0][3], rows[1][3], rows[2][3]],
-            rpy_deg: rpy,
-        }
-    }
-}
-
-/// One within-station centre distance (true value 0; paper Fig. 5).
-#[derive(Debug, Clone, PartialEq)]
-pub struct PairDistance {
-    /// Station id.
-    pub station: String,
-    /// Measurement ids of the pair.
-    pub ids: (String, String),
-    /// Distance with the nominal model and initial hand-eye, mm.
-    pub before: f64,
-    /// Distance with the calibrated model and hand-eye, mm.
-    pub after: f64,
-}
-
-/// The headline figures: validation statistics before and after.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Headline {
-    /// What the statistics are of, e.g. "54 reference distances (measured − reference)".
-    pub what: String,
-    /// Before and after.
-    pub stats: BeforeAfter,
 }
 
 /// One sphere centre in the base frame.
@@ -190,57 +142,36 @@ impl CentreSet {
 /// Everything the Results, Centres and export views show of one result.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResultView {
-    /// The result file itself (what "Result JSON" exports).
+    /// The result itself (what "Result JSON" exports).
     pub file: ResultFile,
     /// Run or review.
     pub origin: ResultOrigin,
+    /// What every reader shows: headline, pairs, hand-eye, marks, σ.
+    pub shown: Shown,
     /// `solver.method`.
     pub method: String,
-    /// `solver.stop_reason`, when given.
+    /// Why the loop stopped, when the method says.
     pub stop_reason: Option<String>,
-    /// `solver.threshold`, mm, when given.
+    /// The threshold on ε, mm, when the method says.
     pub threshold: Option<f64>,
     /// ε after 0, 1, … updates, mm.
     pub epsilons: Vec<f64>,
-    /// Singular values of the last update, descending.
+    /// Singular values of the last update, descending (paper's method).
     pub singular_values: Vec<f64>,
-    /// `solver.svd_tolerance` (fraction of σ_max), when given.
+    /// SVD tolerance (fraction of σ_max), when given.
     pub svd_tolerance: Option<f64>,
-    /// `solver.kept_directions`, when given.
+    /// SVD directions kept, when given.
     pub kept: Option<usize>,
-    /// `solver.dropped_directions`: the directions the SVD dropped.
+    /// The directions the SVD dropped.
     pub dropped: Vec<String>,
-    /// `solver.fixed`: parameters a method held fixed.
+    /// Parameters a method held fixed.
     pub fixed: Vec<String>,
-    /// `solver.estimated`: parameters a method estimated (when it says).
+    /// Parameters a method estimated (when it says).
     pub estimated: Vec<String>,
-    /// `solver.inseparable` and `solver.strong_correlations`: what the
-    /// method says about parameters the data cannot tell apart.
+    /// What the method says about parameters the data cannot tell apart.
     pub caveats: Vec<String>,
-    /// Every entry of the `solver` block as text (values as compact JSON).
+    /// Every entry of the `solver` block as written (values as compact JSON).
     pub solver_entries: Vec<(String, String)>,
-    /// Parameter labels (`theta1`, `he_z`, …) not identifiable from this
-    /// data, each with why.
-    pub marked: BTreeMap<String, String>,
-    /// Initial hand-eye.
-    pub hand_eye_before: HandEyeView,
-    /// Calibrated hand-eye.
-    pub hand_eye_after: HandEyeView,
-    /// Rotation between the two hand-eyes, deg.
-    pub hand_eye_rotation_change_deg: f64,
-    /// Calibrated minus nominal, per joint (deg, mm).
-    pub joint_errors: Vec<Joint>,
-    /// The headline figures, when the result has validation distances.
-    pub headline: Option<Headline>,
-    /// Within-station distances of the validate stations (or, without
-    /// any, of the identify stations), station order then pair order.
-    pub within: Vec<PairDistance>,
-    /// Which stations `within` is of: "validate" or "identify".
-    pub within_of: &'static str,
-    /// Statistics of `within`.
-    pub within_stats: BeforeAfter,
-    /// Reference-distance comparisons (paper Fig. 6).
-    pub distances: Vec<DistanceRecord>,
     /// Base-frame centres before and after.
     pub centres: CentreSet,
     /// Warnings: e.g. the result names another session.
@@ -253,44 +184,26 @@ impl ResultView {
     #[must_use]
     pub fn new(file: ResultFile, origin: ResultOrigin, session: Option<&Session>) -> Self {
         let solver = &file.solver;
-        let text = |k: &str| solver.get(k).and_then(Value::as_str).map(str::to_string);
-        let number = |k: &str| solver.get(k).and_then(Value::as_f64);
-        let numbers = |k: &str| -> Vec<f64> {
-            solver
-                .get(k)
-                .and_then(Value::as_array)
-                .map(|a| a.iter().filter_map(Value::as_f64).collect())
-                .unwrap_or_default()
-        };
-        let texts = |k: &str| -> Vec<String> {
-            solver
-                .get(k)
-                .and_then(Value::as_array)
-                .map(|a| {
-                    a.iter()
-                        .filter_map(|v| v.as_str().map(str::to_string))
-                        .collect()
-                })
-                .unwrap_or_default()
-        };
-        let dropped = texts("dropped_directions");
-        let fixed = texts("fixed");
-        let marked = crate::engine::report::html::identifiability_marks(solver);
-        let estimated = texts("estimated");
-        let mut caveats = texts("inseparable");
+        let paper = solver.paper();
+        let mut caveats: Vec<String> = solver
+            .ml()
+            .map(|m| m.inseparable.iter().map(ToString::to_string).collect())
+            .unwrap_or_default();
         caveats.extend(
-            texts("strong_correlations")
-                .into_iter()
+            solver
+                .ml()
+                .iter()
+                .flat_map(|m| &m.strong_correlations)
                 .map(|c| format!("strongly correlated: {c}")),
         );
-        let solver_entries = solver
-            .iter()
+        let solver_entries = solver_block(solver)
+            .into_iter()
             .map(|(k, v)| {
                 let text = match v {
-                    Value::String(t) => t.clone(),
+                    Value::String(t) => t,
                     other => other.to_string(),
                 };
-                (k.clone(), text)
+                (k, text)
             })
             .collect();
 
@@ -326,80 +239,32 @@ impl ResultView {
             .map(|c| CentrePoint {
                 id: c.measurement.clone(),
                 station: c.station.clone(),
-                usage: c.usage.clone(),
+                usage: c.usage.as_str().to_string(),
                 index: index_of(&c.measurement),
                 before: c.before,
                 after: Some(c.after),
             })
             .collect();
-        let (within, within_of) = {
-            let validate = within_pairs(&points, Use::Validate);
-            if validate.is_empty() {
-                (within_pairs(&points, Use::Identify), "identify")
-            } else {
-                (validate, "validate")
-            }
-        };
-        let within_stats = BeforeAfter {
-            before: Stats::of(&within.iter().map(|p| p.before).collect::<Vec<_>>()),
-            after: Stats::of(&within.iter().map(|p| p.after).collect::<Vec<_>>()),
-        };
-        let distances = file
-            .validation
-            .as_ref()
-            .map(|v| v.distances.clone())
-            .unwrap_or_default();
-        let headline = match &file.validation {
-            Some(v) if !v.distances.is_empty() => Some(Headline {
-                what: format!(
-                    "validation: {} reference distances (measured − reference)",
-                    v.distances.len()
-                ),
-                stats: BeforeAfter {
-                    before: v.before,
-                    after: v.after,
-                },
-            }),
-            Some(v) => Some(Headline {
-                what: "validation: within-station centre distances".to_string(),
-                stats: v.within_station,
-            }),
-            None => None,
-        };
-        let hand_eye_rotation_change_deg = match (
-            isometry_from_rows(&file.hand_eye_initial),
-            isometry_from_rows(&file.hand_eye),
-        ) {
-            (Ok(a), Ok(b)) => rotation_angle_between(&a, &b).to_degrees(),
-            _ => 0.0,
-        };
         Self {
             origin,
-            method: text("method").unwrap_or_else(|| "?".to_string()),
-            stop_reason: text("stop_reason"),
-            threshold: number("threshold"),
+            shown: Shown::new(&file),
+            method: solver.method().to_string(),
+            stop_reason: solver.stop_reason().map(str::to_string),
+            threshold: solver.threshold(),
             epsilons: file.iterations.iter().map(|r| r.epsilon).collect(),
-            singular_values: numbers("singular_values"),
-            svd_tolerance: number("svd_tolerance"),
-            kept: solver
-                .get("kept_directions")
-                .and_then(Value::as_u64)
-                .and_then(|k| usize::try_from(k).ok()),
-            dropped,
-            fixed,
-            estimated,
+            singular_values: paper
+                .and_then(|p| p.singular_values.clone())
+                .unwrap_or_default(),
+            svd_tolerance: paper.and_then(|p| p.svd_tolerance),
+            kept: paper.and_then(|p| p.kept_directions),
+            dropped: paper
+                .and_then(|p| p.dropped_directions.as_ref())
+                .map(|d| d.iter().map(ToString::to_string).collect())
+                .unwrap_or_default(),
+            fixed: solver.fixed().to_vec(),
+            estimated: solver.estimated().to_vec(),
             caveats,
             solver_entries,
-            marked,
-            hand_eye_before: HandEyeView::new(&file.hand_eye_initial),
-            hand_eye_after: HandEyeView::new(&file.hand_eye),
-            hand_eye_rotation_change_deg,
-            joint_errors: file.joint_errors.clone(),
-            headline,
-            within,
-            within_of,
-            within_stats,
-            distances,
             centres: CentreSet::new(points),
             notes,
             file,
@@ -409,48 +274,8 @@ impl ResultView {
     /// Whether parameter `label` (e.g. `theta2`) is marked not identifiable.
     #[must_use]
     pub fn is_marked(&self, label: &str) -> bool {
-        self.marked.contains_key(label)
+        self.shown.marked.contains_key(label)
     }
-}
-
-/// Pairwise centre distances within each station of `usage`, in the
-/// engine's order (station, then `i < j`), computed by the engine's
-/// [`within_station_distances`].
-fn within_pairs(points: &[CentrePoint], usage: Use) -> Vec<PairDistance> {
-    let mut stations: Vec<(String, Vec<&CentrePoint>)> = Vec::new();
-    for p in points.iter().filter(|p| p.usage == usage.as_str()) {
-        if let Some(s) = stations.iter_mut().find(|(s, _)| *s == p.station) {
-            s.1.push(p);
-        } else {
-            stations.push((p.station.clone(), vec![p]));
-        }
-    }
-    let centres = |f: &dyn Fn(&CentrePoint) -> [f64; 3]| -> Vec<Vec<Vector3<f64>>> {
-        stations
-            .iter()
-            .map(|(_, ps)| ps.iter().map(|p| Vector3::from(f(p))).collect())
-            .collect()
-    };
-    let before = within_station_distances(&centres(&|p| p.before));
-    let after = within_station_distances(&centres(&|p| p.after.unwrap_or(p.before)));
-    let mut labels = Vec::new();
-    for (station, ps) in &stations {
-        for i in 0..ps.len() {
-            for j in i + 1..ps.len() {
-                labels.push((station.clone(), (ps[i].id.clone(), ps[j].id.clone())));
-            }
-        }
-    }
-    labels
-        .into_iter()
-        .zip(before.into_iter().zip(after))
-        .map(|((station, ids), (before, after))| PairDistance {
-            station,
-            ids,
-            before,
-            after,
-        })
-        .collect()
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! without the left-out measurements. Each runs on a job thread.
 
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -12,15 +12,12 @@ use crate::engine::format::{
     RESULT_FORMAT, ResultFile, parse_result, parse_session, session_to_json, write_atomic,
 };
 use crate::engine::import;
-use crate::engine::report::summary;
-use crate::engine::session::{Observation, Session};
+use crate::engine::session::{ExcludeError, Session, exclude_measurements};
 use crate::engine::solve::estimate::Estimate;
-use crate::engine::solve::{self, Control, Options, Progress};
-use crate::engine::solve::{CalibrationError, IdentifyError};
-use crate::engine::stripe::centre_from_stripe;
+use crate::engine::solve::{self, Control, Options, Progress, SolveError, StopReason};
 
 use super::jobs::{Imported, LoadFailure, RunFailure};
-use super::state::{Fit, LoadedSession, Source};
+use super::state::{LoadedSession, Source};
 use super::view::{CentrePoint, CentreSet, ResultOrigin, ResultView};
 use super::wizard::{ImportForm, PREVIEW_ROWS};
 
@@ -86,23 +83,15 @@ pub fn open_path(path: &Path) -> Result<Opened, LoadFailure> {
     }
 }
 
-/// Fits every stripe (for the table and the stripe view) and computes the
-/// centres before calibration (nominal model, initial hand-eye).
+/// Fits every stripe once (for the table, the stripe view and later runs)
+/// and computes the centres before calibration (nominal model, initial
+/// hand-eye).
 #[must_use]
 pub fn analyse(session: Session, source: Source) -> LoadedSession {
-    let radius = session.sphere_radius();
-    let fits = session
-        .measurements
-        .iter()
-        .map(|m| match &m.observation {
-            Observation::Centre(_) => Fit::GivenCentre,
-            Observation::Stripe(points) => match centre_from_stripe(points, radius, m.side) {
-                Ok(r) => Fit::Stripe(Box::new(r)),
-                Err(e) => Fit::Failed(e.to_string()),
-            },
-        })
-        .collect();
-    let before = solve::prepare(&session)
+    let analysis = solve::analyse(&session);
+    let before = analysis
+        .clone()
+        .prepared(&session)
         .map(|prepared| {
             let start = Estimate {
                 robot: session.robot.clone(),
@@ -128,31 +117,35 @@ pub fn analyse(session: Session, source: Source) -> LoadedSession {
         bytes: session_to_json(&session).into_bytes(),
         session,
         source,
-        fits,
+        analysis,
         before,
     }
 }
 
 /// The session without the `excluded` measurements, checked against every
-/// FORMAT.md rule by a round trip through the file format (what a saved
-/// file would load as). The name is kept.
+/// FORMAT.md rule the removal can break, with the indices (into the
+/// loaded session) of the measurements it keeps. The name is kept.
 ///
 /// # Errors
-/// Leaving these measurements out breaks a rule: the loader's message.
-pub fn without(session: &Session, excluded: &BTreeSet<String>) -> Result<Session, String> {
-    let mut kept = session.clone();
-    kept.measurements.retain(|m| !excluded.contains(&m.id));
-    let left_out = session.measurements.len() - kept.measurements.len();
-    if left_out == 0 {
-        return Ok(kept);
-    }
-    let label = PathBuf::from(format!(
-        "{} without {left_out} left-out measurement(s)",
-        session.name
-    ));
-    let mut checked = parse_session(&session_to_json(&kept), &label).map_err(|e| e.to_string())?;
-    checked.name.clone_from(&session.name);
-    Ok(checked)
+/// Leaving these measurements out breaks a rule: the engine's message.
+pub fn without(
+    session: &Session,
+    excluded: &BTreeSet<String>,
+) -> Result<(Session, Vec<usize>), ExcludeError> {
+    let ids: Vec<String> = excluded.iter().cloned().collect();
+    let kept = if ids.is_empty() {
+        session.clone()
+    } else {
+        exclude_measurements(session, &ids)?
+    };
+    let indices = session
+        .measurements
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| !excluded.contains(&m.id))
+        .map(|(i, _)| i)
+        .collect();
+    Ok((kept, indices))
 }
 
 /// Writes the session without the `excluded` measurements to `path`
@@ -165,40 +158,41 @@ pub fn save_without(
     excluded: &BTreeSet<String>,
     path: &Path,
 ) -> Result<usize, String> {
-    let kept = without(session, excluded).map_err(|e| {
+    let (kept, _) = without(session, excluded).map_err(|e| {
         format!("not saved: the session without the left-out measurements is not valid: {e}")
     })?;
     write_atomic(path, session_to_json(&kept).as_bytes()).map_err(|e| e.to_string())?;
     Ok(kept.measurements.len())
 }
 
-/// The whole calibration of `session` without the `excluded`
-/// measurements: prepare, run (reporting every ε, stopping when `cancel`
-/// is set), and the result file and its view.
+/// The whole calibration of the loaded session without the `excluded`
+/// measurements: the stripes fitted when it was loaded (none is fitted
+/// again), the run (reporting every ε, stopping when `cancel` is set),
+/// and the result and its view.
 ///
 /// # Errors
 /// [`RunFailure::Cancelled`] after a cancel, [`RunFailure::Failed`] with
 /// the engine's message otherwise.
 pub fn calibrate_session(
-    session: &Session,
+    loaded: &LoadedSession,
     excluded: &BTreeSet<String>,
     options: &Options,
     cancel: &AtomicBool,
     on_progress: &mut dyn FnMut(&Progress) -> bool,
 ) -> Result<ResultView, RunFailure> {
     let started = Instant::now();
-    let kept = without(session, excluded).map_err(|e| {
+    let (kept, indices) = without(&loaded.session, excluded).map_err(|e| {
         RunFailure::Failed(format!(
             "the session without the left-out measurements is not valid: {e}"
         ))
     })?;
-    let failed = |e: CalibrationError| match e {
-        CalibrationError::Identify(IdentifyError::Cancelled { iterations }) => {
-            RunFailure::Cancelled(iterations)
-        }
-        other => RunFailure::Failed(other.to_string()),
+    let analysis = if excluded.is_empty() {
+        loaded.analysis.clone()
+    } else {
+        loaded.analysis.subset(&kept, &indices)
     };
-    let prepared = solve::prepare(&kept).map_err(failed)?;
+    let failed = |e: SolveError| RunFailure::Failed(e.to_string());
+    let prepared = analysis.prepared(&kept).map_err(failed)?;
     let cal = solve::run(&kept, &prepared, options, &mut |p| {
         let delivered = on_progress(p);
         if cancel.load(Ordering::Relaxed) || !delivered {
@@ -208,12 +202,15 @@ pub fn calibrate_session(
         }
     })
     .map_err(failed)?;
-    let file = summary::result_file(&kept, &prepared, &cal);
+    if let StopReason::Cancelled { updates, .. } = cal.stop {
+        return Err(RunFailure::Cancelled(updates));
+    }
+    let file = ResultFile::from_calibration(&kept, &cal);
     let origin = ResultOrigin::Run {
         seconds: started.elapsed().as_secs_f64(),
-        excluded: session.measurements.len() - kept.measurements.len(),
+        excluded: loaded.session.measurements.len() - kept.measurements.len(),
     };
-    Ok(ResultView::new(file, origin, Some(session)))
+    Ok(ResultView::new(file, origin, Some(&loaded.session)))
 }
 
 /// The import wizard's preview: the joint log's header, the form with the

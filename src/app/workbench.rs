@@ -20,7 +20,6 @@ use super::view::ResultOrigin;
 use super::wizard::ProfilesKind;
 use super::work::{self, Opened};
 use crate::engine::format::write_atomic;
-use crate::engine::geometry::isometry_from_rows;
 use crate::engine::history::{self, DriftOptions, HistoryError};
 use crate::engine::plan::{self, Controller, Plan};
 
@@ -362,7 +361,7 @@ impl WorkbenchApp {
             .state
             .result
             .as_ref()
-            .and_then(|v| isometry_from_rows(&v.file.hand_eye).ok())
+            .map(|v| v.file.hand_eye)
             .or_else(|| self.state.loaded.as_ref().and_then(|l| l.session.hand_eye));
         let config = match self.forms.plan.config(session_hand_eye) {
             Ok(c) => c,
@@ -704,14 +703,14 @@ impl WorkbenchApp {
             self.state.say(Level::Warning, "open a session first");
             return;
         };
-        let session = loaded.session.clone();
-        let options = self.forms.solver.options(&session);
+        let options = self.forms.solver.options(&loaded.session);
+        let loaded = loaded.clone();
         let excluded = self.state.excluded.clone();
         let cancel = Arc::new(AtomicBool::new(false));
         let flag = Arc::clone(&cancel);
         let n_excluded = self.state.excluded_count();
         let started = self.spawn(ctx, "solver", move |rep| {
-            let outcome = work::calibrate_session(&session, &excluded, &options, &flag, &mut |p| {
+            let outcome = work::calibrate_session(&loaded, &excluded, &options, &flag, &mut |p| {
                 rep.send(JobMessage::Progress(*p))
             });
             rep.send(JobMessage::RunFinished(outcome.map(Box::new)));
@@ -774,11 +773,9 @@ impl WorkbenchApp {
                     .say(Level::Warning, "a report needs the session: open it first");
                 return;
             };
-            let session = loaded.session.clone();
-            let bytes = loaded.bytes.clone();
-            let label = loaded.source.label();
+            let loaded = loaded.clone();
             let started = self.spawn(ctx, "export", move |rep| {
-                let outcome = export::write_report(&view, &session, &bytes, &label, &path);
+                let outcome = export::write_report(&view, &loaded, &path);
                 rep.send(JobMessage::Exported {
                     kind,
                     path,
@@ -1157,15 +1154,15 @@ impl WorkbenchApp {
         self.state.selected = (!loaded.session.measurements.is_empty()).then_some(0);
         self.state.result = None;
         self.state.notice = None;
-        let failed = loaded
-            .fits
-            .iter()
-            .filter(|f| matches!(f, super::state::Fit::Failed(_)))
-            .count();
+        let failed = loaded.analysis.failures().count();
         let warned = loaded
-            .fits
+            .analysis
+            .measurements
             .iter()
-            .filter(|f| f.stripe().is_some_and(|s| !s.warnings.is_empty()))
+            .filter(|m| {
+                m.as_ref()
+                    .is_ok_and(|p| p.stripe.as_ref().is_some_and(|s| !s.warnings.is_empty()))
+            })
             .count();
         let mut text = format!(
             "opened {}: {} measurements",

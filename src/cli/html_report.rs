@@ -14,7 +14,7 @@ use clap::Args;
 use super::{CliError, parse_method};
 use crate::engine::format::{self, FileError};
 use crate::engine::report::html::{self, ReportInput, ReportMeta};
-use crate::engine::report::summary;
+use crate::engine::result_view;
 use crate::engine::solve::{self, Control, Method, Options};
 
 /// `spherecal report`.
@@ -68,7 +68,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let result = match &args.result {
         Some(path) => {
             let result = format::load_result(path).map_err(|e| CliError::from_file(&e, true))?;
-            html::check_result(&session, &result, Some(&prepared)).map_err(|e| {
+            result_view::check_result(&session, &result, Some(&prepared)).map_err(|e| {
                 CliError::input(format!(
                     "{} does not belong to {}: {e}",
                     path.display(),
@@ -82,7 +82,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
             options.method = args.method;
             let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
                 .map_err(|e| CliError::from_calibration(&e, &args.session))?;
-            summary::result_file(&session, &prepared, &cal)
+            format::ResultFile::from_calibration(&session, &cal)
         }
     };
     let meta = ReportMeta::new(args.session.display().to_string(), SystemTime::now());

@@ -22,10 +22,10 @@ use clap::{Args, Parser, Subcommand};
 use crate::engine::format;
 use crate::engine::format::FileError;
 use crate::engine::report::summary;
-use crate::engine::solve::CalibrationError;
-use crate::engine::solve::ml::{self, Loss, MlOptions, MlReport};
+use crate::engine::session;
+use crate::engine::solve::ml::{Loss, MlOptions};
 use crate::engine::solve::paper::Pairing;
-use crate::engine::solve::{self, Control, HandEyeSource, Method, Options};
+use crate::engine::solve::{self, Control, HandEyeSource, Method, Options, SolveError};
 
 /// spherecal: calibrate a robot-mounted laser-stripe sensor (hand-eye and
 /// kinematic errors) against a reference sphere.
@@ -219,7 +219,7 @@ impl CliError {
 
     /// From a calibration error of the session at `path`.
     #[must_use]
-    pub fn from_calibration(e: &CalibrationError, path: &Path) -> Self {
+    pub fn from_calibration(e: &SolveError, path: &Path) -> Self {
         let message = format!("{e} ({})", path.display());
         if e.is_input_error() {
             Self::input(message)
@@ -240,7 +240,7 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     let session = if args.exclude.is_empty() {
         session
     } else {
-        ml::exclude_measurements(&session, &args.exclude)
+        session::exclude_measurements(&session, &args.exclude)
             .map_err(|e| CliError::input(format!("{e} ({})", args.session.display())))?
     };
     let mut options = Options::from_session(&session);
@@ -288,13 +288,10 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     }
     let cal = solve::run(&session, &prepared, &options, &mut on_progress)
         .map_err(|e| CliError::from_calibration(&e, &args.session))?;
-    let result = summary::result_file(&session, &prepared, &cal);
+    let result = format::ResultFile::from_calibration(&session, &cal);
     format::save_result(&result, &args.out).map_err(|e| CliError::from_file(&e, false))?;
     if !quiet {
         print!("{}", summary::summary(&session, &cal));
-        if let Some(r) = MlReport::from_solver_block(&cal.solver) {
-            print!("{}", r.summary());
-        }
         println!(
             "wrote {} ({:.0} ms)",
             args.out.display(),

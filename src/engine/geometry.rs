@@ -160,6 +160,23 @@ pub fn rigid_from_rows(rows: &[[f64; 4]; 4]) -> Isometry3<f64> {
     )
 }
 
+/// Roll, pitch and yaw (deg) of a rotation, the one convention of the
+/// crate (see the crate's "Conventions"): fixed-axis x-y-z,
+/// `R = Rz(yaw) · Ry(pitch) · Rx(roll)`, pitch in [−90°, 90°].
+#[must_use]
+pub fn roll_pitch_yaw_deg(rotation: &UnitQuaternion<f64>) -> [f64; 3] {
+    let (r, p, y) = rotation.euler_angles();
+    [r.to_degrees(), p.to_degrees(), y.to_degrees()]
+}
+
+/// The rotation of roll, pitch and yaw (deg), [`roll_pitch_yaw_deg`]'s
+/// convention.
+#[must_use]
+pub fn rotation_from_rpy_deg(rpy_deg: [f64; 3]) -> UnitQuaternion<f64> {
+    let [r, p, y] = rpy_deg.map(f64::to_radians);
+    UnitQuaternion::from_euler_angles(r, p, y)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -207,5 +224,14 @@ mod tests {
         assert_eq!(wrap_deg(-180.0), 180.0);
         assert_eq!(wrap_deg(540.0), 180.0);
         assert!((wrap_deg(-725.0) - -5.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn angle_changes_wrap_across_180() {
+        assert!((wrap_deg(358.9) - (-1.1)).abs() < 1e-9);
+        assert!((wrap_deg(-359.0) - 1.0).abs() < 1e-9);
+        assert!((wrap_deg(0.25) - 0.25).abs() < 1e-12);
+        assert_eq!(wrap_deg(180.0), 180.0);
+        assert_eq!(wrap_deg(-180.0), 180.0);
     }
 }

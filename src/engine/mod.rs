@@ -28,6 +28,7 @@ pub mod import;
 pub mod numeric;
 pub mod plan;
 pub mod report;
+pub mod result_view;
 pub mod robot;
 pub mod session;
 pub mod simulate;

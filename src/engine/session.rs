@@ -2,6 +2,8 @@
 //! `session.rs` turns a FORMAT.md file into a [`Session`] (enforcing every
 //! rule) and back; nothing else reads or writes session files.
 
+use std::collections::HashSet;
+
 use nalgebra::{Isometry3, Vector3};
 
 use crate::engine::robot::Robot;
@@ -16,6 +18,7 @@ pub const DEFAULT_MAX_ITERATIONS: usize = 20;
 pub const MIN_STRIPE_POINTS: usize = 5;
 
 /// What a measurement is used for (FORMAT.md `measurements[].use`).
+/// Compares equal to its file spelling (`Use::Identify == "identify"`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Use {
     /// Pure translation about one station: initial rotation (eq. 6-7).
@@ -59,6 +62,12 @@ impl Use {
         Self::Identify,
         Self::Validate,
     ];
+}
+
+impl PartialEq<&str> for Use {
+    fn eq(&self, other: &&str) -> bool {
+        self.as_str() == *other
+    }
 }
 
 /// What the sensor reported for one measurement.
@@ -114,6 +123,33 @@ impl Default for SolverSettings {
         Self {
             threshold: DEFAULT_THRESHOLD,
             max_iterations: DEFAULT_MAX_ITERATIONS,
+        }
+    }
+}
+
+/// A session rule that spans measurements, broken: the measurement it is
+/// in (when one is to blame) and what is wrong.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{}{message}", measurement.as_ref().map(|m| format!("measurement {m}: ")).unwrap_or_default())]
+pub struct RuleError {
+    /// The measurement to blame, if one is.
+    pub measurement: Option<String>,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl RuleError {
+    fn at(measurement: &str, message: String) -> Self {
+        Self {
+            measurement: Some(measurement.to_string()),
+            message,
+        }
+    }
+
+    fn general(message: String) -> Self {
+        Self {
+            measurement: None,
+            message,
         }
     }
 }
@@ -178,4 +214,172 @@ impl Session {
         }
         out
     }
+
+    /// Checks the rules of FORMAT.md `measurements[].use` and `station`
+    /// that span measurements. Whether the translations are collinear and the
+    /// rotations too similar is checked by the initial hand-eye itself.
+    ///
+    /// # Errors
+    /// The first broken rule, naming the measurement where there is one.
+    pub fn check_rules(&self) -> Result<(), RuleError> {
+        let session = self;
+        let ids = |indices: &[usize]| -> String {
+            indices
+                .iter()
+                .map(|&i| session.measurements[i].id.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        for usage in [Use::Translation, Use::Rotation] {
+            let stations = session.stations(usage);
+            if let [(first, first_ids), (second, second_ids), ..] = stations.as_slice() {
+                let offender = &session.measurements[second_ids[0]].id;
+                return Err(RuleError::at(
+                    offender,
+                    format!(
+                        "all {} measurements must share one station: {} at station {first}, {} at station {second}",
+                        usage.as_str(),
+                        ids(first_ids),
+                        ids(second_ids)
+                    ),
+                ));
+            }
+        }
+        if session.hand_eye.is_none() {
+            for (usage, needed, purpose) in [
+                (Use::Translation, 3, "the initial rotation (paper eq. 6-7)"),
+                (Use::Rotation, 2, "the initial translation (paper eq. 8-9)"),
+            ] {
+                let found: Vec<usize> = (0..session.measurements.len())
+                    .filter(|&i| session.measurements[i].usage == usage)
+                    .collect();
+                if found.len() < needed {
+                    let list = if found.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" ({})", ids(&found))
+                    };
+                    return Err(RuleError::general(format!(
+                        "without `hand_eye`, {purpose} needs at least {needed} {} measurements; the session has {}{list}",
+                        usage.as_str(),
+                        found.len()
+                    )));
+                }
+            }
+        }
+        for (station, indices) in session.stations(Use::Identify) {
+            if indices.len() < 2 {
+                let id = &session.measurements[indices[0]].id;
+                return Err(RuleError::at(
+                    id,
+                    format!(
+                        "identify station {station} has only 1 measurement ({id}); an identify station needs at least 2"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Why [`exclude_measurements`] refused.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ExcludeError {
+    /// An id names no measurement of the session.
+    #[error("cannot exclude measurement {0}: the session has no measurement with that id")]
+    UnknownId(String),
+    /// An identify station would keep fewer than 2 measurements.
+    #[error(
+        "excluding {} leaves identify station {station} with {remaining} measurement(s); an identify station needs at least 2",
+        excluded.join(", ")
+    )]
+    StationTooSmall {
+        /// The station.
+        station: String,
+        /// Measurements it would keep.
+        remaining: usize,
+        /// The excluded ids of that station.
+        excluded: Vec<String>,
+    },
+    /// A validate station named by a reference distance would be empty.
+    #[error(
+        "excluding {} leaves validate station {station} with no measurement, but reference distance {from} → {to} names it",
+        excluded.join(", ")
+    )]
+    ReferencedStationEmpty {
+        /// The station.
+        station: String,
+        /// The excluded ids of that station.
+        excluded: Vec<String>,
+        /// The reference distance's `from`.
+        from: String,
+        /// The reference distance's `to`.
+        to: String,
+    },
+    /// The session left breaks another rule (too few translation or
+    /// rotation measurements for the initial hand-eye, say).
+    #[error("without the left-out measurements, {0}")]
+    Rule(#[from] RuleError),
+}
+
+/// The session without the measurements `ids` (exclude-and-rerun, or a
+/// session saved without them), re-checking every FORMAT.md rule the
+/// removal can break: every identify station keeps at least 2
+/// measurements, every validate station a reference distance names keeps
+/// at least one, and without a `hand_eye` enough translation and rotation
+/// measurements remain ([`Session::check_rules`]).
+///
+/// # Errors
+/// [`ExcludeError`] naming the unknown id or the station.
+pub fn exclude_measurements(session: &Session, ids: &[String]) -> Result<Session, ExcludeError> {
+    let known: HashSet<&str> = session.measurements.iter().map(|m| m.id.as_str()).collect();
+    if let Some(bad) = ids.iter().find(|id| !known.contains(id.as_str())) {
+        return Err(ExcludeError::UnknownId(bad.clone()));
+    }
+    let drop: HashSet<&str> = ids.iter().map(String::as_str).collect();
+    let mut out = session.clone();
+    out.measurements.retain(|m| !drop.contains(m.id.as_str()));
+    let excluded_of = |station: &str, usage: Use| -> Vec<String> {
+        session
+            .measurements
+            .iter()
+            .filter(|m| m.station == station && m.usage == usage && drop.contains(m.id.as_str()))
+            .map(|m| m.id.clone())
+            .collect()
+    };
+    for (station, _) in session.stations(Use::Identify) {
+        let remaining = out
+            .measurements
+            .iter()
+            .filter(|m| m.usage == Use::Identify && m.station == station)
+            .count();
+        if remaining < 2 {
+            let excluded = excluded_of(&station, Use::Identify);
+            if !excluded.is_empty() {
+                return Err(ExcludeError::StationTooSmall {
+                    station,
+                    remaining,
+                    excluded,
+                });
+            }
+        }
+    }
+    for r in &session.reference_distances {
+        for station in [&r.from, &r.to] {
+            let left = out
+                .measurements
+                .iter()
+                .any(|m| m.usage == Use::Validate && &m.station == station);
+            if !left {
+                return Err(ExcludeError::ReferencedStationEmpty {
+                    station: station.clone(),
+                    excluded: excluded_of(station, Use::Validate),
+                    from: r.from.clone(),
+                    to: r.to.clone(),
+                });
+            }
+        }
+    }
+    out.check_rules()?;
+    Ok(out)
 }

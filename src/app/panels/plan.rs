@@ -271,7 +271,7 @@ fn outcome_ui(
             .id_salt("plan_inseparable")
             .show(ui, |ui| {
                 for s in &st.inseparable {
-                    ui.label(s);
+                    ui.label(s.to_string());
                 }
             });
     }

@@ -15,6 +15,7 @@ use super::{AFTER, BAD, BEFORE, MUTED, WARN, labelled_field, ratio_text};
 use crate::app::commands::Command;
 use crate::app::state::{AppState, DialogPurpose, ExportKind, Forms};
 use crate::app::view::{HandEyeView, ResultOrigin, ResultView};
+use crate::engine::geometry::{rows_from_isometry, wrap_deg};
 use crate::engine::robot::{PARAM_NAMES, PARAMS_PER_JOINT};
 use crate::engine::solve::estimate::HAND_EYE_LABELS;
 
@@ -95,7 +96,7 @@ fn origin_ui(ui: &mut egui::Ui, view: &ResultView) {
 fn headline_ui(ui: &mut egui::Ui, view: &ResultView) {
     egui::Frame::group(ui.style()).show(ui, |ui| {
         ui.set_width(ui.available_width());
-        match &view.headline {
+        match &view.shown.headline {
             Some(h) => {
                 ui.label(RichText::new(&h.what).strong());
                 let (b, a) = (h.stats.before, h.stats.after);
@@ -111,10 +112,10 @@ fn headline_ui(ui: &mut egui::Ui, view: &ResultView) {
                 ui.label(RichText::new("No validate measurements in this session: accuracy is not checked.").color(WARN));
             }
         }
-        let w = &view.within_stats;
+        let w = &view.shown.within_stats;
         ui.label(format!(
             "{} stations, centre distances (true value 0): std {:.3} → {:.3} mm, max {:.3} → {:.3} mm · ε {:.4} → {:.4} mm",
-            view.within_of,
+            view.shown.within_of.as_str(),
             w.before.std,
             w.after.std,
             w.before.max,
@@ -192,7 +193,7 @@ fn plots_ui(ui: &mut egui::Ui, view: &ResultView) -> f32 {
         cols[0].label(
             RichText::new(format!(
                 "Centre distances within {} stations, per pair (cf. paper Fig. 5)",
-                view.within_of
+                view.shown.within_of.as_str()
             ))
             .strong(),
         );
@@ -265,23 +266,26 @@ fn before_after_series(p: &mut egui_plot::PlotUi<'_>, before: Vec<[f64; 2]>, aft
 
 fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
     let before: Vec<[f64; 2]> = view
+        .shown
         .within
         .iter()
         .enumerate()
         .map(|(k, p)| [(k + 1) as f64, p.before])
         .collect();
     let after: Vec<[f64; 2]> = view
+        .shown
         .within
         .iter()
         .enumerate()
         .map(|(k, p)| [(k + 1) as f64, p.after])
         .collect();
     let top = view
+        .shown
         .within
         .iter()
         .map(|p| p.before.max(p.after))
         .fold(0.0, f64::max);
-    let within = &view.within;
+    let within = &view.shown.within;
     Plot::new("fig5")
         .height(PLOT_HEIGHT)
         .x_axis_label("pair (station by station)")
@@ -328,25 +332,27 @@ fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
 }
 
 fn fig6_ui(ui: &mut egui::Ui, view: &ResultView) {
-    if view.distances.is_empty() {
+    if view.shown.distances.is_empty() {
         ui.allocate_ui(egui::vec2(ui.available_width(), PLOT_HEIGHT), |ui| {
             ui.label(RichText::new("No reference distances in this session.").color(MUTED));
         });
         return;
     }
     let before: Vec<[f64; 2]> = view
+        .shown
         .distances
         .iter()
         .enumerate()
         .map(|(k, d)| [(k + 1) as f64, d.error_before()])
         .collect();
     let after: Vec<[f64; 2]> = view
+        .shown
         .distances
         .iter()
         .enumerate()
         .map(|(k, d)| [(k + 1) as f64, d.error_after()])
         .collect();
-    let distances = &view.distances;
+    let distances = &view.shown.distances;
     Plot::new("fig6")
         .height(PLOT_HEIGHT)
         .x_axis_label("distance")
@@ -501,7 +507,7 @@ fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
 }
 
 fn marked_cell(ui: &mut egui::Ui, view: &ResultView, label: &str, text: String) {
-    if let Some(why) = view.marked.get(label) {
+    if let Some(why) = view.shown.marked.get(label) {
         ui.label(RichText::new(format!("{text} †")).color(MUTED))
             .on_hover_text(format!("{label} is not identifiable from this data: {why}"));
     } else {
@@ -511,7 +517,8 @@ fn marked_cell(ui: &mut egui::Ui, view: &ResultView, label: &str, text: String) 
 
 fn hand_eye_ui(ui: &mut egui::Ui, view: &ResultView) {
     ui.label(RichText::new("Hand-eye eT_s (sensor to flange)").strong());
-    let (b, a): (&HandEyeView, &HandEyeView) = (&view.hand_eye_before, &view.hand_eye_after);
+    let (b, a): (&HandEyeView, &HandEyeView) =
+        (&view.shown.hand_eye_before, &view.shown.hand_eye_after);
     egui::Grid::new("hand_eye")
         .striped(true)
         .num_columns(4)
@@ -564,14 +571,17 @@ fn hand_eye_ui(ui: &mut egui::Ui, view: &ResultView) {
     ui.label(
         RichText::new(format!(
             "rotation changed by {:.4}°",
-            view.hand_eye_rotation_change_deg
+            view.shown.hand_eye_rotation_change_deg
         ))
         .small(),
     );
     egui::CollapsingHeader::new("matrices").show(ui, |ui| {
-        for (title, m) in [("initial", &b.rows), ("calibrated", &a.rows)] {
+        for (title, m) in [
+            ("initial", &view.file.hand_eye_initial),
+            ("calibrated", &view.file.hand_eye),
+        ] {
             ui.label(title);
-            for r in m {
+            for r in rows_from_isometry(m) {
                 ui.monospace(format!(
                     "{:>10.5} {:>10.5} {:>10.5} {:>10.3}",
                     r[0], r[1], r[2], r[3]
@@ -599,7 +609,7 @@ fn joint_errors_ui(ui: &mut egui::Ui, view: &ResultView) {
                 ui.strong(h);
             }
             ui.end_row();
-            for (j, e) in view.joint_errors.iter().enumerate() {
+            for (j, e) in view.file.joint_errors.iter().enumerate() {
                 ui.label(format!("{}", j + 1));
                 for (p, name) in PARAM_NAMES.iter().enumerate() {
                     let label = format!("{name}{}", j + 1);
@@ -608,36 +618,14 @@ fn joint_errors_ui(ui: &mut egui::Ui, view: &ResultView) {
                 ui.end_row();
             }
         });
-    if !view.marked.is_empty() {
+    if !view.shown.marked.is_empty() {
         ui.label(
             RichText::new(format!(
                 "† not identifiable from this data ({} parameter(s)): they lie in a direction the SVD dropped (or the method held them fixed), so the value is not a measurement of the robot. Hover a value for the direction.",
-                view.marked.len()
+                view.shown.marked.len()
             ))
             .small()
             .color(MUTED),
         );
-    }
-}
-
-/// An angle difference wrapped to (−180°, 180°]: a roll near ±180° that
-/// crosses over is a change of a degree, not of 359°.
-#[must_use]
-pub fn wrap_deg(d: f64) -> f64 {
-    let w = (d + 180.0).rem_euclid(360.0) - 180.0;
-    if w == -180.0 { 180.0 } else { w }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::wrap_deg;
-
-    #[test]
-    fn angle_changes_wrap_across_180() {
-        assert!((wrap_deg(358.9) - (-1.1)).abs() < 1e-9);
-        assert!((wrap_deg(-359.0) - 1.0).abs() < 1e-9);
-        assert!((wrap_deg(0.25) - 0.25).abs() < 1e-12);
-        assert_eq!(wrap_deg(180.0), 180.0);
-        assert_eq!(wrap_deg(-180.0), 180.0);
     }
 }

@@ -311,7 +311,7 @@ fn item_row(
             .points(i)
             .map_or_else(|| "—".into(), |n| n.to_string())));
     });
-    let fit = &loaded.fits[i];
+    let fit = loaded.fit(i);
     match fit {
         Fit::GivenCentre => {
             row.col(|ui| {
@@ -325,13 +325,14 @@ fn item_row(
         Fit::Failed(e) => {
             row.col(|ui| {
                 ui.label(RichText::new("fit failed").color(BAD))
-                    .on_hover_text(e);
+                    .on_hover_text(e.to_string());
             });
             row.col(|ui| {
                 ui.label("—");
             });
             row.col(|ui| {
-                ui.label(RichText::new(e).color(BAD)).on_hover_text(e);
+                ui.label(RichText::new(e.to_string()).color(BAD))
+                    .on_hover_text(e.to_string());
             });
         }
         Fit::Stripe(s) => {

@@ -88,7 +88,7 @@ pub fn stripe_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &
             .collect::<Vec<_>>()
             .join(", ")
     ));
-    match (&loaded.fits[i], &m.observation) {
+    match (loaded.fit(i), &m.observation) {
         (Fit::GivenCentre, Observation::Centre(c)) => {
             ui.add_space(10.0);
             ui.label(format!(

@@ -670,7 +670,7 @@ mod tests {
     use crate::engine::geometry::isometry_from_twist;
 
     #[test]
-    pub(super) fn numbers_round_trip_bit_for_bit() {
+    fn numbers_round_trip_bit_for_bit() {
         // A spread of magnitudes and bit patterns, through the writer and
         // the reader.
         let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
@@ -707,7 +707,7 @@ mod tests {
     }
 
     #[test]
-    pub(super) fn settled_matrices_survive_write_and_read() {
+    fn settled_matrices_survive_write_and_read() {
         let read =
             |rows: &[[f64; 4]; 4]| settle(rows, isometry_from_rows(rows).unwrap_or_default());
         let mut misses = 0;
@@ -737,7 +737,7 @@ mod tests {
     }
 
     #[test]
-    pub(super) fn layout_keeps_number_arrays_on_one_line() {
+    fn layout_keeps_number_arrays_on_one_line() {
         let value = serde_json::json!({
             "a": [[1.0, 2.0], [3.5, -4.0]],
             "b": [],

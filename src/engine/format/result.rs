@@ -8,33 +8,42 @@ use serde::de::IgnoredAny;
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
-use super::json::{Ctx, UniqueValue, join, read_text, render, render_lossy, some};
+use nalgebra::Isometry3;
+
+use super::json::{Ctx, UniqueValue, join, read_text, render, render_lossy, settle, some};
 use super::{FORMAT_VERSION, FileError, RESULT_FORMAT, write_atomic};
-use crate::engine::geometry::{isometry_from_rows, rows_from_isometry};
+use crate::engine::geometry::{isometry_from_rows, rigid_from_rows, rows_from_isometry};
 use crate::engine::robot::{Joint, Robot};
-use crate::engine::session::Use;
+use crate::engine::session::{Session, Use};
+use crate::engine::solve::Calibration;
+use crate::engine::solve::ml::MlReport;
+use crate::engine::solve::report::{Direction, PaperReport, SolverReport};
 use crate::engine::validate::Validation;
 
-/// A result file (FORMAT.md "Result file"), field for field; `format` and
-/// `version` are added on writing and checked on reading. Matrices are
-/// row-major 4×4 (mm), joints in deg and mm.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// A result (FORMAT.md "Result file") as the engine holds it: transforms
+/// as [`Isometry3`], the robot as a [`Robot`], the method's report typed.
+/// Made from a run by [`ResultFile::from_calibration`] or read from a file
+/// by [`parse_result`]; [`result_to_json`] writes it (4×4 matrices
+/// row-major in mm, joints in deg and mm) and `format` and `version` are
+/// added on writing and checked on reading. Two results are equal when
+/// they write the same file: transforms compare as their written 4×4
+/// matrices, to the few ulps by which a computed transform and the one
+/// read back from its file may differ.
+#[derive(Debug, Clone)]
 pub struct ResultFile {
     /// Name of the session the result was computed from.
     pub session: String,
-    /// Initial hand-eye `eT_s` (sensor to flange), before identification.
-    pub hand_eye_initial: [[f64; 4]; 4],
-    /// Calibrated hand-eye `eT_s` (sensor to flange).
-    pub hand_eye: [[f64; 4]; 4],
+    /// Initial hand-eye `flange_from_sensor` (`eT_s`), before identification.
+    pub hand_eye_initial: Isometry3<f64>,
+    /// Calibrated hand-eye `flange_from_sensor` (`eT_s`).
+    pub hand_eye: Isometry3<f64>,
     /// The calibrated robot model.
-    pub robot: RobotRecord,
+    pub robot: Robot,
     /// Calibrated minus nominal joint parameters (deg, mm), one per joint
     /// (paper Table 1).
     pub joint_errors: Vec<Joint>,
-    /// How the result was obtained: `method` (required, a string) and the
-    /// method's own settings and diagnostics. Written with `method` first.
-    #[serde(serialize_with = "method_first")]
-    pub solver: Map<String, Value>,
+    /// How the result was obtained: the method's report.
+    pub solver: SolverReport,
     /// ε (mm) after 0, 1, … updates; at least the starting ε.
     pub iterations: Vec<IterationRecord>,
     /// ε (mm) before identification, equal to the first `iterations` entry.
@@ -44,8 +53,105 @@ pub struct ResultFile {
     /// Every measurement's sphere centre in the sensor and base frames.
     pub centres: Vec<CentreRecord>,
     /// Present when the session has validate measurements.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub validation: Option<Validation>,
+}
+
+impl PartialEq for ResultFile {
+    fn eq(&self, other: &Self) -> bool {
+        self.session == other.session
+            && same_transform(&self.hand_eye_initial, &other.hand_eye_initial)
+            && same_transform(&self.hand_eye, &other.hand_eye)
+            && self.robot.name == other.robot.name
+            && self.robot.joints == other.robot.joints
+            && same_transform(&self.robot.base, &other.robot.base)
+            && same_transform(&self.robot.flange, &other.robot.flange)
+            && self.joint_errors == other.joint_errors
+            && self.solver == other.solver
+            && self.iterations == other.iterations
+            && self.epsilon_before == other.epsilon_before
+            && self.epsilon_after == other.epsilon_after
+            && self.centres == other.centres
+            && self.validation == other.validation
+    }
+}
+
+impl ResultFile {
+    /// The result of a run on `session`.
+    #[must_use]
+    pub fn from_calibration(session: &Session, cal: &Calibration) -> Self {
+        Self {
+            session: session.name.clone(),
+            hand_eye_initial: cal.hand_eye_initial,
+            hand_eye: cal.hand_eye,
+            robot: cal.calibrated.clone(),
+            joint_errors: cal.calibrated.joint_errors(&cal.nominal),
+            solver: cal.report.clone(),
+            iterations: cal
+                .iterations
+                .iter()
+                .map(|&epsilon| IterationRecord { epsilon })
+                .collect(),
+            epsilon_before: cal.epsilon_before(),
+            epsilon_after: cal.epsilon_after(),
+            centres: cal
+                .centres
+                .iter()
+                .map(|c| {
+                    let m = &session.measurements[c.index];
+                    CentreRecord {
+                        measurement: m.id.clone(),
+                        station: m.station.clone(),
+                        usage: m.usage,
+                        sensor: c.sensor.into(),
+                        before: c.before.into(),
+                        after: c.after.into(),
+                    }
+                })
+                .collect(),
+            validation: cal.validation.clone(),
+        }
+    }
+
+    /// The session's nominal model: the calibrated one minus the joint
+    /// errors (base and flange as calibrated; sphere data do not move them).
+    #[must_use]
+    pub fn nominal(&self) -> Robot {
+        Robot {
+            joints: self
+                .robot
+                .joints
+                .iter()
+                .zip(&self.joint_errors)
+                .map(|(c, e)| c.minus(e))
+                .collect(),
+            ..self.robot.clone()
+        }
+    }
+}
+
+/// One entry of the result's `iterations`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IterationRecord {
+    /// ε (paper eq. 20, pooled over identify stations), mm.
+    pub epsilon: f64,
+}
+
+/// One entry of the result's `centres`: a measurement's sphere centre.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CentreRecord {
+    /// Measurement id.
+    pub measurement: String,
+    /// Station id.
+    pub station: String,
+    /// The measurement's `use`.
+    pub usage: Use,
+    /// Centre in the sensor frame **S**, mm.
+    pub sensor: [f64; 3],
+    /// Centre in the base frame **B**, nominal model and initial hand-eye, mm.
+    pub before: [f64; 3],
+    /// Centre in the base frame **B**, calibrated model and hand-eye, mm.
+    pub after: [f64; 3],
 }
 
 /// The result's `robot` block: the calibrated model in file units.
@@ -73,63 +179,134 @@ impl RobotRecord {
             flange: rows_from_isometry(&robot.flange),
         }
     }
-
-    /// The robot model of this record.
-    ///
-    /// # Errors
-    /// [`crate::engine::geometry::MatrixError`] when `base` or `flange` is not a
-    /// rigid transform ([`parse_result`] has already checked both).
-    pub fn to_robot(&self) -> Result<Robot, crate::engine::geometry::MatrixError> {
-        Ok(Robot {
-            name: self.name.clone(),
-            joints: self.joints.clone(),
-            base: isometry_from_rows(&self.base)?,
-            flange: isometry_from_rows(&self.flange)?,
-        })
-    }
 }
 
-/// One entry of the result's `iterations`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct IterationRecord {
-    /// ε (paper eq. 20, pooled over identify stations), mm.
-    pub epsilon: f64,
-}
-
-/// One entry of the result's `centres`: a measurement's sphere centre.
+/// A centre as the file holds it (`use` spelled out).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct CentreRecord {
-    /// Measurement id.
-    pub measurement: String,
-    /// Station id.
-    pub station: String,
-    /// The measurement's `use` (FORMAT.md spelling, see [`Use::as_str`]).
+struct CentreWire {
+    measurement: String,
+    station: String,
     #[serde(rename = "use")]
-    pub usage: String,
-    /// Centre in the sensor frame **S**, mm.
-    pub sensor: [f64; 3],
-    /// Centre in the base frame **B**, nominal model and initial hand-eye, mm.
-    pub before: [f64; 3],
-    /// Centre in the base frame **B**, calibrated model and hand-eye, mm.
-    pub after: [f64; 3],
+    usage: String,
+    sensor: [f64; 3],
+    before: [f64; 3],
+    after: [f64; 3],
 }
 
-/// Serialises the `solver` block with `method` first, then the other keys.
-fn method_first<S: serde::Serializer>(
-    solver: &Map<String, Value>,
-    s: S,
-) -> Result<S::Ok, S::Error> {
-    use serde::ser::SerializeMap as _;
-    let mut map = s.serialize_map(Some(solver.len()))?;
-    if let Some(method) = solver.get("method") {
-        map.serialize_entry("method", method)?;
+/// The `solver` block of `report`: what [`result_to_json`] writes (with
+/// `method` first). Keys in the block are sorted, as serde_json's maps are.
+#[must_use]
+pub fn solver_block(report: &SolverReport) -> Map<String, Value> {
+    let (method, mut block) = match report {
+        SolverReport::Paper(r) => ("paper", paper_block(r)),
+        SolverReport::Ml(r) => (
+            "ml",
+            match serde_json::to_value(r.as_ref()) {
+                Ok(Value::Object(m)) => m,
+                _ => Map::new(),
+            },
+        ),
+        SolverReport::Other { method, block } => (method.as_str(), block.clone()),
+    };
+    block.insert("method".into(), Value::String(method.to_string()));
+    block
+}
+
+/// The paper's block: the keys the report holds, and its extra ones.
+fn paper_block(r: &PaperReport) -> Map<String, Value> {
+    let mut m = r.extra.clone();
+    let mut put = |key: &str, value: Option<Value>| {
+        if let Some(v) = value {
+            m.insert(key.into(), v);
+        }
+    };
+    put("pairs", r.pairs.clone().map(Value::String));
+    put("svd_tolerance", r.svd_tolerance.map(Value::from));
+    put(
+        "column_scaling",
+        r.column_scaling.clone().map(Value::String),
+    );
+    put("threshold", r.threshold.map(Value::from));
+    put("max_iterations", r.max_iterations.map(Value::from));
+    put("stop", r.stop.clone().map(Value::String));
+    put("stop_reason", r.stop_reason.clone().map(Value::String));
+    put("kept_directions", r.kept_directions.map(Value::from));
+    put("equations", r.equations.map(Value::from));
+    put(
+        "singular_values",
+        r.singular_values.as_ref().map(|v| Value::from(v.clone())),
+    );
+    put(
+        "dropped_directions",
+        r.dropped_directions
+            .as_ref()
+            .map(|d| d.iter().map(|x| Value::String(x.to_string())).collect()),
+    );
+    put(
+        "unknowns",
+        r.unknowns.as_ref().map(|u| Value::from(u.clone())),
+    );
+    m
+}
+
+/// The report of a `solver` block read from a file (`method` checked to be
+/// a non-empty string before): the paper's and `ml`'s typed, any other
+/// method kept as read. A key of the paper's block that does not read as
+/// its type stays among the extra keys; an `ml` block that does not read
+/// is kept as another method's.
+fn solver_report(mut block: Map<String, Value>) -> SolverReport {
+    let method = match block.remove("method") {
+        Some(Value::String(m)) => m,
+        _ => String::new(),
+    };
+    match method.as_str() {
+        "paper" => SolverReport::Paper(Box::new(paper_report(block))),
+        "ml" => match serde_json::from_value::<MlReport>(Value::Object(block.clone())) {
+            Ok(r) => SolverReport::Ml(Box::new(r)),
+            Err(_) => SolverReport::Other { method, block },
+        },
+        _ => SolverReport::Other { method, block },
     }
-    for (key, value) in solver.iter().filter(|(k, _)| *k != "method") {
-        map.serialize_entry(key, value)?;
+}
+
+/// The paper's block, key by key.
+fn paper_report(mut block: Map<String, Value>) -> PaperReport {
+    fn take<T: serde::de::DeserializeOwned>(
+        block: &mut Map<String, Value>,
+        key: &str,
+    ) -> Option<T> {
+        let value = block.get(key)?;
+        let parsed = serde_json::from_value(value.clone()).ok()?;
+        block.remove(key);
+        Some(parsed)
     }
-    map.end()
+    let dropped: Option<Vec<String>> = block
+        .get("dropped_directions")
+        .and_then(|v| serde_json::from_value::<Vec<String>>(v.clone()).ok());
+    let dropped_directions = dropped.and_then(|d| {
+        d.iter()
+            .map(|t| t.parse::<Direction>().ok())
+            .collect::<Option<Vec<_>>>()
+    });
+    if dropped_directions.is_some() {
+        block.remove("dropped_directions");
+    }
+    PaperReport {
+        pairs: take(&mut block, "pairs"),
+        svd_tolerance: take(&mut block, "svd_tolerance"),
+        column_scaling: take(&mut block, "column_scaling"),
+        threshold: take(&mut block, "threshold"),
+        max_iterations: take(&mut block, "max_iterations"),
+        stop: take(&mut block, "stop"),
+        stop_reason: take(&mut block, "stop_reason"),
+        kept_directions: take(&mut block, "kept_directions"),
+        equations: take(&mut block, "equations"),
+        singular_values: take(&mut block, "singular_values"),
+        dropped_directions,
+        unknowns: take(&mut block, "unknowns"),
+        extra: block,
+    }
 }
 
 /// The result as FORMAT.md version 1 JSON, pretty-printed, with a trailing
@@ -158,9 +335,8 @@ pub fn parse_result(text: &str, path: &Path) -> Result<ResultFile, FileError> {
     let tree: UniqueValue = ctx.parse(top, "", None)?;
     ctx.result_objects(&tree.0)?;
     let keys: ResultKeys = ctx.parse(top, "", None)?;
-    let result = keys.into_result();
-    ctx.check_result(&result)?;
-    Ok(result)
+    ctx.check_result(&keys)?;
+    Ok(keys.into_result())
 }
 
 /// Reads and checks a result file (see [`parse_result`]).
@@ -218,24 +394,61 @@ struct ResultKeys {
     iterations: Vec<IterationRecord>,
     epsilon_before: f64,
     epsilon_after: f64,
-    centres: Vec<CentreRecord>,
+    centres: Vec<CentreWire>,
     #[serde(default, deserialize_with = "some")]
     validation: Option<Validation>,
 }
 
+/// The transform of checked file rows, settled so that it survives its
+/// own save and load bit for bit (see [`settle`]).
+fn transform(rows: &[[f64; 4]; 4]) -> Isometry3<f64> {
+    let iso = isometry_from_rows(rows).unwrap_or_else(|_| rigid_from_rows(rows));
+    settle(rows, iso)
+}
+
+/// Whether two transforms write the same 4×4 matrix, to the rounding of
+/// a matrix read and settled (a few ulps of its rotation entries).
+fn same_transform(a: &Isometry3<f64>, b: &Isometry3<f64>) -> bool {
+    /// Rotation entries are at most 1; settling moves them by a few ulps.
+    const ROUNDING: f64 = 8.0 * f64::EPSILON;
+    let (ra, rb) = (rows_from_isometry(a), rows_from_isometry(b));
+    ra.iter().zip(&rb).all(|(x, y)| {
+        x.iter()
+            .zip(y)
+            .all(|(u, v)| (u - v).abs() <= ROUNDING * u.abs().max(1.0))
+    })
+}
+
 impl ResultKeys {
+    /// The typed result of keys that passed [`Ctx::check_result`].
     fn into_result(self) -> ResultFile {
         ResultFile {
             session: self.session,
-            hand_eye_initial: self.hand_eye_initial,
-            hand_eye: self.hand_eye,
-            robot: self.robot,
+            hand_eye_initial: transform(&self.hand_eye_initial),
+            hand_eye: transform(&self.hand_eye),
+            robot: Robot {
+                name: self.robot.name,
+                joints: self.robot.joints,
+                base: transform(&self.robot.base),
+                flange: transform(&self.robot.flange),
+            },
             joint_errors: self.joint_errors,
-            solver: self.solver,
+            solver: solver_report(self.solver),
             iterations: self.iterations,
             epsilon_before: self.epsilon_before,
             epsilon_after: self.epsilon_after,
-            centres: self.centres,
+            centres: self
+                .centres
+                .into_iter()
+                .map(|c| CentreRecord {
+                    usage: Use::parse(&c.usage).unwrap_or(Use::Identify),
+                    measurement: c.measurement,
+                    station: c.station,
+                    sensor: c.sensor,
+                    before: c.before,
+                    after: c.after,
+                })
+                .collect(),
             validation: self.validation,
         }
     }
@@ -289,7 +502,7 @@ impl<'a> Ctx<'a> {
         Ok(())
     }
 
-    fn check_result(&self, r: &ResultFile) -> Result<(), FileError> {
+    fn check_result(&self, r: &ResultKeys) -> Result<(), FileError> {
         for (key, rows) in [
             ("hand_eye_initial", &r.hand_eye_initial),
             ("hand_eye", &r.hand_eye),
@@ -360,20 +573,70 @@ impl<'a> Ctx<'a> {
     }
 }
 
+/// The result as written: `format` and `version`, then every key of
+/// FORMAT.md in its order, transforms as row-major 4×4 matrices.
 #[derive(Serialize)]
 struct ResultOut<'a> {
     format: &'static str,
     version: u32,
-    #[serde(flatten)]
-    result: &'a ResultFile,
+    session: &'a str,
+    hand_eye_initial: [[f64; 4]; 4],
+    hand_eye: [[f64; 4]; 4],
+    robot: RobotRecord,
+    joint_errors: &'a [Joint],
+    #[serde(serialize_with = "method_first")]
+    solver: Map<String, Value>,
+    iterations: &'a [IterationRecord],
+    epsilon_before: f64,
+    epsilon_after: f64,
+    centres: Vec<CentreWire>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    validation: Option<&'a Validation>,
+}
+
+/// Serialises the `solver` block with `method` first, then the other keys.
+fn method_first<S: serde::Serializer>(
+    solver: &Map<String, Value>,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeMap as _;
+    let mut map = s.serialize_map(Some(solver.len()))?;
+    if let Some(method) = solver.get("method") {
+        map.serialize_entry("method", method)?;
+    }
+    for (key, value) in solver.iter().filter(|(k, _)| *k != "method") {
+        map.serialize_entry(key, value)?;
+    }
+    map.end()
 }
 
 impl<'a> ResultOut<'a> {
-    fn new(result: &'a ResultFile) -> Self {
+    fn new(r: &'a ResultFile) -> Self {
         Self {
             format: RESULT_FORMAT,
             version: FORMAT_VERSION,
-            result,
+            session: &r.session,
+            hand_eye_initial: rows_from_isometry(&r.hand_eye_initial),
+            hand_eye: rows_from_isometry(&r.hand_eye),
+            robot: RobotRecord::from_robot(&r.robot),
+            joint_errors: &r.joint_errors,
+            solver: solver_block(&r.solver),
+            iterations: &r.iterations,
+            epsilon_before: r.epsilon_before,
+            epsilon_after: r.epsilon_after,
+            centres: r
+                .centres
+                .iter()
+                .map(|c| CentreWire {
+                    measurement: c.measurement.clone(),
+                    station: c.station.clone(),
+                    usage: c.usage.as_str().to_string(),
+                    sensor: c.sensor,
+                    before: c.before,
+                    after: c.after,
+                })
+                .collect(),
+            validation: r.validation.as_ref(),
         }
     }
 }

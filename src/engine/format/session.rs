@@ -207,7 +207,9 @@ impl<'a> Ctx<'a> {
         if let Some(raw) = keys.reference_distances {
             session.reference_distances = self.reference_distances(raw, &session)?;
         }
-        self.check_uses(&session)?;
+        session
+            .check_rules()
+            .map_err(|e| self.invalid(e.measurement.as_deref(), e.message))?;
         Ok(session)
     }
 
@@ -506,71 +508,6 @@ impl<'a> Ctx<'a> {
             out.push(ReferenceDistance { from, to, distance });
         }
         Ok(out)
-    }
-
-    /// The rules of FORMAT.md `measurements[].use` and `station` that span
-    /// measurements. Whether the translations are collinear and the
-    /// rotations too similar is checked by the initial hand-eye itself.
-    fn check_uses(&self, session: &Session) -> Result<(), FileError> {
-        let ids = |indices: &[usize]| -> String {
-            indices
-                .iter()
-                .map(|&i| session.measurements[i].id.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        for usage in [Use::Translation, Use::Rotation] {
-            let stations = session.stations(usage);
-            if let [(first, first_ids), (second, second_ids), ..] = stations.as_slice() {
-                let offender = &session.measurements[second_ids[0]].id;
-                return Err(self.invalid(
-                    Some(offender),
-                    format!(
-                        "all {} measurements must share one station: {} at station {first}, {} at station {second}",
-                        usage.as_str(),
-                        ids(first_ids),
-                        ids(second_ids)
-                    ),
-                ));
-            }
-        }
-        if session.hand_eye.is_none() {
-            for (usage, needed, purpose) in [
-                (Use::Translation, 3, "the initial rotation (paper eq. 6-7)"),
-                (Use::Rotation, 2, "the initial translation (paper eq. 8-9)"),
-            ] {
-                let found: Vec<usize> = (0..session.measurements.len())
-                    .filter(|&i| session.measurements[i].usage == usage)
-                    .collect();
-                if found.len() < needed {
-                    let list = if found.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" ({})", ids(&found))
-                    };
-                    return Err(self.invalid(
-                        None,
-                        format!(
-                            "without `hand_eye`, {purpose} needs at least {needed} {} measurements; the session has {}{list}",
-                            usage.as_str(),
-                            found.len()
-                        ),
-                    ));
-                }
-            }
-        }
-        for (station, indices) in session.stations(Use::Identify) {
-            if indices.len() < 2 {
-                let id = &session.measurements[indices[0]].id;
-                return Err(self.invalid(
-                    Some(id),
-                    format!(
-                        "identify station {station} has only 1 measurement ({id}); an identify station needs at least 2"
-                    ),
-                ));
-            }
-        }
-        Ok(())
     }
 }
 

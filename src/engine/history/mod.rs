@@ -107,15 +107,17 @@ use std::io;
 use std::path::{Path, PathBuf};
 use std::time::{SystemTime, UNIX_EPOCH};
 
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
 use serde::Deserialize;
 use serde::de::IgnoredAny;
-use serde_json::{Map, Value};
+use serde_json::Value;
 
 use crate::engine::format::FileError;
 use crate::engine::format::{self, RESULT_FORMAT, ResultFile, SESSION_FORMAT};
-use crate::engine::geometry::isometry_from_rows;
+use crate::engine::geometry::{rotation_from_rpy_deg, wrap_deg};
+use crate::engine::result_view::HandEyeView;
 use crate::engine::robot::{Joint, PARAM_IS_ANGLE, PARAMS_PER_JOINT, Robot};
+use crate::engine::solve::SolverReport;
 use crate::engine::solve::estimate::{ANGLE_SCALE_MM, HAND_EYE_LABELS};
 use crate::engine::validate::Stats;
 
@@ -542,19 +544,17 @@ impl HandEye {
     /// The rotation of `eT_s`.
     #[must_use]
     pub fn rotation(&self) -> UnitQuaternion<f64> {
-        let [r, p, y] = self.rpy_deg.map(f64::to_radians);
-        UnitQuaternion::from_euler_angles(r, p, y)
+        rotation_from_rpy_deg(self.rpy_deg)
     }
 
-    /// From a row-major 4×4 matrix (mm); `None` when it is not rigid.
+    /// The hand-eye `flange_from_sensor` in these numbers.
     #[must_use]
-    pub fn from_rows(rows: &[[f64; 4]; 4]) -> Option<Self> {
-        let iso = isometry_from_rows(rows).ok()?;
-        let (r, p, y) = iso.rotation.euler_angles();
-        Some(Self {
-            translation: iso.translation.vector.into(),
-            rpy_deg: [r.to_degrees(), p.to_degrees(), y.to_degrees()],
-        })
+    pub fn new(flange_from_sensor: &Isometry3<f64>) -> Self {
+        let v = HandEyeView::new(flange_from_sensor);
+        Self {
+            translation: v.translation,
+            rpy_deg: v.rpy_deg,
+        }
     }
 }
 
@@ -1100,8 +1100,7 @@ fn entry_date(
 // Reading a result's parameters
 // ---------------------------------------------------------------------------
 
-/// What the `solver` block says about parameters, read leniently (any
-/// method, any later version of `ml`'s block: missing keys are `None`).
+/// What a result's method says about its parameters.
 #[derive(Debug, Default)]
 struct SolverInfo {
     estimated: Vec<String>,
@@ -1115,90 +1114,43 @@ struct SolverInfo {
     kept_directions: Option<usize>,
 }
 
-fn strings(v: Option<&Value>) -> Vec<String> {
-    v.and_then(Value::as_array)
-        .map(|a| {
-            a.iter()
-                .filter_map(Value::as_str)
-                .map(str::to_string)
-                .collect()
-        })
-        .unwrap_or_default()
-}
-
-fn solver_info(block: &Map<String, Value>) -> SolverInfo {
-    let covariance = block.get("covariance").and_then(|c| {
-        let labels = strings(c.get("labels"));
-        let rows: Vec<Vec<f64>> = c
-            .get("matrix")?
-            .as_array()?
-            .iter()
-            .map(|r| {
-                r.as_array()
-                    .map(|r| r.iter().filter_map(Value::as_f64).collect())
-                    .unwrap_or_default()
-            })
-            .collect();
-        let square = rows.len() == labels.len() && rows.iter().all(|r| r.len() == labels.len());
-        square.then_some((labels, rows))
-    });
-    let stds = block
-        .get("parameters")
-        .and_then(Value::as_array)
-        .map(|a| {
-            a.iter()
-                .filter_map(|p| {
-                    Some((
-                        p.get("parameter")?.as_str()?.to_string(),
-                        p.get("std")?.as_f64()?,
-                    ))
-                })
-                .collect()
-        })
-        .unwrap_or_default();
-    let prior = block.get("prior").and_then(|p| {
-        (p.get("enabled")?.as_bool()?).then_some(())?;
-        Some((
-            p.get("angle_sigma_deg")?.as_f64()?,
-            p.get("length_sigma_mm")?.as_f64()?,
-        ))
-    });
-    SolverInfo {
-        estimated: strings(block.get("estimated")),
-        fixed: strings(block.get("fixed")),
-        combinations: strings(block.get("inseparable"))
-            .iter()
-            .map(|t| parse_combination(t))
-            .collect(),
-        covariance,
-        stds,
-        prior,
-        variance_factor: block.get("variance_factor").and_then(Value::as_f64),
-        kept_directions: block
-            .get("kept_directions")
-            .and_then(Value::as_u64)
-            .and_then(|k| usize::try_from(k).ok()),
-    }
-}
-
-/// Parses `ml`'s sentence: `d6 ~ he_z: …` or `alpha1, a1: no effect …`.
-fn parse_combination(text: &str) -> Combination {
-    let head = text.split_once(':').map_or(text, |(h, _)| h);
-    let list = |s: &str| -> Vec<String> {
-        s.split(',')
-            .map(str::trim)
-            .filter(|s| !s.is_empty())
-            .map(str::to_string)
-            .collect()
-    };
-    let (fixed, partners) = match head.split_once(" ~ ") {
-        Some((f, p)) => (list(f), list(p)),
-        None => (list(head), Vec::new()),
-    };
-    Combination {
-        fixed,
-        partners,
-        text: text.to_string(),
+fn solver_info(report: &SolverReport) -> SolverInfo {
+    match report {
+        SolverReport::Ml(r) => {
+            let c = &r.covariance;
+            let square = c.matrix.len() == c.labels.len()
+                && c.matrix.iter().all(|row| row.len() == c.labels.len());
+            SolverInfo {
+                estimated: r.estimated.clone(),
+                fixed: r.fixed.clone(),
+                combinations: r
+                    .inseparable
+                    .iter()
+                    .map(|i| Combination {
+                        fixed: i.fixed().into_iter().map(str::to_string).collect(),
+                        partners: i.partners().into_iter().map(str::to_string).collect(),
+                        text: i.to_string(),
+                    })
+                    .collect(),
+                covariance: square.then(|| (c.labels.clone(), c.matrix.clone())),
+                stds: r
+                    .parameters
+                    .iter()
+                    .map(|p| (p.parameter.clone(), p.std))
+                    .collect(),
+                prior: r
+                    .prior
+                    .enabled
+                    .then_some((r.prior.angle_sigma_deg, r.prior.length_sigma_mm)),
+                variance_factor: Some(r.variance_factor),
+                kept_directions: None,
+            }
+        }
+        SolverReport::Paper(p) => SolverInfo {
+            kept_directions: p.kept_directions,
+            ..SolverInfo::default()
+        },
+        SolverReport::Other { .. } => SolverInfo::default(),
     }
 }
 
@@ -1212,14 +1164,7 @@ fn twist_block(index: usize) -> &'static [&'static str] {
 }
 
 fn roll_pitch_yaw_deg(q: &UnitQuaternion<f64>) -> Vector3<f64> {
-    let (r, p, y) = q.euler_angles();
-    Vector3::new(r.to_degrees(), p.to_degrees(), y.to_degrees())
-}
-
-/// Wraps an angle difference to (−180, 180] deg.
-fn wrap_deg(d: f64) -> f64 {
-    let w = (d + 180.0).rem_euclid(360.0) - 180.0;
-    if w <= -180.0 { w + 360.0 } else { w }
+    Vector3::from(crate::engine::geometry::roll_pitch_yaw_deg(q))
 }
 
 /// Jacobians of the hand-eye translation (mm / mm) and roll-pitch-yaw
@@ -1265,16 +1210,10 @@ fn build_entry(
     date_source: DateSource,
     notes: Vec<String>,
 ) -> Result<Entry, String> {
-    let he_iso = isometry_from_rows(&result.hand_eye).map_err(|e| format!("hand_eye: {e}"))?;
-    let hand_eye = HandEye::from_rows(&result.hand_eye).ok_or("hand_eye is not rigid")?;
-    let hand_eye_initial =
-        HandEye::from_rows(&result.hand_eye_initial).ok_or("hand_eye_initial is not rigid")?;
-    let method = result
-        .solver
-        .get("method")
-        .and_then(Value::as_str)
-        .unwrap_or("")
-        .to_string();
+    let he_iso = result.hand_eye;
+    let hand_eye = HandEye::new(&result.hand_eye);
+    let hand_eye_initial = HandEye::new(&result.hand_eye_initial);
+    let method = result.solver.method().to_string();
     let info = solver_info(&result.solver);
     let sigma_scale = info.variance_factor.map_or(1.0, |v| v.max(1.0).sqrt());
     let estimated: HashSet<&str> = info.estimated.iter().map(String::as_str).collect();
@@ -2160,23 +2099,6 @@ mod tests {
             Some("cell3")
         );
         assert_eq!(result_stem(Path::new("a/cell3.json")), None);
-    }
-
-    #[test]
-    fn combinations_are_parsed() {
-        let c = parse_combination("d6 ~ he_z: d6 +1 mm is undone by he_z +0.999 mm");
-        assert_eq!(c.fixed, ["d6"]);
-        assert_eq!(c.partners, ["he_z"]);
-        let c = parse_combination(
-            "beta4 ~ theta3, d4: beta4 +1° is undone by theta3 +1.000°, d4 -2.356 mm",
-        );
-        assert_eq!(c.fixed, ["beta4"]);
-        assert_eq!(c.partners, ["theta3", "d4"]);
-        let c = parse_combination(
-            "alpha1, a1, beta1, theta1, d1: no effect on any centre distance (a rigid motion)",
-        );
-        assert_eq!(c.fixed, ["alpha1", "a1", "beta1", "theta1", "d1"]);
-        assert!(c.partners.is_empty());
     }
 
     #[test]

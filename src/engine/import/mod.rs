@@ -568,10 +568,7 @@ pub fn load_robot(source: &RobotSource) -> Result<Robot, ImportError> {
             match parse_session(&text, path) {
                 Ok(s) => Ok(s.robot),
                 Err(session_error) => match parse_result(&text, path) {
-                    Ok(r) => r.robot.to_robot().map_err(|e| ImportError::File {
-                        path: path.clone(),
-                        message: format!("robot: {e}"),
-                    }),
+                    Ok(r) => Ok(r.robot),
                     Err(_) => Err(ImportError::Session(session_error)),
                 },
             }

@@ -103,7 +103,7 @@ use crate::engine::simulate::{
 use crate::engine::solve::estimate::{
     ANGLE_SCALE_MM, Estimate, sensitivity, unknown_is_angle, unknown_label,
 };
-use crate::engine::solve::ml::{self, MlOptions, MlReport};
+use crate::engine::solve::ml::{self, Inseparable, MlOptions, MlReport};
 use crate::engine::solve::{self, Control, HandEyeSource, Method, Options, Prepared};
 
 mod export;
@@ -630,7 +630,7 @@ pub struct PlanStats {
     /// Parameters it cannot identify (fixed at their start).
     pub fixed: Vec<String>,
     /// `ml`'s sentences naming each combination that cannot be separated.
-    pub inseparable: Vec<String>,
+    pub inseparable: Vec<Inseparable>,
     /// The criterion of the identify poses: `ln det` of the information
     /// matrix (prior included, angles scaled by 1000 mm/rad, mm⁻²).
     pub log_det: f64,
@@ -1430,7 +1430,7 @@ impl Planner<'_> {
         let a = DMatrix::from_fn(3, estimated.len(), |i, j| {
             full[(i, estimated[j])] / unknown_scale(estimated[j])
         });
-        let cov = ml::base_covariance(
+        let cov = ml::noise::base_covariance(
             &est,
             &s,
             &self.sensor_covariance(c.side),
@@ -1514,10 +1514,7 @@ impl Planner<'_> {
                 ..MlOptions::default()
             },
         };
-        let cal = solve::run(session, prepared, &options, &mut |_| Control::Continue)
-            .map_err(|e| PlanError::Analysis(e.to_string()))?;
-        MlReport::from_solver_block(&cal.solver)
-            .ok_or_else(|| PlanError::Analysis("ml gave no report".to_owned()))
+        ml::analyse(session, prepared, &options).map_err(|e| PlanError::Analysis(e.to_string()))
     }
 
     /// `ml`'s analysis of every identify candidate.

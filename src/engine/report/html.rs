@@ -34,16 +34,19 @@ use std::time::{SystemTime, UNIX_EPOCH};
 use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
 
-use crate::engine::format::result::{CentreRecord, ResultFile};
-use crate::engine::geometry::{isometry_from_rows, rotation_angle_between};
+use crate::engine::format::result::{ResultFile, solver_block as solver_map};
+use crate::engine::geometry::{rows_from_isometry, wrap_deg};
 use crate::engine::report::svg::{self, Band, Marker, Plot, Rule, Series, escape};
+use crate::engine::result_view::{
+    HandEyeView, PairDistance, ResultView, Sigma, check_result, excluded_measurements,
+};
 use crate::engine::robot::PARAM_NAMES;
 use crate::engine::session::{Observation, Session, Use};
 use crate::engine::solve::estimate::HAND_EYE_LABELS;
 use crate::engine::solve::ml::MlReport;
-use crate::engine::solve::{self, HandEyeSource, Prepared};
+use crate::engine::solve::{self, HandEyeSource, Prepared, SolverReport};
 use crate::engine::stripe::{HIGH_RMS_MM, StripeResult};
-use crate::engine::validate::{BeforeAfter, Stats, within_station_distances};
+use crate::engine::validate::{BeforeAfter, Stats};
 
 /// The version written in the report: this crate's.
 pub const SOFTWARE_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -55,18 +58,6 @@ pub const BEFORE_COLOUR: &str = "#e67828";
 pub const AFTER_COLOUR: &str = "#2896e6";
 /// Colour of discarded values (dropped singular values).
 const BAD_COLOUR: &str = "#e13c3c";
-
-/// A dropped SVD direction marks a parameter as not identifiable when its
-/// coefficient in the (unit) direction is at least this large: about a
-/// tenth of the direction's energy (0.3² ≈ 0.09). The workbench uses the
-/// same value.
-pub const MARK_COEFFICIENT: f64 = 0.3;
-
-/// A sensor-frame centre in the result may differ from the one recomputed
-/// from the session by this much (mm) and still count as the same data:
-/// the result file holds the shortest round-tripping decimal, so the
-/// recomputed fit agrees to far below this.
-pub const CENTRE_MATCH_MM: f64 = 1e-6;
 
 /// Width of a full-width figure, px (the page is about 930 px wide).
 const WIDE: f64 = 920.0;
@@ -115,43 +106,6 @@ pub struct ReportInput<'a> {
     pub meta: &'a ReportMeta,
 }
 
-/// Why a result cannot be reported against a session.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ReportError {
-    /// The result names another session.
-    #[error("the result is of session \"{result}\", not of session \"{session}\"")]
-    OtherSession {
-        /// `session` of the result.
-        result: String,
-        /// `name` of the session.
-        session: String,
-    },
-    /// A result centre has no measurement of that id in the session.
-    #[error("measurement {id} of the result is not in the session")]
-    UnknownMeasurement {
-        /// Measurement id.
-        id: String,
-    },
-    /// A measurement's station or use differs between result and session.
-    #[error("measurement {id}: {what} differs between the result and the session")]
-    Differs {
-        /// Measurement id.
-        id: String,
-        /// `station` or `use`.
-        what: &'static str,
-    },
-    /// A measurement's sensor-frame centre differs (other stripe data).
-    #[error(
-        "measurement {id}: the result's sensor-frame centre is {mm:.6} mm from the one the session gives (other measurement data)"
-    )]
-    OtherData {
-        /// Measurement id.
-        id: String,
-        /// Distance between the two centres, mm.
-        mm: f64,
-    },
-}
-
 /// The SHA-256 of `bytes`, 64 lowercase hex digits.
 #[must_use]
 pub fn sha256_hex(bytes: &[u8]) -> String {
@@ -178,104 +132,6 @@ pub fn format_utc(t: SystemTime) -> String {
     }
 }
 
-/// Checks that `result` was computed from `session`: the same name, every
-/// result measurement in the session with the same station and use, and
-/// (when `prepared` is given) the same sensor-frame centre to
-/// [`CENTRE_MATCH_MM`]. Measurements of the session missing from the
-/// result are allowed: they were left out of the run
-/// ([`excluded_measurements`]).
-///
-/// # Errors
-/// The first mismatch found.
-pub fn check_result(
-    session: &Session,
-    result: &ResultFile,
-    prepared: Option<&Prepared>,
-) -> Result<(), ReportError> {
-    if result.session != session.name {
-        return Err(ReportError::OtherSession {
-            result: result.session.clone(),
-            session: session.name.clone(),
-        });
-    }
-    for c in &result.centres {
-        let Some(i) = session
-            .measurements
-            .iter()
-            .position(|m| m.id == c.measurement)
-        else {
-            return Err(ReportError::UnknownMeasurement {
-                id: c.measurement.clone(),
-            });
-        };
-        let m = &session.measurements[i];
-        if m.station != c.station {
-            return Err(ReportError::Differs {
-                id: m.id.clone(),
-                what: "station",
-            });
-        }
-        if m.usage.as_str() != c.usage {
-            return Err(ReportError::Differs {
-                id: m.id.clone(),
-                what: "use",
-            });
-        }
-        if let Some(p) = prepared.and_then(|p| p.measurements.get(i)) {
-            let mm = (p.centre_in_sensor - nalgebra::Vector3::from(c.sensor)).norm();
-            if mm.is_nan() || mm > CENTRE_MATCH_MM {
-                return Err(ReportError::OtherData {
-                    id: m.id.clone(),
-                    mm,
-                });
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Ids of the session's measurements that the result does not hold (left
-/// out of the run, e.g. `calibrate --exclude`), in session order.
-#[must_use]
-pub fn excluded_measurements(session: &Session, result: &ResultFile) -> Vec<String> {
-    session
-        .measurements
-        .iter()
-        .filter(|m| !result.centres.iter().any(|c| c.measurement == m.id))
-        .map(|m| m.id.clone())
-        .collect()
-}
-
-/// Parameter labels (`theta1`, `he_z`, …) that this result's solver block
-/// marks as not identifiable, each with why: a coefficient of at least
-/// [`MARK_COEFFICIENT`] in a dropped SVD direction (`"+0.71·d6 -0.71·he_z"`,
-/// the paper's method), or held fixed (`fixed`, the `ml` method).
-#[must_use]
-pub fn identifiability_marks(solver: &Map<String, Value>) -> BTreeMap<String, String> {
-    let mut out = BTreeMap::new();
-    for direction in strings(solver, "dropped_directions") {
-        for term in direction.split_whitespace() {
-            let Some((coef, label)) = term.split_once('·') else {
-                continue;
-            };
-            let Ok(c) = coef.replace('−', "-").parse::<f64>() else {
-                continue;
-            };
-            if c.abs() >= MARK_COEFFICIENT {
-                out.entry(label.to_string())
-                    .or_insert_with(|| format!("in the dropped SVD direction {direction}"));
-            }
-        }
-    }
-    for label in strings(solver, "fixed") {
-        out.insert(
-            label,
-            "held fixed at its start: not identifiable from centre distances".to_string(),
-        );
-    }
-    out
-}
-
 /// The value at a JSON pointer (`/loss/kind`) of a JSON object.
 fn lookup<'v>(block: &'v Map<String, Value>, pointer: &str) -> Option<&'v Value> {
     let path = pointer.trim_start_matches('/');
@@ -283,19 +139,6 @@ fn lookup<'v>(block: &'v Map<String, Value>, pointer: &str) -> Option<&'v Value>
         Some((head, rest)) => block.get(head)?.pointer(&format!("/{rest}")),
         None => block.get(path),
     }
-}
-
-/// The strings of array `key` of a JSON object.
-fn strings(block: &Map<String, Value>, key: &str) -> Vec<String> {
-    block
-        .get(key)
-        .and_then(Value::as_array)
-        .map(|a| {
-            a.iter()
-                .filter_map(|v| v.as_str().map(str::to_string))
-                .collect()
-        })
-        .unwrap_or_default()
 }
 
 /// The report as one HTML document.
@@ -383,8 +226,9 @@ pre,.mono{font-size:10px}
 }
 ";
 
-/// Settings of the solver block worth a row of their own: JSON pointer
-/// and label. Those a method does not have are left out.
+/// Labels of the solver settings worth a row of their own, by the JSON
+/// pointer of the key in a result's `solver` block; those a method does
+/// not have are left out.
 const SETTINGS: [(&str, &str); 17] = [
     ("/method", "method"),
     ("/threshold", "threshold on ε (mm)"),
@@ -420,64 +264,73 @@ const SETTINGS: [(&str, &str); 17] = [
     ("/stop_reason", "why the loop stopped"),
 ];
 
+/// The value of setting `pointer` ([`SETTINGS`]) in `report`, as text.
+fn setting(report: &SolverReport, pointer: &str) -> Option<String> {
+    let n = |v: f64| Some(short_number(v));
+    let t = |v: &str| Some(v.to_string());
+    match (report, pointer) {
+        (_, "/method") => t(report.method()),
+        (SolverReport::Other { block, .. }, _) => lookup(block, pointer).and_then(scalar_text),
+        (SolverReport::Paper(p), _) => match pointer {
+            "/threshold" => p.threshold.and_then(n),
+            "/max_iterations" => p.max_iterations.and_then(|v| n(v as f64)),
+            "/pairs" => p.pairs.as_deref().and_then(t),
+            "/svd_tolerance" => p.svd_tolerance.and_then(n),
+            "/column_scaling" => p.column_scaling.as_deref().and_then(t),
+            "/stop_reason" => p.stop_reason.as_deref().and_then(t),
+            _ => None,
+        },
+        (SolverReport::Ml(m), _) => match pointer {
+            "/threshold" => n(m.stop.threshold),
+            "/max_iterations" => n(m.stop.max_iterations as f64),
+            "/noise_model/joint_sigma_deg" => n(m.noise_model.joint_sigma_deg),
+            "/noise_model/centre_sigma_mm" => n(m.noise_model.centre_sigma_mm),
+            "/noise_model/sensor_sigma_floor_mm" => n(m.noise_model.sensor_sigma_floor_mm),
+            "/prior/enabled" => Some(m.prior.enabled.to_string()),
+            "/prior/angle_sigma_deg" => n(m.prior.angle_sigma_deg),
+            "/prior/length_sigma_mm" => n(m.prior.length_sigma_mm),
+            "/loss/kind" => t(m.loss.kind.as_str()),
+            "/loss/scale_sigma" => n(m.loss.scale_sigma),
+            "/identifiability/tolerance" => n(m.identifiability.tolerance),
+            "/outlier_limit_sigma" => n(m.outlier_limit_sigma),
+            "/stop_reason" => t(&m.stop.stop_reason),
+            _ => None,
+        },
+    }
+}
+
 /// What every section reads, computed once.
 struct Ctx<'a> {
     input: &'a ReportInput<'a>,
     prepared: Result<&'a Prepared, String>,
     sha: String,
     method: String,
-    ml: Option<MlReport>,
+    ml: Option<&'a MlReport>,
     marks: BTreeMap<String, String>,
-    /// σ of each `ml` parameter (label → (σ, unit)).
-    sigma: BTreeMap<String, (f64, String)>,
+    /// σ of each `ml` parameter, by label.
+    sigma: BTreeMap<String, Sigma>,
     /// Within-station pairs (Fig. 5) and which stations they are of.
-    within: Vec<Pair>,
+    within: Vec<PairDistance>,
     within_of: &'static str,
     identify_within: BeforeAfter,
     excluded: Vec<String>,
 }
 
-/// One within-station centre distance.
-struct Pair {
-    station: String,
-    ids: (String, String),
-    before: f64,
-    after: f64,
-}
-
 impl<'a> Ctx<'a> {
     fn new(input: &'a ReportInput<'a>, prepared: Result<&'a Prepared, String>) -> Self {
         let result = input.result;
-        let ml = MlReport::from_solver_block(&result.solver);
-        let sigma = ml
-            .iter()
-            .flat_map(|r| &r.parameters)
-            .map(|p| (p.parameter.clone(), (p.std, p.unit.clone())))
-            .collect();
-        let validate = within_pairs(&result.centres, Use::Validate);
-        let identify = within_pairs(&result.centres, Use::Identify);
-        let identify_within = stats_of(&identify);
-        let (within, within_of) = if validate.is_empty() {
-            (identify, "identify")
-        } else {
-            (validate, "validate")
-        };
+        let view = ResultView::new(result);
         Self {
             input,
             prepared,
             sha: sha256_hex(input.session_bytes),
-            method: result
-                .solver
-                .get("method")
-                .and_then(Value::as_str)
-                .unwrap_or("?")
-                .to_string(),
-            ml,
-            marks: identifiability_marks(&result.solver),
-            sigma,
-            within,
-            within_of,
-            identify_within,
+            method: result.solver.method().to_string(),
+            ml: result.solver.ml(),
+            marks: view.marked,
+            sigma: view.sigma,
+            within: view.within,
+            within_of: view.within_of.as_str(),
+            identify_within: view.identify_within,
             excluded: excluded_measurements(input.session, result),
         }
     }
@@ -490,65 +343,8 @@ impl<'a> Ctx<'a> {
         self.input.session
     }
 
-    fn number(&self, key: &str) -> Option<f64> {
-        self.result().solver.get(key).and_then(Value::as_f64)
-    }
-
-    fn text(&self, key: &str) -> Option<String> {
-        self.result()
-            .solver
-            .get(key)
-            .and_then(Value::as_str)
-            .map(str::to_string)
-    }
-}
-
-/// Pairwise distances within each station of `usage` (station order of
-/// first appearance, then `i < j`), by the engine's
-/// [`within_station_distances`].
-fn within_pairs(centres: &[CentreRecord], usage: Use) -> Vec<Pair> {
-    let mut stations: Vec<(&str, Vec<&CentreRecord>)> = Vec::new();
-    for c in centres.iter().filter(|c| c.usage == usage.as_str()) {
-        match stations.iter_mut().find(|(s, _)| *s == c.station) {
-            Some((_, v)) => v.push(c),
-            None => stations.push((&c.station, vec![c])),
-        }
-    }
-    let of = |f: fn(&CentreRecord) -> [f64; 3]| -> Vec<Vec<nalgebra::Vector3<f64>>> {
-        stations
-            .iter()
-            .map(|(_, cs)| cs.iter().map(|c| f(c).into()).collect())
-            .collect()
-    };
-    let before = within_station_distances(&of(|c| c.before));
-    let after = within_station_distances(&of(|c| c.after));
-    let mut labels = Vec::new();
-    for (station, cs) in &stations {
-        for i in 0..cs.len() {
-            for j in i + 1..cs.len() {
-                labels.push((
-                    (*station).to_string(),
-                    (cs[i].measurement.clone(), cs[j].measurement.clone()),
-                ));
-            }
-        }
-    }
-    labels
-        .into_iter()
-        .zip(before.into_iter().zip(after))
-        .map(|((station, ids), (before, after))| Pair {
-            station,
-            ids,
-            before,
-            after,
-        })
-        .collect()
-}
-
-fn stats_of(pairs: &[Pair]) -> BeforeAfter {
-    BeforeAfter {
-        before: Stats::of(&pairs.iter().map(|p| p.before).collect::<Vec<_>>()),
-        after: Stats::of(&pairs.iter().map(|p| p.after).collect::<Vec<_>>()),
+    fn solver(&self) -> &SolverReport {
+        &self.result().solver
     }
 }
 
@@ -757,8 +553,9 @@ fn summary(h: &mut String, ctx: &Ctx<'_>) {
         num(r.epsilon_before, 4),
         num(r.epsilon_after, 4),
         r.iterations.len().saturating_sub(1),
-        ctx.text("stop_reason")
-            .map(|s| format!(" Stop: {}.", escape(&s)))
+        ctx.solver()
+            .stop_reason()
+            .map(|s| format!(" Stop: {}.", escape(s)))
             .unwrap_or_default()
     );
     h.push_str("</div>\n<table class=\"keep\">\n");
@@ -874,9 +671,8 @@ fn settings(h: &mut String, ctx: &Ctx<'_>) {
     }
     h.push_str("<table class=\"keep\" id=\"settings-table\">\n");
     head_row(h, &["setting", "value"]);
-    let solver = &ctx.result().solver;
     for (path, label) in SETTINGS {
-        if let Some(t) = lookup(solver, path).and_then(scalar_text) {
+        if let Some(t) = setting(ctx.solver(), path) {
             let _ = writeln!(
                 h,
                 "<tr><td>{}</td><td>{}</td></tr>",
@@ -1100,7 +896,7 @@ fn figures(h: &mut String, ctx: &Ctx<'_>) {
             "<p id=\"fig5\">No station has two measurements: no within-station distances.</p>\n",
         );
     } else {
-        let pts = |f: fn(&Pair) -> f64| -> Vec<[f64; 2]> {
+        let pts = |f: fn(&PairDistance) -> f64| -> Vec<[f64; 2]> {
             ctx.within
                 .iter()
                 .enumerate()
@@ -1197,7 +993,7 @@ fn figures(h: &mut String, ctx: &Ctx<'_>) {
         .enumerate()
         .map(|(k, i)| [k as f64, i.epsilon])
         .collect();
-    let threshold = ctx.number("threshold");
+    let threshold = ctx.solver().threshold();
     let plot = Plot {
         title: "ε per update".into(),
         x_label: "update".into(),
@@ -1241,12 +1037,9 @@ fn figures(h: &mut String, ctx: &Ctx<'_>) {
 }
 
 fn singular_values(h: &mut String, ctx: &Ctx<'_>) {
-    let values: Vec<f64> = ctx
-        .result()
-        .solver
-        .get("singular_values")
-        .and_then(Value::as_array)
-        .map(|a| a.iter().filter_map(Value::as_f64).collect())
+    let paper = ctx.solver().paper();
+    let values: Vec<f64> = paper
+        .and_then(|p| p.singular_values.clone())
         .unwrap_or_default();
     if values.is_empty() {
         let what = if ctx.ml.is_some() {
@@ -1261,10 +1054,10 @@ fn singular_values(h: &mut String, ctx: &Ctx<'_>) {
         return;
     }
     let smax = values.iter().copied().fold(0.0, f64::max);
-    let kept = ctx
-        .number("kept_directions")
-        .map_or(values.len(), |k| k as usize);
-    let cut = ctx.number("svd_tolerance").map(|t| t * smax);
+    let kept = paper
+        .and_then(|p| p.kept_directions)
+        .unwrap_or(values.len());
+    let cut = paper.and_then(|p| p.svd_tolerance).map(|t| t * smax);
     let pts = |keep: bool| -> Vec<[f64; 2]> {
         values
             .iter()
@@ -1358,7 +1151,8 @@ fn identifiability(h: &mut String, ctx: &Ctx<'_>) {
         );
         if !ml.inseparable.is_empty() {
             h.push_str("<h3>Combinations the data cannot separate</h3>\n");
-            list(h, "inseparable", &ml.inseparable);
+            let sentences: Vec<String> = ml.inseparable.iter().map(ToString::to_string).collect();
+            list(h, "inseparable", &sentences);
         }
         if !ml.strong_correlations.is_empty() {
             h.push_str("<h3>Strongly correlated estimates (|ρ| ≥ 0.95)</h3>\n");
@@ -1403,18 +1197,16 @@ fn identifiability(h: &mut String, ctx: &Ctx<'_>) {
         }
         h.push_str("</ul>\n<p class=\"muted\">σ of every estimated parameter: in the hand-eye and joint-error tables below (± values).</p>\n");
     } else {
-        let unknowns = r
-            .solver
-            .get("unknowns")
-            .and_then(Value::as_array)
-            .map_or(0, Vec::len);
-        match ctx.number("kept_directions") {
+        let paper = ctx.solver().paper();
+        let unknowns = paper.and_then(|p| p.unknowns.as_ref()).map_or(0, Vec::len);
+        match paper.and_then(|p| p.kept_directions) {
             Some(k) => {
                 let _ = writeln!(
                     h,
                     "<p>The <strong>{}</strong> method kept {k} of {unknowns} SVD directions in its last update (relative tolerance {}); the others are not identifiable from this data and were not moved:</p>",
                     escape(&ctx.method),
-                    ctx.number("svd_tolerance")
+                    paper
+                        .and_then(|p| p.svd_tolerance)
                         .map_or("?".to_string(), |t| format!("{t:e}"))
                 );
             }
@@ -1426,12 +1218,15 @@ fn identifiability(h: &mut String, ctx: &Ctx<'_>) {
                 );
             }
         }
-        let dropped = strings(&r.solver, "dropped_directions");
+        let dropped: Vec<String> = paper
+            .and_then(|p| p.dropped_directions.as_ref())
+            .map(|d| d.iter().map(ToString::to_string).collect())
+            .unwrap_or_default();
         if !dropped.is_empty() {
             h.push_str("<h3>Directions the SVD dropped</h3>\n");
             list(h, "dropped", &dropped);
         }
-        let fixed = strings(&r.solver, "fixed");
+        let fixed = ctx.solver().fixed();
         if !fixed.is_empty() {
             let _ = writeln!(
                 h,
@@ -1458,7 +1253,7 @@ fn marked_cell(ctx: &Ctx<'_>, label: &str, text: String) -> String {
     let sigma = ctx
         .sigma
         .get(label)
-        .map(|(s, _)| format!(" <span class=\"muted\">± {}</span>", num(*s, 4)))
+        .map(|s| format!(" <span class=\"muted\">± {}</span>", num(s.std, 4)))
         .unwrap_or_default();
     match ctx.marks.get(label) {
         Some(why) => format!(
@@ -1470,17 +1265,15 @@ fn marked_cell(ctx: &Ctx<'_>, label: &str, text: String) -> String {
     }
 }
 
-/// Roll, pitch, yaw (deg) and translation (mm) of a 4×4 matrix.
-fn pose_parts(rows: &[[f64; 4]; 4]) -> ([f64; 3], [f64; 3]) {
-    let rpy = isometry_from_rows(rows).map_or([f64::NAN; 3], |iso| {
-        let (r, p, y) = iso.rotation.euler_angles();
-        [r.to_degrees(), p.to_degrees(), y.to_degrees()]
-    });
-    ([rows[0][3], rows[1][3], rows[2][3]], rpy)
+/// Roll, pitch, yaw (deg) and translation (mm) of a hand-eye.
+fn pose_parts(he: &nalgebra::Isometry3<f64>) -> ([f64; 3], [f64; 3]) {
+    let v = HandEyeView::new(he);
+    (v.translation, v.rpy_deg)
 }
 
-fn matrix_text(rows: &[[f64; 4]; 4]) -> String {
-    rows.iter()
+fn matrix_text(he: &nalgebra::Isometry3<f64>) -> String {
+    rows_from_isometry(he)
+        .iter()
         .map(|r| {
             format!(
                 "{:>11.6} {:>11.6} {:>11.6} {:>11.4}",
@@ -1512,7 +1305,7 @@ fn hand_eye(h: &mut String, ctx: &Ctx<'_>) {
         } else {
             let (b, a) = (rb[k - 3], ra[k - 3]);
             // An angle's change the short way round (179° → −179° is +2°).
-            (b, a, (a - b + 180.0).rem_euclid(360.0) - 180.0)
+            (b, a, wrap_deg(a - b))
         };
         let _ = writeln!(
             h,
@@ -1523,17 +1316,13 @@ fn hand_eye(h: &mut String, ctx: &Ctx<'_>) {
         );
     }
     h.push_str("</table>\n");
-    if let (Ok(b), Ok(a)) = (
-        isometry_from_rows(&r.hand_eye_initial),
-        isometry_from_rows(&r.hand_eye),
-    ) {
-        let _ = writeln!(
-            h,
-            "<p>The calibration moved the hand-eye by {} mm and turned it by {}°. Roll, pitch, yaw: rotations about x, y, z (R = Rz(yaw)·Ry(pitch)·Rx(roll)).</p>",
-            num((a.translation.vector - b.translation.vector).norm(), 4),
-            num(rotation_angle_between(&b, &a).to_degrees(), 4)
-        );
-    }
+    let (b, a) = (&r.hand_eye_initial, &r.hand_eye);
+    let _ = writeln!(
+        h,
+        "<p>The calibration moved the hand-eye by {} mm and turned it by {}°. Roll, pitch, yaw: rotations about x, y, z (R = Rz(yaw)·Ry(pitch)·Rx(roll)).</p>",
+        num((a.translation.vector - b.translation.vector).norm(), 4),
+        num(b.rotation.angle_to(&a.rotation).to_degrees(), 4)
+    );
     let _ = writeln!(
         h,
         "<div class=\"grid2\"><div><h3>initial</h3><pre>{}</pre></div><div><h3>calibrated</h3><pre>{}</pre></div></div>",
@@ -1660,7 +1449,7 @@ fn validation(h: &mut String, ctx: &Ctx<'_>) {
             ],
         );
         for s in stations {
-            let pairs: Vec<&Pair> = ctx.within.iter().filter(|p| p.station == s).collect();
+            let pairs: Vec<&PairDistance> = ctx.within.iter().filter(|p| p.station == s).collect();
             let b = Stats::of(&pairs.iter().map(|p| p.before).collect::<Vec<_>>());
             let a = Stats::of(&pairs.iter().map(|p| p.after).collect::<Vec<_>>());
             let _ = writeln!(
@@ -1806,7 +1595,7 @@ fn solver_block(h: &mut String, ctx: &Ctx<'_>) {
     h.push_str("<table class=\"small\">\n");
     head_row(h, &["key", "value"]);
     let mut omitted = Vec::new();
-    let solver = &ctx.result().solver;
+    let solver = solver_map(ctx.solver());
     let keys = solver
         .get_key_value("method")
         .into_iter()

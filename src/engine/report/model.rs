@@ -26,7 +26,8 @@ use std::fmt::Write as _;
 use nalgebra::{Isometry3, Rotation3};
 
 use crate::engine::format::ResultFile;
-use crate::engine::geometry::{MatrixError, isometry_from_rows, rot_x, rot_y, rot_z, trans};
+use crate::engine::format::result::RobotRecord;
+use crate::engine::geometry::{rot_x, rot_y, rot_z, rows_from_isometry, trans};
 use crate::engine::robot::{Joint, Robot};
 
 /// Millimetres per metre: file lengths are mm, URDF lengths are m.
@@ -59,14 +60,6 @@ pub enum ModelFormat {
 /// Why a model cannot be exported.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ExportError {
-    /// A 4×4 matrix of the result is not a rigid transform.
-    #[error("`{matrix}` {source}")]
-    Matrix {
-        /// Which matrix: `robot.base`, `robot.flange` or `hand_eye`.
-        matrix: &'static str,
-        /// What is wrong with it.
-        source: MatrixError,
-    },
     /// `joint_errors` does not have one entry per joint.
     #[error("`joint_errors` has {found} entries, the robot has {joints} joints")]
     JointErrorCount {
@@ -98,7 +91,7 @@ pub fn export(
     Ok(match format {
         ModelFormat::Json => robot_json(result),
         ModelFormat::Csv => mdh_csv(result),
-        ModelFormat::Urdf => urdf(result, source)?,
+        ModelFormat::Urdf => urdf(result, source),
     })
 }
 
@@ -145,7 +138,7 @@ fn joint_values(j: &Joint) -> [f64; 5] {
 /// that they read back to the same `f64`.
 #[must_use]
 pub fn robot_json(result: &ResultFile) -> String {
-    let mut text = serde_json::to_string_pretty(&result.robot)
+    let mut text = serde_json::to_string_pretty(&RobotRecord::from_robot(&result.robot))
         .unwrap_or_else(|e| format!("serialisation failed: {e}"));
     text.push('\n');
     text
@@ -188,7 +181,7 @@ pub fn mdh_csv(result: &ResultFile) -> String {
         ("flange", &result.robot.flange),
         ("hand_eye", &result.hand_eye),
     ] {
-        for (r, row) in m.iter().enumerate() {
+        for (r, row) in rows_from_isometry(m).iter().enumerate() {
             let _ = writeln!(
                 out,
                 "{name},{},{},{},{},{}",
@@ -311,23 +304,9 @@ fn push_fixed(out: &mut String, name: &str, parent: &str, child: &str, origin: &
 /// no geometry or inertia, and the joint limits are not part of the
 /// calibration: the fragment says to take them from the vendor's URDF.
 ///
-/// # Errors
-/// [`ExportError::Matrix`] when `base`, `flange` or `hand_eye` is not a
-/// rigid transform.
-pub fn urdf(result: &ResultFile, source: &str) -> Result<String, ExportError> {
-    let matrix = |name: &'static str, rows| {
-        isometry_from_rows(rows).map_err(|source| ExportError::Matrix {
-            matrix: name,
-            source,
-        })
-    };
-    let robot = Robot {
-        name: result.robot.name.clone(),
-        joints: result.robot.joints.clone(),
-        base: matrix("robot.base", &result.robot.base)?,
-        flange: matrix("robot.flange", &result.robot.flange)?,
-    };
-    let hand_eye = matrix("hand_eye", &result.hand_eye)?;
+pub fn urdf(result: &ResultFile, source: &str) -> String {
+    let robot = &result.robot;
+    let hand_eye = result.hand_eye;
     let n = robot.joints.len();
     let mut out = String::new();
     out.push_str("<?xml version=\"1.0\"?>\n");
@@ -355,7 +334,7 @@ pub fn urdf(result: &ResultFile, source: &str) -> Result<String, ExportError> {
     if has_base {
         push_fixed(&mut out, "base_joint", "world", "base_link", &robot.base);
     }
-    let origins = urdf_joint_origins(&robot);
+    let origins = urdf_joint_origins(robot);
     let mut parent = "base_link".to_string();
     for (i, origin) in origins.iter().take(n).enumerate() {
         let child = format!("link_{}", i + 1);
@@ -378,5 +357,5 @@ pub fn urdf(result: &ResultFile, source: &str) -> Result<String, ExportError> {
     }
     push_fixed(&mut out, "sensor_joint", "flange", "sensor", &hand_eye);
     out.push_str("</robot>\n");
-    Ok(out)
+    out
 }

@@ -1,55 +1,9 @@
-//! From a finished [`Calibration`] to what people and files read: the
-//! FORMAT.md result file ([`result_file`]) and a short text summary
-//! ([`summary`]) for the command line.
+//! The command line's text summary of a finished [`Calibration`].
 
 use std::fmt::Write as _;
 
-use crate::engine::format::result::{CentreRecord, IterationRecord, ResultFile, RobotRecord};
-use crate::engine::geometry::rows_from_isometry;
 use crate::engine::session::Session;
-use crate::engine::solve::{Calibration, Prepared};
-
-/// The FORMAT.md result file of a run.
-#[must_use]
-pub fn result_file(session: &Session, prepared: &Prepared, cal: &Calibration) -> ResultFile {
-    let _ = prepared;
-    ResultFile {
-        session: session.name.clone(),
-        hand_eye_initial: rows_from_isometry(&cal.hand_eye_initial),
-        hand_eye: rows_from_isometry(&cal.hand_eye),
-        robot: RobotRecord {
-            name: cal.calibrated.name.clone(),
-            joints: cal.calibrated.joints.clone(),
-            base: rows_from_isometry(&cal.calibrated.base),
-            flange: rows_from_isometry(&cal.calibrated.flange),
-        },
-        joint_errors: cal.calibrated.joint_errors(&cal.nominal),
-        solver: cal.solver.clone(),
-        iterations: cal
-            .iterations
-            .iter()
-            .map(|&epsilon| IterationRecord { epsilon })
-            .collect(),
-        epsilon_before: cal.epsilon_before(),
-        epsilon_after: cal.epsilon_after(),
-        centres: cal
-            .centres
-            .iter()
-            .map(|c| {
-                let m = &session.measurements[c.index];
-                CentreRecord {
-                    measurement: m.id.clone(),
-                    station: m.station.clone(),
-                    usage: m.usage.as_str().to_string(),
-                    sensor: c.sensor.into(),
-                    before: c.before.into(),
-                    after: c.after.into(),
-                }
-            })
-            .collect(),
-        validation: cal.validation.clone(),
-    }
-}
+use crate::engine::solve::Calibration;
 
 /// A few lines for people: why the loop stopped, what the SVD kept, how
 /// the hand-eye moved, and the before/after validation figures.
@@ -63,16 +17,20 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
         cal.epsilon_before(),
         cal.epsilon_after()
     );
-    if let Some(u) = &cal.last_update {
+    if let Some((p, kept)) = cal
+        .report
+        .paper()
+        .and_then(|p| p.kept_directions.map(|k| (p, k)))
+    {
         let _ = writeln!(
             s,
             "SVD: kept {} of {} directions (tolerance {:.1e} of σ_max), {} equations",
-            u.kept,
-            u.delta.len(),
+            kept,
+            p.unknowns.as_ref().map_or(0, Vec::len),
             cal.options.paper.svd_tolerance,
-            u.rows
+            p.equations.unwrap_or(0)
         );
-        for d in &u.dropped {
+        for d in p.dropped_directions.iter().flatten() {
             let _ = writeln!(s, "  not identifiable from this data: {d}");
         }
     }
@@ -133,6 +91,9 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
                 session.name
             );
         }
+    }
+    if let Some(r) = cal.report.ml() {
+        s.push_str(&r.summary());
     }
     s
 }

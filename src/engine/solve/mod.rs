@@ -1,32 +1,52 @@
-//! The whole calibration of a session (paper Fig. 2): sphere centres from
-//! the stripes (eq. 21), the initial hand-eye (eq. 6-9), then the loop of
-//! FORMAT.md "The iteration" around an identification update, then the
-//! before/after statistics. The command line and the workbench both call
-//! [`prepare`] and [`run`]; `run` reports every ε through a callback that
-//! can cancel.
+//! Problem in, steppable solver, result out: the loop of FORMAT.md "The
+//! iteration" (paper Fig. 2) around one method's update, the paper's
+//! ([`paper`], section 3.2, eq. 17-19) or maximum likelihood ([`ml`]),
+//! both linearised by [`estimate`] (eq. 10-16).
+//!
+//! [`prepare`] gives the sphere centres (eq. 21) and the initial hand-eye
+//! (eq. 6-9); [`run`] computes ε (eq. 20), and while ε is above the
+//! threshold and the iteration bound is not reached, asks the method for
+//! one update ([`Update`]) and computes ε again. Every ε goes to a progress
+//! callback that may cancel; why the loop stopped ([`StopReason`], with
+//! the measured ε beside the threshold) is recorded, a cancel being one of
+//! the reasons. The [`Calibration`] holds the calibrated model and
+//! hand-eye, every centre before and after, the statistics, and the
+//! method's typed report ([`SolverReport`]).
 
 pub mod estimate;
 pub mod ml;
 pub mod paper;
+pub mod prepare;
+pub mod report;
 
-use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
-use serde_json::{Map, Value, json};
+use nalgebra::{Isometry3, Point3, Vector3};
 
 use crate::engine::handeye::HandEyeError;
-use crate::engine::handeye::{InitialHandEye, Sighting, initial_hand_eye};
 use crate::engine::robot::Robot;
-use crate::engine::session::{Observation, Session, Use};
-use crate::engine::solve::estimate::{Estimate, Station, unknown_label};
-use crate::engine::solve::paper::{Pairing, PaperOptions, UpdateInfo, paper_update};
+use crate::engine::session::{Session, Use};
 use crate::engine::stripe::StripeError;
-use crate::engine::stripe::{StripeResult, centre_from_stripe};
 use crate::engine::validate::{
     BeforeAfter, StationCentres, Stats, Validation, epsilon, validation, within_station_distances,
 };
+use estimate::Estimate;
+use paper::PaperOptions;
+pub use prepare::{Analysis, HandEyeSource, Prepared, PreparedMeasurement, analyse, prepare};
+pub use report::{LoopRecord, SolverReport};
 
-/// The identification (paper 3.2 or the ML method) cannot run or failed.
+/// Why a calibration of a loaded session could not run, or failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum IdentifyError {
+pub enum SolveError {
+    /// One stripe could not give a sphere centre.
+    #[error("measurement {id}: {source}")]
+    Stripe {
+        /// Measurement id.
+        id: String,
+        /// The stripe problem.
+        source: StripeError,
+    },
+    /// The initial hand-eye could not be determined.
+    #[error(transparent)]
+    HandEye(#[from] HandEyeError),
     /// No identify station has two measurements.
     #[error(
         "identification needs at least one identify station with 2 or more measurements; {detail}"
@@ -41,48 +61,17 @@ pub enum IdentifyError {
         /// Update number.
         iteration: usize,
     },
-    /// The user cancelled the run.
-    #[error("cancelled by the user after {iterations} update(s)")]
-    Cancelled {
-        /// Updates made before the cancel.
-        iterations: usize,
-    },
     /// An option is out of range.
     #[error("invalid solver option: {0}")]
     InvalidOption(String),
 }
 
-/// Anything that stops a calibration of a loaded session.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum CalibrationError {
-    /// One stripe could not give a sphere centre.
-    #[error("measurement {id}: {source}")]
-    Stripe {
-        /// Measurement id.
-        id: String,
-        /// The stripe problem.
-        source: StripeError,
-    },
-    /// The initial hand-eye could not be determined.
-    #[error(transparent)]
-    HandEye(#[from] HandEyeError),
-    /// The identification could not run.
-    #[error(transparent)]
-    Identify(#[from] IdentifyError),
-}
-
-impl CalibrationError {
-    /// True when the cause is the input data (exit status 2), false for an
-    /// internal failure or a cancel.
+impl SolveError {
+    /// True when the cause is the input data or the settings (exit status
+    /// 2), false for an internal failure.
     #[must_use]
     pub fn is_input_error(&self) -> bool {
-        match self {
-            Self::Stripe { .. } | Self::HandEye(_) => true,
-            Self::Identify(e) => matches!(
-                e,
-                IdentifyError::NotEnoughData { .. } | IdentifyError::InvalidOption(_)
-            ),
-        }
+        !matches!(self, Self::NonFinite { .. })
     }
 }
 
@@ -93,7 +82,7 @@ pub enum Method {
     Paper,
     /// Maximum likelihood: station centres as unknowns, noise-model
     /// weighting, identifiable set by pivoted QR, prior, robust loss
-    /// ([`crate::engine::solve::ml`]).
+    /// ([`ml`]).
     Ml,
 }
 
@@ -133,7 +122,7 @@ pub struct Options {
     /// Settings of the paper's update.
     pub paper: PaperOptions,
     /// Settings of the `ml` method.
-    pub ml: crate::engine::solve::ml::MlOptions,
+    pub ml: ml::MlOptions,
 }
 
 impl Options {
@@ -147,136 +136,9 @@ impl Options {
             threshold: session.solver.threshold,
             max_iterations: session.solver.max_iterations,
             paper: PaperOptions::default(),
-            ml: crate::engine::solve::ml::MlOptions::default(),
+            ml: ml::MlOptions::default(),
         }
     }
-}
-
-/// A measurement's sphere centre in the sensor frame, ready for the solver.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PreparedMeasurement {
-    /// Index into `session.measurements`.
-    pub index: usize,
-    /// Sphere centre in the sensor frame, mm.
-    pub centre_in_sensor: Vector3<f64>,
-    /// Its covariance, mm² (from the circle fit; `None` for given centres).
-    pub covariance: Option<Matrix3<f64>>,
-    /// Circle fit and quality, for stripe measurements.
-    pub stripe: Option<StripeResult>,
-}
-
-/// Where the initial hand-eye came from.
-#[derive(Debug, Clone, PartialEq)]
-pub enum HandEyeSource {
-    /// The session's `hand_eye`.
-    File,
-    /// Computed by eq. 6-9, with its diagnostics.
-    Computed(InitialHandEye),
-}
-
-/// A session with every centre computed and the initial hand-eye known.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Prepared {
-    /// One per session measurement, same order.
-    pub measurements: Vec<PreparedMeasurement>,
-    /// `eT_s` before identification.
-    pub hand_eye_initial: Isometry3<f64>,
-    /// Where it came from.
-    pub hand_eye_source: HandEyeSource,
-    /// Warnings `(measurement id, text)` from the stripe fits.
-    pub warnings: Vec<(String, String)>,
-}
-
-impl Prepared {
-    /// Sightings of the measurements with this use, grouped by station in
-    /// order of first appearance.
-    #[must_use]
-    pub fn stations(&self, session: &Session, usage: Use) -> Vec<Station> {
-        session
-            .stations(usage)
-            .into_iter()
-            .map(|(id, idx)| Station {
-                id,
-                sightings: idx.iter().map(|&i| self.sighting(session, i)).collect(),
-            })
-            .collect()
-    }
-
-    /// The sighting of measurement `i`.
-    #[must_use]
-    pub fn sighting(&self, session: &Session, i: usize) -> Sighting {
-        let m = &session.measurements[i];
-        Sighting {
-            id: m.id.clone(),
-            joints: m.joints.clone(),
-            centre_in_sensor: self.measurements[i].centre_in_sensor,
-        }
-    }
-}
-
-/// Sphere centres of every measurement (eq. 21) and the initial hand-eye
-/// (the file's, else eq. 6-9 on the nominal model).
-///
-/// # Errors
-/// A stripe that cannot be fitted (naming the measurement) or a pose set
-/// that does not determine the hand-eye.
-pub fn prepare(session: &Session) -> Result<Prepared, CalibrationError> {
-    let radius = session.sphere_radius();
-    let mut measurements = Vec::with_capacity(session.measurements.len());
-    let mut warnings = Vec::new();
-    for (index, m) in session.measurements.iter().enumerate() {
-        let prepared = match &m.observation {
-            Observation::Centre(c) => PreparedMeasurement {
-                index,
-                centre_in_sensor: *c,
-                covariance: None,
-                stripe: None,
-            },
-            Observation::Stripe(points) => {
-                let fit = centre_from_stripe(points, radius, m.side).map_err(|source| {
-                    CalibrationError::Stripe {
-                        id: m.id.clone(),
-                        source,
-                    }
-                })?;
-                warnings.extend(fit.warnings.iter().map(|w| (m.id.clone(), w.clone())));
-                PreparedMeasurement {
-                    index,
-                    centre_in_sensor: fit.sphere.centre_in_sensor,
-                    covariance: Some(fit.sphere.covariance),
-                    stripe: Some(fit),
-                }
-            }
-        };
-        measurements.push(prepared);
-    }
-    let mut out = Prepared {
-        measurements,
-        hand_eye_initial: Isometry3::identity(),
-        hand_eye_source: HandEyeSource::File,
-        warnings,
-    };
-    if let Some(he) = session.hand_eye {
-        out.hand_eye_initial = he;
-    } else {
-        let sightings = |usage| -> Vec<Sighting> {
-            session
-                .measurements
-                .iter()
-                .enumerate()
-                .filter(|(_, m)| m.usage == usage)
-                .map(|(i, _)| out.sighting(session, i))
-                .collect()
-        };
-        let initial = initial_hand_eye(
-            &session.robot,
-            &sightings(Use::Translation),
-            &sightings(Use::Rotation),
-        )?;
-        out.hand_eye_initial = initial.flange_from_sensor;
-        out.hand_eye_source = HandEyeSource::Computed(initial);
-    }
-    Ok(out)
 }
 
 /// Reported after every ε evaluation.
@@ -297,7 +159,7 @@ pub struct Progress {
 pub enum Control {
     /// Go on.
     Continue,
-    /// Stop now; `run` returns [`IdentifyError::Cancelled`].
+    /// Stop now: the run ends with [`StopReason::Cancelled`].
     Cancel,
 }
 
@@ -336,6 +198,16 @@ pub enum StopReason {
         updates: usize,
         /// Relative cost decrease of the last step (0 when none was possible).
         relative_change: f64,
+    },
+    /// The caller cancelled the run (the estimate is the one reached so
+    /// far, and a method's costly diagnostics are left out).
+    Cancelled {
+        /// ε when cancelled, mm.
+        epsilon: f64,
+        /// Threshold, mm.
+        threshold: f64,
+        /// Updates made.
+        updates: usize,
     },
 }
 
@@ -380,6 +252,30 @@ impl StopReason {
             } => format!(
                 "converged: the maximum-likelihood solve reached its optimum (last relative cost change {relative_change:.1e}) after {updates} update(s); ε = {epsilon:.4} mm is above the threshold {threshold:.4} mm, which is below what the noise of this data allows"
             ),
+            Self::Cancelled {
+                epsilon,
+                threshold,
+                updates,
+            } => format!(
+                "cancelled by the user after {updates} update(s): ε = {epsilon:.4} mm (threshold {threshold:.4} mm)"
+            ),
+        }
+    }
+
+    /// Whether the caller cancelled the run.
+    #[must_use]
+    pub fn is_cancelled(&self) -> bool {
+        matches!(self, Self::Cancelled { .. })
+    }
+
+    /// The loop's record for the result's `solver` block.
+    #[must_use]
+    pub fn record(&self, options: &Options) -> LoopRecord {
+        LoopRecord {
+            threshold: options.threshold,
+            max_iterations: options.max_iterations,
+            stop: self.code().to_string(),
+            stop_reason: self.describe(),
         }
     }
 
@@ -390,6 +286,7 @@ impl StopReason {
             Self::Converged { .. } => "threshold",
             Self::IterationLimit { .. } => "max_iterations",
             Self::SolverConverged { .. } => "converged",
+            Self::Cancelled { .. } => "cancelled",
         }
     }
 }
@@ -424,10 +321,8 @@ pub struct Calibration {
     pub iterations: Vec<f64>,
     /// Why the loop stopped.
     pub stop: StopReason,
-    /// The last update's SVD (None when no update was made).
-    pub last_update: Option<UpdateInfo>,
-    /// The result file's `solver` block.
-    pub solver: Map<String, Value>,
+    /// The method's report (the result file's `solver` block).
+    pub report: SolverReport,
     /// Every measurement's centre, session order.
     pub centres: Vec<CentreRow>,
     /// Within-station distance statistics of the identify stations.
@@ -450,115 +345,165 @@ impl Calibration {
     }
 }
 
+/// What one update of a method did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Step {
+    /// The estimate moved; the method would go on.
+    Moved,
+    /// The estimate moved and the method has converged with it (`ml`: LM
+    /// stopped on a negligible cost decrease).
+    Converged {
+        /// Relative cost decrease of the last step.
+        relative_change: f64,
+    },
+    /// No step is possible any more: converged before this update; the
+    /// estimate did not move.
+    Stuck {
+        /// Relative cost decrease of the last step taken (0 if none).
+        relative_change: f64,
+    },
+}
+
+/// A method inside the loop: its estimate, one update, and its report
+/// once the loop has stopped.
+pub trait Update {
+    /// The model and hand-eye now.
+    fn estimate(&self) -> &Estimate;
+
+    /// Makes update number `update` (1, 2, …).
+    ///
+    /// # Errors
+    /// A bad option, or a non-finite step.
+    fn update(&mut self, update: usize) -> Result<Step, SolveError>;
+
+    /// The method's report on the run that stopped for `stop` (a method
+    /// leaves out its costly diagnostics after a cancel).
+    fn report(self: Box<Self>, stop: &StopReason) -> SolverReport;
+}
+
 /// Runs the identification loop (FORMAT.md "The iteration"): compute ε;
-/// while ε > threshold and fewer than `max_iterations` updates were made,
-/// update and compute ε again. `progress` is called with every ε; returning
-/// [`Control::Cancel`] stops the run.
+/// while ε > threshold and fewer than `max_iterations` updates were made
+/// (and the method has not converged), update and compute ε again.
+/// `progress` is called with every ε; returning [`Control::Cancel`] ends
+/// the run with [`StopReason::Cancelled`].
 ///
 /// # Errors
-/// Too little identify data, a bad option, a non-finite update, or a cancel.
+/// Too little identify data, a bad option, or a non-finite update.
 pub fn run(
     session: &Session,
     prepared: &Prepared,
     options: &Options,
     progress: &mut dyn FnMut(&Progress) -> Control,
-) -> Result<Calibration, CalibrationError> {
+) -> Result<Calibration, SolveError> {
     if !(options.threshold >= 0.0 && options.threshold.is_finite()) {
-        return Err(IdentifyError::InvalidOption(format!(
+        return Err(SolveError::InvalidOption(format!(
             "threshold must be a non-negative number of mm, got {}",
             options.threshold
-        ))
-        .into());
+        )));
     }
     let stations = prepared.stations(session, Use::Identify);
     let usable = stations.iter().filter(|s| s.sightings.len() >= 2).count();
     if usable == 0 {
-        return Err(IdentifyError::NotEnoughData {
+        return Err(SolveError::NotEnoughData {
             detail: format!(
                 "the session has {} identify station(s) and none has 2 measurements",
                 stations.len()
             ),
-        }
-        .into());
-    }
-    if options.method == Method::Ml {
-        return crate::engine::solve::ml::run(session, prepared, options, progress);
+        });
     }
     let start = Estimate {
         robot: session.robot.clone(),
         flange_from_sensor: prepared.hand_eye_initial,
     };
-    let mut est = start.clone();
-    let mut eps = epsilon(&est.station_centres(&stations));
+    let mut method: Box<dyn Update> = match options.method {
+        Method::Paper => Box::new(paper::PaperUpdate::new(
+            start.clone(),
+            stations.clone(),
+            options,
+        )),
+        Method::Ml => Box::new(ml::MlUpdate::new(
+            session,
+            prepared,
+            &start,
+            stations.clone(),
+            options,
+        )?),
+    };
+    let eps_of = |est: &Estimate| epsilon(&est.station_centres(&stations));
+    let mut eps = eps_of(method.estimate());
     let mut iterations = vec![eps];
-    let mut last_update = None;
     let report = |updates: usize, epsilon: f64| Progress {
         updates,
         epsilon,
         max_iterations: options.max_iterations,
         threshold: options.threshold,
     };
-    if progress(&report(0, eps)) == Control::Cancel {
-        return Err(IdentifyError::Cancelled { iterations: 0 }.into());
-    }
-    while eps > options.threshold && iterations.len() - 1 < options.max_iterations {
+    let mut cancelled = progress(&report(0, eps)) == Control::Cancel;
+    let mut converged = None;
+    while !cancelled
+        && converged.is_none()
+        && eps > options.threshold
+        && iterations.len() - 1 < options.max_iterations
+    {
         let updates = iterations.len();
-        let info = match options.method {
-            Method::Paper | Method::Ml => paper_update(&est, &stations, &options.paper)?,
-        };
-        if info.delta.iter().any(|d| !d.is_finite()) {
-            return Err(IdentifyError::NonFinite { iteration: updates }.into());
+        match method.update(updates)? {
+            Step::Moved => {}
+            Step::Converged { relative_change } => converged = Some(relative_change),
+            Step::Stuck { relative_change } => {
+                converged = Some(relative_change);
+                continue;
+            }
         }
-        est = est.updated(&info.delta);
-        eps = epsilon(&est.station_centres(&stations));
+        eps = eps_of(method.estimate());
         if !eps.is_finite() {
-            return Err(IdentifyError::NonFinite { iteration: updates }.into());
+            return Err(SolveError::NonFinite { iteration: updates });
         }
         iterations.push(eps);
-        last_update = Some(info);
-        if progress(&report(updates, eps)) == Control::Cancel {
-            return Err(IdentifyError::Cancelled {
-                iterations: updates,
-            }
-            .into());
-        }
+        cancelled = progress(&report(updates, eps)) == Control::Cancel;
     }
     let updates = iterations.len() - 1;
-    let stop = if eps <= options.threshold {
+    let n = iterations.len();
+    let stop = if cancelled {
+        StopReason::Cancelled {
+            epsilon: eps,
+            threshold: options.threshold,
+            updates,
+        }
+    } else if eps <= options.threshold {
         StopReason::Converged {
             epsilon: eps,
             threshold: options.threshold,
             updates,
         }
+    } else if let Some(relative_change) = converged {
+        StopReason::SolverConverged {
+            epsilon: eps,
+            threshold: options.threshold,
+            updates,
+            relative_change,
+        }
     } else {
-        let n = iterations.len();
-        let last_change = if n >= 2 {
-            (iterations[n - 1] - iterations[n - 2]).abs()
-        } else {
-            f64::INFINITY
-        };
         StopReason::IterationLimit {
             epsilon: eps,
             threshold: options.threshold,
             updates,
-            last_change,
+            last_change: if n >= 2 {
+                (iterations[n - 1] - iterations[n - 2]).abs()
+            } else {
+                f64::INFINITY
+            },
         }
     };
+    let est = method.estimate().clone();
+    let report = method.report(&stop);
     Ok(finish(
-        session,
-        prepared,
-        options,
-        &start,
-        est,
-        iterations,
-        stop,
-        last_update,
+        session, prepared, options, &start, est, iterations, stop, report,
     ))
 }
 
-/// The centres, statistics and solver block of a finished run.
+/// The centres and statistics of a finished run.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn finish(
+fn finish(
     session: &Session,
     prepared: &Prepared,
     options: &Options,
@@ -566,7 +511,7 @@ pub(crate) fn finish(
     est: Estimate,
     iterations: Vec<f64>,
     stop: StopReason,
-    last_update: Option<UpdateInfo>,
+    report: SolverReport,
 ) -> Calibration {
     let centre = |e: &Estimate, i: usize| -> Vector3<f64> {
         let m = &session.measurements[i];
@@ -610,7 +555,6 @@ pub(crate) fn finish(
     } else {
         Some(validation(&session.reference_distances, &validate))
     };
-    let solver = solver_block(options, &stop, last_update.as_ref());
     Calibration {
         options: *options,
         nominal: session.robot.clone(),
@@ -619,46 +563,11 @@ pub(crate) fn finish(
         hand_eye: est.flange_from_sensor,
         iterations,
         stop,
-        last_update,
-        solver,
+        report,
         centres,
         identify_within,
         validation,
     }
-}
-
-/// The result file's `solver` block for the paper's method.
-fn solver_block(
-    options: &Options,
-    stop: &StopReason,
-    last: Option<&UpdateInfo>,
-) -> Map<String, Value> {
-    let mut m = Map::new();
-    m.insert("method".into(), json!(options.method.as_str()));
-    m.insert("pairs".into(), json!(options.paper.pairing.as_str()));
-    m.insert("svd_tolerance".into(), json!(options.paper.svd_tolerance));
-    m.insert(
-        "column_scaling".into(),
-        json!(format!(
-            "angle unknowns × {} mm/rad before the SVD",
-            crate::engine::solve::estimate::ANGLE_SCALE_MM
-        )),
-    );
-    m.insert("threshold".into(), json!(options.threshold));
-    m.insert("max_iterations".into(), json!(options.max_iterations));
-    m.insert("stop".into(), json!(stop.code()));
-    m.insert("stop_reason".into(), json!(stop.describe()));
-    if let Some(info) = last {
-        m.insert("kept_directions".into(), json!(info.kept));
-        m.insert("equations".into(), json!(info.rows));
-        m.insert("singular_values".into(), json!(info.singular_values));
-        m.insert("dropped_directions".into(), json!(info.dropped));
-        m.insert(
-            "unknowns".into(),
-            json!((0..info.delta.len()).map(unknown_label).collect::<Vec<_>>()),
-        );
-    }
-    m
 }
 
 /// `prepare` then `run` with no progress reporting.
@@ -668,14 +577,8 @@ fn solver_block(
 pub fn calibrate(
     session: &Session,
     options: &Options,
-) -> Result<(Prepared, Calibration), CalibrationError> {
+) -> Result<(Prepared, Calibration), SolveError> {
     let prepared = prepare(session)?;
     let cal = run(session, &prepared, options, &mut |_| Control::Continue)?;
     Ok((prepared, cal))
-}
-
-/// Sets the pairing by name (for callers parsing options).
-#[must_use]
-pub fn pairing_from_name(name: &str) -> Option<Pairing> {
-    Pairing::parse(name)
 }

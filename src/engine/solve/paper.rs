@@ -1,18 +1,7 @@
 //! Joint identification of hand-eye and kinematic errors, the paper's
-//! section 3.2 (eq. 10-19): one linearised update of the unknowns
-//! `ΔY = [ΔX; ΔP]` (6 hand-eye errors, `5·n` MDH errors).
-//!
-//! For a measurement `i` the base-frame centre is
-//! `X_i = bT_e(q_i) · eT_s · X_si` (eq. 10). To first order a hand-eye error
-//! `ΔX` (a twist in the sensor frame, `eT_s ← eT_s · exp(ΔX)`) and kinematic
-//! errors `ΔP` move it by
-//!
-//! ```text
-//! ΔX_i = R(bT_s,i) · P_i · ΔX + Q_i · J_i · ΔP          (eq. 12-16)
-//! P_i = [I | −[X_si]×]    (eq. 14; the rotation is that of bT_s = bT_e·eT_s,
-//!                           the corrected eq. 13 of NOTES.md)
-//! Q_i = [I | −[X_bi]×]    (eq. 16; J_i from robot::flange_jacobian)
-//! ```
+//! section 3.2 (eq. 17-19): one linearised update of the unknowns
+//! `ΔY = [ΔX; ΔP]` (6 hand-eye errors, `5·n` MDH errors), whose first-order
+//! effect on a centre (eq. 10-16) is [`sensitivity`].
 //!
 //! Two measurements of one station see one point, so for a pair `(i, j)`
 //! `X_i − X_j = [R_j·P_j − R_i·P_i,  Q_j·J_j − Q_i·J_i] · ΔY` (eq. 17, with
@@ -28,7 +17,10 @@
 
 use nalgebra::{DMatrix, DVector, Vector3};
 
-use super::IdentifyError;
+use super::report::{Direction, PaperReport, SolverReport};
+use super::{Options, SolveError, Step, StopReason, Update};
+use crate::engine::numeric::as_written;
+
 use super::estimate::{
     ANGLE_SCALE_MM, Estimate, Station, sensitivity, unknown_is_angle, unknown_label,
 };
@@ -117,23 +109,23 @@ pub struct UpdateInfo {
     /// The update `ΔY` (mm, rad).
     pub delta: Vec<f64>,
     /// The dropped directions, each as its dominant unknowns, e.g.
-    /// `"+0.71·d6 −0.71·he_z"`, strongest first.
-    pub dropped: Vec<String>,
+    /// `+0.71·d6 −0.71·he_z`, strongest first.
+    pub dropped: Vec<Direction>,
 }
 
 /// Eq. 17-19: builds `U ΔY = V` over all pairs of all stations and solves
 /// it with the truncated SVD. Returns the update and what it saw.
 ///
 /// # Errors
-/// [`IdentifyError::NotEnoughData`] when no station yields a pair,
-/// [`IdentifyError::InvalidOption`] for a tolerance outside (0, 1).
+/// [`SolveError::NotEnoughData`] when no station yields a pair,
+/// [`SolveError::InvalidOption`] for a tolerance outside (0, 1).
 pub fn paper_update(
     est: &Estimate,
     stations: &[Station],
     options: &PaperOptions,
-) -> Result<UpdateInfo, IdentifyError> {
+) -> Result<UpdateInfo, SolveError> {
     if !(options.svd_tolerance > 0.0 && options.svd_tolerance < 1.0) {
-        return Err(IdentifyError::InvalidOption(format!(
+        return Err(SolveError::InvalidOption(format!(
             "svd tolerance must be in (0, 1), got {}",
             options.svd_tolerance
         )));
@@ -150,7 +142,7 @@ pub fn paper_update(
         }
     }
     if blocks.is_empty() {
-        return Err(IdentifyError::NotEnoughData {
+        return Err(SolveError::NotEnoughData {
             detail: format!(
                 "{} identify station(s), none with 2 or more measurements",
                 stations.len()
@@ -234,7 +226,7 @@ fn truncated_solve(
 }
 
 /// A direction of `ΔY` (scaled space) as its dominant unknowns.
-fn describe_direction(d: &[f64]) -> String {
+fn describe_direction(d: &[f64]) -> Direction {
     /// Components smaller than this are left out of the description.
     const SHOWN: f64 = 0.2;
     let mut parts: Vec<(usize, f64)> = d
@@ -246,11 +238,74 @@ fn describe_direction(d: &[f64]) -> String {
     parts.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
     // Make the largest component positive so the sign is canonical.
     let sign = parts.first().map_or(1.0, |p| p.1.signum());
-    parts
-        .iter()
-        .map(|(k, c)| format!("{:+.2}·{}", c * sign, unknown_label(*k)))
-        .collect::<Vec<_>>()
-        .join(" ")
+    Direction {
+        terms: parts
+            .iter()
+            .map(|(k, c)| (as_written(c * sign, 2), unknown_label(*k)))
+            .collect(),
+    }
+}
+
+/// The paper's update inside the loop: one [`paper_update`] per update.
+pub struct PaperUpdate {
+    est: Estimate,
+    stations: Vec<Station>,
+    options: Options,
+    last: Option<UpdateInfo>,
+}
+
+impl PaperUpdate {
+    /// The update from the start `est` over the identify `stations`.
+    #[must_use]
+    pub fn new(est: Estimate, stations: Vec<Station>, options: &Options) -> Self {
+        Self {
+            est,
+            stations,
+            options: *options,
+            last: None,
+        }
+    }
+}
+
+impl Update for PaperUpdate {
+    fn estimate(&self) -> &Estimate {
+        &self.est
+    }
+
+    fn update(&mut self, update: usize) -> Result<Step, SolveError> {
+        let info = paper_update(&self.est, &self.stations, &self.options.paper)?;
+        if info.delta.iter().any(|d| !d.is_finite()) {
+            return Err(SolveError::NonFinite { iteration: update });
+        }
+        self.est = self.est.updated(&info.delta);
+        self.last = Some(info);
+        Ok(Step::Moved)
+    }
+
+    fn report(self: Box<Self>, stop: &StopReason) -> SolverReport {
+        let o = &self.options;
+        let record = stop.record(o);
+        let last = self.last;
+        SolverReport::Paper(Box::new(PaperReport {
+            pairs: Some(o.paper.pairing.as_str().to_string()),
+            svd_tolerance: Some(o.paper.svd_tolerance),
+            column_scaling: Some(format!(
+                "angle unknowns × {ANGLE_SCALE_MM} mm/rad before the SVD"
+            )),
+            threshold: Some(record.threshold),
+            max_iterations: Some(record.max_iterations),
+            stop: Some(record.stop),
+            stop_reason: Some(record.stop_reason),
+            kept_directions: last.as_ref().map(|i| i.kept),
+            equations: last.as_ref().map(|i| i.rows),
+            unknowns: last
+                .as_ref()
+                .map(|i| (0..i.delta.len()).map(unknown_label).collect()),
+            singular_values: last.as_ref().map(|i| i.singular_values.clone()),
+            dropped_directions: last.map(|i| i.dropped),
+            extra: serde_json::Map::new(),
+        }))
+    }
 }
 
 #[cfg(test)]

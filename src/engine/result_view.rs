@@ -1,0 +1,357 @@
+//! What every reader shows of a result, computed once from the typed
+//! [`ResultFile`]: the headline figures, the within-station centre
+//! distances (paper Fig. 5) with their pairs, the hand-eye as translation
+//! and roll/pitch/yaw, each parameter's σ, and which parameters the data
+//! could not identify. The workbench, the HTML report, history and the
+//! planner read these; none of them looks into the solver block itself.
+//! Also here: whether a result belongs to a session.
+
+use std::collections::BTreeMap;
+
+use nalgebra::{Isometry3, Vector3};
+
+use crate::engine::format::result::{CentreRecord, ResultFile};
+use crate::engine::geometry::roll_pitch_yaw_deg;
+use crate::engine::session::{Session, Use};
+use crate::engine::solve::{Prepared, SolverReport};
+use crate::engine::validate::{BeforeAfter, DistanceRecord, Stats, within_station_distances};
+
+/// A dropped SVD direction marks a parameter as not identifiable when its
+/// coefficient in the (unit) direction is at least this large: about a
+/// tenth of the direction's energy (0.3² ≈ 0.09). The workbench uses the
+/// same value.
+pub const MARK_COEFFICIENT: f64 = 0.3;
+
+/// A sensor-frame centre in the result may differ from the one recomputed
+/// from the session by this much (mm) and still count as the same data:
+/// the result file holds the shortest round-tripping decimal, so the
+/// recomputed fit agrees to far below this.
+pub const CENTRE_MATCH_MM: f64 = 1e-6;
+
+/// Why a result cannot be reported against a session.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ReportError {
+    /// The result names another session.
+    #[error("the result is of session \"{result}\", not of session \"{session}\"")]
+    OtherSession {
+        /// `session` of the result.
+        result: String,
+        /// `name` of the session.
+        session: String,
+    },
+    /// A result centre has no measurement of that id in the session.
+    #[error("measurement {id} of the result is not in the session")]
+    UnknownMeasurement {
+        /// Measurement id.
+        id: String,
+    },
+    /// A measurement's station or use differs between result and session.
+    #[error("measurement {id}: {what} differs between the result and the session")]
+    Differs {
+        /// Measurement id.
+        id: String,
+        /// `station` or `use`.
+        what: &'static str,
+    },
+    /// A measurement's sensor-frame centre differs (other stripe data).
+    #[error(
+        "measurement {id}: the result's sensor-frame centre is {mm:.6} mm from the one the session gives (other measurement data)"
+    )]
+    OtherData {
+        /// Measurement id.
+        id: String,
+        /// Distance between the two centres, mm.
+        mm: f64,
+    },
+}
+
+/// Checks that `result` was computed from `session`: the same name, every
+/// result measurement in the session with the same station and use, and
+/// (when `prepared` is given) the same sensor-frame centre to
+/// [`CENTRE_MATCH_MM`]. Measurements of the session missing from the
+/// result are allowed: they were left out of the run
+/// ([`excluded_measurements`]).
+///
+/// # Errors
+/// The first mismatch found.
+pub fn check_result(
+    session: &Session,
+    result: &ResultFile,
+    prepared: Option<&Prepared>,
+) -> Result<(), ReportError> {
+    if result.session != session.name {
+        return Err(ReportError::OtherSession {
+            result: result.session.clone(),
+            session: session.name.clone(),
+        });
+    }
+    for c in &result.centres {
+        let Some(i) = session
+            .measurements
+            .iter()
+            .position(|m| m.id == c.measurement)
+        else {
+            return Err(ReportError::UnknownMeasurement {
+                id: c.measurement.clone(),
+            });
+        };
+        let m = &session.measurements[i];
+        if m.station != c.station {
+            return Err(ReportError::Differs {
+                id: m.id.clone(),
+                what: "station",
+            });
+        }
+        if m.usage != c.usage {
+            return Err(ReportError::Differs {
+                id: m.id.clone(),
+                what: "use",
+            });
+        }
+        if let Some(p) = prepared.and_then(|p| p.measurements.get(i)) {
+            let mm = (p.centre_in_sensor - nalgebra::Vector3::from(c.sensor)).norm();
+            if mm.is_nan() || mm > CENTRE_MATCH_MM {
+                return Err(ReportError::OtherData {
+                    id: m.id.clone(),
+                    mm,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Ids of the session's measurements that the result does not hold (left
+/// out of the run, e.g. `calibrate --exclude`), in session order.
+#[must_use]
+pub fn excluded_measurements(session: &Session, result: &ResultFile) -> Vec<String> {
+    session
+        .measurements
+        .iter()
+        .filter(|m| !result.centres.iter().any(|c| c.measurement == m.id))
+        .map(|m| m.id.clone())
+        .collect()
+}
+
+/// Parameter labels (`theta1`, `he_z`, …) this result marks as not
+/// identifiable, each with why: a coefficient of at least
+/// [`MARK_COEFFICIENT`] (as written, two decimals) in a dropped SVD
+/// direction (the paper's method), or held fixed (`ml`).
+#[must_use]
+pub fn identifiability_marks(solver: &SolverReport) -> BTreeMap<String, String> {
+    let mut out = BTreeMap::new();
+    if let Some(dropped) = solver.paper().and_then(|p| p.dropped_directions.as_ref()) {
+        for direction in dropped {
+            for (c, label) in &direction.terms {
+                if c.abs() >= MARK_COEFFICIENT {
+                    out.entry(label.clone())
+                        .or_insert_with(|| format!("in the dropped SVD direction {direction}"));
+                }
+            }
+        }
+    }
+    for label in solver.fixed() {
+        out.insert(
+            label.clone(),
+            "held fixed at its start: not identifiable from centre distances".to_string(),
+        );
+    }
+    out
+}
+
+/// The hand-eye `eT_s` in numbers people read.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HandEyeView {
+    /// Translation, mm, flange frame.
+    pub translation: [f64; 3],
+    /// Roll, pitch, yaw, deg ([`roll_pitch_yaw_deg`]).
+    pub rpy_deg: [f64; 3],
+}
+
+impl HandEyeView {
+    /// The view of `flange_from_sensor`.
+    #[must_use]
+    pub fn new(flange_from_sensor: &Isometry3<f64>) -> Self {
+        Self {
+            translation: flange_from_sensor.translation.vector.into(),
+            rpy_deg: roll_pitch_yaw_deg(&flange_from_sensor.rotation),
+        }
+    }
+}
+
+/// One within-station centre distance (true value 0; paper Fig. 5).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairDistance {
+    /// Station id.
+    pub station: String,
+    /// Measurement ids of the pair.
+    pub ids: (String, String),
+    /// Distance with the nominal model and initial hand-eye, mm.
+    pub before: f64,
+    /// Distance with the calibrated model and hand-eye, mm.
+    pub after: f64,
+}
+
+/// The headline figures: validation statistics before and after.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Headline {
+    /// What the statistics are of, e.g. "validation: 54 reference distances (measured − reference)".
+    pub what: String,
+    /// Before and after.
+    pub stats: BeforeAfter,
+}
+
+/// A parameter's standard deviation as the method reports it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sigma {
+    /// 1σ, file units.
+    pub std: f64,
+    /// `mm` or `deg`.
+    pub unit: String,
+}
+
+/// What every reader shows of a result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResultView {
+    /// The headline figures, when the result has validation.
+    pub headline: Option<Headline>,
+    /// Within-station distances of the validate stations (or, without any,
+    /// of the identify stations), station order then pair order.
+    pub within: Vec<PairDistance>,
+    /// Which stations `within` is of: validate or identify.
+    pub within_of: Use,
+    /// Statistics of `within`.
+    pub within_stats: BeforeAfter,
+    /// Statistics of the identify stations' within-station distances.
+    pub identify_within: BeforeAfter,
+    /// Reference-distance comparisons (paper Fig. 6).
+    pub distances: Vec<DistanceRecord>,
+    /// Initial hand-eye.
+    pub hand_eye_before: HandEyeView,
+    /// Calibrated hand-eye.
+    pub hand_eye_after: HandEyeView,
+    /// Rotation between the two hand-eyes, deg.
+    pub hand_eye_rotation_change_deg: f64,
+    /// Parameter labels not identifiable from this data, each with why.
+    pub marked: BTreeMap<String, String>,
+    /// σ of each estimated parameter (`ml`), by label.
+    pub sigma: BTreeMap<String, Sigma>,
+}
+
+impl ResultView {
+    /// The view of `result`.
+    #[must_use]
+    pub fn new(result: &ResultFile) -> Self {
+        let validate = within_pairs(&result.centres, Use::Validate);
+        let identify = within_pairs(&result.centres, Use::Identify);
+        let identify_within = pair_stats(&identify);
+        let (within, within_of) = if validate.is_empty() {
+            (identify, Use::Identify)
+        } else {
+            (validate, Use::Validate)
+        };
+        let headline = match &result.validation {
+            Some(v) if !v.distances.is_empty() => Some(Headline {
+                what: format!(
+                    "validation: {} reference distances (measured − reference)",
+                    v.distances.len()
+                ),
+                stats: BeforeAfter {
+                    before: v.before,
+                    after: v.after,
+                },
+            }),
+            Some(v) => Some(Headline {
+                what: "validation: within-station centre distances".to_string(),
+                stats: v.within_station,
+            }),
+            None => None,
+        };
+        let sigma = result
+            .solver
+            .ml()
+            .iter()
+            .flat_map(|r| &r.parameters)
+            .map(|p| {
+                (
+                    p.parameter.clone(),
+                    Sigma {
+                        std: p.std,
+                        unit: p.unit.clone(),
+                    },
+                )
+            })
+            .collect();
+        Self {
+            headline,
+            within_stats: pair_stats(&within),
+            within,
+            within_of,
+            identify_within,
+            distances: result
+                .validation
+                .as_ref()
+                .map(|v| v.distances.clone())
+                .unwrap_or_default(),
+            hand_eye_before: HandEyeView::new(&result.hand_eye_initial),
+            hand_eye_after: HandEyeView::new(&result.hand_eye),
+            hand_eye_rotation_change_deg: result
+                .hand_eye_initial
+                .rotation
+                .angle_to(&result.hand_eye.rotation)
+                .to_degrees(),
+            marked: identifiability_marks(&result.solver),
+            sigma,
+        }
+    }
+}
+
+/// Statistics of the before and after distances of `pairs`.
+fn pair_stats(pairs: &[PairDistance]) -> BeforeAfter {
+    BeforeAfter {
+        before: Stats::of(&pairs.iter().map(|p| p.before).collect::<Vec<_>>()),
+        after: Stats::of(&pairs.iter().map(|p| p.after).collect::<Vec<_>>()),
+    }
+}
+
+/// Pairwise distances within each station of `usage` (station order of
+/// first appearance, then `i < j`), by [`within_station_distances`].
+#[must_use]
+pub fn within_pairs(centres: &[CentreRecord], usage: Use) -> Vec<PairDistance> {
+    let mut stations: Vec<(&str, Vec<&CentreRecord>)> = Vec::new();
+    for c in centres.iter().filter(|c| c.usage == usage) {
+        match stations.iter_mut().find(|(s, _)| *s == c.station) {
+            Some((_, v)) => v.push(c),
+            None => stations.push((&c.station, vec![c])),
+        }
+    }
+    let of = |f: fn(&CentreRecord) -> [f64; 3]| -> Vec<Vec<Vector3<f64>>> {
+        stations
+            .iter()
+            .map(|(_, cs)| cs.iter().map(|c| f(c).into()).collect())
+            .collect()
+    };
+    let before = within_station_distances(&of(|c| c.before));
+    let after = within_station_distances(&of(|c| c.after));
+    let mut labels = Vec::new();
+    for (station, cs) in &stations {
+        for i in 0..cs.len() {
+            for j in i + 1..cs.len() {
+                labels.push((
+                    (*station).to_string(),
+                    (cs[i].measurement.clone(), cs[j].measurement.clone()),
+                ));
+            }
+        }
+    }
+    labels
+        .into_iter()
+        .zip(before.into_iter().zip(after))
+        .map(|((station, ids), (before, after))| PairDistance {
+            station,
+            ids,
+            before,
+            after,
+        })
+        .collect()
+}

@@ -1,0 +1,203 @@
+//! What a method reports about a run: the typed form of the result file's
+//! `solver` block. A run fills it in directly; the
+//! [`format`](crate::engine::format) module writes it to a result file and
+//! reads it back, and nothing else touches the JSON.
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+use serde_json::{Map, Value};
+
+use super::ml::MlReport;
+
+/// The solver block of a result: the paper's method, `ml`, or a method this
+/// build does not know (a later version's result, kept as read).
+#[derive(Debug, Clone, PartialEq)]
+pub enum SolverReport {
+    /// The paper's update (section 3.2): paired differences, truncated SVD.
+    Paper(Box<PaperReport>),
+    /// The maximum-likelihood method.
+    Ml(Box<MlReport>),
+    /// Another method's block, as read from a file.
+    Other {
+        /// `solver.method`.
+        method: String,
+        /// Every other key of the block.
+        block: Map<String, Value>,
+    },
+}
+
+impl SolverReport {
+    /// `solver.method`: `paper`, `ml`, or what the file says.
+    #[must_use]
+    pub fn method(&self) -> &str {
+        match self {
+            Self::Paper(_) => "paper",
+            Self::Ml(_) => "ml",
+            Self::Other { method, .. } => method,
+        }
+    }
+
+    /// The `ml` report, when the method is `ml`.
+    #[must_use]
+    pub fn ml(&self) -> Option<&MlReport> {
+        match self {
+            Self::Ml(r) => Some(r),
+            _ => None,
+        }
+    }
+
+    /// The paper's report, when the method is the paper's.
+    #[must_use]
+    pub fn paper(&self) -> Option<&PaperReport> {
+        match self {
+            Self::Paper(r) => Some(r),
+            _ => None,
+        }
+    }
+
+    /// The threshold on ε of the loop, mm, when the block says.
+    #[must_use]
+    pub fn threshold(&self) -> Option<f64> {
+        match self {
+            Self::Paper(r) => r.threshold,
+            Self::Ml(r) => Some(r.stop.threshold),
+            Self::Other { .. } => None,
+        }
+    }
+
+    /// Why the loop stopped, in words, when the block says.
+    #[must_use]
+    pub fn stop_reason(&self) -> Option<&str> {
+        match self {
+            Self::Paper(r) => r.stop_reason.as_deref(),
+            Self::Ml(r) => Some(&r.stop.stop_reason),
+            Self::Other { .. } => None,
+        }
+    }
+
+    /// Parameters the method held fixed at their start (`ml`'s fixed set;
+    /// empty for a method that does not fix parameters).
+    #[must_use]
+    pub fn fixed(&self) -> &[String] {
+        match self {
+            Self::Ml(r) => &r.fixed,
+            _ => &[],
+        }
+    }
+
+    /// Parameters the method estimated (`ml`'s identifiable set; empty when
+    /// the method does not say).
+    #[must_use]
+    pub fn estimated(&self) -> &[String] {
+        match self {
+            Self::Ml(r) => &r.estimated,
+            _ => &[],
+        }
+    }
+}
+
+/// The loop of FORMAT.md "The iteration" as a result records it.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct LoopRecord {
+    /// Threshold on ε, mm.
+    pub threshold: f64,
+    /// Most updates.
+    pub max_iterations: usize,
+    /// Stop code (`threshold`, `converged`, `max_iterations`, `cancelled`).
+    pub stop: String,
+    /// Why the loop stopped, in words, with ε beside the threshold.
+    pub stop_reason: String,
+}
+
+/// The paper's method as reported. Every key is optional: a run fills
+/// them all in, a file written by another implementation may hold fewer,
+/// and [`format`](crate::engine::format) writes back only those present
+/// (keys it does not know, or of another type, stay in `extra`).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PaperReport {
+    /// Pairing of a station's measurements (`disjoint` or `all`).
+    pub pairs: Option<String>,
+    /// Relative SVD tolerance (fraction of σ_max).
+    pub svd_tolerance: Option<f64>,
+    /// How the unknowns were scaled before the SVD, in words.
+    pub column_scaling: Option<String>,
+    /// Threshold on ε, mm.
+    pub threshold: Option<f64>,
+    /// Most updates.
+    pub max_iterations: Option<usize>,
+    /// Stop code.
+    pub stop: Option<String>,
+    /// Why the loop stopped, in words.
+    pub stop_reason: Option<String>,
+    /// Singular values the last update's SVD kept.
+    pub kept_directions: Option<usize>,
+    /// Rows of the last update's `U` (3 per pair).
+    pub equations: Option<usize>,
+    /// Singular values of the column-scaled `U`, descending.
+    pub singular_values: Option<Vec<f64>>,
+    /// The directions the truncation dropped.
+    pub dropped_directions: Option<Vec<Direction>>,
+    /// Labels of the unknowns, `ΔY` order.
+    pub unknowns: Option<Vec<String>>,
+    /// Keys of the block this build does not read, kept as they were.
+    pub extra: Map<String, Value>,
+}
+
+/// A direction of `ΔY` (scaled space) by its dominant unknowns, strongest
+/// first, coefficients as written (two decimals): `+0.71·d6 -0.71·he_z`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Direction {
+    /// `(coefficient, label)`, the largest coefficient positive.
+    pub terms: Vec<(f64, String)>,
+}
+
+impl fmt::Display for Direction {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (k, (c, label)) in self.terms.iter().enumerate() {
+            if k > 0 {
+                f.write_str(" ")?;
+            }
+            write!(f, "{c:+.2}·{label}")?;
+        }
+        Ok(())
+    }
+}
+
+impl FromStr for Direction {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let mut terms = Vec::new();
+        for term in s.split_whitespace() {
+            let (c, label) = term
+                .split_once('·')
+                .ok_or_else(|| format!("`{term}` is not `coefficient·label`"))?;
+            let c: f64 = c
+                .replace('−', "-")
+                .parse()
+                .map_err(|_| format!("`{c}` is not a number"))?;
+            terms.push((c, label.to_string()));
+        }
+        Ok(Self { terms })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn directions_read_back_as_written() {
+        let d = Direction {
+            terms: vec![(0.7049, "d6".into()), (-0.7093, "he_z".into())],
+        };
+        assert_eq!(d.to_string(), "+0.70·d6 -0.71·he_z");
+        let back: Direction = d.to_string().parse().unwrap();
+        assert_eq!(back.to_string(), d.to_string());
+        assert_eq!(back.terms[1], (-0.71, "he_z".to_string()));
+        assert!("0.5".parse::<Direction>().is_err());
+    }
+}
