@@ -589,3 +589,24 @@ fn simulating_its_own_poses_as_a_plan_reproduces_a_session() {
     });
     assert!(simulate::import_files(&centres).is_err());
 }
+
+/// The example sessions in `sessions/` (and their truth files) are what
+/// `simulate` writes today from the configuration each truth file echoes:
+/// byte for byte, so that a change of the simulator (or of the session
+/// writer) that would change them is seen.
+#[test]
+fn example_sessions_are_regenerated_byte_for_byte() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("sessions");
+    for stem in ["demo-irb2400", "centres-irb2400", "ur5e"] {
+        let session_text = std::fs::read_to_string(dir.join(format!("{stem}.json"))).unwrap();
+        let truth_text = std::fs::read_to_string(dir.join(format!("{stem}.truth.json"))).unwrap();
+        let truth = simulate::parse_truth(&truth_text).unwrap();
+        let (session, again) = simulate(&truth.config);
+        assert_eq!(
+            format::session_to_json(&session),
+            session_text,
+            "{stem}.json"
+        );
+        assert_eq!(simulate::truth_to_json(&again), truth_text, "{stem}.truth.json");
+    }
+}
