@@ -8,7 +8,7 @@
 // message (clippy.toml allows this only inside `#[test]` functions).
 #![allow(clippy::expect_used)]
 
-use spherecal::cli::evaluate;
+use spherecal::engine::evaluate::study as evaluate;
 use spherecal::engine::evaluate::{TruthScore, score, validation_errors};
 use spherecal::engine::format::result::solver_block;
 use spherecal::engine::format::{self, ResultFile};

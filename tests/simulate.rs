@@ -607,6 +607,10 @@ fn example_sessions_are_regenerated_byte_for_byte() {
             session_text,
             "{stem}.json"
         );
-        assert_eq!(simulate::truth_to_json(&again), truth_text, "{stem}.truth.json");
+        assert_eq!(
+            simulate::truth_to_json(&again),
+            truth_text,
+            "{stem}.truth.json"
+        );
     }
 }

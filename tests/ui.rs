@@ -728,12 +728,12 @@ fn a_plan_is_made_exported_simulated_and_calibrated() {
     assert_eq!(h.state().forms().tab, Tab::Plan);
     {
         let f = &mut h.state_mut().forms_mut().plan;
-        f.n_identify = 3;
-        f.identify_poses = 4;
-        f.n_validate = 2;
-        f.validate_poses = 3;
-        f.candidates = 8;
-        f.predict_runs = 1;
+        f.request.n_identify = 3;
+        f.request.identify_poses = 4;
+        f.request.n_validate = 2;
+        f.request.validate_poses = 3;
+        f.request.candidates = 8;
+        f.request.predict_runs = 1;
     }
     h.get_by_label("Make plan").click();
     settle(&mut h);

@@ -10,65 +10,36 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use nalgebra::Isometry3;
 
 use crate::engine::cell::workspace::Workspace;
+use crate::engine::import::RobotSource;
 use crate::engine::plan::{
-    self, DEFAULT_CANDIDATES, DEFAULT_CUT_ANGLE_DEG, Plan, PlanConfig, PlanError, PlanStage,
-    PredictConfig, Prediction,
+    self, Plan, PlanConfig, PlanError, PlanRequest, PlanStage, PredictConfig, Prediction,
 };
-use crate::engine::robot;
 use crate::engine::robot::RobotChoice;
 use crate::engine::session::Session;
 use crate::engine::simulate::{self, PlanExecution, SimConfig};
 use crate::engine::solve::Control;
 
-/// The Plan view's fields.
+/// The Plan view's fields: the robot preset and where the hand-eye guess
+/// comes from, and the rest of the request as the command line has it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlanForm {
     /// Robot preset key.
     pub robot: String,
-    /// Rough sphere position, base frame, mm.
-    pub sphere: [f64; 3],
     /// Take the hand-eye guess from the open session (when it has one)
     /// instead of the paper's initial hand-eye.
     pub hand_eye_from_session: bool,
-    /// Translation poses at P0.
-    pub n_translation: usize,
-    /// Rotation poses at P0.
-    pub n_rotation: usize,
-    /// Identify stations.
-    pub n_identify: usize,
-    /// Poses per identify station.
-    pub identify_poses: usize,
-    /// Validate stations.
-    pub n_validate: usize,
-    /// Poses per validate station.
-    pub validate_poses: usize,
-    /// Cut angle of the laser plane, deg.
-    pub cut_angle: f64,
-    /// Orientation candidates per station.
-    pub candidates: usize,
-    /// Seed of the plan (and of the simulated session).
-    pub seed: u64,
-    /// Simulated calibrations for the predicted accuracy (0: none).
-    pub predict_runs: usize,
+    /// The plan asked for (its robot and hand-eye are set from the fields
+    /// above when it is made).
+    pub request: PlanRequest,
 }
 
 impl Default for PlanForm {
     fn default() -> Self {
-        let predict = PredictConfig::default();
+        let key = RobotChoice::Irb2400.key();
         Self {
-            robot: RobotChoice::Irb2400.key().to_string(),
-            sphere: default_sphere(RobotChoice::Irb2400.key()),
+            robot: key.to_string(),
             hand_eye_from_session: false,
-            n_translation: 4,
-            n_rotation: 6,
-            n_identify: 9,
-            identify_poses: 6,
-            n_validate: 10,
-            validate_poses: 6,
-            cut_angle: DEFAULT_CUT_ANGLE_DEG,
-            candidates: DEFAULT_CANDIDATES,
-            seed: 1,
-            predict_runs: predict.runs,
+            request: PlanRequest::new(RobotSource::Preset(key.to_string()), default_sphere(key)),
         }
     }
 }
@@ -90,24 +61,16 @@ impl PlanForm {
     /// # Errors
     /// An unknown preset, or the session hand-eye asked for but absent.
     pub fn config(&self, session_hand_eye: Option<Isometry3<f64>>) -> Result<PlanConfig, String> {
-        let preset = robot::preset(&self.robot)
-            .ok_or_else(|| format!("unknown robot preset `{}`", self.robot))?;
-        let mut c = PlanConfig::for_preset(&preset, self.sphere);
-        if self.hand_eye_from_session {
-            c.flange_from_sensor = session_hand_eye.ok_or(
+        let mut request = self.request.clone();
+        request.robot = RobotSource::Preset(self.robot.clone());
+        request.hand_eye = if self.hand_eye_from_session {
+            Some(session_hand_eye.ok_or(
                 "no hand-eye in the result on show or the open session: untick \"hand-eye guess from the open calibration\" to use the paper's initial one",
-            )?;
-        }
-        c.n_translation = self.n_translation;
-        c.n_rotation = self.n_rotation;
-        c.n_identify = self.n_identify;
-        c.identify_poses = self.identify_poses;
-        c.n_validate = self.n_validate;
-        c.validate_poses = self.validate_poses;
-        c.cut_angle = self.cut_angle;
-        c.candidates = self.candidates;
-        c.seed = self.seed;
-        Ok(c)
+            )?)
+        } else {
+            None
+        };
+        request.config().map_err(|e| e.to_string())
     }
 }
 
@@ -228,7 +191,7 @@ mod tests {
     #[test]
     fn defaults_match_the_cli_and_the_preset_workspace() {
         let f = PlanForm::default();
-        assert_eq!(f.sphere, [1050.0, 0.0, 475.0]);
+        assert_eq!(f.request.sphere, [1050.0, 0.0, 475.0]);
         let c = f.config(None).unwrap();
         assert_eq!(c.n_identify, 9);
         assert_eq!(c.seed, 1);

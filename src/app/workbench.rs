@@ -371,7 +371,7 @@ impl WorkbenchApp {
                 return;
             }
         };
-        let runs = self.forms.plan.predict_runs;
+        let runs = self.forms.plan.request.predict_runs;
         let cancel = Arc::new(AtomicBool::new(false));
         let flag = Arc::clone(&cancel);
         let started = self.spawn(ctx, "plan", move |rep| {
@@ -433,7 +433,7 @@ impl WorkbenchApp {
             return;
         };
         let robot = self.forms.plan.robot.clone();
-        let seed = self.forms.plan.seed;
+        let seed = self.forms.plan.request.seed;
         let started = self.spawn(ctx, "simulate", move |rep| {
             let outcome = planner::simulate_plan(&plan, &robot, seed)
                 .map(|session| Box::new(work::analyse(session, Source::Simulated)));

@@ -8,16 +8,13 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args;
-use nalgebra::Isometry3;
-use serde_json::Value;
 
 use super::CliError;
-use crate::engine::cell::workspace;
 use crate::engine::format;
-use crate::engine::geometry::isometry_from_rows;
-use crate::engine::import::{self, RobotSource};
+use crate::engine::import::RobotSource;
 use crate::engine::plan::{
-    self, Controller, PlanConfig, PlanError, PlanStage, PredictConfig, Selection, StationLayout,
+    self, Controller, PlanConfig, PlanError, PlanRequest, PlanStage, PredictConfig, RequestError,
+    Selection, defaults, read_hand_eye, read_stations,
 };
 use crate::engine::robot::{self, JointLimit};
 use crate::engine::simulate;
@@ -39,25 +36,25 @@ pub struct PlanArgs {
     #[arg(long)]
     pub hand_eye: Option<PathBuf>,
     /// Sphere diameter, mm.
-    #[arg(long, default_value_t = 38.1)]
+    #[arg(long, default_value_t = defaults::DIAMETER_MM)]
     pub diameter: f64,
     /// Translation poses at P0 (0, or at least 3).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = defaults::TRANSLATIONS)]
     pub translations: usize,
     /// Rotation poses at P0 (0, or at least 2).
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, default_value_t = defaults::ROTATIONS)]
     pub rotations: usize,
     /// Identify stations (in the station box).
-    #[arg(long, default_value_t = 9)]
+    #[arg(long, default_value_t = defaults::IDENTIFY_STATIONS)]
     pub identify_stations: usize,
     /// Poses per identify station.
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, default_value_t = defaults::IDENTIFY_POSES)]
     pub identify_poses: usize,
     /// Validate stations (in the station box); consecutive ones get a reference distance.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = defaults::VALIDATE_STATIONS)]
     pub validate_stations: usize,
     /// Poses per validate station.
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, default_value_t = defaults::VALIDATE_POSES)]
     pub validate_poses: usize,
     /// Station box `dx,dy,dz` (mm, base axes) centred on --sphere (default: the preset's simulator box, e.g. 400,600,450 for the IRB 2400; 300 mm cube otherwise).
     #[arg(long, value_parser = parse_triple)]
@@ -78,7 +75,7 @@ pub struct PlanArgs {
     #[arg(long)]
     pub random: bool,
     /// Seed of every random choice; the same arguments give the same plan.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = defaults::SEED)]
     pub seed: u64,
     /// Write the plan as a joint log CSV (the layout `spherecal import` reads, with the ABB flange pose).
     #[arg(long)]
@@ -109,13 +106,7 @@ fn parse_triple(s: &str) -> Result<[f64; 3], String> {
     }
 }
 
-fn parse_limits(items: &[String], dof: usize) -> Result<Vec<JointLimit>, CliError> {
-    if items.len() != dof {
-        return Err(CliError::input(format!(
-            "--limits has {} entries, the robot has {dof} joints",
-            items.len()
-        )));
-    }
+fn parse_limits(items: &[String]) -> Result<Vec<JointLimit>, CliError> {
     items
         .iter()
         .map(|item| {
@@ -132,80 +123,56 @@ fn parse_limits(items: &[String], dof: usize) -> Result<Vec<JointLimit>, CliErro
         .collect()
 }
 
-/// A hand-eye `flange_from_sensor` from a JSON file: a bare 4×4 array of
-/// rows, or an object with a `hand_eye` 4×4 (a session or result file).
+/// The engine's request of these flags (files read).
 ///
 /// # Errors
-/// [`CliError`] (status 2) naming the file and what is wrong.
-pub fn read_hand_eye(path: &Path) -> Result<Isometry3<f64>, CliError> {
-    let fail = |m: String| CliError::input(format!("hand-eye: {m} ({})", path.display()));
-    let text = std::fs::read_to_string(path).map_err(|e| fail(format!("reading failed: {e}")))?;
-    let value: Value = serde_json::from_str(&text).map_err(|e| fail(e.to_string()))?;
-    let matrix = match &value {
-        Value::Object(map) => map
-            .get("hand_eye")
-            .cloned()
-            .ok_or_else(|| fail("the file has no `hand_eye`".to_owned()))?,
-        other => other.clone(),
+/// [`CliError`] (status 2) for bad limits, an unreadable hand-eye or
+/// stations file.
+pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
+    let input = |e: RequestError| CliError::input(e.to_string());
+    let robot = if robot::preset(&args.robot).is_some() {
+        RobotSource::Preset(args.robot.clone())
+    } else {
+        RobotSource::File(PathBuf::from(&args.robot))
     };
-    let rows: [[f64; 4]; 4] = serde_json::from_value(matrix)
-        .map_err(|e| fail(format!("expected a 4x4 matrix of numbers: {e}")))?;
-    isometry_from_rows(&rows).map_err(|e| fail(e.to_string()))
-}
-
-/// Explicit stations from a CSV with columns `use`, `x`, `y`, `z`.
-fn read_stations(path: &Path) -> Result<StationLayout, CliError> {
-    let fail =
-        |line: usize, m: String| CliError::input(format!("line {line}: {m} ({})", path.display()));
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| CliError::input(format!("reading failed: {e} ({})", path.display())))?;
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let Some((hl, header)) = lines.next() else {
-        return Err(fail(1, "no header row".to_owned()));
-    };
-    let header: Vec<String> = header
-        .split(',')
-        .map(|h| h.trim().to_ascii_lowercase())
-        .collect();
-    let col = |name: &str| {
-        header
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| fail(hl, format!("no column `{name}`")))
-    };
-    let (u, x, y, z) = (col("use")?, col("x")?, col("y")?, col("z")?);
-    let (mut identify, mut validate) = (Vec::new(), Vec::new());
-    for (line, l) in lines {
-        let f: Vec<&str> = l.split(',').map(str::trim).collect();
-        if f.len() != header.len() {
-            return Err(fail(
-                line,
-                format!("{} fields, the header has {}", f.len(), header.len()),
-            ));
-        }
-        let num = |c: usize| {
-            f[c].parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| fail(line, format!("`{}` is not a finite number", f[c])))
-        };
-        let p = [num(x)?, num(y)?, num(z)?];
-        match f[u] {
-            "identify" => identify.push(p),
-            "validate" => validate.push(p),
-            other => {
-                return Err(fail(
-                    line,
-                    format!("use `{other}` is not identify or validate"),
-                ));
-            }
-        }
-    }
-    Ok(StationLayout::Explicit { identify, validate })
+    Ok(PlanRequest {
+        limits: if args.limits.is_empty() {
+            None
+        } else {
+            Some(parse_limits(&args.limits)?)
+        },
+        hand_eye: args
+            .hand_eye
+            .as_deref()
+            .map(read_hand_eye)
+            .transpose()
+            .map_err(input)?,
+        diameter: args.diameter,
+        n_translation: args.translations,
+        n_rotation: args.rotations,
+        n_identify: args.identify_stations,
+        identify_poses: args.identify_poses,
+        n_validate: args.validate_stations,
+        validate_poses: args.validate_poses,
+        box_size: args.box_size,
+        stations: args
+            .stations
+            .as_deref()
+            .map(read_stations)
+            .transpose()
+            .map_err(input)?,
+        cut_angle: args.angle,
+        cone_angle: args.cone,
+        candidates: args.candidates,
+        seed: args.seed,
+        selection: if args.random {
+            Selection::Random
+        } else {
+            Selection::DOptimal
+        },
+        predict_runs: args.predict,
+        ..PlanRequest::new(robot, args.sphere)
+    })
 }
 
 /// The engine configuration of these flags.
@@ -214,57 +181,9 @@ fn read_stations(path: &Path) -> Result<StationLayout, CliError> {
 /// [`CliError`] (status 2) for an unknown robot, bad limits, an unreadable
 /// hand-eye or stations file.
 pub fn config(args: &PlanArgs) -> Result<PlanConfig, CliError> {
-    let mut config = match robot::preset(&args.robot) {
-        Some(preset) => PlanConfig::for_preset(&preset, args.sphere),
-        None => {
-            let path = PathBuf::from(&args.robot);
-            let robot = import::load_robot(&RobotSource::File(path))
-                .map_err(|e| CliError::input(e.to_string()))?;
-            let named = robot::presets()
-                .into_iter()
-                .find(|p| p.robot.name == robot.name);
-            let limits = if !args.limits.is_empty() {
-                parse_limits(&args.limits, robot.dof())?
-            } else if let Some(p) = &named {
-                workspace::cell_limits(p.key, &p.limits)
-            } else {
-                return Err(CliError::input(format!(
-                    "robot {} from {} is not a preset: give its joint limits with --limits min:max,... (deg)",
-                    robot.name, args.robot
-                )));
-            };
-            PlanConfig::new(robot, limits, args.sphere)
-        }
-    };
-    if !args.limits.is_empty() {
-        config.limits = parse_limits(&args.limits, config.robot.dof())?;
-    }
-    if let Some(path) = &args.hand_eye {
-        config.flange_from_sensor = read_hand_eye(path)?;
-    }
-    config.diameter = args.diameter;
-    config.n_translation = args.translations;
-    config.n_rotation = args.rotations;
-    config.n_identify = args.identify_stations;
-    config.identify_poses = args.identify_poses;
-    config.n_validate = args.validate_stations;
-    config.validate_poses = args.validate_poses;
-    if let Some(size) = args.box_size {
-        config.stations = StationLayout::Box { size };
-    }
-    if let Some(path) = &args.stations {
-        config.stations = read_stations(path)?;
-    }
-    config.cut_angle = args.angle;
-    config.cone_angle = args.cone;
-    config.candidates = args.candidates;
-    config.seed = args.seed;
-    config.selection = if args.random {
-        Selection::Random
-    } else {
-        Selection::DOptimal
-    };
-    Ok(config)
+    request(args)?
+        .config()
+        .map_err(|e| CliError::input(e.to_string()))
 }
 
 fn plan_error(e: &PlanError) -> CliError {
@@ -385,6 +304,7 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
     use super::*;
+    use crate::engine::plan::StationLayout;
     use clap::Parser;
 
     #[derive(Debug, Parser)]

@@ -256,9 +256,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
                 .map(|p| p.robot)
                 .ok_or_else(|| anyhow::anyhow!("unknown robot {}", config.robot.key()))?;
             let hand_eye = match &args.hand_eye {
-                Some(he) => {
-                    super::plan::read_hand_eye(he).map_err(|e| anyhow::anyhow!(e.message))?
-                }
+                Some(he) => plan::read_hand_eye(he).map_err(|e| anyhow::anyhow!(e.to_string()))?,
                 None => sensor::paper_hand_eye(),
             };
             let execution = if args.touch_up {

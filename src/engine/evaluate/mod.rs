@@ -5,6 +5,8 @@
 //! data. Used by the accuracy tests, the `simulate` summary and the
 //! method comparison of the README.
 
+pub mod study;
+
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use crate::engine::robot::Robot;

@@ -7,9 +7,10 @@
 use nalgebra::{Cholesky, DMatrix, Dyn, Matrix3};
 use rand_chacha::ChaCha8Rng;
 
-use super::{Candidate, Planner, Site, joint_gap, side_quota, unknown_scale};
+use super::{Candidate, Planner, Site, joint_gap, side_quota};
 use crate::engine::robot::Robot;
 use crate::engine::solve::estimate::unknown_is_angle;
+use crate::engine::solve::estimate::unknown_scale;
 use crate::engine::solve::ml::MlOptions;
 
 /// Weak prior σ of the hand-eye translation in the criterion, mm: only

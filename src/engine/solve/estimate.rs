@@ -98,6 +98,17 @@ pub fn unknown_is_angle(k: usize) -> bool {
     }
 }
 
+/// Scale of `ΔY` unknown `k` in a solve: angles in mm of motion at
+/// [`ANGLE_SCALE_MM`] mm, lengths as they are (scaled = raw × scale).
+#[must_use]
+pub fn unknown_scale(k: usize) -> f64 {
+    if unknown_is_angle(k) {
+        ANGLE_SCALE_MM
+    } else {
+        1.0
+    }
+}
+
 /// The 3 × (6 + 5n) sensitivity `A_i` of one sighting's base-frame centre
 /// to `ΔY` (the bracket of eq. 17 for one measurement), and the centre.
 #[must_use]

@@ -22,7 +22,7 @@ use super::{Options, SolveError, Step, StopReason, Update};
 use crate::engine::numeric::as_written;
 
 use super::estimate::{
-    ANGLE_SCALE_MM, Estimate, Station, sensitivity, unknown_is_angle, unknown_label,
+    ANGLE_SCALE_MM, Estimate, Station, sensitivity, unknown_label, unknown_scale,
 };
 
 /// Default relative SVD tolerance: singular values below this fraction of
@@ -157,15 +157,7 @@ pub fn paper_update(
         v.fixed_rows_mut::<3>(3 * k).copy_from(bv);
     }
     // Column scaling: unknown_scaled = scale · unknown.
-    let scale: Vec<f64> = (0..n_unknowns)
-        .map(|k| {
-            if unknown_is_angle(k) {
-                ANGLE_SCALE_MM
-            } else {
-                1.0
-            }
-        })
-        .collect();
+    let scale: Vec<f64> = (0..n_unknowns).map(unknown_scale).collect();
     for (c, s) in scale.iter().enumerate() {
         u.column_mut(c).scale_mut(1.0 / s);
     }

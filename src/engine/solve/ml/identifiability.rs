@@ -8,9 +8,10 @@ use std::fmt;
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use super::problem::{Obs, unknown_scale};
+use super::problem::Obs;
 use crate::engine::handeye::Sighting;
 use crate::engine::numeric::as_written;
+use crate::engine::solve::estimate::unknown_scale;
 use crate::engine::solve::estimate::{Estimate, sensitivity, unknown_is_angle, unknown_label};
 
 /// Default relative pivot tolerance of the identifiability QR: exact

@@ -79,6 +79,7 @@ pub mod report;
 
 use nalgebra::Vector3;
 
+use super::estimate::unknown_scale;
 use super::estimate::{Estimate, Station};
 use super::prepare::Prepared;
 use super::{Options, SolveError, SolverReport, Step, StopReason, Update};
@@ -92,7 +93,7 @@ use noise::{
     base_covariance, chi3_quantile, sensor_covariance, whitening,
 };
 use prior::{DEFAULT_PRIOR_ANGLE_DEG, DEFAULT_PRIOR_LENGTH_MM, chart_prior};
-use problem::{LAMBDA_START, Obs, Problem, State, unknown_scale};
+use problem::{LAMBDA_START, Obs, Problem, State};
 pub use report::{
     CrossStation, CrossValidation, DistanceStd, IterationRecord, LabelledMatrix, MlReport,
     OutlierRecord, ParameterRecord,

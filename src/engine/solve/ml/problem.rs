@@ -10,7 +10,7 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use super::noise::Loss;
 use super::report::{CrossStation, CrossValidation};
 use crate::engine::handeye::Sighting;
-use crate::engine::solve::estimate::{ANGLE_SCALE_MM, Estimate, sensitivity, unknown_is_angle};
+use crate::engine::solve::estimate::{Estimate, sensitivity};
 
 /// Marquardt's starting damping (relative to `diag(JᵀJ)`): small, because
 /// the nominal model is close enough for Gauss-Newton steps.
@@ -114,15 +114,6 @@ pub(super) struct Problem {
     pub(super) n_unknowns: usize,
     pub(super) loss: Loss,
     pub(super) loss_scale: f64,
-}
-
-/// Scale of ΔY unknown `k`: angles in mm of motion at 1 m.
-pub(super) fn unknown_scale(k: usize) -> f64 {
-    if unknown_is_angle(k) {
-        ANGLE_SCALE_MM
-    } else {
-        1.0
-    }
 }
 
 impl Problem {

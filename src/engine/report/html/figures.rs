@@ -1,0 +1,292 @@
+//! The report's figures: the paper's Fig. 5 and 6, ε per update and the
+//! singular values, as inline SVG.
+
+use std::fmt::Write as _;
+
+use super::*;
+use crate::engine::report::svg::{self, Band, Marker, Plot, Rule, Series, escape};
+use crate::engine::result_view::PairDistance;
+
+/// Width of a full-width figure, px (the page is about 930 px wide).
+pub(super) const WIDE: f64 = 920.0;
+
+/// Width of a half-width figure, px.
+pub(super) const HALF: f64 = 450.0;
+
+/// Height of every figure, px.
+pub(super) const FIG_HEIGHT: f64 = 300.0;
+
+pub(super) fn before_after_series(before: Vec<[f64; 2]>, after: Vec<[f64; 2]>) -> Vec<Series> {
+    vec![
+        Series {
+            name: "before (nominal model, initial hand-eye)".into(),
+            colour: BEFORE_COLOUR.into(),
+            points: before,
+            marker: Marker::Square,
+            line: true,
+        },
+        Series {
+            name: "after (calibrated)".into(),
+            colour: AFTER_COLOUR.into(),
+            points: after,
+            marker: Marker::Circle,
+            line: true,
+        },
+    ]
+}
+
+/// Consecutive runs of equal labels over 1-based positions, as bands.
+pub(super) fn bands(labels: impl Iterator<Item = String>) -> Vec<Band> {
+    let mut out: Vec<Band> = Vec::new();
+    for (k, label) in labels.enumerate() {
+        let x = (k + 1) as f64;
+        match out.last_mut() {
+            Some(b) if b.label == label => b.to = x + 0.5,
+            _ => out.push(Band {
+                from: x - 0.5,
+                to: x + 0.5,
+                label,
+            }),
+        }
+    }
+    out
+}
+
+pub(super) fn figure(h: &mut String, id: &str, svg: &str, caption: &str) {
+    let _ = writeln!(
+        h,
+        "<figure id=\"{id}\">{svg}<figcaption>{}</figcaption></figure>",
+        escape(caption)
+    );
+}
+
+pub(super) fn figures(h: &mut String, ctx: &Ctx<'_>) {
+    let r = ctx.result();
+    section(h, "figures", "Before and after (cf. paper Fig. 5 and 6)");
+    // Fig. 5.
+    if ctx.within.is_empty() {
+        h.push_str(
+            "<p id=\"fig5\">No station has two measurements: no within-station distances.</p>\n",
+        );
+    } else {
+        let pts = |f: fn(&PairDistance) -> f64| -> Vec<[f64; 2]> {
+            ctx.within
+                .iter()
+                .enumerate()
+                .map(|(k, p)| [(k + 1) as f64, f(p)])
+                .collect()
+        };
+        let plot = Plot {
+            title: format!(
+                "Centre distances within {} stations, per pair, before and after",
+                ctx.within_of
+            ),
+            x_label: "pair (station by station)".into(),
+            y_label: "centre distance (mm)".into(),
+            series: before_after_series(pts(|p| p.before), pts(|p| p.after)),
+            bands: bands(ctx.within.iter().map(|p| p.station.clone())),
+            include_zero: true,
+            x_integer: true,
+            width: WIDE,
+            height: FIG_HEIGHT,
+            ..Plot::default()
+        };
+        let stations = bands(ctx.within.iter().map(|p| p.station.clone())).len();
+        figure(
+            h,
+            "fig5",
+            &svg::render(&plot),
+            &format!(
+                "Fig. 5 (after the paper's): distances between the sphere centres of the {} pairs of measurements within each of the {stations} {} station(s); the sphere did not move, so the true value is 0 mm.",
+                ctx.within.len(),
+                ctx.within_of
+            ),
+        );
+    }
+    // Fig. 6.
+    let distances = r
+        .validation
+        .as_ref()
+        .map(|v| v.distances.as_slice())
+        .unwrap_or_default();
+    if distances.is_empty() {
+        let why = if r.validation.is_some() {
+            "The session has no reference distances"
+        } else {
+            "The session has no validate measurements"
+        };
+        let _ = writeln!(
+            h,
+            "<p id=\"fig6\" class=\"warn\">{why}: no Fig. 6 (reference-distance errors).</p>"
+        );
+    } else {
+        let pts = |f: fn(&crate::engine::validate::DistanceRecord) -> f64| -> Vec<[f64; 2]> {
+            distances
+                .iter()
+                .enumerate()
+                .map(|(k, d)| [(k + 1) as f64, f(d)])
+                .collect()
+        };
+        let plot = Plot {
+            title: "Reference-distance errors, measured − reference, before and after".into(),
+            x_label: "distance (reference pair, pose by pose)".into(),
+            y_label: "error (mm)".into(),
+            series: before_after_series(
+                pts(crate::engine::validate::DistanceRecord::error_before),
+                pts(crate::engine::validate::DistanceRecord::error_after),
+            ),
+            rules: vec![Rule {
+                y: 0.0,
+                colour: svg::MUTED.into(),
+                dashed: false,
+                label: String::new(),
+            }],
+            bands: bands(distances.iter().map(|d| format!("{}→{}", d.from, d.to))),
+            include_zero: true,
+            x_integer: true,
+            width: WIDE,
+            height: FIG_HEIGHT,
+            ..Plot::default()
+        };
+        figure(
+            h,
+            "fig6",
+            &svg::render(&plot),
+            &format!(
+                "Fig. 6 (after the paper's): error of each of the {} distances between validate centres against its reference distance (e.g. a laser tracker's), measured − reference.",
+                distances.len()
+            ),
+        );
+    }
+    // ε, and the singular values of the paper's method.
+    h.push_str("<div class=\"grid2\">\n");
+    let eps: Vec<[f64; 2]> = r
+        .iterations
+        .iter()
+        .enumerate()
+        .map(|(k, i)| [k as f64, i.epsilon])
+        .collect();
+    let threshold = ctx.solver().threshold();
+    let plot = Plot {
+        title: "ε per update".into(),
+        x_label: "update".into(),
+        y_label: "ε (mm, log scale)".into(),
+        series: vec![Series {
+            name: "ε".into(),
+            colour: AFTER_COLOUR.into(),
+            points: eps,
+            marker: Marker::Circle,
+            line: true,
+        }],
+        rules: threshold
+            .filter(|t| *t > 0.0)
+            .map(|t| Rule {
+                y: t,
+                colour: BEFORE_COLOUR.into(),
+                dashed: true,
+                label: format!("threshold {t} mm"),
+            })
+            .into_iter()
+            .collect(),
+        y_log: true,
+        x_integer: true,
+        width: HALF,
+        height: FIG_HEIGHT,
+        ..Plot::default()
+    };
+    figure(
+        h,
+        "epsilon",
+        &svg::render(&plot),
+        &format!(
+            "ε (paper eq. 20, pooled over the identify stations) after each update: {} → {} mm.",
+            num(r.epsilon_before, 4),
+            num(r.epsilon_after, 4)
+        ),
+    );
+    singular_values(h, ctx);
+    h.push_str("</div>\n");
+    end_section(h);
+}
+
+pub(super) fn singular_values(h: &mut String, ctx: &Ctx<'_>) {
+    let paper = ctx.solver().paper();
+    let values: Vec<f64> = paper
+        .and_then(|p| p.singular_values.clone())
+        .unwrap_or_default();
+    if values.is_empty() {
+        let what = if ctx.ml.is_some() {
+            "The ml method has no SVD truncation: its identifiable set is listed under Identifiability."
+        } else {
+            "No singular values in the result (no update was made)."
+        };
+        let _ = writeln!(
+            h,
+            "<figure id=\"singular\"><p class=\"muted\">{what}</p></figure>"
+        );
+        return;
+    }
+    let smax = values.iter().copied().fold(0.0, f64::max);
+    let kept = paper
+        .and_then(|p| p.kept_directions)
+        .unwrap_or(values.len());
+    let cut = paper.and_then(|p| p.svd_tolerance).map(|t| t * smax);
+    let pts = |keep: bool| -> Vec<[f64; 2]> {
+        values
+            .iter()
+            .enumerate()
+            .filter(|(k, v)| (*k < kept) == keep && **v > 0.0)
+            .map(|(k, v)| [(k + 1) as f64, *v])
+            .collect()
+    };
+    let zeros = values.iter().filter(|v| **v <= 0.0).count();
+    let plot = Plot {
+        title: "Singular values of the last update".into(),
+        x_label: "index".into(),
+        y_label: "singular value (log scale)".into(),
+        series: vec![
+            Series {
+                name: "kept".into(),
+                colour: AFTER_COLOUR.into(),
+                points: pts(true),
+                marker: Marker::Circle,
+                line: false,
+            },
+            Series {
+                name: "dropped".into(),
+                colour: BAD_COLOUR.into(),
+                points: pts(false),
+                marker: Marker::Cross,
+                line: false,
+            },
+        ],
+        rules: cut
+            .map(|c| Rule {
+                y: c,
+                colour: BEFORE_COLOUR.into(),
+                dashed: true,
+                label: "truncation".into(),
+            })
+            .into_iter()
+            .collect(),
+        y_log: true,
+        x_integer: true,
+        width: HALF,
+        height: FIG_HEIGHT,
+        ..Plot::default()
+    };
+    let zero_note = if zeros > 0 {
+        format!(" {zeros} singular value(s) are 0 and not drawn.")
+    } else {
+        String::new()
+    };
+    figure(
+        h,
+        "singular",
+        &svg::render(&plot),
+        &format!(
+            "Singular values of the paper's method's last update (scaled): kept {kept} of {}, truncated below tolerance × σ_max.{zero_note}",
+            values.len()
+        ),
+    );
+}
