@@ -11,7 +11,8 @@ use std::time::Duration;
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
-use spherecal::app::state::{Prefs, Tab};
+use spherecal::app::forms::Tab;
+use spherecal::app::state::Prefs;
 use spherecal::engine::format::parse_session;
 use spherecal::engine::report::model::{self, ModelFormat};
 use spherecal::engine::solve::{Method, Options, calibrate};
@@ -296,10 +297,12 @@ fn left_out_measurements_are_saved_and_a_bad_exclusion_is_refused() {
     {
         h.state_mut().command(
             &ctx,
-            spherecal::app::commands::Command::SetIncluded {
-                id: m.id.clone(),
-                included: false,
-            },
+            spherecal::app::commands::Command::View(
+                spherecal::app::commands::ViewCommand::SetIncluded {
+                    id: m.id.clone(),
+                    included: false,
+                },
+            ),
         );
     }
     let other = dir.path().join("broken.json");

@@ -1,14 +1,35 @@
-//! What the panels ask the workbench to do. A `*_ui` function reads the
-//! state, draws, and pushes [`Command`]s; the workbench applies them after
-//! the frame's drawing (rerun's `SystemCommand`).
+//! What the panels ask the workbench to do, by feature. A `*_ui` function
+//! reads the state, draws, and pushes [`Command`]s; the workbench hands
+//! each to its feature's handler after the frame's drawing (rerun's
+//! `SystemCommand`).
 
 use std::path::PathBuf;
 
-use super::state::{DialogPurpose, ExportKind, PlanExport, Tab};
+use super::forms::Tab;
+use super::state::{DialogPurpose, ExportKind, PlanExport};
 
-/// A request from the UI.
+/// A request from the UI, by the feature that handles it.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
+    /// Opening and saving files.
+    Files(FilesCommand),
+    /// The session on show: views, selection, measurements left out.
+    View(ViewCommand),
+    /// The calibration run.
+    Run(RunCommand),
+    /// Write one export file of the result into the export folder.
+    Export(ExportKind),
+    /// The import wizard.
+    Import(ImportCommand),
+    /// The library of past results.
+    History(HistoryCommand),
+    /// The pose planner.
+    Plan(PlanCommand),
+}
+
+/// Opening and saving files.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FilesCommand {
     /// Open the embedded demo session.
     OpenDemo,
     /// Open a file: a session, or a result to review (told apart by its
@@ -16,6 +37,16 @@ pub enum Command {
     OpenPath(PathBuf),
     /// Show a native file dialog (on a background thread).
     Browse(DialogPurpose),
+    /// Write the session without the left-out measurements to the path
+    /// field's file (atomic; asks before overwriting).
+    SaveSession,
+    /// Empty the recent-files list.
+    ClearRecent,
+}
+
+/// The session on show.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ViewCommand {
     /// Switch the central view.
     ShowTab(Tab),
     /// Select a measurement (index into the session's measurements).
@@ -40,37 +71,50 @@ pub enum Command {
     },
     /// Use every measurement again.
     IncludeAll,
-    /// Write the session without the left-out measurements to the path
-    /// field's file (atomic; asks before overwriting).
-    SaveSession,
-    /// Start the solver with the form's settings.
-    Run,
-    /// Ask a running solver to stop.
-    Cancel,
-    /// Write one export file into the export folder.
-    Export(ExportKind),
     /// Close the error notice.
     DismissNotice,
-    /// Empty the recent-files list.
-    ClearRecent,
+}
+
+/// The calibration run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunCommand {
+    /// Start the solver with the form's settings.
+    Start,
+    /// Ask a running solver to stop.
+    Cancel,
+}
+
+/// The import wizard.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImportCommand {
     /// Read the joint log's header, guess the mapping and preview the
     /// first rows.
-    ImportPreview {
+    Preview {
         /// Overwrite the mapping fields with the guesses from the header.
         guess: bool,
     },
     /// Build the session from the import form and open it.
-    ImportRun,
+    Run,
+}
+
+/// The library of past results.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HistoryCommand {
     /// Scan the History form's folder.
-    HistoryScan,
+    Scan,
     /// Recompute the drift after the robot, the ticks or `k` changed.
-    HistoryDrift,
+    Drift,
+}
+
+/// The pose planner.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlanCommand {
     /// Make a plan with the Plan form's settings (and predict it).
-    PlanMake,
+    Make,
     /// Stop the planning job.
-    PlanCancel,
+    Cancel,
     /// Write the plan into the export folder.
-    PlanExport(PlanExport),
+    Export(PlanExport),
     /// Simulate a session of the plan and open it.
-    PlanSimulate,
+    Simulate,
 }

@@ -12,10 +12,10 @@ use crate::engine::history::Library;
 use crate::engine::import::PoseCheck;
 use crate::engine::solve::Progress;
 
-use super::planner::PlanEvent;
-use super::state::{DialogPurpose, ExportKind, LoadedSession, PlanExport};
+use super::error::JobError;
+use super::forms::ImportForm;
+use super::state::{DialogPurpose, ExportKind, LoadedSession, PlanExport, PlanOutcome};
 use super::view::ResultView;
-use super::wizard::ImportForm;
 
 /// Messages a job may have in flight before it waits for the UI to drain
 /// them: far more than a run's ε reports (one per update), so the solver
@@ -23,17 +23,34 @@ use super::wizard::ImportForm;
 pub const CHANNEL_BOUND: usize = 256;
 
 /// Why a run gave no result.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug)]
 pub enum RunFailure {
     /// Cancel was pressed; the solver stopped after this many updates.
     Cancelled(usize),
-    /// The session or the solver failed: the engine's message.
-    Failed(String),
+    /// The session or the solver failed.
+    Failed(JobError),
 }
 
-/// What a job reports.
+/// What a job reports, by the feature that started it.
 #[derive(Debug)]
 pub enum JobMessage {
+    /// Opening and saving files.
+    Files(FilesMessage),
+    /// The calibration run.
+    Run(RunMessage),
+    /// The result's exports.
+    Export(ExportMessage),
+    /// The import wizard.
+    Import(ImportMessage),
+    /// The library of past results.
+    History(HistoryMessage),
+    /// The pose planner.
+    Plan(PlanMessage),
+}
+
+/// What the file jobs report.
+#[derive(Debug)]
+pub enum FilesMessage {
     /// A session file (or the demo) was read and its stripes fitted.
     SessionLoaded(Box<LoadedSession>),
     /// A result file was read for review.
@@ -44,11 +61,12 @@ pub enum JobMessage {
         view: Box<ResultView>,
     },
     /// A file could not be opened.
-    LoadFailed(LoadFailure),
-    /// The solver computed another ε.
-    Progress(Progress),
-    /// The run ended.
-    RunFinished(Result<Box<ResultView>, RunFailure>),
+    LoadFailed {
+        /// The file (or the demo's name).
+        what: String,
+        /// Why, naming file and measurement.
+        error: JobError,
+    },
     /// A file dialog closed; `None` when it chose nothing or could not open.
     Dialog {
         /// What it was for.
@@ -62,50 +80,49 @@ pub enum JobMessage {
         /// Target file.
         path: PathBuf,
         /// Measurements written, or why not.
-        outcome: Result<usize, String>,
+        outcome: Result<usize, JobError>,
     },
+}
+
+/// What the solver job reports.
+#[derive(Debug)]
+pub enum RunMessage {
+    /// The solver computed another ε.
+    Progress(Progress),
+    /// The run ended.
+    Finished(Result<Box<ResultView>, RunFailure>),
+}
+
+/// What the export jobs report.
+#[derive(Debug)]
+pub enum ExportMessage {
     /// The window's pixels for a plots PNG arrived.
     Screenshot(Arc<egui::ColorImage>),
-    /// The import wizard's joint log was read: its header and the preview.
-    ImportPreviewed {
-        /// The header, empty when it could not be read.
-        header: Vec<String>,
-        /// The form with the mapping guessed from the header, when asked.
-        guessed: Option<Box<ImportForm>>,
-        /// The mapped rows, or the engine's message.
-        preview: Result<String, String>,
-    },
-    /// The import wizard built a session, or why not.
-    Imported(Result<Imported, String>),
-    /// The planning job's progress or result.
-    Plan(PlanEvent),
-    /// A plan file was written, or why not.
-    PlanWritten {
-        /// What was written.
-        kind: PlanExport,
-        /// Target file.
-        path: PathBuf,
-        /// Success or the error message.
-        outcome: Result<(), String>,
-    },
-    /// A session simulated from the plan, or why not.
-    PlanSimulated(Result<Box<LoadedSession>, String>),
-    /// A library folder was scanned, or why not.
-    Scanned {
-        /// The folder.
-        folder: PathBuf,
-        /// The library or the engine's message.
-        outcome: Result<Box<Library>, String>,
-    },
     /// An export file was written, or why not.
-    Exported {
+    Written {
         /// What was exported.
         kind: ExportKind,
         /// Target file.
         path: PathBuf,
-        /// Success or the error message.
-        outcome: Result<(), String>,
+        /// Success or why not.
+        outcome: Result<(), JobError>,
     },
+}
+
+/// What the import jobs report.
+#[derive(Debug)]
+pub enum ImportMessage {
+    /// The joint log was read: its header and the preview.
+    Previewed {
+        /// The header, empty when it could not be read.
+        header: Vec<String>,
+        /// The form with the mapping guessed from the header, when asked.
+        guessed: Option<Box<ImportForm>>,
+        /// The mapped rows, or why not.
+        preview: Result<String, JobError>,
+    },
+    /// The import built a session, or why not.
+    Imported(Result<Imported, JobError>),
 }
 
 /// The outcome of an import job.
@@ -117,13 +134,36 @@ pub struct Imported {
     pub checks: Vec<PoseCheck>,
 }
 
-/// A file that could not be opened: which, and the engine's message.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct LoadFailure {
-    /// The file (or the demo's name).
-    pub what: String,
-    /// The message, naming file and measurement.
-    pub message: String,
+/// What the history jobs report.
+#[derive(Debug)]
+pub enum HistoryMessage {
+    /// A library folder was scanned, or why not.
+    Scanned {
+        /// The folder.
+        folder: PathBuf,
+        /// The library.
+        outcome: Result<Box<Library>, JobError>,
+    },
+}
+
+/// What the planning jobs report.
+#[derive(Debug)]
+pub enum PlanMessage {
+    /// A stage of the planner, or a finished prediction run, in words.
+    Progress(String),
+    /// The plan, and its prediction when one was asked for.
+    Finished(Result<PlanOutcome, JobError>),
+    /// A plan file was written, or why not.
+    Written {
+        /// What was written.
+        kind: PlanExport,
+        /// Target file.
+        path: PathBuf,
+        /// Success or why not.
+        outcome: Result<(), JobError>,
+    },
+    /// A session simulated from the plan, or why not.
+    Simulated(Result<Box<LoadedSession>, JobError>),
 }
 
 /// The sending end handed to a job.
@@ -169,19 +209,18 @@ impl Jobs {
     /// Runs `work` on a new thread named `spherecal-<name>`.
     ///
     /// # Errors
-    /// The thread could not be started (the message says so).
+    /// The thread could not be started.
     pub fn spawn(
         &self,
         name: &str,
         ctx: &egui::Context,
         work: impl FnOnce(&Reporter) + Send + 'static,
-    ) -> Result<(), String> {
+    ) -> std::io::Result<()> {
         let reporter = self.reporter(ctx);
         std::thread::Builder::new()
             .name(format!("spherecal-{name}"))
             .spawn(move || work(&reporter))
             .map(|_| ())
-            .map_err(|e| format!("could not start the {name} thread: {e}"))
     }
 
     /// Every message waiting now, oldest first (never blocks).

@@ -2,34 +2,39 @@
 //! loading a session to exporting the result. It calls the same engine
 //! functions as the command line; nothing here computes a calibration.
 //!
-//! Layout of the code (STYLE.md habit 5):
+//! Layout of the code (STYLE.md habit 5), each unit using only those
+//! above it:
 //!
-//! - [`state`]: what the app knows ([`state::AppState`], changed only by
-//!   commands and job messages) and the form fields widgets edit;
-//! - [`commands`]: what the panels ask for;
-//! - [`workbench`]: applies commands, starts jobs, drains their messages;
-//! - [`jobs`] and [`work`]: named background threads and the engine calls
-//!   they make (load and fit, solve, save, export);
 //! - [`view`]: view models built from engine outputs (a run and a reviewed
 //!   result file both go through the FORMAT.md result);
-//! - [`export`]: the export files;
-//! - [`wizard`]: the import wizard's form and the engine spec it builds;
-//! - [`planner`]: the Plan view's form and the planning job;
-//! - [`panels`]: one module per panel or view, each a `*_ui` function.
+//! - [`forms`]: the fields widgets edit in place, with the import wizard's
+//!   and the planner's forms and the engine requests they build;
+//! - [`state`]: what the app knows ([`state::AppState`], changed only by
+//!   commands and job messages);
+//! - [`commands`]: what the panels ask for, by feature;
+//! - [`error`]: why a job failed ([`error::JobError`], the engine's error
+//!   as its source);
+//! - [`jobs`]: named background threads and the messages they send, by
+//!   feature;
+//! - [`features`]: one module per feature (files, view, run, export,
+//!   import, history, plan), each with its command handler, its message
+//!   handler and the engine calls its jobs make;
+//! - [`panels`]: one module per panel or view, each a `*_ui` function
+//!   that reads the state, edits the forms and pushes commands;
+//! - [`workbench`]: the frame loop that ties them together.
 //!
 //! Layout of the window, for an operator at 1366×768: the load and solver
 //! panel on the left, the Session, Stripe, Centres and Results views in the
 //! middle, a status bar at the bottom.
 
 pub mod commands;
-pub mod export;
+pub mod error;
+pub mod features;
+pub mod forms;
 pub mod jobs;
 pub mod panels;
-pub mod planner;
 pub mod state;
 pub mod view;
-pub mod wizard;
-pub mod work;
 pub mod workbench;
 
 use std::path::PathBuf;

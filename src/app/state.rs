@@ -1,7 +1,8 @@
 //! What the workbench knows: the loaded session with its per-measurement
-//! fits, the run in progress, the result on show and the messages for the
-//! operator ([`AppState`], changed only by commands and job messages), and
-//! the form fields the widgets edit directly ([`Forms`]).
+//! fits, the run in progress, the result on show, what each view shows and
+//! the messages for the operator ([`AppState`], changed only by commands
+//! and job messages). The fields widgets edit are in
+//! [`forms`](super::forms).
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -11,18 +12,21 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::engine::session::{Session, Use};
-use crate::engine::solve::paper::{DEFAULT_SVD_TOLERANCE, Pairing, PaperOptions};
-use crate::engine::solve::{Analysis, Method, Options};
+use crate::engine::history::{Drift, Library};
+use crate::engine::import::PoseCheck;
+use crate::engine::plan::{Plan, PlanError, Prediction};
+use crate::engine::session::Session;
+use crate::engine::solve::{Analysis, SolveError};
 use crate::engine::stripe::{StripeError, StripeResult};
 
-use super::planner::{PlanForm, PlanOutcome};
+use super::forms::{Forms, Grouping};
 use super::view::{CentreSet, ResultView};
-use super::wizard::{ImportForm, ImportView};
-use crate::engine::history::{DEFAULT_K, Drift, Library};
 
 /// How many recent files the start list keeps.
 pub const RECENT_MAX: usize = 8;
+
+/// What the status line says when a file dialog returned nothing.
+pub const NO_DIALOG: &str = "no file chosen — or no file dialog is available on this machine (no desktop portal); type the path instead";
 
 /// Where a session came from.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -122,7 +126,7 @@ pub struct LoadedSession {
     /// Sphere centres in the base frame with the nominal model and the
     /// initial hand-eye, or why they cannot be computed (a failed stripe, a
     /// pose set that does not determine the hand-eye).
-    pub before: Result<CentreSet, String>,
+    pub before: Result<CentreSet, SolveError>,
 }
 
 impl LoadedSession {
@@ -155,62 +159,6 @@ impl LoadedSession {
             }
         }
         out
-    }
-}
-
-/// The solver settings as the form edits them.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SolverForm {
-    /// Identification method.
-    pub method: Method,
-    /// Pairing of a station's measurements (paper's method).
-    pub pairing: Pairing,
-    /// Stop when ε ≤ this, mm.
-    pub threshold: f64,
-    /// Most updates.
-    pub max_iterations: usize,
-    /// Relative SVD truncation tolerance (fraction of σ_max).
-    pub svd_tolerance: f64,
-}
-
-impl Default for SolverForm {
-    fn default() -> Self {
-        Self {
-            method: Method::ALL[0],
-            pairing: Pairing::Disjoint,
-            threshold: crate::engine::session::DEFAULT_THRESHOLD,
-            max_iterations: crate::engine::session::DEFAULT_MAX_ITERATIONS,
-            svd_tolerance: DEFAULT_SVD_TOLERANCE,
-        }
-    }
-}
-
-impl SolverForm {
-    /// The session's settings (threshold and iteration bound from its file).
-    #[must_use]
-    pub fn from_session(session: &Session) -> Self {
-        let o = Options::from_session(session);
-        Self {
-            method: o.method,
-            pairing: o.paper.pairing,
-            threshold: o.threshold,
-            max_iterations: o.max_iterations,
-            svd_tolerance: o.paper.svd_tolerance,
-        }
-    }
-
-    /// The engine options these settings stand for.
-    #[must_use]
-    pub fn options(&self, session: &Session) -> Options {
-        let mut o = Options::from_session(session);
-        o.method = self.method;
-        o.threshold = self.threshold;
-        o.max_iterations = self.max_iterations;
-        o.paper = PaperOptions {
-            pairing: self.pairing,
-            svd_tolerance: self.svd_tolerance,
-        };
-        o
     }
 }
 
@@ -376,174 +324,26 @@ impl ExportKind {
     }
 }
 
-/// The central views.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Tab {
-    /// The measurement table.
-    Session,
-    /// One stripe and its circle.
-    Stripe,
-    /// Sphere centres in the base frame.
-    Centres,
-    /// Plots and tables of a result.
-    Results,
-    /// The import wizard: joint log and profiles to a session.
-    Import,
-    /// The library of past results and the drift of one robot.
-    History,
-    /// The pose planner.
-    Plan,
+/// A finished plan.
+#[derive(Debug, Clone)]
+pub struct PlanOutcome {
+    /// The plan.
+    pub plan: Box<Plan>,
+    /// The predicted accuracy, when asked for, or why it failed.
+    pub prediction: Option<Result<Prediction, PlanError>>,
 }
 
-impl Tab {
-    /// All tabs, in display order.
-    pub const ALL: [Self; 7] = [
-        Self::Session,
-        Self::Stripe,
-        Self::Centres,
-        Self::Results,
-        Self::Plan,
-        Self::Import,
-        Self::History,
-    ];
-
-    /// The tab's title.
-    #[must_use]
-    pub fn label(self) -> &'static str {
-        match self {
-            Self::Session => "Session",
-            Self::Stripe => "Stripe",
-            Self::Centres => "Centres",
-            Self::Results => "Results",
-            Self::Import => "Import",
-            Self::History => "History",
-            Self::Plan => "Plan",
-        }
-    }
-}
-
-/// How the session table groups its rows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Grouping {
-    /// File order.
-    None,
-    /// By station, stations in order of first appearance.
-    Station,
-    /// By use (translation, rotation, identify, validate).
-    Use,
-}
-
-impl Grouping {
-    /// All groupings.
-    pub const ALL: [Self; 3] = [Self::None, Self::Station, Self::Use];
-
-    /// Display text.
-    #[must_use]
-    pub fn label(self) -> &'static str {
-        match self {
-            Self::None => "file order",
-            Self::Station => "station",
-            Self::Use => "use",
-        }
-    }
-}
-
-/// The camera of the 3D centres view (orthographic, orbiting the centres).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Camera {
-    /// Rotation about the base z axis, rad.
-    pub yaw: f32,
-    /// Elevation above the base xy plane, rad.
-    pub pitch: f32,
-    /// Zoom factor (1 = fit all).
-    pub zoom: f32,
-}
-
-impl Default for Camera {
-    fn default() -> Self {
-        Self {
-            yaw: -0.6,
-            pitch: 0.5,
-            zoom: 1.0,
-        }
-    }
-}
-
-/// Display options of the centres view.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CentresForm {
-    /// Draw the centres before calibration.
-    pub show_before: bool,
-    /// Draw the centres after calibration.
-    pub show_after: bool,
-    /// Draw each centre's deviation from its station mean magnified by
-    /// `magnify`, placed at the station mean.
-    pub relative: bool,
-    /// Magnification of the deviations in relative mode.
-    pub magnify: f32,
-    /// The orbit camera.
-    pub camera: Camera,
-}
-
-impl Default for CentresForm {
-    fn default() -> Self {
-        Self {
-            show_before: true,
-            show_after: true,
-            relative: true,
-            magnify: 50.0,
-            camera: Camera::default(),
-        }
-    }
-}
-
-/// Fields the widgets edit in place: text fields, filters, settings of
-/// the next run, view options.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Forms {
-    /// The current tab.
-    pub tab: Tab,
-    /// The path field of the load panel.
-    pub open_path: String,
-    /// Where "Save as" writes the edited session.
-    pub save_path: String,
-    /// The export folder.
-    pub export_dir: String,
-    /// Session table: only this station.
-    pub filter_station: Option<String>,
-    /// Session table: only this use.
-    pub filter_use: Option<Use>,
-    /// Session table grouping.
-    pub group: Grouping,
-    /// Settings of the next run.
-    pub solver: SolverForm,
-    /// Centres view options.
-    pub centres: CentresForm,
-    /// The import wizard's fields.
-    pub import: ImportForm,
-    /// The History view's fields.
-    pub history: HistoryForm,
-    /// The Plan view's fields.
-    pub plan: PlanForm,
-}
-
-impl Default for Forms {
-    fn default() -> Self {
-        Self {
-            tab: Tab::Session,
-            open_path: String::new(),
-            save_path: String::new(),
-            export_dir: String::new(),
-            filter_station: None,
-            filter_use: None,
-            group: Grouping::None,
-            solver: SolverForm::default(),
-            centres: CentresForm::default(),
-            import: ImportForm::default(),
-            history: HistoryForm::default(),
-            plan: PlanForm::default(),
-        }
-    }
+/// What the wizard shows besides its form.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ImportView {
+    /// The joint log's header, once read.
+    pub header: Vec<String>,
+    /// The preview text (mapped rows), or why it failed.
+    pub preview: Option<Result<String, String>>,
+    /// The flange-pose checks of the last import.
+    pub checks: Vec<PoseCheck>,
+    /// The last import's outcome in one line, or its error.
+    pub outcome: Option<Result<String, String>>,
 }
 
 /// What the Plan view shows.
@@ -553,34 +353,10 @@ pub struct PlanView {
     pub progress: Option<String>,
     /// Set to stop the planning job; `Some` while it runs.
     pub cancel: Option<Arc<AtomicBool>>,
-    /// The last plan, or why planning failed.
+    /// The last plan, or why planning failed (the message).
     pub outcome: Option<Result<PlanOutcome, String>>,
     /// Plan files being written or a plan being simulated.
     pub writing: usize,
-}
-
-/// The History view's fields.
-#[derive(Debug, Clone, PartialEq)]
-pub struct HistoryForm {
-    /// The library folder.
-    pub folder: String,
-    /// The robot whose drift is shown.
-    pub robot: Option<String>,
-    /// Result files left out of the drift (unticked in the table).
-    pub unselected: BTreeSet<PathBuf>,
-    /// Flag a change beyond `k` combined σ.
-    pub k: f64,
-}
-
-impl Default for HistoryForm {
-    fn default() -> Self {
-        Self {
-            folder: String::new(),
-            robot: None,
-            unselected: BTreeSet::new(),
-            k: DEFAULT_K,
-        }
-    }
 }
 
 /// What the History view shows.

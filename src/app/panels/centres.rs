@@ -7,8 +7,9 @@ use egui::{Color32, Pos2, Rect, RichText, Sense, Stroke, Vec2};
 use egui_plot::{MarkerShape, Plot, PlotPoints, Points};
 
 use super::{AFTER, BEFORE, station_colour};
-use crate::app::commands::Command;
-use crate::app::state::{AppState, Camera, CentresForm, Forms};
+use crate::app::commands::{Command, ViewCommand};
+use crate::app::forms::{Camera, CentresForm, Forms};
+use crate::app::state::AppState;
 use crate::app::view::{CentrePoint, CentreSet};
 
 /// A click selects the nearest centre within this many points of the pointer.
@@ -66,7 +67,7 @@ pub fn centres_ui(
                 &mut forms.centres.camera,
                 selected,
             ) {
-                commands.push(Command::Select(i));
+                commands.push(Command::View(ViewCommand::Select(i)));
             }
         });
         ui.vertical(|ui| {
@@ -81,7 +82,7 @@ pub fn centres_ui(
             {
                 ui.label(RichText::new(name).small().weak());
                 if let Some(i) = projection_ui(ui, k, (a, b), h, &markers, set, selected) {
-                    commands.push(Command::Select(i));
+                    commands.push(Command::View(ViewCommand::Select(i)));
                 }
             }
         });

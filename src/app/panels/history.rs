@@ -8,8 +8,9 @@ use egui::RichText;
 use egui_plot::{Line, LineStyle, MarkerShape, Plot, PlotPoints, Points};
 
 use super::{AFTER, BAD, MUTED, WARN, labelled_field};
-use crate::app::commands::Command;
-use crate::app::state::{AppState, DialogPurpose, Forms};
+use crate::app::commands::{Command, FilesCommand, HistoryCommand};
+use crate::app::forms::Forms;
+use crate::app::state::{AppState, DialogPurpose};
 use crate::engine::history::{Drift, Entry, Library, Series, Verdict};
 
 /// Height of one drift plot, points.
@@ -46,7 +47,7 @@ pub fn history_ui(
                     .on_hover_text("choose the folder with the desktop's dialog")
                     .clicked()
                 {
-                    commands.push(Command::Browse(DialogPurpose::HistoryFolder));
+                    commands.push(Command::Files(FilesCommand::Browse(DialogPurpose::HistoryFolder)));
                 }
                 if ui
                     .add_enabled(!busy, egui::Button::new("Scan"))
@@ -54,7 +55,7 @@ pub fn history_ui(
                     .clicked()
                     || (entered && !busy)
                 {
-                    commands.push(Command::HistoryScan);
+                    commands.push(Command::History(HistoryCommand::Scan));
                 }
                 if busy {
                     ui.spinner();
@@ -156,7 +157,7 @@ fn library_ui(
     });
     changed |= table_ui(ui, library, forms);
     if changed {
-        commands.push(Command::HistoryDrift);
+        commands.push(Command::History(HistoryCommand::Drift));
     }
 }
 

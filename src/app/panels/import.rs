@@ -7,9 +7,10 @@
 use egui::RichText;
 
 use super::{BAD, WARN, labelled_field};
-use crate::app::commands::Command;
-use crate::app::state::{AppState, DialogPurpose, Forms};
-use crate::app::wizard::{CONVENTIONS, ImportForm, ProfilesKind};
+use crate::app::commands::{Command, FilesCommand, ImportCommand};
+use crate::app::forms::Forms;
+use crate::app::forms::import::{CONVENTIONS, ImportForm, ProfilesKind};
+use crate::app::state::{AppState, DialogPurpose};
 use crate::engine::import::{AngleUnit, LengthUnit};
 use crate::engine::robot;
 
@@ -52,14 +53,14 @@ pub fn import_ui(
                     .on_hover_text("read the header and show the first rows with this mapping")
                     .clicked()
                 {
-                    commands.push(Command::ImportPreview { guess: false });
+                    commands.push(Command::Import(ImportCommand::Preview { guess: false }));
                 }
                 if ui
                     .add_enabled(!busy, egui::Button::new("Guess mapping"))
                     .on_hover_text("fill the column names from the header where they are obvious")
                     .clicked()
                 {
-                    commands.push(Command::ImportPreview { guess: true });
+                    commands.push(Command::Import(ImportCommand::Preview { guess: true }));
                 }
                 let import = ui
                     .add_enabled(
@@ -68,7 +69,7 @@ pub fn import_ui(
                     )
                     .on_hover_text("build the session and open it (save it with Save as… afterwards)");
                 if import.clicked() {
-                    commands.push(Command::ImportRun);
+                    commands.push(Command::Import(ImportCommand::Run));
                 }
                 if state.busy.importing > 0 {
                     ui.spinner();
@@ -159,7 +160,7 @@ fn path_row(
         ))
         .clicked()
     {
-        commands.push(Command::Browse(purpose));
+        commands.push(Command::Files(FilesCommand::Browse(purpose)));
     }
     ui.end_row();
 }

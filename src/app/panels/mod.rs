@@ -14,8 +14,9 @@ pub mod stripe;
 
 use egui::{Color32, RichText};
 
-use super::commands::Command;
-use super::state::{AppState, Forms, Tab};
+use super::commands::{Command, ViewCommand};
+use super::forms::{Forms, Tab};
+use super::state::AppState;
 
 /// Colour of "before calibration" series (nominal model, initial hand-eye).
 pub const BEFORE: Color32 = Color32::from_rgb(230, 120, 40);
@@ -73,7 +74,7 @@ pub fn tabs_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mu
                 text = text.strong();
             }
             if ui.selectable_label(forms.tab == tab, text).clicked() {
-                commands.push(Command::ShowTab(tab));
+                commands.push(Command::View(ViewCommand::ShowTab(tab)));
             }
         }
         ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {

@@ -8,9 +8,9 @@ use egui::RichText;
 use egui_plot::{MarkerShape, Plot, PlotPoints, Points};
 
 use super::{AFTER, BAD, BEFORE, MUTED, labelled_field};
-use crate::app::commands::Command;
-use crate::app::planner::{PlanOutcome, default_sphere};
-use crate::app::state::{AppState, DialogPurpose, Forms, PlanExport};
+use crate::app::commands::{Command, FilesCommand, PlanCommand};
+use crate::app::forms::{Forms, plan::default_sphere};
+use crate::app::state::{AppState, DialogPurpose, PlanExport, PlanOutcome};
 use crate::engine::plan::{Plan, StationRole};
 use crate::engine::robot;
 use crate::engine::session::Use;
@@ -151,13 +151,13 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
             )
             .clicked()
         {
-            commands.push(Command::PlanMake);
+            commands.push(Command::Plan(PlanCommand::Make));
         }
         if ui
             .add_enabled(running, egui::Button::new("Cancel plan"))
             .clicked()
         {
-            commands.push(Command::PlanCancel);
+            commands.push(Command::Plan(PlanCommand::Cancel));
         }
         if running {
             ui.spinner();
@@ -285,7 +285,7 @@ fn outcome_ui(
             240.0,
         );
         if ui.button("Browse…").clicked() {
-            commands.push(Command::Browse(DialogPurpose::ExportFolder));
+            commands.push(Command::Files(FilesCommand::Browse(DialogPurpose::ExportFolder)));
         }
         for kind in [PlanExport::Csv, PlanExport::Rapid] {
             let hint = match kind {
@@ -297,7 +297,7 @@ fn outcome_ui(
                 .on_hover_text(hint)
                 .clicked()
             {
-                commands.push(Command::PlanExport(kind));
+                commands.push(Command::Plan(PlanCommand::Export(kind)));
             }
         }
         if ui
@@ -305,7 +305,7 @@ fn outcome_ui(
             .on_hover_text("a session of this plan on a simulated robot with kinematic errors, each pose touched up as when teaching: try the calibration before going to the cell")
             .clicked()
         {
-            commands.push(Command::PlanSimulate);
+            commands.push(Command::Plan(PlanCommand::Simulate));
         }
     });
     ui.separator();

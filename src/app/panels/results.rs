@@ -12,8 +12,9 @@ use egui_plot::{
 
 use super::side::epsilon_plot_ui;
 use super::{AFTER, BAD, BEFORE, MUTED, WARN, labelled_field, ratio_text};
-use crate::app::commands::Command;
-use crate::app::state::{AppState, DialogPurpose, ExportKind, Forms};
+use crate::app::commands::{Command, FilesCommand};
+use crate::app::forms::Forms;
+use crate::app::state::{AppState, DialogPurpose, ExportKind};
 use crate::app::view::{HandEyeView, ResultOrigin, ResultView};
 use crate::engine::geometry::{rows_from_isometry, wrap_deg};
 use crate::engine::robot::{PARAM_NAMES, PARAMS_PER_JOINT};
@@ -144,7 +145,9 @@ fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
             .on_hover_text("choose the folder with the desktop's dialog")
             .clicked()
         {
-            commands.push(Command::Browse(DialogPurpose::ExportFolder));
+            commands.push(Command::Files(FilesCommand::Browse(
+                DialogPurpose::ExportFolder,
+            )));
         }
         ui.separator();
         for kind in ExportKind::ALL {

@@ -6,8 +6,9 @@ use egui::{Color32, RichText};
 use egui_extras::{Column, TableBuilder};
 
 use super::{BAD, MUTED, WARN, labelled_field};
-use crate::app::commands::Command;
-use crate::app::state::{AppState, DialogPurpose, Fit, Forms, Grouping, LoadedSession};
+use crate::app::commands::{Command, FilesCommand, ViewCommand};
+use crate::app::forms::{Forms, Grouping};
+use crate::app::state::{AppState, DialogPurpose, Fit, LoadedSession};
 use crate::engine::session::Use;
 
 /// A row of the table: a group header or a measurement.
@@ -95,7 +96,7 @@ fn filters_ui(
             .on_hover_text("include every measurement again")
             .clicked()
         {
-            commands.push(Command::IncludeAll);
+            commands.push(Command::View(ViewCommand::IncludeAll));
         }
     });
 }
@@ -119,7 +120,9 @@ fn save_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
             .on_hover_text("choose the file with the desktop's dialog")
             .clicked()
         {
-            commands.push(Command::Browse(DialogPurpose::SaveSession));
+            commands.push(Command::Files(FilesCommand::Browse(
+                DialogPurpose::SaveSession,
+            )));
         }
         let label = if replace { "Replace" } else { "Save" };
         let save = ui
@@ -127,7 +130,7 @@ fn save_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
             .on_hover_text("write the session without the left-out measurements (atomic write)");
         let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
         if save.clicked() || entered {
-            commands.push(Command::SaveSession);
+            commands.push(Command::Files(FilesCommand::SaveSession));
         }
     });
 }
@@ -239,10 +242,10 @@ fn table_ui(
                                 .on_hover_text(format!("use every measurement of station {s}"))
                                 .changed()
                             {
-                                commands.push(Command::SetStationIncluded {
+                                commands.push(Command::View(ViewCommand::SetStationIncluded {
                                     station: s.clone(),
                                     included: v,
-                                });
+                                }));
                             }
                         }
                     });
@@ -259,9 +262,9 @@ fn table_ui(
                     item_row(&mut row, state, loaded, i, commands);
                     let r = row.response();
                     if r.double_clicked() {
-                        commands.push(Command::Inspect(i));
+                        commands.push(Command::View(ViewCommand::Inspect(i)));
                     } else if r.clicked() {
-                        commands.push(Command::Select(i));
+                        commands.push(Command::View(ViewCommand::Select(i)));
                     }
                 }
             });
@@ -291,10 +294,10 @@ fn item_row(
             .on_hover_text(format!("use measurement {} in the solver", m.id))
             .changed()
         {
-            commands.push(Command::SetIncluded {
+            commands.push(Command::View(ViewCommand::SetIncluded {
                 id: m.id.clone(),
                 included: v,
-            });
+            }));
         }
     });
     row.col(|ui| {

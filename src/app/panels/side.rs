@@ -9,9 +9,9 @@ use crate::engine::solve::Method;
 use crate::engine::solve::paper::Pairing;
 
 use super::{AFTER, BAD, BEFORE, labelled_field};
-use crate::app::commands::Command;
-use crate::app::state::{AppState, DialogPurpose, Forms};
-use crate::app::workbench::NO_DIALOG;
+use crate::app::commands::{Command, FilesCommand, RunCommand, ViewCommand};
+use crate::app::forms::Forms;
+use crate::app::state::{AppState, DialogPurpose, NO_DIALOG};
 
 /// The whole left panel.
 pub fn side_ui(
@@ -62,7 +62,7 @@ pub fn load_ui(
                 ui.label(RichText::new(&notice.title).strong().color(BAD));
                 ui.label(&notice.body);
                 if ui.button("Dismiss").clicked() {
-                    commands.push(Command::DismissNotice);
+                    commands.push(Command::View(ViewCommand::DismissNotice));
                 }
             });
     }
@@ -87,20 +87,22 @@ pub fn load_ui(
             .clicked()
             || entered
         {
-            commands.push(Command::OpenPath(forms.open_path.trim().into()));
+            commands.push(Command::Files(FilesCommand::OpenPath(
+                forms.open_path.trim().into(),
+            )));
         }
         let dialog = ui
             .add_enabled(!state.busy.dialog, egui::Button::new("Open…"))
             .on_hover_text("choose a file with the desktop's file dialog");
         if dialog.clicked() {
-            commands.push(Command::Browse(DialogPurpose::Open));
+            commands.push(Command::Files(FilesCommand::Browse(DialogPurpose::Open)));
         }
         if ui
             .button("Demo")
             .on_hover_text("the demo session built into the program")
             .clicked()
         {
-            commands.push(Command::OpenDemo);
+            commands.push(Command::Files(FilesCommand::OpenDemo));
         }
     });
     if state.dialog_empty {
@@ -125,11 +127,11 @@ pub fn load_ui(
                         .on_hover_text(p.display().to_string())
                         .clicked()
                     {
-                        commands.push(Command::OpenPath(p.clone()));
+                        commands.push(Command::Files(FilesCommand::OpenPath(p.clone())));
                     }
                 }
                 if ui.small_button("Clear list").clicked() {
-                    commands.push(Command::ClearRecent);
+                    commands.push(Command::Files(FilesCommand::ClearRecent));
                 }
             });
     }
@@ -159,7 +161,7 @@ pub fn solver_ui(
             .on_hover_text("calibrate the session with these settings")
             .clicked()
         {
-            commands.push(Command::Run);
+            commands.push(Command::Run(RunCommand::Start));
         }
         let cancel = ui.add_enabled(
             running && !state.run.as_ref().is_some_and(|r| r.cancelling),
@@ -169,7 +171,7 @@ pub fn solver_ui(
             .on_hover_text("stop the solver at its next iteration")
             .clicked()
         {
-            commands.push(Command::Cancel);
+            commands.push(Command::Run(RunCommand::Cancel));
         }
     });
     if let Some(l) = &state.loaded

@@ -8,8 +8,9 @@ use egui::RichText;
 use egui_plot::{HLine, Legend, Line, LineStyle, MarkerShape, Plot, PlotPoints, Points};
 
 use super::{AFTER, BAD, BEFORE, MUTED, WARN};
-use crate::app::commands::Command;
-use crate::app::state::{AppState, Fit, Forms};
+use crate::app::commands::{Command, ViewCommand};
+use crate::app::forms::Forms;
+use crate::app::state::{AppState, Fit};
 use crate::engine::session::Observation;
 use crate::engine::stripe::StripeResult;
 
@@ -37,7 +38,7 @@ pub fn stripe_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &
             .add_enabled(pos.is_some_and(|p| p > 0), egui::Button::new("◀ Previous"))
             .clicked()
         {
-            commands.push(Command::Step(-1));
+            commands.push(Command::View(ViewCommand::Step(-1)));
         }
         egui::ComboBox::from_id_salt("stripe_measurement")
             .selected_text(RichText::new(&m.id).strong())
@@ -52,7 +53,7 @@ pub fn stripe_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &
                         )
                         .clicked()
                     {
-                        commands.push(Command::Select(r));
+                        commands.push(Command::View(ViewCommand::Select(r)));
                     }
                 }
             })
@@ -65,15 +66,15 @@ pub fn stripe_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &
             )
             .clicked()
         {
-            commands.push(Command::Step(1));
+            commands.push(Command::View(ViewCommand::Step(1)));
         }
         let used = !state.excluded.contains(&m.id);
         let mut v = used;
         if ui.checkbox(&mut v, "use in solver").changed() {
-            commands.push(Command::SetIncluded {
+            commands.push(Command::View(ViewCommand::SetIncluded {
                 id: m.id.clone(),
                 included: v,
-            });
+            }));
         }
         ui.label(RichText::new("arrow keys: previous / next").small().weak());
     });

@@ -7,8 +7,8 @@ use std::path::PathBuf;
 
 use crate::engine::import::{
     AngleUnit, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
-    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit, PoseCheck,
-    ProfileSource, RobotSource,
+    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit, ProfileSource,
+    RobotSource,
 };
 
 /// Rows the preview shows.
@@ -240,19 +240,6 @@ impl ImportForm {
         }
         set
     }
-}
-
-/// What the wizard shows besides its form.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ImportView {
-    /// The joint log's header, once read.
-    pub header: Vec<String>,
-    /// The preview text (mapped rows), or why it failed.
-    pub preview: Option<Result<String, String>>,
-    /// The flange-pose checks of the last import.
-    pub checks: Vec<PoseCheck>,
-    /// The last import's outcome in one line, or its error.
-    pub outcome: Option<Result<String, String>>,
 }
 
 #[cfg(test)]

@@ -1,0 +1,499 @@
+//! Opening and saving files: the demo session, a session or result file
+//! (told apart by its `format` key), the native file dialogs, and "Save
+//! as" of the session without the left-out measurements. Reading a
+//! session fits every stripe once ([`analyse`]): what the tables, the
+//! stripe view and every later run use.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
+
+use crate::engine::format::{
+    FileError, RESULT_FORMAT, ResultFile, parse_result, parse_session, session_to_json,
+    write_atomic,
+};
+use crate::engine::session::{ExcludeError, Session, exclude_measurements};
+use crate::engine::solve::{self, estimate::Estimate};
+
+use super::Core;
+use crate::app::commands::FilesCommand;
+use crate::app::error::JobError;
+use crate::app::forms::{ProfilesKind, SolverForm, Tab};
+use crate::app::jobs::{FilesMessage, JobMessage};
+use crate::app::state::{DialogPurpose, Level, LoadedSession, NO_DIALOG, Notice, Source};
+use crate::app::view::{CentrePoint, CentreSet, ResultOrigin, ResultView};
+
+/// What a file turned out to be.
+#[derive(Debug)]
+pub enum Opened {
+    /// A session, analysed.
+    Session(Box<LoadedSession>),
+    /// A result file, checked.
+    Result(Box<ResultFile>),
+}
+
+/// The embedded demo session, analysed.
+///
+/// # Errors
+/// Only if the embedded text were broken (a build error in practice).
+pub fn open_demo() -> Result<LoadedSession, FileError> {
+    let name = Path::new(crate::DEMO_SESSION_NAME);
+    let session = parse_session(crate::DEMO_SESSION_JSON, name)?;
+    let mut loaded = analyse(session, Source::Demo);
+    loaded.bytes = crate::DEMO_SESSION_JSON.as_bytes().to_vec();
+    Ok(loaded)
+}
+
+/// Reads `path` and, by its `format` key, loads it as a result file or
+/// as a session (anything else goes to the session loader, whose message
+/// then says what is wrong).
+///
+/// # Errors
+/// The file cannot be read or breaks a FORMAT.md rule; the message names
+/// the file and, where it applies, the measurement.
+pub fn open_path(path: &Path) -> Result<Opened, FileError> {
+    let text = std::fs::read_to_string(path).map_err(|source| FileError::Io {
+        action: "reading",
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let is_result = serde_json::from_str::<serde_json::Value>(&text)
+        .ok()
+        .and_then(|v| {
+            v.get("format")
+                .and_then(|f| f.as_str())
+                .map(|f| f == RESULT_FORMAT)
+        })
+        .unwrap_or(false);
+    if is_result {
+        Ok(Opened::Result(Box::new(parse_result(&text, path)?)))
+    } else {
+        let session = parse_session(&text, path)?;
+        let mut loaded = analyse(session, Source::File(path.to_path_buf()));
+        loaded.bytes = text.into_bytes();
+        Ok(Opened::Session(Box::new(loaded)))
+    }
+}
+
+/// Fits every stripe once (for the table, the stripe view and later runs)
+/// and computes the centres before calibration (nominal model, initial
+/// hand-eye).
+#[must_use]
+pub fn analyse(session: Session, source: Source) -> LoadedSession {
+    let analysis = solve::analyse(&session);
+    let before = analysis.clone().prepared(&session).map(|prepared| {
+        let start = Estimate {
+            robot: session.robot.clone(),
+            flange_from_sensor: prepared.hand_eye_initial,
+        };
+        let points = session
+            .measurements
+            .iter()
+            .enumerate()
+            .map(|(i, m)| CentrePoint {
+                id: m.id.clone(),
+                station: m.station.clone(),
+                usage: m.usage.as_str().to_string(),
+                index: Some(i),
+                before: start.centre_in_base(&prepared.sighting(&session, i)).into(),
+                after: None,
+            })
+            .collect();
+        CentreSet::new(points)
+    });
+    LoadedSession {
+        bytes: session_to_json(&session).into_bytes(),
+        session,
+        source,
+        analysis,
+        before,
+    }
+}
+
+/// The session without the `excluded` measurements, checked against every
+/// FORMAT.md rule the removal can break, with the indices (into the
+/// loaded session) of the measurements it keeps. The name is kept.
+///
+/// # Errors
+/// Leaving these measurements out breaks a rule: the engine's message.
+pub fn without(
+    session: &Session,
+    excluded: &BTreeSet<String>,
+) -> Result<(Session, Vec<usize>), ExcludeError> {
+    let ids: Vec<String> = excluded.iter().cloned().collect();
+    let kept = if ids.is_empty() {
+        session.clone()
+    } else {
+        exclude_measurements(session, &ids)?
+    };
+    let indices = session
+        .measurements
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| !excluded.contains(&m.id))
+        .map(|(i, _)| i)
+        .collect();
+    Ok((kept, indices))
+}
+
+/// Writes the session without the `excluded` measurements to `path`
+/// (atomically). Returns how many measurements the file holds.
+///
+/// # Errors
+/// The edited session breaks a rule, or the file cannot be written.
+pub fn save_without(
+    session: &Session,
+    excluded: &BTreeSet<String>,
+    path: &Path,
+) -> Result<usize, JobError> {
+    let (kept, _) = without(session, excluded)?;
+    write_atomic(path, session_to_json(&kept).as_bytes())?;
+    Ok(kept.measurements.len())
+}
+
+impl Core {
+    /// Handles a [`FilesCommand`].
+    pub(super) fn files(&mut self, ctx: &egui::Context, command: FilesCommand) {
+        match command {
+            FilesCommand::OpenDemo => self.open_demo(ctx),
+            FilesCommand::OpenPath(path) => self.open_path(ctx, path),
+            FilesCommand::Browse(purpose) => self.browse(ctx, purpose),
+            FilesCommand::SaveSession => self.save_session(ctx, false),
+            FilesCommand::ClearRecent => self.state.prefs.recent.clear(),
+        }
+    }
+
+    fn open_demo(&mut self, ctx: &egui::Context) {
+        self.state.say(Level::Info, "opening the demo session…");
+        let started = self.spawn(ctx, "load", |rep| {
+            rep.send(JobMessage::Files(match open_demo() {
+                Ok(l) => FilesMessage::SessionLoaded(Box::new(l)),
+                Err(e) => FilesMessage::LoadFailed {
+                    what: crate::DEMO_SESSION_NAME.to_string(),
+                    error: e.into(),
+                },
+            }));
+        });
+        if started {
+            self.state.busy.loading += 1;
+        }
+    }
+
+    fn open_path(&mut self, ctx: &egui::Context, path: PathBuf) {
+        if path.as_os_str().is_empty() {
+            self.state.say(
+                Level::Warning,
+                "type the path of a session or result file first",
+            );
+            return;
+        }
+        self.forms.open_path = path.display().to_string();
+        self.state
+            .say(Level::Info, format!("opening {}…", path.display()));
+        let session = self.state.loaded.as_ref().map(|l| l.session.clone());
+        let started = self.spawn(ctx, "load", move |rep| {
+            let message = match open_path(&path) {
+                Ok(Opened::Session(l)) => FilesMessage::SessionLoaded(l),
+                Ok(Opened::Result(file)) => {
+                    let view = ResultView::new(
+                        *file,
+                        ResultOrigin::Review(path.clone()),
+                        session.as_ref(),
+                    );
+                    FilesMessage::ResultLoaded {
+                        path,
+                        view: Box::new(view),
+                    }
+                }
+                Err(e) => FilesMessage::LoadFailed {
+                    what: path.display().to_string(),
+                    error: e.into(),
+                },
+            };
+            rep.send(JobMessage::Files(message));
+        });
+        if started {
+            self.state.busy.loading += 1;
+        }
+    }
+
+    fn browse(&mut self, ctx: &egui::Context, purpose: DialogPurpose) {
+        if self.state.busy.dialog {
+            return;
+        }
+        let folder = match purpose {
+            DialogPurpose::ExportFolder => Some(PathBuf::from(self.forms.export_dir.trim())),
+            DialogPurpose::HistoryFolder => self
+                .state
+                .prefs
+                .history_folder
+                .clone()
+                .or_else(|| self.state.prefs.last_folder.clone()),
+            DialogPurpose::ImportProfiles | DialogPurpose::ImportReferences => {
+                Path::new(self.forms.import.joints.trim())
+                    .parent()
+                    .map(Path::to_path_buf)
+                    .filter(|d| !d.as_os_str().is_empty())
+                    .or_else(|| self.state.prefs.last_folder.clone())
+            }
+            _ => self.state.prefs.last_folder.clone(),
+        };
+        let profiles_folder = self.forms.import.profiles_kind == ProfilesKind::Folder;
+        let file_name = Path::new(self.forms.save_path.trim())
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned());
+        let started = self.spawn(ctx, "file-dialog", move |rep| {
+            let mut dialog = rfd::FileDialog::new();
+            if let Some(dir) = folder.filter(|d| d.is_dir()) {
+                dialog = dialog.set_directory(dir);
+            }
+            let path = match purpose {
+                DialogPurpose::Open => dialog
+                    .add_filter("spherecal session or result", &["json"])
+                    .pick_file(),
+                DialogPurpose::SaveSession => {
+                    let dialog = dialog.add_filter("spherecal session", &["json"]);
+                    match file_name {
+                        Some(n) => dialog.set_file_name(n),
+                        None => dialog,
+                    }
+                    .save_file()
+                }
+                DialogPurpose::ExportFolder | DialogPurpose::HistoryFolder => dialog.pick_folder(),
+                DialogPurpose::ImportJoints | DialogPurpose::ImportReferences => {
+                    dialog.add_filter("CSV", &["csv", "txt"]).pick_file()
+                }
+                DialogPurpose::ImportProfiles if profiles_folder => dialog.pick_folder(),
+                DialogPurpose::ImportProfiles => {
+                    dialog.add_filter("CSV", &["csv", "txt"]).pick_file()
+                }
+            };
+            rep.send(JobMessage::Files(FilesMessage::Dialog { purpose, path }));
+        });
+        self.state.busy.dialog = started;
+        if started {
+            self.state.say(Level::Info, "waiting for the file dialog…");
+        }
+    }
+
+    fn save_session(&mut self, ctx: &egui::Context, confirmed: bool) {
+        let Some(loaded) = &self.state.loaded else {
+            self.state.say(Level::Warning, "no session to save");
+            return;
+        };
+        let text = self.forms.save_path.trim();
+        if text.is_empty() {
+            self.state
+                .say(Level::Warning, "type where to save the session first");
+            return;
+        }
+        let path = PathBuf::from(text);
+        let confirmed = confirmed || self.state.confirm_overwrite.as_ref() == Some(&path);
+        if path.exists() && !confirmed {
+            let opened = loaded.source.path() == Some(path.as_path());
+            self.state.say(
+                Level::Warning,
+                format!(
+                    "{} exists{}: press Save again to replace it",
+                    path.display(),
+                    if opened {
+                        " (it is the opened session file)"
+                    } else {
+                        ""
+                    }
+                ),
+            );
+            self.state.confirm_overwrite = Some(path);
+            return;
+        }
+        self.state.confirm_overwrite = None;
+        let session = loaded.session.clone();
+        let excluded = self.state.excluded.clone();
+        let started = self.spawn(ctx, "save", move |rep| {
+            let outcome = save_without(&session, &excluded, &path);
+            rep.send(JobMessage::Files(FilesMessage::Saved { path, outcome }));
+        });
+        self.state.busy.saving = started;
+    }
+
+    /// Handles a [`FilesMessage`].
+    pub(super) fn on_files(&mut self, ctx: &egui::Context, message: FilesMessage) {
+        match message {
+            FilesMessage::SessionLoaded(loaded) => {
+                self.state.busy.loading = self.state.busy.loading.saturating_sub(1);
+                self.on_session(ctx, *loaded);
+            }
+            FilesMessage::ResultLoaded { path, view } => {
+                self.state.busy.loading = self.state.busy.loading.saturating_sub(1);
+                self.state.prefs.remember(&path);
+                let notes = view.notes.join("; ");
+                self.forms.centres.magnify = view.centres.suggested_magnify;
+                self.state.result = Some(*view);
+                self.forms.tab = Tab::Results;
+                if notes.is_empty() {
+                    self.state.say(
+                        Level::Info,
+                        format!(
+                            "reviewing {} as it was computed (the solver was not run)",
+                            path.display()
+                        ),
+                    );
+                } else {
+                    self.state.say(
+                        Level::Warning,
+                        format!("reviewing {}: {notes}", path.display()),
+                    );
+                }
+            }
+            FilesMessage::LoadFailed { what, error } => {
+                self.state.busy.loading = self.state.busy.loading.saturating_sub(1);
+                self.state
+                    .say(Level::Error, format!("could not open {what}"));
+                self.state.notice = Some(Notice {
+                    title: format!("Could not open {what}"),
+                    body: error.to_string(),
+                });
+                if let Some(p) = self.state.pending_result.take() {
+                    self.open_path(ctx, p);
+                }
+            }
+            FilesMessage::Dialog { purpose, path } => self.on_dialog(ctx, purpose, path),
+            FilesMessage::Saved { path, outcome } => {
+                self.state.busy.saving = false;
+                match outcome {
+                    Ok(n) => {
+                        self.state.prefs.remember(&path);
+                        self.state.say(
+                            Level::Info,
+                            format!(
+                                "saved {n} measurements to {} (atomic write)",
+                                path.display()
+                            ),
+                        );
+                    }
+                    Err(e) => {
+                        self.state.say(Level::Error, "the session was not saved");
+                        self.state.notice = Some(Notice {
+                            title: format!("Could not save {}", path.display()),
+                            body: format!("not saved: {e}"),
+                        });
+                    }
+                }
+            }
+        }
+    }
+
+    fn on_dialog(&mut self, ctx: &egui::Context, purpose: DialogPurpose, path: Option<PathBuf>) {
+        self.state.busy.dialog = false;
+        self.state.dialog_empty = path.is_none();
+        let Some(path) = path else {
+            self.state.say(Level::Warning, NO_DIALOG);
+            return;
+        };
+        match purpose {
+            DialogPurpose::Open => self.open_path(ctx, path),
+            DialogPurpose::SaveSession => {
+                self.forms.save_path = path.display().to_string();
+                // The dialog has asked about replacing a file already.
+                self.save_session(ctx, true);
+            }
+            DialogPurpose::ExportFolder => {
+                self.forms.export_dir = path.display().to_string();
+                self.state
+                    .say(Level::Info, format!("exports go to {}", path.display()));
+            }
+            DialogPurpose::ImportJoints => {
+                self.forms.import.joints = path.display().to_string();
+                self.import_preview(ctx, true);
+            }
+            DialogPurpose::ImportProfiles => {
+                self.forms.import.profiles = path.display().to_string();
+            }
+            DialogPurpose::ImportReferences => {
+                self.forms.import.references = path.display().to_string();
+            }
+            DialogPurpose::HistoryFolder => {
+                self.forms.history.folder = path.display().to_string();
+                self.history_scan(ctx);
+            }
+        }
+    }
+
+    /// Shows a session that was opened, imported or simulated: resets the
+    /// forms and the selection, says what was found, and opens the result
+    /// waiting for it.
+    pub(super) fn on_session(&mut self, ctx: &egui::Context, loaded: LoadedSession) {
+        if let Some(run) = self.state.run.take() {
+            // The run was of the previous session: stop it, forget it.
+            run.cancel.store(true, Ordering::Relaxed);
+        }
+        if let Some(p) = loaded.source.path() {
+            self.state.prefs.remember(p);
+            self.forms.open_path = p.display().to_string();
+        }
+        let dir = loaded
+            .source
+            .folder()
+            .map(Path::to_path_buf)
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_default();
+        let file_name = match loaded.source {
+            Source::Imported(_) => format!("{}.json", loaded.source.stem()),
+            _ => format!("{}-edited.json", loaded.source.stem()),
+        };
+        self.forms.save_path = dir.join(file_name).display().to_string();
+        self.forms.solver = SolverForm::from_session(&loaded.session);
+        self.forms.filter_station = None;
+        self.forms.filter_use = None;
+        if self.forms.tab == Tab::Results {
+            self.forms.tab = Tab::Session;
+        }
+        self.state.excluded.clear();
+        self.state.confirm_overwrite = None;
+        self.state.selected = (!loaded.session.measurements.is_empty()).then_some(0);
+        self.state.result = None;
+        self.state.notice = None;
+        let (level, text) = opened_line(&loaded);
+        self.state.say(level, text);
+        if let Ok(set) = &loaded.before {
+            self.forms.centres.magnify = set.suggested_magnify;
+        }
+        self.state.loaded = Some(loaded);
+        if let Some(p) = self.state.pending_result.take() {
+            self.open_path(ctx, p);
+        }
+    }
+}
+
+/// The status line for an opened session: how many measurements, how
+/// many stripes warned or failed, and why the solver cannot run.
+fn opened_line(loaded: &LoadedSession) -> (Level, String) {
+    let failed = loaded.analysis.failures().count();
+    let warned = loaded
+        .analysis
+        .measurements
+        .iter()
+        .filter(|m| {
+            m.as_ref()
+                .is_ok_and(|p| p.stripe.as_ref().is_some_and(|s| !s.warnings.is_empty()))
+        })
+        .count();
+    let mut text = format!(
+        "opened {}: {} measurements",
+        loaded.session.name,
+        loaded.session.measurements.len()
+    );
+    let mut level = Level::Info;
+    if warned > 0 {
+        text.push_str(&format!(", {warned} with stripe warnings"));
+    }
+    if failed > 0 {
+        text.push_str(&format!(", {failed} stripe(s) could not be fitted"));
+        level = Level::Warning;
+    }
+    if let Err(e) = &loaded.before {
+        text.push_str(&format!("; the solver cannot run: {e}"));
+        level = Level::Warning;
+    }
+    (level, text)
+}

@@ -1,0 +1,173 @@
+//! The import wizard's work: read the joint log's header, guess the
+//! column mapping, preview the mapped rows, and build the session with
+//! the engine's [`import::import`] (as `spherecal import`), analysed like
+//! an opened file.
+
+use std::path::Path;
+
+use crate::engine::import;
+
+use super::Core;
+use super::files::analyse;
+use crate::app::commands::ImportCommand;
+use crate::app::error::JobError;
+use crate::app::forms::{ImportForm, Tab, import::PREVIEW_ROWS};
+use crate::app::jobs::{ImportMessage, Imported, JobMessage};
+use crate::app::state::{Level, Source};
+
+/// The wizard's preview: the joint log's header (empty when it cannot be
+/// read), the form with the mapping guessed from it (when `guess`), and
+/// the first rows mapped.
+pub fn import_preview(
+    mut form: ImportForm,
+    guess: bool,
+) -> (
+    Vec<String>,
+    Option<Box<ImportForm>>,
+    Result<String, JobError>,
+) {
+    if form.joints.trim().is_empty() {
+        return (
+            Vec::new(),
+            None,
+            Err(JobError::ImportForm(
+                "choose the joint log CSV first".into(),
+            )),
+        );
+    }
+    let header = match import::header(Path::new(form.joints.trim())) {
+        Ok(h) => h,
+        Err(e) => return (Vec::new(), None, Err(e.into())),
+    };
+    if guess {
+        form.guess_mapping(&header);
+    }
+    let preview = form
+        .spec()
+        .map_err(JobError::ImportForm)
+        .and_then(|spec| Ok(import::preview(&spec, PREVIEW_ROWS)?));
+    (header, guess.then(|| Box::new(form)), preview)
+}
+
+/// Runs the import of the wizard's form and analyses the session like an
+/// opened file.
+///
+/// # Errors
+/// The form is incomplete or the engine's import failed (naming the file,
+/// line, column or pose id).
+pub fn import_session(form: &ImportForm) -> Result<Imported, JobError> {
+    let spec = form.spec().map_err(JobError::ImportForm)?;
+    let (session, checks) = import::import(&spec)?;
+    Ok(Imported {
+        loaded: Box::new(analyse(session, Source::Imported(spec.joint_log))),
+        checks,
+    })
+}
+
+impl Core {
+    /// Handles an [`ImportCommand`].
+    pub(super) fn import(&mut self, ctx: &egui::Context, command: ImportCommand) {
+        match command {
+            ImportCommand::Preview { guess } => self.import_preview(ctx, guess),
+            ImportCommand::Run => self.import_run(ctx),
+        }
+    }
+
+    /// Starts a preview job (also after the joint log was chosen in a
+    /// dialog).
+    pub(super) fn import_preview(&mut self, ctx: &egui::Context, guess: bool) {
+        let form = self.forms.import.clone();
+        let started = self.spawn(ctx, "import", move |rep| {
+            let (header, guessed, preview) = import_preview(form, guess);
+            rep.send(JobMessage::Import(ImportMessage::Previewed {
+                header,
+                guessed,
+                preview,
+            }));
+        });
+        if started {
+            self.state.busy.importing += 1;
+        }
+    }
+
+    fn import_run(&mut self, ctx: &egui::Context) {
+        let form = self.forms.import.clone();
+        if let Err(e) = form.spec() {
+            self.state.import.outcome = Some(Err(e.clone()));
+            self.state.say(Level::Warning, e);
+            return;
+        }
+        self.state.say(Level::Info, "importing…");
+        let started = self.spawn(ctx, "import", move |rep| {
+            rep.send(JobMessage::Import(ImportMessage::Imported(import_session(
+                &form,
+            ))));
+        });
+        if started {
+            self.state.busy.importing += 1;
+        }
+    }
+
+    /// Handles an [`ImportMessage`].
+    pub(super) fn on_import(&mut self, ctx: &egui::Context, message: ImportMessage) {
+        self.state.busy.importing = self.state.busy.importing.saturating_sub(1);
+        match message {
+            ImportMessage::Previewed {
+                header,
+                guessed,
+                preview,
+            } => {
+                if let Some(form) = guessed {
+                    let f = &mut self.forms.import;
+                    f.id_column = form.id_column;
+                    f.station_column = form.station_column;
+                    f.use_column = form.use_column;
+                    f.side_column = form.side_column;
+                    f.joint_columns = form.joint_columns;
+                }
+                self.state.import.header = header;
+                match &preview {
+                    Ok(_) => self
+                        .state
+                        .say(Level::Info, "preview of the mapped rows below"),
+                    Err(e) => self.state.say(Level::Warning, format!("preview: {e}")),
+                }
+                self.state.import.preview = Some(preview.map_err(|e| e.to_string()));
+            }
+            ImportMessage::Imported(Ok(imported)) => {
+                let flagged = imported.checks.iter().filter(|c| c.flagged).count();
+                let n = imported.loaded.session.measurements.len();
+                let refs = imported.loaded.session.reference_distances.len();
+                let mut line = format!("imported {n} measurements and {refs} reference distances");
+                if !imported.checks.is_empty() {
+                    line.push_str(&format!(
+                        "; flange poses: {} checked, {flagged} flagged",
+                        imported.checks.len()
+                    ));
+                }
+                self.state.import.checks = imported.checks;
+                self.state.import.outcome = Some(Ok(line.clone()));
+                self.on_session(ctx, *imported.loaded);
+                self.forms.tab = if flagged > 0 {
+                    Tab::Import
+                } else {
+                    Tab::Session
+                };
+                let level = if flagged > 0 {
+                    Level::Warning
+                } else {
+                    Level::Info
+                };
+                self.state.say(
+                    level,
+                    format!("{line}: not saved yet, use Save as… on the Session view"),
+                );
+            }
+            ImportMessage::Imported(Err(e)) => {
+                self.state.say(Level::Error, "the import failed");
+                self.state.import.checks.clear();
+                self.state.import.outcome = Some(Err(e.to_string()));
+            }
+        }
+    }
+}

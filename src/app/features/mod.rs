@@ -1,0 +1,142 @@
+//! What the workbench does, one module per feature. Each feature has the
+//! handler of its [`Command`]s (checks the forms, starts a job), the
+//! handler of its jobs' [`JobMessage`]s (updates the state, says what
+//! happened) and the plain functions its jobs run (engine calls, no egui
+//! beyond the screenshot's pixels):
+//!
+//! | feature | commands | job work |
+//! |---|---|---|
+//! | [`files`] | open, browse, save | read and fit a session, read a result, save without the left-out measurements |
+//! | [`view`] | tab, selection, measurements left out | — |
+//! | [`run`] | run, cancel | the calibration |
+//! | [`export`] | the Results view's exports | result JSON, CSV, PNG, HTML report, model |
+//! | [`import`] | preview, import | the import wizard's engine calls |
+//! | [`history`] | scan, drift | scan a library folder |
+//! | [`plan`] | plan, cancel, export, simulate | the pose planner and its prediction |
+//!
+//! [`Core`] holds what they share: the state, the forms and the job runner.
+
+pub mod export;
+pub mod files;
+pub mod history;
+pub mod import;
+pub mod plan;
+pub mod run;
+pub mod view;
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use super::commands::Command;
+use super::error::JobError;
+use super::forms::Forms;
+use super::jobs::{JobMessage, Jobs, Reporter};
+use super::state::{AppState, Level, Notice};
+
+/// How long to wait for the window's screenshot for a plots PNG: a frame
+/// takes milliseconds; a backend that cannot take one never answers.
+pub const SCREENSHOT_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// The state, the forms and the job runner, with every feature's
+/// handlers. The workbench owns one and draws the panels from it.
+pub struct Core {
+    /// What the workbench knows.
+    pub state: AppState,
+    /// The fields the widgets edit.
+    pub forms: Forms,
+    /// The job runner.
+    pub jobs: Jobs,
+    /// Screen rectangle of the Results view's plots in the last frame.
+    pub plots_rect: Option<egui::Rect>,
+    /// Where the awaited screenshot's PNG goes, and since when.
+    pub png_target: Option<(PathBuf, Instant)>,
+}
+
+impl Core {
+    /// A core with these state and forms and no job in flight.
+    #[must_use]
+    pub fn new(state: AppState, forms: Forms) -> Self {
+        Self {
+            state,
+            forms,
+            jobs: Jobs::default(),
+            plots_rect: None,
+            png_target: None,
+        }
+    }
+
+    /// Hands a command to its feature.
+    pub fn apply(&mut self, ctx: &egui::Context, command: Command) {
+        match command {
+            Command::Files(c) => self.files(ctx, c),
+            Command::View(c) => self.view(c),
+            Command::Run(c) => self.run(ctx, c),
+            Command::Export(kind) => self.export(ctx, kind),
+            Command::Import(c) => self.import(ctx, c),
+            Command::History(c) => self.history(ctx, c),
+            Command::Plan(c) => self.plan(ctx, c),
+        }
+    }
+
+    /// Hands a job's message to its feature.
+    pub fn on_message(&mut self, ctx: &egui::Context, message: JobMessage) {
+        match message {
+            JobMessage::Files(m) => self.on_files(ctx, m),
+            JobMessage::Run(m) => self.on_run(m),
+            JobMessage::Export(m) => self.on_export(ctx, m),
+            JobMessage::Import(m) => self.on_import(ctx, m),
+            JobMessage::History(m) => self.on_history(m),
+            JobMessage::Plan(m) => self.on_plan(ctx, m),
+        }
+    }
+
+    /// Starts a job, or says why it could not start.
+    fn spawn(
+        &mut self,
+        ctx: &egui::Context,
+        name: &str,
+        work: impl FnOnce(&Reporter) + Send + 'static,
+    ) -> bool {
+        match self.jobs.spawn(name, ctx, work) {
+            Ok(()) => true,
+            Err(e) => {
+                self.state.say(
+                    Level::Error,
+                    format!("could not start the {name} job (no thread: {e})"),
+                );
+                false
+            }
+        }
+    }
+
+    /// The export folder of the form, remembered; `None` (with a notice)
+    /// when it does not exist.
+    fn export_folder(&mut self) -> Option<PathBuf> {
+        let dir = PathBuf::from(self.forms.export_dir.trim());
+        if !dir.is_dir() {
+            self.state.notice = Some(Notice {
+                title: "Nothing exported".to_string(),
+                body: format!("the export folder {} does not exist", dir.display()),
+            });
+            return None;
+        }
+        self.state.prefs.export_folder = Some(dir.clone());
+        Some(dir)
+    }
+
+    /// The status line for a written file, or the notice of why not.
+    fn say_written(&mut self, what: &str, path: &Path, outcome: Result<(), JobError>) {
+        match outcome {
+            Ok(()) => self
+                .state
+                .say(Level::Info, format!("wrote {what} to {}", path.display())),
+            Err(e) => {
+                self.state.say(Level::Error, format!("{what} not written"));
+                self.state.notice = Some(Notice {
+                    title: format!("Could not write {what}"),
+                    body: e.to_string(),
+                });
+            }
+        }
+    }
+}
