@@ -10,9 +10,7 @@ fn main() -> ExitCode {
     let parsed = Cli::parse();
     let outcome = match parsed.command {
         Some(Command::Calibrate(args)) => cli::calibrate_command(&args),
-        Some(Command::Simulate(args)) => {
-            cli::simulate::run(&args).map_err(|e| CliError::input(format!("{e:#}")))
-        }
+        Some(Command::Simulate(args)) => cli::simulate::run(&args),
         Some(Command::Gui(args)) => gui(args.session, args.result),
         Some(Command::Evaluate(args)) => cli::evaluate::run(&args),
         Some(Command::ExportModel(args)) => cli::export_model::run(&args),

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
 
-use crate::engine::history::Library;
+use crate::engine::history::{Drift, Library};
 use crate::engine::import::PoseCheck;
 use crate::engine::solve::Progress;
 
@@ -143,6 +143,19 @@ pub enum HistoryMessage {
         folder: PathBuf,
         /// The library.
         outcome: Result<Box<Library>, JobError>,
+    },
+    /// The drift of the chosen robot over the ticked results, or why
+    /// there is none.
+    Drift {
+        /// Which request this answers (only the latest is shown).
+        generation: u64,
+        /// The robot.
+        robot: String,
+        /// The library with only the ticked results (what the drift's
+        /// entry indices refer to).
+        ticked: Box<Library>,
+        /// The drift.
+        outcome: Result<Box<Drift>, JobError>,
     },
 }
 

@@ -370,6 +370,11 @@ pub struct HistoryView {
     pub drift: Option<Result<Drift, String>>,
     /// The library the drift's entry indices refer to (the ticked results).
     pub drift_of: Option<Library>,
+    /// The latest drift request; a drift job's answer to an older one is
+    /// dropped.
+    pub drift_generation: u64,
+    /// A drift job is in flight.
+    pub drifting: bool,
 }
 
 /// What lasts across runs of the program (eframe storage).
@@ -474,6 +479,7 @@ impl AppState {
             || self.busy.screenshot
             || self.busy.importing > 0
             || self.busy.scanning
+            || self.history.drifting
             || self.plan.cancel.is_some()
             || self.plan.writing > 0
     }

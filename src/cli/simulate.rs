@@ -9,9 +9,9 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::Context as _;
 use clap::ValueEnum;
 
+use super::CliError;
 use crate::engine::cell::sensor;
 use crate::engine::format;
 use crate::engine::plan;
@@ -203,19 +203,25 @@ impl SimulateArgs {
 
 /// Writes the import inputs of `session` into `dir` (created if needed),
 /// each file atomically.
-fn write_import_files(session: &Session, dir: &Path) -> anyhow::Result<()> {
-    let files = simulate::import_files(session)?;
+fn write_import_files(session: &Session, dir: &Path) -> Result<(), CliError> {
+    let files = simulate::import_files(session).map_err(|e| CliError::input(e.to_string()))?;
     let profiles = dir.join("profiles");
     std::fs::create_dir_all(&profiles)
-        .with_context(|| format!("creating {} failed", profiles.display()))?;
-    format::write_atomic(&dir.join("joints.csv"), files.joints_csv.as_bytes())?;
+        .map_err(|e| CliError::input(format!("creating {} failed: {e}", profiles.display())))?;
+    write(&dir.join("joints.csv"), &files.joints_csv)?;
     for (id, text) in &files.profiles {
-        format::write_atomic(&profiles.join(format!("{id}.csv")), text.as_bytes())?;
+        write(&profiles.join(format!("{id}.csv")), text)?;
     }
     if let Some(text) = &files.references_csv {
-        format::write_atomic(&dir.join("references.csv"), text.as_bytes())?;
+        write(&dir.join("references.csv"), text)?;
     }
     Ok(())
+}
+
+/// Writes `text` to `path` atomically; a failure is reported with exit
+/// status 2, as every failure of `simulate`.
+fn write(path: &Path, text: &str) -> Result<(), CliError> {
+    format::write_atomic(path, text.as_bytes()).map_err(|e| CliError::input(e.to_string()))
 }
 
 fn default_truth_path(out: &Path) -> PathBuf {
@@ -235,28 +241,29 @@ fn default_truth_path(out: &Path) -> PathBuf {
 /// A setting out of range or an unreachable station (the engine's
 /// message), the two paths being the same file, or a file that cannot be
 /// written (naming it).
-pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
+pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let started = Instant::now();
     let truth_path = args.truth_path();
     if truth_path == args.out {
-        anyhow::bail!(
+        return Err(CliError::input(format!(
             "the session and the truth would both be written to {}; give --truth another path",
             args.out.display()
-        );
+        )));
     }
     let config = args.to_config();
     let (session, truth) = match &args.plan {
-        None => simulate::simulate(&config)?,
+        None => simulate::simulate(&config).map_err(|e| CliError::input(e.to_string()))?,
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("reading failed ({})", path.display()))?;
+            let text = std::fs::read_to_string(path).map_err(|e| {
+                CliError::input(format!("reading failed ({}): {e}", path.display()))
+            })?;
             let poses = plan::read_plan_csv(&text)
-                .map_err(|e| anyhow::anyhow!("{e} ({})", path.display()))?;
+                .map_err(|e| CliError::input(format!("{e} ({})", path.display())))?;
             let nominal = robot::preset(config.robot.key())
                 .map(|p| p.robot)
-                .ok_or_else(|| anyhow::anyhow!("unknown robot {}", config.robot.key()))?;
+                .ok_or_else(|| CliError::input(format!("unknown robot {}", config.robot.key())))?;
             let hand_eye = match &args.hand_eye {
-                Some(he) => plan::read_hand_eye(he).map_err(|e| anyhow::anyhow!(e.to_string()))?,
+                Some(he) => plan::read_hand_eye(he).map_err(|e| CliError::input(e.to_string()))?,
                 None => sensor::paper_hand_eye(),
             };
             let execution = if args.touch_up {
@@ -265,14 +272,14 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
                 PlanExecution::AsPlanned
             };
             simulate::simulate_plan(&config, &nominal, &hand_eye, &poses, execution)
-                .map_err(|e| anyhow::anyhow!("{e} ({})", path.display()))?
+                .map_err(|e| CliError::input(format!("{e} ({})", path.display())))?
         }
     };
     if let Some(dir) = &args.csv_out {
         write_import_files(&session, dir)?;
     }
-    format::write_atomic(&truth_path, simulate::truth_to_json(&truth).as_bytes())?;
-    format::write_atomic(&args.out, format::session_to_json(&session).as_bytes())?;
+    write(&truth_path, &simulate::truth_to_json(&truth))?;
+    write(&args.out, &format::session_to_json(&session))?;
     let count = |usage: Use| session.with_use(usage).count();
     println!(
         "simulated {} (seed {}): {} measurements ({} translation, {} rotation, {} identify, {} validate), {} reference distances -> {}, truth {} ({:.0} ms)",

@@ -15,3 +15,52 @@ pub fn round_to(value: f64, decimals: i32) -> f64 {
 pub fn as_written(value: f64, decimals: usize) -> f64 {
     format!("{value:.decimals$}").parse().unwrap_or(value)
 }
+
+/// Median of the finite values of a sample: the middle value, or the mean
+/// of the two middle values for an even count; `None` when none is finite.
+/// For summaries (history's ranking of parameters).
+#[must_use]
+pub fn median(values: &[f64]) -> Option<f64> {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        f64::midpoint(v[n / 2 - 1], v[n / 2])
+    })
+}
+
+/// Upper median of `values` (the value at index `len / 2` once ordered:
+/// for an even count the upper of the two middle values), found in linear
+/// time without allocating; reorders `values`. For robust scales in inner
+/// loops (the stripe fit's residual median and MAD), where averaging the
+/// middle pair buys nothing. NaN sorts last ([`f64::total_cmp`]).
+///
+/// # Panics
+/// On an empty slice.
+#[must_use]
+pub fn upper_median(values: &mut [f64]) -> f64 {
+    let mid = values.len() / 2;
+    let (_, m, _) = values.select_nth_unstable_by(mid, f64::total_cmp);
+    *m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn medians() {
+        assert_eq!(median(&[5.0, 1.0, 3.0, 2.0, 4.0]), Some(3.0));
+        assert_eq!(median(&[4.0, 1.0, f64::NAN, 3.0, 2.0]), Some(2.5));
+        assert_eq!(median(&[f64::INFINITY]), None);
+        let mut v = [5.0, 1.0, 3.0, 2.0, 4.0];
+        assert_eq!(upper_median(&mut v), 3.0);
+        let mut w = [4.0, 1.0, 3.0, 2.0];
+        assert_eq!(upper_median(&mut w), 3.0);
+    }
+}

@@ -1,14 +1,14 @@
-//! The library of past results: scan a folder on a job thread (every
-//! result and session file read), then the drift of the chosen robot over
-//! the ticked results, computed at once (no file is read, a few hundred
-//! numbers are compared).
+//! The library of past results: scan a folder, then the drift of the
+//! chosen robot over the ticked results, each on a job thread. A drift
+//! answer to anything but the latest request is dropped.
 
 use std::path::PathBuf;
 
-use crate::engine::history::{self, DriftOptions, HistoryError};
+use crate::engine::history::{self, DriftOptions, HistoryError, Library};
 
 use super::Core;
 use crate::app::commands::HistoryCommand;
+use crate::app::error::JobError;
 use crate::app::jobs::{HistoryMessage, JobMessage};
 use crate::app::state::Level;
 
@@ -17,7 +17,7 @@ impl Core {
     pub(super) fn history(&mut self, ctx: &egui::Context, command: HistoryCommand) {
         match command {
             HistoryCommand::Scan => self.history_scan(ctx),
-            HistoryCommand::Drift => self.history_drift(),
+            HistoryCommand::Drift => self.history_drift(ctx),
         }
     }
 
@@ -45,12 +45,15 @@ impl Core {
         self.state.busy.scanning = started;
     }
 
-    /// The drift of the chosen robot over the ticked results.
-    fn history_drift(&mut self) {
+    /// Starts the drift of the chosen robot over the ticked results on a
+    /// job thread (a library of hundreds of results takes longer than a
+    /// frame); without a library or a robot there is none.
+    pub(super) fn history_drift(&mut self, ctx: &egui::Context) {
         let view = &mut self.state.history;
-        view.drift = None;
-        view.drift_of = None;
+        view.drift_generation += 1;
         let (Some(Ok(library)), Some(robot)) = (&view.library, &self.forms.history.robot) else {
+            view.drift = None;
+            view.drift_of = None;
             return;
         };
         let mut ticked = library.clone();
@@ -62,19 +65,55 @@ impl Core {
             k: self.forms.history.k,
             ..DriftOptions::default()
         };
-        view.drift = Some(match history::drift(&ticked, robot, &options) {
-            Ok(d) => Ok(d),
-            Err(HistoryError::UnknownRobot { .. }) => Err(format!(
-                "no ticked result of {robot}: tick some in the table"
-            )),
-            Err(e) => Err(e.to_string()),
+        let generation = view.drift_generation;
+        let robot = robot.clone();
+        let started = self.spawn(ctx, "drift", move |rep| {
+            let outcome = history::drift(&ticked, &robot, &options)
+                .map(Box::new)
+                .map_err(Into::into);
+            rep.send(JobMessage::History(HistoryMessage::Drift {
+                generation,
+                robot,
+                ticked: Box::new(ticked),
+                outcome,
+            }));
         });
-        view.drift_of = Some(ticked);
+        self.state.history.drifting |= started;
     }
 
     /// Handles a [`HistoryMessage`].
-    pub(super) fn on_history(&mut self, message: HistoryMessage) {
-        let HistoryMessage::Scanned { folder, outcome } = message;
+    pub(super) fn on_history(&mut self, ctx: &egui::Context, message: HistoryMessage) {
+        match message {
+            HistoryMessage::Scanned { folder, outcome } => self.on_scanned(ctx, folder, outcome),
+            HistoryMessage::Drift {
+                generation,
+                robot,
+                ticked,
+                outcome,
+            } => {
+                let view = &mut self.state.history;
+                if generation != view.drift_generation {
+                    return; // a later request is on its way
+                }
+                view.drifting = false;
+                view.drift = Some(match outcome {
+                    Ok(d) => Ok(*d),
+                    Err(JobError::History(HistoryError::UnknownRobot { .. })) => Err(format!(
+                        "no ticked result of {robot}: tick some in the table"
+                    )),
+                    Err(e) => Err(e.to_string()),
+                });
+                view.drift_of = Some(*ticked);
+            }
+        }
+    }
+
+    fn on_scanned(
+        &mut self,
+        ctx: &egui::Context,
+        folder: PathBuf,
+        outcome: Result<Box<Library>, JobError>,
+    ) {
         self.state.busy.scanning = false;
         match outcome {
             Ok(library) => {
@@ -119,6 +158,6 @@ impl Core {
                 self.state.history.library = Some(Err(e.to_string()));
             }
         }
-        self.history_drift();
+        self.history_drift(ctx);
     }
 }

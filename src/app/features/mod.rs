@@ -85,7 +85,7 @@ impl Core {
             JobMessage::Run(m) => self.on_run(m),
             JobMessage::Export(m) => self.on_export(ctx, m),
             JobMessage::Import(m) => self.on_import(ctx, m),
-            JobMessage::History(m) => self.on_history(m),
+            JobMessage::History(m) => self.on_history(ctx, m),
             JobMessage::Plan(m) => self.on_plan(ctx, m),
         }
     }

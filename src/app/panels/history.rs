@@ -76,6 +76,12 @@ pub fn history_ui(
                 Some(Ok(library)) => {
                     library_ui(ui, library, forms, commands);
                     ui.separator();
+                    if state.history.drifting {
+                        ui.horizontal(|ui| {
+                            ui.spinner();
+                            ui.label("computing the drift of the ticked results…");
+                        });
+                    }
                     if let (Some(drift), Some(of)) =
                         (&state.history.drift, &state.history.drift_of)
                     {

@@ -6,6 +6,7 @@ use std::collections::HashSet;
 use super::entry::*;
 use super::*;
 use crate::engine::geometry::wrap_deg;
+use crate::engine::numeric::median;
 use crate::engine::robot::{Joint, PARAM_IS_ANGLE, PARAMS_PER_JOINT, Robot};
 use crate::engine::solve::estimate::ANGLE_SCALE_MM;
 
@@ -298,7 +299,7 @@ pub fn drift(
                 })
                 .collect()
             };
-            median(scores).map(|m| (i, m))
+            median(&scores).map(|m| (i, m))
         })
         .collect();
     ranked.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
@@ -352,20 +353,6 @@ pub fn drift(
         series,
         checks,
         notes,
-    })
-}
-
-pub(super) fn median(mut v: Vec<f64>) -> Option<f64> {
-    v.retain(|x| x.is_finite());
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    Some(if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        f64::midpoint(v[n / 2 - 1], v[n / 2])
     })
 }
 
