@@ -26,7 +26,19 @@
 //!   order alpha, a, beta, theta, d (rad, mm); link transform
 //!   `Rx(alpha)·Tx(a)·Ry(beta)·Rz(q + theta)·Tz(d)` (FORMAT.md).
 //! - **Twists** (differential motions, paper eq. 13-16): `[Δx, Δy, Δz, δx, δy, δz]`,
-//!   translation first; a point `X` moves by `Δ + δ × X`.
+//!   translation first; a point `X` moves by `Δ + δ × X`; the rigid motion of
+//!   a twist is [`engine::geometry::isometry_from_twist`].
+//! - **Hand-eye perturbation**: an update of the hand-eye is a right twist
+//!   in the sensor frame, `eT_s ← eT_s · exp(ΔX)`; the unknowns of both
+//!   methods are these 6 numbers followed by the `5·n` kinematic errors
+//!   ([`engine::solve::estimate`]). Hand-eye σs and correlations in a
+//!   result refer to these directions.
+//! - **Roll, pitch, yaw** (degrees, wherever a rotation is shown: workbench,
+//!   report, history, model export): `R = Rz(yaw) · Ry(pitch) · Rx(roll)`,
+//!   pitch in [−90°, 90°] ([`engine::geometry::roll_pitch_yaw_deg`] and its
+//!   inverse [`engine::geometry::rotation_from_rpy_deg`]).
+//! - **Angles shown** are wrapped to (−180°, 180°]
+//!   ([`engine::geometry::wrap_deg`]).
 
 pub mod cli;
 pub mod engine;

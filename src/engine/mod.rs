@@ -6,17 +6,21 @@
 //! | unit | holds |
 //! |---|---|
 //! | [`geometry`], [`numeric`] | rigid transforms, twists, roll/pitch/yaw; rounding, medians |
-//! | [`robot`] | the MDH model, forward kinematics and Jacobians, presets, inverse kinematics |
-//! | [`session`] | the in-memory session every function takes |
+//! | [`robot`] | the MDH model, forward kinematics and Jacobians (eq. 1-2, 16), presets, inverse kinematics |
+//! | [`session`] | the in-memory session every function takes, its rules, leaving measurements out |
 //! | [`stripe`] | circle fit of a stripe, the sphere centre (eq. 21) |
 //! | [`handeye`] | the initial hand-eye (eq. 3-9) |
 //! | [`validate`] | ε (eq. 20), statistics, Fig. 5 and 6 distances |
-//! | [`solve`] | the loop of Fig. 2 around the paper's update (eq. 10-19) or `ml` |
-//! | [`format`] | session and result files, atomic writes |
-//! | [`report`] | text summary, HTML report, model export |
-//! | [`cell`] | what the simulator and the planner share about a cell |
+//! | [`solve`] | prepare (each stripe fitted once), the one loop of Fig. 2 around a step: the paper's update (eq. 10-19) or `ml`'s |
+//! | [`format`](mod@format) | session and result files (typed both ways), JSON text, atomic writes |
+//! | [`result_view`] | one view of a result: headline, within-station pairs, roll/pitch/yaw, identifiability marks |
+//! | [`report`] | text summary, HTML report with SVG figures, model export |
+//! | [`cell`] | what the simulator and the planner share about a cell: sensor, workspace, approach cones, joint logs, seeded streams |
 //! | [`import`] | joint logs and profiles into a session |
-//! | [`simulate`], [`plan`], [`history`], [`evaluate`] | simulated sessions, pose plans, drift over time, method comparison |
+//! | [`simulate`] | simulated sessions with their truth |
+//! | [`evaluate`] | scoring against the truth; the method comparison study |
+//! | [`plan`] | pose plans and their predicted accuracy |
+//! | [`history`] | a library of results, drift over time |
 
 pub mod cell;
 pub mod evaluate;

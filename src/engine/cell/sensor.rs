@@ -18,7 +18,7 @@ pub const PAPER_HAND_EYE_ROWS: [[f64; 4]; 3] = [
 
 /// The paper's *initial* hand-eye (section 4.2, from eq. 7 and 9), rows of
 /// the 3×4 block as printed. Written into a session when
-/// [`InitialHandEye::Paper`] is chosen.
+/// [`InitialHandEye::Paper`](crate::engine::simulate::InitialHandEye::Paper) is chosen.
 pub const PAPER_INITIAL_HAND_EYE_ROWS: [[f64; 4]; 3] = [
     [0.8704, 0.4921, -0.0133, -7.4422],
     [0.4917, -0.8704, -0.0235, -1.012],

@@ -2,7 +2,7 @@
 //! `1..=N` of five simulated scenarios it calibrates each session with the
 //! paper's method and with `ml` (default options of both, the session's
 //! threshold and iteration bound) and scores the validation distances
-//! against the **true** station distances ([`score`](super::score)):
+//! against the **true** station distances ([`score`]):
 //! the validation std of each method and of the noise floor (the true
 //! model and hand-eye on the same noisy data).
 //!

@@ -41,7 +41,7 @@
 //!
 //! 4×4 matrices are held as [`Isometry3`] (a unit quaternion), which cannot
 //! hold the file's 16 numbers bit for bit. The loader checks each matrix with
-//! [`isometry_from_rows`] and then settles its rotation on a quaternion, at
+//! [`isometry_from_rows`](crate::engine::geometry::isometry_from_rows) and then settles its rotation on a quaternion, at
 //! most a few ulps away, that survives its own write and read unchanged, so a
 //! loaded session saves and reloads to an equal [`Session`]. (A transform
 //! computed in code may move by those few ulps on its first save.)

@@ -40,10 +40,10 @@
 //! has a covariance (the `ml` method; the paper's method reports none):
 //!
 //! - **Hand-eye**: the calibrated `eT_s` as translation `hand_eye.x/y/z`
-//!   (mm, flange frame) and `hand_eye.roll/pitch/yaw` (deg, `R = Rz(yaw) ·
-//!   Ry(pitch) · Rx(roll)`, the workbench's convention). `ml` reports the
-//!   covariance of a twist applied on the right of the calibrated hand-eye
-//!   (`eT_s · exp(Δ)`, sensor frame, [`HAND_EYE_LABELS`]); it is carried to
+//!   (mm, flange frame) and `hand_eye.roll/pitch/yaw` (deg; the crate's
+//!   roll/pitch/yaw convention, see the crate docs). `ml` reports the
+//!   covariance of the hand-eye perturbation (the crate's convention: a
+//!   right twist in the sensor frame, [`HAND_EYE_LABELS`](crate::engine::solve::estimate::HAND_EYE_LABELS)); it is carried to
 //!   these six numbers by their Jacobian (the rotation for the
 //!   translation, central differences for roll, pitch and yaw). The values
 //!   are absolute, not `ml`'s change from the session's initial hand-eye,
@@ -78,7 +78,7 @@
 //! deviation from nominal is: the errors the data show most clearly);
 //! when no result of the series has a σ (paper method only), by the
 //! median `|value|` with angles taken as their effect at 1 m (1° ≈
-//! 17.45 mm), the paper's own scaling ([`ANGLE_SCALE_MM`]).
+//! 17.45 mm), the paper's own scaling ([`ANGLE_SCALE_MM`](crate::engine::solve::estimate::ANGLE_SCALE_MM)).
 //!
 //! Between every two consecutive results each parameter is checked
 //! ([`JumpCheck`]): a jump when `|b − a| > k · sqrt(σa² + σb²)` (angle
@@ -329,7 +329,7 @@ pub struct Combination {
     /// Fixed parameters (`d6`; several for "no effect" groups).
     pub fixed: Vec<String>,
     /// Estimated parameters that undo their effect (`he_z`; `ml`'s
-    /// hand-eye twist labels [`HAND_EYE_LABELS`] or kinematic labels);
+    /// hand-eye twist labels [`HAND_EYE_LABELS`](crate::engine::solve::estimate::HAND_EYE_LABELS) or kinematic labels);
     /// empty when the fixed ones move no distance at all.
     pub partners: Vec<String>,
     /// `ml`'s sentence, e.g. `d6 ~ he_z: d6 +1 mm is undone by he_z +0.999 mm`.

@@ -68,7 +68,7 @@ pub fn plan_csv(plan: &Plan) -> String {
 
 /// Reads the poses of a plan CSV ([`plan_csv`]'s layout; columns found by
 /// name, case-insensitively; `#` and blank lines skipped) for
-/// [`simulate::simulate_plan`]. The joint columns are `j1`, `j2`, … as
+/// [`simulate::simulate_plan`](crate::engine::simulate::simulate_plan). The joint columns are `j1`, `j2`, … as
 /// many as the header has.
 ///
 /// # Errors

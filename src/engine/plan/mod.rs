@@ -38,7 +38,7 @@
 //!    candidate, kept only when the reference forward kinematics puts the
 //!    planned sensor-frame centre on the station (to 1e-6 mm).
 //! 2. **Identifiable parameters.** The `ml` method's own identifiability
-//!    analysis ([`ml::run`] with no update) is run on the whole candidate
+//!    analysis ([`solve::run`](crate::engine::solve::run) with no update) is run on the whole candidate
 //!    pool; the parameters it estimates are the ones the plan is judged on.
 //! 3. **Greedy D-optimal selection** of the identify poses: the criterion is
 //!    `ln det` of the information matrix of those parameters, Gauss-Newton
@@ -301,7 +301,7 @@ impl Plan {
         self.stations.iter().find(|s| s.id == id)
     }
 
-    /// The poses as [`simulate::simulate_plan`] takes them.
+    /// The poses as [`simulate::simulate_plan`](crate::engine::simulate::simulate_plan) takes them.
     #[must_use]
     pub fn simulation_poses(&self) -> Vec<PlanPose> {
         self.poses

@@ -20,7 +20,7 @@ pub const RANDOM_LENGTH_SIGMA_MM: f64 = 0.3;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ErrorModel {
-    /// The paper's Table 1 ([`TABLE1`]) times `error_scale`.
+    /// The paper's Table 1 ([`TABLE1`](crate::engine::robot::presets::TABLE1)) times `error_scale`.
     #[default]
     Table1,
     /// Independent Gaussian errors: σ = [`RANDOM_ANGLE_SIGMA_DEG`]·scale for
@@ -53,7 +53,7 @@ pub enum InitialHandEye {
     /// measurements (paper 3.1).
     #[default]
     None,
-    /// The paper's initial hand-eye ([`PAPER_INITIAL_HAND_EYE_ROWS`]).
+    /// The paper's initial hand-eye ([`PAPER_INITIAL_HAND_EYE_ROWS`](crate::engine::cell::sensor::PAPER_INITIAL_HAND_EYE_ROWS)).
     Paper,
     /// The true hand-eye (a perfect start, for tests).
     Truth,
@@ -192,7 +192,7 @@ impl Default for SimConfig {
     }
 }
 
-/// Why [`simulate`] could not build a session.
+/// Why [`simulate`](crate::engine::simulate::simulate) could not build a session.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
     /// A setting is out of range; the message names it.

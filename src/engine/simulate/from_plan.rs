@@ -26,7 +26,7 @@ pub(super) const PLAN_MIN_CUT_DEG: f64 = 5.0;
 /// precision (shared/paper/NOTES.md, "The cut angle matters").
 pub(super) const PLAN_MAX_CUT_DEG: f64 = 80.0;
 
-/// One commanded pose of a measurement plan (e.g. [`plan`](super::plan)'s
+/// One commanded pose of a measurement plan (e.g. [`plan`](crate::engine::plan::plan)'s
 /// CSV), for [`simulate_plan`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlanPose {
@@ -64,7 +64,7 @@ pub struct PlanPose {
 ///   ([`SimError::PlanMiss`]).
 /// - Stripes (or centres), noise and the reference distances between
 ///   consecutive validate stations (in order of first appearance) are made
-///   as in [`simulate`]; measurement ids are the plan's.
+///   as in [`simulate`](crate::engine::simulate::simulate); measurement ids are the plan's.
 ///
 /// # Errors
 /// [`SimError::InvalidConfig`] for a bad setting, a robot that is not

@@ -3,7 +3,7 @@
 //! ([`paper`], section 3.2, eq. 17-19) or maximum likelihood ([`ml`]),
 //! both linearised by [`estimate`] (eq. 10-16).
 //!
-//! [`prepare`] gives the sphere centres (eq. 21) and the initial hand-eye
+//! [`prepare`](fn@prepare) gives the sphere centres (eq. 21) and the initial hand-eye
 //! (eq. 6-9); [`run`] computes ε (eq. 20), and while ε is above the
 //! threshold and the iteration bound is not reached, asks the method for
 //! one update ([`Update`]) and computes ε again. Every ε goes to a progress
@@ -573,7 +573,7 @@ fn finish(
 /// `prepare` then `run` with no progress reporting.
 ///
 /// # Errors
-/// As [`prepare`] and [`run`].
+/// As [`prepare`](fn@prepare) and [`run`].
 pub fn calibrate(
     session: &Session,
     options: &Options,

@@ -12,7 +12,7 @@
 //! - settings: every scalar of the result's `solver` block and where the
 //!   initial hand-eye came from;
 //! - stripe quality: fitted radii, arc spans, cut angles, fit RMS
-//!   distribution, trimmed points, warnings (from [`solve::prepare`]);
+//!   distribution, trimmed points, warnings (from [`solve::prepare`](fn@crate::engine::solve::prepare));
 //! - the paper's Fig. 5 (within-station centre distances, per pair) and
 //!   Fig. 6 (reference-distance errors, per distance), before and after;
 //! - ε per update, and the singular values of the paper's method;
@@ -100,7 +100,7 @@ pub struct ReportInput<'a> {
     /// The result to report.
     pub result: &'a ResultFile,
     /// The session's stripe fits and initial hand-eye, when the caller has
-    /// them; `None` recomputes them with [`solve::prepare`].
+    /// them; `None` recomputes them with [`solve::prepare`](fn@crate::engine::solve::prepare).
     pub prepared: Option<&'a Prepared>,
     /// File name, time and version.
     pub meta: &'a ReportMeta,

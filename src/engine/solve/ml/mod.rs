@@ -22,7 +22,7 @@
 //!
 //! **Solver.** Levenberg-Marquardt on the stacked whitened residuals, with
 //! the unknowns scaled so that every one is in mm of motion (angles ×
-//! [`ANGLE_SCALE_MM`], as in the paper's update) and Marquardt damping
+//! [`ANGLE_SCALE_MM`](crate::engine::solve::estimate::ANGLE_SCALE_MM), as in the paper's update) and Marquardt damping
 //! `λ · diag(JᵀJ)`. The normal equations (parameters and all station
 //! centres, ≤ 36 + 3·S unknowns) are solved densely by Cholesky. One
 //! update of the loop of FORMAT.md "The iteration" is a complete LM solve
@@ -61,7 +61,7 @@
 //! residual, applied by iteratively reweighted least squares inside LM
 //! (the cost that LM compares is the robust one). Measurements whose
 //! standardised residual exceeds the 99.9 % point of χ(3) are reported as
-//! outliers; [`exclude_measurements`] removes them for a rerun.
+//! outliers; [`exclude_measurements`](crate::engine::session::exclude_measurements) removes them for a rerun.
 //!
 //! **Uncertainty.** The parameter covariance is the parameter block of the
 //! inverse of the final Gauss-Newton matrix; it predicts the standard
@@ -291,7 +291,7 @@ impl Update for MlUpdate<'_> {
         &self.state.est
     }
 
-    /// LM steps until LM converges or [`MAX_LM_STEPS`] steps were taken.
+    /// LM steps until LM converges or `MAX_LM_STEPS` steps were taken.
     fn update(&mut self, _update: usize) -> Result<Step, SolveError> {
         let mut taken = 0;
         while taken < MAX_LM_STEPS {
