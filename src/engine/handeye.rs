@@ -95,10 +95,23 @@ pub const MIN_ROTATION_CONDITION: f64 = 0.02;
 pub struct Sighting {
     /// Measurement id (for messages).
     pub id: String,
-    /// Joint readings, deg.
+    /// Joint readings, deg (empty when `flange` is given).
     pub joints: Vec<f64>,
+    /// The flange pose as the controller reported it (a pose-only
+    /// measurement), used instead of forward kinematics of `joints`.
+    pub flange: Option<Isometry3<f64>>,
     /// Sphere centre in the sensor frame, mm.
     pub centre_in_sensor: Vector3<f64>,
+}
+
+impl Sighting {
+    /// The flange pose `bT_e`: the given pose, else `robot`'s forward
+    /// kinematics of the joint readings.
+    #[must_use]
+    pub fn base_from_flange(&self, robot: &Robot) -> Isometry3<f64> {
+        self.flange
+            .unwrap_or_else(|| robot.base_from_flange(&self.joints))
+    }
 }
 
 /// The initial hand-eye and how well the data determined it.
@@ -136,7 +149,7 @@ pub fn initial_rotation(
     }
     let poses: Vec<Isometry3<f64>> = translations
         .iter()
-        .map(|s| robot.base_from_flange(&s.joints))
+        .map(|s| s.base_from_flange(robot))
         .collect();
     let first = &poses[0];
     let drift = poses
@@ -215,7 +228,7 @@ pub fn initial_translation(
     }
     let poses: Vec<Isometry3<f64>> = rotations
         .iter()
-        .map(|s| robot.base_from_flange(&s.joints))
+        .map(|s| s.base_from_flange(robot))
         .collect();
     let rs = rotation.to_rotation_matrix();
     let mut rows_a: Vec<Matrix3<f64>> = Vec::new();
@@ -320,6 +333,7 @@ mod tests {
         Sighting {
             id: id.into(),
             joints: q.to_vec(),
+            flange: None,
             centre_in_sensor: c.coords,
         }
     }
@@ -393,6 +407,7 @@ mod tests {
         let s = |id: &str, c: [f64; 3]| Sighting {
             id: id.into(),
             joints: q.to_vec(),
+            flange: None,
             centre_in_sensor: Vector3::from(c),
         };
         // Same joints: zero robot displacement → no spread.
@@ -425,6 +440,7 @@ mod tests {
         let s = |id: &str, q: [f64; 6]| Sighting {
             id: id.into(),
             joints: q.to_vec(),
+            flange: None,
             centre_in_sensor: Vector3::zeros(),
         };
         let err = initial_translation(

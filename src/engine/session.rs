@@ -92,8 +92,13 @@ pub struct Measurement {
     pub side_given: Option<i8>,
     /// Effective side: `side_given`, else the session's `sensor.side`.
     pub side: i8,
-    /// Joint readings, deg, one per robot joint.
+    /// Joint readings, deg, one per robot joint; empty when the
+    /// measurement gives its flange pose instead.
     pub joints: Vec<f64>,
+    /// The flange pose `bT_e` as the controller reported it (FORMAT.md
+    /// `measurements[].flange`, mm), given instead of `joints` in a
+    /// pose-only session.
+    pub flange: Option<Isometry3<f64>>,
     /// Stripe or centre.
     pub observation: Observation,
 }
@@ -161,8 +166,11 @@ pub struct Session {
     pub name: String,
     /// Whether `name` was written in the file (so a save keeps it absent).
     pub name_given: bool,
-    /// Nominal robot model.
+    /// Nominal robot model. A pose-only session without a `robot` block
+    /// holds a robot with no joints (see [`Session::robot_given`]).
     pub robot: Robot,
+    /// Whether the file had a `robot` block (always, unless pose-only).
+    pub robot_given: bool,
     /// Whether the file gave `robot.base` / `robot.flange` explicitly.
     pub base_given: bool,
     /// See `base_given`.
@@ -186,6 +194,38 @@ pub struct Session {
 }
 
 impl Session {
+    /// True for a pose-only session (FORMAT.md "Additions to version 1"):
+    /// every measurement gives its flange pose instead of joint readings,
+    /// so only the hand-eye and the station centres are calibrated.
+    #[must_use]
+    pub fn pose_only(&self) -> bool {
+        self.measurements
+            .first()
+            .is_some_and(|m| m.flange.is_some())
+    }
+
+    /// The robot whose parameters the solver estimates: the nominal robot,
+    /// or for a pose-only session a robot with no joints (no kinematic
+    /// unknown; the given flange poses stand in for forward kinematics).
+    #[must_use]
+    pub fn solver_robot(&self) -> Robot {
+        if self.pose_only() {
+            Robot::new(self.robot.name.clone(), Vec::new())
+        } else {
+            self.robot.clone()
+        }
+    }
+
+    /// The flange pose `bT_e` of measurement `i` under `robot`: the given
+    /// pose of a pose-only measurement, else `robot`'s forward kinematics
+    /// of its joint readings.
+    #[must_use]
+    pub fn base_from_flange(&self, robot: &Robot, i: usize) -> Isometry3<f64> {
+        let m = &self.measurements[i];
+        m.flange
+            .unwrap_or_else(|| robot.base_from_flange(&m.joints))
+    }
+
     /// Sphere radius `R`, mm.
     #[must_use]
     pub fn sphere_radius(&self) -> f64 {

@@ -370,10 +370,20 @@ impl<'a> Ctx<'a> {
 
     /// A 4×4 rigid transform (FORMAT.md "Units and frames").
     pub(super) fn matrix(&self, raw: &'a RawValue, key: &str) -> Result<Isometry3<f64>, FileError> {
-        let items: Vec<&'a RawValue> = self.parse(raw, key, None)?;
+        self.matrix_in(raw, key, None)
+    }
+
+    /// A 4×4 rigid transform inside a measurement (named in messages).
+    pub(super) fn matrix_in(
+        &self,
+        raw: &'a RawValue,
+        key: &str,
+        measurement: Option<&str>,
+    ) -> Result<Isometry3<f64>, FileError> {
+        let items: Vec<&'a RawValue> = self.parse(raw, key, measurement)?;
         if items.len() != 4 {
             return Err(self.invalid(
-                None,
+                measurement,
                 format!(
                     "{key} must be 4 rows of 4 numbers, found {} rows{}",
                     items.len(),
@@ -383,10 +393,10 @@ impl<'a> Ctx<'a> {
         }
         let mut rows = [[0.0; 4]; 4];
         for (i, (row, item)) in rows.iter_mut().zip(items).enumerate() {
-            *row = self.numbers(item, &format!("{key}[{i}]"), "", None)?;
+            *row = self.numbers(item, &format!("{key}[{i}]"), "", measurement)?;
         }
         let iso = isometry_from_rows(&rows)
-            .map_err(|e| self.invalid(None, format!("{key}: {e}{}", self.at(raw))))?;
+            .map_err(|e| self.invalid(measurement, format!("{key}: {e}{}", self.at(raw))))?;
         Ok(settle(&rows, iso))
     }
 

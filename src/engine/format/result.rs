@@ -37,10 +37,13 @@ pub struct ResultFile {
     pub hand_eye_initial: Isometry3<f64>,
     /// Calibrated hand-eye `flange_from_sensor` (`eT_s`).
     pub hand_eye: Isometry3<f64>,
-    /// The calibrated robot model.
-    pub robot: Robot,
+    /// The calibrated robot model; `None` for a pose-only session without
+    /// a robot (FORMAT.md "Additions to version 1": `robot: null`). A
+    /// pose-only session's given robot is written back unchanged.
+    pub robot: Option<Robot>,
     /// Calibrated minus nominal joint parameters (deg, mm), one per joint
-    /// (paper Table 1).
+    /// (paper Table 1); empty for a pose-only session (no kinematic
+    /// parameter is identified).
     pub joint_errors: Vec<Joint>,
     /// How the result was obtained: the method's report.
     pub solver: SolverReport,
@@ -61,10 +64,16 @@ impl PartialEq for ResultFile {
         self.session == other.session
             && same_transform(&self.hand_eye_initial, &other.hand_eye_initial)
             && same_transform(&self.hand_eye, &other.hand_eye)
-            && self.robot.name == other.robot.name
-            && self.robot.joints == other.robot.joints
-            && same_transform(&self.robot.base, &other.robot.base)
-            && same_transform(&self.robot.flange, &other.robot.flange)
+            && match (&self.robot, &other.robot) {
+                (Some(a), Some(b)) => {
+                    a.name == b.name
+                        && a.joints == b.joints
+                        && same_transform(&a.base, &b.base)
+                        && same_transform(&a.flange, &b.flange)
+                }
+                (None, None) => true,
+                _ => false,
+            }
             && self.joint_errors == other.joint_errors
             && self.solver == other.solver
             && self.iterations == other.iterations
@@ -83,8 +92,16 @@ impl ResultFile {
             session: session.name.clone(),
             hand_eye_initial: cal.hand_eye_initial,
             hand_eye: cal.hand_eye,
-            robot: cal.calibrated.clone(),
-            joint_errors: cal.calibrated.joint_errors(&cal.nominal),
+            robot: if session.pose_only() {
+                session.robot_given.then(|| session.robot.clone())
+            } else {
+                Some(cal.calibrated.clone())
+            },
+            joint_errors: if session.pose_only() {
+                Vec::new()
+            } else {
+                cal.calibrated.joint_errors(&cal.nominal)
+            },
             solver: cal.report.clone(),
             iterations: cal
                 .iterations
@@ -114,20 +131,39 @@ impl ResultFile {
 
     /// The session's nominal model: the calibrated one minus the joint
     /// errors (base and flange as calibrated; sphere data do not move them).
+    /// `None` when the result has no robot (pose-only).
     #[must_use]
-    pub fn nominal(&self) -> Robot {
-        Robot {
-            joints: self
-                .robot
+    pub fn nominal(&self) -> Option<Robot> {
+        let robot = self.robot.as_ref()?;
+        Some(Robot {
+            joints: robot
                 .joints
                 .iter()
                 .zip(&self.joint_errors)
                 .map(|(c, e)| c.minus(e))
                 .collect(),
-            ..self.robot.clone()
-        }
+            ..robot.clone()
+        })
+    }
+
+    /// The robot's name, or [`NO_ROBOT`] for a pose-only result without
+    /// a robot (what history groups such results under).
+    #[must_use]
+    pub fn robot_name(&self) -> &str {
+        self.robot.as_ref().map_or(NO_ROBOT, |r| r.name.as_str())
+    }
+
+    /// True when no kinematic parameter was identified (a pose-only
+    /// session): the result calibrates the hand-eye only.
+    #[must_use]
+    pub fn hand_eye_only(&self) -> bool {
+        self.joint_errors.is_empty()
     }
 }
+
+/// What a pose-only result without a robot is called where a robot name
+/// is expected (history's grouping, the workbench).
+pub const NO_ROBOT: &str = "(no robot: pose-only)";
 
 /// One entry of the result's `iterations`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -378,8 +414,12 @@ const RESULT_OBJECTS: &[&str] = &[
 /// The result file as read: [`ResultFile`] plus `format` and `version`
 /// (checked by [`Ctx::header`] before). Converting it to [`ResultFile`] names
 /// every field, so the two cannot drift apart.
+///
+/// Unknown top-level keys are ignored (FORMAT.md "Additions to version
+/// 1": a result may carry further keys of the engine's own); the records
+/// inside stay strict.
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a result object")]
+#[serde(expecting = "a result object")]
 struct ResultKeys {
     #[allow(dead_code, reason = "checked by the header pass")]
     format: IgnoredAny,
@@ -388,7 +428,7 @@ struct ResultKeys {
     session: String,
     hand_eye_initial: [[f64; 4]; 4],
     hand_eye: [[f64; 4]; 4],
-    robot: RobotRecord,
+    robot: Option<RobotRecord>,
     joint_errors: Vec<Joint>,
     solver: Map<String, Value>,
     iterations: Vec<IterationRecord>,
@@ -426,12 +466,12 @@ impl ResultKeys {
             session: self.session,
             hand_eye_initial: transform(&self.hand_eye_initial),
             hand_eye: transform(&self.hand_eye),
-            robot: Robot {
-                name: self.robot.name,
-                joints: self.robot.joints,
-                base: transform(&self.robot.base),
-                flange: transform(&self.robot.flange),
-            },
+            robot: self.robot.map(|r| Robot {
+                name: r.name,
+                joints: r.joints,
+                base: transform(&r.base),
+                flange: transform(&r.flange),
+            }),
             joint_errors: self.joint_errors,
             solver: solver_report(self.solver),
             iterations: self.iterations,
@@ -485,6 +525,10 @@ impl<'a> Ctx<'a> {
                 nodes = next;
             }
             for (path, node) in nodes {
+                // A pose-only result without a robot has `robot: null`.
+                if path == "robot" && node.is_null() {
+                    continue;
+                }
                 if !node.is_object() {
                     let found = match node {
                         Value::Array(_) => "an array",
@@ -503,26 +547,45 @@ impl<'a> Ctx<'a> {
     }
 
     fn check_result(&self, r: &ResultKeys) -> Result<(), FileError> {
-        for (key, rows) in [
+        let mut matrices = vec![
             ("hand_eye_initial", &r.hand_eye_initial),
             ("hand_eye", &r.hand_eye),
-            ("robot.base", &r.robot.base),
-            ("robot.flange", &r.robot.flange),
-        ] {
+        ];
+        if let Some(robot) = &r.robot {
+            matrices.push(("robot.base", &robot.base));
+            matrices.push(("robot.flange", &robot.flange));
+        }
+        for (key, rows) in matrices {
             isometry_from_rows(rows).map_err(|e| self.invalid(None, format!("{key}: {e}")))?;
         }
-        if r.robot.joints.is_empty() {
-            return Err(self.invalid(None, "robot.joints is empty: at least one joint is needed"));
-        }
-        if r.joint_errors.len() != r.robot.joints.len() {
-            return Err(self.invalid(
-                None,
-                format!(
-                    "joint_errors has {} entries, robot.joints has {}; one is needed per joint",
-                    r.joint_errors.len(),
-                    r.robot.joints.len()
-                ),
-            ));
+        match &r.robot {
+            Some(robot) if robot.joints.is_empty() => {
+                return Err(
+                    self.invalid(None, "robot.joints is empty: at least one joint is needed")
+                );
+            }
+            // A pose-only result identifies no kinematic parameter.
+            Some(_) | None if r.joint_errors.is_empty() => {}
+            Some(robot) if r.joint_errors.len() != robot.joints.len() => {
+                return Err(self.invalid(
+                    None,
+                    format!(
+                        "joint_errors has {} entries, robot.joints has {}; one is needed per joint (or none, for a pose-only result)",
+                        r.joint_errors.len(),
+                        robot.joints.len()
+                    ),
+                ));
+            }
+            Some(_) => {}
+            None => {
+                return Err(self.invalid(
+                    None,
+                    format!(
+                        "joint_errors has {} entries but robot is null; a result without a robot (pose-only) has none",
+                        r.joint_errors.len()
+                    ),
+                ));
+            }
         }
         match r.solver.get("method") {
             Some(Value::String(m)) if !m.is_empty() => {}
@@ -582,7 +645,7 @@ struct ResultOut<'a> {
     session: &'a str,
     hand_eye_initial: [[f64; 4]; 4],
     hand_eye: [[f64; 4]; 4],
-    robot: RobotRecord,
+    robot: Option<RobotRecord>,
     joint_errors: &'a [Joint],
     #[serde(serialize_with = "method_first")]
     solver: Map<String, Value>,
@@ -618,7 +681,7 @@ impl<'a> ResultOut<'a> {
             session: &r.session,
             hand_eye_initial: rows_from_isometry(&r.hand_eye_initial),
             hand_eye: rows_from_isometry(&r.hand_eye),
-            robot: RobotRecord::from_robot(&r.robot),
+            robot: r.robot.as_ref().map(RobotRecord::from_robot),
             joint_errors: &r.joint_errors,
             solver: solver_block(&r.solver),
             iterations: &r.iterations,

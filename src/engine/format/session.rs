@@ -131,7 +131,7 @@ keys_struct!(SolverKeys, "an object with threshold and max_iterations" {
 });
 keys_struct!(ReferenceKeys, "an object with from, to and distance" { from, to, distance });
 keys_struct!(MeasurementKeys, "a measurement object" {
-    id, station, usage as "use", side, joints, stripe, centre,
+    id, station, usage as "use", side, joints, flange, stripe, centre,
 });
 keys_struct!(StripeKeys, "an object with points" { points });
 
@@ -146,8 +146,12 @@ impl<'a> Ctx<'a> {
                 |s| s.to_string_lossy().into_owned(),
             ),
         };
-        let robot_raw = self.required(keys.robot, top, "", "robot", None)?;
-        let (robot, base_given, flange_given) = self.robot(robot_raw)?;
+        let robot_given = keys.robot.is_some();
+        let (robot, base_given, flange_given) = match keys.robot {
+            Some(raw) => self.robot(raw)?,
+            // Only a pose-only session may leave it out (checked below).
+            None => (Robot::new(String::new(), Vec::new()), false, false),
+        };
         let sphere_diameter =
             self.sphere(self.required(keys.sphere, top, "", "sphere", None)?)?;
         let sensor_given = keys.sensor.is_some();
@@ -175,7 +179,7 @@ impl<'a> Ctx<'a> {
         let mut measurements = Vec::with_capacity(items.len());
         let mut first_index: HashMap<String, usize> = HashMap::new();
         for (index, raw) in items.into_iter().enumerate() {
-            let m = self.measurement(index, raw, robot.joints.len(), default_side)?;
+            let m = self.measurement(index, raw, &robot, robot_given, default_side)?;
             if let Some(&first) = first_index.get(&m.id) {
                 return Err(self.invalid(
                     Some(&m.id),
@@ -187,12 +191,19 @@ impl<'a> Ctx<'a> {
                 ));
             }
             first_index.insert(m.id.clone(), index);
+            if let Some(first) = measurements.first() {
+                self.same_pose_kind(first, &m, raw)?;
+            }
             measurements.push(m);
+        }
+        if !robot_given && measurements.is_empty() {
+            self.required(keys.robot, top, "", "robot", None)?;
         }
         let mut session = Session {
             name,
             name_given,
             robot,
+            robot_given,
             base_given,
             flange_given,
             sphere_diameter,
@@ -303,13 +314,45 @@ impl<'a> Ctx<'a> {
         Ok(solver)
     }
 
+    /// Every measurement gives `joints`, or every one gives `flange`
+    /// (FORMAT.md "Additions to version 1"): mixing them is an error.
+    fn same_pose_kind(
+        &self,
+        first: &Measurement,
+        m: &Measurement,
+        raw: &'a RawValue,
+    ) -> Result<(), FileError> {
+        let kind = |m: &Measurement| {
+            if m.flange.is_some() {
+                "flange"
+            } else {
+                "joints"
+            }
+        };
+        if kind(first) == kind(m) {
+            return Ok(());
+        }
+        Err(self.invalid(
+            Some(&m.id),
+            format!(
+                "gives `{}` but measurement {} gives `{}`: a session uses `joints` in every measurement or `flange` in every measurement, not both{}",
+                kind(m),
+                first.id,
+                kind(first),
+                self.at(raw)
+            ),
+        ))
+    }
+
     fn measurement(
         &self,
         index: usize,
         raw: &'a RawValue,
-        robot_joints: usize,
+        robot: &Robot,
+        robot_given: bool,
         default_side: i8,
     ) -> Result<Measurement, FileError> {
+        let robot_joints = robot.joints.len();
         // The id is picked out leniently first so that every later error,
         // even a malformed key, can name the measurement.
         let lenient_id = serde_json::from_str::<Value>(raw.get())
@@ -369,19 +412,45 @@ impl<'a> Ctx<'a> {
             None => None,
         };
 
-        let joints_raw = self.required(keys.joints, raw, &scope, "joints", m)?;
-        let joints: Vec<f64> = self.array(joints_raw, &join(&scope, "joints"), m)?;
-        if joints.len() != robot_joints {
-            return Err(self.invalid(
-                m,
-                format!(
-                    "{} has {} readings, the robot has {robot_joints} joints{}",
-                    join(&scope, "joints"),
-                    joints.len(),
-                    self.at(joints_raw)
-                ),
-            ));
-        }
+        let (joints, flange) = match (keys.joints, keys.flange) {
+            (Some(_), Some(_)) => {
+                return Err(self.invalid(
+                    m,
+                    format!(
+                        "{}both `joints` and `flange` are given; give exactly one{}",
+                        prefix(&scope),
+                        self.at(raw)
+                    ),
+                ));
+            }
+            (None, None) => {
+                return Err(self.invalid(
+                    m,
+                    format!(
+                        "{}missing key `joints` (or `flange`, the flange pose, in a pose-only session){}",
+                        prefix(&scope),
+                        self.at(raw)
+                    ),
+                ));
+            }
+            (None, Some(flange_raw)) => {
+                let pose = self.matrix_in(flange_raw, &join(&scope, "flange"), m)?;
+                (Vec::new(), Some(pose))
+            }
+            (Some(joints_raw), None) => {
+                if !robot_given {
+                    return Err(self.invalid(
+                        m,
+                        format!(
+                            "{}gives `joints` but the session has no `robot`: joint readings need the robot model (only a pose-only session, `flange` in every measurement, may leave `robot` out){}",
+                            prefix(&scope),
+                            self.at(joints_raw)
+                        ),
+                    ));
+                }
+                (self.joints(joints_raw, &scope, m, robot_joints)?, None)
+            }
+        };
 
         let observation = match (keys.stripe, keys.centre) {
             (Some(_), Some(_)) => {
@@ -443,8 +512,32 @@ impl<'a> Ctx<'a> {
             side_given,
             side: side_given.unwrap_or(default_side),
             joints,
+            flange,
             observation,
         })
+    }
+
+    /// The joint readings of a measurement: one per robot joint.
+    fn joints(
+        &self,
+        raw: &'a RawValue,
+        scope: &str,
+        m: Option<&str>,
+        robot_joints: usize,
+    ) -> Result<Vec<f64>, FileError> {
+        let joints: Vec<f64> = self.array(raw, &join(scope, "joints"), m)?;
+        if joints.len() != robot_joints {
+            return Err(self.invalid(
+                m,
+                format!(
+                    "{} has {} readings, the robot has {robot_joints} joints{}",
+                    join(scope, "joints"),
+                    joints.len(),
+                    self.at(raw)
+                ),
+            ));
+        }
+        Ok(joints)
     }
 
     fn reference_distances(
@@ -521,7 +614,8 @@ struct SessionOut<'a> {
     version: u32,
     #[serde(skip_serializing_if = "Option::is_none")]
     name: Option<&'a str>,
-    robot: RobotOut<'a>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    robot: Option<RobotOut<'a>>,
     sphere: SphereOut,
     #[serde(skip_serializing_if = "Option::is_none")]
     sensor: Option<SensorOut>,
@@ -575,7 +669,10 @@ struct MeasurementOut<'a> {
     usage: &'static str,
     #[serde(skip_serializing_if = "Option::is_none")]
     side: Option<i8>,
-    joints: &'a [f64],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    joints: Option<&'a [f64]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    flange: Option<[[f64; 4]; 4]>,
     #[serde(skip_serializing_if = "Option::is_none")]
     stripe: Option<StripeOut<'a>>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -598,12 +695,12 @@ impl<'a> SessionOut<'a> {
             format: SESSION_FORMAT,
             version: FORMAT_VERSION,
             name: s.name_given.then_some(s.name.as_str()),
-            robot: RobotOut {
+            robot: (s.robot_given || !s.pose_only()).then(|| RobotOut {
                 name: &s.robot.name,
                 joints: &s.robot.joints,
                 base: matrix(s.base_given, &s.robot.base),
                 flange: matrix(s.flange_given, &s.robot.flange),
-            },
+            }),
             sphere: SphereOut {
                 diameter: s.sphere_diameter,
             },
@@ -638,7 +735,8 @@ impl<'a> SessionOut<'a> {
                     side: m
                         .side_given
                         .or((m.side != s.default_side).then_some(m.side)),
-                    joints: &m.joints,
+                    joints: m.flange.is_none().then_some(m.joints.as_slice()),
+                    flange: m.flange.as_ref().map(rows_from_isometry),
                     stripe: match &m.observation {
                         Observation::Stripe(points) => Some(StripeOut { points }),
                         Observation::Centre(_) => None,

@@ -227,9 +227,11 @@ pub(super) fn build_entry(
             prior_held,
         });
     }
-    let nominal: Vec<Joint> = result
-        .robot
-        .joints
+    let calibrated: Vec<Joint> = match &result.robot {
+        Some(r) if !result.hand_eye_only() => r.joints.clone(),
+        _ => Vec::new(),
+    };
+    let nominal: Vec<Joint> = calibrated
         .iter()
         .zip(&result.joint_errors)
         .map(|(c, e)| c.minus(e))
@@ -241,7 +243,7 @@ pub(super) fn build_entry(
         paired_by,
         date,
         date_source,
-        robot: result.robot.name.clone(),
+        robot: result.robot_name().to_string(),
         session: result.session.clone(),
         method,
         epsilon_before: result.epsilon_before,
@@ -253,7 +255,7 @@ pub(super) fn build_entry(
         hand_eye,
         hand_eye_initial,
         nominal,
-        calibrated: result.robot.joints.clone(),
+        calibrated,
         joint_errors: result.joint_errors.clone(),
         params,
         estimated: info.estimated,

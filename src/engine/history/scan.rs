@@ -77,10 +77,11 @@ pub fn scan(folder: &Path) -> Result<Library, HistoryError> {
         let session = session_index.map(|i| &sessions[i]);
         let (date, date_source) = entry_date(&result, &path, modified, session);
         if let Some((s, _)) = session {
-            if s.robot != result.robot.name {
+            if s.robot != result.robot_name() {
                 notes.push(format!(
                     "the session file's robot is {:?}, the result's {:?}",
-                    s.robot, result.robot.name
+                    s.robot,
+                    result.robot_name()
                 ));
             }
             if paired_by == Some(PairedBy::FileName) && s.name != result.session {
@@ -224,7 +225,11 @@ pub(super) fn read_file(path: &Path) -> Result<Found, String> {
             let s = format::parse_session(&text, path).map_err(|e| file_error_message(&e))?;
             Ok(Found::Session {
                 name: s.name,
-                robot: s.robot.name,
+                robot: if s.robot_given {
+                    s.robot.name
+                } else {
+                    crate::engine::format::result::NO_ROBOT.to_string()
+                },
                 measurements: s.measurements.len(),
                 modified,
             })

@@ -565,10 +565,15 @@ pub fn load_robot(source: &RobotSource) -> Result<Robot, ImportError> {
                 path: path.clone(),
                 source,
             })?;
+            let no_robot = || ImportError::File {
+                path: path.clone(),
+                message: "the file has no robot model (a pose-only session or result)".into(),
+            };
             match parse_session(&text, path) {
-                Ok(s) => Ok(s.robot),
+                Ok(s) if s.robot_given => Ok(s.robot),
+                Ok(_) => Err(no_robot()),
                 Err(session_error) => match parse_result(&text, path) {
-                    Ok(r) => Ok(r.robot),
+                    Ok(r) => r.robot.ok_or_else(no_robot),
                     Err(_) => Err(ImportError::Session(session_error)),
                 },
             }
@@ -765,6 +770,7 @@ pub fn import(spec: &ImportSpec) -> Result<(Session, Vec<PoseCheck>), ImportErro
             side_given,
             side: side_given.unwrap_or(1),
             joints,
+            flange: None,
             observation: Observation::Stripe(points),
         });
     }
@@ -779,6 +785,7 @@ pub fn import(spec: &ImportSpec) -> Result<(Session, Vec<PoseCheck>), ImportErro
         base_given: robot.base != Isometry3::identity(),
         flange_given: robot.flange != Isometry3::identity(),
         robot,
+        robot_given: true,
         sphere_diameter: spec.sphere_diameter,
         default_side: 1,
         sensor_given: false,

@@ -451,6 +451,7 @@ impl Planner<'_> {
         Sighting {
             id: id.to_owned(),
             joints: c.joints.to_vec(),
+            flange: None,
             centre_in_sensor: c.centre,
         }
     }
@@ -501,6 +502,7 @@ impl Planner<'_> {
                 side_given: Some(cand.side),
                 side: cand.side,
                 joints: cand.joints.to_vec(),
+                flange: None,
                 observation: Observation::Centre(cand.centre),
             });
             prepared.push(solve::PreparedMeasurement {
@@ -522,6 +524,7 @@ impl Planner<'_> {
             name: "plan".to_owned(),
             name_given: true,
             robot: c.robot.clone(),
+            robot_given: true,
             base_given: false,
             flange_given: false,
             sphere_diameter: c.diameter,

@@ -60,6 +60,11 @@ pub enum ModelFormat {
 /// Why a model cannot be exported.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ExportError {
+    /// The result calibrated no kinematic model (a pose-only session).
+    #[error(
+        "the result has no calibrated kinematic model: it is of a pose-only session (flange poses, no joints), so only the hand-eye was calibrated; export the hand-eye from the result file instead"
+    )]
+    HandEyeOnly,
     /// `joint_errors` does not have one entry per joint.
     #[error("`joint_errors` has {found} entries, the robot has {joints} joints")]
     JointErrorCount {
@@ -87,31 +92,29 @@ pub fn export(
     format: ModelFormat,
     source: &str,
 ) -> Result<String, ExportError> {
-    check(result)?;
+    let robot = check(result)?;
     Ok(match format {
-        ModelFormat::Json => robot_json(result),
-        ModelFormat::Csv => mdh_csv(result),
-        ModelFormat::Urdf => urdf(result, source),
+        ModelFormat::Json => robot_json(robot),
+        ModelFormat::Csv => mdh_csv(result, robot),
+        ModelFormat::Urdf => urdf(result, robot, source),
     })
 }
 
 /// Checks what the exporters rely on: finite joints, one joint error per
 /// joint.
-fn check(result: &ResultFile) -> Result<(), ExportError> {
-    let joints = result.robot.joints.len();
+fn check(result: &ResultFile) -> Result<&Robot, ExportError> {
+    let robot = match &result.robot {
+        Some(r) if !result.hand_eye_only() => r,
+        _ => return Err(ExportError::HandEyeOnly),
+    };
+    let joints = robot.joints.len();
     if result.joint_errors.len() != joints {
         return Err(ExportError::JointErrorCount {
             found: result.joint_errors.len(),
             joints,
         });
     }
-    for (i, (j, e)) in result
-        .robot
-        .joints
-        .iter()
-        .zip(&result.joint_errors)
-        .enumerate()
-    {
+    for (i, (j, e)) in robot.joints.iter().zip(&result.joint_errors).enumerate() {
         for (k, v) in joint_values(j).iter().chain(&joint_values(e)).enumerate() {
             if !v.is_finite() {
                 let what = if k < 5 {
@@ -125,7 +128,7 @@ fn check(result: &ResultFile) -> Result<(), ExportError> {
             }
         }
     }
-    Ok(())
+    Ok(robot)
 }
 
 fn joint_values(j: &Joint) -> [f64; 5] {
@@ -137,8 +140,8 @@ fn joint_values(j: &Joint) -> [f64; 5] {
 /// in mm), pretty-printed with a trailing newline. Numbers are written so
 /// that they read back to the same `f64`.
 #[must_use]
-pub fn robot_json(result: &ResultFile) -> String {
-    let mut text = serde_json::to_string_pretty(&RobotRecord::from_robot(&result.robot))
+fn robot_json(robot: &Robot) -> String {
+    let mut text = serde_json::to_string_pretty(&RobotRecord::from_robot(robot))
         .unwrap_or_else(|e| format!("serialisation failed: {e}"));
     text.push('\n');
     text
@@ -156,17 +159,11 @@ pub fn robot_json(result: &ResultFile) -> String {
 /// Numbers use Rust's shortest round-trip form, so they read back to the
 /// same `f64`.
 #[must_use]
-pub fn mdh_csv(result: &ResultFile) -> String {
+fn mdh_csv(result: &ResultFile, robot: &Robot) -> String {
     let mut out = String::new();
     out.push_str(CSV_HEADER);
     out.push('\n');
-    for (i, (j, e)) in result
-        .robot
-        .joints
-        .iter()
-        .zip(&result.joint_errors)
-        .enumerate()
-    {
+    for (i, (j, e)) in robot.joints.iter().zip(&result.joint_errors).enumerate() {
         let _ = write!(out, "{}", i + 1);
         for v in joint_values(j).iter().chain(&joint_values(e)) {
             let _ = write!(out, ",{v}");
@@ -177,8 +174,8 @@ pub fn mdh_csv(result: &ResultFile) -> String {
     out.push_str(CSV_MATRIX_HEADER);
     out.push('\n');
     for (name, m) in [
-        ("base", &result.robot.base),
-        ("flange", &result.robot.flange),
+        ("base", &robot.base),
+        ("flange", &robot.flange),
         ("hand_eye", &result.hand_eye),
     ] {
         for (r, row) in rows_from_isometry(m).iter().enumerate() {
@@ -304,8 +301,7 @@ fn push_fixed(out: &mut String, name: &str, parent: &str, child: &str, origin: &
 /// no geometry or inertia, and the joint limits are not part of the
 /// calibration: the fragment says to take them from the vendor's URDF.
 ///
-pub fn urdf(result: &ResultFile, source: &str) -> String {
-    let robot = &result.robot;
+fn urdf(result: &ResultFile, robot: &Robot, source: &str) -> String {
     let hand_eye = result.hand_eye;
     let n = robot.joints.len();
     let mut out = String::new();

@@ -236,6 +236,7 @@ pub fn simulate_plan(
         name: name.clone(),
         name_given: true,
         robot: nominal.clone(),
+        robot_given: true,
         base_given: nominal.base != Isometry3::identity(),
         flange_given: nominal.flange != Isometry3::identity(),
         sphere_diameter: config.diameter,

@@ -165,6 +165,7 @@ fn record(
             side_given: (pose.side != default_side).then_some(pose.side),
             side: pose.side,
             joints,
+            flange: None,
             observation,
         });
         truths.push((
@@ -284,6 +285,7 @@ pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
         name: name.clone(),
         name_given: true,
         robot: nominal.clone(),
+        robot_given: true,
         base_given: false,
         flange_given: false,
         sphere_diameter: config.diameter,

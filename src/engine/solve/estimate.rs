@@ -49,7 +49,7 @@ impl Estimate {
     /// The base-frame sphere centre of one sighting (eq. 10), mm.
     #[must_use]
     pub fn centre_in_base(&self, s: &Sighting) -> Vector3<f64> {
-        let base_from_sensor = self.robot.base_from_flange(&s.joints) * self.flange_from_sensor;
+        let base_from_sensor = s.base_from_flange(&self.robot) * self.flange_from_sensor;
         (base_from_sensor * Point3::from(s.centre_in_sensor)).coords
     }
 
@@ -113,7 +113,11 @@ pub fn unknown_scale(k: usize) -> f64 {
 /// to `ΔY` (the bracket of eq. 17 for one measurement), and the centre.
 #[must_use]
 pub fn sensitivity(est: &Estimate, s: &Sighting) -> (Vector3<f64>, DMatrix<f64>) {
-    let (base_from_flange, jac) = est.robot.flange_jacobian(&s.joints);
+    let (base_from_flange, jac) = match &s.flange {
+        // A given flange pose does not depend on the kinematic parameters.
+        Some(pose) => (*pose, nalgebra::Matrix6xX::zeros(est.robot.n_params())),
+        None => est.robot.flange_jacobian(&s.joints),
+    };
     let base_from_sensor = base_from_flange * est.flange_from_sensor;
     let x_b = (base_from_sensor * Point3::from(s.centre_in_sensor)).coords;
     let r_bs: Matrix3<f64> = base_from_sensor.rotation.to_rotation_matrix().into_inner();
@@ -147,6 +151,7 @@ mod tests {
         let s = Sighting {
             id: "x".into(),
             joints: vec![12.5, 20.1, -3.4, 40.0, 35.2, -10.0],
+            flange: None,
             centre_in_sensor: Vector3::new(12.2, -1.3, 2.4),
         };
         let (x0, a) = sensitivity(&est, &s);

@@ -412,7 +412,7 @@ pub fn run(
         });
     }
     let start = Estimate {
-        robot: session.robot.clone(),
+        robot: session.solver_robot(),
         flange_from_sensor: prepared.hand_eye_initial,
     };
     let mut method: Box<dyn Update> = match options.method {
@@ -514,8 +514,7 @@ fn finish(
     report: SolverReport,
 ) -> Calibration {
     let centre = |e: &Estimate, i: usize| -> Vector3<f64> {
-        let m = &session.measurements[i];
-        let base_from_sensor = e.robot.base_from_flange(&m.joints) * e.flange_from_sensor;
+        let base_from_sensor = session.base_from_flange(&e.robot, i) * e.flange_from_sensor;
         (base_from_sensor * Point3::from(prepared.measurements[i].centre_in_sensor)).coords
     };
     let centres: Vec<CentreRow> = (0..session.measurements.len())
@@ -557,7 +556,7 @@ fn finish(
     };
     Calibration {
         options: *options,
-        nominal: session.robot.clone(),
+        nominal: session.solver_robot(),
         calibrated: est.robot,
         hand_eye_initial: start.flange_from_sensor,
         hand_eye: est.flange_from_sensor,

@@ -94,6 +94,7 @@ fn sighting(session: &Session, i: usize, centre_in_sensor: Vector3<f64>) -> Sigh
     Sighting {
         id: m.id.clone(),
         joints: m.joints.clone(),
+        flange: m.flange,
         centre_in_sensor,
     }
 }

@@ -67,10 +67,11 @@ pub(super) struct Identifiability {
 /// exactly null, as it is for distances, and every exact redundancy of
 /// the model (`theta6` with the hand-eye, say) stays exact.
 pub(super) fn sensitivity_at(est: &Estimate, s: &Sighting, point: &Vector3<f64>) -> DMatrix<f64> {
-    let base_from_sensor = est.robot.base_from_flange(&s.joints) * est.flange_from_sensor;
+    let base_from_sensor = s.base_from_flange(&est.robot) * est.flange_from_sensor;
     let moved = Sighting {
         id: s.id.clone(),
         joints: s.joints.clone(),
+        flange: s.flange,
         centre_in_sensor: base_from_sensor
             .inverse_transform_point(&nalgebra::Point3::from(*point))
             .coords,
