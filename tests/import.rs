@@ -110,7 +110,7 @@ fn spec(dir: &Path, o: &LogOptions) -> ImportSpec {
         },
         joint_unit: AngleUnit::Deg,
         profiles: ProfileSource::Folder(dir.join("profiles")),
-        profile_unit: LengthUnit::Mm,
+        profile_format: import::ProfileFormat::default(),
         robot: RobotSource::Preset("irb2400".into()),
         sphere_diameter: DEFAULT_SPHERE_DIAMETER,
         name: Some("imported".into()),
@@ -138,7 +138,9 @@ fn simulated_session_round_trips_and_calibrates() {
     let original = simulated();
     let dir = tempfile::tempdir().unwrap();
     write_files(&original, dir.path(), &PLAIN);
-    let (session, checks) = import::import(&spec(dir.path(), &PLAIN)).unwrap();
+    let import::Imported {
+        session, checks, ..
+    } = import::import(&spec(dir.path(), &PLAIN)).unwrap();
     assert!(checks.is_empty());
     assert_same_measurements(&original, &session);
     assert_eq!(session.robot, robot::irb2400().robot);
@@ -174,8 +176,8 @@ fn radians_semicolons_and_micrometres_convert() {
     }
     let mut s = spec(dir.path(), &o);
     s.joint_unit = AngleUnit::Rad;
-    s.profile_unit = LengthUnit::Um;
-    let (session, _) = import::import(&s).unwrap();
+    s.profile_format.unit = LengthUnit::Um;
+    let import::Imported { session, .. } = import::import(&s).unwrap();
     for (x, y) in original.measurements.iter().zip(&session.measurements) {
         for (p, q) in x.joints.iter().zip(&y.joints) {
             assert!((p - q).abs() < 1e-9, "{}: joint {p} vs {q}", x.id);
@@ -211,7 +213,7 @@ fn single_profile_file_with_pose_column() {
         path: file,
         pose_column: "pose".into(),
     };
-    let (session, _) = import::import(&s).unwrap();
+    let import::Imported { session, .. } = import::import(&s).unwrap();
     assert_same_measurements(&original, &session);
 }
 
@@ -225,7 +227,7 @@ fn correct_flange_poses_pass_in_every_convention() {
             ..PLAIN
         };
         write_files(&original, dir.path(), &o);
-        let (_, checks) = import::import(&spec(dir.path(), &o)).unwrap();
+        let import::Imported { checks, .. } = import::import(&spec(dir.path(), &o)).unwrap();
         assert_eq!(checks.len(), original.measurements.len());
         for ch in &checks {
             assert!(
@@ -276,7 +278,7 @@ fn radians_declared_degrees_are_flagged_with_the_unit_hint() {
         ..PLAIN
     };
     write_files(&original, dir.path(), &o);
-    let (_, checks) = import::import(&spec(dir.path(), &o)).unwrap();
+    let import::Imported { checks, .. } = import::import(&spec(dir.path(), &o)).unwrap();
     for ch in &checks {
         assert!(ch.flagged, "{ch:?}");
         assert!(
@@ -298,7 +300,7 @@ fn swapped_joint_columns_are_flagged_with_the_swap_hint() {
         ..PLAIN
     };
     write_files(&original, dir.path(), &o);
-    let (_, checks) = import::import(&spec(dir.path(), &o)).unwrap();
+    let import::Imported { checks, .. } = import::import(&spec(dir.path(), &o)).unwrap();
     // Where joints 2 and 3 read nearly the same, a swap is invisible.
     let visible: Vec<_> = checks
         .iter()
@@ -329,7 +331,7 @@ fn wrong_robot_is_flagged() {
     write_files(&original, dir.path(), &o);
     let mut s = spec(dir.path(), &o);
     s.robot = RobotSource::Preset("irb120".into());
-    let (_, checks) = import::import(&s).unwrap();
+    let import::Imported { checks, .. } = import::import(&s).unwrap();
     assert!(checks.iter().all(|c| c.flagged));
     assert!(
         checks
@@ -400,9 +402,14 @@ fn session_rules_are_the_loaders() {
         "y,z\n1,2\n2,3\n3,4\n",
     )
     .unwrap();
+    // The message names the pose and the profile file it came from (not a
+    // line of the generated session JSON).
     let e = import::import(&spec(dir.path(), &PLAIN)).unwrap_err();
-    assert!(matches!(e, ImportError::Session(_)), "{e:?}");
-    assert!(e.to_string().contains(id.as_str()), "{e}");
+    assert!(matches!(e, ImportError::File { .. }), "{e:?}");
+    let text = e.to_string();
+    assert!(text.contains(&format!("pose {id}")), "{text}");
+    assert!(text.contains(&format!("{id}.csv")), "{text}");
+    assert!(text.contains("at least 5"), "{text}");
 }
 
 #[test]
@@ -508,7 +515,7 @@ fn reference_distances_import_and_validate() {
     write_files(&original, dir.path(), &PLAIN);
     let mut s = spec(dir.path(), &PLAIN);
     s.references = Some(write_references(&original, dir.path()));
-    let (session, _) = import::import(&s).unwrap();
+    let import::Imported { session, .. } = import::import(&s).unwrap();
     assert_eq!(session.reference_distances, original.reference_distances);
     let (_, cal) = solve::calibrate(&session, &Options::from_session(&session)).unwrap();
     let v = cal.validation.as_ref().expect("validation with references");
@@ -561,7 +568,7 @@ fn a_side_column_is_read_without_a_mapping() {
     write_files(&original, dir.path(), &PLAIN);
     let mut s = spec(dir.path(), &PLAIN);
     s.columns.side = None;
-    let (session, _) = import::import(&s).unwrap();
+    let import::Imported { session, .. } = import::import(&s).unwrap();
     for (a, b) in session.measurements.iter().zip(&original.measurements) {
         assert_eq!(a.side, b.side, "{}", a.id);
     }

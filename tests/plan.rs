@@ -16,8 +16,8 @@ use nalgebra::{Point3, Vector3};
 use spherecal::engine::evaluate;
 use spherecal::engine::format;
 use spherecal::engine::import::{
-    self, AngleUnit, ColumnMap, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit,
-    ProfileSource, RobotSource,
+    self, AngleUnit, ColumnMap, FlangeCheck, FlangeConvention, ImportSpec, ProfileSource,
+    RobotSource,
 };
 use spherecal::engine::plan::{
     self, Controller, Plan, PlanConfig, PlanError, PredictConfig, Selection, StationRole,
@@ -315,7 +315,7 @@ fn import_spec(dir: &Path, joint_log: &Path, robot: &Plan) -> ImportSpec {
         },
         joint_unit: AngleUnit::Deg,
         profiles: ProfileSource::Folder(dir.join("profiles")),
-        profile_unit: LengthUnit::Mm,
+        profile_format: import::ProfileFormat::default(),
         robot: RobotSource::Preset("irb2400".into()),
         sphere_diameter: robot.diameter,
         name: None,
@@ -361,7 +361,11 @@ fn simulated_data_from_a_plan_imports_through_the_csv_path_and_calibrates() {
     .unwrap();
     write_import_files(&session, dir.path());
     let spec = import_spec(dir.path(), &dir.path().join("joints.csv"), plan);
-    let (imported, checks) = import::import(&spec).unwrap();
+    let import::Imported {
+        session: imported,
+        checks,
+        ..
+    } = import::import(&spec).unwrap();
     assert_eq!(checks.len(), plan.poses.len());
     assert!(
         checks
@@ -407,7 +411,11 @@ fn simulated_data_from_a_plan_imports_through_the_csv_path_and_calibrates() {
     write_import_files(&session, dir2.path());
     std::fs::write(dir2.path().join("plan.csv"), &csv).unwrap();
     let spec = import_spec(dir2.path(), &dir2.path().join("plan.csv"), plan);
-    let (imported, checks) = import::import(&spec).unwrap();
+    let import::Imported {
+        session: imported,
+        checks,
+        ..
+    } = import::import(&spec).unwrap();
     assert!(
         checks
             .iter()

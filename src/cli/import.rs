@@ -1,7 +1,9 @@
-//! `spherecal import`: a joint log CSV plus stripe profiles become a session
-//! file (written atomically), with an optional check of the controller's
-//! flange poses against the nominal model. A thin caller of
-//! [`crate::engine::import`].
+//! `spherecal import`: a pose log plus stripe profiles become a session
+//! file (written atomically). A joint log (`--joints`) gives a session
+//! with joint readings, with an optional check of the controller's flange
+//! poses against the nominal model; a flange-pose log (`--poses`, e.g.
+//! RobCalibrator's `RobPoses.rob`) gives a pose-only session. A thin
+//! caller of [`crate::engine::import`].
 
 use std::path::PathBuf;
 
@@ -9,28 +11,57 @@ use clap::Args;
 
 use crate::engine::format;
 use crate::engine::import::{
-    self, AngleUnit, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
-    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportError, ImportSpec, LengthUnit,
-    ProfileSource, RobotSource,
+    self, AngleUnit, AxisMap, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM,
+    DEFAULT_ROTATION_TOLERANCE_DEG, DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention,
+    ImportError, ImportSpec, Imported, LengthUnit, PoseImportSpec, ProfileFormat, ProfileSource,
+    RobotSource, SideChoice,
 };
 
 use super::CliError;
 
 /// `spherecal import`.
 #[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("log").required(true).args(["joints", "poses"])))]
 pub struct ImportArgs {
     /// The joint log CSV: one row a pose, with id, station, use and joint columns.
     #[arg(long)]
-    pub joints: PathBuf,
-    /// A folder of `<id>.csv` stripe files (columns y, z) or one CSV with a pose column.
+    pub joints: Option<PathBuf>,
+    /// A flange-pose log instead of joints (pose-only session): JSON or RobCalibrator `.rob` (a list of poses), or CSV with the convention's columns and optional id, station, use, side.
+    #[arg(long, requires = "pose_convention")]
+    pub poses: Option<PathBuf>,
+    /// How the pose log writes a pose: ABB (x y z q1..q4), KUKA (x y z A B C), FANUC (x y z W P R), UR (x y z m, rotation vector) or matrix (16 numbers row-major).
+    #[arg(long, value_parser = parse_convention)]
+    pub pose_convention: Option<FlangeConvention>,
+    /// The pose columns of a CSV pose log, in the convention's order (default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44).
+    #[arg(long, value_delimiter = ',')]
+    pub pose_columns: Vec<String>,
+    /// A folder of stripe profiles (`<id>.csv|txt|yml|yaml|json`, or for a pose log without ids every profile file in natural order) or one CSV with a pose column.
     #[arg(long)]
     pub profiles: PathBuf,
     /// Column of the pose id in a single profile file.
     #[arg(long, default_value = "pose")]
     pub pose_column: String,
-    /// Robot preset key (irb2400, irb120, ur5e) or a session/result file whose `robot` block is the nominal model.
+    /// Robot: a preset key (irb2400, irb120, ur5e), a session/result file whose `robot` block is the nominal model, a URDF or a DH table CSV (with --dh). Needed with --joints; optional with --poses.
     #[arg(long)]
-    pub robot: String,
+    pub robot: Option<String>,
+    /// The tip link of a URDF robot (default: the chain's only end link), e.g. tool0.
+    #[arg(long)]
+    pub urdf_tip: Option<String>,
+    /// The convention of a DH table robot: standard or modified.
+    #[arg(long, value_parser = super::parse_dh)]
+    pub dh: Option<crate::engine::robot::DhConvention>,
+    /// Axis map from the sensor's axes to spherecal's (laser plane x = 0): `auto` (the constant coordinate is the plane's normal) or e.g. `-y,x,z` (spherecal x = -y, y = x, z = z). A mirroring map is refused.
+    #[arg(long, default_value = "auto")]
+    pub axes: String,
+    /// The sensor's no-return value in the profiles (file units), dropped like NaN.
+    #[arg(long, allow_hyphen_values = true)]
+    pub no_return: Option<f64>,
+    /// Key of the point list in OpenCV YAML/JSON profiles (default: scan_line, profile, points, data, or the only list).
+    #[arg(long)]
+    pub profile_key: Option<String>,
+    /// Side of the sphere centres for a pose log without a side column: +1, -1 or auto (both calibrated, the clearly better chosen, else refused).
+    #[arg(long, default_value = "auto", allow_hyphen_values = true, value_parser = parse_side)]
+    pub side: SideChoice,
     /// Where to write the session file (required unless --preview).
     #[arg(long, short)]
     pub out: Option<PathBuf>,
@@ -80,8 +111,72 @@ fn parse_length_unit(s: &str) -> Result<LengthUnit, String> {
 }
 
 fn parse_convention(s: &str) -> Result<FlangeConvention, String> {
-    FlangeConvention::parse(s)
-        .ok_or_else(|| format!("unknown flange convention `{s}`, expected ABB, KUKA, FANUC or UR"))
+    FlangeConvention::parse(s).ok_or_else(|| {
+        format!("unknown pose convention `{s}`, expected ABB, KUKA, FANUC, UR or matrix")
+    })
+}
+
+fn parse_side(s: &str) -> Result<SideChoice, String> {
+    SideChoice::parse(s).ok_or_else(|| format!("unknown side `{s}`, expected +1, -1 or auto"))
+}
+
+/// A robot argument: a JSON file (session or result), a URDF, a DH table
+/// or a preset key.
+fn robot_source(args: &ImportArgs, text: &str) -> Result<RobotSource, CliError> {
+    RobotSource::from_text(text, args.urdf_tip.clone(), args.dh).map_err(CliError::input)
+}
+
+/// The profile flags as the engine's format.
+fn profile_format(args: &ImportArgs) -> Result<ProfileFormat, CliError> {
+    let axes = if args.axes.trim().eq_ignore_ascii_case("auto") {
+        None
+    } else {
+        Some(AxisMap::parse(&args.axes).map_err(|e| CliError::input(format!("--axes: {e}")))?)
+    };
+    Ok(ProfileFormat {
+        unit: args.profile_unit,
+        axes,
+        no_return: args.no_return,
+        key: args.profile_key.clone(),
+    })
+}
+
+/// Where the profiles are, from the flag.
+fn profile_source(args: &ImportArgs) -> ProfileSource {
+    if args.profiles.is_dir() {
+        ProfileSource::Folder(args.profiles.clone())
+    } else {
+        ProfileSource::File {
+            path: args.profiles.clone(),
+            pose_column: args.pose_column.clone(),
+        }
+    }
+}
+
+/// The engine's spec of a flange-pose log from the flags.
+///
+/// # Errors
+/// [`CliError`] (status 2) for a missing convention or a bad axis map.
+pub fn pose_spec(args: &ImportArgs, poses: &std::path::Path) -> Result<PoseImportSpec, CliError> {
+    let convention = args.pose_convention.ok_or_else(|| {
+        CliError::input("--poses needs --pose-convention (abb, kuka, fanuc, ur or matrix)")
+    })?;
+    Ok(PoseImportSpec {
+        poses: poses.to_path_buf(),
+        convention,
+        pose_columns: (!args.pose_columns.is_empty()).then(|| args.pose_columns.clone()),
+        profiles: profile_source(args),
+        profile_format: profile_format(args)?,
+        robot: args
+            .robot
+            .as_deref()
+            .map(|r| robot_source(args, r))
+            .transpose()?,
+        sphere_diameter: args.sphere_diameter,
+        side: args.side,
+        name: args.name.clone(),
+        references: args.references.clone(),
+    })
 }
 
 fn input(e: &ImportError) -> CliError {
@@ -93,11 +188,17 @@ fn input(e: &ImportError) -> CliError {
 /// # Errors
 /// [`CliError`] (status 2) for a bad `--map` entry or an unknown robot.
 pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
-    let robot = if args.robot.ends_with(".json") {
-        RobotSource::File(PathBuf::from(&args.robot))
-    } else {
-        RobotSource::Preset(args.robot.clone())
+    let Some(joint_log) = &args.joints else {
+        return Err(CliError::input("a joint log (--joints) is needed here"));
     };
+    let robot = robot_source(
+        args,
+        args.robot.as_deref().ok_or_else(|| {
+            CliError::input(
+                "--joints needs --robot (a preset key, a session/result file, a URDF or a DH table)",
+            )
+        })?,
+    )?;
     let dof = import::load_robot(&robot).map_err(|e| input(&e))?.dof();
     let mut columns = ColumnMap {
         id: "id".into(),
@@ -132,14 +233,7 @@ pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
             }
         }
     }
-    let profiles = if args.profiles.is_dir() {
-        ProfileSource::Folder(args.profiles.clone())
-    } else {
-        ProfileSource::File {
-            path: args.profiles.clone(),
-            pose_column: args.pose_column.clone(),
-        }
-    };
+    let profiles = profile_source(args);
     let flange = args.flange_poses.map(|convention| {
         let mut check = FlangeCheck::new(convention);
         if !args.flange_columns.is_empty() {
@@ -150,16 +244,23 @@ pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
         check
     });
     Ok(ImportSpec {
-        joint_log: args.joints.clone(),
+        joint_log: joint_log.clone(),
         columns,
         joint_unit: args.joint_unit,
         profiles,
-        profile_unit: args.profile_unit,
+        profile_format: profile_format(args)?,
         robot,
         sphere_diameter: args.sphere_diameter,
         name: args.name.clone(),
         flange,
         references: args.references.clone(),
+    })
+}
+
+/// The `--out` path, required unless only previewing.
+fn out_path(args: &ImportArgs) -> Result<PathBuf, CliError> {
+    args.out.clone().ok_or_else(|| {
+        CliError::input("--out SESSION.json is needed (or --preview N to only look)")
     })
 }
 
@@ -169,17 +270,32 @@ pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
 /// [`CliError`] with status 2 for bad input, 1 when the session cannot be
 /// written.
 pub fn run(args: &ImportArgs) -> Result<(), CliError> {
-    let spec = spec(args)?;
-    if let Some(n) = args.preview {
-        print!("{}", import::preview(&spec, n).map_err(|e| input(&e))?);
-        return Ok(());
-    }
-    let Some(out) = &args.out else {
-        return Err(CliError::input(
-            "--out SESSION.json is needed (or --preview N to only look)",
-        ));
+    let imported = if let Some(poses) = &args.poses {
+        if args.preview.is_some() {
+            return Err(CliError::input("--preview reads a joint log (--joints)"));
+        }
+        let spec = pose_spec(args, poses)?;
+        let out = out_path(args)?;
+        (import::import_poses(&spec).map_err(|e| input(&e))?, out)
+    } else {
+        let spec = spec(args)?;
+        if let Some(n) = args.preview {
+            print!("{}", import::preview(&spec, n).map_err(|e| input(&e))?);
+            return Ok(());
+        }
+        let out = out_path(args)?;
+        (import::import(&spec).map_err(|e| input(&e))?, out)
     };
-    let (session, checks) = import::import(&spec).map_err(|e| input(&e))?;
+    let (
+        Imported {
+            session,
+            checks,
+            notes,
+            ..
+        },
+        out,
+    ) = imported;
+    let out = &out;
     let text = format::session_to_json(&session);
     format::write_atomic(out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
     if !session.reference_distances.is_empty() {
@@ -203,6 +319,9 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         },
         out.display()
     );
+    for note in &notes {
+        println!("{note}");
+    }
     if !checks.is_empty() {
         let flagged: Vec<_> = checks.iter().filter(|c| c.flagged).collect();
         let worst = checks

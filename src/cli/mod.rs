@@ -159,6 +159,17 @@ impl MlArgs {
     }
 }
 
+/// `standard` or `modified` (a DH table's convention).
+fn parse_dh(s: &str) -> Result<crate::engine::robot::DhConvention, String> {
+    match s.to_ascii_lowercase().as_str() {
+        "standard" | "dh" => Ok(crate::engine::robot::DhConvention::Standard),
+        "modified" | "mdh" => Ok(crate::engine::robot::DhConvention::Modified),
+        _ => Err(format!(
+            "unknown DH convention `{s}`, expected standard or modified"
+        )),
+    }
+}
+
 fn parse_loss(s: &str) -> Result<Loss, String> {
     Loss::parse(s)
         .ok_or_else(|| format!("unknown loss `{s}`, expected `squared`, `huber` or `cauchy`"))

@@ -23,9 +23,15 @@ use crate::engine::solve::Control;
 /// `spherecal plan`.
 #[derive(Debug, Args)]
 pub struct PlanArgs {
-    /// Robot: a preset key (irb2400, irb120, ur5e) or a session/result file whose `robot` block is the nominal model.
+    /// Robot: a preset key (irb2400, irb120, ur5e), a session/result file whose `robot` block is the nominal model, a URDF (joint limits from its <limit> tags) or a DH table CSV (with --dh).
     #[arg(long, default_value = "irb2400")]
     pub robot: String,
+    /// The tip link of a URDF robot (default: the chain's only end link), e.g. tool0.
+    #[arg(long)]
+    pub urdf_tip: Option<String>,
+    /// The convention of a DH table robot: standard or modified.
+    #[arg(long, value_parser = super::parse_dh)]
+    pub dh: Option<crate::engine::robot::DhConvention>,
     /// Joint limits, deg, `min:max` per joint, comma-separated (default: the preset's; a robot from a file needs them unless it is named like a preset).
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub limits: Vec<String>,
@@ -133,7 +139,8 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
     let robot = if robot::preset(&args.robot).is_some() {
         RobotSource::Preset(args.robot.clone())
     } else {
-        RobotSource::File(PathBuf::from(&args.robot))
+        RobotSource::from_text(&args.robot, args.urdf_tip.clone(), args.dh)
+            .map_err(CliError::input)?
     };
     Ok(PlanRequest {
         limits: if args.limits.is_empty() {

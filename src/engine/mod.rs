@@ -38,4 +38,5 @@ pub mod session;
 pub mod simulate;
 pub mod solve;
 pub mod stripe;
+pub mod table;
 pub mod validate;

@@ -57,10 +57,10 @@ pub fn import_preview(
 /// line, column or pose id).
 pub fn import_session(form: &ImportForm) -> Result<Imported, JobError> {
     let spec = form.spec().map_err(JobError::ImportForm)?;
-    let (session, checks) = import::import(&spec)?;
+    let imported = import::import(&spec)?;
     Ok(Imported {
-        loaded: Box::new(analyse(session, Source::Imported(spec.joint_log))),
-        checks,
+        loaded: Box::new(analyse(imported.session, Source::Imported(spec.joint_log))),
+        checks: imported.checks,
     })
 }
 

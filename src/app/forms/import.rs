@@ -7,8 +7,8 @@ use std::path::PathBuf;
 
 use crate::engine::import::{
     AngleUnit, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
-    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit, ProfileSource,
-    RobotSource,
+    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit, ProfileFormat,
+    ProfileSource, RobotSource,
 };
 
 /// Rows the preview shows.
@@ -183,7 +183,10 @@ impl ImportForm {
             },
             joint_unit: self.joint_unit,
             profiles,
-            profile_unit: self.profile_unit,
+            profile_format: ProfileFormat {
+                unit: self.profile_unit,
+                ..ProfileFormat::default()
+            },
             robot,
             sphere_diameter: self.sphere_diameter,
             name: (!name.is_empty()).then(|| name.to_string()),

@@ -3,103 +3,14 @@
 //! the controller reports (`x,y,z,q1..q4`: ABB's mm and unit quaternion
 //! w, x, y, z), then any further columns. The planner writes it for the
 //! cell to teach, the simulator writes it as a cell would record it, and
-//! the import and the simulator read it back: one reader and one writer.
+//! the import and the simulator read it back ([`Table`](crate::engine::table::Table)):
+//! one reader and one writer.
 
 use std::fmt::Write as _;
 
 use nalgebra::Isometry3;
 
 use crate::engine::session::Use;
-
-/// A CSV table as read: header and data rows with their 1-based line
-/// numbers. Blank lines and lines starting with `#` are skipped; the
-/// separator is `;` when the header has one, else `,`; fields are trimmed
-/// and a field in double quotes loses them.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Table {
-    /// Line of the header row.
-    pub header_line: usize,
-    /// Column names as written.
-    pub header: Vec<String>,
-    /// `(line, fields)`, one per data row, each with as many fields as the header.
-    pub rows: Vec<(usize, Vec<String>)>,
-}
-
-/// Why a text is not a [`Table`]: the line and what is wrong.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{message} (line {line})")]
-pub struct TableError {
-    /// 1-based line.
-    pub line: usize,
-    /// What is wrong.
-    pub message: String,
-}
-
-/// A field with surrounding blanks and one pair of double quotes removed.
-fn clean(field: &str) -> String {
-    let f = field.trim();
-    let f = f
-        .strip_prefix('"')
-        .and_then(|s| s.strip_suffix('"'))
-        .unwrap_or(f);
-    f.trim().to_string()
-}
-
-impl Table {
-    /// Parses `text`.
-    ///
-    /// # Errors
-    /// No header row, or a data row whose field count differs from the
-    /// header's.
-    pub fn parse(text: &str) -> Result<Self, TableError> {
-        let mut lines = text
-            .lines()
-            .enumerate()
-            .map(|(i, l)| (i + 1, l))
-            .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-        let Some((header_line, header_text)) = lines.next() else {
-            return Err(TableError {
-                line: 1,
-                message: "no header row".into(),
-            });
-        };
-        let sep = if header_text.contains(';') { ';' } else { ',' };
-        let header: Vec<String> = header_text.split(sep).map(clean).collect();
-        let mut rows = Vec::new();
-        for (line, l) in lines {
-            let fields: Vec<String> = l.split(sep).map(clean).collect();
-            if fields.len() != header.len() {
-                return Err(TableError {
-                    line,
-                    message: format!("{} fields, the header has {}", fields.len(), header.len()),
-                });
-            }
-            rows.push((line, fields));
-        }
-        Ok(Self {
-            header_line,
-            header,
-            rows,
-        })
-    }
-
-    /// The index of the column named `name` (case-insensitive).
-    #[must_use]
-    pub fn column(&self, name: &str) -> Option<usize> {
-        self.header
-            .iter()
-            .position(|h| h.eq_ignore_ascii_case(name))
-    }
-
-    /// "no column `name` (the header has: …)".
-    #[must_use]
-    pub fn no_column(&self, name: &str) -> String {
-        format!(
-            "no column `{name}` (the header has: {})",
-            self.header.join(", ")
-        )
-    }
-}
 
 /// The flange pose as an ABB controller reports it: `x, y, z` (mm) and the
 /// unit quaternion `q1..q4 = w, x, y, z`, with `w ≥ 0`.
@@ -198,16 +109,5 @@ mod tests {
             assert_eq!(joint_text(q), format!("{q}"), "{q}");
         }
         assert_eq!(joint_text(12.345_678_901_234), "12.345678901");
-    }
-
-    #[test]
-    fn tables_parse_and_name_lines() {
-        let t = Table::parse("# c\nid;\"use\"\n\na;identify\n").unwrap();
-        assert_eq!(t.header, ["id", "use"]);
-        assert_eq!(t.rows, [(4, vec!["a".to_string(), "identify".to_string()])]);
-        assert_eq!(t.column("USE"), Some(1));
-        let e = Table::parse("id,use\na\n").unwrap_err();
-        assert_eq!(e.line, 2);
-        assert!(Table::parse("# only a comment\n").is_err());
     }
 }

@@ -7,9 +7,10 @@ use std::fmt::Write as _;
 use nalgebra::Vector3;
 
 use super::{Plan, PlanError};
-use crate::engine::cell::joint_log::{self, Table};
+use crate::engine::cell::joint_log;
 use crate::engine::session::Use;
 use crate::engine::simulate::PlanPose;
+use crate::engine::table::Table;
 
 /// The plan as a joint log CSV that `spherecal import` reads: header
 /// `id,station,use,side,j1..jn,x,y,z,q1,q2,q3,q4` (joints deg; the nominal

@@ -13,11 +13,11 @@ use super::config::{
     StationLayout,
 };
 use super::predict::PredictConfig;
-use crate::engine::cell::joint_log::Table;
 use crate::engine::cell::workspace;
 use crate::engine::geometry::isometry_from_rows;
 use crate::engine::import::{RobotSource, load_robot};
 use crate::engine::robot::{self, JointLimit};
+use crate::engine::table::Table;
 
 /// Why a request cannot be made into a plan configuration, or a file it
 /// names cannot be read: what and where.
@@ -153,7 +153,25 @@ impl PlanRequest {
                     .ok_or_else(|| RequestError::Robot(format!("unknown robot preset `{key}`")))?;
                 PlanConfig::for_preset(&preset, self.sphere)
             }
-            RobotSource::File(path) => {
+            RobotSource::Urdf { path, tip } => {
+                let options = robot::UrdfOptions {
+                    tip: tip.clone(),
+                    ..robot::UrdfOptions::default()
+                };
+                let urdf = robot::load_urdf(path, &options)
+                    .map_err(|e| RequestError::Robot(e.to_string()))?;
+                // A continuous joint has no limits: one turn each way.
+                let limits = urdf
+                    .limits
+                    .iter()
+                    .map(|l| robot::JointLimit {
+                        min: l.min.max(-360.0),
+                        max: l.max.min(360.0),
+                    })
+                    .collect();
+                PlanConfig::new(urdf.robot, limits, self.sphere)
+            }
+            RobotSource::File(path) | RobotSource::DhTable { path, .. } => {
                 let robot =
                     load_robot(&self.robot).map_err(|e| RequestError::Robot(e.to_string()))?;
                 match robot::presets()

@@ -1,0 +1,78 @@
+//! A CSV file of the import: a [`Table`] (the `csv` crate: quotes, a UTF-8
+//! byte-order mark, line numbers) with its path, so that every message
+//! names the file and the line.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use super::ImportError;
+use crate::engine::table::Table;
+
+/// A parsed CSV file: header and data rows with their 1-based lines.
+pub(super) struct CsvFile {
+    /// The file.
+    pub path: PathBuf,
+    /// Column names as written.
+    pub header: Vec<String>,
+    /// `(line, fields)` of every data row.
+    pub rows: Vec<(usize, Vec<String>)>,
+}
+
+impl CsvFile {
+    /// Reads and parses `path`.
+    pub fn read(path: &Path) -> Result<Self, ImportError> {
+        let text = fs::read_to_string(path).map_err(|source| ImportError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses `text`, the content of `path`.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, ImportError> {
+        let table = Table::parse(text).map_err(|e| ImportError::Csv {
+            path: path.to_path_buf(),
+            line: e.line,
+            message: e.message,
+        })?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            header: table.header,
+            rows: table.rows,
+        })
+    }
+
+    /// The index of column `name` (case-insensitive), or "no column".
+    pub fn column(&self, name: &str) -> Result<usize, ImportError> {
+        self.optional_column(name).ok_or_else(|| ImportError::File {
+            path: self.path.clone(),
+            message: format!(
+                "no column `{name}` (the header has: {})",
+                self.header.join(", ")
+            ),
+        })
+    }
+
+    /// The index of column `name` (case-insensitive), if there is one.
+    pub fn optional_column(&self, name: &str) -> Option<usize> {
+        self.header
+            .iter()
+            .position(|h| h.eq_ignore_ascii_case(name))
+    }
+
+    /// The finite number in `row[col]`, or a message naming line and column.
+    pub fn number(&self, line: usize, row: &[String], col: usize) -> Result<f64, ImportError> {
+        let s = &row[col];
+        match s.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(ImportError::Csv {
+                path: self.path.clone(),
+                line,
+                message: format!(
+                    "column `{}`: `{s}` is not a finite number",
+                    self.header[col]
+                ),
+            }),
+        }
+    }
+}
