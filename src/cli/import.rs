@@ -305,7 +305,7 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         );
     }
     println!(
-        "imported {} measurements at {} stations into {}",
+        "imported {} measurements at {} station(s) into {}",
         session.measurements.len(),
         {
             let mut s: Vec<&str> = session

@@ -137,6 +137,9 @@ pub struct MlArgs {
     /// ml: skip the leave-one-station-out cross-validation.
     #[arg(long)]
     pub no_cross_validation: bool,
+    /// ml, pose-only sessions: σ of each base-frame coordinate from the error of the flange poses the controller reports (the robot's accuracy), mm (default: estimated from the scatter of the station centres at the start).
+    #[arg(long)]
+    pub pose_sigma: Option<f64>,
 }
 
 impl MlArgs {
@@ -155,6 +158,7 @@ impl MlArgs {
             loss_scale: self.loss_scale.unwrap_or(d.loss_scale),
             rank_tolerance: self.rank_tolerance.unwrap_or(d.rank_tolerance),
             cross_validation: d.cross_validation && !self.no_cross_validation,
+            pose_sigma: self.pose_sigma.or(d.pose_sigma),
         }
     }
 }

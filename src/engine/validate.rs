@@ -42,6 +42,25 @@ impl Stats {
     }
 }
 
+/// The scatter of the centres about their station's mean: the RMS of
+/// the 3-D deviations `|X_i − mean_s|` over every centre of every station
+/// with at least two, mm (0 without any). For one station it is what a
+/// hand-eye-only calibration is judged by.
+#[must_use]
+pub fn scatter_rms(stations: &[Vec<Vector3<f64>>]) -> f64 {
+    let mut sum = 0.0;
+    let mut n = 0usize;
+    for centres in stations.iter().filter(|c| c.len() >= 2) {
+        let mean = centres.iter().sum::<Vector3<f64>>() / centres.len() as f64;
+        sum += centres
+            .iter()
+            .map(|c| (c - mean).norm_squared())
+            .sum::<f64>();
+        n += centres.len();
+    }
+    if n == 0 { 0.0 } else { (sum / n as f64).sqrt() }
+}
+
 /// Paper eq. 20 pooled over stations (FORMAT.md "The iteration"): over all
 /// stations and all pairs `i < j` within a station, with `N` pairs,
 /// `ε = sqrt(Σ |X_i − X_j|² / (N − 1))`, mm.

@@ -478,6 +478,7 @@ impl Planner<'_> {
             &s,
             &self.sensor_covariance(c.side),
             self.config.joint_sigma_deg,
+            0.0,
         );
         let w = cov.try_inverse().unwrap_or_else(Matrix3::zeros);
         Info { a, w }

@@ -2,8 +2,12 @@
 
 use std::fmt::Write as _;
 
-use crate::engine::session::Session;
+use crate::engine::result_view::HandEyeStrength;
+use nalgebra::Vector3;
+
+use crate::engine::session::{Session, Use};
 use crate::engine::solve::Calibration;
+use crate::engine::validate::scatter_rms;
 
 /// A few lines for people: why the loop stopped, what the SVD kept, how
 /// the hand-eye moved, and the before/after validation figures.
@@ -52,6 +56,11 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
         "identify stations, centre distances: std {:.4} → {:.4} mm, max {:.4} → {:.4} mm",
         within.before.std, within.after.std, within.before.max, within.after.max
     );
+    let (before, after) = identify_scatter(session, cal);
+    let _ = writeln!(
+        s,
+        "identify stations, centre scatter about each station's mean (3-D rms): {before:.4} → {after:.4} mm"
+    );
     match &cal.validation {
         Some(v) if !v.distances.is_empty() => {
             let _ = writeln!(
@@ -95,5 +104,42 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
     if let Some(r) = cal.report.ml() {
         s.push_str(&r.summary());
     }
+    if session.pose_only() {
+        let _ = writeln!(
+            s,
+            "pose-only session (flange poses, no joint readings): the hand-eye and the station centres were calibrated; no kinematic parameter was identified"
+        );
+        let robot = session.solver_robot();
+        let poses: Vec<_> = (0..session.measurements.len())
+            .map(|i| session.base_from_flange(&robot, i))
+            .collect();
+        if let Some(strength) = cal
+            .report
+            .ml()
+            .and_then(|r| HandEyeStrength::of(r, Some(&poses)))
+        {
+            for line in strength.lines() {
+                let _ = writeln!(s, "{line}");
+            }
+        }
+    }
     s
+}
+
+/// The 3-D rms scatter of the identify centres about their station means,
+/// before and after ([`scatter_rms`]).
+fn identify_scatter(session: &Session, cal: &Calibration) -> (f64, f64) {
+    let stations = session.stations(Use::Identify);
+    let group = |after: bool| -> Vec<Vec<Vector3<f64>>> {
+        stations
+            .iter()
+            .map(|(_, idx)| {
+                idx.iter()
+                    .filter_map(|&i| cal.centres.iter().find(|c| c.index == i))
+                    .map(|c| if after { c.after } else { c.before })
+                    .collect()
+            })
+            .collect()
+    };
+    (scatter_rms(&group(false)), scatter_rms(&group(true)))
 }

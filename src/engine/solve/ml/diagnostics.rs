@@ -109,6 +109,7 @@ pub(super) fn settings(solver: &MlUpdate<'_>, stop: &StopReason) -> MlReport {
     MlReport {
         noise_model: NoiseModel {
             joint_sigma_deg: mo.joint_sigma_deg,
+            pose_sigma_mm: mo.pose_sigma,
             centre_sigma_mm: mo.centre_sigma,
             sensor_sigma_floor_mm: mo.sensor_sigma_floor,
             whitening: "each centre residual (base frame) multiplied by the inverse Cholesky factor of R_bs·Σ_sensor·R_bsᵀ + G·σ_q²·Gᵀ, computed once from the initial model and hand-eye".into(),
@@ -296,6 +297,7 @@ pub(super) fn report(solver: &MlUpdate<'_>, stop: &StopReason) -> MlReport {
             &s,
             &sensor_covariance(&prepared.measurements[i], mo),
             mo.joint_sigma_deg,
+            mo.pose_sigma.unwrap_or(0.0),
         );
         (s, cov)
     };

@@ -99,6 +99,37 @@ pub use report::{
     OutlierRecord, ParameterRecord,
 };
 
+/// Smallest σ of a reported flange pose's error estimated from the data,
+/// mm: a station whose centres agree to the micrometre says nothing finer
+/// about a robot's accuracy.
+const MIN_POSE_SIGMA_MM: f64 = 0.005;
+
+/// The σ (mm, each base-frame coordinate) of the flange poses' error
+/// implied by the scatter of the station centres under `start`: the
+/// pooled per-coordinate variance about each station's mean (divisor
+/// `n − 1` per station), at least [`MIN_POSE_SIGMA_MM`]. In a pose-only
+/// session the robot's absolute accuracy, not the stripe fit, dominates
+/// that scatter.
+fn pose_sigma_at(start: &Estimate, stations: &[Station]) -> f64 {
+    let mut sum = 0.0;
+    let mut dof = 0usize;
+    for centres in start.station_centres(stations) {
+        if centres.len() < 2 {
+            continue;
+        }
+        let mean = centres.iter().sum::<Vector3<f64>>() / centres.len() as f64;
+        sum += centres
+            .iter()
+            .map(|c| (c - mean).norm_squared())
+            .sum::<f64>();
+        dof += 3 * (centres.len() - 1);
+    }
+    if dof == 0 {
+        return MIN_POSE_SIGMA_MM;
+    }
+    (sum / dof as f64).sqrt().max(MIN_POSE_SIGMA_MM)
+}
+
 /// LM steps in one update of the loop. From the nominal model LM takes
 /// 5-10 steps; 100 only guards against a pathological session.
 const MAX_LM_STEPS: usize = 100;
@@ -126,6 +157,10 @@ pub struct MlOptions {
     pub rank_tolerance: f64,
     /// Whether to run leave-one-station-out cross-validation after the solve.
     pub cross_validation: bool,
+    /// σ of each base-frame coordinate of a centre from the error of a
+    /// flange pose the controller reports (pose-only sessions), mm; `None`:
+    /// estimated from the scatter of the station centres at the start.
+    pub pose_sigma: Option<f64>,
 }
 
 impl Default for MlOptions {
@@ -141,6 +176,7 @@ impl Default for MlOptions {
             loss_scale: chi3_quantile(LOSS_QUANTILE),
             rank_tolerance: DEFAULT_RANK_TOLERANCE,
             cross_validation: true,
+            pose_sigma: None,
         }
     }
 }
@@ -167,6 +203,9 @@ impl MlOptions {
         check("ml prior angle sigma (deg)", self.prior_angle_deg, false)?;
         check("ml prior length sigma (mm)", self.prior_length, false)?;
         check("ml loss scale (σ)", self.loss_scale, false)?;
+        if let Some(s) = self.pose_sigma {
+            check("ml pose sigma (mm)", s, false)?;
+        }
         if !(self.rank_tolerance > 0.0 && self.rank_tolerance < 1.0) {
             return Err(SolveError::InvalidOption(format!(
                 "ml rank tolerance must be in (0, 1), got {}",
@@ -207,8 +246,13 @@ impl<'a> MlUpdate<'a> {
         stations: Vec<Station>,
         options: &Options,
     ) -> Result<Self, SolveError> {
+        options.ml.validate()?;
+        let mut options = *options;
+        if session.pose_only() {
+            let estimated = pose_sigma_at(start, &stations);
+            options.ml.pose_sigma = Some(options.ml.pose_sigma.unwrap_or(estimated));
+        }
         let mo = &options.ml;
-        mo.validate()?;
         let groups = session.stations(Use::Identify);
         let groups: Vec<(String, Vec<usize>)> = groups
             .into_iter()
@@ -223,6 +267,7 @@ impl<'a> MlUpdate<'a> {
                     &sighting,
                     &sensor_covariance(&prepared.measurements[i], mo),
                     mo.joint_sigma_deg,
+                    mo.pose_sigma.unwrap_or(0.0),
                 );
                 let whiten = whitening(&cov).ok_or_else(|| {
                     SolveError::InvalidOption(format!(
@@ -267,7 +312,7 @@ impl<'a> MlUpdate<'a> {
         Ok(Self {
             session,
             prepared,
-            options: *options,
+            options,
             stations,
             problem,
             ident,

@@ -148,14 +148,23 @@ pub fn sensor_covariance(m: &PreparedMeasurement, options: &MlOptions) -> Matrix
 
 /// The base-frame covariance (mm²) of a sighting's centre under `est`:
 /// `R_bs · Σ_sensor · R_bsᵀ + G · σ_q² · Gᵀ`, `G = [I | −[X_b]×] · ∂bT_e/∂q`
-/// (per rad), `σ_q` in deg.
+/// (per rad), `σ_q` in deg. A sighting with a given flange pose (a
+/// pose-only session) has no joint term; the error of the pose the
+/// controller reports (the robot's accuracy) enters as `σ_pose² · I`
+/// instead.
 #[must_use]
 pub fn base_covariance(
     est: &Estimate,
     sighting: &Sighting,
     sensor_cov: &Matrix3<f64>,
     joint_sigma_deg: f64,
+    pose_sigma_mm: f64,
 ) -> Matrix3<f64> {
+    if let Some(base_from_flange) = sighting.flange {
+        let base_from_sensor = base_from_flange * est.flange_from_sensor;
+        let r: Matrix3<f64> = base_from_sensor.rotation.to_rotation_matrix().into_inner();
+        return r * sensor_cov * r.transpose() + Matrix3::identity() * pose_sigma_mm.powi(2);
+    }
     let (base_from_flange, jq) = est.robot.joint_jacobian(&sighting.joints);
     let base_from_sensor = base_from_flange * est.flange_from_sensor;
     let x_b = (base_from_sensor * nalgebra::Point3::from(sighting.centre_in_sensor)).coords;

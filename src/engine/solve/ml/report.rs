@@ -126,6 +126,11 @@ pub struct OutlierRecord {
 pub struct NoiseModel {
     /// σ of the joint readings, deg.
     pub joint_sigma_deg: f64,
+    /// σ of each base-frame coordinate from the error of a reported flange
+    /// pose, mm (pose-only sessions only; estimated from the data unless
+    /// set).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pose_sigma_mm: Option<f64>,
     /// σ of each coordinate of a given centre, mm.
     pub centre_sigma_mm: f64,
     /// Floor of each principal σ of the sensor-frame covariance, mm.
@@ -269,11 +274,14 @@ impl MlReport {
             );
         }
         let p = &self.predicted_distance_std_identify;
-        let _ = writeln!(
-            s,
-            "  predicted σ of distances across the identify volume: mean {:.4} mm, max {:.4} mm (parameters alone: mean {:.4} mm)",
-            p.mean, p.max, p.parameter_mean
-        );
+        // With one station there is no distance across the volume.
+        if self.stations > 1 {
+            let _ = writeln!(
+                s,
+                "  predicted σ of distances across the identify volume: mean {:.4} mm, max {:.4} mm (parameters alone: mean {:.4} mm)",
+                p.mean, p.max, p.parameter_mean
+            );
+        }
         if let Some(cv) = &self.cross_validation {
             let worst = cv.stations.iter().max_by(|a, b| a.rms.total_cmp(&b.rms));
             let _ = writeln!(

@@ -4,7 +4,10 @@
 //! and roll/pitch/yaw, each parameter's σ, and which parameters the data
 //! could not identify. The workbench, the HTML report, history and the
 //! planner read these; none of them looks into the solver block itself.
-//! Also here: whether a result belongs to a session.
+//! Also here: whether a result belongs to a session, and how well a
+//! hand-eye-only result determined the hand-eye ([`strength`]).
+
+pub mod strength;
 
 use std::collections::BTreeMap;
 
@@ -15,6 +18,7 @@ use crate::engine::geometry::roll_pitch_yaw_deg;
 use crate::engine::session::{Session, Use};
 use crate::engine::solve::{Prepared, SolverReport};
 use crate::engine::validate::{BeforeAfter, DistanceRecord, Stats, within_station_distances};
+pub use strength::HandEyeStrength;
 
 /// A dropped SVD direction marks a parameter as not identifiable when its
 /// coefficient in the (unit) direction is at least this large: about a
