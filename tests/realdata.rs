@@ -65,7 +65,7 @@ fn robcalibrator_hand_eye(dir: &Path) -> Isometry3<f64> {
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     let m = &v["Solution"]["HTM"];
     let at = |i: usize, j: usize| m[i][j].as_f64().unwrap();
-    let r = Matrix3::from_fn(|i, j| at(i, j));
+    let r = Matrix3::from_fn(at);
     let rotation = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix(&r));
     Isometry3::from_parts(Translation3::new(at(0, 3), at(1, 3), at(2, 3)), rotation)
 }
