@@ -686,3 +686,45 @@ fn clean_stripes_are_rarely_trimmed() {
         );
     }
 }
+
+#[test]
+fn a_raw_profile_is_searched_for_the_sphere_arc() {
+    // An 80 mm sphere cut at 30°: r = 40·cos 30°, the arc facing the
+    // sensor, between a flat table on both sides (0.03 mm pitch).
+    let r_big = 40.0;
+    let r = r_big * 30f64.to_radians().cos();
+    let centre = [50.0, 10.0];
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let noise = Normal::new(0.0, 0.01).unwrap();
+    let mut points = Vec::new();
+    let mut on_arc = Vec::new();
+    let mut y = 0.0;
+    while y < 100.0 {
+        let dy: f64 = y - centre[0];
+        if dy.abs() < r * 0.9 {
+            let z = centre[1] - (r * r - dy * dy).sqrt();
+            points.push([y, z + noise.sample(&mut rng)]);
+            on_arc.push(true);
+        } else {
+            points.push([y, 12.0 + noise.sample(&mut rng)]);
+            on_arc.push(false);
+        }
+        y += 0.03;
+    }
+    let s = centre_from_stripe(&points, r_big, 1).unwrap();
+    let seg = s.segment.as_ref().expect("searched as a raw profile");
+    assert_eq!(seg.on_arc.len(), points.len());
+    let wrong = seg
+        .on_arc
+        .iter()
+        .zip(&on_arc)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(wrong < points.len() / 200, "{wrong} points misassigned");
+    assert!((s.fit.radius - r).abs() < 0.005, "r = {}", s.fit.radius);
+    assert!((s.fit.centre[0] - centre[0]).abs() < 0.005);
+    assert!(s.warnings.iter().any(|w| w.contains("raw profile")));
+    // A clean stripe is fitted whole, as before.
+    let clean = centre_from_stripe(&arc(centre, r, 200.0, 100.0, 60), r_big, 1).unwrap();
+    assert!(clean.segment.is_none());
+}

@@ -786,3 +786,61 @@ fn a_plan_is_made_exported_simulated_and_calibrated() {
     let result = h.state().state().result.as_ref().expect("calibrated");
     assert!(result.file.epsilon_after < result.file.epsilon_before);
 }
+
+/// The real data set beside the repository (see tests/realdata.rs), or
+/// `None` after a loud skip when it is absent and not required.
+fn realdata() -> Option<std::path::PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realdata/robcalibrator-sphere");
+    if dir.join("RobPoses.rob").is_file() {
+        return Some(dir);
+    }
+    let required = std::env::var("SPHERECAL_REQUIRE_REALDATA").is_ok_and(|v| v == "1");
+    assert!(!required, "the real data set is missing: {}", dir.display());
+    eprintln!(
+        "\n*** SKIPPED: real data not found at {} ***\n",
+        dir.display()
+    );
+    None
+}
+
+#[test]
+fn the_wizard_imports_flange_poses_and_the_run_calibrates_the_hand_eye_only() {
+    let Some(dir) = realdata() else {
+        return;
+    };
+    let mut h = demo_app();
+    h.get_by_label("Import").click();
+    h.run();
+    {
+        let form = &mut h.state_mut().forms_mut().import;
+        form.log_kind = spherecal::app::forms::import::LogKind::FlangePoses;
+        form.poses = dir.join("RobPoses.rob").display().to_string();
+        form.profiles = dir.display().to_string();
+        form.pose_convention = spherecal::engine::import::FlangeConvention::FanucWpr;
+        form.sphere_diameter = 80.0;
+    }
+    h.run();
+    assert!(
+        h.query_all_by_label_contains("Flange-pose log").count() > 0,
+        "the pose-log fields are shown"
+    );
+    h.get_by_label("Import and open").click();
+    settle(&mut h);
+    let loaded = h.state().state().loaded.as_ref().expect("a session");
+    assert!(loaded.session.pose_only());
+    assert_eq!(loaded.session.measurements.len(), 15);
+    let outcome = h.state().state().import.outcome.clone().expect("outcome");
+    let text = outcome.expect("imported");
+    assert!(text.contains("side +1 chosen"), "{text}");
+    assert!(text.contains("axis map -y,x,z"), "{text}");
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    let view = h.state().state().result.as_ref().expect("a result");
+    assert!(view.hand_eye_only.is_some());
+    assert!(
+        h.query_all_by_label_contains("no kinematic parameter was identified")
+            .count()
+            > 0,
+        "the Results view says what was calibrated"
+    );
+}

@@ -132,6 +132,9 @@ pub struct Imported {
     pub loaded: Box<LoadedSession>,
     /// The flange-pose checks (empty without a check).
     pub checks: Vec<PoseCheck>,
+    /// What the import decided, in words (axis map, side, initial
+    /// hand-eye).
+    pub notes: Vec<String>,
 }
 
 /// What the history jobs report.

@@ -222,6 +222,8 @@ pub enum DialogPurpose {
     ExportFolder,
     /// Import wizard: the joint log CSV.
     ImportJoints,
+    /// Import wizard: the flange-pose log (JSON, `.rob`, CSV).
+    ImportPoses,
     /// Import wizard: the profiles folder (or file, as the form says).
     ImportProfiles,
     /// Import wizard: the reference distances CSV.

@@ -176,6 +176,9 @@ pub struct ResultView {
     pub centres: CentreSet,
     /// Warnings: e.g. the result names another session.
     pub notes: Vec<String>,
+    /// For a result that calibrated the hand-eye only (a pose-only
+    /// session): what was and was not identified, and how well.
+    pub hand_eye_only: Option<Vec<String>>,
 }
 
 impl ResultView {
@@ -267,6 +270,7 @@ impl ResultView {
             solver_entries,
             centres: CentreSet::new(points),
             notes,
+            hand_eye_only: crate::engine::result_view::hand_eye_only_lines(&file, session),
             file,
         }
     }

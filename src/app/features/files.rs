@@ -263,6 +263,9 @@ impl Core {
                 DialogPurpose::ImportJoints | DialogPurpose::ImportReferences => {
                     dialog.add_filter("CSV", &["csv", "txt"]).pick_file()
                 }
+                DialogPurpose::ImportPoses => dialog
+                    .add_filter("pose log", &["json", "rob", "csv", "txt"])
+                    .pick_file(),
                 DialogPurpose::ImportProfiles if profiles_folder => dialog.pick_folder(),
                 DialogPurpose::ImportProfiles => {
                     dialog.add_filter("CSV", &["csv", "txt"]).pick_file()
@@ -405,6 +408,9 @@ impl Core {
             DialogPurpose::ImportJoints => {
                 self.forms.import.joints = path.display().to_string();
                 self.import_preview(ctx, true);
+            }
+            DialogPurpose::ImportPoses => {
+                self.forms.import.poses = path.display().to_string();
             }
             DialogPurpose::ImportProfiles => {
                 self.forms.import.profiles = path.display().to_string();

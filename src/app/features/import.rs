@@ -11,7 +11,8 @@ use super::Core;
 use super::files::analyse;
 use crate::app::commands::ImportCommand;
 use crate::app::error::JobError;
-use crate::app::forms::{ImportForm, Tab, import::PREVIEW_ROWS};
+use crate::app::forms::import::{LogKind, PREVIEW_ROWS};
+use crate::app::forms::{ImportForm, Tab};
 use crate::app::jobs::{ImportMessage, Imported, JobMessage};
 use crate::app::state::{Level, Source};
 
@@ -49,18 +50,27 @@ pub fn import_preview(
     (header, guess.then(|| Box::new(form)), preview)
 }
 
-/// Runs the import of the wizard's form and analyses the session like an
-/// opened file.
+/// Runs the import of the wizard's form (a joint log or a flange-pose
+/// log) and analyses the session like an opened file.
 ///
 /// # Errors
 /// The form is incomplete or the engine's import failed (naming the file,
 /// line, column or pose id).
 pub fn import_session(form: &ImportForm) -> Result<Imported, JobError> {
-    let spec = form.spec().map_err(JobError::ImportForm)?;
-    let imported = import::import(&spec)?;
+    let (imported, log) = match form.log_kind {
+        LogKind::Joints => {
+            let spec = form.spec().map_err(JobError::ImportForm)?;
+            (import::import(&spec)?, spec.joint_log)
+        }
+        LogKind::FlangePoses => {
+            let spec = form.pose_spec().map_err(JobError::ImportForm)?;
+            (import::import_poses(&spec)?, spec.poses)
+        }
+    };
     Ok(Imported {
-        loaded: Box::new(analyse(imported.session, Source::Imported(spec.joint_log))),
+        loaded: Box::new(analyse(imported.session, Source::Imported(log))),
         checks: imported.checks,
+        notes: imported.notes,
     })
 }
 
@@ -92,7 +102,11 @@ impl Core {
 
     fn import_run(&mut self, ctx: &egui::Context) {
         let form = self.forms.import.clone();
-        if let Err(e) = form.spec() {
+        let ready = match form.log_kind {
+            LogKind::Joints => form.spec().map(|_| ()),
+            LogKind::FlangePoses => form.pose_spec().map(|_| ()),
+        };
+        if let Err(e) = ready {
             self.state.import.outcome = Some(Err(e.clone()));
             self.state.say(Level::Warning, e);
             return;
@@ -145,8 +159,12 @@ impl Core {
                         imported.checks.len()
                     ));
                 }
+                let mut outcome = line.clone();
+                for note in &imported.notes {
+                    outcome.push_str(&format!("\n{note}"));
+                }
                 self.state.import.checks = imported.checks;
-                self.state.import.outcome = Some(Ok(line.clone()));
+                self.state.import.outcome = Some(Ok(outcome));
                 self.on_session(ctx, *imported.loaded);
                 self.forms.tab = if flagged > 0 {
                     Tab::Import

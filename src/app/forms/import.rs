@@ -1,15 +1,17 @@
-//! The import wizard's form: what the operator chose (files, robot, units,
-//! column mapping, flange-pose check) and the engine's [`ImportSpec`] it
-//! stands for. The import itself is [`crate::engine::import`], the same
-//! function `spherecal import` calls.
+//! The import wizard's form: what the operator chose (a joint log or a
+//! flange-pose log, profiles and their axes, robot, units, column mapping,
+//! flange-pose check) and the engine's [`ImportSpec`] or
+//! [`PoseImportSpec`] it stands for. The import itself is
+//! [`crate::engine::import`], the same functions `spherecal import` calls.
 
 use std::path::PathBuf;
 
 use crate::engine::import::{
-    AngleUnit, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
-    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit, ProfileFormat,
-    ProfileSource, RobotSource,
+    AngleUnit, AxisMap, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
+    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit, PoseImportSpec,
+    ProfileFormat, ProfileSource, RobotSource, SideChoice,
 };
+use crate::engine::robot::DhConvention;
 
 /// Rows the preview shows.
 pub const PREVIEW_ROWS: usize = 8;
@@ -41,11 +43,36 @@ pub const CONVENTIONS: [(FlangeConvention, &str); 4] = [
     ),
 ];
 
+/// What kind of pose log the wizard imports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LogKind {
+    /// A joint log CSV (id, station, use, joints).
+    Joints,
+    /// The controller's flange poses (JSON, `.rob` or CSV), no joints: a
+    /// pose-only session.
+    FlangePoses,
+}
+
 /// The import wizard's fields.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImportForm {
+    /// Joint log or flange-pose log.
+    pub log_kind: LogKind,
     /// The joint log CSV.
     pub joints: String,
+    /// The flange-pose log (JSON, `.rob` or CSV).
+    pub poses: String,
+    /// How the flange-pose log writes a pose.
+    pub pose_convention: FlangeConvention,
+    /// Side of the sphere centres for a flange-pose log without a side
+    /// column.
+    pub side: SideChoice,
+    /// Axis map of the profiles: `auto` or e.g. `-y,x,z`.
+    pub axes: String,
+    /// The sensor's no-return value (empty: none).
+    pub no_return: String,
+    /// The convention of a DH-table robot file (`.csv`).
+    pub dh: DhConvention,
     /// Folder or file of the stripe profiles.
     pub profiles: String,
     /// Whether `profiles` is a folder or one file.
@@ -90,7 +117,14 @@ pub struct ImportForm {
 impl Default for ImportForm {
     fn default() -> Self {
         Self {
+            log_kind: LogKind::Joints,
             joints: String::new(),
+            poses: String::new(),
+            pose_convention: FlangeConvention::FanucWpr,
+            side: SideChoice::Auto,
+            axes: "auto".into(),
+            no_return: String::new(),
+            dh: DhConvention::Standard,
             profiles: String::new(),
             profiles_kind: ProfilesKind::Folder,
             pose_column: "pose".into(),
@@ -115,16 +149,9 @@ impl Default for ImportForm {
 }
 
 impl ImportForm {
-    /// The engine's spec, or what is missing.
-    ///
-    /// # Errors
-    /// No joint log or profiles chosen, a non-positive sphere diameter or
-    /// tolerance: a sentence for the operator.
-    pub fn spec(&self) -> Result<ImportSpec, String> {
-        let joints = self.joints.trim();
-        if joints.is_empty() {
-            return Err("choose the joint log CSV first".into());
-        }
+    /// The profiles' source, format and the sphere check shared by both
+    /// kinds of log.
+    fn profile_choices(&self) -> Result<(ProfileSource, ProfileFormat), String> {
         let profiles = self.profiles.trim();
         if profiles.is_empty() {
             return Err("choose the stripe profiles (a folder or one file) first".into());
@@ -135,21 +162,92 @@ impl ImportForm {
                 self.sphere_diameter
             ));
         }
-        if !(self.tolerance_mm > 0.0 && self.tolerance_deg > 0.0) {
-            return Err("the flange-check tolerances must be positive".into());
-        }
-        let profiles = match self.profiles_kind {
+        let source = match self.profiles_kind {
             ProfilesKind::Folder => ProfileSource::Folder(PathBuf::from(profiles)),
             ProfilesKind::File => ProfileSource::File {
                 path: PathBuf::from(profiles),
                 pose_column: self.pose_column.trim().to_string(),
             },
         };
-        let robot = if self.robot_file.trim().is_empty() {
-            RobotSource::Preset(self.robot_preset.clone())
-        } else {
-            RobotSource::File(PathBuf::from(self.robot_file.trim()))
+        let axes = match self.axes.trim() {
+            "" | "auto" => None,
+            text => Some(AxisMap::parse(text)?),
         };
+        let no_return = match self.no_return.trim() {
+            "" => None,
+            text => Some(
+                text.parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| format!("the no-return value `{text}` is not a number"))?,
+            ),
+        };
+        Ok((
+            source,
+            ProfileFormat {
+                unit: self.profile_unit,
+                axes,
+                no_return,
+                key: None,
+            },
+        ))
+    }
+
+    /// The nominal robot: the file (session/result, URDF, DH table) when
+    /// one is given, else the preset.
+    fn robot_source(&self) -> Result<RobotSource, String> {
+        let file = self.robot_file.trim();
+        if file.is_empty() {
+            Ok(RobotSource::Preset(self.robot_preset.clone()))
+        } else {
+            RobotSource::from_text(file, None, Some(self.dh))
+        }
+    }
+
+    /// The engine's spec of a flange-pose log, or what is missing.
+    ///
+    /// # Errors
+    /// No pose log or profiles chosen, a bad axis map or sphere diameter:
+    /// a sentence for the operator.
+    pub fn pose_spec(&self) -> Result<PoseImportSpec, String> {
+        let poses = self.poses.trim();
+        if poses.is_empty() {
+            return Err("choose the flange-pose log first".into());
+        }
+        let (profiles, profile_format) = self.profile_choices()?;
+        let name = self.name.trim();
+        let references = self.references.trim();
+        Ok(PoseImportSpec {
+            poses: PathBuf::from(poses),
+            convention: self.pose_convention,
+            pose_columns: None,
+            profiles,
+            profile_format,
+            robot: (!self.robot_file.trim().is_empty())
+                .then(|| self.robot_source())
+                .transpose()?,
+            sphere_diameter: self.sphere_diameter,
+            side: self.side,
+            name: (!name.is_empty()).then(|| name.to_string()),
+            references: (!references.is_empty()).then(|| PathBuf::from(references)),
+        })
+    }
+
+    /// The engine's spec, or what is missing.
+    ///
+    /// # Errors
+    /// No joint log or profiles chosen, a non-positive sphere diameter or
+    /// tolerance: a sentence for the operator.
+    pub fn spec(&self) -> Result<ImportSpec, String> {
+        let joints = self.joints.trim();
+        if joints.is_empty() {
+            return Err("choose the joint log CSV first".into());
+        }
+        if !(self.tolerance_mm > 0.0 && self.tolerance_deg > 0.0) {
+            return Err("the flange-check tolerances must be positive".into());
+        }
+        let (profiles, profile_format) = self.profile_choices()?;
+        let robot = self.robot_source()?;
         let side = self.side_column.trim();
         let flange = self.flange.map(|convention| {
             let mut check = FlangeCheck::new(convention);
@@ -183,10 +281,7 @@ impl ImportForm {
             },
             joint_unit: self.joint_unit,
             profiles,
-            profile_format: ProfileFormat {
-                unit: self.profile_unit,
-                ..ProfileFormat::default()
-            },
+            profile_format,
             robot,
             sphere_diameter: self.sphere_diameter,
             name: (!name.is_empty()).then(|| name.to_string()),

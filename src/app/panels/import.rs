@@ -1,18 +1,21 @@
-//! The Import view: a wizard that turns a joint log CSV and stripe profile
+//! The Import view: a wizard that turns a pose log and stripe profile
 //! files into a session (the engine's [`crate::engine::import`], as
-//! `spherecal import`). Three steps on one page: files, robot and units,
-//! column mapping with a preview of the first rows; then Import opens the
-//! session and lists the flange-pose checks.
+//! `spherecal import`). A joint log CSV, or the controller's flange poses
+//! (JSON, RobCalibrator `.rob`, CSV) for a pose-only session; profiles as
+//! CSV/TXT or OpenCV YAML/JSON in the sensor's axes. Steps on one page:
+//! files, robot, units and axes, column mapping with a preview of the
+//! first rows (joint logs); then Import opens the session and says what it
+//! decided (axis map, side, initial hand-eye) and the flange-pose checks.
 
 use egui::RichText;
 
 use super::{BAD, WARN, labelled_field};
 use crate::app::commands::{Command, FilesCommand, ImportCommand};
 use crate::app::forms::Forms;
-use crate::app::forms::import::{CONVENTIONS, ImportForm, ProfilesKind};
+use crate::app::forms::import::{CONVENTIONS, ImportForm, LogKind, ProfilesKind};
 use crate::app::state::{AppState, DialogPurpose};
-use crate::engine::import::{AngleUnit, LengthUnit};
-use crate::engine::robot;
+use crate::engine::import::{AngleUnit, FlangeConvention, LengthUnit, SideChoice};
+use crate::engine::robot::{self, DhConvention};
 
 /// Width of the path fields, points.
 const PATH_WIDTH: f32 = 420.0;
@@ -29,11 +32,13 @@ pub fn import_ui(
     egui::ScrollArea::vertical()
         .auto_shrink([false, false])
         .show(ui, |ui| {
-            ui.heading("Import a joint log and stripe profiles");
+            ui.heading("Import a pose log and stripe profiles");
             ui.label(
                 RichText::new(
-                    "One row of the joint log per pose (id, station, use, joints); one CSV of y,z points per pose, \
-                     or one file with a pose column. The session is checked by the same rules as a session file.",
+                    "A joint log (one row per pose: id, station, use, joints) or the controller's flange poses \
+                     (no joints: a pose-only session that calibrates the hand-eye); one profile file per pose \
+                     (CSV/TXT, OpenCV YAML/JSON) or one file with a pose column. The session is checked by the \
+                     same rules as a session file.",
                 )
                 .weak(),
             );
@@ -43,20 +48,23 @@ pub fn import_ui(
             ui.separator();
             robot_ui(ui, &mut forms.import);
             ui.separator();
-            mapping_ui(ui, state, &mut forms.import);
-            ui.separator();
-            flange_ui(ui, &mut forms.import);
-            ui.separator();
+            let joints = forms.import.log_kind == LogKind::Joints;
+            if joints {
+                mapping_ui(ui, state, &mut forms.import);
+                ui.separator();
+                flange_ui(ui, &mut forms.import);
+                ui.separator();
+            }
             ui.horizontal(|ui| {
                 if ui
-                    .add_enabled(!busy, egui::Button::new("Preview"))
+                    .add_enabled(!busy && joints, egui::Button::new("Preview"))
                     .on_hover_text("read the header and show the first rows with this mapping")
                     .clicked()
                 {
                     commands.push(Command::Import(ImportCommand::Preview { guess: false }));
                 }
                 if ui
-                    .add_enabled(!busy, egui::Button::new("Guess mapping"))
+                    .add_enabled(!busy && joints, egui::Button::new("Guess mapping"))
                     .on_hover_text("fill the column names from the header where they are obvious")
                     .clicked()
                 {
@@ -82,21 +90,61 @@ pub fn import_ui(
 
 fn files_ui(ui: &mut egui::Ui, busy: bool, f: &mut ImportForm, commands: &mut Vec<Command>) {
     ui.label(RichText::new("1 · Files").strong());
+    ui.horizontal(|ui| {
+        ui.label("Pose log");
+        ui.radio_value(&mut f.log_kind, LogKind::Joints, "joint log (CSV)");
+        ui.radio_value(
+            &mut f.log_kind,
+            LogKind::FlangePoses,
+            "flange poses, no joints (pose-only)",
+        );
+    });
     egui::Grid::new("import_files")
         .num_columns(3)
         .spacing([8.0, 6.0])
         .show(ui, |ui| {
-            path_row(
-                ui,
-                "Joint log CSV",
-                &mut f.joints,
-                "/path/to/joints.csv",
-                busy,
-                DialogPurpose::ImportJoints,
-                commands,
-            );
+            if f.log_kind == LogKind::Joints {
+                path_row(
+                    ui,
+                    "Joint log CSV",
+                    &mut f.joints,
+                    "/path/to/joints.csv",
+                    busy,
+                    DialogPurpose::ImportJoints,
+                    commands,
+                );
+            } else {
+                path_row(
+                    ui,
+                    "Flange-pose log",
+                    &mut f.poses,
+                    "/path/to/RobPoses.rob (JSON) or poses.csv",
+                    busy,
+                    DialogPurpose::ImportPoses,
+                    commands,
+                );
+                let l = ui.label("Pose convention");
+                egui::ComboBox::from_id_salt("import_pose_convention")
+                    .selected_text(f.pose_convention.describe())
+                    .width(PATH_WIDTH)
+                    .show_ui(ui, |ui| {
+                        for c in FlangeConvention::ALL {
+                            ui.selectable_value(&mut f.pose_convention, c, c.describe());
+                        }
+                    })
+                    .response
+                    .labelled_by(l.id);
+                ui.end_row();
+                ui.label("Sphere side");
+                ui.horizontal(|ui| {
+                    ui.radio_value(&mut f.side, SideChoice::Auto, "decide from the data");
+                    ui.radio_value(&mut f.side, SideChoice::Plus, "+1 (sensor x > 0)");
+                    ui.radio_value(&mut f.side, SideChoice::Minus, "−1");
+                });
+                ui.end_row();
+            }
             let hint = match f.profiles_kind {
-                ProfilesKind::Folder => "/path/to/profiles/ (one <id>.csv each)",
+                ProfilesKind::Folder => "/path/to/profiles/ (one file per pose: <id>.csv, .yml …)",
                 ProfilesKind::File => "/path/to/profiles.csv (with a pose column)",
             };
             path_row(
@@ -113,7 +161,7 @@ fn files_ui(ui: &mut egui::Ui, busy: bool, f: &mut ImportForm, commands: &mut Ve
                 ui.radio_value(
                     &mut f.profiles_kind,
                     ProfilesKind::Folder,
-                    "a folder of <id>.csv",
+                    "a folder, one file per pose",
                 );
                 ui.radio_value(&mut f.profiles_kind, ProfilesKind::File, "one file");
                 let l = ui.label("pose column");
@@ -193,11 +241,25 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
                     ui,
                     "or robot file",
                     &mut f.robot_file,
-                    "a session or result file with the robot block",
+                    "session/result file, URDF or DH table CSV",
                     260.0,
                 );
+                if f.robot_file.trim().to_ascii_lowercase().ends_with(".csv") {
+                    ui.radio_value(&mut f.dh, DhConvention::Standard, "standard DH");
+                    ui.radio_value(&mut f.dh, DhConvention::Modified, "modified DH");
+                }
             });
             ui.end_row();
+            if f.log_kind == LogKind::FlangePoses {
+                ui.label("");
+                ui.label(
+                    RichText::new(
+                        "pose-only: no robot model is needed (no kinematic parameter is identified); a robot given here is kept in the session",
+                    )
+                    .weak(),
+                );
+                ui.end_row();
+            }
             ui.label("Joint unit");
             ui.horizontal(|ui| {
                 for u in [AngleUnit::Deg, AngleUnit::Rad] {
@@ -208,8 +270,28 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
             ui.label("Profile unit");
             ui.horizontal(|ui| {
                 for u in [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M] {
-                    ui.radio_value(&mut f.profile_unit, u, u.as_str());
+                    ui.radio_value(&mut f.profile_unit, u, u.symbol());
                 }
+            });
+            ui.end_row();
+            let l = ui.label("Profile axes");
+            ui.horizontal(|ui| {
+                ui.add(
+                    egui::TextEdit::singleline(&mut f.axes)
+                        .hint_text("auto")
+                        .desired_width(COLUMN_WIDTH),
+                )
+                .labelled_by(l.id)
+                .on_hover_text(
+                    "auto: the coordinate that is constant is the laser plane's normal; or a map such as -y,x,z (spherecal x = −y, y = x, z = z); a mirroring map is refused",
+                );
+                labelled_field(
+                    ui,
+                    "no-return value",
+                    &mut f.no_return,
+                    "none",
+                    COLUMN_WIDTH,
+                );
             });
             ui.end_row();
             let l = ui.label("Sphere diameter");

@@ -150,11 +150,23 @@ fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
             )));
         }
         ui.separator();
+        let hand_eye_only = state
+            .result
+            .as_ref()
+            .is_some_and(|v| v.hand_eye_only.is_some());
         for kind in ExportKind::ALL {
-            let enabled = kind != ExportKind::PlotsPng || !state.busy.screenshot;
+            let model = matches!(
+                kind,
+                ExportKind::ModelJson | ExportKind::ModelCsv | ExportKind::ModelUrdf
+            );
+            let enabled = (kind != ExportKind::PlotsPng || !state.busy.screenshot)
+                && !(model && hand_eye_only);
             if ui
                 .add_enabled(enabled, egui::Button::new(kind.label()))
                 .on_hover_text(export_hint(kind))
+                .on_disabled_hover_text(
+                    "a pose-only result calibrated the hand-eye only: there is no kinematic model to export",
+                )
                 .clicked()
             {
                 commands.push(Command::Export(kind));
@@ -475,7 +487,10 @@ fn identifiable_set_ui(ui: &mut egui::Ui, view: &ResultView) {
 fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
     ui.columns(2, |cols| {
         hand_eye_ui(&mut cols[0], view);
-        joint_errors_ui(&mut cols[1], view);
+        match &view.hand_eye_only {
+            Some(lines) => hand_eye_only_ui(&mut cols[1], lines),
+            None => joint_errors_ui(&mut cols[1], view),
+        }
     });
     if !view.dropped.is_empty() {
         ui.add_space(6.0);
@@ -592,6 +607,21 @@ fn hand_eye_ui(ui: &mut egui::Ui, view: &ResultView) {
             }
         }
     });
+}
+
+/// A pose-only result: no joint table; what was calibrated and how well.
+fn hand_eye_only_ui(ui: &mut egui::Ui, lines: &[String]) {
+    ui.label(RichText::new("Hand-eye only: no kinematic model").strong());
+    for (k, line) in lines.iter().enumerate() {
+        let text = RichText::new(line);
+        ui.label(if line.starts_with("weakly") {
+            text.color(WARN)
+        } else if k == 0 {
+            text
+        } else {
+            text.color(MUTED)
+        });
+    }
 }
 
 fn joint_errors_ui(ui: &mut egui::Ui, view: &ResultView) {

@@ -112,11 +112,20 @@ pub fn stripe_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &
 fn facts_ui(ui: &mut egui::Ui, s: &StripeResult, sphere_radius: f64) {
     let f = &s.fit;
     let c = &s.sphere.centre_in_sensor;
+    let off_arc = s
+        .segment
+        .as_ref()
+        .map_or(0, |seg| seg.on_arc.iter().filter(|k| !**k).count());
     ui.horizontal_wrapped(|ui| {
         ui.label(format!(
-            "points {} used, {} rejected · circle centre ({:.3}, {:.3}) mm · r = {:.3} ± {:.3} mm (R = {:.3} mm, r/R = {:.3}) · RMS {:.4} mm · arc {:.0}° · cut angle {:+.1}°",
+            "points {} used, {} rejected{} · circle centre ({:.3}, {:.3}) mm · r = {:.3} ± {:.3} mm (R = {:.3} mm, r/R = {:.3}) · RMS {:.4} mm · arc {:.0}° · cut angle {:+.1}°",
             f.used(),
-            f.rejected(),
+            f.rejected() - off_arc,
+            if off_arc > 0 {
+                format!(", {off_arc} off the sphere's arc")
+            } else {
+                String::new()
+            },
             f.centre[0],
             f.centre[1],
             f.radius,
@@ -146,18 +155,22 @@ fn facts_ui(ui: &mut egui::Ui, s: &StripeResult, sphere_radius: f64) {
 
 fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) {
     let inlier = |k: usize| fit.is_none_or(|s| s.fit.inlier.get(k).copied().unwrap_or(true));
-    let kept: Vec<[f64; 2]> = points
-        .iter()
-        .enumerate()
-        .filter(|(k, _)| inlier(*k))
-        .map(|(_, p)| *p)
-        .collect();
-    let rejected: Vec<[f64; 2]> = points
-        .iter()
-        .enumerate()
-        .filter(|(k, _)| !inlier(*k))
-        .map(|(_, p)| *p)
-        .collect();
+    // Points a raw profile's arc search left out (background, the stand).
+    let off_arc = |k: usize| {
+        fit.and_then(|s| s.segment.as_ref())
+            .is_some_and(|seg| !seg.on_arc.get(k).copied().unwrap_or(true))
+    };
+    let pick = |keep: &dyn Fn(usize) -> bool| -> Vec<[f64; 2]> {
+        points
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| keep(*k))
+            .map(|(_, p)| *p)
+            .collect()
+    };
+    let kept = pick(&|k| inlier(k));
+    let rejected = pick(&|k| !inlier(k) && !off_arc(k));
+    let dropped = pick(&|k| off_arc(k));
     let height = ui.available_height().max(200.0);
     let width = ui.available_width();
     ui.horizontal(|ui| {
@@ -193,6 +206,13 @@ fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) 
                                 .color(BEFORE),
                         );
                     }
+                    if !dropped.is_empty() {
+                        p.points(
+                            Points::new("off the arc (dropped)", PlotPoints::from(dropped))
+                                .color(MUTED)
+                                .radius(1.5),
+                        );
+                    }
                     p.points(
                         Points::new("stripe points", PlotPoints::from(kept))
                             .color(AFTER)
@@ -219,8 +239,9 @@ fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) 
                 .filter(|&k| inlier(k))
                 .map(|k| [k as f64, um(k)])
                 .collect();
+            // Points off the arc are far from the circle: not plotted here.
             let out: Vec<[f64; 2]> = (0..points.len())
-                .filter(|&k| !inlier(k))
+                .filter(|&k| !inlier(k) && !off_arc(k))
                 .map(|k| [k as f64, um(k)])
                 .collect();
             let rms = s.fit.rms * 1000.0;

@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use crate::engine::result_view::HandEyeStrength;
+use crate::engine::result_view::{HAND_EYE_ONLY, HandEyeStrength, flange_poses};
 use nalgebra::Vector3;
 
 use crate::engine::session::{Session, Use};
@@ -105,18 +105,12 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
         s.push_str(&r.summary());
     }
     if session.pose_only() {
-        let _ = writeln!(
-            s,
-            "pose-only session (flange poses, no joint readings): the hand-eye and the station centres were calibrated; no kinematic parameter was identified"
-        );
-        let robot = session.solver_robot();
-        let poses: Vec<_> = (0..session.measurements.len())
-            .map(|i| session.base_from_flange(&robot, i))
-            .collect();
+        let _ = writeln!(s, "{HAND_EYE_ONLY}");
+        let poses = flange_poses(session);
         if let Some(strength) = cal
             .report
             .ml()
-            .and_then(|r| HandEyeStrength::of(r, Some(&poses)))
+            .and_then(|r| HandEyeStrength::of(r, poses.as_deref()))
         {
             for line in strength.lines() {
                 let _ = writeln!(s, "{line}");

@@ -18,7 +18,7 @@ use crate::engine::geometry::roll_pitch_yaw_deg;
 use crate::engine::session::{Session, Use};
 use crate::engine::solve::{Prepared, SolverReport};
 use crate::engine::validate::{BeforeAfter, DistanceRecord, Stats, within_station_distances};
-pub use strength::HandEyeStrength;
+pub use strength::{HAND_EYE_ONLY, HandEyeStrength, flange_poses, hand_eye_only_lines};
 
 /// A dropped SVD direction marks a parameter as not identifiable when its
 /// coefficient in the (unit) direction is at least this large: about a

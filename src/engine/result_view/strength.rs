@@ -8,8 +8,44 @@
 
 use nalgebra::{Isometry3, Matrix3, SymmetricEigen, Vector3};
 
+use crate::engine::format::ResultFile;
+use crate::engine::session::Session;
 use crate::engine::solve::estimate::HAND_EYE_LABELS;
 use crate::engine::solve::ml::MlReport;
+
+/// What a hand-eye-only result calibrated, in one sentence.
+pub const HAND_EYE_ONLY: &str = "pose-only session (flange poses, no joint readings): the hand-eye and the station centres were calibrated; no kinematic parameter was identified";
+
+/// The flange poses of a pose-only session, in measurement order.
+#[must_use]
+pub fn flange_poses(session: &Session) -> Option<Vec<Isometry3<f64>>> {
+    session.pose_only().then(|| {
+        let robot = session.solver_robot();
+        (0..session.measurements.len())
+            .map(|i| session.base_from_flange(&robot, i))
+            .collect()
+    })
+}
+
+/// For a result that calibrated the hand-eye only: [`HAND_EYE_ONLY`] and
+/// the [`HandEyeStrength`] lines (with the poses' spread when `session`
+/// is given). `None` for a result with a kinematic model.
+#[must_use]
+pub fn hand_eye_only_lines(result: &ResultFile, session: Option<&Session>) -> Option<Vec<String>> {
+    if !result.hand_eye_only() {
+        return None;
+    }
+    let mut lines = vec![HAND_EYE_ONLY.to_string()];
+    let poses = session.and_then(flange_poses);
+    if let Some(strength) = result
+        .solver
+        .ml()
+        .and_then(|m| HandEyeStrength::of(m, poses.as_deref()))
+    {
+        lines.extend(strength.lines());
+    }
+    Some(lines)
+}
 
 /// A translation direction determined worse than this (1σ, mm) is called
 /// weak: more than a typical sensor's accuracy and a robot's repeatability.

@@ -47,6 +47,7 @@
 //! or three Levenberg-Marquardt steps: a few microseconds.
 
 pub mod circle;
+pub mod segment;
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -94,6 +95,15 @@ pub enum StripeError {
         sphere: f64,
         /// `(r − R)/R` in percent.
         excess_pct: f64,
+    },
+    /// The whole profile is not one clean arc and no arc of the sphere was
+    /// found in it (the segmentation's message).
+    #[error("no arc of the sphere in the profile: {fit}; searching the raw profile: {search}")]
+    NoArc {
+        /// Why the whole-profile fit was not used.
+        fit: String,
+        /// Why the arc search found none.
+        search: String,
     },
     /// The sphere radius, the side or the fitted circle handed to the
     /// sphere-centre computation is unusable (radius not finite and
@@ -271,13 +281,93 @@ pub fn sphere_centre(
 /// quality warnings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StripeResult {
-    /// The circle fit in the laser plane.
+    /// The circle fit in the laser plane. Its `residuals` and `inlier`
+    /// cover every point of the stripe; after a segmentation a point off
+    /// the arc is not an inlier (see `segment`).
     pub fit: CircleFit,
     /// The sphere centre in the sensor frame.
     pub sphere: SphereCentre,
     /// Human-readable quality warnings with numbers and units; empty when
     /// the stripe is good.
     pub warnings: Vec<String>,
+    /// The arc found in a raw profile, when the whole stripe was not one
+    /// clean arc ([`segment::find_arc`]).
+    pub segment: Option<ArcSegment>,
+}
+
+/// The sphere's arc in a raw profile: which points it kept, and in words.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArcSegment {
+    /// One per stripe point: on the arc (kept) or dropped.
+    pub on_arc: Vec<bool>,
+    /// "kept 2,419 of 2,439 points; 20 dropped: …".
+    pub summary: String,
+}
+
+/// Whether the whole-stripe fit is one clean circle: fitted to noise
+/// level. Otherwise the stripe is taken as a raw profile and searched for
+/// the sphere's arc. (A clean circle larger than the sphere stays an error
+/// of its radius.)
+fn clean_arc(fit: &CircleFit) -> bool {
+    fit.rms <= HIGH_RMS_MM
+}
+
+/// The circle of the stripe: the whole-stripe fit when it is a clean arc
+/// (every clean stripe, as before), else the arc found in the raw profile,
+/// its fit spread back over every point (residuals to the circle, points
+/// off the arc not inliers).
+fn stripe_circle(
+    points: &[[f64; 2]],
+    sphere_radius: f64,
+) -> Result<(CircleFit, Option<ArcSegment>), StripeError> {
+    let whole = fit_circle(points);
+    if let Ok(fit) = &whole
+        && clean_arc(fit)
+    {
+        return Ok((fit.clone(), None));
+    }
+    if points.len() < segment::MIN_ARC_POINTS {
+        return whole.map(|fit| (fit, None));
+    }
+    match segment::find_arc(points, sphere_radius) {
+        Ok(arc) => {
+            let mut fit = arc.fit.clone();
+            let mut on_arc = vec![false; points.len()];
+            let mut inlier = vec![false; points.len()];
+            for (k, &i) in arc.kept.iter().enumerate() {
+                on_arc[i] = true;
+                inlier[i] = fit.inlier.get(k).copied().unwrap_or(true);
+            }
+            fit.residuals = points
+                .iter()
+                .map(|p| (p[0] - fit.centre[0]).hypot(p[1] - fit.centre[1]) - fit.radius)
+                .collect();
+            fit.inlier = inlier;
+            Ok((
+                fit,
+                Some(ArcSegment {
+                    on_arc,
+                    summary: arc.summary(),
+                }),
+            ))
+        }
+        // A whole-stripe fit with a high RMS is still a fit: keep it (its
+        // warnings say so) rather than fail.
+        Err(search) => match whole {
+            Ok(fit) if fit.radius <= sphere_radius * (1.0 + RADIUS_TOLERANCE) => Ok((fit, None)),
+            Ok(fit) => Err(StripeError::NoArc {
+                fit: format!(
+                    "the whole stripe fits a circle of r = {:.3} mm, larger than the sphere (R = {sphere_radius:.3} mm)",
+                    fit.radius
+                ),
+                search: search.to_string(),
+            }),
+            Err(e) => Err(StripeError::NoArc {
+                fit: e.to_string(),
+                search: search.to_string(),
+            }),
+        },
+    }
 }
 
 /// Fits the stripe's circle, computes the sphere centre (eq. 21) and lists
@@ -296,11 +386,13 @@ pub fn centre_from_stripe(
     sphere_radius: f64,
     side: i8,
 ) -> Result<StripeResult, StripeError> {
-    let fit = fit_circle(points)?;
+    let (fit, segment) = stripe_circle(points, sphere_radius)?;
     let sphere = sphere_centre(&fit, sphere_radius, side)?;
     let mut warnings = Vec::new();
     let rejected = fit.rejected();
-    if rejected > 0 {
+    if let Some(seg) = &segment {
+        warnings.push(format!("raw profile, the sphere's arc: {}", seg.summary));
+    } else if rejected > 0 {
         let worst = fit
             .residuals
             .iter()
@@ -355,6 +447,7 @@ pub fn centre_from_stripe(
         fit,
         sphere,
         warnings,
+        segment,
     })
 }
 

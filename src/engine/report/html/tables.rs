@@ -11,7 +11,7 @@ use super::*;
 use crate::engine::format::result::solver_block as solver_map;
 use crate::engine::geometry::{rows_from_isometry, wrap_deg};
 use crate::engine::report::svg::escape;
-use crate::engine::result_view::{HandEyeView, PairDistance};
+use crate::engine::result_view::{HandEyeView, PairDistance, hand_eye_only_lines};
 use crate::engine::robot::PARAM_NAMES;
 use crate::engine::session::Observation;
 use crate::engine::solve::estimate::HAND_EYE_LABELS;
@@ -232,6 +232,19 @@ pub(super) fn hand_eye(h: &mut String, ctx: &Ctx<'_>) {
 }
 
 pub(super) fn joint_errors(h: &mut String, ctx: &Ctx<'_>) {
+    if let Some(lines) = hand_eye_only_lines(ctx.result(), Some(ctx.session())) {
+        section(h, "joints", "Hand-eye only: no kinematic model");
+        for line in lines {
+            let class = if line.starts_with("weakly") {
+                " class=\"warn\""
+            } else {
+                ""
+            };
+            let _ = writeln!(h, "<p{class}>{}</p>", escape(&line));
+        }
+        end_section(h);
+        return;
+    }
     section(
         h,
         "joints",

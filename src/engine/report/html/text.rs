@@ -99,15 +99,16 @@ pub(super) fn header(h: &mut String, ctx: &Ctx<'_>) {
         "SHA-256 of the file",
         &format!("<span class=\"mono\" id=\"sha256\">{}</span>", ctx.sha),
     );
-    meta_row(
-        h,
-        "Robot",
-        &format!(
+    let robot = if s.pose_only() {
+        "none: a pose-only session (the controller's flange poses, no joint readings)".to_string()
+    } else {
+        format!(
             "{} ({} joints, nominal model of the session)",
             escape(&s.robot.name),
             s.robot.dof()
-        ),
-    );
+        )
+    };
+    meta_row(h, "Robot", &robot);
     meta_row(
         h,
         "Sphere",

@@ -112,7 +112,7 @@ pub(super) fn settings(solver: &MlUpdate<'_>, stop: &StopReason) -> MlReport {
             pose_sigma_mm: mo.pose_sigma,
             centre_sigma_mm: mo.centre_sigma,
             sensor_sigma_floor_mm: mo.sensor_sigma_floor,
-            whitening: "each centre residual (base frame) multiplied by the inverse Cholesky factor of R_bs·Σ_sensor·R_bsᵀ + G·σ_q²·Gᵀ, computed once from the initial model and hand-eye".into(),
+            whitening: "each centre residual (base frame) multiplied by the inverse Cholesky factor of R_bs·Σ_sensor·R_bsᵀ + G·σ_q²·Gᵀ (for a given flange pose: + σ_pose²·I instead of the joint term), computed once from the initial model and hand-eye".into(),
         },
         prior: PriorRecord {
             enabled: mo.prior,
