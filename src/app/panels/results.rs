@@ -124,6 +124,10 @@ fn headline_ui(ui: &mut egui::Ui, view: &ResultView) {
             view.file.epsilon_before,
             view.file.epsilon_after
         ));
+        let (b, a) = view.shown.identify_scatter;
+        ui.label(format!(
+            "identify centres about their station's mean (3-D rms): {b:.3} → {a:.3} mm"
+        ));
     });
 }
 

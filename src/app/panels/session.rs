@@ -34,7 +34,11 @@ pub fn session_ui(
     let n = loaded.session.measurements.len();
     let excluded = state.excluded_count();
     ui.horizontal_wrapped(|ui| {
-        ui.label(format!("{n} measurements in {} stations.", loaded.station_ids().len()));
+        let stations = loaded.station_ids().len();
+        ui.label(format!(
+            "{n} measurements in {stations} station{}.",
+            if stations == 1 { "" } else { "s" }
+        ));
         if excluded > 0 {
             ui.label(
                 RichText::new(format!(

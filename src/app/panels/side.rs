@@ -45,10 +45,16 @@ pub fn load_ui(
             ui.label(RichText::new(l.source.label()).small().weak())
                 .on_hover_text(l.source.label());
             let n = l.session.measurements.len();
+            let stations = l.station_ids().len();
             ui.label(format!(
-                "{n} measurements, {} stations, sphere Ø {} mm",
-                l.station_ids().len(),
-                l.session.sphere_diameter
+                "{n} measurements, {stations} station{}, sphere Ø {} mm{}",
+                if stations == 1 { "" } else { "s" },
+                l.session.sphere_diameter,
+                if l.session.pose_only() {
+                    " · pose-only (flange poses)"
+                } else {
+                    ""
+                }
             ));
         }
         None => {

@@ -11,6 +11,7 @@ use super::{AFTER, BAD, BEFORE, MUTED, WARN};
 use crate::app::commands::{Command, ViewCommand};
 use crate::app::forms::Forms;
 use crate::app::state::{AppState, Fit};
+use crate::engine::geometry::roll_pitch_yaw_deg;
 use crate::engine::session::Observation;
 use crate::engine::stripe::StripeResult;
 
@@ -78,16 +79,29 @@ pub fn stripe_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &
         }
         ui.label(RichText::new("arrow keys: previous / next").small().weak());
     });
+    let pose = match &m.flange {
+        Some(f) => {
+            let t = f.translation.vector;
+            let [roll, pitch, yaw] = roll_pitch_yaw_deg(&f.rotation);
+            format!(
+                "flange at ({:.2}, {:.2}, {:.2}) mm, roll/pitch/yaw ({roll:.3}, {pitch:.3}, {yaw:.3})°",
+                t.x, t.y, t.z
+            )
+        }
+        None => format!(
+            "joints [{}] deg",
+            m.joints
+                .iter()
+                .map(|q| format!("{q:.2}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
     ui.label(format!(
-        "station {}, use {}, side {:+}, joints [{}] deg",
+        "station {}, use {}, side {:+}, {pose}",
         m.station,
         m.usage.as_str(),
         m.side,
-        m.joints
-            .iter()
-            .map(|q| format!("{q:.2}"))
-            .collect::<Vec<_>>()
-            .join(", ")
     ));
     match (loaded.fit(i), &m.observation) {
         (Fit::GivenCentre, Observation::Centre(c)) => {

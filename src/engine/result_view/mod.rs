@@ -17,7 +17,9 @@ use crate::engine::format::result::{CentreRecord, ResultFile};
 use crate::engine::geometry::roll_pitch_yaw_deg;
 use crate::engine::session::{Session, Use};
 use crate::engine::solve::{Prepared, SolverReport};
-use crate::engine::validate::{BeforeAfter, DistanceRecord, Stats, within_station_distances};
+use crate::engine::validate::{
+    BeforeAfter, DistanceRecord, Stats, scatter_rms, within_station_distances,
+};
 pub use strength::{HAND_EYE_ONLY, HandEyeStrength, flange_poses, hand_eye_only_lines};
 
 /// A dropped SVD direction marks a parameter as not identifiable when its
@@ -240,6 +242,10 @@ pub struct ResultView {
     pub marked: BTreeMap<String, String>,
     /// σ of each estimated parameter (`ml`), by label.
     pub sigma: BTreeMap<String, Sigma>,
+    /// The 3-D rms scatter of the identify centres about their station
+    /// means, before and after, mm ([`scatter_rms`]): what a hand-eye-only
+    /// result is judged by.
+    pub identify_scatter: (f64, f64),
 }
 
 impl ResultView {
@@ -306,8 +312,33 @@ impl ResultView {
                 .to_degrees(),
             marked: identifiability_marks(&result.solver),
             sigma,
+            identify_scatter: identify_scatter(&result.centres),
         }
     }
+}
+
+/// The scatter of the identify centres about their station means, before
+/// and after.
+fn identify_scatter(centres: &[CentreRecord]) -> (f64, f64) {
+    let mut stations: Vec<&str> = Vec::new();
+    for c in centres.iter().filter(|c| c.usage == Use::Identify) {
+        if !stations.contains(&c.station.as_str()) {
+            stations.push(&c.station);
+        }
+    }
+    let group = |after: bool| -> Vec<Vec<Vector3<f64>>> {
+        stations
+            .iter()
+            .map(|s| {
+                centres
+                    .iter()
+                    .filter(|c| c.usage == Use::Identify && c.station == *s)
+                    .map(|c| Vector3::from(if after { c.after } else { c.before }))
+                    .collect()
+            })
+            .collect()
+    };
+    (scatter_rms(&group(false)), scatter_rms(&group(true)))
 }
 
 /// Statistics of the before and after distances of `pairs`.

@@ -201,6 +201,8 @@ struct Ctx<'a> {
     within: Vec<PairDistance>,
     within_of: &'static str,
     identify_within: BeforeAfter,
+    /// 3-D rms scatter of the identify centres, before and after, mm.
+    identify_scatter: (f64, f64),
     excluded: Vec<String>,
 }
 
@@ -219,6 +221,7 @@ impl<'a> Ctx<'a> {
             within: view.within,
             within_of: view.within_of.as_str(),
             identify_within: view.identify_within,
+            identify_scatter: view.identify_scatter,
             excluded: excluded_measurements(input.session, result),
         }
     }

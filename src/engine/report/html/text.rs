@@ -219,9 +219,18 @@ pub(super) fn summary(h: &mut String, ctx: &Ctx<'_>) {
             }
             h.push_str("</p>\n");
         }
-        None => h.push_str(
-            "<p class=\"warn\" id=\"no-validation\">No validate measurements in this session: accuracy is not checked (no Fig. 6, no validation table).</p>\n",
-        ),
+        None => {
+            h.push_str(
+                "<p class=\"warn\" id=\"no-validation\">No validate measurements in this session: accuracy is not checked (no Fig. 6, no validation table).</p>\n",
+            );
+            let (b, a) = ctx.identify_scatter;
+            let _ = writeln!(
+                h,
+                "<p>Identify centres about their station's mean (3-D rms): <span class=\"big\">{} → {} mm</span></p>",
+                num(b, 3),
+                num(a, 3)
+            );
+        }
     }
     let _ = writeln!(
         h,
