@@ -32,7 +32,7 @@ pub mod robot_source;
 pub mod units;
 
 use std::collections::HashMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use nalgebra::Isometry3;
 
@@ -50,6 +50,7 @@ pub use crate::engine::robot::controller::FlangeConvention;
 use self::csv_file::CsvFile;
 use crate::engine::format::FileError;
 use crate::engine::format::{parse_session, session_to_json};
+use crate::engine::robot::Robot;
 use crate::engine::session::{
     MIN_STRIPE_POINTS, Measurement, Observation, Session, SolverSettings, Use,
 };
@@ -368,25 +369,14 @@ pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
             .file_stem()
             .map_or_else(|| "imported".into(), |s| s.to_string_lossy().into_owned())
     });
-    let session = Session {
+    let session = new_session(
         name,
-        name_given: true,
-        base_given: robot.base != Isometry3::identity(),
-        flange_given: robot.flange != Isometry3::identity(),
-        robot,
-        robot_given: true,
-        sphere_diameter: spec.sphere_diameter,
-        default_side: 1,
-        sensor_given: false,
-        hand_eye: None,
-        solver: SolverSettings::default(),
-        solver_given: false,
-        reference_distances: match &spec.references {
-            Some(path) => read_references(path)?,
-            None => Vec::new(),
-        },
+        Some(robot),
+        spec.sphere_diameter,
+        None,
+        spec.references.as_deref(),
         measurements,
-    };
+    )?;
     let session = parse_session(&session_to_json(&session), &spec.joint_log)?;
     let notes = vec![report.summary()];
     Ok(Imported {
@@ -394,5 +384,50 @@ pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
         checks,
         profiles: report,
         notes,
+    })
+}
+
+/// A session built by an import: `name` given, the robot (none for a
+/// pose-only log without one), the sphere, `side` as `sensor.side` when
+/// the import decided it, the reference distances of `references`, and
+/// default solver settings.
+pub(crate) fn new_session(
+    name: String,
+    robot: Option<Robot>,
+    sphere_diameter: f64,
+    side: Option<i8>,
+    references: Option<&Path>,
+    measurements: Vec<Measurement>,
+) -> Result<Session, ImportError> {
+    let robot_given = robot.is_some();
+    let robot = robot.unwrap_or_else(|| Robot::new(String::new(), Vec::new()));
+    Ok(Session {
+        name,
+        name_given: true,
+        base_given: robot.base != Isometry3::identity(),
+        flange_given: robot.flange != Isometry3::identity(),
+        robot,
+        robot_given,
+        sphere_diameter,
+        default_side: side.unwrap_or(1),
+        sensor_given: side.is_some(),
+        hand_eye: None,
+        solver: SolverSettings::default(),
+        solver_given: false,
+        reference_distances: match references {
+            Some(path) => read_references(path)?,
+            None => Vec::new(),
+        },
+        measurements,
+    })
+}
+
+/// The JSON value of a file's text (a UTF-8 byte-order mark allowed), or
+/// the syntax error at its line.
+pub(crate) fn json_value(text: &str, path: &Path) -> Result<serde_json::Value, ImportError> {
+    serde_json::from_str(text.trim_start_matches('\u{feff}')).map_err(|e| ImportError::Csv {
+        path: path.to_path_buf(),
+        line: e.line(),
+        message: format!("not valid JSON: {e}"),
     })
 }

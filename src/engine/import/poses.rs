@@ -41,13 +41,10 @@ use serde_json::Value;
 
 use super::csv_file::CsvFile;
 use super::profiles::{self, PlaneProfile, ProfileFormat, ProfileSource};
-use super::{
-    FlangeConvention, ImportError, Imported, ProfileReport, RobotSource, load_robot, log,
-    read_references,
-};
+use super::{FlangeConvention, ImportError, Imported, ProfileReport, RobotSource, load_robot, log};
 use crate::engine::format::{parse_session, session_to_json};
 use crate::engine::robot::Robot;
-use crate::engine::session::{Measurement, Observation, Session, SolverSettings, Use};
+use crate::engine::session::{Measurement, Observation, Session, Use};
 use crate::engine::solve::{self, Options};
 
 /// Largest orientation difference (deg) between poses counted as "the
@@ -169,13 +166,7 @@ fn json_poses(
     path: &Path,
     convention: FlangeConvention,
 ) -> Result<Vec<PoseRecord>, ImportError> {
-    let value: Value = serde_json::from_str(text.trim_start_matches('\u{feff}')).map_err(|e| {
-        ImportError::Csv {
-            path: path.to_path_buf(),
-            line: e.line(),
-            message: format!("not valid JSON: {e}"),
-        }
-    })?;
+    let value = super::json_value(text, path)?;
     let file_error = |message: String| ImportError::File {
         path: path.to_path_buf(),
         message,
@@ -472,27 +463,14 @@ fn draft(
             .file_stem()
             .map_or_else(|| "imported".into(), |s| s.to_string_lossy().into_owned())
     });
-    let robot_given = robot.is_some();
-    let robot = robot.unwrap_or_else(|| Robot::new(String::new(), Vec::new()));
-    let session = Session {
+    let session = super::new_session(
         name,
-        name_given: true,
-        base_given: robot.base != Isometry3::identity(),
-        flange_given: robot.flange != Isometry3::identity(),
         robot,
-        robot_given,
-        sphere_diameter: spec.sphere_diameter,
-        default_side: side,
-        sensor_given: true,
-        hand_eye: None,
-        solver: SolverSettings::default(),
-        solver_given: false,
-        reference_distances: match &spec.references {
-            Some(path) => read_references(path)?,
-            None => Vec::new(),
-        },
+        spec.sphere_diameter,
+        Some(side),
+        spec.references.as_deref(),
         measurements,
-    };
+    )?;
     Ok(Draft {
         session,
         auto_uses,

@@ -198,3 +198,53 @@ impl FlangeConvention {
         }
     }
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::engine::geometry::{rot_x, rot_y, rot_z, trans};
+
+    #[test]
+    fn every_convention_round_trips() {
+        let pose = trans(-195.8, 1363.3, 524.8) * rot_z(0.4) * rot_y(-0.3) * rot_x(2.9);
+        for c in FlangeConvention::ALL {
+            let v = c.values_from_pose(&pose);
+            assert_eq!(v.len(), c.n_columns(), "{c:?}");
+            let back = c.pose_from_values(&v).unwrap();
+            assert!(
+                (back.translation.vector - pose.translation.vector).norm() < 1e-9,
+                "{c:?}"
+            );
+            assert!(back.rotation.angle_to(&pose.rotation) < 1e-12, "{c:?}");
+            assert_eq!(FlangeConvention::parse(c.key()), Some(c));
+        }
+    }
+
+    #[test]
+    fn fanuc_wpr_is_rz_ry_rx() {
+        // RobCalibrator's first pose: R = Rz(r)·Ry(p)·Rx(w).
+        let (w, p, r) = (-179.924_f64, 0.889_f64, 179.635_f64);
+        let pose = FlangeConvention::FanucWpr
+            .pose_from_values(&[-195.8, 1363.305, 524.812, w, p, r])
+            .unwrap();
+        let expected = rot_z(r.to_radians()) * rot_y(p.to_radians()) * rot_x(w.to_radians());
+        assert!(pose.rotation.angle_to(&expected.rotation) < 1e-12);
+        assert!((pose.translation.vector.x + 195.8).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_values_are_named() {
+        let e = FlangeConvention::FanucWpr
+            .pose_from_values(&[1.0, 2.0, 3.0, 4.0, 5.0])
+            .unwrap_err();
+        assert!(e.contains("5 values"), "{e}");
+        let mut m = vec![0.0; 16];
+        m[0] = 2.0;
+        assert!(FlangeConvention::Matrix.pose_from_values(&m).is_err());
+        let nan = FlangeConvention::KukaAbc
+            .pose_from_values(&[1.0, 2.0, f64::NAN, 0.0, 0.0, 0.0])
+            .unwrap_err();
+        assert!(nan.contains("finite"), "{nan}");
+    }
+}

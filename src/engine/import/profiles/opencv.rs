@@ -225,13 +225,7 @@ pub(super) fn read_json(
     path: &Path,
     format: &ProfileFormat,
 ) -> Result<RawProfile, ImportError> {
-    let value: Value = serde_json::from_str(text.trim_start_matches('\u{feff}')).map_err(|e| {
-        ImportError::Csv {
-            path: path.to_path_buf(),
-            line: e.line(),
-            message: format!("not valid JSON: {e}"),
-        }
-    })?;
+    let value = crate::engine::import::json_value(text, path)?;
     let Value::Object(map) = value else {
         return Err(ImportError::File {
             path: path.to_path_buf(),
