@@ -22,6 +22,9 @@ fn demo() -> spherecal::engine::session::Session {
 fn bench(c: &mut Criterion) {
     let session = demo();
     let mut group = c.benchmark_group("demo_session");
+    group.bench_function("load (parse and check the 237 KB session)", |b| {
+        b.iter(demo);
+    });
     group.bench_function("prepare (stripe fits + initial hand-eye)", |b| {
         b.iter(|| solve::prepare(&session).expect("prepare"));
     });
@@ -37,6 +40,11 @@ fn bench(c: &mut Criterion) {
     }
     group.bench_function("whole calibration, default options", |b| {
         b.iter(|| solve::calibrate(&session, &Options::from_session(&session)).expect("calibrate"));
+    });
+    let (_, cal) = solve::calibrate(&session, &Options::from_session(&session)).expect("calibrate");
+    let file = spherecal::engine::format::ResultFile::from_calibration(&session, &cal);
+    group.bench_function("result file text (write)", |b| {
+        b.iter(|| spherecal::engine::format::result_to_json(&file));
     });
     group.finish();
 }

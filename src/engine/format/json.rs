@@ -10,7 +10,7 @@ use std::fs;
 use std::path::Path;
 
 use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion};
-use serde::de::{self, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
+use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 use serde_json::{Map, Value};
@@ -235,9 +235,10 @@ impl<'a> Ctx<'a> {
             .unwrap_or_default()
     }
 
-    /// The whole text as one JSON value, after a full syntax check.
+    /// The whole text as one JSON value, after a full syntax check (one
+    /// pass: the raw value's parse checks the whole text).
     pub(super) fn document(&self) -> Result<&'a RawValue, FileError> {
-        if let Err(e) = serde_json::from_str::<IgnoredAny>(self.text) {
+        serde_json::from_str::<&RawValue>(self.text).map_err(|e| {
             let mut message = format!(
                 "not valid JSON: {} at line {} column {}",
                 describe(&e),
@@ -247,10 +248,8 @@ impl<'a> Ctx<'a> {
             if self.non_finite_literal_at(e.line(), e.column()) {
                 message.push_str("; NaN and Infinity are not JSON numbers");
             }
-            return Err(self.invalid(None, message));
-        }
-        serde_json::from_str::<&RawValue>(self.text)
-            .map_err(|e| self.invalid(None, format!("not valid JSON: {}", describe(&e))))
+            self.invalid(None, message)
+        })
     }
 
     /// Whether a `NaN` or `Infinity` literal sits at the position of a
@@ -418,6 +417,19 @@ impl<'a> Ctx<'a> {
                 format!("{key} must be 1 or -1, found {v}{}", self.at(raw)),
             ))
         }
+    }
+
+    /// Whether `format` and `version` name a version 1 file of kind
+    /// `expected` (the fast check; [`Self::header`] says what is wrong).
+    pub(super) fn is_header(
+        &self,
+        format: Option<&'a RawValue>,
+        version: Option<&'a RawValue>,
+        expected: &str,
+    ) -> bool {
+        let format = format.and_then(|r| serde_json::from_str::<&str>(r.get()).ok());
+        let version = version.and_then(|r| serde_json::from_str::<f64>(r.get()).ok());
+        format == Some(expected) && version == Some(f64::from(FORMAT_VERSION))
     }
 
     /// `format` and `version` (FORMAT.md: a later version is a new number).

@@ -51,7 +51,6 @@ use std::path::Path;
 
 use nalgebra::Isometry3;
 use serde::{Deserialize, Serialize};
-use serde_json::Value;
 use serde_json::value::RawValue;
 
 use super::FORMAT_VERSION;
@@ -90,8 +89,17 @@ pub fn load_session(path: &Path) -> Result<Session, FileError> {
 pub fn parse_session(text: &str, path: &Path) -> Result<Session, FileError> {
     let ctx = Ctx::new(text, path);
     let top = ctx.document()?;
-    ctx.header(top, SESSION_FORMAT)?;
-    ctx.session(top)
+    // The keys first: when they parse and name a version 1 session, the
+    // header pass (a whole scan of the text) is not needed; otherwise it
+    // says what the file is before any key is blamed.
+    let keys = match ctx.object::<SessionKeys>(top, "", None) {
+        Ok(keys) if ctx.is_header(keys.format, keys.version, SESSION_FORMAT) => keys,
+        other => {
+            ctx.header(top, SESSION_FORMAT)?;
+            other?
+        }
+    };
+    ctx.session(top, keys)
 }
 
 /// The session as FORMAT.md version 1 JSON, pretty-printed, with a trailing
@@ -135,9 +143,16 @@ keys_struct!(MeasurementKeys, "a measurement object" {
 });
 keys_struct!(StripeKeys, "an object with points" { points });
 
+/// The id of a measurement, picked out leniently (other keys skipped
+/// unparsed) so that every later error can name the measurement.
+#[derive(Deserialize)]
+struct IdProbe {
+    #[serde(default)]
+    id: Option<String>,
+}
+
 impl<'a> Ctx<'a> {
-    fn session(&self, top: &'a RawValue) -> Result<Session, FileError> {
-        let keys: SessionKeys = self.object(top, "", None)?;
+    fn session(&self, top: &'a RawValue, keys: SessionKeys<'a>) -> Result<Session, FileError> {
         let name_given = keys.name.is_some();
         let name = match keys.name {
             Some(raw) => self.parse::<String>(raw, "name", None)?,
@@ -353,19 +368,37 @@ impl<'a> Ctx<'a> {
         default_side: i8,
     ) -> Result<Measurement, FileError> {
         let robot_joints = robot.joints.len();
-        // The id is picked out leniently first so that every later error,
-        // even a malformed key, can name the measurement.
-        let lenient_id = serde_json::from_str::<Value>(raw.get())
-            .ok()
-            .and_then(|v| v.get("id")?.as_str().map(str::to_owned))
-            .filter(|id| !id.is_empty());
-        let m = lenient_id.as_deref();
-        let scope = if m.is_some() {
-            String::new()
-        } else {
-            format!("measurements[{index}]")
-        };
-        let keys: MeasurementKeys = self.object(raw, &scope, m)?;
+        // Parsed strictly first; only when that fails is the id picked out
+        // leniently, so that the error can name the measurement.
+        let (keys, m, scope): (MeasurementKeys, Option<String>, String) =
+            match self.object::<MeasurementKeys>(raw, "", None) {
+                Ok(keys) => {
+                    let lenient = keys
+                        .id
+                        .and_then(|r| serde_json::from_str::<String>(r.get()).ok())
+                        .filter(|id| !id.is_empty());
+                    let scope = if lenient.is_some() {
+                        String::new()
+                    } else {
+                        format!("measurements[{index}]")
+                    };
+                    (keys, lenient, scope)
+                }
+                Err(_) => {
+                    let lenient = serde_json::from_str::<IdProbe>(raw.get())
+                        .ok()
+                        .and_then(|p| p.id)
+                        .filter(|id| !id.is_empty());
+                    let scope = if lenient.is_some() {
+                        String::new()
+                    } else {
+                        format!("measurements[{index}]")
+                    };
+                    let keys = self.object(raw, &scope, lenient.as_deref())?;
+                    (keys, lenient, scope)
+                }
+            };
+        let m = m.as_deref();
 
         let id_raw = self.required(keys.id, raw, &scope, "id", m)?;
         let id: String = self.parse(id_raw, &join(&scope, "id"), m)?;
@@ -479,14 +512,21 @@ impl<'a> Ctx<'a> {
                 let points_raw =
                     self.required(stripe.points, stripe_raw, &stripe_key, "points", m)?;
                 let points_key = join(&stripe_key, "points");
-                let items: Vec<&'a RawValue> = self.parse(points_raw, &points_key, m)?;
-                let points = items
-                    .into_iter()
-                    .enumerate()
-                    .map(|(i, item)| {
-                        self.numbers::<2>(item, &format!("{points_key}[{i}]"), " [y, z]", m)
-                    })
-                    .collect::<Result<Vec<_>, _>>()?;
+                // One pass for a well-formed list; on any problem, item by
+                // item for a message that names the point.
+                let points = match serde_json::from_str::<Vec<[f64; 2]>>(points_raw.get()) {
+                    Ok(points) => points,
+                    Err(_) => {
+                        let items: Vec<&'a RawValue> = self.parse(points_raw, &points_key, m)?;
+                        items
+                            .into_iter()
+                            .enumerate()
+                            .map(|(i, item)| {
+                                self.numbers::<2>(item, &format!("{points_key}[{i}]"), " [y, z]", m)
+                            })
+                            .collect::<Result<Vec<_>, _>>()?
+                    }
+                };
                 if points.len() < MIN_STRIPE_POINTS {
                     let problem = StripeError::TooFewPoints {
                         found: points.len(),
