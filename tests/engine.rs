@@ -170,7 +170,9 @@ fn epsilon_series_follows_the_loop_of_format_md() {
     options.max_iterations = 4;
     let mut seen = Vec::new();
     let cal = solve::run(&session, &prepared, &options, &mut |p| {
-        seen.push((p.updates, p.epsilon));
+        if p.phase == solve::Phase::Loop {
+            seen.push((p.updates, p.epsilon));
+        }
         solve::Control::Continue
     })
     .unwrap();
@@ -212,4 +214,25 @@ fn too_little_identify_data_is_explained() {
     session.measurements.retain(|m| m.usage != Use::Identify);
     let err = solve::calibrate(&session, &paper_options(&session)).unwrap_err();
     assert!(err.to_string().contains("identify station"), "{err}");
+}
+
+#[test]
+fn the_paper_loop_stops_when_epsilon_has_levelled_off() {
+    // Threshold 0 and a bound of 100,000: the loop must stop once ε no
+    // longer moves, not run every update.
+    let (session, _) = simulate(&SimConfig::default());
+    let prepared = solve::prepare(&session).unwrap();
+    let mut options = paper_options(&session);
+    options.threshold = 0.0;
+    options.max_iterations = 100_000;
+    let cal = solve::run(&session, &prepared, &options, &mut |_| {
+        solve::Control::Continue
+    })
+    .unwrap();
+    assert_eq!(cal.stop.code(), "levelled_off", "{}", cal.stop.describe());
+    assert!(
+        cal.iterations.len() < 200,
+        "{} updates",
+        cal.iterations.len()
+    );
 }

@@ -351,7 +351,9 @@ fn the_loop_of_format_md_holds_for_ml() {
     options.threshold = 0.0;
     let mut seen = Vec::new();
     let cal = solve::run(&session, &prepared, &options, &mut |p| {
-        seen.push((p.updates, p.epsilon));
+        if p.phase == solve::Phase::Loop {
+            seen.push((p.updates, p.epsilon));
+        }
         Control::Continue
     })
     .expect("run");
@@ -434,4 +436,32 @@ fn evaluate_smoke_two_seeds() {
     let table = evaluate::markdown(&results, 2);
     assert_eq!(table.lines().count(), 2 + 5, "{table}");
     assert!(evaluate::select("nope").is_err());
+}
+
+#[test]
+fn a_cancel_in_the_diagnostics_ends_the_run_as_cancelled() {
+    let (session, _) = simulate(&SimConfig::default());
+    let prepared = solve::prepare(&session).expect("prepare");
+    let options = ml_options(&session);
+    let mut phases = Vec::new();
+    let cal = solve::run(&session, &prepared, &options, &mut |p| {
+        phases.push(p.phase);
+        if matches!(p.phase, solve::Phase::CrossValidation { done: 3, .. }) {
+            Control::Cancel
+        } else {
+            Control::Continue
+        }
+    })
+    .expect("run");
+    assert!(cal.stop.is_cancelled(), "{}", cal.stop.describe());
+    let report = cal.report.ml().expect("ml");
+    assert!(report.cross_validation.is_none() && report.parameters.is_empty());
+    // Every phase reported itself before the cancel.
+    assert!(phases.contains(&solve::Phase::Covariance));
+    assert!(phases.contains(&solve::Phase::Prediction));
+    assert!(
+        phases
+            .iter()
+            .any(|p| matches!(p, solve::Phase::Step { .. }))
+    );
 }

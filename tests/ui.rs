@@ -15,7 +15,7 @@ use spherecal::app::forms::Tab;
 use spherecal::app::state::Prefs;
 use spherecal::engine::format::parse_session;
 use spherecal::engine::report::model::{self, ModelFormat};
-use spherecal::engine::solve::{Method, Options, calibrate};
+use spherecal::engine::solve::{Options, calibrate};
 
 /// Frames to wait for background work (with a short sleep each): generous
 /// for a loaded CI machine; a run of the demo takes well under a second.
@@ -224,17 +224,36 @@ fn session_name() -> String {
 #[test]
 fn cancel_stops_a_run() {
     let mut h = demo_app();
-    // A run that only Cancel can end: the paper's method with threshold 0
-    // and an iteration bound of a million updates (hours of work). The
-    // solver checks the cancel flag at every ε, so whenever Cancel lands
-    // the run stops within one update; without a working Cancel, `settle`
-    // gives up and the test fails.
-    {
-        let solver = &mut h.state_mut().forms_mut().solver;
-        solver.method = Method::Paper;
-        solver.threshold = 0.0;
-        solver.max_iterations = 1_000_000;
-    }
+    // A run long enough to cancel: ml on a session of 2,470 measurements
+    // (400 identify stations), whose every phase (LM steps, covariance,
+    // leave-one-station-out over 400 stations) checks the cancel flag.
+    // Without a working Cancel the run ends with a result and the test
+    // fails.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (session, _) =
+        spherecal::engine::simulate::simulate(&spherecal::engine::simulate::SimConfig {
+            n_identify: 400,
+            ..spherecal::engine::simulate::SimConfig::default()
+        })
+        .expect("simulate");
+    let path = dir.path().join("big.json");
+    spherecal::engine::format::save_session(&session, &path).expect("save");
+    let ctx = h.ctx.clone();
+    h.state_mut().command(
+        &ctx,
+        spherecal::app::commands::Command::Files(spherecal::app::commands::FilesCommand::OpenPath(
+            path,
+        )),
+    );
+    settle(&mut h);
+    assert_eq!(
+        h.state()
+            .state()
+            .loaded
+            .as_ref()
+            .map(|l| l.session.measurements.len()),
+        Some(session.measurements.len())
+    );
     h.get_by_label("▶ Run").click();
     // Let the run get going (the window repaints while it works).
     for _ in 0..10 {

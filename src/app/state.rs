@@ -179,6 +179,9 @@ pub struct RunState {
     pub started: Instant,
     /// Measurements left out of this run.
     pub excluded: usize,
+    /// What the solver is doing now (a phase after or inside an update),
+    /// with the fraction done when there is one.
+    pub phase: Option<(String, Option<f64>)>,
 }
 
 /// How serious a status line is.

@@ -273,7 +273,7 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
         solve::prepare(&session).map_err(|e| CliError::from_calibration(&e, &args.session))?;
     let quiet = args.quiet;
     let mut on_progress = |p: &solve::Progress| {
-        if !quiet {
+        if !quiet && p.phase == solve::Phase::Loop {
             println!("  ε after {:>2} update(s): {:.4} mm", p.updates, p.epsilon);
         }
         Control::Continue

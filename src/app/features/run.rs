@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use crate::engine::format::ResultFile;
-use crate::engine::solve::{self, Control, Options, Progress, StopReason};
+use crate::engine::solve::{self, Control, Options, Phase, Progress, StopReason};
 
 use super::Core;
 use super::files::without;
@@ -109,6 +109,7 @@ impl Core {
                 cancelling: false,
                 started: Instant::now(),
                 excluded: n_excluded,
+                phase: None,
             });
             self.state.say(Level::Info, "running the calibration…");
         }
@@ -119,8 +120,13 @@ impl Core {
         match message {
             RunMessage::Progress(p) => {
                 if let Some(run) = &mut self.state.run {
-                    run.epsilons.truncate(p.updates);
-                    run.epsilons.push(p.epsilon);
+                    if p.phase == Phase::Loop {
+                        run.epsilons.truncate(p.updates);
+                        run.epsilons.push(p.epsilon);
+                        run.phase = None;
+                    } else {
+                        run.phase = Some((p.phase.describe(p.updates), p.phase.fraction()));
+                    }
                 }
             }
             RunMessage::Finished(outcome) => {

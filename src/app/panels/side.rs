@@ -199,14 +199,18 @@ pub fn solver_ui(
         ui.horizontal(|ui| {
             ui.spinner();
             let updates = run.epsilons.len().saturating_sub(1);
-            match run.epsilons.last() {
-                Some(eps) => ui.label(format!(
+            match (&run.phase, run.epsilons.last()) {
+                (Some((what, _)), _) => ui.label(what),
+                (None, Some(eps)) => ui.label(format!(
                     "update {updates} of ≤ {}: ε = {eps:.4} mm",
                     run.max_iterations
                 )),
-                None => ui.label("preparing: stripe fits and initial hand-eye…"),
+                (None, None) => ui.label("preparing: stripe fits and initial hand-eye…"),
             };
         });
+        if let Some((_, Some(fraction))) = &run.phase {
+            ui.add(egui::ProgressBar::new(*fraction as f32).show_percentage());
+        }
         epsilon_plot_ui(
             ui,
             "live_epsilon",

@@ -152,6 +152,61 @@ pub struct Progress {
     pub max_iterations: usize,
     /// The threshold, mm.
     pub threshold: f64,
+    /// What the run is doing: a new ε of the loop, or a phase inside an
+    /// update or after the loop.
+    pub phase: Phase,
+}
+
+/// What a run is doing, for progress reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// The loop computed ε after `updates` updates.
+    Loop,
+    /// Inside update `updates + 1`: the method's inner step `step` (`ml`:
+    /// a Levenberg-Marquardt step) was taken.
+    Step {
+        /// Inner steps taken in this update.
+        step: usize,
+    },
+    /// `ml`: the parameter covariance and the leverages.
+    Covariance,
+    /// `ml`: the predicted σ of the distances.
+    Prediction,
+    /// `ml`: leave-one-station-out refits, `done` of `of` stations.
+    CrossValidation {
+        /// Stations done.
+        done: usize,
+        /// Stations in all.
+        of: usize,
+    },
+    /// `ml`: residuals, outliers and the variance factor.
+    Outliers,
+}
+
+impl Phase {
+    /// In words, with the count done where there is one.
+    #[must_use]
+    pub fn describe(&self, updates: usize) -> String {
+        match *self {
+            Self::Loop => format!("update {updates}"),
+            Self::Step { step } => format!("update {}: solver step {step}", updates + 1),
+            Self::Covariance => "covariance and leverages".to_string(),
+            Self::Prediction => "predicted distance σ".to_string(),
+            Self::CrossValidation { done, of } => {
+                format!("leave-one-station-out: {done} of {of} stations")
+            }
+            Self::Outliers => "outliers and variance factor".to_string(),
+        }
+    }
+
+    /// The fraction of the phase done, when it has one.
+    #[must_use]
+    pub fn fraction(&self) -> Option<f64> {
+        match *self {
+            Self::CrossValidation { done, of } if of > 0 => Some(done as f64 / of as f64),
+            _ => None,
+        }
+    }
 }
 
 /// What the progress callback asks for.
@@ -199,6 +254,19 @@ pub enum StopReason {
         /// Relative cost decrease of the last step (0 when none was possible).
         relative_change: f64,
     },
+    /// ε stopped changing (by at most [`LEVELLED_OFF_STOP_MM`] over each
+    /// of [`LEVELLED_OFF_UPDATES`] updates) above the threshold: more
+    /// updates would not lower it.
+    LevelledOff {
+        /// Final ε, mm.
+        epsilon: f64,
+        /// Threshold, mm.
+        threshold: f64,
+        /// Updates made.
+        updates: usize,
+        /// |ε change| over the last update, mm.
+        last_change: f64,
+    },
     /// The caller cancelled the run (the estimate is the one reached so
     /// far, and a method's costly diagnostics are left out).
     Cancelled {
@@ -214,6 +282,14 @@ pub enum StopReason {
 /// Below this change of ε (mm) over one update the loop is said to have
 /// levelled off: 1 µm is far below any stripe sensor's resolution.
 pub const LEVELLED_OFF_MM: f64 = 1e-3;
+
+/// The loop stops when ε changed by at most this (mm) over each of the
+/// last [`LEVELLED_OFF_UPDATES`] updates: a picometre, where only rounding
+/// moves it.
+pub const LEVELLED_OFF_STOP_MM: f64 = 1e-9;
+
+/// Updates in a row with ε levelled off before the loop stops.
+pub const LEVELLED_OFF_UPDATES: usize = 2;
 
 impl StopReason {
     /// A sentence for people.
@@ -252,6 +328,14 @@ impl StopReason {
             } => format!(
                 "converged: the maximum-likelihood solve reached its optimum (last relative cost change {relative_change:.1e}) after {updates} update(s); ε = {epsilon:.4} mm is above the threshold {threshold:.4} mm, which is below what the noise of this data allows"
             ),
+            Self::LevelledOff {
+                epsilon,
+                threshold,
+                updates,
+                last_change,
+            } => format!(
+                "ε levelled off: it changed by {last_change:.1e} mm over the last update; stopped after {updates} update(s) with ε = {epsilon:.4} mm above the threshold {threshold:.4} mm, which is below what the noise of this data allows"
+            ),
             Self::Cancelled {
                 epsilon,
                 threshold,
@@ -266,6 +350,46 @@ impl StopReason {
     #[must_use]
     pub fn is_cancelled(&self) -> bool {
         matches!(self, Self::Cancelled { .. })
+    }
+
+    /// The same stop, cancelled (a cancel during a method's diagnostics).
+    #[must_use]
+    pub fn cancelled(&self) -> Self {
+        let (epsilon, threshold, updates) = match *self {
+            Self::Converged {
+                epsilon,
+                threshold,
+                updates,
+            }
+            | Self::IterationLimit {
+                epsilon,
+                threshold,
+                updates,
+                ..
+            }
+            | Self::SolverConverged {
+                epsilon,
+                threshold,
+                updates,
+                ..
+            }
+            | Self::LevelledOff {
+                epsilon,
+                threshold,
+                updates,
+                ..
+            }
+            | Self::Cancelled {
+                epsilon,
+                threshold,
+                updates,
+            } => (epsilon, threshold, updates),
+        };
+        Self::Cancelled {
+            epsilon,
+            threshold,
+            updates,
+        }
     }
 
     /// The loop's record for the result's `solver` block.
@@ -286,6 +410,7 @@ impl StopReason {
             Self::Converged { .. } => "threshold",
             Self::IterationLimit { .. } => "max_iterations",
             Self::SolverConverged { .. } => "converged",
+            Self::LevelledOff { .. } => "levelled_off",
             Self::Cancelled { .. } => "cancelled",
         }
     }
@@ -362,6 +487,9 @@ pub enum Step {
         /// Relative cost decrease of the last step taken (0 if none).
         relative_change: f64,
     },
+    /// The caller cancelled inside the update (the estimate is the last
+    /// accepted one).
+    Cancelled,
 }
 
 /// A method inside the loop: its estimate, one update, and its report
@@ -370,15 +498,27 @@ pub trait Update {
     /// The model and hand-eye now.
     fn estimate(&self) -> &Estimate;
 
-    /// Makes update number `update` (1, 2, …).
+    /// Makes update number `update` (1, 2, …), telling `phase` of each
+    /// inner step; a [`Control::Cancel`] from it ends the update at once
+    /// with [`Step::Cancelled`].
     ///
     /// # Errors
     /// A bad option, or a non-finite step.
-    fn update(&mut self, update: usize) -> Result<Step, SolveError>;
+    fn update(
+        &mut self,
+        update: usize,
+        phase: &mut dyn FnMut(Phase) -> Control,
+    ) -> Result<Step, SolveError>;
 
     /// The method's report on the run that stopped for `stop` (a method
-    /// leaves out its costly diagnostics after a cancel).
-    fn report(self: Box<Self>, stop: &StopReason) -> SolverReport;
+    /// leaves out its costly diagnostics after a cancel), telling `phase`
+    /// of each diagnostic; the flag is true when `phase` cancelled them
+    /// (the report then holds the settings only).
+    fn report(
+        self: Box<Self>,
+        stop: &StopReason,
+        phase: &mut dyn FnMut(Phase) -> Control,
+    ) -> (SolverReport, bool);
 }
 
 /// Runs the identification loop (FORMAT.md "The iteration"): compute ε;
@@ -432,38 +572,58 @@ pub fn run(
     let eps_of = |est: &Estimate| epsilon(&est.station_centres(&stations));
     let mut eps = eps_of(method.estimate());
     let mut iterations = vec![eps];
-    let report = |updates: usize, epsilon: f64| Progress {
+    let report = |updates: usize, epsilon: f64, phase: Phase| Progress {
         updates,
         epsilon,
         max_iterations: options.max_iterations,
         threshold: options.threshold,
+        phase,
     };
-    let mut cancelled = progress(&report(0, eps)) == Control::Cancel;
+    let mut cancelled = progress(&report(0, eps, Phase::Loop)) == Control::Cancel;
     let mut converged = None;
+    let mut levelled = 0_usize;
     while !cancelled
         && converged.is_none()
+        && levelled < LEVELLED_OFF_UPDATES
         && eps > options.threshold
         && iterations.len() - 1 < options.max_iterations
     {
         let updates = iterations.len();
-        match method.update(updates)? {
+        let (done, now) = (updates - 1, eps);
+        let mut inner = |phase: Phase| progress(&report(done, now, phase));
+        match method.update(updates, &mut inner)? {
             Step::Moved => {}
             Step::Converged { relative_change } => converged = Some(relative_change),
             Step::Stuck { relative_change } => {
                 converged = Some(relative_change);
                 continue;
             }
+            Step::Cancelled => {
+                cancelled = true;
+                continue;
+            }
         }
+        let previous = eps;
         eps = eps_of(method.estimate());
         if !eps.is_finite() {
             return Err(SolveError::NonFinite { iteration: updates });
         }
         iterations.push(eps);
-        cancelled = progress(&report(updates, eps)) == Control::Cancel;
+        levelled = if (eps - previous).abs() <= LEVELLED_OFF_STOP_MM {
+            levelled + 1
+        } else {
+            0
+        };
+        cancelled = progress(&report(updates, eps, Phase::Loop)) == Control::Cancel;
     }
     let updates = iterations.len() - 1;
     let n = iterations.len();
-    let stop = if cancelled {
+    let last_change = if n >= 2 {
+        (iterations[n - 1] - iterations[n - 2]).abs()
+    } else {
+        f64::INFINITY
+    };
+    let mut stop = if cancelled {
         StopReason::Cancelled {
             epsilon: eps,
             threshold: options.threshold,
@@ -482,20 +642,27 @@ pub fn run(
             updates,
             relative_change,
         }
+    } else if levelled >= LEVELLED_OFF_UPDATES {
+        StopReason::LevelledOff {
+            epsilon: eps,
+            threshold: options.threshold,
+            updates,
+            last_change,
+        }
     } else {
         StopReason::IterationLimit {
             epsilon: eps,
             threshold: options.threshold,
             updates,
-            last_change: if n >= 2 {
-                (iterations[n - 1] - iterations[n - 2]).abs()
-            } else {
-                f64::INFINITY
-            },
+            last_change,
         }
     };
     let est = method.estimate().clone();
-    let report = method.report(&stop);
+    let mut after = |phase: Phase| progress(&report(updates, eps, phase));
+    let (report, cancelled_late) = method.report(&stop, &mut after);
+    if cancelled_late {
+        stop = stop.cancelled();
+    }
     Ok(finish(
         session, prepared, options, &start, est, iterations, stop, report,
     ))

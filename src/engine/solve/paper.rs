@@ -18,7 +18,7 @@
 use nalgebra::{DMatrix, DVector, Vector3};
 
 use super::report::{Direction, PaperReport, SolverReport};
-use super::{Options, SolveError, Step, StopReason, Update};
+use super::{Control, Options, Phase, SolveError, Step, StopReason, Update};
 use crate::engine::numeric::as_written;
 
 use super::estimate::{
@@ -264,7 +264,11 @@ impl Update for PaperUpdate {
         &self.est
     }
 
-    fn update(&mut self, update: usize) -> Result<Step, SolveError> {
+    fn update(
+        &mut self,
+        update: usize,
+        _phase: &mut dyn FnMut(Phase) -> Control,
+    ) -> Result<Step, SolveError> {
         let info = paper_update(&self.est, &self.stations, &self.options.paper)?;
         if info.delta.iter().any(|d| !d.is_finite()) {
             return Err(SolveError::NonFinite { iteration: update });
@@ -274,11 +278,15 @@ impl Update for PaperUpdate {
         Ok(Step::Moved)
     }
 
-    fn report(self: Box<Self>, stop: &StopReason) -> SolverReport {
+    fn report(
+        self: Box<Self>,
+        stop: &StopReason,
+        _phase: &mut dyn FnMut(Phase) -> Control,
+    ) -> (SolverReport, bool) {
         let o = &self.options;
         let record = stop.record(o);
         let last = self.last;
-        SolverReport::Paper(Box::new(PaperReport {
+        let report = SolverReport::Paper(Box::new(PaperReport {
             pairs: Some(o.paper.pairing.as_str().to_string()),
             svd_tolerance: Some(o.paper.svd_tolerance),
             column_scaling: Some(format!(
@@ -296,7 +304,8 @@ impl Update for PaperUpdate {
             singular_values: last.as_ref().map(|i| i.singular_values.clone()),
             dropped_directions: last.map(|i| i.dropped),
             extra: serde_json::Map::new(),
-        }))
+        }));
+        (report, false)
     }
 }
 

@@ -7,18 +7,23 @@ use nalgebra::{DMatrix, DVector, Matrix3};
 use super::MlUpdate;
 use super::identifiability::raw_per_file_unit;
 use super::noise::{OUTLIER_QUANTILE, base_covariance, chi3_quantile, sensor_covariance};
-use super::problem::{Problem, Rows};
+use super::problem::Problem;
 use super::report::*;
 use crate::engine::handeye::Sighting;
 use crate::engine::session::Use;
-use crate::engine::solve::StopReason;
 use crate::engine::solve::estimate::{
     ANGLE_SCALE_MM, Estimate, sensitivity, unknown_is_angle, unknown_label,
 };
+use crate::engine::solve::{Control, Phase, StopReason};
 
 /// Correlations at least this large (absolute) are listed by name: beyond
 /// 0.95 two parameters are nearly interchangeable for this data.
 pub const STRONG_CORRELATION: f64 = 0.95;
+
+/// Most station pairs the predicted σ of distances across the identify
+/// volume is averaged over; beyond it an even sample of the pairs (every
+/// pair of up to 46 stations counts).
+pub const MAX_STATION_PAIRS: usize = 1000;
 
 /// Column `u` of `A` restricted and scaled to the estimated slots.
 pub(super) fn restricted(a: &DMatrix<f64>, problem: &Problem) -> DVector<f64> {
@@ -153,25 +158,27 @@ pub(super) fn settings(solver: &MlUpdate<'_>, stop: &StopReason) -> MlReport {
 /// The report of a run that stopped for `stop`: the settings, and unless
 /// it was cancelled the covariance, correlation, predicted distances,
 /// cross-validation and outliers at the final state.
-pub(super) fn report(solver: &MlUpdate<'_>, stop: &StopReason) -> MlReport {
+pub(super) fn report(
+    solver: &MlUpdate<'_>,
+    stop: &StopReason,
+    phase: &mut dyn FnMut(Phase) -> Control,
+) -> (MlReport, bool) {
     let base = settings(solver, stop);
     if stop.is_cancelled() {
-        return base;
+        return (base, false);
+    }
+    let cancelled = |solver: &MlUpdate<'_>| (settings(solver, &stop.cancelled()), true);
+    if phase(Phase::Covariance) == Control::Cancel {
+        return cancelled(solver);
     }
     let (session, prepared) = (solver.session, solver.prepared);
     let problem = &solver.problem;
     let state = &solver.state;
     let mo = &solver.options.ml;
     let k = problem.estimated.len();
-    let lin = problem.linearize(state, Rows::All);
-    let full_inv = lin
-        .h
-        .clone()
-        .cholesky()
-        .map(|c| c.inverse())
-        .or_else(|| lin.h.clone().pseudo_inverse(1e-14).ok())
-        .unwrap_or_else(|| DMatrix::zeros(lin.h.nrows(), lin.h.ncols()));
-    let cov_scaled = full_inv.view((0, 0), (k, k)).into_owned();
+    let lin = problem.linearize(state);
+    let inverse = lin.inverse_blocks();
+    let cov_scaled = inverse.p.clone();
     // File units: scaled → raw (÷ scale) → deg for angles.
     let to_file: Vec<f64> = problem
         .estimated
@@ -254,19 +261,18 @@ pub(super) fn report(solver: &MlUpdate<'_>, stop: &StopReason) -> MlReport {
         })
         .collect();
     // Residual statistics, leverage and outliers.
+    if phase(Phase::Outliers) == Control::Cancel {
+        return cancelled(solver);
+    }
     let limit = chi3_quantile(OUTLIER_QUANTILE);
     let mut chi2 = 0.0;
     let mut outliers = Vec::new();
     for o in &problem.obs {
         let (r, jp) = problem.obs_jacobian(o, state);
         chi2 += r.norm_squared();
-        // Leverage: tr(J_i H⁻¹ J_iᵀ)/3 with J_i = [jp | −C⁻¹].
-        let c0 = k + 3 * o.station;
-        let mut ji = DMatrix::zeros(3, problem.dim());
-        ji.view_mut((0, 0), (3, k)).copy_from(&jp);
-        ji.view_mut((0, c0), (3, 3))
-            .copy_from(&DMatrix::from_iterator(3, 3, (-o.whiten).iter().copied()));
-        let hat = &ji * &full_inv * ji.transpose();
+        // Leverage: tr(J_i H⁻¹ J_iᵀ)/3 with J_i = [jp | −C⁻¹], from the
+        // blocks of H⁻¹ (the station centres eliminated).
+        let hat = inverse.hat(&jp, &(-o.whiten), o.station);
         let lev = (hat.trace() / 3.0).clamp(0.0, 0.99);
         let sigma = r.norm() / (1.0 - lev).sqrt();
         if sigma > limit {
@@ -290,6 +296,9 @@ pub(super) fn report(solver: &MlUpdate<'_>, stop: &StopReason) -> MlReport {
     let dof = (3 * problem.obs.len()).saturating_sub(problem.dim()).max(1);
     let variance_factor = chi2 / dof as f64;
     // Predicted distance σ.
+    if phase(Phase::Prediction) == Control::Cancel {
+        return cancelled(solver);
+    }
     let noisy = |i: usize| -> NoisySighting {
         let s = prepared.sighting(session, i);
         let cov = base_covariance(
@@ -312,9 +321,18 @@ pub(super) fn report(solver: &MlUpdate<'_>, stop: &StopReason) -> MlReport {
         }
     }
     let identify = session.stations(Use::Identify);
+    let station_pairs = identify.len() * identify.len().saturating_sub(1) / 2;
+    // Every pair of stations up to MAX_STATION_PAIRS, else an even sample
+    // of them: the count grows as the square of the stations.
+    let stride = station_pairs.div_ceil(MAX_STATION_PAIRS).max(1);
     let mut ipairs = Vec::new();
+    let mut nth = 0_usize;
     for (ia, (_, a)) in identify.iter().enumerate() {
         for (_, b) in identify.iter().skip(ia + 1) {
+            nth += 1;
+            if !(nth - 1).is_multiple_of(stride) {
+                continue;
+            }
             for kk in 0..a.len().min(b.len()) {
                 ipairs.push((noisy(a[kk]), noisy(b[kk])));
             }
@@ -324,9 +342,15 @@ pub(super) fn report(solver: &MlUpdate<'_>, stop: &StopReason) -> MlReport {
         (!vpairs.is_empty()).then(|| distance_std(problem, &state.est, &cov_scaled, &vpairs));
     let predicted_identify = distance_std(problem, &state.est, &cov_scaled, &ipairs);
     // Leave-one-station-out.
-    let cross_validation =
-        (mo.cross_validation && problem.stations.len() >= 2).then(|| problem.cross_validate(state));
-    MlReport {
+    let cross_validation = if mo.cross_validation && problem.stations.len() >= 2 {
+        match problem.cross_validate(state, phase) {
+            Some(cv) => Some(cv),
+            None => return cancelled(solver),
+        }
+    } else {
+        None
+    };
+    let report = MlReport {
         parameters,
         covariance: LabelledMatrix {
             labels: labels.clone(),
@@ -346,5 +370,6 @@ pub(super) fn report(solver: &MlUpdate<'_>, stop: &StopReason) -> MlReport {
         outlier_limit_sigma: limit,
         outliers,
         ..base
-    }
+    };
+    (report, false)
 }

@@ -82,7 +82,7 @@ use nalgebra::Vector3;
 use super::estimate::unknown_scale;
 use super::estimate::{Estimate, Station};
 use super::prepare::Prepared;
-use super::{Options, SolveError, SolverReport, Step, StopReason, Update};
+use super::{Control, Options, Phase, SolveError, SolverReport, Step, StopReason, Update};
 use crate::engine::session::{Session, Use};
 use crate::engine::validate::epsilon;
 pub use identifiability::Inseparable;
@@ -337,7 +337,11 @@ impl Update for MlUpdate<'_> {
     }
 
     /// LM steps until LM converges or `MAX_LM_STEPS` steps were taken.
-    fn update(&mut self, _update: usize) -> Result<Step, SolveError> {
+    fn update(
+        &mut self,
+        _update: usize,
+        phase: &mut dyn FnMut(Phase) -> Control,
+    ) -> Result<Step, SolveError> {
         let mut taken = 0;
         while taken < MAX_LM_STEPS {
             let Some(step) = self.problem.lm_step(&self.state, &mut self.lambda) else {
@@ -358,6 +362,9 @@ impl Update for MlUpdate<'_> {
                 epsilon: epsilon(&step.state.est.station_centres(&self.stations)),
             });
             self.state = step.state;
+            if phase(Phase::Step { step: taken }) == Control::Cancel {
+                return Ok(Step::Cancelled);
+            }
             if done {
                 return Ok(Step::Converged {
                     relative_change: self.last_relative_change(),
@@ -367,8 +374,13 @@ impl Update for MlUpdate<'_> {
         Ok(Step::Moved)
     }
 
-    fn report(self: Box<Self>, stop: &StopReason) -> SolverReport {
-        SolverReport::Ml(Box::new(diagnostics::report(&self, stop)))
+    fn report(
+        self: Box<Self>,
+        stop: &StopReason,
+        phase: &mut dyn FnMut(Phase) -> Control,
+    ) -> (SolverReport, bool) {
+        let (report, cancelled) = diagnostics::report(&self, stop, phase);
+        (SolverReport::Ml(Box::new(report)), cancelled)
     }
 }
 
@@ -395,5 +407,5 @@ pub fn analyse(
         updates: 0,
         last_change: f64::INFINITY,
     };
-    Ok(diagnostics::report(&update, &stop))
+    Ok(diagnostics::report(&update, &stop, &mut |_| Control::Continue).0)
 }

@@ -3,14 +3,13 @@
 //! rows, and Levenberg-Marquardt over the estimated parameters and all
 //! station centres; leave-one-station-out refits by one Gauss-Newton step.
 
-use std::ops::AddAssign;
-
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use super::noise::Loss;
 use super::report::{CrossStation, CrossValidation};
 use crate::engine::handeye::Sighting;
 use crate::engine::solve::estimate::{Estimate, sensitivity};
+use crate::engine::solve::{Control, Phase};
 
 /// Marquardt's starting damping (relative to `diag(JᵀJ)`): small, because
 /// the nominal model is close enough for Gauss-Newton steps.
@@ -38,6 +37,12 @@ pub(super) const DIAG_FLOOR_REL: f64 = 1e-12;
 /// residuals, so 1e-10 relative is ~1e-8 σ²).
 pub(super) const COST_TOL: f64 = 1e-10;
 
+/// A cost decrease smaller than this fraction is not progress: the cost
+/// is a sum of hundreds to thousands of terms whose rounding reaches
+/// 1e-13 of it, and such a step moves no centre by a nanometre. It is not
+/// taken.
+pub(super) const COST_NOISE_REL: f64 = 1e-12;
+
 /// Converged when the largest scaled step is below this, mm: a picometre.
 pub(super) const STEP_TOL_MM: f64 = 1e-9;
 
@@ -60,32 +65,155 @@ pub(super) struct State {
     pub(super) centres: Vec<Vector3<f64>>,
 }
 
-/// Which measurement rows a linearisation takes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Rows {
-    /// Every measurement and the prior.
-    All,
-    /// Only the measurements of one station (no prior).
-    Only(usize),
+/// One station's part of the normal equations: the rows of its
+/// measurements touch the parameters and its own centre only.
+#[derive(Debug, Clone)]
+pub(super) struct StationBlock {
+    /// Its contribution to the parameter block, `Σ JpᵀwJp` (k × k).
+    pub(super) a: DMatrix<f64>,
+    /// Its contribution to the parameter gradient (k).
+    pub(super) gp: DVector<f64>,
+    /// Cross block parameters × centre, `Σ JpᵀwJc` (k × 3).
+    pub(super) b: DMatrix<f64>,
+    /// Centre block `Σ JcᵀwJc` (3 × 3).
+    pub(super) c: Matrix3<f64>,
+    /// Centre gradient (3).
+    pub(super) gc: Vector3<f64>,
 }
 
-impl Rows {
-    pub(super) fn includes(self, station: usize) -> bool {
-        match self {
-            Self::All => true,
-            Self::Only(s) => s == station,
+/// The linearised problem at a state, arranged for eliminating the
+/// station centres (the Schur complement, as bundle adjusters do): a
+/// `k × k` parameter block and one small block per station, so that a
+/// step, the covariance and the diagnostics cost `O(measurements)` in
+/// time and memory instead of the cube of the number of stations.
+pub(super) struct Linear {
+    /// Parameter block of `JᵀWJ` over all rows (and the prior).
+    pub(super) a: DMatrix<f64>,
+    /// Parameter gradient `JᵀW·r`.
+    pub(super) gp: DVector<f64>,
+    /// One per station, in station order.
+    pub(super) stations: Vec<StationBlock>,
+    /// Robust cost.
+    pub(super) cost: f64,
+}
+
+impl Linear {
+    /// The largest diagonal entry of the whole `JᵀWJ`.
+    fn diag_max(&self) -> f64 {
+        let params = (0..self.a.nrows())
+            .map(|i| self.a[(i, i)])
+            .fold(0.0_f64, f64::max);
+        self.stations
+            .iter()
+            .flat_map(|st| (0..3).map(move |i| st.c[(i, i)]))
+            .fold(params, f64::max)
+    }
+
+    /// The reduced system `S = A − Σ B·C⁻¹·Bᵀ`, `r = gp − Σ B·C⁻¹·gc`
+    /// with Marquardt damping `λ·max(diag, floor)` on both blocks, and
+    /// each station's damped `C⁻¹`. `None` when a centre block is singular.
+    fn reduced(&self, lambda: f64, floor: f64) -> Option<Reduced> {
+        let k = self.a.nrows();
+        let mut s = self.a.clone();
+        for i in 0..k {
+            s[(i, i)] += lambda * self.a[(i, i)].max(floor);
+        }
+        let mut r = self.gp.clone();
+        let mut inverses = Vec::with_capacity(self.stations.len());
+        for st in &self.stations {
+            let mut c = st.c;
+            for i in 0..3 {
+                c[(i, i)] += lambda * st.c[(i, i)].max(floor);
+            }
+            let cinv = c.try_inverse()?;
+            let e = &st.b * cinv;
+            s -= &e * st.b.transpose();
+            r -= &e * st.gc;
+            inverses.push(cinv);
+        }
+        Some((s, r, inverses))
+    }
+
+    /// The damped Gauss-Newton step (scaled parameters, then the centres),
+    /// or `None` when the damped system is not positive definite.
+    pub(super) fn step(&self, lambda: f64, floor: f64) -> Option<DVector<f64>> {
+        let k = self.a.nrows();
+        let (s, r, inverses) = self.reduced(lambda, floor)?;
+        let dp = -s.cholesky()?.solve(&r);
+        let mut step = DVector::zeros(k + 3 * self.stations.len());
+        step.rows_mut(0, k).copy_from(&dp);
+        for (i, (st, cinv)) in self.stations.iter().zip(&inverses).enumerate() {
+            let dc = -cinv * (st.gc + st.b.transpose() * &dp);
+            step.fixed_rows_mut::<3>(k + 3 * i).copy_from(&dc);
+        }
+        Some(step)
+    }
+
+    /// The blocks of the inverse of the (undamped) `JᵀWJ` that the
+    /// diagnostics need: the parameter block `P = S⁻¹` and, per station,
+    /// `E = B·C⁻¹` and `C⁻¹`, from which the cross block `−P·E` and the
+    /// centre block `C⁻¹ + Eᵀ·P·E` follow. A singular `S` gets its
+    /// pseudo-inverse.
+    pub(super) fn inverse_blocks(&self) -> InverseBlocks {
+        let k = self.a.nrows();
+        let Some((s, _, inverses)) = self.reduced(0.0, 0.0) else {
+            return InverseBlocks {
+                p: DMatrix::zeros(k, k),
+                e: vec![DMatrix::zeros(k, 3); self.stations.len()],
+                cinv: vec![Matrix3::zeros(); self.stations.len()],
+            };
+        };
+        let p = s
+            .clone()
+            .cholesky()
+            .map(|c| c.inverse())
+            .or_else(|| s.pseudo_inverse(1e-14).ok())
+            .unwrap_or_else(|| DMatrix::zeros(k, k));
+        let e = self
+            .stations
+            .iter()
+            .zip(&inverses)
+            .map(|(st, cinv)| {
+                let e = &st.b * cinv;
+                DMatrix::from_iterator(k, 3, e.iter().copied())
+            })
+            .collect();
+        InverseBlocks {
+            p,
+            e,
+            cinv: inverses,
         }
     }
 }
 
-/// The linearised problem at a state.
-pub(super) struct Linear {
-    /// `JᵀWJ` over [estimated parameters (scaled); centres].
-    pub(super) h: DMatrix<f64>,
-    /// `JᵀW·r`.
-    pub(super) g: DVector<f64>,
-    /// Robust cost.
-    pub(super) cost: f64,
+/// The reduced system: `S`, `r` and each station's (damped) `C⁻¹`.
+type Reduced = (DMatrix<f64>, DVector<f64>, Vec<Matrix3<f64>>);
+
+/// Blocks of the inverse of `JᵀWJ` (see [`Linear::inverse_blocks`]).
+pub(super) struct InverseBlocks {
+    /// Parameter block, `S⁻¹` (scaled units): the parameter covariance.
+    pub(super) p: DMatrix<f64>,
+    /// Per station `B·C⁻¹` (k × 3).
+    pub(super) e: Vec<DMatrix<f64>>,
+    /// Per station `C⁻¹`.
+    pub(super) cinv: Vec<Matrix3<f64>>,
+}
+
+impl InverseBlocks {
+    /// `J·H⁻¹·Jᵀ` for one measurement's rows `J = [jp | jc]` (3 × k
+    /// parameters, 3 × 3 on its station's centre): its hat matrix.
+    pub(super) fn hat(&self, jp: &DMatrix<f64>, jc: &Matrix3<f64>, station: usize) -> Matrix3<f64> {
+        let e = &self.e[station];
+        let p_e = &self.p * e;
+        // Parameter block, cross terms through −P·E, centre block.
+        let pp = jp * &self.p * jp.transpose();
+        let cross = jp * &p_e * jc.transpose();
+        let centre = self.cinv[station] + e.transpose() * &p_e;
+        let cc = jc * centre * jc.transpose();
+        let pp = Matrix3::from_iterator(pp.iter().copied());
+        let cross = Matrix3::from_iterator(cross.iter().copied());
+        pp - cross - cross.transpose() + cc
+    }
 }
 
 /// The prior on the kinematic deviations, in the estimated chart.
@@ -170,41 +298,42 @@ impl Problem {
         (o.whiten * (x_b - state.centres[o.station]), jp)
     }
 
-    /// Gauss-Newton matrix, gradient and cost at `state` (IRLS weights from
-    /// the current residuals), over the rows `rows` selects.
-    pub(super) fn linearize(&self, state: &State, rows: Rows) -> Linear {
+    /// Gauss-Newton blocks, gradient and cost at `state` (IRLS weights
+    /// from the current residuals).
+    pub(super) fn linearize(&self, state: &State) -> Linear {
         let k = self.estimated.len();
-        let n = self.dim();
-        let mut h = DMatrix::zeros(n, n);
-        let mut g = DVector::zeros(n);
+        let mut stations: Vec<StationBlock> = (0..self.stations.len())
+            .map(|_| StationBlock {
+                a: DMatrix::zeros(k, k),
+                gp: DVector::zeros(k),
+                b: DMatrix::zeros(k, 3),
+                c: Matrix3::zeros(),
+                gc: Vector3::zeros(),
+            })
+            .collect();
         let mut cost = 0.0;
         for o in &self.obs {
-            if !rows.includes(o.station) {
-                continue;
-            }
             let (r, jp) = self.obs_jacobian(o, state);
             let s = r.norm();
             cost += self.loss.rho(s, self.loss_scale);
             let w = self.loss.weight(s, self.loss_scale);
             let jc = -o.whiten;
-            let c0 = k + 3 * o.station;
+            let st = &mut stations[o.station];
             let jpt = jp.transpose();
-            {
-                let mut hpp = h.view_mut((0, 0), (k, k));
-                hpp += &jpt * &jp * w;
-            }
-            let hpc = &jpt * jc * w;
-            h.view_mut((0, c0), (k, 3)).add_assign(&hpc);
-            h.view_mut((c0, 0), (3, k)).add_assign(&hpc.transpose());
-            let hcc = jc.transpose() * jc * w;
-            h.view_mut((c0, c0), (3, 3))
-                .add_assign(&DMatrix::from_iterator(3, 3, hcc.iter().copied()));
-            let gp = &jpt * DVector::from_iterator(3, r.iter().copied()) * w;
-            g.rows_mut(0, k).add_assign(&gp);
-            let gc = jc.transpose() * r * w;
-            g.fixed_rows_mut::<3>(c0).add_assign(&gc);
+            st.a += &jpt * &jp * w;
+            let jc_dyn = DMatrix::from_iterator(3, 3, jc.iter().copied());
+            st.b += &jpt * jc_dyn * w;
+            st.c += jc.transpose() * jc * w;
+            st.gp += &jpt * DVector::from_iterator(3, r.iter().copied()) * w;
+            st.gc += jc.transpose() * r * w;
         }
-        if let (Some(prior), false) = (&self.prior, matches!(rows, Rows::Only(_))) {
+        let mut a = DMatrix::zeros(k, k);
+        let mut gp = DVector::zeros(k);
+        for st in &stations {
+            a += &st.a;
+            gp += &st.gp;
+        }
+        if let Some(prior) = &self.prior {
             let r = self.prior_residual(state);
             // Jacobian of the prior rows in the scaled slots.
             let mut jp = DMatrix::zeros(r.len(), k);
@@ -212,12 +341,16 @@ impl Problem {
                 jp.set_column(slot, &(prior.whiten.column(col) / self.scale[slot]));
             }
             let jpt = jp.transpose();
-            let mut hpp = h.view_mut((0, 0), (k, k));
-            hpp += &jpt * &jp;
-            g.rows_mut(0, k).add_assign(&(&jpt * &r));
+            a += &jpt * &jp;
+            gp += &jpt * &r;
             cost += 0.5 * r.norm_squared();
         }
-        Linear { h, g, cost }
+        Linear {
+            a,
+            gp,
+            stations,
+            cost,
+        }
     }
 
     /// The state moved by a scaled solver step.
@@ -242,31 +375,24 @@ impl Problem {
     /// damping until the cost falls. `None` when no damping lowers it
     /// (the state is at the optimum to numerical precision).
     pub(super) fn lm_step(&self, state: &State, lambda: &mut f64) -> Option<LmStep> {
-        let lin = self.linearize(state, Rows::All);
-        let n = self.dim();
-        let dmax = (0..n).map(|i| lin.h[(i, i)]).fold(0.0_f64, f64::max);
-        let floor = (dmax * DIAG_FLOOR_REL).max(f64::MIN_POSITIVE);
+        let lin = self.linearize(state);
+        let floor = (lin.diag_max() * DIAG_FLOOR_REL).max(f64::MIN_POSITIVE);
         while *lambda <= LAMBDA_MAX {
-            let mut a = lin.h.clone();
-            for i in 0..n {
-                a[(i, i)] += *lambda * lin.h[(i, i)].max(floor);
-            }
-            if let Some(chol) = a.cholesky() {
-                let step = -chol.solve(&lin.g);
-                if step.iter().all(|v| v.is_finite()) {
-                    let trial = self.apply(state, &step);
-                    let cost = self.cost(&trial);
-                    if cost.is_finite() && cost < lin.cost {
-                        let used = *lambda;
-                        *lambda = (*lambda * LAMBDA_DOWN).max(LAMBDA_MIN);
-                        return Some(LmStep {
-                            state: trial,
-                            cost_before: lin.cost,
-                            cost_after: cost,
-                            step_max: step.amax(),
-                            lambda: used,
-                        });
-                    }
+            if let Some(step) = lin.step(*lambda, floor)
+                && step.iter().all(|v| v.is_finite())
+            {
+                let trial = self.apply(state, &step);
+                let cost = self.cost(&trial);
+                if cost.is_finite() && cost < lin.cost * (1.0 - COST_NOISE_REL) {
+                    let used = *lambda;
+                    *lambda = (*lambda * LAMBDA_DOWN).max(LAMBDA_MIN);
+                    return Some(LmStep {
+                        state: trial,
+                        cost_before: lin.cost,
+                        cost_after: cost,
+                        step_max: step.amax(),
+                        lambda: used,
+                    });
                 }
             }
             *lambda *= LAMBDA_UP;
@@ -283,29 +409,42 @@ impl Problem {
     /// factorisation instead of a whole LM run per station). The model
     /// refitted without `s` then predicts the within-station distances
     /// of `s`, whose true value is zero.
-    pub(super) fn cross_validate(&self, state: &State) -> CrossValidation {
+    pub(super) fn cross_validate(
+        &self,
+        state: &State,
+        phase: &mut dyn FnMut(Phase) -> Control,
+    ) -> Option<CrossValidation> {
         let k = self.estimated.len();
-        let full = self.linearize(state, Rows::All);
+        let full = self.linearize(state);
+        // The reduced system of all stations; leaving station `s` out
+        // removes its rows from the parameter block and its centre term
+        // from the complement (its centre is then free and irrelevant).
+        let reduced = full.reduced(0.0, 0.0);
         let mut rows = Vec::new();
         let (mut sum, mut count) = (0.0, 0_usize);
+        let of = self.stations.len();
+        // Each station's measurements, grouped once.
+        let mut members: Vec<Vec<&Obs>> = vec![Vec::new(); of];
+        for o in &self.obs {
+            members[o.station].push(o);
+        }
         for (s, id) in self.stations.iter().enumerate() {
-            let own = self.linearize(state, Rows::Only(s));
-            let mut h = &full.h - &own.h;
-            let mut g = &full.g - &own.g;
-            // The left-out station has no rows: pin its centre.
-            let c0 = k + 3 * s;
-            for d in 0..3 {
-                h[(c0 + d, c0 + d)] = 1.0;
-                g[c0 + d] = 0.0;
+            if phase(Phase::CrossValidation { done: s, of }) == Control::Cancel {
+                return None;
             }
-            let refit = match h.cholesky() {
-                Some(chol) => self.apply(state, &(-chol.solve(&g))),
-                None => state.clone(),
-            };
-            let centres: Vec<Vector3<f64>> = self
-                .obs
+            let refit = reduced.as_ref().and_then(|(sfull, rfull, inverses)| {
+                let st = &full.stations[s];
+                let e = &st.b * inverses[s];
+                let h = sfull - &st.a + &e * st.b.transpose();
+                let g = rfull - &st.gp + &e * st.gc;
+                let dp = -h.cholesky()?.solve(&g);
+                let mut step = DVector::zeros(k + 3 * self.stations.len());
+                step.rows_mut(0, k).copy_from(&dp);
+                Some(self.apply(state, &step))
+            });
+            let refit = refit.as_ref().unwrap_or(state);
+            let centres: Vec<Vector3<f64>> = members[s]
                 .iter()
-                .filter(|o| o.station == s)
                 .map(|o| refit.est.centre_in_base(&o.sighting))
                 .collect();
             let (mut ss, mut n) = (0.0, 0_usize);
@@ -323,14 +462,14 @@ impl Problem {
                 rms: if n > 0 { (ss / n as f64).sqrt() } else { 0.0 },
             });
         }
-        CrossValidation {
+        Some(CrossValidation {
             stations: rows,
             rms: if count > 0 {
                 (sum / count as f64).sqrt()
             } else {
                 0.0
             },
-        }
+        })
     }
 }
 
