@@ -321,10 +321,8 @@ fn stripe_circle(
     sphere_radius: f64,
 ) -> Result<(CircleFit, Option<ArcSegment>), StripeError> {
     let whole = fit_circle(points);
-    if let Ok(fit) = &whole
-        && clean_arc(fit)
-    {
-        return Ok((fit.clone(), None));
+    if whole.as_ref().is_ok_and(clean_arc) {
+        return whole.map(|fit| (fit, None));
     }
     if points.len() < segment::MIN_ARC_POINTS {
         return whole.map(|fit| (fit, None));
