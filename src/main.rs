@@ -7,6 +7,12 @@ use clap::Parser;
 use spherecal::cli::{self, Cli, CliError, Command};
 
 fn main() -> ExitCode {
+    // Ctrl-C or a kill: remove the temporary file of a write under way
+    // (the target keeps its old content), then end as interrupted.
+    let _ = ctrlc::set_handler(|| {
+        spherecal::engine::format::remove_pending();
+        std::process::exit(130);
+    });
     let parsed = Cli::parse();
     let outcome = match parsed.command {
         Some(Command::Calibrate(args)) => cli::calibrate_command(&args),

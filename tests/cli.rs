@@ -193,3 +193,113 @@ fn simulate_is_deterministic_and_calibrates() {
     let (status, _, stderr) = calibrate(&path, &out);
     assert_eq!(status, 0, "{stderr}");
 }
+
+/// Runs the binary with `args`; returns (status, stdout, stderr).
+fn run(args: &[&str]) -> (i32, String, String) {
+    let o = spherecal().args(args).output().unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn an_output_that_is_an_input_is_refused_and_the_input_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = demo_path(dir.path());
+    let s = session.to_str().unwrap();
+    let before = std::fs::read(&session).unwrap();
+    // The same file under another spelling is still the same file.
+    let other_spelling = dir.path().join(".").join("demo.json");
+    for args in [
+        vec!["calibrate", s, "--out", s],
+        vec!["calibrate", s, "--out", other_spelling.to_str().unwrap()],
+        vec!["report", s, "--out", s],
+    ] {
+        let (code, _, err) = run(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains("would be destroyed"), "{err}");
+        assert_eq!(std::fs::read(&session).unwrap(), before, "{args:?}");
+    }
+    let result = dir.path().join("r.json");
+    let r = result.to_str().unwrap();
+    assert_eq!(run(&["calibrate", s, "--out", r, "-q"]).0, 0);
+    let result_bytes = std::fs::read(&result).unwrap();
+    let (code, _, err) = run(&["export-model", r, "--format", "json", "--out", r]);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(std::fs::read(&result).unwrap(), result_bytes);
+    let (code, out, err) = run(&[
+        "export-model",
+        r,
+        "--format",
+        "csv",
+        "--out",
+        dir.path().join("m.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("wrote the MDH CSV model"), "{out}");
+}
+
+#[cfg(unix)]
+#[test]
+fn special_files_are_refused_and_links_written_through() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = demo_path(dir.path());
+    let s = session.to_str().unwrap();
+    let (code, _, err) = run(&["calibrate", s, "--out", "/dev/null", "-q"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("a device"), "{err}");
+    assert!(
+        !Path::new("/dev/null")
+            .metadata()
+            .unwrap()
+            .file_type()
+            .is_file()
+    );
+    let (code, _, err) = run(&["calibrate", s, "--out", dir.path().to_str().unwrap(), "-q"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("a folder"), "{err}");
+    let target = dir.path().join("target.json");
+    std::fs::write(&target, "old").unwrap();
+    let link = dir.path().join("link.json");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    assert_eq!(
+        run(&["calibrate", s, "--out", link.to_str().unwrap(), "-q"]).0,
+        0
+    );
+    assert!(link.symlink_metadata().unwrap().file_type().is_symlink());
+    assert!(
+        std::fs::read_to_string(&target)
+            .unwrap()
+            .contains("spherecal-result")
+    );
+    assert!(
+        !files_in(dir.path()).iter().any(|f| f.ends_with(".tmp")),
+        "no temporary file left"
+    );
+}
+
+#[test]
+fn a_closed_stdout_neither_panics_nor_costs_the_result() {
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    let session = demo_path(dir.path());
+    let out = dir.path().join("r.json");
+    let mut child = spherecal()
+        .arg("calibrate")
+        .arg(&session)
+        .arg("--out")
+        .arg(&out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The reader goes away at once, as `| head -0` would.
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(out.exists(), "the result is written");
+}

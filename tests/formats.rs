@@ -823,6 +823,52 @@ fn saves_reload_and_leave_no_temporary_files() {
     assert_eq!(names, ["cell.json", "cell.result.json"]);
 }
 
+/// Issue 12: a reference distance of 1e308 gave `"std": null` in a result
+/// that `report` and `export-model` then rejected. A result with a
+/// non-finite number is not written at all, and the error names the key.
+#[test]
+fn a_result_with_a_non_finite_number_is_not_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = load_result(&data("v1/result.json")).unwrap();
+    let path = dir.path().join("r.json");
+    let cases: Vec<(
+        Box<dyn Fn(&mut spherecal::engine::format::ResultFile)>,
+        &str,
+    )> = vec![
+        (Box::new(|r| r.epsilon_after = f64::NAN), "epsilon_after"),
+        (
+            Box::new(|r| r.centres[1].sensor[2] = f64::INFINITY),
+            "centres[1].sensor[2]",
+        ),
+        (
+            Box::new(|r| {
+                if let Some(v) = r.validation.as_mut() {
+                    v.after.std = f64::NAN;
+                }
+            }),
+            "validation.after.std",
+        ),
+    ];
+    for (spoil, key) in cases {
+        let mut r = good.clone();
+        spoil(&mut r);
+        let e = save_result(&r, &path).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("`{key}` is not a finite number")),
+            "{e}"
+        );
+        assert!(e.contains("not written"), "{e}");
+        assert!(!path.exists(), "{key}: a file was written");
+        assert!(
+            entries(dir.path()).is_empty(),
+            "{key}: {:?}",
+            entries(dir.path())
+        );
+    }
+    save_result(&good, &path).unwrap();
+    assert_eq!(load_result(&path).unwrap(), good);
+}
+
 // ---------------------------------------------------------------------------
 // Atomic writes
 // ---------------------------------------------------------------------------

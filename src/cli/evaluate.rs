@@ -42,9 +42,9 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
         );
     }
     if args.markdown {
-        print!("{}", markdown(&results, args.seeds));
+        say!("{}", markdown(&results, args.seeds));
     } else {
-        print!("{}", text(&results, args.seeds));
+        say!("{}", text(&results, args.seeds));
     }
     Ok(())
 }

@@ -22,6 +22,18 @@ pub enum FormatArg {
     Urdf,
 }
 
+impl FormatArg {
+    /// How the format is called in messages.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Json => "JSON robot-block",
+            Self::Csv => "MDH CSV",
+            Self::Urdf => "URDF",
+        }
+    }
+}
+
 impl From<FormatArg> for ModelFormat {
     fn from(f: FormatArg) -> Self {
         match f {
@@ -51,10 +63,17 @@ pub struct ExportModelArgs {
 /// [`CliError`] with status 2 when the result file cannot be read or is
 /// not a valid result, 1 when the output cannot be written.
 pub fn run(args: &ExportModelArgs) -> Result<(), CliError> {
+    CliError::guard_output(&args.out, &[&args.result])?;
     let result = format::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;
     let source = args.result.display().to_string();
     let text = model::export(&result, args.format.into(), &source)
         .map_err(|e| CliError::input(format!("{e} ({source})")))?;
     format::write_atomic(&args.out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
+    sayln!(
+        "wrote the {} model of {} to {}",
+        args.format.name(),
+        args.result.display(),
+        args.out.display()
+    );
     Ok(())
 }

@@ -4,7 +4,7 @@
 //! of [`crate::engine::history`]; it prints, the engine does not.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use crate::engine::format;
 use crate::engine::history::{
@@ -77,14 +77,23 @@ pub fn run(args: &HistoryArgs) -> Result<(), CliError> {
         Some(_) => drifts.iter().flat_map(|d| d.entries.clone()).collect(),
         None => (0..library.entries.len()).collect(),
     };
-    print!("{}", library_text(&library, &shown));
+    say!("{}", library_text(&library, &shown));
     for d in &drifts {
-        print!("{}", drift_text(&library, d));
+        say!("{}", drift_text(&library, d));
     }
     if let Some(path) = &args.csv {
+        let inputs: Vec<&Path> = library
+            .entries
+            .iter()
+            .map(|e| e.path.as_path())
+            .chain(library.sessions.iter().map(|s| s.path.as_path()))
+            .chain(library.problems.iter().map(|p| p.path.as_path()))
+            .chain(library.ignored.iter().map(|(p, _)| p.as_path()))
+            .collect();
+        CliError::guard_output(path, &inputs)?;
         format::write_atomic(path, history::drift_csv(&library, &drifts).as_bytes())
             .map_err(|e| CliError::from_file(&e, false))?;
-        println!("\nwrote {}", path.display());
+        sayln!("\nwrote {}", path.display());
     }
     Ok(())
 }

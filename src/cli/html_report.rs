@@ -44,6 +44,9 @@ pub struct ReportArgs {
 /// a result of another session, a session that cannot be calibrated), 1
 /// when the report cannot be written.
 pub fn run(args: &ReportArgs) -> Result<(), CliError> {
+    let mut inputs = vec![args.session.as_path()];
+    inputs.extend(args.result.as_deref());
+    CliError::guard_output(&args.out, &inputs)?;
     let started = Instant::now();
     let bytes = std::fs::read(&args.session).map_err(|source| {
         CliError::from_file(
@@ -101,7 +104,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
             Some(_) => "the given result".to_string(),
             None => format!("a run of method {}", args.method.as_str()),
         };
-        println!(
+        sayln!(
             "wrote {} ({:.0} KB, {how}; {:.0} ms in all, {render_ms:.1} ms of it rendering)",
             args.out.display(),
             html.len() as f64 / 1024.0,

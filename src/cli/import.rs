@@ -258,10 +258,32 @@ pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
 }
 
 /// The `--out` path, required unless only previewing.
+/// The `--out` path, refused when it is one of the import's inputs (the
+/// pose log, a profile, the references or the robot file).
 fn out_path(args: &ImportArgs) -> Result<PathBuf, CliError> {
-    args.out.clone().ok_or_else(|| {
+    let out = args.out.clone().ok_or_else(|| {
         CliError::input("--out SESSION.json is needed (or --preview N to only look)")
-    })
+    })?;
+    let mut inputs: Vec<PathBuf> = args
+        .joints
+        .iter()
+        .chain(&args.poses)
+        .chain(&args.references)
+        .cloned()
+        .collect();
+    if let Some(r) = &args.robot {
+        inputs.push(PathBuf::from(r));
+    }
+    if args.profiles.is_dir() {
+        if let Ok(files) = crate::engine::import::profiles::profile_files(&args.profiles) {
+            inputs.extend(files);
+        }
+    } else {
+        inputs.push(args.profiles.clone());
+    }
+    let inputs: Vec<&std::path::Path> = inputs.iter().map(PathBuf::as_path).collect();
+    CliError::guard_output(&out, &inputs)?;
+    Ok(out)
 }
 
 /// Runs `spherecal import`.
@@ -280,7 +302,7 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
     } else {
         let spec = spec(args)?;
         if let Some(n) = args.preview {
-            print!("{}", import::preview(&spec, n).map_err(|e| input(&e))?);
+            say!("{}", import::preview(&spec, n).map_err(|e| input(&e))?);
             return Ok(());
         }
         let out = out_path(args)?;
@@ -299,12 +321,12 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
     let text = format::session_to_json(&session);
     format::write_atomic(out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
     if !session.reference_distances.is_empty() {
-        println!(
+        sayln!(
             "{} reference distances between validate stations",
             session.reference_distances.len()
         );
     }
-    println!(
+    sayln!(
         "imported {} measurements at {} station(s) into {}",
         session.measurements.len(),
         {
@@ -320,7 +342,7 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         out.display()
     );
     for note in &notes {
-        println!("{note}");
+        sayln!("{note}");
     }
     if !checks.is_empty() {
         let flagged: Vec<_> = checks.iter().filter(|c| c.flagged).collect();
@@ -328,15 +350,18 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
             .iter()
             .map(|c| c.position_error_mm)
             .fold(0.0_f64, f64::max);
-        println!(
+        sayln!(
             "flange poses: {} checked, {} flagged (largest position mismatch {worst:.3} mm)",
             checks.len(),
             flagged.len()
         );
         for c in flagged {
-            println!(
+            sayln!(
                 "  flagged pose {}: {:.3} mm, {:.3} deg: {}",
-                c.id, c.position_error_mm, c.rotation_error_deg, c.hint
+                c.id,
+                c.position_error_mm,
+                c.rotation_error_deg,
+                c.hint
             );
         }
     }

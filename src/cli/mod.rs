@@ -6,6 +6,25 @@
 //! and the problem, 1 on an internal failure. A result file is written
 //! atomically or not at all.
 
+/// Prints to stdout with a newline, as `println!`, but a closed stdout (the
+/// reader of a pipe went away: `| head`) is not an error: the work is
+/// done, the rest of the text is dropped, nothing panics.
+macro_rules! sayln {
+    () => {
+        $crate::cli::write_line(format_args!(""))
+    };
+    ($($arg:tt)*) => {
+        $crate::cli::write_line(format_args!($($arg)*))
+    };
+}
+
+/// As [`sayln!`] without the newline.
+macro_rules! say {
+    ($($arg:tt)*) => {
+        $crate::cli::write_text(format_args!($($arg)*))
+    };
+}
+
 pub mod evaluate;
 pub mod export_model;
 pub mod history;
@@ -58,6 +77,20 @@ pub enum Command {
     Report(html_report::ReportArgs),
     /// Library of a folder of sessions and results: per robot the drift of the hand-eye and kinematic deviations over time, jumps beyond k combined σ flagged.
     History(history::HistoryArgs),
+}
+
+/// Writes `args` and a newline to stdout, ignoring a closed pipe.
+pub fn write_line(args: std::fmt::Arguments<'_>) {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    let _ = out.write_fmt(args);
+    let _ = out.write_all(b"\n");
+}
+
+/// Writes `args` to stdout, ignoring a closed pipe.
+pub fn write_text(args: std::fmt::Arguments<'_>) {
+    use std::io::Write as _;
+    let _ = std::io::stdout().lock().write_fmt(args);
 }
 
 /// `spherecal gui`.
@@ -232,6 +265,15 @@ impl CliError {
         }
     }
 
+    /// Refuses an output that is one of the command's inputs (the same
+    /// file: it would be destroyed), with status 2.
+    ///
+    /// # Errors
+    /// The refusal, naming both.
+    pub fn guard_output(output: &Path, inputs: &[&Path]) -> Result<(), Self> {
+        format::refuse_inputs(output, inputs).map_err(|e| Self::input(e.to_string()))
+    }
+
     /// From a calibration error of the session at `path`.
     #[must_use]
     pub fn from_calibration(e: &SolveError, path: &Path) -> Self {
@@ -251,6 +293,7 @@ impl CliError {
 /// [`CliError`] with status 2 for bad input, 1 for internal failures.
 pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     let started = Instant::now();
+    CliError::guard_output(&args.out, &[&args.session])?;
     let session = format::load_session(&args.session).map_err(|e| CliError::from_file(&e, true))?;
     let session = if args.exclude.is_empty() {
         session
@@ -274,27 +317,28 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     let quiet = args.quiet;
     let mut on_progress = |p: &solve::Progress| {
         if !quiet && p.phase == solve::Phase::Loop {
-            println!("  ε after {:>2} update(s): {:.4} mm", p.updates, p.epsilon);
+            sayln!("  ε after {:>2} update(s): {:.4} mm", p.updates, p.epsilon);
         }
         Control::Continue
     };
     if !quiet {
-        println!(
+        sayln!(
             "session {:?}: {} measurements",
             session.name,
             session.measurements.len()
         );
         for (id, w) in &prepared.warnings {
-            println!("  warning: measurement {id}: {w}");
+            sayln!("  warning: measurement {id}: {w}");
         }
         match &prepared.hand_eye_source {
-            HandEyeSource::File => println!("initial hand-eye: from the session file"),
-            HandEyeSource::Computed(h) => println!(
+            HandEyeSource::File => sayln!("initial hand-eye: from the session file"),
+            HandEyeSource::Computed(h) => sayln!(
                 "initial hand-eye (eq. 6-9): rotation residual {:.4} mm, translation residual {:.4} mm",
-                h.rotation_residual, h.translation_residual
+                h.rotation_residual,
+                h.translation_residual
             ),
         }
-        println!(
+        sayln!(
             "identification: method {}, threshold {} mm, at most {} update(s)",
             options.method.as_str(),
             options.threshold,
@@ -306,8 +350,8 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     let result = format::ResultFile::from_calibration(&session, &cal);
     format::save_result(&result, &args.out).map_err(|e| CliError::from_file(&e, false))?;
     if !quiet {
-        print!("{}", summary::summary(&session, &cal));
-        println!(
+        say!("{}", summary::summary(&session, &cal));
+        sayln!(
             "wrote {} ({:.0} ms)",
             args.out.display(),
             started.elapsed().as_secs_f64() * 1e3

@@ -211,6 +211,16 @@ fn write(path: &Path, text: &str) -> Result<(), CliError> {
 /// (unreachable sphere, too few reachable poses, collinear translations),
 /// 1 when a file cannot be written.
 pub fn run(args: &PlanArgs) -> Result<(), CliError> {
+    let inputs: Vec<&Path> = args
+        .hand_eye
+        .iter()
+        .chain(&args.stations)
+        .map(PathBuf::as_path)
+        .chain(std::iter::once(Path::new(&args.robot)))
+        .collect();
+    for out in args.csv.iter().chain(&args.rapid) {
+        CliError::guard_output(out, &inputs)?;
+    }
     let started = Instant::now();
     let mut programs: Vec<(Controller, PathBuf)> = Vec::new();
     if let Some(path) = &args.rapid {
@@ -248,7 +258,7 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     .map_err(|e| plan_error(&e))?;
     let end = Instant::now();
     if !quiet {
-        print!("{}", plan::summary(&made));
+        say!("{}", plan::summary(&made));
         let stages: Vec<String> = marks
             .iter()
             .enumerate()
@@ -257,7 +267,7 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
                 format!("{name} {:.0}", (next - *at).as_secs_f64() * 1e3)
             })
             .collect();
-        println!(
+        sayln!(
             "  planned in {:.0} ms ({} ms)",
             (end - started).as_secs_f64() * 1e3,
             stages.join(", ")
@@ -273,7 +283,7 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         let p = plan::predict(&made, &predict, &mut |_, _| Control::Continue)
             .map_err(|e| plan_error(&e))?;
         if !quiet {
-            println!(
+            sayln!(
                 "  predicted validation std after calibration (ml, {} simulated robots with random errors σ {}°/{} mm, joint noise {}°, stripe noise {} mm): {:.4} ± {:.4} mm",
                 p.runs.len(),
                 simulate::config::RANDOM_ANGLE_SIGMA_DEG,
@@ -283,7 +293,7 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
                 p.after_mean,
                 p.after_spread
             );
-            println!(
+            sayln!(
                 "    before {:.3} mm; noise floor {:.4} mm; after / floor {:.2} ({:.0} ms)",
                 p.before_mean,
                 p.floor_mean,
@@ -295,13 +305,13 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     if let Some(path) = &args.csv {
         write(path, &plan::plan_csv(&made))?;
         if !quiet {
-            println!("wrote {} (joint log CSV)", path.display());
+            sayln!("wrote {} (joint log CSV)", path.display());
         }
     }
     for (controller, path) in &programs {
         write(path, &controller.render(&made))?;
         if !quiet {
-            println!("wrote {} ({} program)", path.display(), controller.key());
+            sayln!("wrote {} ({} program)", path.display(), controller.key());
         }
     }
     Ok(())

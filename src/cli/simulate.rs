@@ -250,6 +250,14 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             args.out.display()
         )));
     }
+    let inputs: Vec<&Path> = args
+        .plan
+        .iter()
+        .chain(&args.hand_eye)
+        .map(PathBuf::as_path)
+        .collect();
+    CliError::guard_output(&args.out, &inputs)?;
+    CliError::guard_output(&truth_path, &inputs)?;
     let config = args.to_config();
     let (session, truth) = match &args.plan {
         None => simulate::simulate(&config).map_err(|e| CliError::input(e.to_string()))?,
@@ -281,7 +289,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     write(&truth_path, &simulate::truth_to_json(&truth))?;
     write(&args.out, &format::session_to_json(&session))?;
     let count = |usage: Use| session.with_use(usage).count();
-    println!(
+    sayln!(
         "simulated {} (seed {}): {} measurements ({} translation, {} rotation, {} identify, {} validate), {} reference distances -> {}, truth {} ({:.0} ms)",
         session.robot.name,
         config.seed,

@@ -12,7 +12,9 @@
 //!
 //! Degenerate sets are detected before solving and reported with the ids.
 
-use nalgebra::{DMatrix, DVector, Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{DMatrix, DVector, Isometry3, Matrix3, SVD, Translation3, UnitQuaternion, Vector3};
+
+use crate::engine::numeric::MAX_DECOMPOSITION_SWEEPS;
 
 use crate::engine::robot::Robot;
 
@@ -65,6 +67,12 @@ pub enum HandEyeError {
         /// The stations found.
         stations: Vec<String>,
     },
+    /// The poses or centres give numbers that are not finite (far beyond
+    /// any cell's size): no hand-eye can be computed.
+    #[error(
+        "the translation and rotation measurements give numbers that are not finite: check their poses and centres"
+    )]
+    NonFinite,
 }
 
 fn list_ids(ids: &[String]) -> String {
@@ -168,7 +176,15 @@ pub fn initial_rotation(
         b.set_column(k - 1, &dt);
     }
     let spread = {
-        let sv = b.clone().svd(false, false).singular_values;
+        let sv = SVD::try_new(
+            b.clone(),
+            false,
+            false,
+            f64::EPSILON,
+            MAX_DECOMPOSITION_SWEEPS,
+        )
+        .map(|d| d.singular_values)
+        .ok_or(HandEyeError::NonFinite)?;
         let mut s: Vec<f64> = sv.iter().copied().collect();
         s.sort_by(|x, y| y.total_cmp(x));
         if s.len() < 2 || s[0] <= 0.0 {
@@ -198,7 +214,9 @@ pub fn initial_rotation(
 /// The proper rotation `R` minimising `Σ |R·a_k − b_k|²` given
 /// `m = Σ a_k·b_kᵀ` (Kabsch; eq. 7 with the determinant forced to +1).
 fn procrustes(m: &Matrix3<f64>) -> UnitQuaternion<f64> {
-    let svd = m.svd(true, true);
+    let Some(svd) = SVD::try_new(*m, true, true, f64::EPSILON, MAX_DECOMPOSITION_SWEEPS) else {
+        return UnitQuaternion::identity();
+    };
     let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
         return UnitQuaternion::identity();
     };
@@ -267,7 +285,14 @@ pub fn initial_translation(
         a.fixed_view_mut::<3, 3>(3 * k, 0).copy_from(ak);
         b.fixed_rows_mut::<3>(3 * k).copy_from(bk);
     }
-    let svd = a.clone().svd(true, true);
+    let svd = SVD::try_new(
+        a.clone(),
+        true,
+        true,
+        f64::EPSILON,
+        MAX_DECOMPOSITION_SWEEPS,
+    )
+    .ok_or(HandEyeError::NonFinite)?;
     let sv = &svd.singular_values;
     let (smax, smin) = (sv.max(), sv.min());
     let condition = if smax > 0.0 { smin / smax } else { 0.0 };

@@ -1,6 +1,23 @@
 //! Small numerical helpers shared by the engine: rounding for files,
 //! medians and quantiles of samples.
 
+/// Sweeps a singular value or symmetric eigen decomposition may take
+/// before it is abandoned: converging ones take a few per dimension; the
+/// bound keeps a matrix with a NaN from spinning forever.
+pub const MAX_DECOMPOSITION_SWEEPS: usize = 10_000;
+
+/// A number for a message: as written for everyday sizes, in scientific
+/// notation beyond them (`1e160`, not 161 digits).
+#[must_use]
+pub fn show(value: f64) -> String {
+    let a = value.abs();
+    if a != 0.0 && !(1e-4..1e7).contains(&a) {
+        format!("{value:e}")
+    } else {
+        format!("{value}")
+    }
+}
+
 /// `value` rounded to `decimals` decimal places (half away from zero).
 #[must_use]
 pub fn round_to(value: f64, decimals: i32) -> f64 {

@@ -10,7 +10,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::{Instant, SystemTime};
 
-use crate::engine::format::{result_to_json, write_atomic};
+use crate::engine::format::{result_text_checked, write_atomic};
 use crate::engine::report::html::{self, ReportInput, ReportMeta};
 use crate::engine::report::model::{self, ModelFormat};
 use crate::engine::result_view;
@@ -101,7 +101,7 @@ fn csv_field(s: &str) -> String {
 /// exported, or `kind` is not a text export.
 pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<(), JobError> {
     let text = match kind {
-        ExportKind::ResultJson => result_to_json(&view.file),
+        ExportKind::ResultJson => result_text_checked(&view.file, path)?,
         ExportKind::CentresCsv => centres_csv(view),
         ExportKind::DistancesCsv => distances_csv(view),
         ExportKind::PlotsPng => {

@@ -396,6 +396,18 @@ impl<'a> Ctx<'a> {
         }
         let iso = isometry_from_rows(&rows)
             .map_err(|e| self.invalid(measurement, format!("{key}: {e}{}", self.at(raw))))?;
+        let limit = crate::engine::session::limits::LENGTH_MM;
+        if let Some(v) = rows[..3].iter().map(|r| r[3]).find(|v| v.abs() > limit) {
+            return Err(self.invalid(
+                measurement,
+                format!(
+                    "{key}: a translation of {} mm is not plausible for a sphere calibration (at most {} mm){}",
+                    crate::engine::numeric::show(v),
+                    crate::engine::numeric::show(limit),
+                    self.at(raw)
+                ),
+            ));
+        }
         Ok(settle(&rows, iso))
     }
 

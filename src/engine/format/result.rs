@@ -390,8 +390,66 @@ pub fn load_result(path: &Path) -> Result<ResultFile, FileError> {
 /// [`FileError::Io`] when the file cannot be written; the old file, if any,
 /// is then unchanged.
 pub fn save_result(result: &ResultFile, path: &Path) -> Result<(), FileError> {
-    let text = render(&ResultOut::new(result), path)?;
+    let text = result_text_checked(result, path)?;
     write_atomic(path, text.as_bytes())
+}
+
+/// The text of the result file, refused unless it loads back: every
+/// number must be finite (JSON has no NaN or infinity; serde_json would
+/// write `null`) and the whole must pass [`parse_result`], so a written
+/// result always opens in `report`, `export-model` and `history`.
+///
+/// # Errors
+/// [`FileError::Invalid`] naming the first non-finite number (by its key
+/// path) or what the reader rejects; nothing is written.
+pub fn result_text_checked(result: &ResultFile, path: &Path) -> Result<String, FileError> {
+    let out = ResultOut::new(result);
+    let refuse = |message: String| FileError::Invalid {
+        path: path.to_path_buf(),
+        measurement: None,
+        message: format!("the result is not written: {message}"),
+    };
+    if let Ok(tree) = serde_json::to_value(&out)
+        && let Some(key) = first_non_finite(&tree, "")
+    {
+        return Err(refuse(format!(
+            "`{key}` is not a finite number (the calibration diverged or an input is out of range)"
+        )));
+    }
+    let text = render(&out, path)?;
+    parse_result(&text, path).map_err(|e| refuse(format!("it would not load back: {e}")))?;
+    Ok(text)
+}
+
+/// Keys whose `null` is a legal value: a pose-only result's robot, and
+/// the optional parts of ml's report (no validate pairs, no
+/// cross-validation).
+fn null_allowed(key: &str) -> bool {
+    let last = key.rsplit('.').next().unwrap_or(key);
+    key == "robot"
+        || (key.starts_with("solver.")
+            && matches!(last, "predicted_distance_std_validate" | "cross_validation"))
+}
+
+/// The key path of the first `null` that stands for a number (serde_json
+/// writes NaN and ±infinity as `null`).
+fn first_non_finite(v: &Value, key: &str) -> Option<String> {
+    match v {
+        Value::Null if !null_allowed(key) => Some(key.to_string()),
+        Value::Array(items) => items
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| first_non_finite(x, &format!("{key}[{i}]"))),
+        Value::Object(map) => map.iter().find_map(|(k, x)| {
+            let sub = if key.is_empty() {
+                k.clone()
+            } else {
+                format!("{key}.{k}")
+            };
+            first_non_finite(x, &sub)
+        }),
+        _ => None,
+    }
 }
 
 /// Where the result file holds objects (`[]`: every element of an array).

@@ -57,10 +57,11 @@ use super::FORMAT_VERSION;
 use super::json::{Ctx, join, keys_struct, prefix, present, read_text, render, render_lossy};
 use super::{FileError, SESSION_FORMAT, write_atomic};
 use crate::engine::geometry::rows_from_isometry;
+use crate::engine::numeric::show;
 use crate::engine::robot::{Joint, Robot};
 use crate::engine::session::{
     DEFAULT_MAX_ITERATIONS, DEFAULT_THRESHOLD, MIN_STRIPE_POINTS, Measurement, Observation,
-    ReferenceDistance, Session, SolverSettings, Use,
+    ReferenceDistance, Session, SolverSettings, Use, limits,
 };
 use crate::engine::stripe::StripeError;
 use nalgebra::Vector3;
@@ -251,8 +252,27 @@ impl<'a> Ctx<'a> {
         let joints = items
             .into_iter()
             .enumerate()
-            .map(|(i, item)| self.object::<Joint>(item, &format!("robot.joints[{i}]"), None))
-            .collect::<Result<Vec<_>, _>>()?;
+            .map(|(i, item)| {
+                let joint = self.object::<Joint>(item, &format!("robot.joints[{i}]"), None)?;
+                for (name, v, limit, unit) in [
+                    ("alpha", joint.alpha, limits::ANGLE_DEG, "deg"),
+                    ("a", joint.a, limits::LENGTH_MM, "mm"),
+                    ("beta", joint.beta, limits::ANGLE_DEG, "deg"),
+                    ("theta", joint.theta, limits::ANGLE_DEG, "deg"),
+                    ("d", joint.d, limits::LENGTH_MM, "mm"),
+                ] {
+                    self.plausible(
+                        v,
+                        limit,
+                        &format!("robot.joints[{i}].{name}"),
+                        unit,
+                        None,
+                        item,
+                    )?;
+                }
+                Ok(joint)
+            })
+            .collect::<Result<Vec<_>, FileError>>()?;
         if joints.is_empty() {
             return Err(self.invalid(
                 None,
@@ -283,17 +303,25 @@ impl<'a> Ctx<'a> {
         let keys: SphereKeys = self.object(raw, "sphere", None)?;
         let d_raw = self.required(keys.diameter, raw, "sphere", "diameter", None)?;
         let diameter: f64 = self.parse(d_raw, "sphere.diameter", None)?;
-        if diameter > 0.0 && diameter.is_finite() {
-            Ok(diameter)
-        } else {
-            Err(self.invalid(
+        if !(diameter > 0.0 && diameter.is_finite()) {
+            return Err(self.invalid(
                 None,
                 format!(
-                    "sphere.diameter must be positive (mm), found {diameter}{}",
+                    "sphere.diameter must be positive (mm), found {}{}",
+                    show(diameter),
                     self.at(d_raw)
                 ),
-            ))
+            ));
         }
+        self.plausible(
+            diameter,
+            limits::SPHERE_DIAMETER_MM,
+            "sphere.diameter",
+            "mm",
+            None,
+            d_raw,
+        )?;
+        Ok(diameter)
     }
 
     fn solver(&self, raw: &'a RawValue) -> Result<SolverSettings, FileError> {
@@ -305,11 +333,20 @@ impl<'a> Ctx<'a> {
                 return Err(self.invalid(
                     None,
                     format!(
-                        "solver.threshold must be zero or positive (mm), found {threshold}{}",
+                        "solver.threshold must be zero or positive (mm), found {}{}",
+                        show(threshold),
                         self.at(t_raw)
                     ),
                 ));
             }
+            self.plausible(
+                threshold,
+                limits::THRESHOLD_MM,
+                "solver.threshold",
+                "mm",
+                None,
+                t_raw,
+            )?;
             solver.threshold = threshold;
         }
         if let Some(n_raw) = keys.max_iterations {
@@ -318,15 +355,53 @@ impl<'a> Ctx<'a> {
                 return Err(self.invalid(
                     None,
                     format!(
-                        "solver.max_iterations must be a non-negative integer, found {n}{}",
+                        "solver.max_iterations must be a non-negative integer, found {}{}",
+                        show(n),
                         self.at(n_raw)
                     ),
                 ));
             }
+            self.plausible(
+                n,
+                limits::MAX_ITERATIONS,
+                "solver.max_iterations",
+                "",
+                None,
+                n_raw,
+            )?;
             // Exact: an integer in [0, 2^53].
             solver.max_iterations = n as usize;
         }
         Ok(solver)
+    }
+
+    /// Refuses `|value| > limit` (a [`limits`] constant) as not plausible.
+    fn plausible(
+        &self,
+        value: f64,
+        limit: f64,
+        key: &str,
+        unit: &str,
+        m: Option<&str>,
+        raw: &'a RawValue,
+    ) -> Result<(), FileError> {
+        if value.abs() <= limit {
+            return Ok(());
+        }
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
+        Err(self.invalid(
+            m,
+            format!(
+                "{key} = {}{unit} is not plausible for a sphere calibration (at most {}{unit}){}",
+                show(value),
+                show(limit),
+                self.at(raw)
+            ),
+        ))
     }
 
     /// Every measurement gives `joints`, or every one gives `flange`
@@ -527,6 +602,25 @@ impl<'a> Ctx<'a> {
                             .collect::<Result<Vec<_>, _>>()?
                     }
                 };
+                if let Some((i, p)) = points
+                    .iter()
+                    .enumerate()
+                    .find(|(_, p)| p.iter().any(|v| v.abs() > limits::SENSOR_COORDINATE_MM))
+                {
+                    let v = if p[0].abs() > limits::SENSOR_COORDINATE_MM {
+                        p[0]
+                    } else {
+                        p[1]
+                    };
+                    self.plausible(
+                        v,
+                        limits::SENSOR_COORDINATE_MM,
+                        &format!("{points_key}[{i}]"),
+                        "mm",
+                        m,
+                        points_raw,
+                    )?;
+                }
                 if points.len() < MIN_STRIPE_POINTS {
                     let problem = StripeError::TooFewPoints {
                         found: points.len(),
@@ -541,6 +635,16 @@ impl<'a> Ctx<'a> {
             }
             (None, Some(centre_raw)) => {
                 let c = self.numbers::<3>(centre_raw, &join(&scope, "centre"), " [x, y, z]", m)?;
+                for v in c {
+                    self.plausible(
+                        v,
+                        limits::SENSOR_COORDINATE_MM,
+                        &join(&scope, "centre"),
+                        "mm",
+                        m,
+                        centre_raw,
+                    )?;
+                }
                 Observation::Centre(Vector3::from(c))
             }
         };
@@ -566,6 +670,16 @@ impl<'a> Ctx<'a> {
         robot_joints: usize,
     ) -> Result<Vec<f64>, FileError> {
         let joints: Vec<f64> = self.array(raw, &join(scope, "joints"), m)?;
+        for (k, q) in joints.iter().enumerate() {
+            self.plausible(
+                *q,
+                limits::ANGLE_DEG,
+                &format!("{}[{k}]", join(scope, "joints")),
+                "deg",
+                m,
+                raw,
+            )?;
+        }
         if joints.len() != robot_joints {
             return Err(self.invalid(
                 m,
@@ -633,11 +747,20 @@ impl<'a> Ctx<'a> {
                 return Err(self.invalid(
                     None,
                     format!(
-                        "{key}.distance must be positive (mm), found {distance}{}",
+                        "{key}.distance must be positive (mm), found {}{}",
+                        show(distance),
                         self.at(d_raw)
                     ),
                 ));
             }
+            self.plausible(
+                distance,
+                limits::DISTANCE_MM,
+                &format!("{key}.distance"),
+                "mm",
+                None,
+                d_raw,
+            )?;
             out.push(ReferenceDistance { from, to, distance });
         }
         Ok(out)

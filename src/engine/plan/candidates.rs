@@ -620,7 +620,14 @@ impl Planner<'_> {
             let all: Vec<usize> = (0..infos.len()).collect();
             m += StationInfo::of(&infos, &all, k).schur();
         }
-        let eig = nalgebra::SymmetricEigen::new(m).eigenvalues;
+        let Some(eig) = nalgebra::SymmetricEigen::try_new(
+            m,
+            f64::EPSILON,
+            crate::engine::numeric::MAX_DECOMPOSITION_SWEEPS,
+        )
+        .map(|e| e.eigenvalues) else {
+            return f64::INFINITY;
+        };
         let max = eig.iter().copied().fold(0.0_f64, f64::max);
         let min = eig.iter().copied().fold(f64::INFINITY, f64::min);
         if min > 0.0 {

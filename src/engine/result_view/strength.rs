@@ -95,7 +95,11 @@ impl HandEyeStrength {
                 t[(i, j)] = entry(i, j)?;
             }
         }
-        let eig = SymmetricEigen::new((t + t.transpose()) * 0.5);
+        let eig = SymmetricEigen::try_new(
+            (t + t.transpose()) * 0.5,
+            f64::EPSILON,
+            crate::engine::numeric::MAX_DECOMPOSITION_SWEEPS,
+        )?;
         let (mut hi, mut lo) = (0, 0);
         for k in 0..3 {
             if eig.eigenvalues[k] > eig.eigenvalues[hi] {

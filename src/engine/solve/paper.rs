@@ -189,7 +189,15 @@ fn truncated_solve(
 ) -> (Vec<f64>, Vec<f64>, usize, Vec<Vec<f64>>) {
     let ncols = u.ncols();
     // Thin SVD of a tall matrix: min(rows, cols) singular values.
-    let svd = u.svd(true, true);
+    let Some(svd) = nalgebra::SVD::try_new(
+        u,
+        true,
+        true,
+        f64::EPSILON,
+        crate::engine::numeric::MAX_DECOMPOSITION_SWEEPS,
+    ) else {
+        return (vec![0.0; ncols], vec![0.0; ncols], 0, Vec::new());
+    };
     let (Some(left), Some(right_t)) = (svd.u, svd.v_t) else {
         return (vec![0.0; ncols], vec![0.0; ncols], 0, Vec::new());
     };

@@ -410,14 +410,20 @@ pub(super) fn name_inseparable(
     for (slot, &u) in estimated.iter().enumerate() {
         je.set_column(slot, &j.column(u));
     }
-    let svd = je.clone().svd(true, true);
+    let svd = nalgebra::SVD::try_new(
+        je.clone(),
+        true,
+        true,
+        f64::EPSILON,
+        crate::engine::numeric::MAX_DECOMPOSITION_SWEEPS,
+    );
     for &f in fixed {
         let col = j.column(f).into_owned();
         if col.norm() <= NO_EFFECT_REL * r11 {
             no_effect.push(unknown_label(f));
             continue;
         }
-        let Ok(c) = svd.solve(&col, 1e-12 * r11) else {
+        let Some(Ok(c)) = svd.as_ref().map(|d| d.solve(&col, 1e-12 * r11)) else {
             out.push(Inseparable::Unresolved(unknown_label(f)));
             continue;
         };

@@ -141,7 +141,13 @@ pub fn sensor_covariance(m: &PreparedMeasurement, options: &MlOptions) -> Matrix
         .unwrap_or_else(|| Matrix3::identity() * options.centre_sigma.powi(2));
     let floor = options.sensor_sigma_floor.powi(2);
     let sym = (base + base.transpose()) * 0.5;
-    let eig = SymmetricEigen::new(sym);
+    let Some(eig) = SymmetricEigen::try_new(
+        sym,
+        f64::EPSILON,
+        crate::engine::numeric::MAX_DECOMPOSITION_SWEEPS,
+    ) else {
+        return Matrix3::identity() * floor;
+    };
     let values = eig.eigenvalues.map(|v| v.max(floor));
     eig.eigenvectors * Matrix3::from_diagonal(&values) * eig.eigenvectors.transpose()
 }

@@ -167,7 +167,17 @@ impl Linear {
             .clone()
             .cholesky()
             .map(|c| c.inverse())
-            .or_else(|| s.pseudo_inverse(1e-14).ok())
+            .or_else(|| {
+                nalgebra::SVD::try_new(
+                    s,
+                    true,
+                    true,
+                    f64::EPSILON,
+                    crate::engine::numeric::MAX_DECOMPOSITION_SWEEPS,
+                )?
+                .pseudo_inverse(1e-14)
+                .ok()
+            })
             .unwrap_or_else(|| DMatrix::zeros(k, k));
         let e = self
             .stations
