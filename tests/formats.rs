@@ -831,10 +831,8 @@ fn a_result_with_a_non_finite_number_is_not_written() {
     let dir = tempfile::tempdir().unwrap();
     let good = load_result(&data("v1/result.json")).unwrap();
     let path = dir.path().join("r.json");
-    let cases: Vec<(
-        Box<dyn Fn(&mut spherecal::engine::format::ResultFile)>,
-        &str,
-    )> = vec![
+    type Spoil = Box<dyn Fn(&mut spherecal::engine::format::ResultFile)>;
+    let cases: Vec<(Spoil, &str)> = vec![
         (Box::new(|r| r.epsilon_after = f64::NAN), "epsilon_after"),
         (
             Box::new(|r| r.centres[1].sensor[2] = f64::INFINITY),

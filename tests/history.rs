@@ -481,6 +481,48 @@ fn bad_files_are_reported_and_the_scan_goes_on() {
     ));
 }
 
+/// Issue 12: `history` skipped symlinked subfolders silently and rejected
+/// a result with a UTF-8 BOM that `calibrate` and `report` accept. Linked
+/// folders are followed; a link back (a loop) is reported once, not
+/// followed forever; a BOM is skipped.
+#[cfg(unix)]
+#[test]
+fn linked_folders_are_followed_without_loops_and_a_bom_is_accepted() {
+    let top = tempfile::tempdir().unwrap();
+    let lib = top.path().join("lib");
+    let outside = top.path().join("elsewhere");
+    fs::create_dir_all(&lib).unwrap();
+    let (_, linked_result) = write_pair(&outside, &calibrations()[0]);
+    std::os::unix::fs::symlink(&outside, lib.join("linked")).unwrap();
+    std::os::unix::fs::symlink(&lib, outside.join("back")).unwrap();
+    let bom = format!(
+        "\u{feff}{}",
+        format::result_to_json(&calibrations()[1].result)
+    );
+    fs::write(lib.join("bom.result.json"), bom).unwrap();
+
+    let library = history::scan(&lib).unwrap();
+    let found: Vec<&Path> = library.entries.iter().map(|e| e.path.as_path()).collect();
+    assert_eq!(found.len(), 2, "{found:?} {:?}", library.problems);
+    assert!(
+        found.contains(
+            &lib.join("linked")
+                .join(linked_result.file_name().unwrap())
+                .as_path()
+        )
+    );
+    assert!(found.contains(&lib.join("bom.result.json").as_path()));
+    // The result in the linked folder is paired with its session there.
+    assert_eq!(library.sessions.len(), 1);
+    assert_eq!(library.problems.len(), 1, "{:?}", library.problems);
+    assert!(library.problems[0].path.ends_with("linked/back"));
+    assert!(
+        library.problems[0].message.contains("already scanned"),
+        "{}",
+        library.problems[0].message
+    );
+}
+
 #[test]
 fn a_second_robot_is_kept_apart() {
     let (_dir, library) = library();

@@ -578,3 +578,207 @@ fn a_side_column_is_read_without_a_mapping() {
             .contains("side from column `side`")
     );
 }
+
+// ---------------------------------------------------------------------------
+// Issue 12: each defect of the import, reproduced
+// ---------------------------------------------------------------------------
+
+/// Excel's "CSV UTF-8" starts the file with a byte-order mark; the joint
+/// log and the profiles were rejected with "no column `id` (the header
+/// has: id, …)".
+#[test]
+fn a_byte_order_mark_in_the_log_and_the_profiles_is_read() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let mut files = vec![dir.path().join("log.csv")];
+    files.extend(
+        original
+            .measurements
+            .iter()
+            .map(|m| dir.path().join("profiles").join(format!("{}.csv", m.id))),
+    );
+    for f in &files {
+        let text = fs::read_to_string(f).unwrap();
+        fs::write(f, format!("\u{feff}{text}")).unwrap();
+    }
+    let imported = import::import(&spec(dir.path(), &PLAIN)).unwrap();
+    assert_same_measurements(&original, &imported.session);
+}
+
+/// A log in degrees read as radians gave ε 1558 → 17.9 mm and exit 0.
+#[test]
+fn degrees_read_as_radians_are_refused_with_the_flag_to_change() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let mut s = spec(dir.path(), &PLAIN);
+    s.joint_unit = AngleUnit::Rad;
+    let msg = import::import(&s).unwrap_err().to_string();
+    assert!(msg.contains("--joint-unit deg"), "{msg}");
+    assert!(msg.contains("beyond any robot joint's range"), "{msg}");
+    assert!(msg.contains("log.csv") && msg.contains("line "), "{msg}");
+    // Radians read as degrees cannot be refused (small moves are possible)
+    // but are warned about.
+    let o = LogOptions {
+        radians: true,
+        ..PLAIN
+    };
+    write_files(&original, dir.path(), &o);
+    let imported = import::import(&spec(dir.path(), &o)).unwrap();
+    assert!(
+        imported
+            .notes
+            .iter()
+            .any(|n| n.contains("--joint-unit rad")),
+        "{:?}",
+        imported.notes
+    );
+    // Read right, no warning.
+    let mut s = spec(dir.path(), &o);
+    s.joint_unit = AngleUnit::Rad;
+    let imported = import::import(&s).unwrap();
+    assert!(!imported.notes.iter().any(|n| n.contains("warning")));
+}
+
+/// Profiles in mm read as µm gave r = 0.015 mm with only warnings; in µm
+/// read as mm they are a thousand times the sphere.
+#[test]
+fn profiles_in_the_wrong_unit_are_refused_with_the_flag_to_change() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let mut s = spec(dir.path(), &PLAIN);
+    s.profile_format.unit = LengthUnit::Um;
+    let msg = import::import(&s).unwrap_err().to_string();
+    assert!(msg.contains("--profile-unit mm"), "{msg}");
+    assert!(msg.contains("against a sphere of 38.1 mm"), "{msg}");
+    // µm written, read as mm.
+    for m in &original.measurements {
+        let Observation::Stripe(points) = &m.observation else {
+            unreachable!()
+        };
+        let mut p = String::from("y,z\n");
+        for [y, z] in points {
+            writeln!(p, "{:?},{:?}", y * 1000.0, z * 1000.0).unwrap();
+        }
+        fs::write(dir.path().join("profiles").join(format!("{}.csv", m.id)), p).unwrap();
+    }
+    let msg = import::import(&spec(dir.path(), &PLAIN))
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("--profile-unit um"), "{msg}");
+}
+
+/// "stripe has 2 points … at line 988 column 19 (joints.csv)": a rule of
+/// the session loader broken by a profile is blamed on the profile file,
+/// without a position in the generated JSON.
+#[test]
+fn a_stripe_rule_broken_by_a_profile_names_the_profile_file() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let id = &original.measurements[4].id;
+    let path = dir.path().join("profiles").join(format!("{id}.csv"));
+    let text = fs::read_to_string(&path).unwrap();
+    fs::write(&path, format!("{text}20000.0,5.0\n")).unwrap();
+    let e = import::import(&spec(dir.path(), &PLAIN)).unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.contains(&format!("pose {id}")), "{msg}");
+    assert!(msg.ends_with(&format!("({})", path.display())), "{msg}");
+    assert!(msg.contains("not plausible"), "{msg}");
+    assert!(
+        !msg.contains("column 1") && !msg.contains(" at line"),
+        "{msg}"
+    );
+}
+
+/// An unknown reference station was blamed on the joint log; it is the
+/// references file's row.
+#[test]
+fn an_unknown_reference_station_names_the_references_row() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let path = dir.path().join("references.csv");
+    let mut s = spec(dir.path(), &PLAIN);
+    s.references = Some(path.clone());
+    let validate: Vec<&str> = original
+        .measurements
+        .iter()
+        .filter(|m| m.usage.as_str() == "validate")
+        .map(|m| m.station.as_str())
+        .collect();
+    fs::write(
+        &path,
+        format!(
+            "# tracker\nfrom,to,distance\n{},{},100\nV1,Q9,100\n",
+            validate[0],
+            validate.last().unwrap()
+        ),
+    )
+    .unwrap();
+    let msg = import::import(&s).unwrap_err().to_string();
+    assert!(msg.contains("Q9"), "{msg}");
+    assert!(msg.starts_with("line 4:"), "{msg}");
+    assert!(msg.ends_with(&format!("({})", path.display())), "{msg}");
+}
+
+/// A pose id given twice in the joint log is named as such (it said "no
+/// stripe profile").
+#[test]
+fn a_duplicate_pose_id_is_named_as_such() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let log = dir.path().join("log.csv");
+    let text = fs::read_to_string(&log).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let second_id = original.measurements[1].id.clone();
+    let first_id = original.measurements[0].id.clone();
+    lines[3] = lines[3].replacen(&second_id, &first_id, 1);
+    fs::write(&log, lines.join("\n")).unwrap();
+    let msg = import::import(&spec(dir.path(), &PLAIN))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains(&format!(
+            "pose id `{first_id}` is used twice (first at line 3)"
+        )),
+        "{msg}"
+    );
+    assert!(msg.starts_with("line 4:"), "{msg}");
+}
+
+/// A large profile is read row by row (no row of text fields kept): 200,000
+/// points with a header import, and a bad cell deep in it still names
+/// its line.
+#[test]
+fn a_large_profile_is_streamed_and_a_bad_cell_names_its_line() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let id = &original.measurements[0].id;
+    let path = dir.path().join("profiles").join(format!("{id}.csv"));
+    let Observation::Stripe(points) = &original.measurements[0].observation else {
+        unreachable!()
+    };
+    let mut p = String::from("# big\ny,z\n");
+    for k in 0..200_000 {
+        let [y, z] = points[k % points.len()];
+        writeln!(p, "{y:?},{z:?}").unwrap();
+    }
+    fs::write(&path, &p).unwrap();
+    let imported = import::import(&spec(dir.path(), &PLAIN)).unwrap();
+    let Observation::Stripe(read) = &imported.session.measurements[0].observation else {
+        unreachable!()
+    };
+    assert_eq!(read.len(), 200_000);
+    let bad = p.replacen(&format!("\n{:?},", points[3][0]), "\nx7,", 1);
+    fs::write(&path, bad).unwrap();
+    let msg = import::import(&spec(dir.path(), &PLAIN))
+        .unwrap_err()
+        .to_string();
+    assert!(msg.starts_with("line 6:"), "{msg}");
+    assert!(msg.contains("`x7` is not a number"), "{msg}");
+}

@@ -18,6 +18,28 @@ pub fn show(value: f64) -> String {
     }
 }
 
+/// A computed number for a message, to 4 significant digits: `2578`,
+/// `0.01524`, `1.5e160` (a reading the user typed is shown whole by
+/// [`show`]).
+#[must_use]
+pub fn approx(value: f64) -> String {
+    let a = value.abs();
+    if !value.is_finite() || a == 0.0 {
+        return format!("{value}");
+    }
+    if !(1e-4..1e7).contains(&a) {
+        return format!("{value:.3e}");
+    }
+    // Decimals that leave 4 significant digits, none for large numbers.
+    let decimals = usize::try_from((3 - a.log10().floor() as i32).max(0)).unwrap_or(0);
+    let text = format!("{value:.decimals$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    }
+}
+
 /// `value` rounded to `decimals` decimal places (half away from zero).
 #[must_use]
 pub fn round_to(value: f64, decimals: i32) -> f64 {
@@ -69,6 +91,16 @@ pub fn upper_median(values: &mut [f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn approx_keeps_four_significant_digits() {
+        assert_eq!(approx(2_578.310_078), "2578");
+        assert_eq!(approx(0.015_240_1), "0.01524");
+        assert_eq!(approx(38.1), "38.1");
+        assert_eq!(approx(-45.0), "-45");
+        assert_eq!(approx(1.5e160), "1.500e160");
+        assert_eq!(approx(0.0), "0");
+    }
 
     #[test]
     fn medians() {

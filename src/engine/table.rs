@@ -46,6 +46,60 @@ fn separator(text: &str) -> u8 {
     }
 }
 
+/// The line of a byte offset, for offsets that mostly grow: counted on
+/// from the last answer (linear in the text overall, no table of line
+/// starts). The `csv` crate reports where it started reading a record,
+/// before the comment and blank lines it skipped, and does not count
+/// comment lines: the record's line is the first line from there on that
+/// is neither.
+struct LineCounter<'a> {
+    text: &'a str,
+    /// Byte offset of the start of line `line`.
+    start: usize,
+    line: usize,
+}
+
+impl<'a> LineCounter<'a> {
+    fn new(text: &'a str) -> Self {
+        Self {
+            text,
+            start: 0,
+            line: 1,
+        }
+    }
+
+    fn line_at(&mut self, byte: u64) -> usize {
+        let byte = usize::try_from(byte)
+            .unwrap_or(usize::MAX)
+            .min(self.text.len());
+        if byte < self.start {
+            *self = Self::new(self.text);
+        }
+        let bytes = self.text.as_bytes();
+        while let Some(nl) = bytes[self.start..byte].iter().position(|&b| b == b'\n') {
+            self.start += nl + 1;
+            self.line += 1;
+        }
+        // Skip the comment and blank lines the reader passed over.
+        let mut start = self.start;
+        let mut line = self.line;
+        loop {
+            let end = bytes[start..]
+                .iter()
+                .position(|&b| b == b'\n')
+                .map_or(bytes.len(), |i| start + i);
+            let l = self.text.get(start..end).unwrap_or("");
+            let l = l.trim_start_matches('\u{feff}');
+            if end < bytes.len() && (l.trim().is_empty() || l.starts_with('#')) {
+                start = end + 1;
+                line += 1;
+            } else {
+                return line;
+            }
+        }
+    }
+}
+
 impl Table {
     /// Parses `text`.
     ///
@@ -53,57 +107,17 @@ impl Table {
     /// No header row, a malformed quoted field, or a data row whose field
     /// count differs from the header's.
     pub fn parse(text: &str) -> Result<Self, TableError> {
-        let mut reader = csv::ReaderBuilder::new()
-            .has_headers(false)
-            .flexible(true)
-            .comment(Some(b'#'))
-            .delimiter(separator(text))
-            .trim(csv::Trim::All)
-            .from_reader(text.as_bytes());
-        // The crate reports where it started reading a record, before the
-        // comment and blank lines it skipped, and does not count comment
-        // lines: the record's line is the first line from there on that
-        // is neither.
-        let lines: Vec<&str> = text.split('\n').collect();
-        let line_starts: Vec<usize> = std::iter::once(0)
-            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
-            .collect();
-        let line_at = |byte: u64| {
-            let byte = usize::try_from(byte).unwrap_or(usize::MAX);
-            let mut line = line_starts.partition_point(|&start| start <= byte);
-            while let Some(l) = lines.get(line - 1) {
-                let l = l.trim_start_matches('\u{feff}');
-                if l.trim().is_empty() || l.starts_with('#') {
-                    line += 1;
-                } else {
-                    break;
-                }
-            }
-            line
-        };
         let mut header: Option<(usize, Vec<String>)> = None;
         let mut rows = Vec::new();
-        for record in reader.records() {
-            let record = record.map_err(|e| TableError {
-                line: e.position().map_or(1, |p| line_at(p.byte())),
-                message: format!("not valid CSV: {e}"),
-            })?;
-            let line = record.position().map_or(1, |p| line_at(p.byte()));
-            if record.iter().all(str::is_empty) {
-                continue;
-            }
+        Self::scan(text, |line, record| {
             let fields: Vec<String> = record.iter().map(str::to_string).collect();
-            match &header {
-                None => header = Some((line, fields)),
-                Some((_, h)) if fields.len() != h.len() => {
-                    return Err(TableError {
-                        line,
-                        message: format!("{} fields, the header has {}", fields.len(), h.len()),
-                    });
-                }
-                Some(_) => rows.push((line, fields)),
+            if header.is_none() {
+                header = Some((line, fields));
+            } else {
+                rows.push((line, fields));
             }
-        }
+            Ok::<(), TableError>(())
+        })?;
         let Some((header_line, header)) = header else {
             return Err(TableError {
                 line: 1,
@@ -115,6 +129,60 @@ impl Table {
             header,
             rows,
         })
+    }
+
+    /// Reads `text` record by record without keeping the rows: `each` gets
+    /// the 1-based line and the fields of the header (the first record)
+    /// and then of every data row, in order. Memory stays that of one row,
+    /// whatever the size of the file (a profile of millions of points).
+    ///
+    /// # Errors
+    /// A malformed quoted field, or a data row whose field count differs
+    /// from the header's; or the first error `each` returns. No header row
+    /// is not an error here (`each` is then never called).
+    pub fn scan<E: From<TableError>>(
+        text: &str,
+        mut each: impl FnMut(usize, &csv::StringRecord) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .comment(Some(b'#'))
+            .delimiter(separator(text))
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes());
+        let mut lines = LineCounter::new(text);
+        let mut width: Option<usize> = None;
+        let mut record = csv::StringRecord::new();
+        loop {
+            match reader.read_record(&mut record) {
+                Ok(false) => return Ok(()),
+                Ok(true) => {}
+                Err(e) => {
+                    return Err(TableError {
+                        line: e.position().map_or(1, |p| lines.line_at(p.byte())),
+                        message: format!("not valid CSV: {e}"),
+                    }
+                    .into());
+                }
+            }
+            let line = record.position().map_or(1, |p| lines.line_at(p.byte()));
+            if record.iter().all(str::is_empty) {
+                continue;
+            }
+            match width {
+                None => width = Some(record.len()),
+                Some(w) if record.len() != w => {
+                    return Err(TableError {
+                        line,
+                        message: format!("{} fields, the header has {w}", record.len()),
+                    }
+                    .into());
+                }
+                Some(_) => {}
+            }
+            each(line, &record)?;
+        }
     }
 
     /// The index of the column named `name` (case-insensitive).

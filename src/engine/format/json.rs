@@ -152,6 +152,10 @@ impl<'de> Visitor<'de> for UniqueVisitor {
 pub(super) struct Ctx<'a> {
     pub(super) text: &'a str,
     pub(super) path: &'a Path,
+    /// Whether messages give the line and column: not for a text the
+    /// engine generated itself (an import's session), whose positions mean
+    /// nothing to the user.
+    pub(super) placed: bool,
 }
 
 /// `parent: ` or nothing, to start a message about a key of `parent`.
@@ -204,7 +208,11 @@ impl<'a> Ctx<'a> {
     pub(super) fn new(text: &'a str, path: &'a Path) -> Self {
         // A UTF-8 byte-order mark is not JSON but some editors write one.
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        Self { text, path }
+        Self {
+            text,
+            path,
+            placed: true,
+        }
     }
 
     pub(super) fn invalid(
@@ -221,6 +229,9 @@ impl<'a> Ctx<'a> {
 
     /// Line and column (1-based) of the start of `raw` in the text.
     pub(super) fn line_column(&self, raw: &RawValue) -> Option<(usize, usize)> {
+        if !self.placed {
+            return None;
+        }
         let offset = (raw.get().as_ptr() as usize).checked_sub(self.text.as_ptr() as usize)?;
         let before = self.text.get(..offset)?;
         let line = before.bytes().filter(|&b| b == b'\n').count() + 1;

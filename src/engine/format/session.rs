@@ -103,6 +103,23 @@ pub fn parse_session(text: &str, path: &Path) -> Result<Session, FileError> {
     ctx.session(top, keys)
 }
 
+/// Checks a session the engine built (an import) against every rule of
+/// the loader, by writing it and reading it back; messages name the key
+/// and the measurement but no line or column (the JSON is not the user's
+/// file; `path` is the file the caller blames).
+///
+/// # Errors
+/// [`FileError::Invalid`] as [`parse_session`], without positions.
+pub fn recheck_session(session: &Session, path: &Path) -> Result<Session, FileError> {
+    let text = session_to_json(session);
+    let mut ctx = Ctx::new(&text, path);
+    ctx.placed = false;
+    let top = ctx.document()?;
+    ctx.header(top, SESSION_FORMAT)?;
+    let keys: SessionKeys = ctx.object(top, "", None)?;
+    ctx.session(top, keys)
+}
+
 /// The session as FORMAT.md version 1 JSON, pretty-printed, with a trailing
 /// newline. [`parse_session`] reads it back to an equal [`Session`] (for a
 /// session that itself came from [`parse_session`]; see the module doc on

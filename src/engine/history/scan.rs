@@ -2,6 +2,7 @@
 //! deep), each result paired with its session, dated, and read into an
 //! [`Entry`].
 
+use std::collections::HashSet;
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
@@ -37,7 +38,8 @@ pub fn scan(folder: &Path) -> Result<Library, HistoryError> {
         path: folder.to_path_buf(),
         source,
     })?;
-    walk(top, folder, 0, &mut files, &mut problems);
+    let mut visited: HashSet<PathBuf> = fs::canonicalize(folder).into_iter().collect();
+    walk(top, folder, 0, &mut visited, &mut files, &mut problems);
     files.sort();
 
     let mut results: Vec<(PathBuf, ResultFile, Option<SystemTime>)> = Vec::new();
@@ -122,10 +124,15 @@ pub fn scan(folder: &Path) -> Result<Library, HistoryError> {
 }
 
 /// Collects `*.json` files below `dir` (already opened), depth-first.
+/// Symbolic links are followed, to files and to folders; `visited` holds
+/// the real path of every folder entered, so a link back to a folder
+/// already scanned (a loop, or a second way to the same folder) is
+/// reported once as a problem instead of being scanned again.
 pub(super) fn walk(
     read: fs::ReadDir,
     dir: &Path,
     depth: usize,
+    visited: &mut HashSet<PathBuf>,
     files: &mut Vec<PathBuf>,
     problems: &mut Vec<Problem>,
 ) {
@@ -146,16 +153,23 @@ pub(super) fn walk(
         if name.starts_with('.') {
             continue;
         }
-        // `file_type` does not follow symbolic links: a linked folder is
-        // not entered (no cycles), a linked file is read.
-        let Ok(kind) = item.file_type() else {
-            problems.push(Problem {
-                path,
-                message: "cannot read the file type".into(),
-            });
-            continue;
+        // `metadata` follows a symbolic link to what it points to.
+        let meta = match fs::metadata(&path) {
+            Ok(m) => m,
+            Err(e) => {
+                let linked = item.file_type().is_ok_and(|t| t.is_symlink());
+                problems.push(Problem {
+                    path,
+                    message: if linked {
+                        format!("a link to nothing readable: {e}")
+                    } else {
+                        format!("cannot read the file type: {e}")
+                    },
+                });
+                continue;
+            }
         };
-        if kind.is_dir() {
+        if meta.is_dir() {
             if depth + 1 > MAX_DEPTH {
                 problems.push(Problem {
                     path,
@@ -163,14 +177,25 @@ pub(super) fn walk(
                 });
                 continue;
             }
+            let real = fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
+            if !visited.insert(real.clone()) {
+                problems.push(Problem {
+                    path,
+                    message: format!(
+                        "not scanned again: a link to {}, which is already scanned",
+                        real.display()
+                    ),
+                });
+                continue;
+            }
             match fs::read_dir(&path) {
-                Ok(sub) => walk(sub, &path, depth + 1, files, problems),
+                Ok(sub) => walk(sub, &path, depth + 1, visited, files, problems),
                 Err(e) => problems.push(Problem {
                     path,
                     message: format!("cannot read the folder: {e}"),
                 }),
             }
-        } else if name.to_ascii_lowercase().ends_with(".json") && !kind.is_dir() {
+        } else if meta.is_file() && name.to_ascii_lowercase().ends_with(".json") {
             files.push(path);
         }
     }
@@ -211,18 +236,21 @@ pub(super) fn read_file(path: &Path) -> Result<Found, String> {
     }
     let modified = meta.modified().ok();
     let text = fs::read_to_string(path).map_err(|e| format!("cannot read the file: {e}"))?;
+    // A UTF-8 byte-order mark (Windows editors) is not part of the JSON;
+    // the session and result readers skip it too.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let format = if text.trim_start().starts_with('{') {
-        serde_json::from_str::<Header>(&text)
+        serde_json::from_str::<Header>(text)
             .map_err(|e| format!("not valid JSON: {e}"))?
             .format
     } else {
         // Valid JSON that is not an object (an array, a number) is not ours.
-        serde_json::from_str::<IgnoredAny>(&text).map_err(|e| format!("not valid JSON: {e}"))?;
+        serde_json::from_str::<IgnoredAny>(text).map_err(|e| format!("not valid JSON: {e}"))?;
         None
     };
     match format.as_ref().and_then(Value::as_str) {
         Some(SESSION_FORMAT) => {
-            let s = format::parse_session(&text, path).map_err(|e| file_error_message(&e))?;
+            let s = format::parse_session(text, path).map_err(|e| file_error_message(&e))?;
             Ok(Found::Session {
                 name: s.name,
                 robot: if s.robot_given {
@@ -235,7 +263,7 @@ pub(super) fn read_file(path: &Path) -> Result<Found, String> {
             })
         }
         Some(RESULT_FORMAT) => {
-            let result = format::parse_result(&text, path).map_err(|e| file_error_message(&e))?;
+            let result = format::parse_result(text, path).map_err(|e| file_error_message(&e))?;
             Ok(Found::Result {
                 result: Box::new(result),
                 modified,

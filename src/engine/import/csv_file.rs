@@ -6,7 +6,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use super::ImportError;
-use crate::engine::table::Table;
+use crate::engine::table::{Table, TableError};
 
 /// A parsed CSV file: header and data rows with their 1-based lines.
 pub(super) struct CsvFile {
@@ -39,6 +39,61 @@ impl CsvFile {
             path: path.to_path_buf(),
             header: table.header,
             rows: table.rows,
+        })
+    }
+
+    /// Reads `text` (the content of `path`) row by row without keeping the
+    /// rows: `each` gets the file (header, no rows), the 1-based line and
+    /// the fields of every data row. Memory is that of one row, whatever
+    /// the file's size.
+    ///
+    /// # Errors
+    /// No header row, malformed CSV, a row with the wrong field count (all
+    /// naming the file and line), or the first error `each` returns.
+    pub fn stream(
+        text: &str,
+        path: &Path,
+        mut each: impl FnMut(&Self, usize, &csv::StringRecord) -> Result<(), ImportError>,
+    ) -> Result<Self, ImportError> {
+        /// A table error (still to be given its file) or the caller's.
+        enum Fail {
+            Table(TableError),
+            Row(ImportError),
+        }
+        impl From<TableError> for Fail {
+            fn from(e: TableError) -> Self {
+                Self::Table(e)
+            }
+        }
+        let mut file: Option<Self> = None;
+        let scanned = Table::scan(text, |line, record| {
+            match &file {
+                None => {
+                    file = Some(Self {
+                        path: path.to_path_buf(),
+                        header: record.iter().map(str::to_string).collect(),
+                        rows: Vec::new(),
+                    });
+                }
+                Some(f) => each(f, line, record).map_err(Fail::Row)?,
+            }
+            Ok::<(), Fail>(())
+        });
+        match scanned {
+            Ok(()) => {}
+            Err(Fail::Row(e)) => return Err(e),
+            Err(Fail::Table(e)) => {
+                return Err(ImportError::Csv {
+                    path: path.to_path_buf(),
+                    line: e.line,
+                    message: e.message,
+                });
+            }
+        }
+        file.ok_or_else(|| ImportError::Csv {
+            path: path.to_path_buf(),
+            line: 1,
+            message: "no header row".into(),
         })
     }
 

@@ -42,14 +42,14 @@ pub use self::check::{
 pub use self::log::{ColumnMap, DEFAULT_SIDE_COLUMN, header, preview};
 pub use self::poses::{PoseImportSpec, SideChoice, import_poses};
 pub use self::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource, RawProfile};
-pub use self::references::read_references;
+pub use self::references::{read_references, reference_rows};
 pub use self::robot_source::{RobotSource, load_robot};
 pub use self::units::{AngleUnit, LengthUnit};
 pub use crate::engine::robot::controller::FlangeConvention;
 
 use self::csv_file::CsvFile;
 use crate::engine::format::FileError;
-use crate::engine::format::{parse_session, session_to_json};
+use crate::engine::format::recheck_session;
 use crate::engine::robot::Robot;
 use crate::engine::session::{
     MIN_STRIPE_POINTS, Measurement, Observation, Session, SolverSettings, Use,
@@ -204,17 +204,37 @@ pub fn read_profiles(
     ids: &[String],
 ) -> Result<(Vec<PlaneProfile>, ProfileReport), ImportError> {
     let raws: Vec<RawProfile> = match source {
-        ProfileSource::Folder(dir) => ids
-            .iter()
-            .map(|id| {
-                let path =
-                    profiles::file_of(dir, id).ok_or_else(|| ImportError::MissingProfile {
-                        id: id.clone(),
-                        path: dir.join(format!("{id}.csv")),
-                    })?;
-                profiles::read_profile(&path, format)
-            })
-            .collect::<Result<_, _>>()?,
+        ProfileSource::Folder(dir) => {
+            let file = |id: &String| {
+                profiles::file_of(dir, id).ok_or_else(|| ImportError::MissingProfile {
+                    id: id.clone(),
+                    path: dir.join(format!("{id}.csv")),
+                })
+            };
+            if let Some(axes) = format.axes {
+                // The map is known: each file is read and put in the plane
+                // on its own, one raw profile in memory at a time.
+                let mut planes = Vec::with_capacity(ids.len());
+                let mut poses = Vec::with_capacity(ids.len());
+                for id in ids {
+                    let raw = profiles::read_profile(&file(id)?, format)?;
+                    let (plane, count) = plane_of(&raw, &axes, id)?;
+                    planes.push(plane);
+                    poses.push(count);
+                }
+                return Ok((
+                    planes,
+                    ProfileReport {
+                        axes,
+                        axes_guessed: false,
+                        poses,
+                    },
+                ));
+            }
+            ids.iter()
+                .map(|id| profiles::read_profile(&file(id)?, format))
+                .collect::<Result<_, _>>()?
+        }
         ProfileSource::File { path, pose_column } => {
             let (order, mut by_id) = profiles::read_profile_table(path, pose_column, format)?;
             if let Some(stray) = order.iter().find(|id| !ids.contains(id)) {
@@ -236,7 +256,9 @@ pub fn read_profiles(
     planar(raws, format, ids)
 }
 
-/// Raw profiles in the laser plane, with their report.
+/// Raw profiles in the laser plane, with their report. Each raw profile
+/// is dropped as soon as it is converted, so the peak is the raw data
+/// plus one converted profile, not both sets.
 pub(crate) fn planar(
     raws: Vec<RawProfile>,
     format: &ProfileFormat,
@@ -254,27 +276,11 @@ pub(crate) fn planar(
     };
     let mut planes = Vec::with_capacity(raws.len());
     let mut poses = Vec::with_capacity(raws.len());
-    for (raw, id) in raws.iter().zip(ids) {
-        let plane = raw.to_plane(&axes)?;
-        if plane.points.len() < MIN_STRIPE_POINTS {
-            return Err(ImportError::File {
-                path: raw.source.clone(),
-                message: format!(
-                    "pose {id}: the profile has {} usable points ({} non-finite and {} no-return dropped); a stripe needs at least {MIN_STRIPE_POINTS}",
-                    plane.points.len(),
-                    plane.non_finite,
-                    plane.no_return
-                ),
-            });
-        }
-        poses.push(ProfileCount {
-            id: id.clone(),
-            file: raw.source.clone(),
-            points: plane.points.len(),
-            non_finite: plane.non_finite,
-            no_return: plane.no_return,
-        });
+    for (raw, id) in raws.into_iter().zip(ids) {
+        let (plane, count) = plane_of(&raw, &axes, id)?;
+        drop(raw);
         planes.push(plane);
+        poses.push(count);
     }
     Ok((
         planes,
@@ -284,6 +290,57 @@ pub(crate) fn planar(
             poses,
         },
     ))
+}
+
+/// One raw profile in the laser plane, with its count; too few points is
+/// an error naming the profile file.
+fn plane_of(
+    raw: &RawProfile,
+    axes: &AxisMap,
+    id: &str,
+) -> Result<(PlaneProfile, ProfileCount), ImportError> {
+    let plane = raw.to_plane(axes)?;
+    if plane.points.len() < MIN_STRIPE_POINTS {
+        return Err(ImportError::File {
+            path: raw.source.clone(),
+            message: format!(
+                "pose {id}: the profile has {} usable points ({} non-finite and {} no-return dropped); a stripe needs at least {MIN_STRIPE_POINTS}",
+                plane.points.len(),
+                plane.non_finite,
+                plane.no_return
+            ),
+        });
+    }
+    let count = ProfileCount {
+        id: id.to_string(),
+        file: raw.source.clone(),
+        points: plane.points.len(),
+        non_finite: plane.non_finite,
+        no_return: plane.no_return,
+    };
+    Ok((plane, count))
+}
+
+/// Refuses profiles whose size does not fit the sphere (a unit read
+/// wrong), naming the profile unit that would fit
+/// ([`units::check_profile_unit`]).
+///
+/// # Errors
+/// [`ImportError::File`] naming the first profile's file.
+pub(crate) fn check_profile_size(
+    planes: &[PlaneProfile],
+    format: &ProfileFormat,
+    sphere_diameter: f64,
+) -> Result<(), ImportError> {
+    let extents: Vec<f64> = planes.iter().map(PlaneProfile::extent).collect();
+    units::check_profile_unit(format.unit, sphere_diameter, &extents).map_err(|message| {
+        ImportError::File {
+            path: planes
+                .first()
+                .map_or_else(PathBuf::new, |p| p.source.clone()),
+            message,
+        }
+    })
 }
 
 /// Builds the session of a joint log and checks the flange poses, if
@@ -309,6 +366,7 @@ pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
         }
     }
     let (planes, report) = read_profiles(&spec.profiles, &spec.profile_format, &ids)?;
+    check_profile_size(&planes, &spec.profile_format, spec.sphere_diameter)?;
     let mut measurements = Vec::with_capacity(log.rows.len());
     let mut checks = Vec::new();
     for (((line, row), id), plane) in log.rows.iter().zip(ids).zip(planes) {
@@ -333,6 +391,13 @@ pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
             .iter()
             .map(|&c| log.number(*line, row, c))
             .collect::<Result<_, _>>()?;
+        units::check_joint_unit(spec.joint_unit, [(*line, id.as_str(), raw.as_slice())]).map_err(
+            |(line, message)| ImportError::Csv {
+                path: log.path.clone(),
+                line,
+                message,
+            },
+        )?;
         let joints: Vec<f64> = raw.iter().map(|&v| spec.joint_unit.to_deg(v)).collect();
         if let Some(f) = &spec.flange {
             let values: Vec<f64> = cols
@@ -377,14 +442,114 @@ pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
         spec.references.as_deref(),
         measurements,
     )?;
-    let session = parse_session(&session_to_json(&session), &spec.joint_log)?;
-    let notes = vec![report.summary()];
+    let lines: HashMap<&str, usize> = log
+        .rows
+        .iter()
+        .map(|(line, row)| (row[cols.id].as_str(), *line))
+        .collect();
+    let session = recheck(
+        &session,
+        &Sources {
+            log: &spec.joint_log,
+            lines: &lines,
+            profiles: &report,
+            references: spec.references.as_deref(),
+        },
+    )?;
+    let mut notes = vec![report.summary()];
+    notes.extend(units::joint_unit_warning(
+        spec.joint_unit,
+        session
+            .measurements
+            .iter()
+            .flat_map(|m| m.joints.iter().copied()),
+    ));
     Ok(Imported {
         session,
         checks,
         profiles: report,
         notes,
     })
+}
+
+/// Where an imported session's data came from, so that a rule the
+/// session breaks is blamed on the file the user can fix.
+pub(crate) struct Sources<'a> {
+    /// The pose log.
+    pub log: &'a Path,
+    /// Line of each pose id in the log.
+    pub lines: &'a HashMap<&'a str, usize>,
+    /// Each pose's profile file.
+    pub profiles: &'a ProfileReport,
+    /// The reference distances file, if any.
+    pub references: Option<&'a Path>,
+}
+
+/// The session checked by every rule of the session loader
+/// ([`recheck_session`]); a broken rule is blamed on its source: a
+/// stripe's on the pose's profile file, a pose's other data on its log
+/// line, a reference distance on its row of the references file, the
+/// rest on the log.
+///
+/// # Errors
+/// The loader's message, placed in the file it came from.
+pub(crate) fn recheck(session: &Session, sources: &Sources) -> Result<Session, ImportError> {
+    let e = match recheck_session(session, sources.log) {
+        Ok(s) => return Ok(s),
+        Err(e) => e,
+    };
+    let FileError::Invalid {
+        measurement,
+        message,
+        ..
+    } = &e
+    else {
+        return Err(e.into());
+    };
+    if let Some(id) = measurement {
+        let profile = sources.profiles.poses.iter().find(|p| p.id == *id);
+        if let Some(p) = profile.filter(|_| message.contains("stripe")) {
+            return Err(ImportError::File {
+                path: p.file.clone(),
+                message: format!("pose {id}: {message}"),
+            });
+        }
+        if let Some(&line) = sources.lines.get(id.as_str()) {
+            return Err(ImportError::Csv {
+                path: sources.log.to_path_buf(),
+                line,
+                message: format!("pose {id}: {message}"),
+            });
+        }
+    }
+    if let Some(path) = sources.references
+        && let Some(index) = reference_index(message)
+    {
+        let line = reference_rows(path)
+            .ok()
+            .and_then(|rows| rows.get(index).map(|(line, _)| *line));
+        return Err(match line {
+            Some(line) => ImportError::Csv {
+                path: path.to_path_buf(),
+                line,
+                message: message.clone(),
+            },
+            None => ImportError::File {
+                path: path.to_path_buf(),
+                message: message.clone(),
+            },
+        });
+    }
+    Err(ImportError::File {
+        path: sources.log.to_path_buf(),
+        message: message.clone(),
+    })
+}
+
+/// `i` of the first `reference_distances[i]` a loader message names.
+fn reference_index(message: &str) -> Option<usize> {
+    let rest = message.split("reference_distances[").nth(1)?;
+    rest.split(']').next()?.parse().ok()
 }
 
 /// A session built by an import: `name` given, the robot (none for a

@@ -42,7 +42,6 @@ use serde_json::Value;
 use super::csv_file::CsvFile;
 use super::profiles::{self, PlaneProfile, ProfileFormat, ProfileSource};
 use super::{FlangeConvention, ImportError, Imported, ProfileReport, RobotSource, load_robot, log};
-use crate::engine::format::{parse_session, session_to_json};
 use crate::engine::robot::Robot;
 use crate::engine::session::{Measurement, Observation, Session, Use};
 use crate::engine::solve::{self, Options};
@@ -397,6 +396,7 @@ fn draft(
     robot: Option<Robot>,
     side: i8,
 ) -> Result<Draft, ImportError> {
+    super::check_profile_size(&planes, &spec.profile_format, spec.sphere_diameter)?;
     let mut notes = Vec::new();
     let given_uses = records.iter().filter(|r| r.usage.is_some()).count();
     if given_uses != 0 && given_uses != records.len() {
@@ -593,7 +593,22 @@ pub fn import_poses(spec: &PoseImportSpec) -> Result<Imported, ImportError> {
     ));
     notes.extend(draft.notes);
     notes.extend(side_note);
-    let session = parse_session(&session_to_json(&draft.session), &spec.poses)?;
+    let lines: HashMap<&str, usize> = records
+        .iter()
+        .filter_map(|r| {
+            let line = r.at.strip_prefix("line ")?.parse().ok()?;
+            Some((r.id.as_deref()?, line))
+        })
+        .collect();
+    let session = super::recheck(
+        &draft.session,
+        &super::Sources {
+            log: &spec.poses,
+            lines: &lines,
+            profiles: &report,
+            references: spec.references.as_deref(),
+        },
+    )?;
     Ok(Imported {
         session,
         checks: Vec::new(),

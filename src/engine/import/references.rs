@@ -15,6 +15,14 @@ use crate::engine::session::ReferenceDistance;
 /// Unreadable file, missing column, a distance that is not a positive
 /// finite number, an empty station id or no rows at all.
 pub fn read_references(path: &Path) -> Result<Vec<ReferenceDistance>, ImportError> {
+    Ok(reference_rows(path)?.into_iter().map(|(_, r)| r).collect())
+}
+
+/// [`read_references`] with the 1-based line of each row in the file.
+///
+/// # Errors
+/// As [`read_references`].
+pub fn reference_rows(path: &Path) -> Result<Vec<(usize, ReferenceDistance)>, ImportError> {
     let csv = CsvFile::read(path)?;
     let from = csv.column("from")?;
     let to = csv.column("to")?;
@@ -36,11 +44,14 @@ pub fn read_references(path: &Path) -> Result<Vec<ReferenceDistance>, ImportErro
         if row[from] == row[to] {
             return Err(fail(format!("from and to are both `{}`", row[from])));
         }
-        out.push(ReferenceDistance {
-            from: row[from].clone(),
-            to: row[to].clone(),
-            distance: d,
-        });
+        out.push((
+            *line,
+            ReferenceDistance {
+                from: row[from].clone(),
+                to: row[to].clone(),
+                distance: d,
+            },
+        ));
     }
     if out.is_empty() {
         return Err(ImportError::File {

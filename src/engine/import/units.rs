@@ -93,3 +93,129 @@ impl LengthUnit {
         }
     }
 }
+
+/// Largest joint reading taken as plausible, deg: two turns. A joint log
+/// in degrees read as radians multiplies every reading by 57.3, so any
+/// joint beyond 12.6° shows up far beyond this.
+pub const MAX_PLAUSIBLE_JOINT_DEG: f64 = 720.0;
+
+/// Catches joint readings in the wrong unit: read as radians, a log in
+/// degrees gives readings of thousands of degrees; the message says which
+/// flag to change. `rows` are `(line, pose id, raw readings)` in file
+/// units.
+///
+/// # Errors
+/// The first implausible reading, its pose and what reading it as the
+/// other unit gives.
+pub fn check_joint_unit<'a>(
+    unit: AngleUnit,
+    rows: impl IntoIterator<Item = (usize, &'a str, &'a [f64])>,
+) -> Result<(), (usize, String)> {
+    let rows: Vec<(usize, &str, &[f64])> = rows.into_iter().collect();
+    let worst = rows
+        .iter()
+        .flat_map(|&(line, id, raw)| raw.iter().enumerate().map(move |(j, &v)| (line, id, j, v)))
+        .max_by(|a, b| a.3.abs().total_cmp(&b.3.abs()));
+    let Some((line, id, j, v)) = worst else {
+        return Ok(());
+    };
+    let deg = unit.to_deg(v);
+    if deg.abs() <= MAX_PLAUSIBLE_JOINT_DEG {
+        return Ok(());
+    }
+    let hint = match unit {
+        AngleUnit::Rad if v.abs() <= MAX_PLAUSIBLE_JOINT_DEG => format!(
+            "; the log looks like degrees: read with --joint-unit deg, joint {} would be {}°",
+            j + 1,
+            crate::engine::numeric::approx(v)
+        ),
+        _ => String::new(),
+    };
+    Err((
+        line,
+        format!(
+            "pose {id}: joint {} reads {} {} = {}°, beyond any robot joint's range (±{MAX_PLAUSIBLE_JOINT_DEG}°){hint}",
+            j + 1,
+            crate::engine::numeric::show(v),
+            unit.as_str(),
+            crate::engine::numeric::approx(deg)
+        ),
+    ))
+}
+
+/// A warning when every joint reading of a log read in degrees lies
+/// within ±2π: a calibration moves its joints by tens of degrees, so the
+/// log is probably in radians.
+#[must_use]
+pub fn joint_unit_warning(
+    unit: AngleUnit,
+    readings: impl IntoIterator<Item = f64>,
+) -> Option<String> {
+    if unit != AngleUnit::Deg {
+        return None;
+    }
+    let (mut count, mut largest) = (0usize, 0.0f64);
+    for v in readings {
+        count += 1;
+        largest = largest.max(v.abs());
+    }
+    (count >= 6 && largest <= std::f64::consts::TAU).then(|| {
+        format!(
+            "warning: every joint reading lies within ±{}°; if the log is in radians, import again with --joint-unit rad",
+            crate::engine::numeric::approx(largest)
+        )
+    })
+}
+
+/// Smallest plausible median profile extent, in sphere diameters.
+const MIN_PROFILE_EXTENT: f64 = 1.0 / 20.0;
+/// Largest plausible median profile extent, in sphere diameters (a
+/// sensor's whole field, background included, around a small sphere).
+const MAX_PROFILE_EXTENT: f64 = 200.0;
+
+/// Catches profile coordinates in the wrong unit: the profiles' typical
+/// size (the median over poses of each profile's bounding-box diagonal,
+/// mm) against the sphere's diameter. A stripe across a sphere spans
+/// about a diameter, more with background; micrometres read as
+/// millimetres make it a thousand times more, millimetres read as
+/// micrometres a thousand times less. The message names the unit flag
+/// that makes the size plausible, if one does.
+///
+/// # Errors
+/// The median size, the sphere and the suggestion.
+pub fn check_profile_unit(
+    unit: LengthUnit,
+    diameter_mm: f64,
+    extents_mm: &[f64],
+) -> Result<(), String> {
+    let Some(median) = crate::engine::numeric::median(extents_mm) else {
+        return Ok(());
+    };
+    let plausible =
+        |e: f64| (MIN_PROFILE_EXTENT * diameter_mm..=MAX_PROFILE_EXTENT * diameter_mm).contains(&e);
+    if plausible(median) {
+        return Ok(());
+    }
+    let show = crate::engine::numeric::approx;
+    let suggestion = [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M]
+        .into_iter()
+        .filter(|&u| u != unit)
+        .map(|u| (u, median / unit.to_mm(1.0) * u.to_mm(1.0)))
+        .find(|&(_, e)| plausible(e));
+    let hint = match suggestion {
+        Some((u, e)) => format!(
+            "; read as {} they would span {} mm: import with --profile-unit {}",
+            u.symbol(),
+            show(e),
+            u.as_str()
+        ),
+        None => "; check --profile-unit and --sphere-diameter".to_string(),
+    };
+    Err(format!(
+        "the profiles span {} mm (median over {} poses) against a sphere of {} mm diameter, read as {}: not plausible{hint}",
+        show(median),
+        extents_mm.len(),
+        show(diameter_mm),
+        unit.symbol()
+    ))
+}

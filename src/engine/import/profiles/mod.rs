@@ -160,6 +160,26 @@ impl RawProfile {
     }
 }
 
+impl PlaneProfile {
+    /// The diagonal of the points' bounding box, mm (0 without points).
+    #[must_use]
+    pub fn extent(&self) -> f64 {
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for p in &self.points {
+            for k in 0..2 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        if self.points.is_empty() {
+            0.0
+        } else {
+            (hi[0] - lo[0]).hypot(hi[1] - lo[1])
+        }
+    }
+}
+
 /// Collects points, dropping non-finite ones and the no-return value.
 struct Collector<'a> {
     format: &'a ProfileFormat,
@@ -304,21 +324,34 @@ pub fn read_profile_table(
     pose_column: &str,
     format: &ProfileFormat,
 ) -> Result<(Vec<String>, HashMap<String, RawProfile>), ImportError> {
-    let csv = CsvFile::read(path)?;
-    let pose = csv.column(pose_column)?;
-    let columns = text::xyz_columns(&csv)?;
+    let text = fs::read_to_string(path).map_err(|source| ImportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
     let mut order: Vec<String> = Vec::new();
     let mut collectors: HashMap<String, Collector> = HashMap::new();
-    for (line, row) in &csv.rows {
-        let id = row[pose].clone();
-        let p = text::xyz_of(&csv, *line, row, &columns)?;
-        collectors
-            .entry(id.clone())
-            .or_insert_with(|| {
-                order.push(id.clone());
-                Collector::new(format)
-            })
-            .push(p);
+    let mut columns: Option<(usize, [Option<usize>; 3])> = None;
+    let csv = CsvFile::stream(&text, path, |csv, line, row| {
+        let (pose, columns) = match columns {
+            Some(c) => c,
+            None => *columns.insert((csv.column(pose_column)?, text::xyz_columns(csv)?)),
+        };
+        let id = row.get(pose).unwrap_or("");
+        let p = text::xyz_of(csv, line, row, &columns)?;
+        match collectors.get_mut(id) {
+            Some(c) => c.push(p),
+            None => {
+                order.push(id.to_string());
+                let mut c = Collector::new(format);
+                c.push(p);
+                collectors.insert(id.to_string(), c);
+            }
+        }
+        Ok(())
+    })?;
+    if columns.is_none() {
+        csv.column(pose_column)?;
+        text::xyz_columns(&csv)?;
     }
     let profiles = collectors
         .into_iter()

@@ -21,11 +21,22 @@ pub(super) fn read_text_profile(
     let has_header = split_fields(first).iter().any(|f| number(f).is_none());
     let mut out = Collector::new(format);
     if has_header {
-        let csv = CsvFile::parse(text, path)?;
-        let columns = xyz_columns(&csv)?;
-        for (line, row) in &csv.rows {
-            out.push(xyz_of(&csv, *line, row, &columns)?);
-        }
+        // Row by row: a profile of millions of points is never held as
+        // text fields.
+        let mut columns = None;
+        CsvFile::stream(text, path, |csv, line, row| {
+            let columns = match columns {
+                Some(c) => c,
+                None => *columns.insert(xyz_columns(csv)?),
+            };
+            out.push(xyz_of(csv, line, row, &columns)?);
+            Ok(())
+        })
+        .and_then(|csv| match columns {
+            // A header and no rows: the columns are still checked.
+            None => xyz_columns(&csv).map(|_| ()),
+            Some(_) => Ok(()),
+        })?;
     } else {
         let mut width = None;
         for (i, line) in text.trim_start_matches('\u{feff}').lines().enumerate() {
@@ -91,16 +102,17 @@ pub(super) fn xyz_columns(csv: &CsvFile) -> Result<[Option<usize>; 3], ImportErr
 pub(super) fn xyz_of(
     csv: &CsvFile,
     line: usize,
-    row: &[String],
+    row: &csv::StringRecord,
     columns: &[Option<usize>; 3],
 ) -> Result<[f64; 3], ImportError> {
     let mut p = [0.0; 3];
     for (v, c) in p.iter_mut().zip(columns) {
         if let Some(c) = *c {
-            *v = number(&row[c]).ok_or_else(|| ImportError::Csv {
+            let cell = row.get(c).unwrap_or("");
+            *v = number(cell).ok_or_else(|| ImportError::Csv {
                 path: csv.path.clone(),
                 line,
-                message: format!("column `{}`: `{}` is not a number", csv.header[c], row[c]),
+                message: format!("column `{}`: `{cell}` is not a number", csv.header[c]),
             })?;
         }
     }
