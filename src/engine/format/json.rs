@@ -599,11 +599,13 @@ pub(super) fn read_text(path: &Path) -> Result<String, FileError> {
 
 /// Pretty JSON of `value` in the file layout, with a trailing newline.
 pub(super) fn try_render<T: Serialize>(value: &T) -> Result<String, serde_json::Error> {
-    let pretty = serde_json::to_string_pretty(value)?;
-    let arrays = collapse(&pretty, '[', ']', usize::MAX);
-    let mut text = collapse(&arrays, '{', '}', MAX_COLLAPSED_LINE);
-    text.push('\n');
-    Ok(text)
+    let mut out = Vec::with_capacity(4096);
+    let mut ser =
+        serde_json::Serializer::with_formatter(&mut out, super::layout::Layout::default());
+    value.serialize(&mut ser)?;
+    out.push(b'\n');
+    String::from_utf8(out)
+        .map_err(|e| serde_json::Error::io(std::io::Error::new(std::io::ErrorKind::InvalidData, e)))
 }
 
 /// [`try_render`] for saving: a failure is reported, never written.
@@ -622,96 +624,130 @@ pub(super) fn render_lossy<T: Serialize>(value: &T) -> String {
     try_render(value).unwrap_or_else(|e| format!("serialisation failed: {e}\n"))
 }
 
-/// Longest object line [`collapse`] makes, indent included.
-const MAX_COLLAPSED_LINE: usize = 120;
-
-/// Puts each `open … close` container whose entries are all scalars on one
-/// line, if the line stays within `max` characters: arrays of numbers
-/// (`[y, z]`, a matrix row, joint readings) and flat objects
-/// (`{"alpha": 0.0, "a": 0.0, …}`, `{"epsilon": 0.466}`), as FORMAT.md shows
-/// them. It works on serde_json's pretty output, where a container that
-/// opens a line ends it with `open`, each entry has its own line two spaces
-/// deeper, and `close` sits at the opening line's indent; only whitespace
-/// changes.
-pub(super) fn collapse(text: &str, open: char, close: char, max: usize) -> String {
-    let lines: Vec<&str> = text.lines().collect();
-    let mut out: Vec<String> = Vec::with_capacity(lines.len());
-    let mut i = 0;
-    while i < lines.len() {
-        let line = lines[i];
-        match flat_container(&lines[i..], open, close, max) {
-            Some((collapsed, used)) => {
-                out.push(collapsed);
-                i += used;
-            }
-            None => {
-                out.push(line.to_owned());
-                i += 1;
-            }
-        }
-    }
-    out.join("\n")
-}
-
-/// Indent of a line of pretty JSON.
-pub(super) fn indent(line: &str) -> usize {
-    line.len() - line.trim_start_matches(' ').len()
-}
-
-/// The one-line form of the container opened at the end of `lines[0]` and
-/// the number of lines it replaces, if its entries are all scalars and it
-/// fits in `max` characters.
-pub(super) fn flat_container(
-    lines: &[&str],
-    open: char,
-    close: char,
-    max: usize,
-) -> Option<(String, usize)> {
-    let first = lines.first()?;
-    if !first.ends_with(open) {
-        return None;
-    }
-    let depth = indent(first);
-    let mut entries = Vec::new();
-    for (n, line) in lines.iter().enumerate().skip(1) {
-        let trimmed = line.trim_start_matches(' ');
-        let closing = trimmed
-            .strip_prefix(close)
-            .is_some_and(|rest| rest.is_empty() || rest == ",");
-        if indent(line) == depth && closing {
-            let collapsed = format!("{first}{}{trimmed}", entries.join(", "));
-            return (!entries.is_empty() && collapsed.len() <= max).then_some((collapsed, n + 1));
-        }
-        let entry = trimmed.strip_suffix(',').unwrap_or(trimmed);
-        let value = if open == '{' {
-            object_value(entry)?
-        } else {
-            entry
-        };
-        if indent(line) != depth + 2 || value.starts_with(['[', '{']) || value.is_empty() {
-            return None;
-        }
-        entries.push(entry);
-    }
-    None
-}
-
-/// The value of an object entry `"key": value`, minding escapes in the key.
-pub(super) fn object_value(entry: &str) -> Option<&str> {
-    let mut escaped = false;
-    for (i, c) in entry.char_indices().skip(1) {
-        match c {
-            '\\' if !escaped => escaped = true,
-            '"' if !escaped => return entry.get(i + 1..)?.strip_prefix(": "),
-            _ => escaped = false,
-        }
-    }
-    None
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    // The layout as it was made before the one-pass formatter: serde_json's
+    // pretty output, then arrays of scalars collapsed, then objects of
+    // scalars within 120 bytes. The formatter must give the same bytes.
+    /// Longest object line [`collapse`] makes, indent included.
+    const MAX_COLLAPSED_LINE: usize = 120;
+
+    /// Puts each `open … close` container whose entries are all scalars on one
+    /// line, if the line stays within `max` characters: arrays of numbers
+    /// (`[y, z]`, a matrix row, joint readings) and flat objects
+    /// (`{"alpha": 0.0, "a": 0.0, …}`, `{"epsilon": 0.466}`), as FORMAT.md shows
+    /// them. It works on serde_json's pretty output, where a container that
+    /// opens a line ends it with `open`, each entry has its own line two spaces
+    /// deeper, and `close` sits at the opening line's indent; only whitespace
+    /// changes.
+    fn collapse(text: &str, open: char, close: char, max: usize) -> String {
+        let lines: Vec<&str> = text.lines().collect();
+        let mut out: Vec<String> = Vec::with_capacity(lines.len());
+        let mut i = 0;
+        while i < lines.len() {
+            let line = lines[i];
+            match flat_container(&lines[i..], open, close, max) {
+                Some((collapsed, used)) => {
+                    out.push(collapsed);
+                    i += used;
+                }
+                None => {
+                    out.push(line.to_owned());
+                    i += 1;
+                }
+            }
+        }
+        out.join("\n")
+    }
+
+    /// Indent of a line of pretty JSON.
+    fn indent(line: &str) -> usize {
+        line.len() - line.trim_start_matches(' ').len()
+    }
+
+    /// The one-line form of the container opened at the end of `lines[0]` and
+    /// the number of lines it replaces, if its entries are all scalars and it
+    /// fits in `max` characters.
+    fn flat_container(
+        lines: &[&str],
+        open: char,
+        close: char,
+        max: usize,
+    ) -> Option<(String, usize)> {
+        let first = lines.first()?;
+        if !first.ends_with(open) {
+            return None;
+        }
+        let depth = indent(first);
+        let mut entries = Vec::new();
+        for (n, line) in lines.iter().enumerate().skip(1) {
+            let trimmed = line.trim_start_matches(' ');
+            let closing = trimmed
+                .strip_prefix(close)
+                .is_some_and(|rest| rest.is_empty() || rest == ",");
+            if indent(line) == depth && closing {
+                let collapsed = format!("{first}{}{trimmed}", entries.join(", "));
+                return (!entries.is_empty() && collapsed.len() <= max)
+                    .then_some((collapsed, n + 1));
+            }
+            let entry = trimmed.strip_suffix(',').unwrap_or(trimmed);
+            let value = if open == '{' {
+                object_value(entry)?
+            } else {
+                entry
+            };
+            if indent(line) != depth + 2 || value.starts_with(['[', '{']) || value.is_empty() {
+                return None;
+            }
+            entries.push(entry);
+        }
+        None
+    }
+
+    /// The value of an object entry `"key": value`, minding escapes in the key.
+    fn object_value(entry: &str) -> Option<&str> {
+        let mut escaped = false;
+        for (i, c) in entry.char_indices().skip(1) {
+            match c {
+                '\\' if !escaped => escaped = true,
+                '"' if !escaped => return entry.get(i + 1..)?.strip_prefix(": "),
+                _ => escaped = false,
+            }
+        }
+        None
+    }
+
+    fn reference_layout<T: Serialize>(value: &T) -> String {
+        let pretty = serde_json::to_string_pretty(value).unwrap();
+        let arrays = collapse(&pretty, '[', ']', usize::MAX);
+        let mut text = collapse(&arrays, '{', '}', MAX_COLLAPSED_LINE);
+        text.push('\n');
+        text
+    }
+
+    #[test]
+    fn the_one_pass_layout_is_the_reference_layout() {
+        let demo: serde_json::Value = serde_json::from_str(crate::DEMO_SESSION_JSON).unwrap();
+        assert_eq!(try_render(&demo).unwrap(), reference_layout(&demo));
+        // Objects around the 120-byte limit, with and without a comma
+        // after them, nested, empty containers, strings with brackets.
+        for width in 90..130 {
+            let long = "x".repeat(width - 40);
+            let v = serde_json::json!({
+                "a": [{"k": long, "n": 1.5}, {"k": long, "n": 2}],
+                "b": {"inner": {"k": long, "m": [1, 2, 3]}, "last": {"k": long}},
+                "c": [[], {}, [1.0, -2e-7], {"s": "[{\"]"}],
+                "d": {"k": long, "z": null}
+            });
+            assert_eq!(
+                try_render(&v).unwrap(),
+                reference_layout(&v),
+                "width {width}"
+            );
+        }
+    }
     use crate::engine::geometry::isometry_from_twist;
 
     #[test]

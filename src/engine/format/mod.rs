@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 pub mod atomic;
 mod json;
+mod layout;
 pub mod result;
 pub mod session;
 
