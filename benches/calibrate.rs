@@ -46,6 +46,21 @@ fn bench(c: &mut Criterion) {
     group.bench_function("result file text (write)", |b| {
         b.iter(|| spherecal::engine::format::result_to_json(&file));
     });
+    group.bench_function(
+        "result file text, checked (finite numbers, loads back)",
+        |b| {
+            b.iter(|| {
+                spherecal::engine::format::result_text_checked(&file, Path::new("r.json"))
+                    .expect("checked")
+            });
+        },
+    );
+    let text = spherecal::engine::format::result_to_json(&file);
+    group.bench_function("result file load", |b| {
+        b.iter(|| {
+            spherecal::engine::format::parse_result(&text, Path::new("r.json")).expect("loads")
+        });
+    });
     group.finish();
 }
 

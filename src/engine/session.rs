@@ -2,7 +2,7 @@
 //! `session.rs` turns a FORMAT.md file into a [`Session`] (enforcing every
 //! rule) and back; nothing else reads or writes session files.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 
 use nalgebra::{Isometry3, Vector3};
 
@@ -264,14 +264,18 @@ impl Session {
     #[must_use]
     pub fn stations(&self, usage: Use) -> Vec<(String, Vec<usize>)> {
         let mut out: Vec<(String, Vec<usize>)> = Vec::new();
+        // Station → its place in `out`: linear in the measurements.
+        let mut index: HashMap<&str, usize> = HashMap::new();
         for (i, m) in self.measurements.iter().enumerate() {
             if m.usage != usage {
                 continue;
             }
-            if let Some(entry) = out.iter_mut().find(|(s, _)| *s == m.station) {
-                entry.1.push(i);
-            } else {
-                out.push((m.station.clone(), vec![i]));
+            match index.get(m.station.as_str()) {
+                Some(&k) => out[k].1.push(i),
+                None => {
+                    index.insert(&m.station, out.len());
+                    out.push((m.station.clone(), vec![i]));
+                }
             }
         }
         out

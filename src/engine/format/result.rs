@@ -394,31 +394,54 @@ pub fn save_result(result: &ResultFile, path: &Path) -> Result<(), FileError> {
     write_atomic(path, text.as_bytes())
 }
 
-/// The text of the result file, refused unless it loads back: every
-/// number must be finite (JSON has no NaN or infinity; serde_json would
-/// write `null`) and the whole must pass [`parse_result`], so a written
-/// result always opens in `report`, `export-model` and `history`.
+/// The text of the result file, refused unless every number in it is
+/// finite (JSON has no NaN or infinity; serde_json would write `null`,
+/// and the file would not load). The text is scanned for a bare `null`
+/// (microseconds); only a result that has one is walked key by key to
+/// tell a legal `null` from a number that is not finite. That every
+/// result written this way loads in `report`, `export-model` and
+/// `history` is a property test (`tests/fuzz.rs`).
 ///
 /// # Errors
-/// [`FileError::Invalid`] naming the first non-finite number (by its key
-/// path) or what the reader rejects; nothing is written.
+/// [`FileError::Invalid`] naming the first non-finite number by its key
+/// path; nothing is written.
 pub fn result_text_checked(result: &ResultFile, path: &Path) -> Result<String, FileError> {
     let out = ResultOut::new(result);
-    let refuse = |message: String| FileError::Invalid {
-        path: path.to_path_buf(),
-        measurement: None,
-        message: format!("the result is not written: {message}"),
-    };
-    if let Ok(tree) = serde_json::to_value(&out)
+    let text = render(&out, path)?;
+    if has_bare_null(&text)
+        && let Ok(tree) = serde_json::to_value(&out)
         && let Some(key) = first_non_finite(&tree, "")
     {
-        return Err(refuse(format!(
-            "`{key}` is not a finite number (the calibration diverged or an input is out of range)"
-        )));
+        return Err(FileError::Invalid {
+            path: path.to_path_buf(),
+            measurement: None,
+            message: format!(
+                "the result is not written: `{key}` is not a finite number (the calibration diverged or an input is out of range)"
+            ),
+        });
     }
-    let text = render(&out, path)?;
-    parse_result(&text, path).map_err(|e| refuse(format!("it would not load back: {e}")))?;
     Ok(text)
+}
+
+/// Whether JSON `text` has a `null` outside its strings.
+fn has_bare_null(text: &str) -> bool {
+    let b = text.as_bytes();
+    let (mut in_string, mut escaped) = (false, false);
+    for (i, &c) in b.iter().enumerate() {
+        if in_string {
+            match c {
+                _ if escaped => escaped = false,
+                b'\\' => escaped = true,
+                b'"' => in_string = false,
+                _ => {}
+            }
+        } else if c == b'"' {
+            in_string = true;
+        } else if c == b'n' && b[i..].starts_with(b"null") {
+            return true;
+        }
+    }
+    false
 }
 
 /// Keys whose `null` is a legal value: a pose-only result's robot, and
@@ -759,5 +782,21 @@ impl<'a> ResultOut<'a> {
                 .collect(),
             validation: r.validation.as_ref(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_bare_null_is_told_from_one_in_a_string() {
+        assert!(has_bare_null(r#"{"a": null}"#));
+        assert!(has_bare_null("[1,\n  null]"));
+        assert!(!has_bare_null(
+            r#"{"session": "null \"null\" null", "b": 1}"#
+        ));
+        assert!(!has_bare_null(r#"{"a\\": "nullable"}"#));
+        assert!(has_bare_null(r#"{"a\\": 1, "b": null}"#));
     }
 }

@@ -124,12 +124,15 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
 /// before and after ([`scatter_rms`]).
 fn identify_scatter(session: &Session, cal: &Calibration) -> (f64, f64) {
     let stations = session.stations(Use::Identify);
+    // Measurement index → its centre: linear in the measurements.
+    let by_index: std::collections::HashMap<usize, &_> =
+        cal.centres.iter().map(|c| (c.index, c)).collect();
     let group = |after: bool| -> Vec<Vec<Vector3<f64>>> {
         stations
             .iter()
             .map(|(_, idx)| {
                 idx.iter()
-                    .filter_map(|&i| cal.centres.iter().find(|c| c.index == i))
+                    .filter_map(|&i| by_index.get(&i).copied())
                     .map(|c| if after { c.after } else { c.before })
                     .collect()
             })
