@@ -302,4 +302,181 @@ fn a_closed_stdout_neither_panics_nor_costs_the_result() {
     assert_eq!(o.status.code(), Some(0), "{err}");
     assert!(!err.contains("panicked"), "{err}");
     assert!(out.exists(), "the result is written");
+    // `history | head` too, on the example library.
+    let mut child = spherecal()
+        .arg("history")
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("sessions/history"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_ne!(o.status.code(), Some(101), "{err}");
+}
+
+/// Runs the binary with a time limit: a hang is a test failure, not a
+/// stuck CI. Returns (status, stdout, stderr).
+fn run_within(args: &[&str], limit: std::time::Duration) -> (i32, String, String) {
+    let mut child = spherecal()
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    loop {
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        if start.elapsed() > limit {
+            child.kill().unwrap();
+            panic!("{args:?} still running after {limit:?}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let o = child.wait_with_output().unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// The session `base` with one JSON edit, written to `dir/name`.
+fn edited(dir: &Path, base: &str, name: &str, edit: impl Fn(&mut serde_json::Value)) -> PathBuf {
+    let mut v: serde_json::Value = serde_json::from_str(base).unwrap();
+    edit(&mut v);
+    let p = dir.join(name);
+    std::fs::write(&p, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    p
+}
+
+/// Issue 12: values that passed validation hung the initial hand-eye at
+/// 100 % CPU (sphere diameter 1e160, a centre of 1e200), wrote `"std":
+/// null` (a reference distance of 1e308), were called "an invalid solver
+/// option" (a hand-eye translation of 1e308) or filled messages with 300
+/// digits. Each is now a clear error within seconds, naming the key.
+#[test]
+fn hostile_numbers_are_refused_quickly_and_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let centres = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("sessions/centres-irb2400.json"),
+    )
+    .unwrap();
+    let demo = spherecal::DEMO_SESSION_JSON;
+    let huge_digits = format!("1{}", "0".repeat(300));
+    let cases: Vec<(PathBuf, &str)> = vec![
+        (
+            edited(dir.path(), demo, "diameter.json", |v| {
+                v["sphere"]["diameter"] = serde_json::json!(1e160);
+            }),
+            "sphere.diameter = 1e160 mm is not plausible",
+        ),
+        (
+            edited(dir.path(), &centres, "centre.json", |v| {
+                v["measurements"][0]["centre"] = serde_json::json!([1e200, 0.0, 0.0]);
+            }),
+            "is not plausible",
+        ),
+        (
+            edited(dir.path(), demo, "reference.json", |v| {
+                v["reference_distances"][0]["distance"] = serde_json::json!(1e308);
+            }),
+            "is not plausible",
+        ),
+        (
+            edited(dir.path(), demo, "hand_eye.json", |v| {
+                v["hand_eye"] = serde_json::json!([
+                    [1.0, 0.0, 0.0, 1e308],
+                    [0.0, 1.0, 0.0, 0.0],
+                    [0.0, 0.0, 1.0, 0.0],
+                    [0.0, 0.0, 0.0, 1.0]
+                ]);
+            }),
+            "hand_eye",
+        ),
+    ];
+    for (session, expect) in cases {
+        let out = dir.path().join("r.json");
+        let (code, _, err) = run_within(
+            &[
+                "calibrate",
+                session.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            std::time::Duration::from_secs(20),
+        );
+        assert_eq!(code, 2, "{}: {err}", session.display());
+        assert!(err.contains(expect), "{}: {err}", session.display());
+        assert!(!err.contains("solver option"), "{err}");
+        assert!(!err.contains(&huge_digits[..30]), "{err}");
+        assert!(!out.exists());
+    }
+    // A sphere of 1e308 mm given to the import is refused there.
+    let imported = dir.path().join("imported.json");
+    let (code, _, err) = run_within(
+        &[
+            "simulate",
+            "--out",
+            dir.path().join("s.json").to_str().unwrap(),
+            "--csv-out",
+            dir.path().join("csv").to_str().unwrap(),
+        ],
+        std::time::Duration::from_secs(60),
+    );
+    assert_eq!(code, 0, "{err}");
+    let csv = dir.path().join("csv");
+    let (code, _, err) = run_within(
+        &[
+            "import",
+            "--joints",
+            csv.join("joints.csv").to_str().unwrap(),
+            "--profiles",
+            csv.join("profiles").to_str().unwrap(),
+            "--robot",
+            "irb2400",
+            "--sphere-diameter=1e308",
+            "--out",
+            imported.to_str().unwrap(),
+        ],
+        std::time::Duration::from_secs(60),
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("--sphere-diameter 1e308 mm is not plausible"),
+        "{err}"
+    );
+    assert!(!imported.exists());
+}
+
+/// Issue 12: `--threshold 0 --max-iterations 100000` with the paper's
+/// method ran all 100,000 updates (21 s) though ε had levelled off.
+#[test]
+fn the_paper_loop_stops_when_epsilon_levels_off() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = demo_path(dir.path());
+    let out = dir.path().join("r.json");
+    let (code, stdout, err) = run_within(
+        &[
+            "calibrate",
+            session.to_str().unwrap(),
+            "--method",
+            "paper",
+            "--threshold",
+            "0",
+            "--max-iterations",
+            "100000",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        std::time::Duration::from_secs(20),
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("levelled off"), "{stdout}");
+    let result = spherecal::engine::format::load_result(&out).unwrap();
+    assert!(result.iterations.len() < 100, "{}", result.iterations.len());
 }

@@ -321,6 +321,22 @@ fn plane_of(
     Ok((plane, count))
 }
 
+/// Refuses a sphere diameter that is not positive or not plausible
+/// (the session loader's limit), before any file is read.
+///
+/// # Errors
+/// [`ImportError::Spec`] naming the value and the limit.
+pub(crate) fn check_sphere_diameter(d: f64) -> Result<(), ImportError> {
+    let limit = crate::engine::session::limits::SPHERE_DIAMETER_MM;
+    if d > 0.0 && d <= limit {
+        return Ok(());
+    }
+    Err(ImportError::Spec(format!(
+        "--sphere-diameter {} mm is not plausible: a reference sphere is more than 0 and at most {limit} mm",
+        crate::engine::numeric::show(d)
+    )))
+}
+
 /// Refuses profiles whose size does not fit the sphere (a unit read
 /// wrong), naming the profile unit that would fit
 /// ([`units::check_profile_unit`]).
@@ -351,6 +367,7 @@ pub(crate) fn check_profile_size(
 /// # Errors
 /// [`ImportError`] naming the file, the line, the column or the pose id.
 pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
+    check_sphere_diameter(spec.sphere_diameter)?;
     let robot = load_robot(&spec.robot)?;
     let log = CsvFile::read(&spec.joint_log)?;
     let cols = log::log_columns(spec, &log, robot.dof())?;

@@ -570,6 +570,7 @@ fn decide_side(
 /// profiles, pose groups that cannot give the initial hand-eye, a side the
 /// data cannot tell.
 pub fn import_poses(spec: &PoseImportSpec) -> Result<Imported, ImportError> {
+    super::check_sphere_diameter(spec.sphere_diameter)?;
     let records = read_pose_log(&spec.poses, spec.convention, spec.pose_columns.as_deref())?;
     let robot = spec.robot.as_ref().map(load_robot).transpose()?;
     let (ids, planes, report) = pair_profiles(spec, &records)?;
