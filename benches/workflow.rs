@@ -54,6 +54,7 @@ fn bench(c: &mut Criterion) {
                 result: &result,
                 prepared: Some(&prepared),
                 meta: &meta,
+                tolerance: None,
             })
         });
     });

@@ -480,3 +480,38 @@ fn the_paper_loop_stops_when_epsilon_levels_off() {
     let result = spherecal::engine::format::load_result(&out).unwrap();
     assert!(result.iterations.len() < 100, "{}", result.iterations.len());
 }
+
+/// Issue 13: `report --tolerance STD,MAX` puts PASS or FAIL in the report
+/// and prints it; a malformed tolerance is a usage error.
+#[test]
+fn the_report_carries_the_verdict_against_a_tolerance() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = demo_path(dir.path());
+    let html = dir.path().join("r.html");
+    for (tolerance, word) in [("5,10", "PASS"), ("0.001,0.001", "FAIL")] {
+        let (code, out, err) = run(&[
+            "report",
+            session.to_str().unwrap(),
+            "-o",
+            html.to_str().unwrap(),
+            "--method",
+            "paper",
+            "--tolerance",
+            tolerance,
+        ]);
+        assert_eq!(code, 0, "{err}");
+        assert!(out.contains(&format!("{word}:")), "{out}");
+        let page = std::fs::read_to_string(&html).unwrap();
+        assert!(page.contains(&format!("id=\"verdict\">{word}")), "{word}");
+    }
+    let (code, _, err) = run(&[
+        "report",
+        session.to_str().unwrap(),
+        "-o",
+        html.to_str().unwrap(),
+        "--tolerance",
+        "0.2",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("STD,MAX"), "{err}");
+}

@@ -195,6 +195,7 @@ fn read_everywhere(session: &Session, result: &ResultFile, dir: &Path, must_load
         result,
         prepared: None,
         meta: &meta,
+        tolerance: None,
     });
     assert!(page.contains("</html>"));
     for f in [ModelFormat::Json, ModelFormat::Csv, ModelFormat::Urdf] {

@@ -54,6 +54,7 @@ fn render(text: &str, session: &Session, result: &ResultFile) -> String {
         result,
         prepared: None,
         meta: &meta,
+        tolerance: None,
     })
 }
 

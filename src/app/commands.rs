@@ -73,6 +73,8 @@ pub enum ViewCommand {
     IncludeAll,
     /// Close the error notice.
     DismissNotice,
+    /// Set the acceptance tolerance (remembered for the session's robot).
+    SetTolerance(crate::engine::result_view::Tolerance),
 }
 
 /// The calibration run.

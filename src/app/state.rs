@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 use crate::engine::history::{Drift, Library};
 use crate::engine::import::PoseCheck;
 use crate::engine::plan::{Plan, PlanError, Prediction};
+use crate::engine::result_view::Tolerance;
 use crate::engine::session::Session;
 use crate::engine::solve::{Analysis, SolveError};
 use crate::engine::stripe::{StripeError, StripeResult};
@@ -383,7 +384,7 @@ pub struct HistoryView {
 }
 
 /// What lasts across runs of the program (eframe storage).
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Prefs {
     /// Recently opened session and result files, newest first.
@@ -394,6 +395,8 @@ pub struct Prefs {
     pub export_folder: Option<PathBuf>,
     /// The last library folder of the History view.
     pub history_folder: Option<PathBuf>,
+    /// The acceptance tolerance last set for each robot (by name).
+    pub tolerances: std::collections::BTreeMap<String, Tolerance>,
 }
 
 impl Prefs {
@@ -442,6 +445,11 @@ pub struct AppState {
     pub run: Option<RunState>,
     /// The result on show (from a run or a reviewed file).
     pub result: Option<ResultView>,
+    /// A run finished while another view was on show: the Results tab
+    /// is marked until it is opened.
+    pub result_unseen: bool,
+    /// Where the HTML report of the result on show was written.
+    pub reported: Option<PathBuf>,
     /// The status line.
     pub status: Option<Status>,
     /// An error shown until dismissed.

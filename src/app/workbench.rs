@@ -149,6 +149,7 @@ impl WorkbenchApp {
                 panels::side::side_ui(ui, state, forms, &mut commands);
             });
         egui::CentralPanel::default().show(ui, |ui| {
+            panels::steps::steps_ui(ui, state, forms, &mut commands);
             panels::tabs_ui(ui, state, forms, &mut commands);
             ui.separator();
             match forms.tab {

@@ -31,6 +31,9 @@ pub struct ReportArgs {
     /// Method of the calibration run when no `--result` is given: `ml` (default) or `paper`.
     #[arg(long, default_value = "ml", value_parser = parse_method)]
     pub method: Method,
+    /// Acceptance tolerance on the validation after calibration, `STD,MAX` in mm (e.g. `0.2,0.5`): the report then says PASS or FAIL.
+    #[arg(long, value_parser = result_view::Tolerance::parse)]
+    pub tolerance: Option<result_view::Tolerance>,
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
@@ -96,10 +99,18 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         result: &result,
         prepared: Some(&prepared),
         meta: &meta,
+        tolerance: args.tolerance,
     });
     let render_ms = rendering.elapsed().as_secs_f64() * 1e3;
     format::write_atomic(&args.out, html.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
     if !args.quiet {
+        if let Some(t) = &args.tolerance {
+            let view = result_view::ResultView::new(&result);
+            sayln!(
+                "{}",
+                result_view::Verdict::of(view.headline.as_ref(), t).describe(t)
+            );
+        }
         let how = match &args.result {
             Some(_) => "the given result".to_string(),
             None => format!("a run of method {}", args.method.as_str()),

@@ -13,7 +13,7 @@ use std::time::{Instant, SystemTime};
 use crate::engine::format::{result_text_checked, write_atomic};
 use crate::engine::report::html::{self, ReportInput, ReportMeta};
 use crate::engine::report::model::{self, ModelFormat};
-use crate::engine::result_view;
+use crate::engine::result_view::{self, Tolerance};
 
 use super::Core;
 use crate::app::error::JobError;
@@ -137,6 +137,7 @@ pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<()
 pub fn write_report(
     view: &ResultView,
     loaded: &LoadedSession,
+    tolerance: Tolerance,
     path: &Path,
 ) -> Result<(), JobError> {
     let session = &loaded.session;
@@ -149,6 +150,7 @@ pub fn write_report(
         result: &view.file,
         prepared: prepared.as_ref(),
         meta: &meta,
+        tolerance: Some(tolerance),
     });
     Ok(write_atomic(path, html.as_bytes())?)
 }
@@ -234,9 +236,10 @@ impl Core {
         } else {
             None
         };
+        let tolerance = self.forms.tolerance;
         let started = self.spawn(ctx, "export", move |rep| {
             let outcome = match &loaded {
-                Some(loaded) => write_report(&view, loaded, &path),
+                Some(loaded) => write_report(&view, loaded, tolerance, &path),
                 None => write_text(kind, &view, &path),
             };
             rep.send(JobMessage::Export(ExportMessage::Written {
@@ -278,6 +281,9 @@ impl Core {
                 outcome,
             } => {
                 self.state.busy.exporting = self.state.busy.exporting.saturating_sub(1);
+                if kind == ExportKind::ReportHtml && outcome.is_ok() {
+                    self.state.reported = Some(path.clone());
+                }
                 self.say_written(kind.label(), &path, outcome);
             }
         }

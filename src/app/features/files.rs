@@ -332,6 +332,7 @@ impl Core {
                 let notes = view.notes.join("; ");
                 self.forms.centres.magnify = view.centres.suggested_magnify;
                 self.state.result = Some(*view);
+                self.state.reported = None;
                 self.forms.tab = Tab::Results;
                 if notes.is_empty() {
                     self.state.say(
@@ -449,6 +450,13 @@ impl Core {
         };
         self.forms.save_path = dir.join(file_name).display().to_string();
         self.forms.solver = SolverForm::from_session(&loaded.session);
+        self.forms.tolerance = self
+            .state
+            .prefs
+            .tolerances
+            .get(&loaded.session.robot.name)
+            .copied()
+            .unwrap_or_default();
         self.forms.filter_station = None;
         self.forms.filter_use = None;
         if self.forms.tab == Tab::Results {
@@ -458,6 +466,7 @@ impl Core {
         self.state.confirm_overwrite = None;
         self.state.selected = (!loaded.session.measurements.is_empty()).then_some(0);
         self.state.result = None;
+        self.state.reported = None;
         self.state.notice = None;
         let (level, text) = opened_line(&loaded);
         self.state.say(level, text);

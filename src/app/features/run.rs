@@ -140,9 +140,16 @@ impl Core {
                         let seconds = run.started.elapsed().as_secs_f64();
                         self.forms.centres.magnify = view.centres.suggested_magnify;
                         self.state.result = Some(*view);
-                        self.forms.tab = Tab::Results;
-                        self.state
-                            .say(Level::Info, format!("calibrated in {seconds:.2} s: {stop}"));
+                        self.state.reported = None;
+                        // The operator stays where they are; the status
+                        // line and the Results tab say a result is ready.
+                        self.state.result_unseen = self.forms.tab != Tab::Results;
+                        self.state.say(
+                            Level::Info,
+                            format!(
+                                "results ready (Results view): calibrated in {seconds:.2} s: {stop}"
+                            ),
+                        );
                     }
                     Err(RunFailure::Cancelled(n)) => self.state.say(
                         Level::Warning,

@@ -11,7 +11,12 @@ impl Core {
     /// Handles a [`ViewCommand`].
     pub(super) fn view(&mut self, command: ViewCommand) {
         match command {
-            ViewCommand::ShowTab(tab) => self.forms.tab = tab,
+            ViewCommand::ShowTab(tab) => {
+                self.forms.tab = tab;
+                if tab == Tab::Results {
+                    self.state.result_unseen = false;
+                }
+            }
             ViewCommand::Select(i) => self.state.selected = Some(i),
             ViewCommand::Inspect(i) => {
                 self.state.selected = Some(i);
@@ -48,6 +53,17 @@ impl Core {
                 self.say_excluded();
             }
             ViewCommand::DismissNotice => self.state.notice = None,
+            ViewCommand::SetTolerance(t) => {
+                if t.is_valid() {
+                    self.forms.tolerance = t;
+                    if let Some(loaded) = &self.state.loaded {
+                        self.state
+                            .prefs
+                            .tolerances
+                            .insert(loaded.session.robot.name.clone(), t);
+                    }
+                }
+            }
         }
     }
 

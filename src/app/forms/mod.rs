@@ -92,14 +92,16 @@ pub enum Tab {
 }
 
 impl Tab {
-    /// All tabs, in display order.
+    /// All tabs, in the order of the job: plan the poses, bring the data
+    /// in, check the stripes and centres, calibrate and validate, follow
+    /// the cell over time.
     pub const ALL: [Self; 7] = [
+        Self::Plan,
+        Self::Import,
         Self::Session,
         Self::Stripe,
         Self::Centres,
         Self::Results,
-        Self::Plan,
-        Self::Import,
         Self::History,
     ];
 
@@ -221,6 +223,9 @@ pub struct Forms {
     pub history: HistoryForm,
     /// The Plan view's fields.
     pub plan: PlanForm,
+    /// The acceptance tolerance the headline's PASS/FAIL and the report
+    /// use (remembered per robot in the preferences).
+    pub tolerance: crate::engine::result_view::Tolerance,
 }
 
 impl Default for Forms {
@@ -238,6 +243,7 @@ impl Default for Forms {
             import: ImportForm::default(),
             history: HistoryForm::default(),
             plan: PlanForm::default(),
+            tolerance: crate::engine::result_view::Tolerance::default(),
         }
     }
 }

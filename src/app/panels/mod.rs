@@ -10,6 +10,7 @@ pub mod results;
 pub mod session;
 pub mod side;
 pub mod status;
+pub mod steps;
 pub mod stripe;
 
 use egui::{Color32, RichText};
@@ -24,6 +25,8 @@ pub const BEFORE: Color32 = Color32::from_rgb(230, 120, 40);
 pub const AFTER: Color32 = Color32::from_rgb(40, 150, 230);
 /// Colour of rejected stripe points and errors.
 pub const BAD: Color32 = Color32::from_rgb(225, 60, 60);
+/// A passed check.
+pub const GOOD: Color32 = Color32::from_rgb(60, 170, 90);
 /// Colour of warnings.
 pub const WARN: Color32 = Color32::from_rgb(230, 170, 40);
 /// Colour of things marked not identifiable.
@@ -69,9 +72,18 @@ pub fn labelled_field(
 pub fn tabs_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mut Vec<Command>) {
     ui.horizontal(|ui| {
         for tab in Tab::ALL {
-            let mut text = RichText::new(tab.label()).size(16.0);
+            let unseen = tab == Tab::Results && state.result_unseen;
+            let label = if unseen {
+                format!("{} ●", tab.label())
+            } else {
+                tab.label().to_string()
+            };
+            let mut text = RichText::new(label).size(16.0);
             if forms.tab == tab {
                 text = text.strong();
+            }
+            if unseen {
+                text = text.color(AFTER);
             }
             if ui.selectable_label(forms.tab == tab, text).clicked() {
                 commands.push(Command::View(ViewCommand::ShowTab(tab)));

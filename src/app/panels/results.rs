@@ -11,12 +11,13 @@ use egui_plot::{
 };
 
 use super::side::epsilon_plot_ui;
-use super::{AFTER, BAD, BEFORE, MUTED, WARN, labelled_field, ratio_text};
-use crate::app::commands::{Command, FilesCommand};
+use super::{AFTER, BAD, BEFORE, GOOD, MUTED, WARN, labelled_field, ratio_text};
+use crate::app::commands::{Command, FilesCommand, ViewCommand};
 use crate::app::forms::Forms;
 use crate::app::state::{AppState, DialogPurpose, ExportKind};
 use crate::app::view::{HandEyeView, ResultOrigin, ResultView};
 use crate::engine::geometry::{rows_from_isometry, wrap_deg};
+use crate::engine::result_view::Verdict;
 use crate::engine::robot::{PARAM_NAMES, PARAMS_PER_JOINT};
 use crate::engine::solve::estimate::HAND_EYE_LABELS;
 
@@ -51,7 +52,7 @@ pub fn results_ui(
             origin_ui(ui, view);
             export_ui(ui, state, forms, commands);
             let top = ui.cursor().min;
-            headline_ui(ui, view);
+            headline_ui(ui, view, forms, commands);
             ui.add_space(4.0);
             let bottom = plots_ui(ui, view);
             plots_rect = Some(Rect::from_min_max(
@@ -93,8 +94,9 @@ fn origin_ui(ui: &mut egui::Ui, view: &ResultView) {
     }
 }
 
-/// Validation std and max before → after in large type, with the ratio.
-fn headline_ui(ui: &mut egui::Ui, view: &ResultView) {
+/// Validation std and max before → after in large type, with the ratio,
+/// and the verdict against the acceptance tolerance (editable here).
+fn headline_ui(ui: &mut egui::Ui, view: &ResultView, forms: &Forms, commands: &mut Vec<Command>) {
     egui::Frame::group(ui.style()).show(ui, |ui| {
         ui.set_width(ui.available_width());
         match &view.shown.headline {
@@ -113,6 +115,7 @@ fn headline_ui(ui: &mut egui::Ui, view: &ResultView) {
                 ui.label(RichText::new("No validate measurements in this session: accuracy is not checked.").color(WARN));
             }
         }
+        verdict_ui(ui, view, forms, commands);
         let w = &view.shown.within_stats;
         ui.label(format!(
             "{} stations, centre distances (true value 0): std {:.3} → {:.3} mm, max {:.3} → {:.3} mm · ε {:.4} → {:.4} mm",
@@ -128,6 +131,51 @@ fn headline_ui(ui: &mut egui::Ui, view: &ResultView) {
         ui.label(format!(
             "identify centres about their station's mean (3-D rms): {b:.3} → {a:.3} mm"
         ));
+    });
+}
+
+/// PASS / FAIL in large type against the tolerance, which is edited
+/// beside it (remembered for the session's robot).
+fn verdict_ui(ui: &mut egui::Ui, view: &ResultView, forms: &Forms, commands: &mut Vec<Command>) {
+    let tolerance = forms.tolerance;
+    let verdict = Verdict::of(view.shown.headline.as_ref(), &tolerance);
+    ui.horizontal_wrapped(|ui| {
+        let colour = match verdict {
+            Verdict::Pass => GOOD,
+            Verdict::Fail(_) => BAD,
+            Verdict::NotChecked => MUTED,
+        };
+        ui.label(
+            RichText::new(verdict.word())
+                .size(28.0)
+                .strong()
+                .color(colour),
+        )
+        .on_hover_text(verdict.describe(&tolerance));
+        ui.add_space(12.0);
+        let mut edited = tolerance;
+        ui.label("tolerance: std ≤");
+        let std = ui.add(
+            egui::DragValue::new(&mut edited.std_mm)
+                .speed(0.005)
+                .range(0.001..=100.0)
+                .max_decimals(3)
+                .suffix(" mm"),
+        );
+        ui.label("max ≤");
+        let max = ui.add(
+            egui::DragValue::new(&mut edited.max_mm)
+                .speed(0.005)
+                .range(0.001..=100.0)
+                .max_decimals(3)
+                .suffix(" mm"),
+        );
+        if (std.changed() || max.changed()) && edited != tolerance {
+            commands.push(Command::View(ViewCommand::SetTolerance(edited)));
+        }
+        if let Verdict::Fail(reasons) = &verdict {
+            ui.label(RichText::new(reasons.join(", ")).color(BAD));
+        }
     });
 }
 
@@ -508,24 +556,28 @@ fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
             }
         });
     }
-    egui::CollapsingHeader::new("Solver block of the result (all entries)").show(ui, |ui| {
-        egui::Grid::new("solver_entries")
-            .striped(true)
-            .num_columns(2)
-            .show(ui, |ui| {
-                for (k, v) in &view.solver_entries {
-                    ui.monospace(k);
-                    let short: String = v.chars().take(SOLVER_ENTRY_CHARS).collect();
-                    let shown = if short.len() < v.len() {
-                        format!("{short}…")
-                    } else {
-                        short
-                    };
-                    ui.add(egui::Label::new(shown).wrap()).on_hover_text(v);
-                    ui.end_row();
-                }
-            });
-    });
+    ml_tables_ui(ui, view);
+    egui::CollapsingHeader::new("Details: the solver block as written in the result file").show(
+        ui,
+        |ui| {
+            egui::Grid::new("solver_entries")
+                .striped(true)
+                .num_columns(2)
+                .show(ui, |ui| {
+                    for (k, v) in &view.solver_entries {
+                        ui.monospace(k);
+                        let short: String = v.chars().take(SOLVER_ENTRY_CHARS).collect();
+                        let shown = if short.len() < v.len() {
+                            format!("{short}…")
+                        } else {
+                            short
+                        };
+                        ui.add(egui::Label::new(shown).wrap()).on_hover_text(v);
+                        ui.end_row();
+                    }
+                });
+        },
+    );
 }
 
 fn marked_cell(ui: &mut egui::Ui, view: &ResultView, label: &str, text: String) {
@@ -541,11 +593,12 @@ fn hand_eye_ui(ui: &mut egui::Ui, view: &ResultView) {
     ui.label(RichText::new("Hand-eye eT_s (sensor to flange)").strong());
     let (b, a): (&HandEyeView, &HandEyeView) =
         (&view.shown.hand_eye_before, &view.shown.hand_eye_after);
+    let sigma = view.shown.hand_eye_sigma;
     egui::Grid::new("hand_eye")
         .striped(true)
-        .num_columns(4)
+        .num_columns(5)
         .show(ui, |ui| {
-            for t in ["", "initial", "calibrated", "change"] {
+            for t in ["", "initial", "calibrated", "± 1σ", "change"] {
                 ui.strong(t);
             }
             ui.end_row();
@@ -581,6 +634,15 @@ fn hand_eye_ui(ui: &mut egui::Ui, view: &ResultView) {
                 ui.label(name);
                 ui.label(format!("{before:.4}"));
                 marked_cell(ui, view, label, format!("{after:.4}"));
+                match sigma {
+                    Some(s) if !view.shown.marked.contains_key(label) => {
+                        ui.label(RichText::new(format!("± {:.4}", s[k])).color(MUTED))
+                    }
+                    _ => ui.label(RichText::new("–").color(MUTED)),
+                }
+                .on_hover_text(
+                    "1σ from ml's covariance, in the row's frame and unit (flange-frame x, y, z; roll, pitch, yaw)",
+                );
                 let change = if k < 3 {
                     after - before
                 } else {
@@ -650,7 +712,11 @@ fn joint_errors_ui(ui: &mut egui::Ui, view: &ResultView) {
                 ui.label(format!("{}", j + 1));
                 for (p, name) in PARAM_NAMES.iter().enumerate() {
                     let label = format!("{name}{}", j + 1);
-                    marked_cell(ui, view, &label, format!("{:+.4}", e.get(p)));
+                    let text = match view.shown.sigma.get(&label) {
+                        Some(s) => format!("{:+.4} ± {:.4}", e.get(p), s.std),
+                        None => format!("{:+.4}", e.get(p)),
+                    };
+                    marked_cell(ui, view, &label, text);
                 }
                 ui.end_row();
             }
@@ -658,11 +724,88 @@ fn joint_errors_ui(ui: &mut egui::Ui, view: &ResultView) {
     if !view.shown.marked.is_empty() {
         ui.label(
             RichText::new(format!(
-                "† not identifiable from this data ({} parameter(s)): they lie in a direction the SVD dropped (or the method held them fixed), so the value is not a measurement of the robot. Hover a value for the direction.",
+                "± 1σ from ml's covariance. † not identifiable from this data ({} parameter(s)): they lie in a direction the SVD dropped (or the method held them fixed), so the value is not a measurement of the robot. Hover a value for the direction.",
                 view.shown.marked.len()
             ))
             .small()
             .color(MUTED),
         );
     }
+}
+
+/// `ml`'s diagnostics as tables: outliers, leave-one-station-out and the
+/// strong correlations (each collapsible, open when it has something to
+/// say).
+fn ml_tables_ui(ui: &mut egui::Ui, view: &ResultView) {
+    let Some(ml) = view.file.solver.ml() else {
+        return;
+    };
+    ui.add_space(6.0);
+    egui::CollapsingHeader::new(format!(
+        "Outliers ({}; limit {:.1} σ)",
+        ml.outliers.len(),
+        ml.outlier_limit_sigma
+    ))
+    .default_open(!ml.outliers.is_empty())
+    .show(ui, |ui| {
+        if ml.outliers.is_empty() {
+            ui.label("No identify measurement's standardised residual exceeds the limit.");
+            return;
+        }
+        egui::Grid::new("outliers").striped(true).show(ui, |ui| {
+            for h in ["measurement", "station", "residual (mm)", "σ", "reason"] {
+                ui.strong(h);
+            }
+            ui.end_row();
+            for o in &ml.outliers {
+                ui.label(&o.measurement);
+                ui.label(&o.station);
+                ui.label(format!("{:.4}", o.residual_mm));
+                ui.label(format!("{:.1}", o.sigma));
+                ui.label(&o.reason);
+                ui.end_row();
+            }
+        });
+    });
+    if let Some(cv) = &ml.cross_validation {
+        egui::CollapsingHeader::new(format!(
+            "Leave-one-station-out: rms {:.4} mm over {} stations",
+            cv.rms,
+            cv.stations.len()
+        ))
+        .show(ui, |ui| {
+            ui.label(
+                RichText::new(
+                    "Each station's within-station centre distances predicted by the model fitted without it: an accuracy estimate without a tracker.",
+                )
+                .color(MUTED),
+            );
+            let mut rows: Vec<_> = cv.stations.iter().collect();
+            rows.sort_by(|a, b| b.rms.total_cmp(&a.rms));
+            egui::Grid::new("loso").striped(true).show(ui, |ui| {
+                for h in ["station", "pairs", "rms (mm)"] {
+                    ui.strong(h);
+                }
+                ui.end_row();
+                for s in rows {
+                    ui.label(&s.station);
+                    ui.label(s.pairs.to_string());
+                    ui.label(format!("{:.4}", s.rms));
+                    ui.end_row();
+                }
+            });
+        });
+    }
+    egui::CollapsingHeader::new(format!(
+        "Strong correlations ({}, |r| ≥ 0.95)",
+        ml.strong_correlations.len()
+    ))
+    .show(ui, |ui| {
+        if ml.strong_correlations.is_empty() {
+            ui.label("No two estimated parameters correlate by 0.95 or more.");
+        }
+        for c in &ml.strong_correlations {
+            ui.label(c);
+        }
+    });
 }

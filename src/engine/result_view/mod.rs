@@ -5,9 +5,11 @@
 //! could not identify. The workbench, the HTML report, history and the
 //! planner read these; none of them looks into the solver block itself.
 //! Also here: whether a result belongs to a session, and how well a
-//! hand-eye-only result determined the hand-eye ([`strength`]).
+//! hand-eye-only result determined the hand-eye ([`strength`]), and the
+//! PASS/FAIL verdict against an acceptance tolerance ([`verdict`]).
 
 pub mod strength;
+pub mod verdict;
 
 use std::collections::BTreeMap;
 
@@ -21,6 +23,7 @@ use crate::engine::validate::{
     BeforeAfter, DistanceRecord, Stats, scatter_rms, within_station_distances,
 };
 pub use strength::{HAND_EYE_ONLY, HandEyeStrength, flange_poses, hand_eye_only_lines};
+pub use verdict::{Tolerance, Verdict};
 
 /// A dropped SVD direction marks a parameter as not identifiable when its
 /// coefficient in the (unit) direction is at least this large: about a
@@ -246,6 +249,11 @@ pub struct ResultView {
     /// means, before and after, mm ([`scatter_rms`]): what a hand-eye-only
     /// result is judged by.
     pub identify_scatter: (f64, f64),
+    /// 1σ of the calibrated hand-eye as the tables show it: x, y, z (mm,
+    /// flange frame) and roll, pitch, yaw (deg), propagated from `ml`'s
+    /// covariance of the sensor-frame perturbation (`None` without one,
+    /// or when a hand-eye direction was held fixed).
+    pub hand_eye_sigma: Option<[f64; 6]>,
 }
 
 impl ResultView {
@@ -313,8 +321,55 @@ impl ResultView {
             marked: identifiability_marks(&result.solver),
             sigma,
             identify_scatter: identify_scatter(&result.centres),
+            hand_eye_sigma: result
+                .solver
+                .ml()
+                .and_then(|ml| hand_eye_sigma(&result.hand_eye, &ml.covariance)),
         }
     }
+}
+
+/// 1σ of the hand-eye's x, y, z (mm, flange frame) and roll, pitch, yaw
+/// (deg) from the covariance of the perturbation `eT_s·exp(ΔX)` (sensor
+/// frame, translation first; `he_x … he_rz`, mm and deg): to first order
+/// the flange-frame translation moves by `R·Δt` and the angles by the
+/// derivative of roll/pitch/yaw under `R·exp(Δω)` (central differences).
+/// `None` when any of the six is not in the covariance (held fixed).
+#[must_use]
+pub fn hand_eye_sigma(
+    hand_eye: &Isometry3<f64>,
+    covariance: &crate::engine::solve::ml::report::LabelledMatrix,
+) -> Option<[f64; 6]> {
+    use crate::engine::solve::estimate::HAND_EYE_LABELS;
+    use nalgebra::{Matrix6, UnitQuaternion};
+    let index: Vec<usize> = HAND_EYE_LABELS
+        .iter()
+        .map(|l| covariance.labels.iter().position(|x| x == l))
+        .collect::<Option<_>>()?;
+    let mut c = Matrix6::<f64>::zeros();
+    for (a, &i) in index.iter().enumerate() {
+        for (b, &j) in index.iter().enumerate() {
+            c[(a, b)] = *covariance.matrix.get(i)?.get(j)?;
+        }
+    }
+    let r = hand_eye.rotation;
+    let mut jac = Matrix6::<f64>::zeros();
+    jac.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(r.to_rotation_matrix().matrix());
+    // Angles per degree of Δω, unwrapped across ±180°.
+    let h = 1e-6_f64;
+    for k in 0..3 {
+        let mut axis = nalgebra::Vector3::zeros();
+        axis[k] = h.to_radians();
+        let plus = roll_pitch_yaw_deg(&(r * UnitQuaternion::from_scaled_axis(axis)));
+        let minus = roll_pitch_yaw_deg(&(r * UnitQuaternion::from_scaled_axis(-axis)));
+        for m in 0..3 {
+            jac[(3 + m, 3 + k)] = crate::engine::geometry::wrap_deg(plus[m] - minus[m]) / (2.0 * h);
+        }
+    }
+    let f = jac * c * jac.transpose();
+    let out: [f64; 6] = std::array::from_fn(|i| f[(i, i)].max(0.0).sqrt());
+    out.iter().all(|v| v.is_finite()).then_some(out)
 }
 
 /// The scatter of the identify centres about their station means, before
@@ -389,4 +444,52 @@ pub fn within_pairs(centres: &[CentreRecord], usage: Use) -> Vec<PairDistance> {
             after,
         })
         .collect()
+}
+
+#[cfg(test)]
+mod sigma_tests {
+    use super::*;
+    use crate::engine::solve::estimate::HAND_EYE_LABELS;
+    use crate::engine::solve::ml::report::LabelledMatrix;
+    use nalgebra::{Translation3, UnitQuaternion, Vector3};
+
+    fn diagonal(values: [f64; 6]) -> LabelledMatrix {
+        LabelledMatrix {
+            labels: HAND_EYE_LABELS.iter().map(|s| (*s).to_string()).collect(),
+            units: vec![],
+            matrix: (0..6)
+                .map(|i| {
+                    (0..6)
+                        .map(|j| if i == j { values[i] } else { 0.0 })
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn the_hand_eye_sigma_turns_into_the_flange_frame() {
+        let c = diagonal([0.01, 0.04, 0.09, 1e-4, 4e-4, 9e-4]);
+        // Identity rotation: the σ are the perturbation's own.
+        let s = hand_eye_sigma(&Isometry3::identity(), &c).unwrap();
+        let expect = [0.1, 0.2, 0.3, 0.01, 0.02, 0.03];
+        for (a, b) in s.iter().zip(expect) {
+            assert!((a - b).abs() < 1e-6, "{s:?}");
+        }
+        // Turned 90° about z: the sensor's x is the flange's y.
+        let he = Isometry3::from_parts(
+            Translation3::new(10.0, 0.0, 50.0),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), std::f64::consts::FRAC_PI_2),
+        );
+        let s = hand_eye_sigma(&he, &c).unwrap();
+        assert!(
+            (s[0] - 0.2).abs() < 1e-9 && (s[1] - 0.1).abs() < 1e-9,
+            "{s:?}"
+        );
+        assert!((s[2] - 0.3).abs() < 1e-9);
+        // A fixed direction (missing label): no σ.
+        let mut partial = c.clone();
+        partial.labels[5] = "beta6".into();
+        assert!(hand_eye_sigma(&he, &partial).is_none());
+    }
 }

@@ -20,6 +20,10 @@ pre{font-size:12px;margin:4px 0;background:#f7f7f7;padding:6px 8px;overflow-x:au
 .headline{border:1px solid #ccc;border-radius:6px;padding:10px 14px;margin:8px 0}
 .big{display:inline-block;font-size:26px;font-weight:600;margin-right:28px;white-space:nowrap}
 .ratio{color:#1f6fae;font-size:16px;font-weight:normal;margin-left:4px}
+.verdict{font-size:22px;font-weight:700;padding:6px 12px;border-radius:4px;margin:8px 0}
+.verdict.pass{background:#e3f4e6;color:#16662a;border-left:6px solid #2e9d4a}
+.verdict.fail{background:#fbe4e4;color:#9b1c1c;border-left:6px solid #d33}
+.verdict.unchecked{background:#f1f1f1;color:#555;border-left:6px solid #999}
 .warn{background:#fff4e0;border-left:4px solid #e6aa28;padding:6px 10px;margin:8px 0}
 .muted,.marked{color:var(--muted)}
 .b{color:#b85a15}.a{color:#1f6fae}

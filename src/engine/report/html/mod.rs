@@ -42,7 +42,7 @@ use sha2::{Digest, Sha256};
 use crate::engine::format::result::ResultFile;
 use crate::engine::report::svg::escape;
 use crate::engine::result_view::{
-    PairDistance, ResultView, Sigma, check_result, excluded_measurements,
+    PairDistance, ResultView, Sigma, Tolerance, Verdict, check_result, excluded_measurements,
 };
 use crate::engine::session::Session;
 use crate::engine::solve::ml::MlReport;
@@ -104,6 +104,9 @@ pub struct ReportInput<'a> {
     pub prepared: Option<&'a Prepared>,
     /// File name, time and version.
     pub meta: &'a ReportMeta,
+    /// The acceptance tolerance, when the operator set one: the summary
+    /// then carries PASS or FAIL.
+    pub tolerance: Option<Tolerance>,
 }
 
 /// The SHA-256 of `bytes`, 64 lowercase hex digits.
@@ -204,6 +207,10 @@ struct Ctx<'a> {
     /// 3-D rms scatter of the identify centres, before and after, mm.
     identify_scatter: (f64, f64),
     excluded: Vec<String>,
+    /// The verdict against the tolerance, when one is given.
+    verdict: Option<(Verdict, Tolerance)>,
+    /// 1σ of the hand-eye as tabled (flange-frame x, y, z; roll, pitch, yaw).
+    hand_eye_sigma: Option<[f64; 6]>,
 }
 
 impl<'a> Ctx<'a> {
@@ -223,6 +230,10 @@ impl<'a> Ctx<'a> {
             identify_within: view.identify_within,
             identify_scatter: view.identify_scatter,
             excluded: excluded_measurements(input.session, result),
+            hand_eye_sigma: view.hand_eye_sigma,
+            verdict: input
+                .tolerance
+                .map(|t| (Verdict::of(view.headline.as_ref(), &t), t)),
         }
     }
 

@@ -164,6 +164,27 @@ pub(super) fn marked_cell(ctx: &Ctx<'_>, label: &str, text: String) -> String {
     }
 }
 
+/// A calibrated hand-eye cell (row `k`: x, y, z, roll, pitch, yaw) with
+/// its σ in the same frame and unit ([`ResultView::hand_eye_sigma`]), and
+/// the † mark.
+pub(super) fn hand_eye_cell(ctx: &Ctx<'_>, k: usize, text: String) -> String {
+    let label = HAND_EYE_LABELS[k];
+    match ctx.marks.get(label) {
+        Some(why) => format!(
+            "<td class=\"n marked\" title=\"{}\">{} †</td>",
+            escape(&format!("{label}: {why}")),
+            escape(&text)
+        ),
+        None => {
+            let sigma = ctx
+                .hand_eye_sigma
+                .map(|s| format!(" <span class=\"muted\">± {}</span>", num(s[k], 4)))
+                .unwrap_or_default();
+            format!("<td class=\"n\">{}{sigma}</td>", escape(&text))
+        }
+    }
+}
+
 /// Roll, pitch, yaw (deg) and translation (mm) of a hand-eye.
 pub(super) fn pose_parts(he: &nalgebra::Isometry3<f64>) -> ([f64; 3], [f64; 3]) {
     let v = HandEyeView::new(he);
@@ -210,7 +231,7 @@ pub(super) fn hand_eye(h: &mut String, ctx: &Ctx<'_>) {
             h,
             "<tr><td>{name}</td><td class=\"n\">{}</td>{}<td class=\"n\">{}</td></tr>",
             num(b, 4),
-            marked_cell(ctx, HAND_EYE_LABELS[k], num(a, 4)),
+            hand_eye_cell(ctx, k, num(a, 4)),
             signed(change, 4)
         );
     }

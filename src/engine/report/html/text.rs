@@ -232,6 +232,18 @@ pub(super) fn summary(h: &mut String, ctx: &Ctx<'_>) {
             );
         }
     }
+    if let Some((verdict, tolerance)) = &ctx.verdict {
+        let class = match verdict {
+            Verdict::Pass => "pass",
+            Verdict::Fail(_) => "fail",
+            Verdict::NotChecked => "unchecked",
+        };
+        let _ = writeln!(
+            h,
+            "<p class=\"verdict {class}\" id=\"verdict\">{}</p>",
+            escape(&verdict.describe(tolerance))
+        );
+    }
     let _ = writeln!(
         h,
         "<p>ε (paper eq. 20) {} → {} mm after {} update(s).{}</p>",
