@@ -725,3 +725,57 @@ fn plan_then_simulate_import_and_calibrate_on_the_command_line() {
     );
     assert!(!Path::new(&far).exists());
 }
+
+/// Issue 13: a UR robot's plan is offered as a URScript program (the
+/// Plan view wrote ABB RAPID for a UR5e): one `movej` per pose in plan
+/// order with the joints in radians, a blocking popup per station.
+#[test]
+fn urscript_program_has_one_movej_per_pose_in_plan_order() {
+    let plan = small_plan();
+    assert_eq!(Controller::parse("urscript"), Some(Controller::UrScript));
+    assert_eq!(
+        Controller::for_robot("Universal Robots UR5e"),
+        Some(Controller::UrScript)
+    );
+    assert_eq!(
+        Controller::for_robot("ABB IRB 2400/16"),
+        Some(Controller::AbbRapid)
+    );
+    assert_eq!(Controller::for_robot("KUKA KR 16"), None);
+    let text = Controller::UrScript.render(plan);
+    assert!(text.is_ascii());
+    let lines: Vec<&str> = text.lines().map(str::trim).collect();
+    assert_eq!(lines.first(), Some(&"def spherecal_plan():"));
+    assert_eq!(lines.last(), Some(&"end"));
+    let moves: Vec<Vec<f64>> = lines
+        .iter()
+        .filter(|l| l.starts_with("movej(["))
+        .map(|l| {
+            let inner = &l["movej([".len()..l.find(']').unwrap()];
+            inner
+                .split(',')
+                .map(|v| v.trim().parse().unwrap())
+                .collect()
+        })
+        .collect();
+    assert_eq!(moves.len(), plan.poses.len());
+    for (q, p) in moves.iter().zip(&plan.poses) {
+        for (a, b) in q.iter().zip(&p.joints) {
+            assert!((a - b.to_radians()).abs() < 1e-6, "{a} vs {b}°");
+        }
+    }
+    let stations = plan
+        .poses
+        .windows(2)
+        .filter(|w| w[0].station != w[1].station)
+        .count()
+        + 1;
+    assert_eq!(
+        lines.iter().filter(|l| l.starts_with("popup(")).count(),
+        stations
+    );
+    assert_eq!(
+        lines.iter().filter(|l| l.starts_with("measure(\"")).count(),
+        plan.poses.len()
+    );
+}

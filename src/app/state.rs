@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::engine::history::{Drift, Library};
 use crate::engine::import::PoseCheck;
+use crate::engine::plan::Controller;
 use crate::engine::plan::{Plan, PlanError, Prediction};
 use crate::engine::result_view::Tolerance;
 use crate::engine::session::Session;
@@ -241,8 +242,8 @@ pub enum DialogPurpose {
 pub enum PlanExport {
     /// The plan as the joint-log CSV `spherecal import` reads.
     Csv,
-    /// An ABB RAPID module of joint targets.
-    Rapid,
+    /// The robot controller's program (RAPID for ABB, URScript for UR).
+    Program(Controller),
 }
 
 impl PlanExport {
@@ -251,7 +252,7 @@ impl PlanExport {
     pub fn label(self) -> &'static str {
         match self {
             Self::Csv => "Plan CSV",
-            Self::Rapid => "RAPID module",
+            Self::Program(c) => c.label(),
         }
     }
 
@@ -260,7 +261,7 @@ impl PlanExport {
     pub fn file_name(self, robot: &str) -> String {
         match self {
             Self::Csv => format!("plan-{robot}.csv"),
-            Self::Rapid => format!("plan-{robot}.mod"),
+            Self::Program(c) => format!("plan-{robot}.{}", c.extension()),
         }
     }
 }
@@ -505,6 +506,19 @@ impl AppState {
             return Vec::new();
         };
         let ms = &loaded.session.measurements;
+        let needle = forms.search.trim().to_lowercase();
+        let problem = |i: usize| {
+            loaded
+                .analysis
+                .measurements
+                .get(i)
+                .is_some_and(Result::is_err)
+                || loaded
+                    .analysis
+                    .warnings
+                    .iter()
+                    .any(|(id, _)| *id == ms[i].id)
+        };
         let mut rows: Vec<usize> = (0..ms.len())
             .filter(|&i| {
                 forms
@@ -512,6 +526,10 @@ impl AppState {
                     .as_ref()
                     .is_none_or(|s| *s == ms[i].station)
                     && forms.filter_use.is_none_or(|u| u == ms[i].usage)
+                    && (needle.is_empty()
+                        || ms[i].id.to_lowercase().contains(&needle)
+                        || ms[i].station.to_lowercase().contains(&needle))
+                    && (!forms.filter_problems || problem(i))
             })
             .collect();
         match forms.group {

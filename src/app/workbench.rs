@@ -24,7 +24,8 @@ pub struct WorkbenchApp {
 
 /// Adds the default monospace font (Hack) as a fallback of the
 /// proportional family: egui's default proportional font has no arrows
-/// (→) or geometric shapes (▶ ● ○ ■), which the workbench uses.
+/// (→) or geometric shapes (▶ ● ○ ■), which the workbench uses; and sets
+/// the text sizes (secondary text 12 px).
 pub fn install_fonts(ctx: &egui::Context) {
     let mut fonts = egui::FontDefinitions::default();
     if fonts.font_data.contains_key("Hack")
@@ -34,6 +35,22 @@ pub fn install_fonts(ctx: &egui::Context) {
         list.push("Hack".to_string());
     }
     ctx.set_fonts(fonts);
+    // Secondary text at least 12 px (egui's small style is 9 px), body
+    // and buttons 14 px: readable on a shop-floor screen.
+    ctx.all_styles_mut(|style| {
+        use egui::{FontFamily, FontId, TextStyle};
+        style.text_styles.insert(
+            TextStyle::Small,
+            FontId::new(12.0, FontFamily::Proportional),
+        );
+        style
+            .text_styles
+            .insert(TextStyle::Body, FontId::new(14.0, FontFamily::Proportional));
+        style.text_styles.insert(
+            TextStyle::Button,
+            FontId::new(14.0, FontFamily::Proportional),
+        );
+    });
 }
 
 impl WorkbenchApp {

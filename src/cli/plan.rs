@@ -89,7 +89,7 @@ pub struct PlanArgs {
     /// Write the plan as an ABB RAPID module (MODULE SpherecalPlan).
     #[arg(long)]
     pub rapid: Option<PathBuf>,
-    /// Write a controller program: `KEY=FILE` (keys: rapid); may be repeated.
+    /// Write a controller program: `KEY=FILE` (keys: rapid for ABB, urscript for Universal Robots); may be repeated.
     #[arg(long)]
     pub program: Vec<String>,
     /// Predict the calibrated accuracy from N simulated calibrations (random kinematic errors, default noise, ml); 0 skips.

@@ -450,6 +450,16 @@ impl Core {
         };
         self.forms.save_path = dir.join(file_name).display().to_string();
         self.forms.solver = SolverForm::from_session(&loaded.session);
+        // The Plan view follows the open session's robot (a preset of the
+        // same name), so a plan and its program are for that robot.
+        if let Some(p) = crate::engine::robot::presets::presets()
+            .into_iter()
+            .find(|p| p.robot.name == loaded.session.robot.name)
+            && self.forms.plan.robot != p.key
+        {
+            self.forms.plan.robot = p.key.to_string();
+            self.forms.plan.request.sphere = crate::app::forms::plan::default_sphere(p.key);
+        }
         self.forms.tolerance = self
             .state
             .prefs

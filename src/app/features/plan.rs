@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::engine::format::write_atomic;
 use crate::engine::plan::{
-    self, Controller, Plan, PlanConfig, PlanError, PlanStage, PredictConfig, RequestError,
+    self, Plan, PlanConfig, PlanError, PlanStage, PredictConfig, RequestError,
 };
 use crate::engine::robot::RobotChoice;
 use crate::engine::session::Session;
@@ -193,7 +193,7 @@ impl Core {
         let started = self.spawn(ctx, "export", move |rep| {
             let text = match kind {
                 PlanExport::Csv => plan::plan_csv(&plan),
-                PlanExport::Rapid => Controller::AbbRapid.render(&plan),
+                PlanExport::Program(c) => c.render(&plan),
             };
             let outcome = write_atomic(&path, text.as_bytes()).map_err(Into::into);
             rep.send(JobMessage::Plan(PlanMessage::Written {

@@ -213,6 +213,10 @@ pub struct Forms {
     pub filter_use: Option<Use>,
     /// Session table grouping.
     pub group: Grouping,
+    /// Session table: only measurements with a stripe warning or failure.
+    pub filter_problems: bool,
+    /// Session table: only ids (or stations) containing this text.
+    pub search: String,
     /// Settings of the next run.
     pub solver: SolverForm,
     /// Centres view options.
@@ -238,6 +242,8 @@ impl Default for Forms {
             filter_station: None,
             filter_use: None,
             group: Grouping::None,
+            filter_problems: false,
+            search: String::new(),
             solver: SolverForm::default(),
             centres: CentresForm::default(),
             import: ImportForm::default(),

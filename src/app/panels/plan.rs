@@ -287,10 +287,23 @@ fn outcome_ui(
         if ui.button("Browse…").clicked() {
             commands.push(Command::Files(FilesCommand::Browse(DialogPurpose::ExportFolder)));
         }
-        for kind in [PlanExport::Csv, PlanExport::Rapid] {
+        let robot_name = crate::engine::robot::presets::preset(&forms.plan.robot)
+            .map(|p| p.robot.name)
+            .unwrap_or_default();
+        let controller = crate::engine::plan::Controller::for_robot(&robot_name);
+        if controller.is_none() {
+            ui.label(
+                RichText::new(format!(
+                    "no program export for the controller of {robot_name}: use the Plan CSV"
+                ))
+                .color(MUTED),
+            );
+        }
+        for kind in std::iter::once(PlanExport::Csv).chain(controller.map(PlanExport::Program)) {
             let hint = match kind {
                 PlanExport::Csv => "the joint-log CSV that `spherecal import` reads (id, station, use, side, joints, nominal ABB flange pose)",
-                PlanExport::Rapid => "an ABB RAPID module: one jointtarget per pose, MoveAbsJ in plan order, a stop per measurement",
+                PlanExport::Program(crate::engine::plan::Controller::AbbRapid) => "an ABB RAPID module: one jointtarget per pose, MoveAbsJ in plan order, a stop per measurement",
+                PlanExport::Program(crate::engine::plan::Controller::UrScript) => "a URScript program for a Universal Robots controller: one movej per pose (rad), a popup per station, a measure hook",
             };
             if ui
                 .add_enabled(state.plan.writing == 0, egui::Button::new(kind.label()))

@@ -537,13 +537,13 @@ fn identifiable_set_ui(ui: &mut egui::Ui, view: &ResultView) {
 }
 
 fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
-    ui.columns(2, |cols| {
-        hand_eye_ui(&mut cols[0], view);
-        match &view.hand_eye_only {
-            Some(lines) => hand_eye_only_ui(&mut cols[1], lines),
-            None => joint_errors_ui(&mut cols[1], view),
-        }
-    });
+    // One above the other: with ± 1σ the joint table needs the width.
+    hand_eye_ui(ui, view);
+    ui.add_space(8.0);
+    match &view.hand_eye_only {
+        Some(lines) => hand_eye_only_ui(ui, lines),
+        None => joint_errors_ui(ui, view),
+    }
     if !view.dropped.is_empty() {
         ui.add_space(6.0);
         egui::CollapsingHeader::new(format!(

@@ -95,6 +95,20 @@ fn filters_ui(
             })
             .response
             .on_hover_text("group the rows");
+        let problems = loaded.analysis.failures().count() + loaded.analysis.warnings.len();
+        ui.checkbox(
+            &mut forms.filter_problems,
+            format!("only warnings and failures ({problems})"),
+        )
+        .on_hover_text("show only the measurements whose stripe fit warned or failed");
+        let search = ui.label("Find");
+        ui.add(
+            egui::TextEdit::singleline(&mut forms.search)
+                .hint_text("id or station")
+                .desired_width(110.0),
+        )
+        .labelled_by(search.id)
+        .on_hover_text("show only measurements whose id or station contains this text");
         if ui
             .button("Use all")
             .on_hover_text("include every measurement again")

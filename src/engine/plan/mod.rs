@@ -108,7 +108,7 @@ pub use config::{
     DEFAULT_CUT_ANGLE_DEG, DEFAULT_MIN_WRIST_DEG, DEFAULT_ROTATION_MAX_DEG,
     DEFAULT_ROTATION_MIN_DEG, DEFAULT_TRANSLATION_STEP_MM, PlanConfig, Selection, StationLayout,
 };
-pub use export::{Controller, RAPID_MODULE, plan_csv, rapid_module, read_plan_csv};
+pub use export::{Controller, RAPID_MODULE, plan_csv, rapid_module, read_plan_csv, ur_script};
 use order::{Metric, order_groups};
 pub use predict::{PredictConfig, Prediction, RunScore, predict, simulated_true_hand_eye};
 pub use request::{PlanRequest, RequestError, defaults, read_hand_eye, read_stations};

@@ -1,0 +1,300 @@
+//! UI tests of the guided workbench (issue 13): the job through the step
+//! bar, PASS/FAIL against a tolerance, Cancel in the last phase keeping
+//! the previous result, the Session table's filters, the Plan view
+//! following the open session's robot. egui_kittest, no display.
+
+#![cfg(feature = "gui")]
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use std::path::Path;
+use std::time::Duration;
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::{NodeT as _, Queryable as _};
+use spherecal::app::WorkbenchApp;
+use spherecal::app::forms::Tab;
+
+mod ui_support;
+use ui_support::{demo_app, settle};
+
+/// The label of the step bar's step `n` (its mark changes with its state).
+fn step_label(h: &Harness<'_, WorkbenchApp>, name: &str) -> String {
+    let labels: Vec<String> = h
+        .query_all_by_label_contains(name)
+        .filter_map(|n| {
+            let a = n.accesskit_node();
+            a.label().or_else(|| a.value())
+        })
+        .filter(|l| l.ends_with(name) && l.len() < name.len() + 8)
+        .collect();
+    assert_eq!(labels.len(), 1, "one step {name}: {labels:?}");
+    labels[0].clone()
+}
+
+/// Issue 13: the whole job on the demo, in order, through the step bar:
+/// plan → simulate → calibrate → validate → report.
+#[test]
+fn the_step_bar_walks_the_job_in_order() {
+    let mut h = demo_app();
+    let dir = tempfile::tempdir().expect("temp dir");
+    h.state_mut().forms_mut().export_dir = dir.path().display().to_string();
+    // The views are in the order of the job.
+    let order: Vec<&str> = Tab::ALL.iter().map(|t| t.label()).collect();
+    assert_eq!(
+        order,
+        [
+            "Plan", "Import", "Session", "Stripe", "Centres", "Results", "History"
+        ]
+    );
+
+    // 1. Plan: the step opens the Plan view; plan and simulate there.
+    let plan = step_label(&h, "1. Plan");
+    h.get_by_label(&plan).click();
+    h.run();
+    assert_eq!(h.state().forms().tab, Tab::Plan);
+    {
+        let f = &mut h.state_mut().forms_mut().plan;
+        f.request.n_identify = 4;
+        f.request.identify_poses = 4;
+        f.request.n_validate = 2;
+        f.request.validate_poses = 3;
+        f.request.candidates = 8;
+        f.request.predict_runs = 0;
+    }
+    h.get_by_label("Make plan").click();
+    settle(&mut h);
+    assert!(step_label(&h, "1. Plan").starts_with('●'), "planned");
+    h.get_by_label("Simulate and open").click();
+    settle(&mut h);
+    assert!(step_label(&h, "2. Data in").starts_with('●'), "data in");
+    assert!(step_label(&h, "3. Stripes checked").starts_with('●'));
+    assert!(step_label(&h, "4. Calibrated").starts_with('○'));
+
+    // 4. Calibrate: the next action is the run.
+    h.get_by_label("Next: ▶ Run the calibration").click();
+    settle(&mut h);
+    assert!(h.state().state().result.is_some());
+    assert!(step_label(&h, "4. Calibrated").starts_with('●'));
+
+    // 5. Validate: the step shows the verdict in the Results view.
+    h.state_mut().forms_mut().tolerance = spherecal::engine::result_view::Tolerance {
+        std_mm: 5.0,
+        max_mm: 10.0,
+    };
+    h.run();
+    assert!(step_label(&h, "5. Validated").starts_with('●'), "a PASS");
+    h.get_by_label(&step_label(&h, "5. Validated")).click();
+    h.run();
+    assert_eq!(h.state().forms().tab, Tab::Results);
+    assert!(h.query_by_label("PASS").is_some());
+
+    // 6. Report: the next action writes the report, with the verdict.
+    h.get_by_label("Next: Write the report").click();
+    settle(&mut h);
+    assert!(step_label(&h, "6. Reported").starts_with('●'));
+    let written = h.state().state().reported.clone().expect("a report");
+    let html = std::fs::read_to_string(&written).expect("the report");
+    assert!(
+        html.contains("id=\"verdict\">PASS"),
+        "the report has the verdict"
+    );
+    assert!(
+        h.query_all_by_label_contains("Next:").count() == 0,
+        "every step is done"
+    );
+}
+
+/// Issue 13: PASS and FAIL against the operator's tolerance, remembered
+/// for the robot.
+#[test]
+fn the_headline_says_pass_or_fail_against_the_tolerance() {
+    let mut h = demo_app();
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    h.get_by_label("Results ●").click();
+    h.run();
+    let after = h
+        .state()
+        .state()
+        .result
+        .as_ref()
+        .and_then(|r| r.shown.headline.as_ref())
+        .expect("validation")
+        .stats
+        .after;
+    let ctx = h.ctx.clone();
+    for (std_mm, max_mm, word) in [
+        (after.std * 2.0, after.max * 2.0, "PASS"),
+        (after.std / 2.0, after.max * 2.0, "FAIL"),
+        (after.std * 2.0, after.max / 2.0, "FAIL"),
+    ] {
+        let t = spherecal::engine::result_view::Tolerance { std_mm, max_mm };
+        h.state_mut().command(
+            &ctx,
+            spherecal::app::commands::Command::View(
+                spherecal::app::commands::ViewCommand::SetTolerance(t),
+            ),
+        );
+        h.run();
+        assert!(h.query_by_label(word).is_some(), "{word} for {t:?}");
+        let robot = &h
+            .state()
+            .state()
+            .loaded
+            .as_ref()
+            .expect("demo")
+            .session
+            .robot
+            .name;
+        assert_eq!(h.state().state().prefs.tolerances.get(robot), Some(&t));
+    }
+    assert!(
+        h.query_all_by_label_contains("mm >").count() > 0,
+        "the reason is shown"
+    );
+}
+
+/// Issue 13: Cancel in the last phase of a long run (leave-one-station-out
+/// on 12,070 measurements) stops it, and the previous result stays on show.
+#[test]
+fn cancel_in_the_last_phase_keeps_the_previous_result() {
+    let mut h = demo_app();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (session, _) =
+        spherecal::engine::simulate::simulate(&spherecal::engine::simulate::SimConfig {
+            n_identify: 2000,
+            ..spherecal::engine::simulate::SimConfig::default()
+        })
+        .expect("simulate");
+    let path = dir.path().join("big.json");
+    spherecal::engine::format::save_session(&session, &path).expect("save");
+    let ctx = h.ctx.clone();
+    h.state_mut().command(
+        &ctx,
+        spherecal::app::commands::Command::Files(spherecal::app::commands::FilesCommand::OpenPath(
+            path,
+        )),
+    );
+    settle(&mut h);
+    // A first, whole run: the result on show.
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    let first = h.state().state().result.clone().expect("a first result");
+    // A second run, cancelled once it has reached leave-one-station-out.
+    h.get_by_label("▶ Run").click();
+    let mut reached = false;
+    for _ in 0..20_000 {
+        h.step();
+        let phase = h
+            .state()
+            .state()
+            .run
+            .as_ref()
+            .and_then(|r| r.phase.as_ref().map(|p| p.0.clone()));
+        if phase.is_some_and(|p| p.starts_with("leave-one-station-out")) {
+            reached = true;
+            break;
+        }
+        assert!(
+            h.state().state().run.is_some(),
+            "the run ended before its last phase"
+        );
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    assert!(reached, "the run reached leave-one-station-out");
+    assert!(
+        h.query_all_by_label_contains("leave-one-station-out")
+            .count()
+            > 0,
+        "the phase is shown"
+    );
+    let cancelled_at = std::time::Instant::now();
+    h.get_by_label("Cancel").click();
+    settle(&mut h);
+    assert!(
+        cancelled_at.elapsed() < Duration::from_secs(1),
+        "stopped within a second"
+    );
+    let state = h.state().state();
+    assert!(state.run.is_none());
+    let shown = state
+        .result
+        .as_ref()
+        .expect("the previous result is still on show");
+    assert_eq!(shown.file, first.file, "the first run's result, unchanged");
+    let status = state
+        .status
+        .as_ref()
+        .map(|s| s.text.clone())
+        .unwrap_or_default();
+    assert!(status.contains("cancelled"), "status: {status}");
+}
+
+/// Issue 13: the demo's one stripe warning was 60 rows down; the Session
+/// table filters to warnings and failures, and finds ids.
+#[test]
+fn the_session_table_filters_to_problems_and_finds_ids() {
+    let mut h = demo_app();
+    h.get_by_label("only warnings and failures (1)").click();
+    h.run();
+    let rows = h.state().state().visible_rows(h.state().forms());
+    assert_eq!(rows.len(), 1, "one measurement warned");
+    let loaded = h.state().state().loaded.as_ref().expect("demo");
+    let warned = &loaded.analysis.warnings[0].0;
+    assert_eq!(&loaded.session.measurements[rows[0]].id, warned);
+    h.get_by_label("only warnings and failures (1)").click();
+    h.get_by_label("Find").click();
+    h.run();
+    h.get_by_label("Find").type_text("V1");
+    h.run();
+    let rows = h.state().state().visible_rows(h.state().forms());
+    let loaded = h.state().state().loaded.as_ref().expect("demo");
+    assert!(!rows.is_empty());
+    assert!(rows.iter().all(|&i| {
+        loaded.session.measurements[i].station.contains("V1")
+            || loaded.session.measurements[i]
+                .id
+                .to_lowercase()
+                .contains("v1")
+    }));
+}
+
+/// Issue 13: the Plan view defaulted to the IRB 2400 with a UR5e session
+/// open and wrote ABB RAPID for it; it follows the session's robot and
+/// offers that controller's program.
+#[test]
+fn the_plan_view_follows_the_open_sessions_robot() {
+    let mut h = demo_app();
+    assert_eq!(h.state().forms().plan.robot, "irb2400");
+    let ctx = h.ctx.clone();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("sessions/ur5e.json");
+    h.state_mut().command(
+        &ctx,
+        spherecal::app::commands::Command::Files(spherecal::app::commands::FilesCommand::OpenPath(
+            path,
+        )),
+    );
+    settle(&mut h);
+    assert_eq!(h.state().forms().plan.robot, "ur5e");
+    h.get_by_label("Plan").click();
+    h.run();
+    {
+        let f = &mut h.state_mut().forms_mut().plan;
+        f.request.n_identify = 3;
+        f.request.identify_poses = 4;
+        f.request.n_validate = 2;
+        f.request.validate_poses = 3;
+        f.request.candidates = 8;
+        f.request.predict_runs = 0;
+    }
+    h.get_by_label("Make plan").click();
+    settle(&mut h);
+    assert!(h.query_by_label("RAPID module").is_none());
+    let dir = tempfile::tempdir().expect("temp dir");
+    h.state_mut().forms_mut().export_dir = dir.path().display().to_string();
+    h.get_by_label("URScript program").click();
+    settle(&mut h);
+    let script = std::fs::read_to_string(dir.path().join("plan-ur5e.script")).expect("script");
+    assert!(script.starts_with("def spherecal_plan():"), "{script}");
+    assert!(script.contains("movej(["));
+}
