@@ -78,6 +78,9 @@ pub struct ImportArgs {
     /// Sphere diameter, mm.
     #[arg(long, default_value_t = DEFAULT_SPHERE_DIAMETER)]
     pub sphere_diameter: f64,
+    /// The sensor's measuring range to write as `sensor.range`: `Y0,Y1,Z0,Z1` in mm (laser plane, sensor frame), e.g. `-40,40,-40,40`; ml then predicts the error over it.
+    #[arg(long, allow_hyphen_values = true, value_parser = super::parse_range)]
+    pub range: Option<crate::engine::session::SensorRange>,
     /// Session name (default: the joint log's file name).
     #[arg(long)]
     pub name: Option<String>,
@@ -310,13 +313,16 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
     };
     let (
         Imported {
-            session,
+            mut session,
             checks,
             notes,
             ..
         },
         out,
     ) = imported;
+    if args.range.is_some() {
+        session.sensor_range = args.range;
+    }
     let out = &out;
     let text = format::session_to_json(&session);
     format::write_atomic(out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;

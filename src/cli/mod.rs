@@ -212,6 +212,28 @@ fn parse_loss(s: &str) -> Result<Loss, String> {
         .ok_or_else(|| format!("unknown loss `{s}`, expected `squared`, `huber` or `cauchy`"))
 }
 
+/// Parses `--range Y0,Y1,Z0,Z1` (mm, sensor frame) into a `sensor.range`.
+///
+/// # Errors
+/// Not four finite numbers with `Y0 < Y1` and `Z0 < Z1`.
+pub fn parse_range(s: &str) -> Result<crate::engine::session::SensorRange, String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("`{s}`: give Y0,Y1,Z0,Z1 in mm, e.g. -40,40,-40,40"))?;
+    let [y0, y1, z0, z1] = v.as_slice() else {
+        return Err(format!("`{s}`: give four numbers Y0,Y1,Z0,Z1 in mm"));
+    };
+    if !(v.iter().all(|x| x.is_finite()) && y0 < y1 && z0 < z1) {
+        return Err(format!("`{s}`: need Y0 < Y1 and Z0 < Z1 (mm)"));
+    }
+    Ok(crate::engine::session::SensorRange {
+        y: [*y0, *y1],
+        z: [*z0, *z1],
+    })
+}
+
 fn parse_method(s: &str) -> Result<Method, String> {
     Method::parse(s).ok_or_else(|| {
         let names: Vec<&str> = Method::ALL.iter().map(|m| m.as_str()).collect();

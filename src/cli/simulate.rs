@@ -91,6 +91,9 @@ pub struct SimulateArgs {
     /// Where to write the session file (FORMAT.md `spherecal-session`).
     #[arg(long, short)]
     pub out: PathBuf,
+    /// The sensor's measuring range to write as `sensor.range`: `Y0,Y1,Z0,Z1` in mm (laser plane, sensor frame), e.g. `-40,40,-40,40`; ml then predicts the error over it.
+    #[arg(long, allow_hyphen_values = true, value_parser = super::parse_range)]
+    pub range: Option<crate::engine::session::SensorRange>,
     /// Where to write the truth file (default: the session path with
     /// `.json` replaced by `.truth.json`).
     #[arg(long)]
@@ -259,7 +262,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     CliError::guard_output(&args.out, &inputs)?;
     CliError::guard_output(&truth_path, &inputs)?;
     let config = args.to_config();
-    let (session, truth) = match &args.plan {
+    let (mut session, truth) = match &args.plan {
         None => simulate::simulate(&config).map_err(|e| CliError::input(e.to_string()))?,
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|e| {
@@ -283,6 +286,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 .map_err(|e| CliError::input(format!("{e} ({})", path.display())))?
         }
     };
+    if args.range.is_some() {
+        session.sensor_range = args.range;
+    }
     if let Some(dir) = &args.csv_out {
         write_import_files(&session, dir)?;
     }

@@ -136,6 +136,24 @@ pub struct ReferenceDistance {
     pub distance: f64,
 }
 
+/// The sensor's measuring range in the laser plane (`sensor.range`), mm,
+/// sensor frame: `y` along the line, `z` in depth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorRange {
+    /// `[min, max]` along the laser line, mm.
+    pub y: [f64; 2],
+    /// `[min, max]` in depth, mm.
+    pub z: [f64; 2],
+}
+
+impl SensorRange {
+    /// The rectangle's area, mm².
+    #[must_use]
+    pub fn area(&self) -> f64 {
+        (self.y[1] - self.y[0]) * (self.z[1] - self.z[0])
+    }
+}
+
 /// FORMAT.md `solver` block of a session.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverSettings {
@@ -203,6 +221,9 @@ pub struct Session {
     pub default_side: i8,
     /// Whether the file had a `sensor` block.
     pub sensor_given: bool,
+    /// `sensor.range`: where in the laser plane the calibrated sensor will
+    /// measure (FORMAT.md "Additions to version 1"); `None` when not given.
+    pub sensor_range: Option<SensorRange>,
     /// Initial hand-eye `eT_s` from the file, if given.
     pub hand_eye: Option<Isometry3<f64>>,
     /// Solver settings (defaults when absent).

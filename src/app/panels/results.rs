@@ -741,6 +741,15 @@ fn ml_tables_ui(ui: &mut egui::Ui, view: &ResultView) {
         return;
     };
     ui.add_space(6.0);
+    if let Some(r) = &ml.range_error {
+        ui.label(r.summary()).on_hover_text(format!(
+            "1σ of points of the laser plane on a {} × {} grid at {} working poses, from ml's covariance, after the best rigid alignment",
+            r.grid, r.grid, r.poses
+        ));
+        if let Some(w) = &r.warning {
+            ui.label(RichText::new(format!("warning: {w}")).color(WARN));
+        }
+    }
     egui::CollapsingHeader::new(format!(
         "Outliers ({}; limit {:.1} σ)",
         ml.outliers.len(),

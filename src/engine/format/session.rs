@@ -61,7 +61,7 @@ use crate::engine::numeric::show;
 use crate::engine::robot::{Joint, Robot};
 use crate::engine::session::{
     DEFAULT_MAX_ITERATIONS, DEFAULT_THRESHOLD, MIN_STRIPE_POINTS, Measurement, Observation,
-    ReferenceDistance, Session, SolverSettings, Use, limits,
+    ReferenceDistance, SensorRange, Session, SolverSettings, Use, limits,
 };
 use crate::engine::stripe::StripeError;
 use nalgebra::Vector3;
@@ -151,7 +151,7 @@ keys_struct!(RobotKeys, "an object with name, joints and optionally base and fla
     name, joints, base, flange,
 });
 keys_struct!(SphereKeys, "an object with diameter" { diameter });
-keys_struct!(SensorKeys, "an object with side" { side });
+keys_struct!(SensorKeys, "an object with side and/or range" { side, range });
 keys_struct!(SolverKeys, "an object with threshold and max_iterations" {
     threshold, max_iterations,
 });
@@ -188,15 +188,20 @@ impl<'a> Ctx<'a> {
         let sphere_diameter =
             self.sphere(self.required(keys.sphere, top, "", "sphere", None)?)?;
         let sensor_given = keys.sensor.is_some();
-        let default_side = match keys.sensor {
+        let (default_side, sensor_range) = match keys.sensor {
             Some(raw) => {
                 let sensor: SensorKeys = self.object(raw, "sensor", None)?;
-                match sensor.side {
+                let side = match sensor.side {
                     Some(side) => self.side(side, "sensor.side", None)?,
                     None => 1,
-                }
+                };
+                let range = match sensor.range {
+                    Some(r) => Some(self.range(r)?),
+                    None => None,
+                };
+                (side, range)
             }
-            None => 1,
+            None => (1, None),
         };
         let hand_eye = match keys.hand_eye {
             Some(raw) => Some(self.matrix(raw, "hand_eye")?),
@@ -242,6 +247,7 @@ impl<'a> Ctx<'a> {
             sphere_diameter,
             default_side,
             sensor_given,
+            sensor_range,
             hand_eye,
             solver,
             solver_given,
@@ -314,6 +320,36 @@ impl<'a> Ctx<'a> {
             flange: flange.unwrap_or_else(Isometry3::identity),
         };
         Ok((robot, base.is_some(), flange.is_some()))
+    }
+
+    /// `sensor.range`: `{"y": [min, max], "z": [min, max]}` in mm, each
+    /// interval finite, `min < max`, within the plausible sensor extent.
+    fn range(&self, raw: &'a RawValue) -> Result<SensorRange, FileError> {
+        #[derive(Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct RangeKeys {
+            y: [f64; 2],
+            z: [f64; 2],
+        }
+        let r: RangeKeys = self.object(raw, "sensor.range", None)?;
+        for (name, v) in [("y", r.y), ("z", r.z)] {
+            let key = format!("sensor.range.{name}");
+            for x in v {
+                self.plausible(x, limits::SENSOR_COORDINATE_MM, &key, "mm", None, raw)?;
+            }
+            if v[0] >= v[1] {
+                return Err(self.invalid(
+                    None,
+                    format!(
+                        "{key} must be [min, max] with min < max (mm), found [{}, {}]{}",
+                        show(v[0]),
+                        show(v[1]),
+                        self.at(raw)
+                    ),
+                ));
+            }
+        }
+        Ok(SensorRange { y: r.y, z: r.z })
     }
 
     fn sphere(&self, raw: &'a RawValue) -> Result<f64, FileError> {
@@ -826,6 +862,14 @@ struct SphereOut {
 #[derive(Serialize)]
 struct SensorOut {
     side: i8,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    range: Option<RangeOut>,
+}
+
+#[derive(Serialize)]
+struct RangeOut {
+    y: [f64; 2],
+    z: [f64; 2],
 }
 
 #[derive(Serialize)]
@@ -884,9 +928,12 @@ impl<'a> SessionOut<'a> {
             sphere: SphereOut {
                 diameter: s.sphere_diameter,
             },
-            sensor: (s.sensor_given || s.default_side != 1).then_some(SensorOut {
-                side: s.default_side,
-            }),
+            sensor: (s.sensor_given || s.default_side != 1 || s.sensor_range.is_some()).then_some(
+                SensorOut {
+                    side: s.default_side,
+                    range: s.sensor_range.map(|r| RangeOut { y: r.y, z: r.z }),
+                },
+            ),
             hand_eye: s.hand_eye.as_ref().map(rows_from_isometry),
             solver: (s.solver_given
                 || s.solver.threshold != DEFAULT_THRESHOLD

@@ -593,6 +593,7 @@ pub(crate) fn new_session(
         sphere_diameter,
         default_side: side.unwrap_or(1),
         sensor_given: side.is_some(),
+        sensor_range: None,
         hand_eye: None,
         solver: SolverSettings::default(),
         solver_given: false,

@@ -531,6 +531,7 @@ impl Planner<'_> {
             sphere_diameter: c.diameter,
             default_side: 1,
             sensor_given: false,
+            sensor_range: None,
             hand_eye: Some(c.flange_from_sensor),
             solver: SolverSettings::default(),
             solver_given: false,

@@ -291,6 +291,7 @@ pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
         sphere_diameter: config.diameter,
         default_side,
         sensor_given: true,
+        sensor_range: None,
         hand_eye,
         solver: SolverSettings {
             threshold: config.threshold,

@@ -94,7 +94,25 @@ pub(super) fn identifiability(h: &mut String, ctx: &Ctx<'_>) {
                 cv.stations.len()
             );
         }
-        h.push_str("</ul>\n<p class=\"muted\">σ of every estimated parameter: in the hand-eye and joint-error tables below (± values).</p>\n");
+        if let Some(re) = &ml.range_error {
+            let _ = writeln!(
+                h,
+                "<li id=\"range-error\">{} ({} × {} grid at {} working poses, after the best rigid alignment)</li>",
+                escape(&re.summary()),
+                re.grid,
+                re.grid,
+                re.poses
+            );
+        }
+        h.push_str("</ul>\n");
+        if let Some(w) = ml.range_error.as_ref().and_then(|re| re.warning.as_ref()) {
+            let _ = writeln!(
+                h,
+                "<p class=\"warn\" id=\"range-warning\">{}</p>",
+                escape(w)
+            );
+        }
+        h.push_str("<p class=\"muted\">σ of every estimated parameter: in the hand-eye and joint-error tables below (± values).</p>\n");
     } else {
         let paper = ctx.solver().paper();
         let unknowns = paper.and_then(|p| p.unknowns.as_ref()).map_or(0, Vec::len);

@@ -341,6 +341,8 @@ pub(super) fn report(
     let predicted_validate =
         (!vpairs.is_empty()).then(|| distance_std(problem, &state.est, &cov_scaled, &vpairs));
     let predicted_identify = distance_std(problem, &state.est, &cov_scaled, &ipairs);
+    let range_error =
+        super::range::range_error(session, prepared, problem, &state.est, &cov_scaled);
     // Leave-one-station-out.
     let cross_validation = if mo.cross_validation && problem.stations.len() >= 2 {
         match problem.cross_validate(state, phase) {
@@ -367,6 +369,7 @@ pub(super) fn report(
         predicted_distance_std_validate: predicted_validate,
         predicted_distance_std_identify: predicted_identify,
         cross_validation,
+        range_error,
         outlier_limit_sigma: limit,
         outliers,
         ..base

@@ -75,6 +75,7 @@ pub mod identifiability;
 pub mod noise;
 mod prior;
 mod problem;
+pub mod range;
 pub mod report;
 
 use nalgebra::Vector3;

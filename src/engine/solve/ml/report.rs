@@ -229,6 +229,10 @@ pub struct MlReport {
     pub predicted_distance_std_identify: DistanceStd,
     /// Leave-one-station-out cross-validation, when enabled.
     pub cross_validation: Option<CrossValidation>,
+    /// Predicted error over the sensor's range (or the region the sphere
+    /// covered), from the covariance ([`super::range`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub range_error: Option<super::range::RangeError>,
     /// Outlier limit, σ of the standardised residual norm.
     pub outlier_limit_sigma: f64,
     /// Measurements beyond the limit.
@@ -292,6 +296,12 @@ impl MlReport {
                     .map(|w| format!(" (worst {} {:.4} mm)", w.station, w.rms))
                     .unwrap_or_default()
             );
+        }
+        if let Some(r) = &self.range_error {
+            let _ = writeln!(s, "  {}", r.summary());
+            if let Some(w) = &r.warning {
+                let _ = writeln!(s, "  warning: {w}");
+            }
         }
         if self.outliers.is_empty() {
             let _ = writeln!(s, "  no outliers beyond {:.2} σ", self.outlier_limit_sigma);

@@ -1,0 +1,289 @@
+//! The predicted error over the sensor's measuring range (beyond the
+//! paper): a sphere calibration learns the hand-eye where the sphere was
+//! seen, and its rotation error grows with the lever to any other point
+//! of the laser plane. From `ml`'s covariance of the estimated parameters
+//! this gives, for a grid of points `(0, y, z)` of the laser plane at the
+//! session's working poses (its validate poses, else its identify poses),
+//! the 1σ of each point's base-frame position (3-D) after the common
+//! rigid motion of all of them is taken out (the base frame is not
+//! observable from a sphere, and a workpiece frame is aligned anyway):
+//! its rms, mean, maximum and where, and the same at the mean sphere
+//! position. To first order the error of point `i` is `G_i·δθ`; the best
+//! rigid motion `R_i·(t, ω)`, `R_i = [I | −[p_i − c]×]`, is fitted to all
+//! of them by least squares and removed: `H_i = G_i − R_i·(RᵀR)⁻¹RᵀG`,
+//! `σ_i² = tr(H_i·C·H_iᵀ)`. The grid covers `sensor.range` when the
+//! session has one, else the region the sphere positions covered (and
+//! says so).
+
+use nalgebra::{DMatrix, Vector3};
+use serde::{Deserialize, Serialize};
+
+use super::diagnostics::restricted;
+use super::problem::Problem;
+use crate::engine::handeye::Sighting;
+use crate::engine::session::{SensorRange, Session, Use};
+use crate::engine::solve::Prepared;
+use crate::engine::solve::estimate::{Estimate, sensitivity};
+
+/// Grid points along each side of the range.
+pub const RANGE_GRID: usize = 9;
+
+/// Most working poses the prediction is averaged over (an even sample
+/// beyond).
+pub const RANGE_POSES: usize = 40;
+
+/// Below this fraction of `sensor.range` covered by the sphere positions
+/// the report warns.
+pub const RANGE_COVERAGE_WARNING: f64 = 0.25;
+
+/// The predicted error over the range (result file: `solver.range_error`).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RangeError {
+    /// What the grid covers: `sensor.range`, or `sphere positions` when
+    /// the session gives no range.
+    pub region: String,
+    /// The grid's `[min, max]` along the line, mm (sensor frame).
+    pub y: [f64; 2],
+    /// The grid's `[min, max]` in depth, mm.
+    pub z: [f64; 2],
+    /// Grid points per side.
+    pub grid: usize,
+    /// Working poses the figures are over.
+    pub poses: usize,
+    /// RMS over grid points and poses of the 3-D 1σ, mm.
+    pub rms_mm: f64,
+    /// Mean of the 3-D 1σ, mm.
+    pub mean_mm: f64,
+    /// Largest 3-D 1σ (at any pose), mm.
+    pub max_mm: f64,
+    /// Where the largest is, `[y, z]` mm.
+    pub max_at: [f64; 2],
+    /// RMS 3-D 1σ at the mean sphere position, mm.
+    pub at_sphere_mm: f64,
+    /// `[min, max]` of the measured sphere positions along the line, mm.
+    pub sphere_y: [f64; 2],
+    /// `[min, max]` of the measured sphere positions in depth, mm.
+    pub sphere_z: [f64; 2],
+    /// Fraction of the range's area inside the sphere positions' extent
+    /// (1 when the region is the sphere positions).
+    pub coverage: f64,
+    /// Set when the sphere covered less than [`RANGE_COVERAGE_WARNING`]
+    /// of the range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warning: Option<String>,
+}
+
+impl RangeError {
+    /// One line for people.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let what = if self.region == "sensor.range" {
+            format!(
+                "over sensor.range (y {:.0}…{:.0}, z {:.0}…{:.0} mm)",
+                self.y[0], self.y[1], self.z[0], self.z[1]
+            )
+        } else {
+            format!(
+                "over the region the sphere covered (y {:.1}…{:.1}, z {:.1}…{:.1} mm; no sensor.range in the session)",
+                self.y[0], self.y[1], self.z[0], self.z[1]
+            )
+        };
+        format!(
+            "predicted point error {what}: rms {:.3} mm, max {:.3} mm at (y {:.0}, z {:.0}); {:.3} mm at the sphere",
+            self.rms_mm, self.max_mm, self.max_at[0], self.max_at[1], self.at_sphere_mm
+        )
+    }
+}
+
+/// The restricted sensitivity `G` (3 × k, scaled units) of sensor point
+/// `g` at the pose of `s`, and the point's base-frame position.
+fn point_rows(
+    problem: &Problem,
+    est: &Estimate,
+    s: &Sighting,
+    g: Vector3<f64>,
+) -> (DMatrix<f64>, Vector3<f64>) {
+    let at = Sighting {
+        centre_in_sensor: g,
+        ..s.clone()
+    };
+    let (p, a) = sensitivity(est, &at);
+    let k = problem.estimated.len();
+    let mut rows = DMatrix::zeros(3, k);
+    for r in 0..3 {
+        let row = a.rows(r, 1).into_owned();
+        rows.set_row(r, &restricted(&row, problem).transpose());
+    }
+    (rows, p)
+}
+
+/// `R_i = [I | −[p − c]×]`: a point's motion under a small rigid motion
+/// `(t, ω)` about `c`.
+fn rigid_rows(p: &Vector3<f64>, c: &Vector3<f64>) -> DMatrix<f64> {
+    let d = p - c;
+    let mut r = DMatrix::zeros(3, 6);
+    r.view_mut((0, 0), (3, 3))
+        .copy_from(&nalgebra::Matrix3::identity());
+    let skew = nalgebra::Matrix3::new(0.0, -d.z, d.y, d.z, 0.0, -d.x, -d.y, d.x, 0.0);
+    r.view_mut((0, 3), (3, 3)).copy_from(&(-skew));
+    r
+}
+
+/// The rigid-motion fit `M = (RᵀR)⁻¹RᵀG` (6 × k) of a set of points.
+fn rigid_fit(points: &[(DMatrix<f64>, Vector3<f64>)], centroid: &Vector3<f64>) -> DMatrix<f64> {
+    let k = points.first().map_or(0, |(g, _)| g.ncols());
+    let mut rtr = DMatrix::zeros(6, 6);
+    let mut rtg = DMatrix::zeros(6, k);
+    for (g, p) in points {
+        let r = rigid_rows(p, centroid);
+        rtr += r.transpose() * &r;
+        rtg += r.transpose() * g;
+    }
+    // A degenerate set (every point on one line) leaves a rotation free:
+    // the pseudo-inverse takes out what can be taken out.
+    let pinv = rtr
+        .clone()
+        .pseudo_inverse(1e-12 * rtr.norm().max(1e-300))
+        .unwrap_or_else(|_| DMatrix::zeros(6, 6));
+    pinv * rtg
+}
+
+/// `σ` (mm) of one point after the rigid fit `m` is removed.
+fn aligned_sigma(
+    g: &DMatrix<f64>,
+    p: &Vector3<f64>,
+    centroid: &Vector3<f64>,
+    m: &DMatrix<f64>,
+    cov: &DMatrix<f64>,
+) -> f64 {
+    let h = g - rigid_rows(p, centroid) * m;
+    (&h * cov * h.transpose()).trace().max(0.0).sqrt()
+}
+
+/// The prediction (see the module doc); `None` without working poses.
+pub(super) fn range_error(
+    session: &Session,
+    prepared: &Prepared,
+    problem: &Problem,
+    est: &Estimate,
+    cov: &DMatrix<f64>,
+) -> Option<RangeError> {
+    let pick = |usage: Use| -> Vec<usize> {
+        (0..session.measurements.len())
+            .filter(|&i| session.measurements[i].usage == usage)
+            .collect()
+    };
+    let identify = pick(Use::Identify);
+    let validate = pick(Use::Validate);
+    let working = if validate.is_empty() {
+        &identify
+    } else {
+        &validate
+    };
+    if working.is_empty() || identify.is_empty() {
+        return None;
+    }
+    let stride = working.len().div_ceil(RANGE_POSES).max(1);
+    let poses: Vec<Sighting> = working
+        .iter()
+        .step_by(stride)
+        .map(|&i| prepared.sighting(session, i))
+        .collect();
+    // Where the sphere was seen (identify centres, sensor frame).
+    let centres: Vec<Vector3<f64>> = identify
+        .iter()
+        .map(|&i| prepared.measurements[i].centre_in_sensor)
+        .collect();
+    let extent = |k: usize| {
+        centres
+            .iter()
+            .fold([f64::INFINITY, f64::NEG_INFINITY], |e, c| {
+                [e[0].min(c[k]), e[1].max(c[k])]
+            })
+    };
+    let (sphere_y, sphere_z) = (extent(1), extent(2));
+    let mean = centres.iter().sum::<Vector3<f64>>() / centres.len() as f64;
+    let (region, range, coverage) = match session.sensor_range {
+        Some(r) => {
+            let overlap = |a: [f64; 2], b: [f64; 2]| (a[1].min(b[1]) - a[0].max(b[0])).max(0.0);
+            let covered = overlap(sphere_y, r.y) * overlap(sphere_z, r.z);
+            ("sensor.range".to_string(), r, covered / r.area())
+        }
+        None => (
+            "sphere positions".to_string(),
+            SensorRange {
+                y: sphere_y,
+                z: sphere_z,
+            },
+            1.0,
+        ),
+    };
+    let at = |lo: f64, hi: f64, k: usize| lo + (hi - lo) * k as f64 / (RANGE_GRID - 1) as f64;
+    let mut grid: Vec<([f64; 2], DMatrix<f64>, Vector3<f64>)> = Vec::new();
+    for ky in 0..RANGE_GRID {
+        for kz in 0..RANGE_GRID {
+            let (y, z) = (
+                at(range.y[0], range.y[1], ky),
+                at(range.z[0], range.z[1], kz),
+            );
+            for s in &poses {
+                let (g, p) = point_rows(problem, est, s, Vector3::new(0.0, y, z));
+                grid.push(([y, z], g, p));
+            }
+        }
+    }
+    let centroid = grid.iter().map(|(_, _, p)| p).sum::<Vector3<f64>>() / grid.len().max(1) as f64;
+    let pairs: Vec<(DMatrix<f64>, Vector3<f64>)> =
+        grid.iter().map(|(_, g, p)| (g.clone(), *p)).collect();
+    let m = rigid_fit(&pairs, &centroid);
+    let (mut sum_sq, mut sum, mut max, mut max_at) = (0.0, 0.0, 0.0_f64, [0.0; 2]);
+    for (yz, g, p) in &grid {
+        let sigma = aligned_sigma(g, p, &centroid, &m, cov);
+        sum_sq += sigma * sigma;
+        sum += sigma;
+        if sigma > max {
+            max = sigma;
+            max_at = *yz;
+        }
+    }
+    let sphere_sq: f64 = poses
+        .iter()
+        .map(|s| {
+            let (g, p) = point_rows(problem, est, s, Vector3::new(0.0, mean.y, mean.z));
+            aligned_sigma(&g, &p, &centroid, &m, cov).powi(2)
+        })
+        .sum();
+    let nf = grid.len().max(1) as f64;
+    let at_sphere_mm = (sphere_sq / poses.len() as f64).sqrt();
+    let warning = (coverage < RANGE_COVERAGE_WARNING).then(|| {
+        format!(
+            "the sphere positions (y {:.1}…{:.1}, z {:.1}…{:.1} mm) cover {:.0} % of sensor.range: the predicted error grows from {:.3} mm at the sphere to {:.3} mm at (y {:.0}, z {:.0}); spread the sphere over the range",
+            sphere_y[0],
+            sphere_y[1],
+            sphere_z[0],
+            sphere_z[1],
+            coverage * 100.0,
+            at_sphere_mm,
+            max,
+            max_at[0],
+            max_at[1]
+        )
+    });
+    Some(RangeError {
+        region,
+        y: range.y,
+        z: range.z,
+        grid: RANGE_GRID,
+        poses: poses.len(),
+        rms_mm: (sum_sq / nf).sqrt(),
+        mean_mm: sum / nf,
+        max_mm: max,
+        max_at,
+        at_sphere_mm,
+        sphere_y,
+        sphere_z,
+        coverage,
+        warning,
+    })
+}
