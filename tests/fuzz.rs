@@ -30,6 +30,10 @@ use spherecal::engine::simulate::{self, SimConfig};
 use spherecal::engine::solve::{self, Method, Options};
 use spherecal::engine::table::Table;
 
+/// The seed of every property test here (a fixed sequence of cases; a
+/// run with another seed explores others: change it locally).
+const SEED: u64 = 0x5EED_0012;
+
 /// Values that broke the tools, or sit at the edge of what parses.
 const EXTREMES: &[&str] = &[
     "1e308",
@@ -219,6 +223,8 @@ proptest! {
     #![proptest_config(ProptestConfig {
         cases: 10,
         failure_persistence: None,
+        // Fixed: the same cases on every run, so CI is reproducible.
+        rng_seed: proptest::test_runner::RngSeed::Fixed(SEED),
         ..ProptestConfig::default()
     })]
 
@@ -258,6 +264,8 @@ proptest! {
     #![proptest_config(ProptestConfig {
         cases: 160,
         failure_persistence: None,
+        // Fixed: the same cases on every run, so CI is reproducible.
+        rng_seed: proptest::test_runner::RngSeed::Fixed(SEED),
         ..ProptestConfig::default()
     })]
 
@@ -337,6 +345,8 @@ proptest! {
     #![proptest_config(ProptestConfig {
         cases: 48,
         failure_persistence: None,
+        // Fixed: the same cases on every run, so CI is reproducible.
+        rng_seed: proptest::test_runner::RngSeed::Fixed(SEED),
         ..ProptestConfig::default()
     })]
 
@@ -388,4 +398,42 @@ proptest! {
             }
         }
     }
+}
+
+/// Found by the fuzz test: a joint log cut after its header gave "every
+/// point has x = inf mm … ()" naming no file. It names the log.
+#[test]
+fn a_joint_log_without_rows_names_the_log() {
+    let (log, profiles) = import_files();
+    let dir = tempfile::tempdir().unwrap();
+    let header = log.lines().next().unwrap();
+    fs::write(dir.path().join("log.csv"), format!("{header}\n")).unwrap();
+    let folder = dir.path().join("profiles");
+    fs::create_dir(&folder).unwrap();
+    for (id, text) in profiles {
+        fs::write(folder.join(format!("{id}.csv")), text).unwrap();
+    }
+    let spec = ImportSpec {
+        joint_log: dir.path().join("log.csv"),
+        columns: ColumnMap {
+            id: "id".into(),
+            station: "station".into(),
+            usage: "use".into(),
+            side: None,
+            joints: (1..=6).map(|k| format!("j{k}")).collect(),
+        },
+        joint_unit: AngleUnit::Deg,
+        profiles: ProfileSource::Folder(folder),
+        profile_format: import::ProfileFormat::default(),
+        robot: RobotSource::Preset("irb2400".into()),
+        sphere_diameter: DEFAULT_SPHERE_DIAMETER,
+        name: None,
+        flange: None,
+        references: None,
+    };
+    let msg = import::import(&spec).unwrap_err().to_string();
+    assert!(
+        msg.contains("no pose rows") && msg.contains("log.csv"),
+        "{msg}"
+    );
 }

@@ -371,6 +371,12 @@ pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
     let robot = load_robot(&spec.robot)?;
     let log = CsvFile::read(&spec.joint_log)?;
     let cols = log::log_columns(spec, &log, robot.dof())?;
+    if log.rows.is_empty() {
+        return Err(ImportError::File {
+            path: log.path.clone(),
+            message: "the joint log has a header but no pose rows".into(),
+        });
+    }
     let ids: Vec<String> = log.rows.iter().map(|(_, r)| r[cols.id].clone()).collect();
     let mut seen: HashMap<&str, usize> = HashMap::new();
     for ((line, _), id) in log.rows.iter().zip(&ids) {

@@ -113,28 +113,54 @@ pub fn unknown_scale(k: usize) -> f64 {
 /// to `ΔY` (the bracket of eq. 17 for one measurement), and the centre.
 #[must_use]
 pub fn sensitivity(est: &Estimate, s: &Sighting) -> (Vector3<f64>, DMatrix<f64>) {
-    let (base_from_flange, jac) = match &s.flange {
-        // A given flange pose does not depend on the kinematic parameters.
-        Some(pose) => (*pose, nalgebra::Matrix6xX::zeros(est.robot.n_params())),
-        None => est.robot.flange_jacobian(&s.joints),
-    };
-    let base_from_sensor = base_from_flange * est.flange_from_sensor;
-    let x_b = (base_from_sensor * Point3::from(s.centre_in_sensor)).coords;
-    let r_bs: Matrix3<f64> = base_from_sensor.rotation.to_rotation_matrix().into_inner();
-    let n = 6 + jac.ncols();
-    let mut a = DMatrix::zeros(3, n);
-    // Hand-eye block: R_bs · [I | −[X_s]×]   (eq. 13-14)
-    a.fixed_view_mut::<3, 3>(0, 0).copy_from(&r_bs);
-    a.fixed_view_mut::<3, 3>(0, 3)
-        .copy_from(&(-(r_bs * skew(&s.centre_in_sensor))));
-    // Kinematic block: Q_i · J_i = [I | −[X_b]×] · J_i   (eq. 15-16)
-    let mut q = nalgebra::Matrix3x6::zeros();
-    q.fixed_view_mut::<3, 3>(0, 0)
-        .copy_from(&Matrix3::identity());
-    q.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew(&x_b)));
-    let qj = q * jac;
-    a.view_mut((0, 6), (3, n - 6)).copy_from(&qj);
-    (x_b, a)
+    PoseSensitivity::new(est, s).at(est, &s.centre_in_sensor)
+}
+
+/// The part of [`sensitivity`] that depends on the pose only (the flange
+/// pose and its Jacobian `J_i`), to evaluate many sensor points at one
+/// pose.
+#[derive(Debug, Clone)]
+pub struct PoseSensitivity {
+    base_from_flange: Isometry3<f64>,
+    jac: nalgebra::Matrix6xX<f64>,
+}
+
+impl PoseSensitivity {
+    /// The pose of sighting `s` under `est`.
+    #[must_use]
+    pub fn new(est: &Estimate, s: &Sighting) -> Self {
+        let (base_from_flange, jac) = match &s.flange {
+            // A given flange pose does not depend on the kinematic parameters.
+            Some(pose) => (*pose, nalgebra::Matrix6xX::zeros(est.robot.n_params())),
+            None => est.robot.flange_jacobian(&s.joints),
+        };
+        Self {
+            base_from_flange,
+            jac,
+        }
+    }
+
+    /// `A_i` and the base-frame position of sensor point `x_s` at this pose.
+    #[must_use]
+    pub fn at(&self, est: &Estimate, x_s: &Vector3<f64>) -> (Vector3<f64>, DMatrix<f64>) {
+        let base_from_sensor = self.base_from_flange * est.flange_from_sensor;
+        let x_b = (base_from_sensor * Point3::from(*x_s)).coords;
+        let r_bs: Matrix3<f64> = base_from_sensor.rotation.to_rotation_matrix().into_inner();
+        let n = 6 + self.jac.ncols();
+        let mut a = DMatrix::zeros(3, n);
+        // Hand-eye block: R_bs · [I | −[X_s]×]   (eq. 13-14)
+        a.fixed_view_mut::<3, 3>(0, 0).copy_from(&r_bs);
+        a.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&(-(r_bs * skew(x_s))));
+        // Kinematic block: Q_i · J_i = [I | −[X_b]×] · J_i   (eq. 15-16)
+        let mut q = nalgebra::Matrix3x6::zeros();
+        q.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&Matrix3::identity());
+        q.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew(&x_b)));
+        let qj = q * &self.jac;
+        a.view_mut((0, 6), (3, n - 6)).copy_from(&qj);
+        (x_b, a)
+    }
 }
 
 #[cfg(test)]

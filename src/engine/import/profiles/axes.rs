@@ -152,6 +152,9 @@ impl AxisMap {
                 hi[k] = hi[k].max(p[k]);
             }
         }
+        if lo.iter().any(|v| !v.is_finite()) {
+            return Err("no profile points to guess the laser plane from".to_string());
+        }
         let spread: Vec<f64> = (0..3).map(|k| hi[k] - lo[k]).collect();
         let Some(normal) = (0..3).find(|&k| spread[k] <= PLANE_TOLERANCE_MM) else {
             return Err(format!(

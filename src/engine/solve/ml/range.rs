@@ -18,19 +18,17 @@
 use nalgebra::{DMatrix, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::diagnostics::restricted;
 use super::problem::Problem;
-use crate::engine::handeye::Sighting;
 use crate::engine::session::{SensorRange, Session, Use};
 use crate::engine::solve::Prepared;
-use crate::engine::solve::estimate::{Estimate, sensitivity};
+use crate::engine::solve::estimate::{Estimate, PoseSensitivity};
 
 /// Grid points along each side of the range.
-pub const RANGE_GRID: usize = 9;
+pub const RANGE_GRID: usize = 7;
 
 /// Most working poses the prediction is averaged over (an even sample
 /// beyond).
-pub const RANGE_POSES: usize = 40;
+pub const RANGE_POSES: usize = 20;
 
 /// Below this fraction of `sensor.range` covered by the sphere positions
 /// the report warns.
@@ -97,24 +95,16 @@ impl RangeError {
 }
 
 /// The restricted sensitivity `G` (3 × k, scaled units) of sensor point
-/// `g` at the pose of `s`, and the point's base-frame position.
+/// `g` at a pose, and the point's base-frame position.
 fn point_rows(
     problem: &Problem,
     est: &Estimate,
-    s: &Sighting,
+    pose: &PoseSensitivity,
     g: Vector3<f64>,
 ) -> (DMatrix<f64>, Vector3<f64>) {
-    let at = Sighting {
-        centre_in_sensor: g,
-        ..s.clone()
-    };
-    let (p, a) = sensitivity(est, &at);
+    let (p, a) = pose.at(est, &g);
     let k = problem.estimated.len();
-    let mut rows = DMatrix::zeros(3, k);
-    for r in 0..3 {
-        let row = a.rows(r, 1).into_owned();
-        rows.set_row(r, &restricted(&row, problem).transpose());
-    }
+    let rows = DMatrix::from_fn(3, k, |r, c| a[(r, problem.estimated[c])] / problem.scale[c]);
     (rows, p)
 }
 
@@ -131,8 +121,11 @@ fn rigid_rows(p: &Vector3<f64>, c: &Vector3<f64>) -> DMatrix<f64> {
 }
 
 /// The rigid-motion fit `M = (RᵀR)⁻¹RᵀG` (6 × k) of a set of points.
-fn rigid_fit(points: &[(DMatrix<f64>, Vector3<f64>)], centroid: &Vector3<f64>) -> DMatrix<f64> {
-    let k = points.first().map_or(0, |(g, _)| g.ncols());
+fn rigid_fit<'a>(
+    points: impl Iterator<Item = (&'a DMatrix<f64>, &'a Vector3<f64>)>,
+    k: usize,
+    centroid: &Vector3<f64>,
+) -> DMatrix<f64> {
     let mut rtr = DMatrix::zeros(6, 6);
     let mut rtg = DMatrix::zeros(6, k);
     for (g, p) in points {
@@ -185,10 +178,10 @@ pub(super) fn range_error(
         return None;
     }
     let stride = working.len().div_ceil(RANGE_POSES).max(1);
-    let poses: Vec<Sighting> = working
+    let poses: Vec<PoseSensitivity> = working
         .iter()
         .step_by(stride)
-        .map(|&i| prepared.sighting(session, i))
+        .map(|&i| PoseSensitivity::new(est, &prepared.sighting(session, i)))
         .collect();
     // Where the sphere was seen (identify centres, sensor frame).
     let centres: Vec<Vector3<f64>> = identify
@@ -234,9 +227,11 @@ pub(super) fn range_error(
         }
     }
     let centroid = grid.iter().map(|(_, _, p)| p).sum::<Vector3<f64>>() / grid.len().max(1) as f64;
-    let pairs: Vec<(DMatrix<f64>, Vector3<f64>)> =
-        grid.iter().map(|(_, g, p)| (g.clone(), *p)).collect();
-    let m = rigid_fit(&pairs, &centroid);
+    let m = rigid_fit(
+        grid.iter().map(|(_, g, p)| (g, p)),
+        problem.estimated.len(),
+        &centroid,
+    );
     let (mut sum_sq, mut sum, mut max, mut max_at) = (0.0, 0.0, 0.0_f64, [0.0; 2]);
     for (yz, g, p) in &grid {
         let sigma = aligned_sigma(g, p, &centroid, &m, cov);
