@@ -298,3 +298,57 @@ fn the_plan_view_follows_the_open_sessions_robot() {
     assert!(script.starts_with("def spherecal_plan():"), "{script}");
     assert!(script.contains("movej(["));
 }
+
+/// Issue 14: a session with `sensor.range`: after a run the Results view
+/// shows the predicted error over the range as a map, with the warning
+/// that the sphere covered little of it.
+#[test]
+fn the_results_view_maps_the_predicted_error_over_the_range() {
+    let mut h = demo_app();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (mut session, _) =
+        spherecal::engine::simulate::simulate(&spherecal::engine::simulate::SimConfig::default())
+            .expect("simulate");
+    session.sensor_range = Some(spherecal::engine::session::SensorRange {
+        y: [-40.0, 40.0],
+        z: [-40.0, 40.0],
+    });
+    let path = dir.path().join("ranged.json");
+    spherecal::engine::format::save_session(&session, &path).expect("save");
+    let ctx = h.ctx.clone();
+    h.state_mut().command(
+        &ctx,
+        spherecal::app::commands::Command::Files(spherecal::app::commands::FilesCommand::OpenPath(
+            path,
+        )),
+    );
+    settle(&mut h);
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    h.get_by_label("Results ●").click();
+    h.run();
+    let range = h
+        .state()
+        .state()
+        .result
+        .as_ref()
+        .and_then(|r| r.file.solver.ml())
+        .and_then(|m| m.range_error.clone())
+        .expect("a range prediction");
+    assert_eq!(range.map.len(), range.grid * range.grid);
+    assert!(
+        h.query_all_by_label_contains("Predicted 1σ over the range")
+            .count()
+            > 0
+    );
+    assert!(
+        h.query_all_by_label_contains("predicted point error over sensor.range")
+            .count()
+            > 0
+    );
+    assert!(
+        h.query_all_by_label_contains("warning: the sphere positions")
+            .count()
+            > 0
+    );
+}

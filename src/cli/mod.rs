@@ -71,7 +71,7 @@ pub enum Command {
     ExportModel(export_model::ExportModelArgs),
     /// Build a session file from a joint log CSV and stripe profile files (mm, deg in the session; units of the inputs chosen by flags).
     Import(import::ImportArgs),
-    /// Plan the poses to teach (translation, rotation, identify and validate groups) for a robot, a rough sphere position and a hand-eye guess; export CSV and RAPID.
+    /// Plan the poses to teach (translation, rotation, identify and validate groups) for a robot, a rough sphere position and a hand-eye guess; export CSV and the controller program (RAPID, URScript).
     Plan(plan::PlanArgs),
     /// Write a self-contained HTML report (figures as inline SVG): calibrates the session first, or reports `--result` as it is.
     Report(html_report::ReportArgs),

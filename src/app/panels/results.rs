@@ -749,6 +749,7 @@ fn ml_tables_ui(ui: &mut egui::Ui, view: &ResultView) {
         if let Some(w) = &r.warning {
             ui.label(RichText::new(format!("warning: {w}")).color(WARN));
         }
+        range_map_ui(ui, r);
     }
     egui::CollapsingHeader::new(format!(
         "Outliers ({}; limit {:.1} σ)",
@@ -817,4 +818,90 @@ fn ml_tables_ui(ui: &mut egui::Ui, view: &ResultView) {
             ui.label(c);
         }
     });
+}
+
+/// A colour from green (low) through yellow to red (high), `t` in 0..1.
+fn heat(t: f64) -> egui::Color32 {
+    let t = t.clamp(0.0, 1.0) as f32;
+    let lerp =
+        |a: u8, b: u8, f: f32| (f32::from(a) + (f32::from(b) - f32::from(a)) * f).round() as u8;
+    let (low, mid, high) = ([60, 170, 90], [230, 200, 60], [225, 60, 60]);
+    let (a, b, f) = if t < 0.5 {
+        (low, mid, t * 2.0)
+    } else {
+        (mid, high, t * 2.0 - 1.0)
+    };
+    egui::Color32::from_rgb(
+        lerp(a[0], b[0], f),
+        lerp(a[1], b[1], f),
+        lerp(a[2], b[2], f),
+    )
+}
+
+/// The predicted error over the range as a map: one cell per grid point
+/// coloured by its σ (green low, red high), the region the sphere
+/// positions covered outlined, the largest σ marked.
+fn range_map_ui(ui: &mut egui::Ui, r: &crate::engine::solve::ml::range::RangeError) {
+    use egui_plot::Polygon;
+    if r.map.is_empty() || r.grid < 2 {
+        return;
+    }
+    let (lo, hi) = r
+        .map
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p[2]), b.max(p[2]))
+        });
+    let span = (hi - lo).max(1e-12);
+    let half_y = (r.y[1] - r.y[0]) / (r.grid - 1) as f64 / 2.0;
+    let half_z = (r.z[1] - r.z[0]) / (r.grid - 1) as f64 / 2.0;
+    ui.label(
+        RichText::new(format!(
+            "Predicted 1σ over the range: {lo:.3} mm (green) to {hi:.3} mm (red); the white outline is where the sphere was seen"
+        ))
+        .color(MUTED),
+    );
+    Plot::new("range_map")
+        .height(PLOT_HEIGHT)
+        .width(PLOT_HEIGHT * 1.3)
+        .data_aspect(1.0)
+        .x_axis_label("y (mm, along the laser line)")
+        .y_axis_label("z (mm, depth)")
+        .allow_drag(false)
+        .allow_scroll(false)
+        .show(ui, |p| {
+            for c in &r.map {
+                let (y, z) = (c[0], c[1]);
+                let cell = vec![
+                    [y - half_y, z - half_z],
+                    [y + half_y, z - half_z],
+                    [y + half_y, z + half_z],
+                    [y - half_y, z + half_z],
+                ];
+                let colour = heat((c[2] - lo) / span);
+                p.polygon(
+                    Polygon::new(format!("σ {:.3} mm", c[2]), PlotPoints::from(cell))
+                        .fill_color(colour)
+                        .stroke(egui::Stroke::new(0.5, colour)),
+                );
+            }
+            let (y0, y1, z0, z1) = (r.sphere_y[0], r.sphere_y[1], r.sphere_z[0], r.sphere_z[1]);
+            p.line(
+                Line::new(
+                    "sphere positions",
+                    PlotPoints::from(vec![[y0, z0], [y1, z0], [y1, z1], [y0, z1], [y0, z0]]),
+                )
+                .color(egui::Color32::WHITE)
+                .width(2.0),
+            );
+            p.points(
+                Points::new(
+                    format!("largest σ {:.3} mm", r.max_mm),
+                    PlotPoints::from(vec![r.max_at]),
+                )
+                .shape(MarkerShape::Cross)
+                .radius(6.0)
+                .color(egui::Color32::WHITE),
+            );
+        });
 }

@@ -66,6 +66,9 @@ pub struct RangeError {
     /// Fraction of the range's area inside the sphere positions' extent
     /// (1 when the region is the sphere positions).
     pub coverage: f64,
+    /// The map: `[y, z, σ]` (mm) of every grid point, σ the rms over the
+    /// working poses.
+    pub map: Vec<[f64; 3]>,
     /// Set when the sphere covered less than [`RANGE_COVERAGE_WARNING`]
     /// of the range.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -233,13 +236,22 @@ pub(super) fn range_error(
         &centroid,
     );
     let (mut sum_sq, mut sum, mut max, mut max_at) = (0.0, 0.0, 0.0_f64, [0.0; 2]);
-    for (yz, g, p) in &grid {
-        let sigma = aligned_sigma(g, p, &centroid, &m, cov);
-        sum_sq += sigma * sigma;
-        sum += sigma;
-        if sigma > max {
-            max = sigma;
-            max_at = *yz;
+    // The grid is point-major: each point's poses follow one another.
+    let mut map: Vec<[f64; 3]> = Vec::with_capacity(RANGE_GRID * RANGE_GRID);
+    for chunk in grid.chunks(poses.len().max(1)) {
+        let mut point_sq = 0.0;
+        for (yz, g, p) in chunk {
+            let sigma = aligned_sigma(g, p, &centroid, &m, cov);
+            sum_sq += sigma * sigma;
+            point_sq += sigma * sigma;
+            sum += sigma;
+            if sigma > max {
+                max = sigma;
+                max_at = *yz;
+            }
+        }
+        if let Some((yz, _, _)) = chunk.first() {
+            map.push([yz[0], yz[1], (point_sq / chunk.len() as f64).sqrt()]);
         }
     }
     let sphere_sq: f64 = poses
@@ -279,6 +291,7 @@ pub(super) fn range_error(
         sphere_y,
         sphere_z,
         coverage,
+        map,
         warning,
     })
 }
