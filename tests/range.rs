@@ -216,6 +216,12 @@ fn the_command_line_reports_the_range_error() {
     let page = std::fs::read_to_string(&html).unwrap();
     assert!(page.contains("id=\"range-error\""));
     assert!(page.contains("id=\"range-warning\""));
+    assert!(page.contains("id=\"range-map\"><svg"));
+    assert_eq!(
+        page.matches("<title>y ").count(),
+        range.map.len(),
+        "one cell per grid point"
+    );
     let (code, _, err) = run(&[
         "simulate",
         "--out",

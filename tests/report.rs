@@ -177,8 +177,10 @@ fn every_section_the_sha256_and_the_headline() {
     let table = &table[..table.find("</table>").unwrap()];
     assert_eq!(table.matches("<tr><td>").count(), v.distances.len());
     // ml: Fig. 5, Fig. 6 and ε are plotted, each SVG with a title, axes
-    // labelled with units and a legend of both series.
-    assert_eq!(html.matches("<svg").count(), 3);
+    // labelled with units and a legend of both series; and the map of the
+    // predicted error over the region the sphere covered.
+    assert_eq!(html.matches("<svg").count(), 4);
+    assert!(html.contains("id=\"range-map\""));
     assert!(html.contains("centre distance (mm)") && html.contains("error (mm)"));
     assert!(html.contains("ε (mm, log scale)"));
     assert_eq!(
@@ -300,7 +302,10 @@ fn a_session_without_validation_says_so() {
     assert!(!html.contains("id=\"distances\""));
     // Fig. 5 falls back to the identify stations; ε is still plotted.
     assert!(html.contains("Centre distances within identify stations"));
-    assert_eq!(html.matches("<svg").count(), 2);
+    // Fig. 5, ε and the map of the predicted error over the region the
+    // sphere covered (ml; no sensor.range).
+    assert_eq!(html.matches("<svg").count(), 3);
+    assert!(html.contains("id=\"range-map\""));
     assert_only_report_tags(&html);
 }
 

@@ -217,12 +217,13 @@ fn the_report_renders_in_headless_chromium() {
             "heading missing from the DOM: {heading}"
         );
     }
-    // Fig. 5, Fig. 6 and ε as SVG elements with their marks.
-    assert_eq!(dom.matches("<svg").count(), 3, "SVG figures in the DOM");
-    // Two marker paths for each of Fig. 5 and 6, one for ε; their lines.
-    assert_eq!(dom.matches("<path").count(), 5);
+    // Fig. 5, Fig. 6, ε and the range map as SVG elements with their marks.
+    assert_eq!(dom.matches("<svg").count(), 4, "SVG figures in the DOM");
+    // Two marker paths for each of Fig. 5 and 6, one for ε, the range
+    // map's cross; their lines.
+    assert_eq!(dom.matches("<path").count(), 6);
     assert!(dom.matches("<polyline").count() >= 5);
-    for id in ["fig5", "fig6", "epsilon"] {
+    for id in ["fig5", "fig6", "epsilon", "range-map"] {
         let at = dom.find(&format!("<figure id=\"{id}\">")).unwrap();
         assert!(
             dom[at..].starts_with(&format!("<figure id=\"{id}\"><svg")),
@@ -437,7 +438,11 @@ fn plan_to_browser_rendered_report_through_the_csv_import() {
         dom.contains(&spherecal::engine::report::html::sha256_hex(&bytes)),
         "the session's SHA-256 is on the page"
     );
-    assert_eq!(dom.matches("<svg").count(), 3, "Fig. 5, Fig. 6 and ε");
+    assert_eq!(
+        dom.matches("<svg").count(),
+        4,
+        "Fig. 5, Fig. 6, ε and the range map"
+    );
     assert!(
         dom.contains(&format!("{:.3}", v.after.std)),
         "the std after"

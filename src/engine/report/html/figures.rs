@@ -290,3 +290,128 @@ pub(super) fn singular_values(h: &mut String, ctx: &Ctx<'_>) {
         ),
     );
 }
+
+/// A colour from green (low) through yellow to red (high), `t` in 0..1,
+/// as `#rrggbb` (the workbench's range map uses the same scale).
+fn heat_hex(t: f64) -> String {
+    let t = t.clamp(0.0, 1.0);
+    let lerp = |a: f64, b: f64, f: f64| (a + (b - a) * f).round() as u8;
+    let (low, mid, high) = (
+        [60.0, 170.0, 90.0],
+        [230.0, 200.0, 60.0],
+        [225.0, 60.0, 60.0],
+    );
+    let (a, b, f) = if t < 0.5 {
+        (low, mid, t * 2.0)
+    } else {
+        (mid, high, t * 2.0 - 1.0)
+    };
+    format!(
+        "#{:02x}{:02x}{:02x}",
+        lerp(a[0], b[0], f),
+        lerp(a[1], b[1], f),
+        lerp(a[2], b[2], f)
+    )
+}
+
+/// The predicted error over the range as an inline SVG map: one cell per
+/// grid point coloured by its σ, the sphere positions outlined, the
+/// largest σ marked, the range's limits on the axes.
+pub(super) fn range_map_svg(re: &crate::engine::solve::ml::range::RangeError) -> String {
+    use std::fmt::Write as _;
+    if re.map.is_empty() || re.grid < 2 {
+        return String::new();
+    }
+    let (size, pad) = (280.0_f64, 46.0_f64);
+    let (lo, hi) = re
+        .map
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p[2]), b.max(p[2]))
+        });
+    let span = (hi - lo).max(1e-12);
+    let cells = re.grid as f64;
+    let (y0, y1, z0, z1) = (re.y[0], re.y[1], re.z[0], re.z[1]);
+    let half_y = (y1 - y0) / (cells - 1.0) / 2.0;
+    let half_z = (z1 - z0) / (cells - 1.0) / 2.0;
+    let (ya, yb, za, zb) = (y0 - half_y, y1 + half_y, z0 - half_z, z1 + half_z);
+    let px = |y: f64| pad + (y - ya) / (yb - ya) * size;
+    // Depth up.
+    let pz = |z: f64| 10.0 + (zb - z) / (zb - za) * size;
+    let mut svg = String::new();
+    let _ = write!(
+        svg,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\" role=\"img\" aria-label=\"predicted error over the range\">",
+        w = size + pad + 20.0,
+        h = size + 56.0
+    );
+    for c in &re.map {
+        let _ = write!(
+            svg,
+            "<rect x=\"{:.1}\" y=\"{:.1}\" width=\"{:.1}\" height=\"{:.1}\" fill=\"{}\"><title>y {:.1}, z {:.1} mm: σ {:.3} mm</title></rect>",
+            px(c[0] - half_y),
+            pz(c[1] + half_z),
+            px(c[0] + half_y) - px(c[0] - half_y),
+            pz(c[1] - half_z) - pz(c[1] + half_z),
+            heat_hex((c[2] - lo) / span),
+            c[0],
+            c[1],
+            c[2]
+        );
+    }
+    let _ = write!(
+        svg,
+        "<rect x=\"{:.1}\" y=\"{:.1}\" width=\"{:.1}\" height=\"{:.1}\" fill=\"none\" stroke=\"#fff\" stroke-width=\"2\"/>",
+        px(re.sphere_y[0]),
+        pz(re.sphere_z[1]),
+        (px(re.sphere_y[1]) - px(re.sphere_y[0])).max(2.0),
+        (pz(re.sphere_z[0]) - pz(re.sphere_z[1])).max(2.0)
+    );
+    let (mx, mz) = (px(re.max_at[0]), pz(re.max_at[1]));
+    let _ = write!(
+        svg,
+        "<path d=\"M{:.1} {:.1}L{:.1} {:.1}M{:.1} {:.1}L{:.1} {:.1}\" stroke=\"#fff\" stroke-width=\"2\"/>",
+        mx - 5.0,
+        mz - 5.0,
+        mx + 5.0,
+        mz + 5.0,
+        mx - 5.0,
+        mz + 5.0,
+        mx + 5.0,
+        mz - 5.0
+    );
+    let axis_y = size + 10.0;
+    for (y, anchor) in [(y0, "start"), (y1, "end")] {
+        let _ = write!(
+            svg,
+            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"{anchor}\">{y:.0}</text>",
+            px(y),
+            axis_y + 16.0
+        );
+    }
+    let _ = write!(
+        svg,
+        "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"middle\">y (mm, along the laser line)</text>",
+        pad + size / 2.0,
+        axis_y + 34.0
+    );
+    for (z, dy) in [(z1, 12.0), (z0, 0.0)] {
+        let _ = write!(
+            svg,
+            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"end\">{z:.0}</text>",
+            pad - 4.0,
+            pz(z) + dy
+        );
+    }
+    let _ = write!(
+        svg,
+        "<text x=\"12\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"middle\" transform=\"rotate(-90 12 {:.1})\">z (mm, depth)</text>",
+        10.0 + size / 2.0,
+        10.0 + size / 2.0
+    );
+    svg.push_str("</svg>");
+    format!(
+        "<figure id=\"range-map\">{svg}<figcaption>Predicted 1σ over the range (rms over {} working poses): {lo:.3} mm (green) to {hi:.3} mm (red); white outline: where the sphere was seen; ×: the largest σ.</figcaption></figure>\n",
+        re.poses
+    )
+}

@@ -112,6 +112,9 @@ pub(super) fn identifiability(h: &mut String, ctx: &Ctx<'_>) {
                 escape(w)
             );
         }
+        if let Some(re) = &ml.range_error {
+            h.push_str(&super::figures::range_map_svg(re));
+        }
         h.push_str("<p class=\"muted\">σ of every estimated parameter: in the hand-eye and joint-error tables below (± values).</p>\n");
     } else {
         let paper = ctx.solver().paper();
