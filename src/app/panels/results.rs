@@ -422,7 +422,7 @@ fn fig6_ui(ui: &mut egui::Ui, view: &ResultView) {
     let distances = &view.shown.distances;
     Plot::new("fig6")
         .height(PLOT_HEIGHT)
-        .x_axis_label("distance")
+        .x_axis_label("reference distance no.")
         .y_axis_label("error (mm)")
         .label_formatter(move |pos| match pos {
             egui_plot::HoverPosition::NearDataPoint {

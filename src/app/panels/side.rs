@@ -320,6 +320,14 @@ pub fn epsilon_plot_ui(
         .x_axis_label("update")
         .y_axis_label("ε (mm, log)")
         .y_axis_formatter(|mark, _| super::log_tick(mark.value))
+        // Updates are whole numbers: no tick at 0.5.
+        .x_axis_formatter(|mark, _| {
+            if (mark.value - mark.value.round()).abs() < 1e-9 && mark.value >= 0.0 {
+                format!("{}", mark.value.round())
+            } else {
+                String::new()
+            }
+        })
         .label_formatter(|pos| match pos {
             egui_plot::HoverPosition::NearDataPoint { position, .. } => Some(format!(
                 "update {}: ε = {:.4} mm",
@@ -343,6 +351,14 @@ pub fn epsilon_plot_ui(
             );
             if let Some(t) = threshold {
                 p.hline(HLine::new("threshold", log(t)).color(BEFORE));
+                p.text(
+                    egui_plot::Text::new(
+                        "threshold label",
+                        egui_plot::PlotPoint::new(0.0, log(t)),
+                        RichText::new(format!("threshold {t:.3} mm")).color(BEFORE),
+                    )
+                    .anchor(egui::Align2::LEFT_BOTTOM),
+                );
             }
         });
 }
