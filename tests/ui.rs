@@ -585,6 +585,18 @@ fn the_import_wizard_guesses_the_mapping_previews_and_opens_the_session() {
             > 0,
         "the preview shows joint 2 of the first pose"
     );
+    // Issue 13: editing the form clears the now stale preview.
+    h.get_by_label("no-return value").click();
+    h.run();
+    h.get_by_label("no-return value").type_text("-999");
+    h.run();
+    assert!(
+        h.state().state().import.preview.is_none(),
+        "an edit clears the old preview"
+    );
+    h.get_by_label("Preview").click();
+    settle(&mut h);
+    assert!(h.state().state().import.preview.is_some());
 
     h.get_by_label("Import and open").click();
     settle(&mut h);

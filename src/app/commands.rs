@@ -97,6 +97,9 @@ pub enum ImportCommand {
     },
     /// Build the session from the import form and open it.
     Run,
+    /// A field of the form changed: the preview, the last outcome and the
+    /// flange checks no longer describe it and are cleared.
+    Edited,
 }
 
 /// The library of past results.

@@ -80,6 +80,12 @@ impl Core {
         match command {
             ImportCommand::Preview { guess } => self.import_preview(ctx, guess),
             ImportCommand::Run => self.import_run(ctx),
+            ImportCommand::Edited => {
+                let view = &mut self.state.import;
+                view.preview = None;
+                view.outcome = None;
+                view.checks.clear();
+            }
         }
     }
 

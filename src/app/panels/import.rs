@@ -29,6 +29,20 @@ pub fn import_ui(
     forms: &mut Forms,
     commands: &mut Vec<Command>,
 ) {
+    // An edit makes the preview, the last outcome and the checks stale.
+    let before = forms.import.clone();
+    import_form_ui(ui, state, forms, commands);
+    if forms.import != before {
+        commands.push(Command::Import(ImportCommand::Edited));
+    }
+}
+
+fn import_form_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
     egui::ScrollArea::vertical()
         .auto_shrink([false, false])
         .show(ui, |ui| {
