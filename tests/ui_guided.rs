@@ -352,3 +352,23 @@ fn the_results_view_maps_the_predicted_error_over_the_range() {
             > 0
     );
 }
+
+/// Issue 13: a measurement was picked from a 124-item drop-down with no
+/// search; the Stripe view's Find narrows the picker and Previous/Next.
+#[test]
+fn the_stripe_view_finds_measurements() {
+    let mut h = demo_app();
+    h.get_by_label("Stripe").click();
+    h.run();
+    h.get_by_label("Find").click();
+    h.run();
+    h.get_by_label("Find").type_text("c5");
+    h.run();
+    let rows = h.state().state().visible_rows(h.state().forms());
+    let loaded = h.state().state().loaded.as_ref().expect("demo");
+    assert!(!rows.is_empty() && rows.len() < 20, "{}", rows.len());
+    assert!(
+        rows.iter()
+            .all(|&i| loaded.session.measurements[i].id.contains("c5"))
+    );
+}

@@ -19,7 +19,12 @@ use crate::engine::stripe::StripeResult;
 const CIRCLE_SEGMENTS: usize = 256;
 
 /// The Stripe view.
-pub fn stripe_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mut Vec<Command>) {
+pub fn stripe_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
     let Some(loaded) = &state.loaded else {
         ui.label("No session open.");
         return;
@@ -41,6 +46,16 @@ pub fn stripe_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &
         {
             commands.push(Command::View(ViewCommand::Step(-1)));
         }
+        // The same search as the Session table's: narrows the picker and
+        // Previous/Next (a session has a hundred measurements and more).
+        let find = ui.label("Find");
+        ui.add(
+            egui::TextEdit::singleline(&mut forms.search)
+                .hint_text("id or station")
+                .desired_width(90.0),
+        )
+        .labelled_by(find.id)
+        .on_hover_text("list only measurements whose id or station contains this text");
         egui::ComboBox::from_id_salt("stripe_measurement")
             .selected_text(RichText::new(&m.id).strong())
             .height(400.0)
