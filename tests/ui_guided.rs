@@ -372,3 +372,15 @@ fn the_stripe_view_finds_measurements() {
             .all(|&i| loaded.session.measurements[i].id.contains("c5"))
     );
 }
+
+/// Issue 13: on first start the demo says what to do; dismissed, it stays
+/// away (remembered in the preferences).
+#[test]
+fn the_demo_says_what_to_do_until_dismissed() {
+    let mut h = demo_app();
+    assert!(h.query_by_label("What to do").is_some());
+    h.get_by_label("Got it").click();
+    h.run();
+    assert!(h.query_by_label("What to do").is_none());
+    assert!(h.state().state().prefs.intro_dismissed);
+}

@@ -73,6 +73,8 @@ pub enum ViewCommand {
     IncludeAll,
     /// Close the error notice.
     DismissNotice,
+    /// Close the first-start "what to do" (remembered).
+    DismissIntro,
     /// Set the acceptance tolerance (remembered for the session's robot).
     SetTolerance(crate::engine::result_view::Tolerance),
 }

@@ -398,6 +398,8 @@ pub struct Prefs {
     pub history_folder: Option<PathBuf>,
     /// The acceptance tolerance last set for each robot (by name).
     pub tolerances: std::collections::BTreeMap<String, Tolerance>,
+    /// The first-start "what to do" on the demo was dismissed.
+    pub intro_dismissed: bool,
 }
 
 impl Prefs {

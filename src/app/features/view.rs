@@ -53,6 +53,7 @@ impl Core {
                 self.say_excluded();
             }
             ViewCommand::DismissNotice => self.state.notice = None,
+            ViewCommand::DismissIntro => self.state.prefs.intro_dismissed = true,
             ViewCommand::SetTolerance(t) => {
                 if t.is_valid() {
                     self.forms.tolerance = t;

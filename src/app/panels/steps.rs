@@ -139,8 +139,34 @@ pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
     ]
 }
 
+/// The first-start "what to do", on the demo until dismissed.
+fn intro_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
+    let on_demo = state
+        .loaded
+        .as_ref()
+        .is_some_and(|l| l.source == crate::app::state::Source::Demo);
+    if !on_demo || state.prefs.intro_dismissed {
+        return;
+    }
+    egui::Frame::group(ui.style()).show(ui, |ui| {
+        ui.horizontal_wrapped(|ui| {
+            ui.label(RichText::new("What to do").strong());
+            ui.label(
+                "This is the demo: a simulated paper-like cell. The bar below is the job in order. \
+                 Press Next to run the calibration, then see the verdict in Results and write the report. \
+                 For your own cell: Plan the poses, Import the robot's log and the sensor's profiles \
+                 (or open a session file on the left), check the stripes, then run.",
+            );
+            if ui.button("Got it").clicked() {
+                commands.push(Command::View(ViewCommand::DismissIntro));
+            }
+        });
+    });
+}
+
 /// The bar: each step with its mark, then the next action's button.
 pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mut Vec<Command>) {
+    intro_ui(ui, state, commands);
     let all = steps(state, forms);
     // The next step: the first not done, else a step that needs attention.
     let next = all
