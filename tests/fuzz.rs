@@ -310,6 +310,29 @@ proptest! {
     }
 }
 
+/// The import of `dir/log.csv` with the profiles in `folder` (IRB 2400,
+/// degrees, mm).
+fn spec_for(dir: &Path, folder: std::path::PathBuf) -> ImportSpec {
+    ImportSpec {
+        joint_log: dir.join("log.csv"),
+        columns: ColumnMap {
+            id: "id".into(),
+            station: "station".into(),
+            usage: "use".into(),
+            side: None,
+            joints: (1..=6).map(|k| format!("j{k}")).collect(),
+        },
+        joint_unit: AngleUnit::Deg,
+        profiles: ProfileSource::Folder(folder),
+        profile_format: import::ProfileFormat::default(),
+        robot: RobotSource::Preset("irb2400".into()),
+        sphere_diameter: DEFAULT_SPHERE_DIAMETER,
+        name: Some("fuzz".into()),
+        flange: None,
+        references: None,
+    }
+}
+
 /// The joint log and profiles of a small simulated session, as CSV text.
 fn import_files() -> &'static (String, Vec<(String, String)>) {
     static F: std::sync::OnceLock<(String, Vec<(String, String)>)> = std::sync::OnceLock::new();
@@ -369,24 +392,7 @@ proptest! {
             let text = if i == k { apply(text, &profile_mutations) } else { text.clone() };
             fs::write(folder.join(format!("{id}.csv")), text).unwrap();
         }
-        let spec = ImportSpec {
-            joint_log: dir.path().join("log.csv"),
-            columns: ColumnMap {
-                id: "id".into(),
-                station: "station".into(),
-                usage: "use".into(),
-                side: None,
-                joints: (1..=6).map(|k| format!("j{k}")).collect(),
-            },
-            joint_unit: AngleUnit::Deg,
-            profiles: ProfileSource::Folder(folder),
-            profile_format: import::ProfileFormat::default(),
-            robot: RobotSource::Preset("irb2400".into()),
-            sphere_diameter: DEFAULT_SPHERE_DIAMETER,
-            name: Some("fuzz".into()),
-            flange: None,
-            references: None,
-        };
+        let spec = spec_for(dir.path(), folder);
         match import::import(&spec) {
             Ok(imported) => {
                 let text = format::session_to_json(&imported.session);
@@ -413,24 +419,7 @@ fn a_joint_log_without_rows_names_the_log() {
     for (id, text) in profiles {
         fs::write(folder.join(format!("{id}.csv")), text).unwrap();
     }
-    let spec = ImportSpec {
-        joint_log: dir.path().join("log.csv"),
-        columns: ColumnMap {
-            id: "id".into(),
-            station: "station".into(),
-            usage: "use".into(),
-            side: None,
-            joints: (1..=6).map(|k| format!("j{k}")).collect(),
-        },
-        joint_unit: AngleUnit::Deg,
-        profiles: ProfileSource::Folder(folder),
-        profile_format: import::ProfileFormat::default(),
-        robot: RobotSource::Preset("irb2400".into()),
-        sphere_diameter: DEFAULT_SPHERE_DIAMETER,
-        name: None,
-        flange: None,
-        references: None,
-    };
+    let spec = spec_for(dir.path(), folder);
     let msg = import::import(&spec).unwrap_err().to_string();
     assert!(
         msg.contains("no pose rows") && msg.contains("log.csv"),

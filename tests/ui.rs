@@ -17,7 +17,7 @@ use spherecal::engine::report::model::{self, ModelFormat};
 use spherecal::engine::solve::{Options, calibrate};
 
 mod ui_support;
-use ui_support::{demo_app, settle};
+use ui_support::{demo_app, open_path, settle};
 
 /// The text of every label that starts with `prefix`.
 fn labels_starting(h: &Harness<'_, WorkbenchApp>, prefix: &str) -> Vec<String> {
@@ -222,14 +222,7 @@ fn cancel_stops_a_run() {
         .expect("simulate");
     let path = dir.path().join("big.json");
     spherecal::engine::format::save_session(&session, &path).expect("save");
-    let ctx = h.ctx.clone();
-    h.state_mut().command(
-        &ctx,
-        spherecal::app::commands::Command::Files(spherecal::app::commands::FilesCommand::OpenPath(
-            path,
-        )),
-    );
-    settle(&mut h);
+    open_path(&mut h, path);
     assert_eq!(
         h.state()
             .state()

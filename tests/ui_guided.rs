@@ -15,7 +15,7 @@ use spherecal::app::WorkbenchApp;
 use spherecal::app::forms::Tab;
 
 mod ui_support;
-use ui_support::{demo_app, settle};
+use ui_support::{demo_app, open_path, settle};
 
 /// The label of the step bar's step `n` (its mark changes with its state).
 fn step_label(h: &Harness<'_, WorkbenchApp>, name: &str) -> String {
@@ -168,14 +168,7 @@ fn cancel_in_the_last_phase_keeps_the_previous_result() {
         .expect("simulate");
     let path = dir.path().join("big.json");
     spherecal::engine::format::save_session(&session, &path).expect("save");
-    let ctx = h.ctx.clone();
-    h.state_mut().command(
-        &ctx,
-        spherecal::app::commands::Command::Files(spherecal::app::commands::FilesCommand::OpenPath(
-            path,
-        )),
-    );
-    settle(&mut h);
+    open_path(&mut h, path);
     // A first, whole run: the result on show.
     h.get_by_label("▶ Run").click();
     settle(&mut h);
@@ -315,14 +308,7 @@ fn the_results_view_maps_the_predicted_error_over_the_range() {
     });
     let path = dir.path().join("ranged.json");
     spherecal::engine::format::save_session(&session, &path).expect("save");
-    let ctx = h.ctx.clone();
-    h.state_mut().command(
-        &ctx,
-        spherecal::app::commands::Command::Files(spherecal::app::commands::FilesCommand::OpenPath(
-            path,
-        )),
-    );
-    settle(&mut h);
+    open_path(&mut h, path);
     h.get_by_label("▶ Run").click();
     settle(&mut h);
     h.get_by_label("Results ●").click();

@@ -41,3 +41,15 @@ pub fn demo_app() -> Harness<'static, WorkbenchApp> {
     );
     h
 }
+
+/// Opens a session or result file as the panels would, and waits.
+pub fn open_path(h: &mut Harness<'_, WorkbenchApp>, path: std::path::PathBuf) {
+    let ctx = h.ctx.clone();
+    h.state_mut().command(
+        &ctx,
+        spherecal::app::commands::Command::Files(spherecal::app::commands::FilesCommand::OpenPath(
+            path,
+        )),
+    );
+    settle(h);
+}

@@ -820,22 +820,10 @@ fn ml_tables_ui(ui: &mut egui::Ui, view: &ResultView) {
     });
 }
 
-/// A colour from green (low) through yellow to red (high), `t` in 0..1.
+/// The engine's map colour scale ([`heat_rgb`](crate::engine::report::svg::heat_rgb)).
 fn heat(t: f64) -> egui::Color32 {
-    let t = t.clamp(0.0, 1.0) as f32;
-    let lerp =
-        |a: u8, b: u8, f: f32| (f32::from(a) + (f32::from(b) - f32::from(a)) * f).round() as u8;
-    let (low, mid, high) = ([60, 170, 90], [230, 200, 60], [225, 60, 60]);
-    let (a, b, f) = if t < 0.5 {
-        (low, mid, t * 2.0)
-    } else {
-        (mid, high, t * 2.0 - 1.0)
-    };
-    egui::Color32::from_rgb(
-        lerp(a[0], b[0], f),
-        lerp(a[1], b[1], f),
-        lerp(a[2], b[2], f),
-    )
+    let [r, g, b] = crate::engine::report::svg::heat_rgb(t);
+    egui::Color32::from_rgb(r, g, b)
 }
 
 /// The predicted error over the range as a map: one cell per grid point

@@ -108,6 +108,25 @@ pub struct Plot {
     pub height: f64,
 }
 
+/// A colour scale for a map, `t` in 0..1: green (low) through yellow to
+/// red (high), as RGB. The HTML report's and the workbench's range maps
+/// both use it.
+#[must_use]
+pub fn heat_rgb(t: f64) -> [u8; 3] {
+    let t = t.clamp(0.0, 1.0);
+    let (low, mid, high) = (
+        [60.0, 170.0, 90.0],
+        [230.0, 200.0, 60.0],
+        [225.0, 60.0, 60.0],
+    );
+    let (a, b, f): ([f64; 3], [f64; 3], f64) = if t < 0.5 {
+        (low, mid, t * 2.0)
+    } else {
+        (mid, high, t * 2.0 - 1.0)
+    };
+    std::array::from_fn(|k| (a[k] + (b[k] - a[k]) * f).round() as u8)
+}
+
 /// Escapes text for HTML and SVG content and attribute values.
 #[must_use]
 pub fn escape(s: &str) -> String {

@@ -291,27 +291,10 @@ pub(super) fn singular_values(h: &mut String, ctx: &Ctx<'_>) {
     );
 }
 
-/// A colour from green (low) through yellow to red (high), `t` in 0..1,
-/// as `#rrggbb` (the workbench's range map uses the same scale).
+/// [`heat_rgb`] as `#rrggbb`.
 fn heat_hex(t: f64) -> String {
-    let t = t.clamp(0.0, 1.0);
-    let lerp = |a: f64, b: f64, f: f64| (a + (b - a) * f).round() as u8;
-    let (low, mid, high) = (
-        [60.0, 170.0, 90.0],
-        [230.0, 200.0, 60.0],
-        [225.0, 60.0, 60.0],
-    );
-    let (a, b, f) = if t < 0.5 {
-        (low, mid, t * 2.0)
-    } else {
-        (mid, high, t * 2.0 - 1.0)
-    };
-    format!(
-        "#{:02x}{:02x}{:02x}",
-        lerp(a[0], b[0], f),
-        lerp(a[1], b[1], f),
-        lerp(a[2], b[2], f)
-    )
+    let [r, g, b] = crate::engine::report::svg::heat_rgb(t);
+    format!("#{r:02x}{g:02x}{b:02x}")
 }
 
 /// The predicted error over the range as an inline SVG map: one cell per
