@@ -5,7 +5,12 @@
 use clap::Args;
 
 use super::CliError;
-use crate::engine::evaluate::study::{StudyError, markdown, run_scenario, select, text};
+use crate::engine::evaluate::planned::{
+    planned_range_markdown, planned_range_study, planned_range_text,
+};
+use crate::engine::evaluate::study::{
+    StudyError, markdown, range_markdown, run_scenario, select, text,
+};
 
 /// `spherecal evaluate`.
 #[derive(Debug, Args)]
@@ -14,12 +19,15 @@ pub struct EvaluateArgs {
     #[arg(long, default_value_t = 5)]
     pub seeds: u64,
     /// One scenario key (`paper-like`, `random-2x`, `stripe-0.05`,
-    /// `outliers-5pct`, `stations-30`) or `all`.
+    /// `outliers-5pct`, `stations-30`, `range-spot`, `range-spread`) or `all`.
     #[arg(long, default_value = "all")]
     pub scenario: String,
     /// Print the README table (Markdown) instead of the text report.
     #[arg(long)]
     pub markdown: bool,
+    /// Instead of the scenarios: the IRB 2400 cell planned for an 80 × 80 mm range with and without spreading the sphere over it, simulated with Table 1 and random errors, the error over the range predicted and realised against the floor.
+    #[arg(long)]
+    pub planned_range: bool,
 }
 
 /// `spherecal evaluate`.
@@ -29,6 +37,18 @@ pub struct EvaluateArgs {
 pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
     if args.seeds == 0 {
         return Err(CliError::input("--seeds must be at least 1"));
+    }
+    if args.planned_range {
+        if !args.markdown {
+            eprintln!("planning with and without the spread, {} seed(s) each…", args.seeds);
+        }
+        let rows = planned_range_study(args.seeds).map_err(|e| CliError::internal(e.to_string()))?;
+        if args.markdown {
+            say!("{}", planned_range_markdown(&rows, args.seeds));
+        } else {
+            say!("{}", planned_range_text(&rows, args.seeds));
+        }
+        return Ok(());
     }
     let scenarios =
         select(&args.scenario).map_err(|e: StudyError| CliError::input(e.to_string()))?;
@@ -43,6 +63,9 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
     }
     if args.markdown {
         say!("{}", markdown(&results, args.seeds));
+        if results.iter().any(|r| !r.range_floor.is_empty()) {
+            say!("\n{}", range_markdown(&results, args.seeds));
+        }
     } else {
         say!("{}", text(&results, args.seeds));
     }

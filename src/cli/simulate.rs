@@ -94,6 +94,11 @@ pub struct SimulateArgs {
     /// The sensor's measuring range to write as `sensor.range`: `Y0,Y1,Z0,Z1` in mm (laser plane, sensor frame), e.g. `-40,40,-40,40`; ml then predicts the error over it.
     #[arg(long, allow_hyphen_values = true, value_parser = super::parse_range)]
     pub range: Option<crate::engine::session::SensorRange>,
+    /// Spread the sphere over --range: identify and validate measurements
+    /// see the sphere centre anywhere in the range (uniform along the line
+    /// and in depth) instead of the paper's ±2, ±3 mm spot.
+    #[arg(long, requires = "range", conflicts_with = "plan")]
+    pub spread: bool,
     /// Where to write the truth file (default: the session path with
     /// `.json` replaced by `.truth.json`).
     #[arg(long)]
@@ -190,6 +195,8 @@ impl SimulateArgs {
             side: self.side.into(),
             tracker_noise: self.tracker_noise,
             diameter: self.diameter,
+            range: self.range,
+            spread: self.spread,
             ..SimConfig::default()
         }
     }
@@ -287,6 +294,8 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         }
     };
     if args.range.is_some() {
+        // A plan's simulation echoes the configuration too; set it here
+        // for every path.
         session.sensor_range = args.range;
     }
     if let Some(dir) = &args.csv_out {

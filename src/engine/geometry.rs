@@ -177,9 +177,67 @@ pub fn rotation_from_rpy_deg(rpy_deg: [f64; 3]) -> UnitQuaternion<f64> {
     UnitQuaternion::from_euler_angles(r, p, y)
 }
 
+/// The rigid motion `T` that best maps `from` onto `to` in least squares
+/// (Kabsch: centroids, then the SVD of the cross-covariance, reflection
+/// excluded). `None` for fewer than 3 pairs, unequal lengths or a failed
+/// SVD.
+#[must_use]
+pub fn kabsch(from: &[Vector3<f64>], to: &[Vector3<f64>]) -> Option<Isometry3<f64>> {
+    if from.len() != to.len() || from.len() < 3 {
+        return None;
+    }
+    let n = from.len() as f64;
+    let cf = from.iter().sum::<Vector3<f64>>() / n;
+    let ct = to.iter().sum::<Vector3<f64>>() / n;
+    let mut h = Matrix3::zeros();
+    for (f, t) in from.iter().zip(to) {
+        h += (f - cf) * (t - ct).transpose();
+    }
+    let svd = nalgebra::linalg::SVD::try_new(
+        h,
+        true,
+        true,
+        f64::EPSILON,
+        crate::engine::numeric::MAX_DECOMPOSITION_SWEEPS,
+    )?;
+    let (u, v_t) = (svd.u?, svd.v_t?);
+    let mut d = Matrix3::identity();
+    if (v_t.transpose() * u.transpose()).determinant() < 0.0 {
+        d[(2, 2)] = -1.0;
+    }
+    let r = Rotation3::from_matrix_unchecked(v_t.transpose() * d * u.transpose());
+    let t = ct - r * cf;
+    Some(Isometry3::from_parts(
+        Translation3::from(t),
+        UnitQuaternion::from_rotation_matrix(&r),
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn kabsch_recovers_a_rigid_motion() {
+        let motion = isometry_from_twist(&[10.0, -5.0, 2.0, 0.3, -0.1, 0.7]);
+        let from: Vec<Vector3<f64>> = [
+            [0.0, 0.0, 0.0],
+            [100.0, 0.0, 0.0],
+            [0.0, 50.0, 0.0],
+            [0.0, 0.0, 30.0],
+            [20.0, -40.0, 10.0],
+        ]
+        .iter()
+        .map(|p| Vector3::from(*p))
+        .collect();
+        let to: Vec<Vector3<f64>> = from
+            .iter()
+            .map(|p| (motion * nalgebra::Point3::from(*p)).coords)
+            .collect();
+        let found = kabsch(&from, &to).unwrap();
+        assert!((found.to_homogeneous() - motion.to_homogeneous()).abs().max() < 1e-9);
+        assert!(kabsch(&from[..2], &to[..2]).is_none());
+    }
 
     #[test]
     fn rows_round_trip() {

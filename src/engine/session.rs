@@ -138,7 +138,7 @@ pub struct ReferenceDistance {
 
 /// The sensor's measuring range in the laser plane (`sensor.range`), mm,
 /// sensor frame: `y` along the line, `z` in depth.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SensorRange {
     /// `[min, max]` along the laser line, mm.
     pub y: [f64; 2],
@@ -151,6 +151,12 @@ impl SensorRange {
     #[must_use]
     pub fn area(&self) -> f64 {
         (self.y[1] - self.y[0]) * (self.z[1] - self.z[0])
+    }
+
+    /// Whether `(y, z)` lies in the rectangle.
+    #[must_use]
+    pub fn contains(&self, y: f64, z: f64) -> bool {
+        (self.y[0]..=self.y[1]).contains(&y) && (self.z[0]..=self.z[1]).contains(&z)
     }
 }
 

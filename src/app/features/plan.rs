@@ -81,6 +81,7 @@ pub fn stage_text(stage: PlanStage) -> String {
         PlanStage::Analysis => "identifiability of the candidate pool…".to_string(),
         PlanStage::Selection => "D-optimal selection…".to_string(),
         PlanStage::Ordering => "ordering for short moves…".to_string(),
+        PlanStage::Comparison => "the plan without the spread, for comparison…".to_string(),
     }
 }
 

@@ -5,6 +5,8 @@
 //! data. Used by the accuracy tests, the `simulate` summary and the
 //! method comparison of the README.
 
+pub mod planned;
+pub mod range;
 pub mod study;
 
 use nalgebra::{Isometry3, Point3, Vector3};

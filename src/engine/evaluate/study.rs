@@ -15,11 +15,19 @@
 //! | `stripe-0.05` | stripe noise 0.05 mm |
 //! | `outliers-5pct` | 5 % of the stripe points are outliers |
 //! | `stations-30` | 30 identify stations |
+//! | `range-spot` | `sensor.range` ±40 mm (80 × 80 mm); the sphere at the paper's one spot |
+//! | `range-spread` | the same range, the sphere spread over it (`SimConfig::spread`) |
+//!
+//! With a range, each method's error over it is scored too
+//! ([`range_score`]): rms over a grid at the validate poses against the
+//! floor (the true model on the same readings).
 
 use std::fmt::Write as _;
 use std::time::Instant;
 
+use super::range::range_score;
 use super::score;
+use crate::engine::session::SensorRange;
 use crate::engine::simulate::{self, ErrorModel, SimConfig, SimError};
 use crate::engine::solve::{self, Control, Method, Options, SolveError};
 
@@ -115,8 +123,29 @@ fn many_stations(seed: u64) -> SimConfig {
     }
 }
 
-/// The five scenarios of the issue, in table order.
-pub const SCENARIOS: [Scenario; 5] = [
+/// The range of the range scenarios: 80 × 80 mm of the laser plane
+/// about the sensor origin (issue 14).
+pub const STUDY_RANGE: SensorRange = SensorRange {
+    y: [-40.0, 40.0],
+    z: [-40.0, 40.0],
+};
+
+fn range_spot(seed: u64) -> SimConfig {
+    SimConfig {
+        range: Some(STUDY_RANGE),
+        ..paper_like(seed)
+    }
+}
+
+fn range_spread(seed: u64) -> SimConfig {
+    SimConfig {
+        spread: true,
+        ..range_spot(seed)
+    }
+}
+
+/// The scenarios of the issues, in table order.
+pub const SCENARIOS: [Scenario; 7] = [
     Scenario {
         key: "paper-like",
         title: "paper-like (Table 1 errors, 9 stations)",
@@ -142,6 +171,16 @@ pub const SCENARIOS: [Scenario; 5] = [
         title: "30 identify stations",
         config: many_stations,
     },
+    Scenario {
+        key: "range-spot",
+        title: "80 × 80 mm range, sphere at one spot",
+        config: range_spot,
+    },
+    Scenario {
+        key: "range-spread",
+        title: "80 × 80 mm range, sphere spread over it",
+        config: range_spread,
+    },
 ];
 
 /// One method's results over the seeds.
@@ -153,6 +192,10 @@ pub struct MethodRuns {
     pub ratio: Vec<f64>,
     /// Wall time of `solve::run`, ms, per seed.
     pub millis: Vec<f64>,
+    /// RMS error over the range, mm, per seed (range scenarios only).
+    pub range_rms: Vec<f64>,
+    /// `range_rms / range floor`, per seed.
+    pub range_ratio: Vec<f64>,
 }
 
 /// One scenario's results.
@@ -164,6 +207,9 @@ pub struct ScenarioResult {
     pub title: &'static str,
     /// Noise floor std per seed, mm.
     pub floor: Vec<f64>,
+    /// Floor of the error over the range (rms, mm) per seed; empty
+    /// without a range.
+    pub range_floor: Vec<f64>,
     /// The paper's method.
     pub paper: MethodRuns,
     /// The `ml` method.
@@ -204,6 +250,7 @@ pub fn run_scenario(scenario: &Scenario, seeds: u64) -> Result<ScenarioResult, S
         key: scenario.key,
         title: scenario.title,
         floor: Vec::new(),
+        range_floor: Vec::new(),
         paper: MethodRuns::default(),
         ml: MethodRuns::default(),
     };
@@ -236,6 +283,16 @@ pub fn run_scenario(scenario: &Scenario, seeds: u64) -> Result<ScenarioResult, S
             runs.ratio.push(score.ratio_to_floor());
             if method == Method::Paper {
                 out.floor.push(score.floor.std);
+            }
+            let initial = &prepared.hand_eye_initial;
+            if let Some(range) =
+                range_score(&session, &truth, initial, &cal.calibrated, &cal.hand_eye, None)
+            {
+                runs.range_rms.push(range.after.rms);
+                runs.range_ratio.push(range.ratio_to_floor());
+                if method == Method::Paper {
+                    out.range_floor.push(range.floor.rms);
+                }
             }
         }
     }
@@ -293,6 +350,52 @@ pub fn text(results: &[ScenarioResult], seeds: u64) -> String {
             "  ml worse than paper in {} of {} seed(s)",
             r.ml_worse_seeds(),
             r.ml.std.len()
+        );
+        if !r.range_floor.is_empty() {
+            let _ = writeln!(
+                s,
+                "  error over the range (rms over a {g} × {g} grid at the validate poses, mm): floor {:.4} / {:.4}",
+                mean(&r.range_floor),
+                max(&r.range_floor),
+                g = super::range::RANGE_SCORE_GRID
+            );
+            for (name, m) in [("paper", &r.paper), ("ml", &r.ml)] {
+                let _ = writeln!(
+                    s,
+                    "  {name:<6} rms {:.4} / {:.4}   ratio {:.2} / {:.2}",
+                    mean(&m.range_rms),
+                    max(&m.range_rms),
+                    mean(&m.range_ratio),
+                    max(&m.range_ratio)
+                );
+            }
+        }
+    }
+    s
+}
+
+/// The README table of the error over the range (Markdown): the
+/// scenarios with a range.
+#[must_use]
+pub fn range_markdown(results: &[ScenarioResult], seeds: u64) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "| scenario ({seeds} seeds) | floor rms, mm | paper rms, mm | ml rms, mm | paper / floor (max) | ml / floor (max) |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|");
+    for r in results.iter().filter(|r| !r.range_floor.is_empty()) {
+        let _ = writeln!(
+            s,
+            "| {} | {:.4} | {:.4} | {:.4} | {:.2} ({:.2}) | {:.2} ({:.2}) |",
+            r.title,
+            mean(&r.range_floor),
+            mean(&r.paper.range_rms),
+            mean(&r.ml.range_rms),
+            mean(&r.paper.range_ratio),
+            max(&r.paper.range_ratio),
+            mean(&r.ml.range_ratio),
+            max(&r.ml.range_ratio)
         );
     }
     s

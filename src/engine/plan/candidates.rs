@@ -15,10 +15,11 @@ use crate::engine::handeye::{MIN_TRANSLATION_SPREAD, Sighting};
 use crate::engine::robot::Robot;
 use crate::engine::robot::ik::{Chain, DOF};
 use crate::engine::session::{
-    Measurement, Observation, ReferenceDistance, Session, SolverSettings, Use,
+    Measurement, Observation, ReferenceDistance, SensorRange, Session, SolverSettings, Use,
 };
 use crate::engine::simulate::SimConfig;
-use crate::engine::solve::estimate::{Estimate, sensitivity, unknown_label};
+use crate::engine::solve::estimate::{Estimate, PoseSensitivity, sensitivity, unknown_label};
+use crate::engine::solve::ml::range::{AlignedGrid, RANGE_POSES};
 use crate::engine::solve::ml::{self, MlOptions, MlReport};
 use crate::engine::solve::{self, HandEyeSource, Method, Options, Prepared};
 
@@ -196,10 +197,10 @@ impl Planner<'_> {
         let mean = self.mean_approach(station);
         let cone = c.cone_angle.to_radians();
         let mut out = Vec::new();
-        for _ in 0..c.candidates {
+        for k in 0..c.candidates {
             let rotation = approach::random_orientation(rng, &mean, cone);
             for side in [1_i8, -1] {
-                let offset = self.offset(rng);
+                let offset = self.station_offset(rng, k, c.candidates);
                 out.extend(self.candidates_at(
                     station,
                     &rotation,
@@ -223,6 +224,30 @@ impl Planner<'_> {
             random::uniform(rng, -y, y),
             random::uniform(rng, -z, z),
         )
+    }
+
+    /// The offset of an identify or validate candidate: anywhere in the
+    /// sensor's range when the plan spreads the sphere (the `k`-th of `n`
+    /// orientations takes the `k`-th cell of a jittered grid over the
+    /// range, so the candidates of a station cover it evenly), else
+    /// [`Self::offset`].
+    pub(super) fn station_offset(&self, rng: &mut ChaCha8Rng, k: usize, n: usize) -> Vector3<f64> {
+        let c = self.config;
+        let (true, Some(r)) = (c.spread, c.range) else {
+            return self.offset(rng);
+        };
+        // A jittered `side × side` grid (the orientations are random, so
+        // cell order does not matter).
+        let side = (n as f64).sqrt().ceil().max(1.0) as usize;
+        let cell = k % (side * side);
+        let (iy, iz) = (cell / side, cell % side);
+        let mut at = |lo: f64, hi: f64, i: usize| {
+            let w = (hi - lo) / side as f64;
+            lo + w * (i as f64 + random::uniform(rng, 0.0, 1.0))
+        };
+        let y = at(r.y[0], r.y[1], iy);
+        let z = at(r.z[0], r.z[1], iz);
+        Vector3::new(0.0, y, z)
     }
 
     /// Every IK branch that sees `station` at `centre` (sensor frame) with
@@ -531,7 +556,7 @@ impl Planner<'_> {
             sphere_diameter: c.diameter,
             default_side: 1,
             sensor_given: false,
-            sensor_range: None,
+            sensor_range: c.range,
             hand_eye: Some(c.flange_from_sensor),
             solver: SolverSettings::default(),
             solver_given: false,
@@ -600,6 +625,38 @@ impl Planner<'_> {
             .collect();
         let (session, prepared) = self.analysis_input(&poses, &validate);
         self.analyse(&session, &prepared)
+    }
+
+    /// `Q` of the range criterion ([`AlignedGrid::weight`]) over `range`
+    /// at the working poses: the chosen validate poses (at most
+    /// [`RANGE_POSES`], evenly), else each identify station's first pose.
+    pub(super) fn range_weight(
+        &self,
+        sites: &[Site],
+        estimated: &[usize],
+        range: &SensorRange,
+    ) -> DMatrix<f64> {
+        let mut working: Vec<&Candidate> = sites
+            .iter()
+            .filter(|s| s.role == StationRole::Validate)
+            .flat_map(|s| s.chosen.iter().map(|&i| &s.candidates[i]))
+            .collect();
+        if working.is_empty() {
+            working = sites
+                .iter()
+                .filter(|s| s.role == StationRole::Identify)
+                .filter_map(|s| self.first_pose(s).map(|i| &s.candidates[i]))
+                .collect();
+        }
+        let stride = working.len().div_ceil(RANGE_POSES).max(1);
+        let est = self.estimate();
+        let poses: Vec<PoseSensitivity> = working
+            .iter()
+            .step_by(stride)
+            .map(|c| PoseSensitivity::new(&est, &Self::sighting("working", c)))
+            .collect();
+        let scale: Vec<f64> = estimated.iter().map(|&k| unknown_scale(k)).collect();
+        AlignedGrid::new(&est, &poses, estimated, &scale, range).weight()
     }
 
     /// Condition number of the whitened, scaled Jacobian of `estimated`

@@ -9,6 +9,7 @@ use crate::engine::cell::workspace::{self, Workspace};
 use crate::engine::robot::ik::DOF;
 use crate::engine::robot::{JointLimit, Preset, Robot, RobotChoice};
 use crate::engine::simulate::SimConfig;
+use crate::engine::session::SensorRange;
 
 use super::*;
 
@@ -130,6 +131,15 @@ pub struct PlanConfig {
     /// mm (NOTES.md). All at `y = z = 0` (on the sensor x axis) would hide
     /// the hand-eye rotation about that axis.
     pub centre_spread: [f64; 2],
+    /// The sensor's measuring range (`sensor.range`, issue 14): the plan's
+    /// analysis predicts the error over it.
+    pub range: Option<SensorRange>,
+    /// Spread the sphere over `range`: identify and validate candidates
+    /// see the centre anywhere in the range (instead of `centre_spread`)
+    /// and the identify poses are chosen for the smallest predicted error
+    /// over the range (`tr(Q·M⁻¹)`, see `select`) instead of `ln det`.
+    /// Needs `range`.
+    pub spread: bool,
 }
 
 impl PlanConfig {
@@ -169,6 +179,8 @@ impl PlanConfig {
             joint_sigma_deg: sim.joint_noise,
             stripe_sigma: sim.stripe_noise,
             centre_spread: DEFAULT_CENTRE_SPREAD_MM,
+            range: None,
+            spread: false,
         }
     }
 
@@ -261,6 +273,18 @@ impl PlanConfig {
                 .all(|v| v.is_finite() && *v >= 0.0),
             || "the centre spread needs two finite, non-negative half-widths (mm)".to_owned(),
         )?;
+        if let Some(r) = &self.range {
+            let ok = |v: [f64; 2]| v.iter().all(|x| x.is_finite()) && v[0] < v[1];
+            check(ok(r.y) && ok(r.z), || {
+                format!(
+                    "the sensor range needs finite [min, max] with min < max, found y {:?}, z {:?} mm",
+                    r.y, r.z
+                )
+            })?;
+        }
+        check(!self.spread || self.range.is_some(), || {
+            "spreading the sphere needs the sensor's range (--range)".to_owned()
+        })?;
         check(self.sphere.iter().all(|v| v.is_finite()), || {
             "the sphere position must be three finite numbers (mm)".to_owned()
         })?;

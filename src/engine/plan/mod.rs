@@ -88,10 +88,11 @@ use nalgebra::{Isometry3, Vector3};
 use crate::engine::cell::random;
 use crate::engine::robot::ik::{Chain, DOF};
 use crate::engine::robot::{JointLimit, Robot};
-use crate::engine::session::Use;
+use crate::engine::session::{SensorRange, Use};
 use crate::engine::simulate::PlanPose;
 use crate::engine::solve::Control;
 use crate::engine::solve::ml::Inseparable;
+use crate::engine::solve::ml::range::RangeError;
 
 mod candidates;
 mod config;
@@ -110,10 +111,13 @@ pub use config::{
 };
 pub use export::{Controller, RAPID_MODULE, plan_csv, rapid_module, read_plan_csv, ur_script};
 use order::{Metric, order_groups};
-pub use predict::{PredictConfig, Prediction, RunScore, predict, simulated_true_hand_eye};
+pub use predict::{
+    PredictConfig, Prediction, RangePrediction, RunScore, predict, simulated_true_hand_eye,
+};
 pub use request::{PlanRequest, RequestError, defaults, read_hand_eye, read_stations};
 use select::{
-    Info, criterion, greedy_selection, prior_information, random_selection, spread_selection,
+    Info, Objective, criterion, greedy_selection, prior_information, random_selection,
+    spread_selection,
 };
 
 /// Why a plan (or its prediction) could not be made.
@@ -265,6 +269,13 @@ pub struct PlanStats {
     pub path_unordered_deg: f64,
     /// Path in plan order, deg.
     pub path_deg: f64,
+    /// `ml`'s predicted error over the sensor's range at the plan's
+    /// validate poses (with a range).
+    pub range_error: Option<RangeError>,
+    /// The same for the plan made without the spread (same seed, the
+    /// sphere at the paper's spot, `ln det`), when this one spreads: what
+    /// the spread gains.
+    pub range_error_unspread: Option<RangeError>,
 }
 
 /// A measurement plan.
@@ -280,6 +291,8 @@ pub struct Plan {
     pub diameter: f64,
     /// Cut angle, deg.
     pub cut_angle: f64,
+    /// The sensor's measuring range planned for, if any.
+    pub range: Option<SensorRange>,
     /// The stations, in visit order.
     pub stations: Vec<PlannedStation>,
     /// The poses, in visit order.
@@ -338,6 +351,8 @@ pub enum PlanStage {
     Selection,
     /// Ordering and the analysis of the chosen plan.
     Ordering,
+    /// The plan without the spread, for comparison.
+    Comparison,
 }
 
 /// Makes a plan (see the module docs). `progress` sees each stage and may
@@ -476,8 +491,26 @@ pub fn plan(
         &mut baseline_rng,
     );
     let log_det_random = criterion(&prior, &infos, &random).unwrap_or(f64::NEG_INFINITY);
+    // The validate poses first: they are the working poses the range
+    // criterion is judged at.
+    for site in &mut sites {
+        if site.role == StationRole::Validate {
+            site.chosen = spread_selection(&planner, site, config.validate_poses);
+        }
+    }
+    let objective = match (config.spread, config.range) {
+        (true, Some(range)) => Objective::Range(planner.range_weight(&sites, &estimated, &range)),
+        _ => Objective::LogDet,
+    };
     let chosen = match config.selection {
-        Selection::DOptimal => greedy_selection(&planner, &sites, &identify_sites, &infos, &prior),
+        Selection::DOptimal => greedy_selection(
+            &planner,
+            &sites,
+            &identify_sites,
+            &infos,
+            &prior,
+            &objective,
+        ),
         Selection::Random => random,
     };
     for (k, c) in chosen {
@@ -494,11 +527,6 @@ pub fn plan(
             .collect::<Vec<_>>(),
     )
     .unwrap_or(f64::NEG_INFINITY);
-    for site in &mut sites {
-        if site.role == StationRole::Validate {
-            site.chosen = spread_selection(&planner, site, config.validate_poses);
-        }
-    }
 
     // Ordering.
     cancel(PlanStage::Ordering)?;
@@ -592,6 +620,7 @@ pub fn plan(
         flange_from_sensor: config.flange_from_sensor,
         diameter: config.diameter,
         cut_angle: config.cut_angle,
+        range: config.range,
         stations,
         poses,
         stats: PlanStats {
@@ -605,6 +634,8 @@ pub fn plan(
             predicted_validation_std: None,
             path_unordered_deg,
             path_deg,
+            range_error: None,
+            range_error_unspread: None,
         },
     };
     let report = planner.plan_report(&plan)?;
@@ -614,6 +645,16 @@ pub fn plan(
     plan.stats.fixed = report.fixed;
     plan.stats.inseparable = report.inseparable;
     plan.stats.predicted_validation_std = report.predicted_distance_std_validate.map(|d| d.centred);
+    plan.stats.range_error = report.range_error;
+    if config.spread {
+        // The comparison: the same cell planned without the spread.
+        let unspread = PlanConfig {
+            spread: false,
+            ..config.clone()
+        };
+        let other = self::plan(&unspread, &mut |_| progress(PlanStage::Comparison))?;
+        plan.stats.range_error_unspread = other.stats.range_error;
+    }
     Ok(plan)
 }
 
@@ -667,6 +708,31 @@ pub fn summary(plan: &Plan) -> String {
             s,
             "  expected validation std after calibration (ml covariance): {v:.4} mm"
         );
+    }
+    if let Some(r) = &st.range_error {
+        let _ = writeln!(
+            s,
+            "  predicted point error over the range (y {:.0}…{:.0}, z {:.0}…{:.0} mm, ml covariance): rms {:.4} mm, max {:.4} mm",
+            r.y[0], r.y[1], r.z[0], r.z[1], r.rms_mm, r.max_mm
+        );
+        match &st.range_error_unspread {
+            Some(u) => {
+                let _ = writeln!(
+                    s,
+                    "    the sphere spread over the range; without the spread: rms {:.4} mm, max {:.4} mm ({:.2}× the rms)",
+                    u.rms_mm,
+                    u.max_mm,
+                    u.rms_mm / r.rms_mm
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "    the sphere at one spot ({:.0} % of the range): spread it over the range for less error away from it",
+                    r.coverage * 100.0
+                );
+            }
+        }
     }
     let _ = writeln!(
         s,

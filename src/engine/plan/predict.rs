@@ -6,6 +6,7 @@ use nalgebra::Isometry3;
 
 use crate::engine::cell::sensor;
 use crate::engine::evaluate;
+use crate::engine::evaluate::range::{RangeScore, range_score};
 use crate::engine::session::Use;
 use crate::engine::simulate::{self, ErrorModel, InitialHandEye, PlanExecution, SimConfig};
 use crate::engine::solve::{self, Control, Options};
@@ -64,6 +65,25 @@ pub struct RunScore {
     pub after_std: f64,
     /// True model and hand-eye on the same data: the noise floor.
     pub floor_std: f64,
+    /// The error over the plan's range (before, after, floor), when the
+    /// plan has one.
+    pub range: Option<RangeScore>,
+}
+
+/// The realised error over the plan's range, mean over the runs, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RangePrediction {
+    /// Mean rms error after calibration.
+    pub after_rms: f64,
+    /// Largest error after calibration in any run.
+    pub after_max: f64,
+    /// Mean rms floor (the true model on the same readings).
+    pub floor_rms: f64,
+    /// Mean of `after / floor`.
+    pub ratio_mean: f64,
+    /// Mean rms model error alone (what `ml`'s range prediction
+    /// estimates).
+    pub model_rms: f64,
 }
 
 /// The predicted accuracy of a plan.
@@ -81,6 +101,8 @@ pub struct Prediction {
     pub ratio_mean: f64,
     /// Mean validation std before calibration, mm.
     pub before_mean: f64,
+    /// The error over the plan's range, when it has one.
+    pub range: Option<RangePrediction>,
 }
 
 /// The true hand-eye of a simulated run: the plan's guess moved by the
@@ -139,6 +161,7 @@ pub fn predict(
             stripe_noise: config.stripe_noise,
             tracker_noise: config.tracker_noise,
             diameter: plan.diameter,
+            range: plan.range,
             initial_hand_eye: if hand_eye_groups {
                 InitialHandEye::None
             } else {
@@ -158,11 +181,20 @@ pub fn predict(
         let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
             .map_err(|e| fail(e.to_string()))?;
         let score = evaluate::score(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
+        let range = range_score(
+            &session,
+            &truth,
+            &prepared.hand_eye_initial,
+            &cal.calibrated,
+            &cal.hand_eye,
+            None,
+        );
         runs.push(RunScore {
             seed,
             before_std: score.before.std,
             after_std: score.after.std,
             floor_std: score.floor.std,
+            range,
         });
         if progress(k + 1, config.runs) == Control::Cancel {
             return Err(PlanError::Cancelled);
@@ -182,7 +214,20 @@ pub fn predict(
     } else {
         0.0
     };
+    let ranges: Vec<RangeScore> = runs.iter().filter_map(|r| r.range).collect();
+    let range = (!ranges.is_empty()).then(|| {
+        let m = ranges.len() as f64;
+        let avg = |f: &dyn Fn(&RangeScore) -> f64| ranges.iter().map(f).sum::<f64>() / m;
+        RangePrediction {
+            after_rms: avg(&|r| r.after.rms),
+            after_max: ranges.iter().map(|r| r.after.max).fold(0.0, f64::max),
+            floor_rms: avg(&|r| r.floor.rms),
+            ratio_mean: avg(&|r| r.ratio_to_floor()),
+            model_rms: avg(&|r| r.model.rms),
+        }
+    });
     Ok(Prediction {
+        range,
         after_mean,
         after_spread,
         floor_mean: mean(&|r| r.floor_std),

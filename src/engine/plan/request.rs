@@ -17,6 +17,7 @@ use crate::engine::cell::workspace;
 use crate::engine::geometry::isometry_from_rows;
 use crate::engine::import::{RobotSource, load_robot};
 use crate::engine::robot::{self, JointLimit};
+use crate::engine::session::SensorRange;
 use crate::engine::table::Table;
 
 /// Why a request cannot be made into a plan configuration, or a file it
@@ -110,6 +111,11 @@ pub struct PlanRequest {
     pub selection: Selection,
     /// Simulated calibrations for the predicted accuracy (0: none).
     pub predict_runs: usize,
+    /// The sensor's measuring range (`sensor.range`): the plan predicts
+    /// the error over it.
+    pub range: Option<SensorRange>,
+    /// Spread the sphere over `range` (the default with a range).
+    pub spread: bool,
 }
 
 impl PlanRequest {
@@ -137,6 +143,8 @@ impl PlanRequest {
             seed: defaults::SEED,
             selection: Selection::DOptimal,
             predict_runs: PredictConfig::default().runs,
+            range: None,
+            spread: false,
         }
     }
 
@@ -219,6 +227,8 @@ impl PlanRequest {
         config.candidates = self.candidates;
         config.seed = self.seed;
         config.selection = self.selection;
+        config.range = self.range;
+        config.spread = self.spread && self.range.is_some();
         Ok(config)
     }
 }

@@ -109,12 +109,16 @@ impl StationInfo {
         }
     }
 
-    /// `ln det(M + ΔM) − ln det(M)` for adding `info`, with `chol` the
-    /// Cholesky factor of `M`: `ΔM = Eᵀ·V·E` with `E = A − C⁻¹Bᵀ` and
+    /// The objective's gain for adding `info`, with `chol` the Cholesky
+    /// factor of `M` and `qt` the objective's prepared matrix
+    /// ([`Objective::prepare`]). `ΔM = Eᵀ·V·E` with `E = A − C⁻¹Bᵀ` and
     /// `V = (W⁻¹ + C⁻¹)⁻¹` (the new sighting against the station's centre
-    /// as the others fix it), by the matrix determinant lemma. Zero for a
+    /// as the others fix it). `ln det` gains `ln det(V⁻¹ + G) − ln det V⁻¹`
+    /// with `G = E·M⁻¹·Eᵀ` (matrix determinant lemma); `tr(Q·M⁻¹)` falls
+    /// by `tr((V⁻¹ + G)⁻¹·E·M⁻¹·Q·M⁻¹·Eᵀ)` (Woodbury), with
+    /// `E·M⁻¹·Q·M⁻¹·Eᵀ = Fᵀ·Q̃·F`, `F = L⁻¹Eᵀ`, `Q̃ = L⁻¹·Q·L⁻ᵀ`. Zero for a
     /// station with no sighting yet (one sighting only fixes its centre).
-    fn gain(&self, info: &Info, chol: &Cholesky<f64, Dyn>) -> f64 {
+    fn gain(&self, info: &Info, chol: &Cholesky<f64, Dyn>, qt: Option<&DMatrix<f64>>) -> f64 {
         let Some(ci) = self.c.try_inverse() else {
             return 0.0;
         };
@@ -128,10 +132,54 @@ impl StationInfo {
         let g = f.transpose() * &f;
         let v_inv = wi + ci;
         let total = v_inv + Matrix3::from_fn(|i, j| g[(i, j)]);
-        match (total.cholesky(), v_inv.cholesky()) {
-            (Some(t), Some(v)) => log_det3(&t) - log_det3(&v),
-            _ => 0.0,
+        match qt {
+            None => match (total.cholesky(), v_inv.cholesky()) {
+                (Some(t), Some(v)) => log_det3(&t) - log_det3(&v),
+                _ => 0.0,
+            },
+            Some(qt) => {
+                let fqf = f.transpose() * qt * &f;
+                let fqf = Matrix3::from_fn(|i, j| fqf[(i, j)]);
+                total
+                    .cholesky()
+                    .map_or(0.0, |t| t.solve(&fqf).trace())
+            }
         }
+    }
+}
+
+/// What the identify selection maximises.
+#[derive(Debug, Clone)]
+pub(super) enum Objective {
+    /// `ln det M`: D-optimal, the parameters as a whole.
+    LogDet,
+    /// `−tr(Q·M⁻¹)`: minus the mean square predicted point error over the
+    /// sensor's range (`Q` from [`AlignedGrid::weight`](crate::engine::solve::ml::range)
+    /// at the plan's working poses), I-optimal for the range.
+    Range(DMatrix<f64>),
+}
+
+impl Objective {
+    /// The objective at `M = LLᵀ`.
+    pub(super) fn value(&self, chol: &Cholesky<f64, Dyn>) -> f64 {
+        match self.prepare(chol) {
+            None => log_det(chol),
+            Some(qt) => -qt.trace(),
+        }
+    }
+
+    /// `Q̃ = L⁻¹·Q·L⁻ᵀ` for [`StationInfo::gain`] (`tr Q̃ = tr(Q·M⁻¹)`);
+    /// `None` for `ln det`.
+    fn prepare(&self, chol: &Cholesky<f64, Dyn>) -> Option<DMatrix<f64>> {
+        let Self::Range(q) = self else {
+            return None;
+        };
+        let l = chol.l_dirty();
+        let mut x = q.clone();
+        l.solve_lower_triangular_mut(&mut x);
+        let mut qt = x.transpose();
+        l.solve_lower_triangular_mut(&mut qt);
+        Some(qt)
     }
 }
 
@@ -195,6 +243,7 @@ pub(super) fn greedy_selection(
     identify: &[usize],
     infos: &[Vec<Info>],
     prior: &DMatrix<f64>,
+    objective: &Objective,
 ) -> Vec<(usize, Vec<usize>)> {
     let n = planner.config.identify_poses;
     let k = prior.nrows();
@@ -221,6 +270,7 @@ pub(super) fn greedy_selection(
     };
     // Greedy additions.
     while let Some(chol) = m.clone().cholesky() {
+        let qt = objective.prepare(&chol);
         let mut best: Option<(f64, usize, usize)> = None;
         for (slot, &s) in identify.iter().enumerate() {
             if chosen[slot].len() >= n {
@@ -230,7 +280,7 @@ pub(super) fn greedy_selection(
                 if !side_ok(&sites[s], &chosen[slot], cand) {
                     continue;
                 }
-                let g = stations[slot].gain(info, &chol);
+                let g = stations[slot].gain(info, &chol, qt.as_ref());
                 if best.is_none_or(|(b, _, _)| g > b) {
                     best = Some((g, slot, cand));
                 }
@@ -250,7 +300,7 @@ pub(super) fn greedy_selection(
         let mut swapped = false;
         for (slot, &s) in identify.iter().enumerate() {
             for pos in 0..chosen[slot].len() {
-                let Some(current) = m.clone().cholesky().map(|c| log_det(&c)) else {
+                let Some(current) = m.clone().cholesky().map(|c| objective.value(&c)) else {
                     continue;
                 };
                 let removed = chosen[slot][pos];
@@ -262,14 +312,15 @@ pub(super) fn greedy_selection(
                 let Some(chol) = m_without.clone().cholesky() else {
                     continue;
                 };
-                let base = log_det(&chol);
+                let base = objective.value(&chol);
+                let qt = objective.prepare(&chol);
                 let side = sites[s].candidates[removed].side;
                 let mut best: Option<(f64, usize)> = None;
                 for (cand, info) in infos[s].iter().enumerate() {
                     if sites[s].candidates[cand].side != side || chosen[slot].contains(&cand) {
                         continue;
                     }
-                    let value = base + without.gain(info, &chol);
+                    let value = base + without.gain(info, &chol, qt.as_ref());
                     if best.is_none_or(|(b, _)| value > b) {
                         best = Some((value, cand));
                     }

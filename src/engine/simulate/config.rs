@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 use super::stripe::stripe_point_count;
 use crate::engine::cell::workspace::Workspace;
 use crate::engine::robot::RobotChoice;
-use crate::engine::session::MIN_STRIPE_POINTS;
+use crate::engine::session::{MIN_STRIPE_POINTS, SensorRange};
 use crate::engine::session::{DEFAULT_MAX_ITERATIONS, DEFAULT_THRESHOLD};
 
 /// σ of the `random` kinematic errors for angles (alpha, beta, theta), deg,
@@ -147,6 +147,14 @@ pub struct SimConfig {
     /// Station box and eye point; `None` is [`Workspace::for_robot`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub workspace: Option<Workspace>,
+    /// The sensor's measuring range, written as `sensor.range` (issue 14).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub range: Option<SensorRange>,
+    /// Spread the sphere over `range`: the identify and validate
+    /// measurements see the sphere centre at `(y, z)` uniform in the range
+    /// instead of the paper's ±2, ±3 mm (the `P0` hand-eye groups keep the
+    /// paper's spot). Needs `range`.
+    pub spread: bool,
 }
 
 impl Default for SimConfig {
@@ -188,6 +196,8 @@ impl Default for SimConfig {
             rotation_min: 20.0,
             rotation_max: 45.0,
             workspace: None,
+            range: None,
+            spread: false,
         }
     }
 }
@@ -393,6 +403,24 @@ pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
         format!(
             "stripes would have only {points} points (FORMAT.md needs {MIN_STRIPE_POINTS}); reduce point_spacing or widen arc_half_angle"
         )
+    })?;
+    if let Some(r) = &c.range {
+        let ok = |v: [f64; 2]| v.iter().all(|x| x.is_finite()) && v[0] < v[1];
+        check(ok(r.y) && ok(r.z), || {
+            format!(
+                "range needs finite [min, max] with min < max, found y {:?}, z {:?}",
+                r.y, r.z
+            )
+        })?;
+        check(r.z[1] + c.diameter < c.view_z, || {
+            format!(
+                "range z reaches {} mm: the sphere would touch the camera at view_z {} mm",
+                r.z[1], c.view_z
+            )
+        })?;
+    }
+    check(!c.spread || c.range.is_some(), || {
+        "spread needs a range: the sphere is spread over the sensor's range".to_owned()
     })?;
     if let Some(w) = &c.workspace {
         let finite = w

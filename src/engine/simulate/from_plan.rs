@@ -242,7 +242,7 @@ pub fn simulate_plan(
         sphere_diameter: config.diameter,
         default_side,
         sensor_given: true,
-        sensor_range: None,
+        sensor_range: config.range,
         hand_eye,
         solver: SolverSettings {
             threshold: config.threshold,

@@ -291,7 +291,7 @@ pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
         sphere_diameter: config.diameter,
         default_side,
         sensor_given: true,
-        sensor_range: None,
+        sensor_range: config.range,
         hand_eye,
         solver: SolverSettings {
             threshold: config.threshold,

@@ -98,6 +98,19 @@ impl Planner<'_> {
         Vector3::new(x, y, z)
     }
 
+    /// The centre of an identify or validate measurement: over the range
+    /// when the configuration spreads the sphere, else
+    /// [`Self::sample_centre`].
+    fn station_centre(&self, rng: &mut ChaCha8Rng, side: i8) -> Vector3<f64> {
+        match (self.config.spread, self.config.range) {
+            (true, Some(r)) => {
+                let x = self.sample_x(rng, side);
+                Vector3::new(x, uniform(rng, r.y[0], r.y[1]), uniform(rng, r.z[0], r.z[1]))
+            }
+            _ => self.sample_centre(rng, side),
+        }
+    }
+
     fn sample_x(&self, rng: &mut ChaCha8Rng, side: i8) -> f64 {
         let c = self.config;
         let cut = uniform(rng, c.cut_angle - c.cut_jitter, c.cut_angle + c.cut_jitter);
@@ -208,7 +221,7 @@ impl Planner<'_> {
         for side in sides {
             let mut found = None;
             for _ in 0..MAX_POSE_ATTEMPTS {
-                let centre = self.sample_centre(rng, side);
+                let centre = self.station_centre(rng, side);
                 let rotation = random_orientation(rng, &mean, cone);
                 if let Some(q) = self.solve(station, &rotation, &centre, None) {
                     found = Some((q, centre));

@@ -97,17 +97,18 @@ impl RangeError {
     }
 }
 
-/// The restricted sensitivity `G` (3 × k, scaled units) of sensor point
-/// `g` at a pose, and the point's base-frame position.
+/// The restricted sensitivity `G` (3 × k, scaled units: column `c` is
+/// parameter `estimated[c]` divided by `scale[c]`) of sensor point `g` at
+/// a pose, and the point's base-frame position.
 fn point_rows(
-    problem: &Problem,
     est: &Estimate,
     pose: &PoseSensitivity,
+    estimated: &[usize],
+    scale: &[f64],
     g: Vector3<f64>,
 ) -> (DMatrix<f64>, Vector3<f64>) {
     let (p, a) = pose.at(est, &g);
-    let k = problem.estimated.len();
-    let rows = DMatrix::from_fn(3, k, |r, c| a[(r, problem.estimated[c])] / problem.scale[c]);
+    let rows = DMatrix::from_fn(3, estimated.len(), |r, c| a[(r, estimated[c])] / scale[c]);
     (rows, p)
 }
 
@@ -123,38 +124,89 @@ fn rigid_rows(p: &Vector3<f64>, c: &Vector3<f64>) -> DMatrix<f64> {
     r
 }
 
-/// The rigid-motion fit `M = (RᵀR)⁻¹RᵀG` (6 × k) of a set of points.
-fn rigid_fit<'a>(
-    points: impl Iterator<Item = (&'a DMatrix<f64>, &'a Vector3<f64>)>,
-    k: usize,
-    centroid: &Vector3<f64>,
-) -> DMatrix<f64> {
-    let mut rtr = DMatrix::zeros(6, 6);
-    let mut rtg = DMatrix::zeros(6, k);
-    for (g, p) in points {
-        let r = rigid_rows(p, centroid);
-        rtr += r.transpose() * &r;
-        rtg += r.transpose() * g;
-    }
-    // A degenerate set (every point on one line) leaves a rotation free:
-    // the pseudo-inverse takes out what can be taken out.
-    let pinv = rtr
-        .clone()
-        .pseudo_inverse(1e-12 * rtr.norm().max(1e-300))
-        .unwrap_or_else(|_| DMatrix::zeros(6, 6));
-    pinv * rtg
+/// The grid over a range at a set of poses, with the common rigid motion
+/// fitted: `H_i = G_i − R_i·M`, `M = (RᵀR)⁻¹RᵀG` (module doc). One home
+/// for the prediction of the result and the planner's criterion.
+pub(crate) struct AlignedGrid {
+    /// `([y, z], G_i, p_i)`, point-major: each grid point's poses follow
+    /// one another.
+    points: Vec<([f64; 2], DMatrix<f64>, Vector3<f64>)>,
+    /// Poses per grid point.
+    poses: usize,
+    centroid: Vector3<f64>,
+    /// The rigid-motion fit `M`, 6 × k.
+    m: DMatrix<f64>,
 }
 
-/// `σ` (mm) of one point after the rigid fit `m` is removed.
-fn aligned_sigma(
-    g: &DMatrix<f64>,
-    p: &Vector3<f64>,
-    centroid: &Vector3<f64>,
-    m: &DMatrix<f64>,
-    cov: &DMatrix<f64>,
-) -> f64 {
-    let h = g - rigid_rows(p, centroid) * m;
-    (&h * cov * h.transpose()).trace().max(0.0).sqrt()
+impl AlignedGrid {
+    /// The `RANGE_GRID × RANGE_GRID` grid over `range` at `poses`.
+    pub(crate) fn new(
+        est: &Estimate,
+        poses: &[PoseSensitivity],
+        estimated: &[usize],
+        scale: &[f64],
+        range: &SensorRange,
+    ) -> Self {
+        let at = |lo: f64, hi: f64, k: usize| lo + (hi - lo) * k as f64 / (RANGE_GRID - 1) as f64;
+        let mut points = Vec::with_capacity(RANGE_GRID * RANGE_GRID * poses.len());
+        for ky in 0..RANGE_GRID {
+            for kz in 0..RANGE_GRID {
+                let (y, z) = (
+                    at(range.y[0], range.y[1], ky),
+                    at(range.z[0], range.z[1], kz),
+                );
+                for s in poses {
+                    let (g, p) = point_rows(est, s, estimated, scale, Vector3::new(0.0, y, z));
+                    points.push(([y, z], g, p));
+                }
+            }
+        }
+        let k = estimated.len();
+        let centroid =
+            points.iter().map(|(_, _, p)| p).sum::<Vector3<f64>>() / points.len().max(1) as f64;
+        let mut rtr = DMatrix::zeros(6, 6);
+        let mut rtg = DMatrix::zeros(6, k);
+        for (_, g, p) in &points {
+            let r = rigid_rows(p, &centroid);
+            rtr += r.transpose() * &r;
+            rtg += r.transpose() * g;
+        }
+        // A degenerate set (every point on one line) leaves a rotation
+        // free: the pseudo-inverse takes out what can be taken out.
+        let pinv = rtr
+            .clone()
+            .pseudo_inverse(1e-12 * rtr.norm().max(1e-300))
+            .unwrap_or_else(|_| DMatrix::zeros(6, 6));
+        Self {
+            points,
+            poses: poses.len(),
+            centroid,
+            m: pinv * rtg,
+        }
+    }
+
+    /// `H` of a point with sensitivity `g` at base position `p`.
+    fn aligned(&self, g: &DMatrix<f64>, p: &Vector3<f64>) -> DMatrix<f64> {
+        g - rigid_rows(p, &self.centroid) * &self.m
+    }
+
+    /// `Q = Σ H_iᵀH_i / n` (k × k): `tr(Q·C)` is the mean square predicted
+    /// error over the grid for a covariance `C` of the (scaled) estimated
+    /// parameters: the planner's criterion.
+    pub(crate) fn weight(&self) -> DMatrix<f64> {
+        let k = self.m.ncols();
+        let mut q = DMatrix::zeros(k, k);
+        for (_, g, p) in &self.points {
+            let h = self.aligned(g, p);
+            q += h.transpose() * &h;
+        }
+        q / self.points.len().max(1) as f64
+    }
+}
+
+/// `σ` (mm) of a point's aligned error `h` under covariance `cov`.
+fn sigma(h: &DMatrix<f64>, cov: &DMatrix<f64>) -> f64 {
+    (h * cov * h.transpose()).trace().max(0.0).sqrt()
 }
 
 /// The prediction (see the module doc); `None` without working poses.
@@ -215,33 +267,13 @@ pub(super) fn range_error(
             1.0,
         ),
     };
-    let at = |lo: f64, hi: f64, k: usize| lo + (hi - lo) * k as f64 / (RANGE_GRID - 1) as f64;
-    let mut grid: Vec<([f64; 2], DMatrix<f64>, Vector3<f64>)> = Vec::new();
-    for ky in 0..RANGE_GRID {
-        for kz in 0..RANGE_GRID {
-            let (y, z) = (
-                at(range.y[0], range.y[1], ky),
-                at(range.z[0], range.z[1], kz),
-            );
-            for s in &poses {
-                let (g, p) = point_rows(problem, est, s, Vector3::new(0.0, y, z));
-                grid.push(([y, z], g, p));
-            }
-        }
-    }
-    let centroid = grid.iter().map(|(_, _, p)| p).sum::<Vector3<f64>>() / grid.len().max(1) as f64;
-    let m = rigid_fit(
-        grid.iter().map(|(_, g, p)| (g, p)),
-        problem.estimated.len(),
-        &centroid,
-    );
+    let grid = AlignedGrid::new(est, &poses, &problem.estimated, &problem.scale, &range);
     let (mut sum_sq, mut sum, mut max, mut max_at) = (0.0, 0.0, 0.0_f64, [0.0; 2]);
-    // The grid is point-major: each point's poses follow one another.
     let mut map: Vec<[f64; 3]> = Vec::with_capacity(RANGE_GRID * RANGE_GRID);
-    for chunk in grid.chunks(poses.len().max(1)) {
+    for chunk in grid.points.chunks(grid.poses.max(1)) {
         let mut point_sq = 0.0;
         for (yz, g, p) in chunk {
-            let sigma = aligned_sigma(g, p, &centroid, &m, cov);
+            let sigma = sigma(&grid.aligned(g, p), cov);
             sum_sq += sigma * sigma;
             point_sq += sigma * sigma;
             sum += sigma;
@@ -257,11 +289,12 @@ pub(super) fn range_error(
     let sphere_sq: f64 = poses
         .iter()
         .map(|s| {
-            let (g, p) = point_rows(problem, est, s, Vector3::new(0.0, mean.y, mean.z));
-            aligned_sigma(&g, &p, &centroid, &m, cov).powi(2)
+            let centre = Vector3::new(0.0, mean.y, mean.z);
+            let (g, p) = point_rows(est, s, &problem.estimated, &problem.scale, centre);
+            sigma(&grid.aligned(&g, &p), cov).powi(2)
         })
         .sum();
-    let nf = grid.len().max(1) as f64;
+    let nf = grid.points.len().max(1) as f64;
     let at_sphere_mm = (sphere_sq / poses.len() as f64).sqrt();
     let warning = (coverage < RANGE_COVERAGE_WARNING).then(|| {
         format!(
