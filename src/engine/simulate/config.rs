@@ -153,7 +153,8 @@ pub struct SimConfig {
     /// Spread the sphere over `range`: the identify and validate
     /// measurements see the sphere centre at `(y, z)` uniform in the range
     /// instead of the paper's ±2, ±3 mm (the `P0` hand-eye groups keep the
-    /// paper's spot). Needs `range`.
+    /// paper's spot). Needs `range`. Not echoed when off.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub spread: bool,
 }
 
