@@ -106,11 +106,7 @@ fn the_range_score_holds_a_model_to_the_truth_and_its_floor() {
     assert!(exact.model.rms < 1e-9, "{:?}", exact.model);
     // The floor is the joint noise seen at the points: 0.003° at about a
     // metre and a half of arm, tenths of a millimetre at most.
-    assert!(
-        (0.03..0.3).contains(&exact.floor.rms),
-        "{:?}",
-        exact.floor
-    );
+    assert!((0.03..0.3).contains(&exact.floor.rms), "{:?}", exact.floor);
     // The nominal model is far off.
     assert!(exact.before.rms > 5.0 * exact.floor.rms, "{exact:?}");
     // Noise-free readings: the floor is zero (up to the joints' written
@@ -181,7 +177,10 @@ fn the_planner_spreads_the_sphere_and_compares() {
         );
         let y = extent(poses.iter().map(|p| p.centre_in_sensor.y));
         let z = extent(poses.iter().map(|p| p.centre_in_sensor.z));
-        assert!(y[1] - y[0] > 60.0 && z[1] - z[0] > 60.0, "{usage:?} {y:?} {z:?}");
+        assert!(
+            y[1] - y[0] > 60.0 && z[1] - z[0] > 60.0,
+            "{usage:?} {y:?} {z:?}"
+        );
     }
     assert!(
         made.poses
@@ -199,7 +198,10 @@ fn the_planner_spreads_the_sphere_and_compares() {
         spread.rms_mm
     );
     let text = plan::summary(&made);
-    assert!(text.contains("predicted point error over the range"), "{text}");
+    assert!(
+        text.contains("predicted point error over the range"),
+        "{text}"
+    );
     assert!(text.contains("without the spread: rms"), "{text}");
     // Spreading needs a range.
     let bad = PlanConfig {
@@ -223,8 +225,14 @@ fn a_spread_plan_is_within_1_2_times_the_floor_over_the_range() {
     }
     assert_eq!(rows.len(), 4);
     for errors in ["table1", "random"] {
-        let spread = rows.iter().find(|r| r.spread && r.errors == errors).unwrap();
-        let spot = rows.iter().find(|r| !r.spread && r.errors == errors).unwrap();
+        let spread = rows
+            .iter()
+            .find(|r| r.spread && r.errors == errors)
+            .unwrap();
+        let spot = rows
+            .iter()
+            .find(|r| !r.spread && r.errors == errors)
+            .unwrap();
         assert!(spread.ratio <= 1.2, "{errors}: {spread:?}");
         assert!(spot.ratio > spread.ratio + 0.2, "{errors}: {spot:?}");
         assert!(spot.predicted_rms > 2.0 * spread.predicted_rms);

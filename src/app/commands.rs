@@ -75,6 +75,9 @@ pub enum ViewCommand {
     DismissNotice,
     /// Close the first-start "what to do" (remembered).
     DismissIntro,
+    /// Set or clear the open session's measuring range (`sensor.range`);
+    /// kept with the session when it is saved, used by the next run.
+    SetSensorRange(Option<crate::engine::session::SensorRange>),
     /// Set the acceptance tolerance (remembered for the session's robot).
     SetTolerance(crate::engine::result_view::Tolerance),
 }

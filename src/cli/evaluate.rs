@@ -40,9 +40,13 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
     }
     if args.planned_range {
         if !args.markdown {
-            eprintln!("planning with and without the spread, {} seed(s) each…", args.seeds);
+            eprintln!(
+                "planning with and without the spread, {} seed(s) each…",
+                args.seeds
+            );
         }
-        let rows = planned_range_study(args.seeds).map_err(|e| CliError::internal(e.to_string()))?;
+        let rows =
+            planned_range_study(args.seeds).map_err(|e| CliError::internal(e.to_string()))?;
         if args.markdown {
             say!("{}", planned_range_markdown(&rows, args.seeds));
         } else {

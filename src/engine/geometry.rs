@@ -235,7 +235,12 @@ mod tests {
             .map(|p| (motion * nalgebra::Point3::from(*p)).coords)
             .collect();
         let found = kabsch(&from, &to).unwrap();
-        assert!((found.to_homogeneous() - motion.to_homogeneous()).abs().max() < 1e-9);
+        assert!(
+            (found.to_homogeneous() - motion.to_homogeneous())
+                .abs()
+                .max()
+                < 1e-9
+        );
         assert!(kabsch(&from[..2], &to[..2]).is_none());
     }
 

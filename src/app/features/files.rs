@@ -460,6 +460,12 @@ impl Core {
             self.forms.plan.robot = p.key.to_string();
             self.forms.plan.request.sphere = crate::app::forms::plan::default_sphere(p.key);
         }
+        // A session that knows its measuring range plans for it.
+        self.forms.range_edit = None;
+        if loaded.session.sensor_range.is_some() {
+            self.forms.plan.request.range = loaded.session.sensor_range;
+            self.forms.plan.request.spread = true;
+        }
         self.forms.tolerance = self
             .state
             .prefs

@@ -100,6 +100,7 @@ pub fn simulate_plan(plan: &Plan, robot: &str, seed: u64) -> Result<Session, Job
         robot: robot_choice,
         seed,
         name: Some(format!("simulated from a plan ({robot}, seed {seed})")),
+        range: plan.range,
         ..SimConfig::default()
     };
     let truth_hand_eye = plan::simulated_true_hand_eye(&plan.flange_from_sensor);

@@ -54,6 +54,15 @@ impl Core {
             }
             ViewCommand::DismissNotice => self.state.notice = None,
             ViewCommand::DismissIntro => self.state.prefs.intro_dismissed = true,
+            ViewCommand::SetSensorRange(range) => {
+                if let Some(loaded) = &mut self.state.loaded {
+                    loaded.session.sensor_range = range;
+                    self.forms.range_edit = None;
+                    if range.is_some() {
+                        self.forms.plan.request.range = range;
+                    }
+                }
+            }
             ViewCommand::SetTolerance(t) => {
                 if t.is_valid() {
                     self.forms.tolerance = t;

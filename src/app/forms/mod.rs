@@ -217,6 +217,9 @@ pub struct Forms {
     pub filter_problems: bool,
     /// Session table: only ids (or stations) containing this text.
     pub search: String,
+    /// The measuring range being edited in the Session view, `[y0, y1,
+    /// z0, z1]` mm; `None`: the session's (or the default) on show.
+    pub range_edit: Option<[f64; 4]>,
     /// Settings of the next run.
     pub solver: SolverForm,
     /// Centres view options.
@@ -244,6 +247,7 @@ impl Default for Forms {
             group: Grouping::None,
             filter_problems: false,
             search: String::new(),
+            range_edit: None,
             solver: SolverForm::default(),
             centres: CentresForm::default(),
             import: ImportForm::default(),

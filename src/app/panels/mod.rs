@@ -68,6 +68,56 @@ pub fn labelled_field(
     .labelled_by(l.id)
 }
 
+/// The default measuring range offered before one is set: 80 × 80 mm
+/// about the sensor origin, `[y0, y1, z0, z1]`.
+pub const DEFAULT_RANGE: [f64; 4] = [-40.0, 40.0, -40.0, 40.0];
+
+/// Four fields for a measuring range `[y0, y1, z0, z1]` (mm, laser plane,
+/// sensor frame), each labelled; true when one changed.
+pub fn range_fields(ui: &mut egui::Ui, id: &str, v: &mut [f64; 4]) -> bool {
+    let mut changed = false;
+    for (k, label, hint) in [
+        (0, "y from", "along the laser line, smallest (mm)"),
+        (1, "to", "along the laser line, largest (mm)"),
+        (2, "z from", "in depth, smallest (mm)"),
+        (3, "to", "in depth, largest (mm)"),
+    ] {
+        let l = ui.label(label);
+        changed |= ui
+            .push_id((id, k), |ui| {
+                ui.add(
+                    egui::DragValue::new(&mut v[k])
+                        .range(-2000.0..=2000.0)
+                        .speed(0.5)
+                        .suffix(" mm"),
+                )
+                .labelled_by(l.id)
+                .on_hover_text(hint)
+            })
+            .inner
+            .changed();
+    }
+    changed
+}
+
+/// The range of `[y0, y1, z0, z1]`, or why it is not one.
+pub fn range_of(v: &[f64; 4]) -> Result<crate::engine::session::SensorRange, &'static str> {
+    if v[0] < v[1] && v[2] < v[3] {
+        Ok(crate::engine::session::SensorRange {
+            y: [v[0], v[1]],
+            z: [v[2], v[3]],
+        })
+    } else {
+        Err("each side needs from < to")
+    }
+}
+
+/// `[y0, y1, z0, z1]` of a range.
+#[must_use]
+pub fn range_values(r: &crate::engine::session::SensorRange) -> [f64; 4] {
+    [r.y[0], r.y[1], r.z[0], r.z[1]]
+}
+
 /// The row of view tabs.
 pub fn tabs_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mut Vec<Command>) {
     ui.horizontal(|ui| {

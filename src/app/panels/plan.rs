@@ -7,7 +7,9 @@
 use egui::RichText;
 use egui_plot::{MarkerShape, Plot, PlotPoints, Points};
 
-use super::{AFTER, BAD, BEFORE, MUTED, labelled_field};
+use super::{
+    AFTER, BAD, BEFORE, DEFAULT_RANGE, MUTED, labelled_field, range_fields, range_of, range_values,
+};
 use crate::app::commands::{Command, FilesCommand, PlanCommand};
 use crate::app::forms::{Forms, plan::default_sphere};
 use crate::app::state::{AppState, DialogPurpose, PlanExport, PlanOutcome};
@@ -136,6 +138,33 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
                 .on_hover_text("the same settings and seed give the same plan");
             ui.end_row();
         });
+    ui.horizontal_wrapped(|ui| {
+        let mut known = f.request.range.is_some();
+        if ui
+            .checkbox(&mut known, "plan for the measuring range")
+            .on_hover_text("sensor.range: predict the error over this part of the laser plane and spread the sphere over it")
+            .changed()
+        {
+            f.request.range = if known {
+                range_of(&DEFAULT_RANGE).ok()
+            } else {
+                None
+            };
+            f.request.spread = known;
+        }
+        if let Some(r) = f.request.range {
+            let mut v = range_values(&r);
+            if range_fields(ui, "plan_range", &mut v)
+                && let Ok(r) = range_of(&v)
+            {
+                f.request.range = Some(r);
+            }
+        }
+    });
+    if f.request.range.is_some() {
+        ui.checkbox(&mut f.request.spread, "spread the sphere over the range")
+            .on_hover_text("identify and validate poses see the sphere anywhere in the range, chosen for the smallest predicted error over it; unticked: the paper's one spot");
+    }
     ui.checkbox(
         &mut f.hand_eye_from_session,
         "hand-eye guess from the open calibration",
@@ -210,6 +239,12 @@ fn outcome_ui(
                 p.floor_mean,
                 p.ratio_mean
             ));
+            if let Some(r) = &p.range {
+                ui.label(format!(
+                    "error over the range in those calibrations: rms {:.3} mm (max {:.3} mm), floor {:.3} mm, after / floor {:.2}×",
+                    r.after_rms, r.after_max, r.floor_rms, r.ratio_mean
+                ));
+            }
         }
         Some(Err(e)) => {
             ui.label(RichText::new(format!("No prediction: {e}")).color(BAD));
@@ -238,6 +273,21 @@ fn outcome_ui(
                 ),
             );
             row("condition number", format!("{:.3e}", st.condition));
+            if let Some(r) = &st.range_error {
+                row(
+                    "predicted error over the range",
+                    format!(
+                        "rms {:.3} mm, max {:.3} mm (y {:.0}…{:.0}, z {:.0}…{:.0} mm)",
+                        r.rms_mm, r.max_mm, r.y[0], r.y[1], r.z[0], r.z[1]
+                    ),
+                );
+            }
+            if let Some(u) = &st.range_error_unspread {
+                row(
+                    "the same without the spread",
+                    format!("rms {:.3} mm, max {:.3} mm", u.rms_mm, u.max_mm),
+                );
+            }
             if let Some(s) = st.predicted_validation_std {
                 row("ml's expected std after (covariance)", format!("{s:.3} mm"));
             }

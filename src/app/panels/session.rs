@@ -5,7 +5,9 @@
 use egui::{Color32, RichText};
 use egui_extras::{Column, TableBuilder};
 
-use super::{BAD, MUTED, WARN, labelled_field};
+use super::{
+    BAD, DEFAULT_RANGE, MUTED, WARN, labelled_field, range_fields, range_of, range_values,
+};
 use crate::app::commands::{Command, FilesCommand, ViewCommand};
 use crate::app::forms::{Forms, Grouping};
 use crate::app::state::{AppState, DialogPurpose, Fit, LoadedSession};
@@ -50,9 +52,70 @@ pub fn session_ui(
             ui.label(RichText::new("Untick a measurement to leave it out of the solver.").weak());
         }
     });
+    range_ui(ui, loaded, forms, commands);
     save_ui(ui, state, forms, commands);
     ui.separator();
     table_ui(ui, state, loaded, forms, commands);
+}
+
+/// The measuring range (`sensor.range`): where the calibrated sensor will
+/// be used, so that `ml` predicts the error over it (Results) and the
+/// planner spreads the sphere over it.
+fn range_ui(
+    ui: &mut egui::Ui,
+    loaded: &LoadedSession,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    let current = loaded.session.sensor_range;
+    ui.horizontal_wrapped(|ui| {
+        ui.label(RichText::new("Measuring range").strong())
+            .on_hover_text("sensor.range: the part of the laser plane the sensor measures in (sensor frame); the next run predicts the error over it");
+        let mut edit = forms
+            .range_edit
+            .unwrap_or_else(|| current.as_ref().map_or(DEFAULT_RANGE, range_values));
+        if range_fields(ui, "session_range", &mut edit) {
+            forms.range_edit = Some(edit);
+        }
+        let parsed = range_of(&edit);
+        let differs = parsed.ok() != current;
+        if ui
+            .add_enabled(parsed.is_ok() && differs, egui::Button::new("Set range"))
+            .on_hover_text("keep this range with the session (saved with it); run again to predict the error over it")
+            .clicked()
+            && let Ok(r) = parsed
+        {
+            commands.push(Command::View(ViewCommand::SetSensorRange(Some(r))));
+        }
+        if current.is_some()
+            && ui
+                .button("Clear")
+                .on_hover_text("forget the range: the error is then predicted where the sphere was seen")
+                .clicked()
+        {
+            commands.push(Command::View(ViewCommand::SetSensorRange(None)));
+        }
+        match (&parsed, current) {
+            (Err(why), _) => {
+                ui.label(RichText::new(*why).color(BAD));
+            }
+            (_, Some(r)) => {
+                ui.label(
+                    RichText::new(format!(
+                        "set: y {:.0}…{:.0}, z {:.0}…{:.0} mm",
+                        r.y[0], r.y[1], r.z[0], r.z[1]
+                    ))
+                    .color(MUTED),
+                );
+            }
+            (_, None) => {
+                ui.label(
+                    RichText::new("not set: the error is predicted only where the sphere was seen")
+                        .color(WARN),
+                );
+            }
+        }
+    });
 }
 
 fn filters_ui(

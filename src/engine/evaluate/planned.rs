@@ -61,8 +61,15 @@ pub fn planned_range_study(seeds: u64) -> Result<Vec<PlannedRangeRow>, PlanError
             ..PlanConfig::for_preset(&preset, STUDY_SPHERE)
         };
         let made = plan::plan(&config, &mut |_| Control::Continue)?;
-        let predicted_rms = made.stats.range_error.as_ref().map_or(f64::NAN, |r| r.rms_mm);
-        for (errors, model) in [("table1", ErrorModel::Table1), ("random", ErrorModel::Random)] {
+        let predicted_rms = made
+            .stats
+            .range_error
+            .as_ref()
+            .map_or(f64::NAN, |r| r.rms_mm);
+        for (errors, model) in [
+            ("table1", ErrorModel::Table1),
+            ("random", ErrorModel::Random),
+        ] {
             let predict = PredictConfig {
                 runs: usize::try_from(seeds).unwrap_or(usize::MAX),
                 seed: 1,

@@ -285,9 +285,14 @@ pub fn run_scenario(scenario: &Scenario, seeds: u64) -> Result<ScenarioResult, S
                 out.floor.push(score.floor.std);
             }
             let initial = &prepared.hand_eye_initial;
-            if let Some(range) =
-                range_score(&session, &truth, initial, &cal.calibrated, &cal.hand_eye, None)
-            {
+            if let Some(range) = range_score(
+                &session,
+                &truth,
+                initial,
+                &cal.calibrated,
+                &cal.hand_eye,
+                None,
+            ) {
                 runs.range_rms.push(range.after.rms);
                 runs.range_ratio.push(range.ratio_to_floor());
                 if method == Method::Paper {

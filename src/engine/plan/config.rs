@@ -8,8 +8,8 @@ use crate::engine::cell::sensor;
 use crate::engine::cell::workspace::{self, Workspace};
 use crate::engine::robot::ik::DOF;
 use crate::engine::robot::{JointLimit, Preset, Robot, RobotChoice};
-use crate::engine::simulate::SimConfig;
 use crate::engine::session::SensorRange;
+use crate::engine::simulate::SimConfig;
 
 use super::*;
 

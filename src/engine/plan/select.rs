@@ -140,9 +140,7 @@ impl StationInfo {
             Some(qt) => {
                 let fqf = f.transpose() * qt * &f;
                 let fqf = Matrix3::from_fn(|i, j| fqf[(i, j)]);
-                total
-                    .cholesky()
-                    .map_or(0.0, |t| t.solve(&fqf).trace())
+                total.cholesky().map_or(0.0, |t| t.solve(&fqf).trace())
             }
         }
     }

@@ -5,8 +5,8 @@ use serde::{Deserialize, Serialize};
 use super::stripe::stripe_point_count;
 use crate::engine::cell::workspace::Workspace;
 use crate::engine::robot::RobotChoice;
-use crate::engine::session::{MIN_STRIPE_POINTS, SensorRange};
 use crate::engine::session::{DEFAULT_MAX_ITERATIONS, DEFAULT_THRESHOLD};
+use crate::engine::session::{MIN_STRIPE_POINTS, SensorRange};
 
 /// σ of the `random` kinematic errors for angles (alpha, beta, theta), deg,
 /// at `error_scale = 1`: the size of the paper's Table 1 angle errors

@@ -105,7 +105,11 @@ impl Planner<'_> {
         match (self.config.spread, self.config.range) {
             (true, Some(r)) => {
                 let x = self.sample_x(rng, side);
-                Vector3::new(x, uniform(rng, r.y[0], r.y[1]), uniform(rng, r.z[0], r.z[1]))
+                Vector3::new(
+                    x,
+                    uniform(rng, r.y[0], r.y[1]),
+                    uniform(rng, r.z[0], r.z[1]),
+                )
             }
             _ => self.sample_centre(rng, side),
         }
