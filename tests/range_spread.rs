@@ -260,3 +260,93 @@ fn ml_on_a_spread_session_reports_full_coverage() {
     // Seen everywhere, the error is nearly even over the range.
     assert!(range.max_mm < 2.0 * range.at_sphere_mm, "{range:?}");
 }
+
+fn run(args: &[&str]) -> (Option<i32>, String, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_spherecal"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// `simulate --spread`, `plan --range [--no-spread]`, `evaluate` with the
+/// range scenarios, from the command line.
+#[test]
+fn the_command_line_spreads_plans_and_scores_the_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = dir.path().join("s.json");
+    let (code, _, err) = run(&["simulate", "--out", s.to_str().unwrap(), "--spread"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("--range"), "{err}");
+    let (code, _, err) = run(&[
+        "simulate",
+        "--out",
+        s.to_str().unwrap(),
+        "--range",
+        "-40,40,-30,30",
+        "--spread",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let truth = simulate::parse_truth(
+        &std::fs::read_to_string(dir.path().join("s.truth.json")).unwrap(),
+    )
+    .unwrap();
+    assert!(truth.config.spread);
+    assert_eq!(truth.config.range, Some(RANGE));
+    let spread_y = extent(
+        truth
+            .measurements
+            .iter()
+            .filter(|(_, m)| m.usage == Use::Identify)
+            .map(|(_, m)| m.sensor_centre[1]),
+    );
+    assert!(spread_y[1] - spread_y[0] > 50.0, "{spread_y:?}");
+
+    let (code, out, err) = run(&[
+        "plan",
+        "--sphere",
+        "1050,0,475",
+        "--range",
+        "-40,40,-40,40",
+        "--identify-stations",
+        "4",
+        "--validate-stations",
+        "3",
+        "--candidates",
+        "10",
+        "--predict",
+        "2",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.contains("predicted point error over the range (y -40…40, z -40…40 mm"), "{out}");
+    assert!(out.contains("without the spread: rms"), "{out}");
+    assert!(out.contains("error over the range (9 × 9 grid"), "{out}");
+    let (code, out, err) = run(&[
+        "plan",
+        "--sphere",
+        "1050,0,475",
+        "--range",
+        "-40,40,-40,40",
+        "--no-spread",
+        "--identify-stations",
+        "4",
+        "--validate-stations",
+        "3",
+        "--candidates",
+        "10",
+        "--predict",
+        "0",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.contains("the sphere at one spot"), "{out}");
+    let (code, _, err) = run(&["plan", "--sphere", "1050,0,475", "--no-spread"]);
+    assert_eq!(code, Some(2), "{err}");
+
+    let (code, out, err) = run(&["evaluate", "--scenario", "range-spread", "--seeds", "1"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.contains("error over the range (rms over a 9 × 9 grid"), "{out}");
+}
