@@ -652,8 +652,13 @@ pub fn plan(
             spread: false,
             ..config.clone()
         };
-        let other = self::plan(&unspread, &mut |_| progress(PlanStage::Comparison))?;
-        plan.stats.range_error_unspread = other.stats.range_error;
+        // Best effort: a comparison that cannot be planned (the spot's
+        // candidates fewer than needed) leaves the figure out, not the plan.
+        match self::plan(&unspread, &mut |_| progress(PlanStage::Comparison)) {
+            Ok(other) => plan.stats.range_error_unspread = other.stats.range_error,
+            Err(PlanError::Cancelled) => return Err(PlanError::Cancelled),
+            Err(_) => {}
+        }
     }
     Ok(plan)
 }
@@ -725,10 +730,17 @@ pub fn summary(plan: &Plan) -> String {
                     u.rms_mm / r.rms_mm
                 );
             }
-            None => {
+            None if r.coverage < crate::engine::solve::ml::range::RANGE_COVERAGE_WARNING => {
                 let _ = writeln!(
                     s,
                     "    the sphere at one spot ({:.0} % of the range): spread it over the range for less error away from it",
+                    r.coverage * 100.0
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "    the sphere seen over {:.0} % of the range",
                     r.coverage * 100.0
                 );
             }
