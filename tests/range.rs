@@ -8,7 +8,8 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
+use nalgebra::{Isometry3, Point3};
+use spherecal::engine::geometry::kabsch;
 use spherecal::engine::format;
 use spherecal::engine::session::{SensorRange, Session, Use};
 use spherecal::engine::simulate::{self, SimConfig, Truth};
@@ -62,23 +63,11 @@ fn realised_rms(session: &Session, truth: &Truth, cal: &Calibration) -> f64 {
         }
     }
     let n = cal_pts.len() as f64;
-    let ca = cal_pts.iter().sum::<Vector3<f64>>() / n;
-    let ta = true_pts.iter().sum::<Vector3<f64>>() / n;
-    let mut h = Matrix3::zeros();
-    for (c, t) in cal_pts.iter().zip(&true_pts) {
-        h += (c - ca) * (t - ta).transpose();
-    }
-    let svd = h.svd(true, true);
-    let (u, v_t) = (svd.u.unwrap(), svd.v_t.unwrap());
-    let mut d = Matrix3::identity();
-    if (v_t.transpose() * u.transpose()).determinant() < 0.0 {
-        d[(2, 2)] = -1.0;
-    }
-    let r = v_t.transpose() * d * u.transpose();
+    let fit = kabsch(&cal_pts, &true_pts).unwrap();
     let sum_sq: f64 = cal_pts
         .iter()
         .zip(&true_pts)
-        .map(|(c, t)| (r * (c - ca) + ta - t).norm_squared())
+        .map(|(c, t)| ((fit * Point3::from(*c)).coords - t).norm_squared())
         .sum();
     (sum_sq / n).sqrt()
 }
