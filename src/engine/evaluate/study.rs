@@ -144,8 +144,15 @@ fn range_spread(seed: u64) -> SimConfig {
     }
 }
 
+fn many_stations_spread(seed: u64) -> SimConfig {
+    SimConfig {
+        n_identify: MANY_STATIONS,
+        ..range_spread(seed)
+    }
+}
+
 /// The scenarios of the issues, in table order.
-pub const SCENARIOS: [Scenario; 7] = [
+pub const SCENARIOS: [Scenario; 8] = [
     Scenario {
         key: "paper-like",
         title: "paper-like (Table 1 errors, 9 stations)",
@@ -180,6 +187,11 @@ pub const SCENARIOS: [Scenario; 7] = [
         key: "range-spread",
         title: "80 × 80 mm range, sphere spread over it",
         config: range_spread,
+    },
+    Scenario {
+        key: "stations-30-spread",
+        title: "30 identify stations, sphere spread over an 80 × 80 mm range",
+        config: many_stations_spread,
     },
 ];
 
