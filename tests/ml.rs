@@ -15,8 +15,11 @@ use spherecal::engine::format::{self, ResultFile};
 use spherecal::engine::session::{self, ExcludeError};
 use spherecal::engine::session::{Observation, Session, Use};
 use spherecal::engine::simulate::{self, SimConfig, Truth};
-use spherecal::engine::solve::ml::MlReport;
-use spherecal::engine::solve::{self, Calibration, Control, Method, Options, Prepared};
+use spherecal::engine::solve::estimate::Estimate;
+use spherecal::engine::solve::ml::{Loss, MlReport, MlUpdate};
+use spherecal::engine::solve::{
+    self, Calibration, Control, Method, Options, Prepared, Step, Update,
+};
 
 fn simulate(config: &SimConfig) -> (Session, Truth) {
     simulate::simulate(config).expect("simulation")
@@ -436,6 +439,70 @@ fn evaluate_smoke_two_seeds() {
     let table = evaluate::markdown(&results, 2);
     assert_eq!(table.lines().count(), 2 + 7, "{table}");
     assert!(evaluate::select("nope").is_err());
+}
+
+/// A reference weighted least-squares fit: `ml`'s problem started at the
+/// TRUE model and hand-eye (so the whitening and every fixed parameter are
+/// exact), with no prior and no robust loss, LM run to its optimum.
+fn reference_fit(session: &Session, prepared: &Prepared, truth: &Truth) -> TruthScore {
+    let start = Estimate {
+        robot: truth.true_robot(),
+        flange_from_sensor: truth.true_hand_eye(),
+    };
+    let mut options = ml_options(session);
+    options.ml.prior = false;
+    options.ml.loss = Loss::Squared;
+    let stations = prepared.stations(session, Use::Identify);
+    let mut update =
+        MlUpdate::new(session, prepared, &start, stations, &options).expect("reference problem");
+    for n in 1..=options.max_iterations {
+        if update.update(n, &mut |_| Control::Continue).expect("LM") != Step::Moved {
+            break;
+        }
+    }
+    let est = update.estimate();
+    score(
+        session,
+        prepared,
+        truth,
+        &est.robot,
+        &est.flange_from_sensor,
+    )
+}
+
+#[test]
+fn many_stations_stay_at_the_efficient_level_and_nine_do_not_lose() {
+    // Issue 14, part 6. At 30 stations the validation std of `ml` is
+    // 1.11x the floor (mean of seeds 1..=5; 1.23 worst), at 9 stations
+    // 1.21x. The rest is not lost by the solver: the reference weighted
+    // least-squares fit from the truth (exact whitening, no prior, no
+    // robust loss) is no closer to the floor (1.16x at 30 stations);
+    // the parameter uncertainty the data leave, mostly the global length
+    // scale, is what remains, and the prior is what takes `ml` below the
+    // reference. The goal of 1.03x is therefore not asserted; these bounds
+    // guard what was measured (README, "Efficiency at many stations").
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let scenario = |key: &str| evaluate::select(key).expect("scenario")[0];
+    let (many_stations, paper_like) = (scenario("stations-30"), scenario("paper-like"));
+    let many = evaluate::run_scenario(&many_stations, 5).expect("stations-30");
+    let nine = evaluate::run_scenario(&paper_like, 5).expect("paper-like");
+    let (many_ml, nine_ml) = (mean(&many.ml.ratio), mean(&nine.ml.ratio));
+    eprintln!("ml / floor: 30 stations {many_ml:.3}, 9 stations {nine_ml:.3}");
+    assert!(many_ml <= 1.12, "30 stations: ml / floor {many_ml}");
+    assert!(nine_ml <= 1.21, "9 stations: ml / floor {nine_ml}");
+    assert!(many_ml < mean(&many.paper.ratio) && nine_ml < mean(&nine.paper.ratio));
+    let mut reference = Vec::new();
+    for seed in 1..=5 {
+        let (session, truth) = simulate(&(many_stations.config)(seed));
+        let prepared = solve::prepare(&session).expect("prepare");
+        reference.push(reference_fit(&session, &prepared, &truth).ratio_to_floor());
+    }
+    let reference = mean(&reference);
+    eprintln!("reference weighted LS from the truth, 30 stations: {reference:.3}");
+    assert!(
+        reference > 1.1 && many_ml <= reference,
+        "reference {reference}, ml {many_ml}"
+    );
 }
 
 #[test]
