@@ -426,7 +426,7 @@ fn ml_result_block_round_trips_and_is_named() {
 fn evaluate_smoke_two_seeds() {
     // The README evidence command, 2 seeds of every scenario.
     let scenarios = evaluate::select("all").expect("scenarios");
-    assert_eq!(scenarios.len(), 7);
+    assert_eq!(scenarios.len(), 8);
     let mut results = Vec::new();
     for s in &scenarios {
         let r = evaluate::run_scenario(s, 2).expect("scenario");
@@ -437,7 +437,7 @@ fn evaluate_smoke_two_seeds() {
         results.push(r);
     }
     let table = evaluate::markdown(&results, 2);
-    assert_eq!(table.lines().count(), 2 + 7, "{table}");
+    assert_eq!(table.lines().count(), 2 + 8, "{table}");
     assert!(evaluate::select("nope").is_err());
 }
 
