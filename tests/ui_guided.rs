@@ -1,7 +1,8 @@
 //! UI tests of the guided workbench (issue 13): the job through the step
 //! bar, PASS/FAIL against a tolerance, Cancel in the last phase keeping
 //! the previous result, the Session table's filters, the Plan view
-//! following the open session's robot. egui_kittest, no display.
+//! following the open session's robot, Run and the side ε plot staying
+//! put, the plots PNG whole on white. egui_kittest, no display.
 
 #![cfg(feature = "gui")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
@@ -376,10 +377,12 @@ fn the_demo_says_what_to_do_until_dismissed() {
 /// between 372 and 578 px, the plot was cut off).
 #[test]
 fn run_and_the_side_epsilon_plot_stay_put() {
-    let mut prefs = spherecal::app::state::Prefs::default();
-    prefs.recent = (0..8)
-        .map(|k| std::path::PathBuf::from(format!("/no/such/cell{k}/session-{k}.json")))
-        .collect();
+    let prefs = spherecal::app::state::Prefs {
+        recent: (0..8)
+            .map(|k| std::path::PathBuf::from(format!("/no/such/cell{k}/session-{k}.json")))
+            .collect(),
+        ..Default::default()
+    };
     let mut h = ui_support::harness(WorkbenchApp::new(prefs, None, None));
     settle(&mut h);
     h.get_by_label("▶ Run").click();
@@ -450,9 +453,6 @@ fn the_plots_png_is_whole_and_light() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     assert_eq!(files, ["demo-irb2400-plots.png"], "one file, no temporary");
-    if let Some(keep) = std::env::var_os("SPHERECAL_KEEP_PNG") {
-        std::fs::copy(dir.path().join(&files[0]), keep).unwrap();
-    }
     let png = image::open(dir.path().join(&files[0])).unwrap().to_rgb8();
     let view = h.state().state().result.clone().expect("result");
     let sheet = spherecal::app::features::export::plots_sheet(&view);

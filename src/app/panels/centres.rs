@@ -25,7 +25,8 @@ pub const AFTER_KEY: &str = "● after (calibrated): filled";
 /// "◆ V5" (shown in its colour).
 #[must_use]
 pub fn station_key(k: usize, name: &str) -> String {
-    format!("{} {name}", station_style(k).glyph)
+    // A no-break space: a wrapped row never parts a shape from its name.
+    format!("{}\u{a0}{name}", station_style(k).glyph)
 }
 
 /// One drawn marker: where, which measurement, before or after.
@@ -232,12 +233,14 @@ fn projection_markers(set: &CentreSet, f: &CentresForm) -> Vec<Marker> {
 }
 
 /// The label of projection axis `k` (0 x, 1 y, 2 z): position in mm, or
-/// in relative mode the deviation from the station mean in µm.
+/// in relative mode the deviation from the station mean in µm (the
+/// caption above each projection says of what; the label must fit the
+/// plot's height).
 #[must_use]
 pub fn projection_axis_label(k: usize, relative: bool) -> String {
     let name = ["x", "y", "z"].get(k).copied().unwrap_or("?");
     if relative {
-        format!("Δ{name} from station mean (µm)")
+        format!("Δ{name} (µm)")
     } else {
         format!("{name} (mm)")
     }
@@ -546,18 +549,28 @@ fn scale_bar_ui(
         );
     }
     painter.text(
-        right - Vec2::new(length / 2.0, 8.0),
-        egui::Align2::CENTER_BOTTOM,
-        format!(
-            "{} µm deviation (×{magnify:.0})",
-            super::plots::tick_label(egui_plot::GridMark {
-                value: um,
-                step_size: um
-            })
-        ),
+        right - Vec2::new(0.0, 8.0),
+        egui::Align2::RIGHT_BOTTOM,
+        format!("{} deviation (×{magnify:.0})", length_text(um)),
         egui::FontId::proportional(13.0),
         colour,
     );
+}
+
+/// A 1-2-5 length given in µm as text: µm below a millimetre, else mm.
+#[must_use]
+pub fn length_text(um: f64) -> String {
+    let text = |v: f64| {
+        super::plots::tick_label(egui_plot::GridMark {
+            value: v,
+            step_size: v,
+        })
+    };
+    if um >= UM_PER_MM {
+        format!("{} mm", text(um / UM_PER_MM))
+    } else {
+        format!("{} µm", text(um))
+    }
 }
 
 /// x (red), y (green), z (blue) in the lower left corner.
@@ -691,7 +704,7 @@ mod tests {
         assert!((largest - 20.0).abs() < 1e-6, "{largest}");
         assert!((pts[2].0[0] - 10.0).abs() < 1e-6, "{:?}", pts[2]);
         assert!((pts[3].0[0] - 1.0).abs() < 1e-6, "after: {:?}", pts[3]);
-        assert_eq!(projection_axis_label(0, true), "Δx from station mean (µm)");
+        assert_eq!(projection_axis_label(0, true), "Δx (µm)");
         assert_eq!(projection_axis_label(2, false), "z (mm)");
         // Not magnified: positions in mm.
         let plain = CentresForm {
@@ -709,6 +722,8 @@ mod tests {
         assert_eq!(um, 500.0);
         assert!((points - 62.5).abs() < 1e-3);
         assert!(scale_bar(0.0).is_none());
-        assert_eq!(station_key(12, "V3"), "■ V3");
+        assert_eq!(length_text(um), "500 µm");
+        assert_eq!(length_text(20_000.0), "20 mm");
+        assert_eq!(station_key(12, "V3"), "■\u{a0}V3");
     }
 }

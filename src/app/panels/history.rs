@@ -16,6 +16,9 @@ use crate::engine::history::{Drift, Entry, Library, Series, Verdict};
 
 /// Height of one drift plot, points.
 const DRIFT_PLOT_HEIGHT: f32 = 170.0;
+/// Room left of the first and right of the last result on a drift plot's
+/// x axis, in results.
+const DATE_ROOM: f64 = 0.6;
 /// Drift plots per row.
 const PLOTS_PER_ROW: usize = 3;
 /// Most rows of the library table before it scrolls.
@@ -388,8 +391,13 @@ fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[St
             ])
         })
         .collect();
+    // Half a result of room each side: the first and last dates, centred
+    // on their ticks, stay inside the plot.
+    let last = dates.len().saturating_sub(1) as f64;
     let plot = Plot::new(("drift", series.name.as_str()))
         .height(DRIFT_PLOT_HEIGHT)
+        .include_x(-DATE_ROOM)
+        .include_x(last + DATE_ROOM)
         .allow_scroll(false);
     labelled_x(readable_y(plot), dates.to_vec(), DATE_LABEL_GAP)
         .y_axis_label(series.unit.as_str())

@@ -7,7 +7,7 @@
 
 use egui::RichText;
 use egui_plot::{
-    HLine, Legend, Line, LineStyle, MarkerShape, Plot, PlotPoint, PlotPoints, Points, Text, VLine,
+    HLine, Legend, Line, LineStyle, MarkerShape, Plot, PlotPoint, PlotPoints, Points, Text,
 };
 
 use super::plots::{readable, spaced_labels};
@@ -30,7 +30,7 @@ const SOLVER_ENTRY_CHARS: usize = 300;
 type Indexed = Vec<(usize, f64)>;
 
 /// Least gap between two of Fig. 5's station names, points.
-const STATION_LABEL_GAP: f32 = 6.0;
+const STATION_LABEL_GAP: f32 = 10.0;
 
 /// Height of each of the four plots, points.
 const PLOT_HEIGHT: f32 = 230.0;
@@ -351,6 +351,8 @@ fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
     let within = &view.shown.within;
     readable(Plot::new("fig5"), true)
         .height(PLOT_HEIGHT)
+        // The wheel scrolls the page, not the plot (drag still pans).
+        .allow_scroll(false)
         .x_axis_label("pair (station by station)")
         .y_axis_label("distance (mm)")
         .include_y(0.0)
@@ -372,7 +374,7 @@ fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
         });
 }
 
-/// Fig. 5's stations: a dotted line between two, and each one's name
+/// Fig. 5's stations: a dotted line between two (under the names), and each one's name
 /// above its pairs where it does not overlap its neighbour's (at 60
 /// stations every few; hover a point for its station).
 fn station_bands_ui(p: &mut egui_plot::PlotUi<'_>, within: &[PairDistance], y: f64) {
@@ -406,10 +408,15 @@ fn station_bands_ui(p: &mut egui_plot::PlotUi<'_>, within: &[PairDistance], y: f
             Text::new("", PlotPoint::new(x_of(r), y), within[r.0].station.as_str()).color(MUTED),
         );
     }
+    // The separators stop under the names, which stay clear to read.
+    let below_names = y * 0.93;
     for r in runs.iter().skip(1) {
-        p.vline(
-            VLine::new("", r.0 as f64 + 0.5)
+        let x = r.0 as f64 + 0.5;
+        p.line(
+            Line::new("", PlotPoints::from(vec![[x, 0.0], [x, below_names]]))
                 .color(MUTED)
+                .width(1.0)
+                .allow_hover(false)
                 .style(LineStyle::dotted_dense()),
         );
     }
@@ -439,6 +446,8 @@ fn fig6_ui(ui: &mut egui::Ui, view: &ResultView) {
     let distances = &view.shown.distances;
     readable(Plot::new("fig6"), true)
         .height(PLOT_HEIGHT)
+        // The wheel scrolls the page, not the plot (drag still pans).
+        .allow_scroll(false)
         .x_axis_label("reference distance no.")
         .y_axis_label("error (mm)")
         .label_formatter(move |pos| match pos {
@@ -866,7 +875,7 @@ fn range_map_ui(ui: &mut egui::Ui, r: &crate::engine::solve::ml::range::RangeErr
         ))
         .color(MUTED),
     );
-    Plot::new("range_map")
+    readable(Plot::new("range_map"), false)
         .height(PLOT_HEIGHT)
         .width(PLOT_HEIGHT * 1.3)
         .data_aspect(1.0)

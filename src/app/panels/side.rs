@@ -49,7 +49,7 @@ pub fn load_ui(
     let line = |ui: &mut egui::Ui, text: RichText| ui.add(egui::Label::new(text).truncate());
     match &state.loaded {
         Some(l) => {
-            line(ui, RichText::new(&l.session.name).strong()).on_hover_text(&l.session.name);
+            name_ui(ui, &l.session.name);
             line(ui, RichText::new(l.source.label()).small().weak())
                 .on_hover_text(l.source.label());
             let n = l.session.measurements.len();
@@ -67,7 +67,7 @@ pub fn load_ui(
             line(ui, RichText::new(&text).small()).on_hover_text(text);
         }
         None => {
-            line(ui, RichText::new("no session open").strong().weak());
+            name_ui(ui, "no session open");
             line(ui, RichText::new(" ").small());
             line(ui, RichText::new(" ").small());
         }
@@ -118,6 +118,39 @@ pub fn load_ui(
         "or drop a file onto the window"
     };
     line(ui, RichText::new(hint).small().weak()).on_hover_text(hint);
+}
+
+/// The session's name in two lines of room whatever its length (wrapped,
+/// cut with … beyond two lines, whole on hover).
+fn name_ui(ui: &mut egui::Ui, name: &str) {
+    let style = egui::TextStyle::Body;
+    let width = ui.available_width();
+    let height = 2.0 * ui.text_style_height(&style);
+    let mut job = egui::text::LayoutJob::single_section(
+        name.to_string(),
+        egui::TextFormat {
+            font_id: style.resolve(ui.style()),
+            color: ui.visuals().strong_text_color(),
+            ..Default::default()
+        },
+    );
+    job.wrap = egui::text::TextWrapping {
+        max_width: width,
+        max_rows: 2,
+        break_anywhere: false,
+        overflow_character: Some('…'),
+    };
+    let rect = egui::Rect::from_min_size(ui.cursor().min, egui::vec2(width, height));
+    let used = ui
+        .scope_builder(egui::UiBuilder::new().max_rect(rect), |ui| {
+            ui.add(egui::Label::new(job)).on_hover_text(name);
+        })
+        .response
+        .rect
+        .height();
+    if used < height {
+        ui.add_space(height - used);
+    }
 }
 
 /// The error of the last thing that failed (a file that did not open, an
