@@ -1,7 +1,8 @@
 //! UI tests of the guided workbench (issue 13): the job through the step
 //! bar, PASS/FAIL against a tolerance, Cancel in the last phase keeping
 //! the previous result, the Session table's filters, the Plan view
-//! following the open session's robot. egui_kittest, no display.
+//! following the open session's robot, Run and the side ε plot staying
+//! put, the plots PNG whole on white. egui_kittest, no display.
 
 #![cfg(feature = "gui")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
@@ -369,4 +370,132 @@ fn the_demo_says_what_to_do_until_dismissed() {
     h.run();
     assert!(h.query_by_label("What to do").is_none());
     assert!(h.state().state().prefs.intro_dismissed);
+}
+
+/// Issue 13: at 1366×768 Run stays where it is and the side panel's ε
+/// plot stays whole when an error and the recent list show (Run moved
+/// between 372 and 578 px, the plot was cut off).
+#[test]
+fn run_and_the_side_epsilon_plot_stay_put() {
+    let prefs = spherecal::app::state::Prefs {
+        recent: (0..8)
+            .map(|k| std::path::PathBuf::from(format!("/no/such/cell{k}/session-{k}.json")))
+            .collect(),
+        ..Default::default()
+    };
+    let mut h = ui_support::harness(WorkbenchApp::new(prefs, None, None));
+    settle(&mut h);
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    h.run();
+    let run_top = h.get_by_label("▶ Run").rect().top();
+    let side_stop = |h: &Harness<'_, WorkbenchApp>| {
+        // The stop reason under the side panel's ε plot (the Results
+        // view, on the right, says it too).
+        let found: Vec<egui::Rect> = h
+            .query_all_by_label_contains("converged")
+            .filter(|n| {
+                let a = n.accesskit_node();
+                a.label()
+                    .or_else(|| a.value())
+                    .is_some_and(|l| l.starts_with("converged"))
+            })
+            .map(|n| n.rect())
+            .filter(|r| r.left() < 300.0)
+            .collect();
+        assert_eq!(found.len(), 1, "{found:?}");
+        found[0]
+    };
+    let before = side_stop(&h);
+    // An error notice: a file that does not exist.
+    open_path(&mut h, "/no/such/session.json".into());
+    h.run();
+    assert!(h.state().state().notice.is_some(), "the error shows");
+    assert!(h.query_by_label("Recent files").is_some());
+    let run_now = h.get_by_label("▶ Run").rect().top();
+    assert!(
+        (run_now - run_top).abs() < 0.5,
+        "Run moved from {run_top} to {run_now}"
+    );
+    let after = side_stop(&h);
+    assert!((after.top() - before.top()).abs() < 0.5, "the ε plot moved");
+    assert!(
+        after.bottom() < 768.0 - 24.0,
+        "the ε plot and the line under it are above the status line: {after:?}"
+    );
+    // The error is on screen too.
+    let title = h
+        .query_all_by_label_contains("Could not open")
+        .next()
+        .expect("the notice")
+        .rect();
+    assert!(title.bottom() < 768.0 - 24.0, "the notice shows: {title:?}");
+}
+
+/// Issue 13: the Plots PNG is the whole sheet of figures on white, at
+/// twice the sheet's size, nothing touching its edges (a clipped label
+/// would), every figure's axis labels drawn; written atomically (no
+/// temporary file left). It used to be a dark crop of the window that
+/// cut off what was scrolled out of view.
+#[test]
+fn the_plots_png_is_whole_and_light() {
+    let mut h = demo_app();
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    h.get_by_label("Results ●").click();
+    settle(&mut h);
+    let dir = tempfile::tempdir().expect("temp dir");
+    h.state_mut().forms_mut().export_dir = dir.path().display().to_string();
+    h.get_by_label("Plots PNG").click();
+    settle(&mut h);
+    let files: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(files, ["demo-irb2400-plots.png"], "one file, no temporary");
+    let png = image::open(dir.path().join(&files[0])).unwrap().to_rgb8();
+    let view = h.state().state().result.clone().expect("result");
+    let sheet = spherecal::app::features::export::plots_sheet(&view);
+    let scale = f64::from(spherecal::app::features::export::PNG_SCALE);
+    assert_eq!(
+        (png.width(), png.height()),
+        (
+            (sheet.width * scale).ceil() as u32,
+            (sheet.height * scale).ceil() as u32
+        )
+    );
+    let dark = |p: &image::Rgb<u8>| p.0.iter().map(|c| u32::from(*c)).sum::<u32>() < 3 * 160;
+    let light = png
+        .pixels()
+        .filter(|p| p.0.iter().all(|c| *c > 235))
+        .count();
+    assert!(
+        light as f64 > 0.8 * f64::from(png.width() * png.height()),
+        "a light background"
+    );
+    // Nothing within the margin's inner half of the edges.
+    let edge = (spherecal::engine::report::sheet::SHEET_MARGIN * scale / 2.0) as u32;
+    for (x, y, p) in png.enumerate_pixels() {
+        let inside = x >= edge && y >= edge && x < png.width() - edge && y < png.height() - edge;
+        assert!(
+            inside || p.0.iter().all(|c| *c > 240),
+            "ink at the edge ({x}, {y})"
+        );
+    }
+    // Each figure's rotated y-axis label (the first 24 px of its box):
+    // ink in the band of Fig. 5, Fig. 6 and ε.
+    let margin = spherecal::engine::report::sheet::SHEET_MARGIN * scale;
+    let band = |y0: f64, y1: f64| {
+        (y0 as u32..y1 as u32)
+            .flat_map(|y| (margin as u32..(margin + 20.0 * scale) as u32).map(move |x| (x, y)))
+            .filter(|&(x, y)| dark(png.get_pixel(x, y)))
+            .count()
+    };
+    let height = png.height() as f64;
+    for (name, y0, y1) in [("Fig. 5", 0.1, 0.4), ("Fig. 6", 0.4, 0.7), ("ε", 0.7, 0.98)] {
+        assert!(
+            band(y0 * height, y1 * height) > 50,
+            "{name}: the y-axis label is drawn"
+        );
+    }
 }

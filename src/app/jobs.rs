@@ -5,7 +5,6 @@
 //! (egui's http_app, rerun's `background_tasks.rs`).
 
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
 
 use crate::engine::history::{Drift, Library};
@@ -96,8 +95,6 @@ pub enum RunMessage {
 /// What the export jobs report.
 #[derive(Debug)]
 pub enum ExportMessage {
-    /// The window's pixels for a plots PNG arrived.
-    Screenshot(Arc<egui::ColorImage>),
     /// An export file was written, or why not.
     Written {
         /// What was exported.
@@ -213,7 +210,7 @@ impl Default for Jobs {
 }
 
 impl Jobs {
-    /// A reporter for `ctx`, e.g. for a screenshot callback.
+    /// A reporter for `ctx`.
     #[must_use]
     pub fn reporter(&self, ctx: &egui::Context) -> Reporter {
         Reporter {

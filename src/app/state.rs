@@ -426,8 +426,6 @@ pub struct Busy {
     pub saving: bool,
     /// Exports being written.
     pub exporting: usize,
-    /// A window screenshot for the plots PNG is awaited.
-    pub screenshot: bool,
     /// Import previews or imports in flight.
     pub importing: usize,
     /// A library folder is being scanned.
@@ -492,7 +490,6 @@ impl AppState {
             || self.busy.dialog
             || self.busy.saving
             || self.busy.exporting > 0
-            || self.busy.screenshot
             || self.busy.importing > 0
             || self.busy.scanning
             || self.history.drifting

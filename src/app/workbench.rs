@@ -127,7 +127,7 @@ impl WorkbenchApp {
     }
 
     /// The non-drawing part of a frame: the start-up commands, the job
-    /// messages, the screenshot timeout. Also run while the window is
+    /// messages. Also run while the window is
     /// hidden (eframe's `logic`), so that a long run never waits on a full
     /// channel.
     pub fn pump(&mut self, ctx: &egui::Context) {
@@ -137,7 +137,6 @@ impl WorkbenchApp {
         for message in self.core.jobs.drain() {
             self.core.on_message(ctx, message);
         }
-        self.core.screenshot_timeout(ctx);
     }
 
     /// One frame: drain job messages, draw everything, apply the commands.
@@ -151,12 +150,7 @@ impl WorkbenchApp {
         self.pump(&ctx);
         let mut commands = Vec::new();
         input_commands(&ctx, &self.core.forms, &mut commands);
-        let Core {
-            state,
-            forms,
-            plots_rect,
-            ..
-        } = &mut self.core;
+        let Core { state, forms, .. } = &mut self.core;
         egui::Panel::bottom("status").show(ui, |ui| panels::status::status_ui(ui, state));
         egui::Panel::left("side")
             .resizable(true)
@@ -173,9 +167,7 @@ impl WorkbenchApp {
                 Tab::Session => panels::session::session_ui(ui, state, forms, &mut commands),
                 Tab::Stripe => panels::stripe::stripe_ui(ui, state, forms, &mut commands),
                 Tab::Centres => panels::centres::centres_ui(ui, state, forms, &mut commands),
-                Tab::Results => {
-                    *plots_rect = panels::results::results_ui(ui, state, forms, &mut commands);
-                }
+                Tab::Results => panels::results::results_ui(ui, state, forms, &mut commands),
                 Tab::Import => panels::import::import_ui(ui, state, forms, &mut commands),
                 Tab::Plan => panels::plan::plan_ui(ui, state, forms, &mut commands),
                 Tab::History => panels::history::history_ui(ui, state, forms, &mut commands),

@@ -1,6 +1,7 @@
 //! Export files of a result: the FORMAT.md result JSON, CSV of the centres
-//! and of the distance errors, a PNG of the plots (cropped from a window
-//! screenshot), the self-contained HTML report, and the calibrated model
+//! and of the distance errors, a PNG of the plots (the engine's plot sheet
+//! drawn off-screen on white, whole whatever is on screen), the
+//! self-contained HTML report, and the calibrated model
 //! (JSON robot block, MDH CSV, URDF fragment, as `spherecal
 //! export-model`). Every file is written atomically by the engine's
 //! [`write_atomic`], on a job thread.
@@ -8,16 +9,16 @@
 use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::Arc;
-use std::time::{Instant, SystemTime};
+use std::time::SystemTime;
 
 use crate::engine::format::{result_text_checked, write_atomic};
 use crate::engine::report::html::{self, ReportInput, ReportMeta};
 use crate::engine::report::model::{self, ModelFormat};
+use crate::engine::report::sheet::{self, SheetInput};
 use crate::engine::result_view::{self, Tolerance};
 
 use super::Core;
 use crate::app::error::JobError;
-use crate::app::forms::Tab;
 use crate::app::jobs::{ExportMessage, JobMessage};
 use crate::app::state::{ExportKind, Level, LoadedSession};
 use crate::app::view::{ResultOrigin, ResultView};
@@ -104,11 +105,7 @@ pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<()
         ExportKind::ResultJson => result_text_checked(&view.file, path)?,
         ExportKind::CentresCsv => centres_csv(view),
         ExportKind::DistancesCsv => distances_csv(view),
-        ExportKind::PlotsPng => {
-            return Err(JobError::Missing(
-                "a PNG is written from a screenshot".to_string(),
-            ));
-        }
+        ExportKind::PlotsPng => return write_plots_png(view, path),
         ExportKind::ReportHtml => {
             return Err(JobError::Missing("a report needs its session".to_string()));
         }
@@ -155,40 +152,112 @@ pub fn write_report(
     Ok(write_atomic(path, html.as_bytes())?)
 }
 
-/// Crops `image` to `rect` (physical pixels: min x, min y, width, height)
-/// and writes it as a PNG to `path` atomically.
-///
-/// # Errors
-/// An empty crop, a PNG encoding error, or a write error.
-pub fn write_png(image: &egui::ColorImage, rect: [usize; 4], path: &Path) -> Result<(), JobError> {
-    let [w_img, h_img] = image.size;
-    let x0 = rect[0].min(w_img);
-    let y0 = rect[1].min(h_img);
-    let w = rect[2].min(w_img - x0);
-    let h = rect[3].min(h_img - y0);
-    if w == 0 || h == 0 {
-        return Err(JobError::Png(
-            "the plots were not on screen: nothing to save".to_string(),
+/// Pixels per sheet px of the plots PNG: 2 prints a 968 px wide sheet
+/// sharp at about 16 cm (300 dpi) and reads well on screen.
+pub const PNG_SCALE: f32 = 2.0;
+
+/// The plot sheet of `view` ([`sheet::plots_sheet`]): its title is the
+/// session and method, the lines under it the headline figures and ε.
+#[must_use]
+pub fn plots_sheet(view: &ResultView) -> sheet::Sheet {
+    let title = format!("{} · method {}", view.file.session, view.method);
+    // Words rather than arrows: the built-in proportional font has no →.
+    let mut lines = Vec::new();
+    if let Some(h) = &view.shown.headline {
+        let (b, a) = (h.stats.before, h.stats.after);
+        lines.push(h.what.clone());
+        lines.push(format!(
+            "std {:.3} mm before, {:.3} mm after · max {:.3} mm before, {:.3} mm after",
+            b.std, a.std, b.max, a.max
         ));
     }
-    let mut rgba = Vec::with_capacity(w * h * 4);
-    for y in y0..y0 + h {
-        for px in &image.pixels[y * w_img + x0..y * w_img + x0 + w] {
-            rgba.extend_from_slice(&px.to_array());
+    lines.push(format!(
+        "ε {:.4} mm before, {:.4} mm after",
+        view.file.epsilon_before, view.file.epsilon_after
+    ));
+    sheet::plots_sheet(&SheetInput {
+        title: &title,
+        lines: &lines,
+        within: &view.shown.within,
+        within_of: view.shown.within_of.as_str(),
+        distances: &view.shown.distances,
+        epsilons: &view.epsilons,
+        threshold: view.threshold,
+        singular_values: &view.singular_values,
+        kept: view.kept,
+        svd_tolerance: view.svd_tolerance,
+    })
+}
+
+/// The fonts the sheet's text is drawn in: egui's own (built into the
+/// program), so that the PNG looks the same on every machine; the
+/// proportional one is the SVG's `sans-serif`.
+fn sheet_fonts() -> resvg::usvg::fontdb::Database {
+    let mut db = resvg::usvg::fontdb::Database::new();
+    let defs = egui::FontDefinitions::default();
+    let proportional = defs
+        .families
+        .get(&egui::FontFamily::Proportional)
+        .and_then(|f| f.first())
+        .cloned();
+    let mut sans = None;
+    for (name, data) in &defs.font_data {
+        let before = db.len();
+        db.load_font_data(data.font.as_ref().as_ref().to_vec());
+        if Some(name) == proportional.as_ref() {
+            sans = db
+                .faces()
+                .skip(before)
+                .find_map(|f| f.families.first().map(|(family, _)| family.clone()));
         }
     }
-    let (Ok(wu), Ok(hu)) = (u32::try_from(w), u32::try_from(h)) else {
-        return Err(JobError::Png("the screenshot is too large".to_string()));
+    if let Some(family) = sans {
+        db.set_sans_serif_family(family);
+    }
+    db
+}
+
+/// The plot sheet of `view` as PNG bytes, [`PNG_SCALE`] pixels per px,
+/// on white.
+///
+/// # Errors
+/// The sheet does not parse or is too large to draw (a bug), or the PNG
+/// cannot be encoded.
+pub fn plots_png(view: &ResultView) -> Result<Vec<u8>, JobError> {
+    use resvg::{tiny_skia, usvg};
+    let sheet = plots_sheet(view);
+    let fontdb = sheet_fonts();
+    let options = usvg::Options {
+        font_family: "sans-serif".to_string(),
+        fontdb: Arc::new(fontdb),
+        ..usvg::Options::default()
     };
-    let mut bytes = Vec::new();
-    image::ImageEncoder::write_image(
-        image::codecs::png::PngEncoder::new(&mut bytes),
-        &rgba,
-        wu,
-        hu,
-        image::ExtendedColorType::Rgba8,
-    )
-    .map_err(|e| JobError::Png(format!("could not encode the PNG: {e}")))?;
+    let tree = usvg::Tree::from_str(&sheet.svg, &options)
+        .map_err(|e| JobError::Png(format!("the plot sheet does not parse: {e}")))?;
+    let size = tree.size();
+    let (w, h) = (
+        (size.width() * PNG_SCALE).ceil() as u32,
+        (size.height() * PNG_SCALE).ceil() as u32,
+    );
+    let mut pixmap = tiny_skia::Pixmap::new(w, h)
+        .ok_or_else(|| JobError::Png(format!("cannot draw a {w} × {h} image")))?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    resvg::render(
+        &tree,
+        tiny_skia::Transform::from_scale(PNG_SCALE, PNG_SCALE),
+        &mut pixmap.as_mut(),
+    );
+    pixmap
+        .encode_png()
+        .map_err(|e| JobError::Png(format!("could not encode the PNG: {e}")))
+}
+
+/// Writes the plots PNG of `view` ([`plots_png`]) to `path` atomically.
+///
+/// # Errors
+/// As [`plots_png`], or the file cannot be written.
+pub fn write_plots_png(view: &ResultView, path: &Path) -> Result<(), JobError> {
+    let bytes = plots_png(view)?;
     Ok(write_atomic(path, &bytes)?)
 }
 
@@ -211,21 +280,6 @@ impl Core {
             None => "result".to_string(),
         };
         let path = dir.join(kind.file_name(&stem));
-        if kind == ExportKind::PlotsPng {
-            if self.state.busy.screenshot {
-                return;
-            }
-            self.forms.tab = Tab::Results;
-            self.png_target = Some((path, Instant::now()));
-            self.state.busy.screenshot = true;
-            let rep = self.jobs.reporter(ctx);
-            ctx.request_screenshot(move |image| {
-                rep.send(JobMessage::Export(ExportMessage::Screenshot(image)));
-            });
-            self.state
-                .say(Level::Info, "taking a screenshot of the plots…");
-            return;
-        }
         let loaded = if kind == ExportKind::ReportHtml {
             let Some(loaded) = &self.state.loaded else {
                 self.state
@@ -253,28 +307,9 @@ impl Core {
         }
     }
 
-    /// Gives up on a window screenshot that never came (a backend that
-    /// cannot take one), so that the export stays usable.
-    pub fn screenshot_timeout(&mut self, ctx: &egui::Context) {
-        let Some((_, since)) = &self.png_target else {
-            return;
-        };
-        if since.elapsed() >= super::SCREENSHOT_TIMEOUT {
-            self.png_target = None;
-            self.state.busy.screenshot = false;
-            self.state.say(
-                Level::Warning,
-                "no screenshot came from the window system: no PNG written",
-            );
-        } else {
-            ctx.request_repaint_after(super::SCREENSHOT_TIMEOUT);
-        }
-    }
-
     /// Handles an [`ExportMessage`].
-    pub(super) fn on_export(&mut self, ctx: &egui::Context, message: ExportMessage) {
+    pub(super) fn on_export(&mut self, message: ExportMessage) {
         match message {
-            ExportMessage::Screenshot(image) => self.on_screenshot(ctx, &image),
             ExportMessage::Written {
                 kind,
                 path,
@@ -286,37 +321,6 @@ impl Core {
                 }
                 self.say_written(kind.label(), &path, outcome);
             }
-        }
-    }
-
-    fn on_screenshot(&mut self, ctx: &egui::Context, image: &Arc<egui::ColorImage>) {
-        self.state.busy.screenshot = false;
-        let (Some((path, _)), Some(rect)) = (self.png_target.take(), self.plots_rect) else {
-            self.state.say(
-                Level::Warning,
-                "the plots were not on screen: no PNG written",
-            );
-            return;
-        };
-        let ppp = ctx.pixels_per_point();
-        let px = |v: f32| (v * ppp).round().max(0.0) as usize;
-        let crop = [
-            px(rect.min.x),
-            px(rect.min.y),
-            px(rect.width()),
-            px(rect.height()),
-        ];
-        let image = Arc::clone(image);
-        let started = self.spawn(ctx, "export", move |rep| {
-            let outcome = write_png(&image, crop, &path);
-            rep.send(JobMessage::Export(ExportMessage::Written {
-                kind: ExportKind::PlotsPng,
-                path,
-                outcome,
-            }));
-        });
-        if started {
-            self.state.busy.exporting += 1;
         }
     }
 }

@@ -1,8 +1,8 @@
 //! What the workbench does, one module per feature. Each feature has the
 //! handler of its [`Command`]s (checks the forms, starts a job), the
 //! handler of its jobs' [`JobMessage`]s (updates the state, says what
-//! happened) and the plain functions its jobs run (engine calls, no egui
-//! beyond the screenshot's pixels):
+//! happened) and the plain functions its jobs run (engine calls; the
+//! plots PNG reads egui's built-in fonts):
 //!
 //! | feature | commands | job work |
 //! |---|---|---|
@@ -25,17 +25,12 @@ pub mod run;
 pub mod view;
 
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
 
 use super::commands::Command;
 use super::error::JobError;
 use super::forms::Forms;
 use super::jobs::{JobMessage, Jobs, Reporter};
 use super::state::{AppState, Level, Notice};
-
-/// How long to wait for the window's screenshot for a plots PNG: a frame
-/// takes milliseconds; a backend that cannot take one never answers.
-pub const SCREENSHOT_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// The state, the forms and the job runner, with every feature's
 /// handlers. The workbench owns one and draws the panels from it.
@@ -46,10 +41,6 @@ pub struct Core {
     pub forms: Forms,
     /// The job runner.
     pub jobs: Jobs,
-    /// Screen rectangle of the Results view's plots in the last frame.
-    pub plots_rect: Option<egui::Rect>,
-    /// Where the awaited screenshot's PNG goes, and since when.
-    pub png_target: Option<(PathBuf, Instant)>,
 }
 
 impl Core {
@@ -60,8 +51,6 @@ impl Core {
             state,
             forms,
             jobs: Jobs::default(),
-            plots_rect: None,
-            png_target: None,
         }
     }
 
@@ -83,7 +72,7 @@ impl Core {
         match message {
             JobMessage::Files(m) => self.on_files(ctx, m),
             JobMessage::Run(m) => self.on_run(m),
-            JobMessage::Export(m) => self.on_export(ctx, m),
+            JobMessage::Export(m) => self.on_export(m),
             JobMessage::Import(m) => self.on_import(ctx, m),
             JobMessage::History(m) => self.on_history(ctx, m),
             JobMessage::Plan(m) => self.on_plan(ctx, m),

@@ -6,7 +6,8 @@
 use egui::{Color32, Pos2, Rect, RichText, Sense, Stroke, Vec2};
 use egui_plot::{MarkerShape, Plot, PlotPoints, Points};
 
-use super::{AFTER, BEFORE, station_colour};
+use super::plots::readable;
+use super::station_style;
 use crate::app::commands::{Command, ViewCommand};
 use crate::app::forms::{Camera, CentresForm, Forms};
 use crate::app::state::AppState;
@@ -14,6 +15,19 @@ use crate::app::view::{CentrePoint, CentreSet};
 
 /// A click selects the nearest centre within this many points of the pointer.
 const PICK_RADIUS: f32 = 10.0;
+
+/// The key of the before markers (hollow, in the station's colour).
+pub const BEFORE_KEY: &str = "○ before (nominal): hollow";
+/// The key of the after markers (filled, in the station's colour).
+pub const AFTER_KEY: &str = "● after (calibrated): filled";
+
+/// The key of station number `k` named `name`: its shape and name, e.g.
+/// "◆ V5" (shown in its colour).
+#[must_use]
+pub fn station_key(k: usize, name: &str) -> String {
+    // A no-break space: a wrapped row never parts a shape from its name.
+    format!("{}\u{a0}{name}", station_style(k).glyph)
+}
 
 /// One drawn marker: where, which measurement, before or after.
 struct Marker {
@@ -47,6 +61,12 @@ pub fn centres_ui(
     let has_after = set.points.iter().any(|p| p.after.is_some());
     options_ui(ui, &mut forms.centres, has_after, set);
     let markers = markers(set, &forms.centres);
+    let flat = projection_markers(set, &forms.centres);
+    let relative = forms.centres.relative;
+    let magnify = forms
+        .centres
+        .relative
+        .then_some(f64::from(forms.centres.magnify));
     let selected = state.selected;
     let size = ui.available_size();
     ui.horizontal(|ui| {
@@ -66,6 +86,7 @@ pub fn centres_ui(
                 set,
                 &mut forms.centres.camera,
                 selected,
+                magnify,
             ) {
                 commands.push(Command::View(ViewCommand::Select(i)));
             }
@@ -80,8 +101,13 @@ pub fn centres_ui(
             .into_iter()
             .enumerate()
             {
+                let name = if relative {
+                    format!("{name}, deviations from each station's mean (all stations about 0)")
+                } else {
+                    name.to_string()
+                };
                 ui.label(RichText::new(name).small().weak());
-                if let Some(i) = projection_ui(ui, k, (a, b), h, &markers, set, selected) {
+                if let Some(i) = projection_ui(ui, k, (a, b), (h, relative), &flat, set, selected) {
                     commands.push(Command::View(ViewCommand::Select(i)));
                 }
             }
@@ -91,16 +117,13 @@ pub fn centres_ui(
 
 fn options_ui(ui: &mut egui::Ui, f: &mut CentresForm, has_after: bool, set: &CentreSet) {
     ui.horizontal_wrapped(|ui| {
-        ui.checkbox(
-            &mut f.show_before,
-            RichText::new("○ before (nominal)").color(BEFORE),
-        );
+        // Both are drawn in their station's colour: the cue is the fill.
+        ui.checkbox(&mut f.show_before, BEFORE_KEY)
+            .on_hover_text("nominal model, initial hand-eye: hollow markers");
         ui.add_enabled_ui(has_after, |ui| {
-            ui.checkbox(
-                &mut f.show_after,
-                RichText::new("● after (calibrated)").color(AFTER),
-            )
-            .on_disabled_hover_text("run the solver first");
+            ui.checkbox(&mut f.show_after, AFTER_KEY)
+                .on_hover_text("calibrated: filled markers")
+                .on_disabled_hover_text("run the solver first");
         });
         ui.checkbox(
             &mut f.relative,
@@ -123,7 +146,8 @@ fn options_ui(ui: &mut egui::Ui, f: &mut CentresForm, has_after: bool, set: &Cen
         }
         ui.separator();
         for (k, s) in set.stations.iter().enumerate() {
-            ui.label(RichText::new(format!("■ {s}")).color(station_colour(k)));
+            let style = station_style(k);
+            ui.label(RichText::new(station_key(k, s)).color(style.colour));
         }
     });
 }
@@ -166,6 +190,86 @@ fn markers(set: &CentreSet, f: &CentresForm) -> Vec<Marker> {
     }
     out
 }
+
+/// Micrometres in a millimetre.
+const UM_PER_MM: f64 = 1000.0;
+
+/// What the plane projections draw: in relative mode each centre's
+/// deviation from its station's mean in µm (before from the mean before,
+/// after from the mean after; every station about one origin, so the
+/// axes carry true deviations, not magnified millimetres), else the
+/// centres in mm.
+fn projection_markers(set: &CentreSet, f: &CentresForm) -> Vec<Marker> {
+    if !f.relative {
+        return markers(set, f);
+    }
+    let dev = |p: [f64; 3], mean: [f64; 3]| -> [f64; 3] {
+        std::array::from_fn(|k| (p[k] - mean[k]) * UM_PER_MM)
+    };
+    let mut out = Vec::new();
+    for p in &set.points {
+        let s = set.station_index(&p.station);
+        let (mean_before, mean_after) = set.means.get(s).copied().unwrap_or(([0.0; 3], [0.0; 3]));
+        if f.show_before {
+            out.push(Marker {
+                pos: dev(p.before, mean_before),
+                index: p.index,
+                station: s,
+                after: false,
+            });
+        }
+        if f.show_after
+            && let Some(a) = p.after
+        {
+            out.push(Marker {
+                pos: dev(a, mean_after),
+                index: p.index,
+                station: s,
+                after: true,
+            });
+        }
+    }
+    out
+}
+
+/// The label of projection axis `k` (0 x, 1 y, 2 z): position in mm, or
+/// in relative mode the deviation from the station mean in µm (the
+/// caption above each projection says of what; the label must fit the
+/// plot's height).
+#[must_use]
+pub fn projection_axis_label(k: usize, relative: bool) -> String {
+    let name = ["x", "y", "z"].get(k).copied().unwrap_or("?");
+    if relative {
+        format!("Δ{name} (µm)")
+    } else {
+        format!("{name} (mm)")
+    }
+}
+
+/// Where the plane projections draw each centre (x, y, z in the units of
+/// [`projection_axis_label`]) and its measurement index.
+#[must_use]
+pub fn projection_points(set: &CentreSet, form: &CentresForm) -> Vec<([f64; 3], Option<usize>)> {
+    projection_markers(set, form)
+        .into_iter()
+        .map(|m| (m.pos, m.index))
+        .collect()
+}
+
+/// The scale bar of the magnified 3D view: a 1-2-5 length of deviation
+/// in µm that draws at least [`SCALE_BAR_MIN`] points long when one µm
+/// draws `points_per_um`; the length and its points.
+#[must_use]
+pub fn scale_bar(points_per_um: f64) -> Option<(f64, f32)> {
+    if !(points_per_um.is_finite() && points_per_um > 0.0) {
+        return None;
+    }
+    let um = super::plots::nice_step(f64::from(SCALE_BAR_MIN) / points_per_um, false);
+    Some((um, (um * points_per_um) as f32))
+}
+
+/// Least length of the scale bar, points.
+const SCALE_BAR_MIN: f32 = 60.0;
 
 /// The accessible name of the 3D view.
 pub const ORBIT_LABEL: &str = "3D view of the sphere centres";
@@ -265,6 +369,7 @@ fn orbit_ui(
     set: &CentreSet,
     cam: &mut Camera,
     selected: Option<usize>,
+    magnify: Option<f64>,
 ) -> Option<usize> {
     let (response, painter) = ui.allocate_painter(size, Sense::click_and_drag());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, ORBIT_LABEL));
@@ -305,12 +410,8 @@ fn orbit_ui(
     drawn.sort_by(|a, b| b.1.total_cmp(&a.1));
     let painter = painter.with_clip_rect(rect);
     for (p, _, m) in &drawn {
-        let colour = station_colour(m.station);
-        if m.after {
-            painter.circle_filled(*p, 4.0, colour);
-        } else {
-            painter.circle_stroke(*p, 4.5, Stroke::new(1.5, colour));
-        }
+        let style = station_style(m.station);
+        paint_marker(&painter, *p, style.shape, style.colour, m.after);
         if m.index.is_some() && m.index == selected {
             painter.circle_stroke(*p, 8.0, Stroke::new(2.0, ui.visuals().strong_text_color()));
         }
@@ -323,11 +424,21 @@ fn orbit_ui(
                 egui::Align2::LEFT_BOTTOM,
                 s,
                 egui::FontId::proportional(13.0),
-                station_colour(k),
+                station_style(k).colour,
             );
         }
     }
     axes_triad(&painter, rect, cy, sy, cp, sp);
+    if let Some(k) = magnify {
+        // Drawn mm per true mm of deviation is k; points per drawn mm is the scale.
+        scale_bar_ui(
+            &painter,
+            rect,
+            view.scale * k / UM_PER_MM,
+            k,
+            ui.visuals().text_color(),
+        );
+    }
     let hit = |pointer: Pos2| -> Option<&Marker> {
         drawn
             .iter()
@@ -369,6 +480,99 @@ fn tooltip(set: &CentreSet, m: &Marker) -> String {
     )
 }
 
+/// A station marker at `p`: its shape, filled (after) or hollow (before).
+fn paint_marker(
+    painter: &egui::Painter,
+    p: Pos2,
+    shape: MarkerShape,
+    colour: Color32,
+    filled: bool,
+) {
+    let r = if filled { 4.0 } else { 4.5 };
+    let corners: Vec<Pos2> = match shape {
+        MarkerShape::Square => vec![
+            p + Vec2::new(-r, -r),
+            p + Vec2::new(r, -r),
+            p + Vec2::new(r, r),
+            p + Vec2::new(-r, r),
+        ],
+        MarkerShape::Diamond => {
+            let d = r * 1.35;
+            vec![
+                p + Vec2::new(0.0, -d),
+                p + Vec2::new(d, 0.0),
+                p + Vec2::new(0.0, d),
+                p + Vec2::new(-d, 0.0),
+            ]
+        }
+        MarkerShape::Right => vec![
+            p + Vec2::new(-r, -r * 1.15),
+            p + Vec2::new(r * 1.3, 0.0),
+            p + Vec2::new(-r, r * 1.15),
+        ],
+        _ => {
+            if filled {
+                painter.circle_filled(p, r, colour);
+            } else {
+                painter.circle_stroke(p, r, Stroke::new(1.5, colour));
+            }
+            return;
+        }
+    };
+    if filled {
+        painter.add(egui::Shape::convex_polygon(corners, colour, Stroke::NONE));
+    } else {
+        painter.add(egui::Shape::closed_line(corners, Stroke::new(1.5, colour)));
+    }
+}
+
+/// The deviation scale of the magnified 3D view, lower right: a bar of a
+/// 1-2-5 number of µm and its length in words.
+fn scale_bar_ui(
+    painter: &egui::Painter,
+    rect: Rect,
+    points_per_um: f64,
+    magnify: f64,
+    colour: Color32,
+) {
+    let Some((um, length)) = scale_bar(points_per_um) else {
+        return;
+    };
+    let right = rect.right_bottom() + Vec2::new(-20.0, -24.0);
+    let left = right - Vec2::new(length, 0.0);
+    let stroke = Stroke::new(2.0, colour);
+    painter.line_segment([left, right], stroke);
+    for end in [left, right] {
+        painter.line_segment(
+            [end - Vec2::new(0.0, 5.0), end + Vec2::new(0.0, 5.0)],
+            stroke,
+        );
+    }
+    painter.text(
+        right - Vec2::new(0.0, 8.0),
+        egui::Align2::RIGHT_BOTTOM,
+        format!("{} deviation (×{magnify:.0})", length_text(um)),
+        egui::FontId::proportional(13.0),
+        colour,
+    );
+}
+
+/// A 1-2-5 length given in µm as text: µm below a millimetre, else mm.
+#[must_use]
+pub fn length_text(um: f64) -> String {
+    let text = |v: f64| {
+        super::plots::tick_label(egui_plot::GridMark {
+            value: v,
+            step_size: v,
+        })
+    };
+    if um >= UM_PER_MM {
+        format!("{} mm", text(um / UM_PER_MM))
+    } else {
+        format!("{} µm", text(um))
+    }
+}
+
 /// x (red), y (green), z (blue) in the lower left corner.
 fn axes_triad(painter: &egui::Painter, rect: Rect, cy: f64, sy: f64, cp: f64, sp: f64) {
     let origin = rect.left_bottom() + Vec2::new(40.0, -40.0);
@@ -398,20 +602,19 @@ fn projection_ui(
     ui: &mut egui::Ui,
     k: usize,
     (a, b): (usize, usize),
-    height: f32,
+    (height, relative): (f32, bool),
     markers: &[Marker],
     set: &CentreSet,
     selected: Option<usize>,
 ) -> Option<usize> {
-    const AXES: [&str; 3] = ["x (mm)", "y (mm)", "z (mm)"];
-    let response = Plot::new(("projection", k))
+    let response = readable(Plot::new(("projection", k)), false)
         .data_aspect(1.0)
         .height(height)
-        .x_axis_label(AXES[a])
-        .y_axis_label(AXES[b])
+        .x_axis_label(projection_axis_label(a, relative))
+        .y_axis_label(projection_axis_label(b, relative))
         .show(ui, |p| {
             for (s, name) in set.stations.iter().enumerate() {
-                let colour = station_colour(s);
+                let style = station_style(s);
                 for after in [false, true] {
                     let pts: Vec<[f64; 2]> = markers
                         .iter()
@@ -423,10 +626,10 @@ fn projection_ui(
                     }
                     p.points(
                         Points::new(name.clone(), PlotPoints::from(pts))
-                            .color(colour)
+                            .color(style.colour)
                             .filled(after)
-                            .shape(MarkerShape::Circle)
-                            .radius(if after { 3.0 } else { 4.0 }),
+                            .shape(style.shape)
+                            .radius(if after { 3.5 } else { 4.0 }),
                     );
                 }
             }
@@ -460,4 +663,67 @@ fn projection_ui(
             }
         });
     response.inner
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(id: &str, station: &str, before: [f64; 3], after: [f64; 3]) -> CentrePoint {
+        CentrePoint {
+            id: id.into(),
+            station: station.into(),
+            usage: "identify".into(),
+            index: None,
+            before,
+            after: Some(after),
+        }
+    }
+
+    /// The issue: at ×250 the magnified projections showed ±2000 "mm".
+    /// Now they show each centre's true deviation in µm.
+    #[test]
+    fn magnified_projections_are_in_micrometres() {
+        let set = CentreSet::new(vec![
+            point("a", "P0", [1000.0, 0.0, 500.0], [1000.0, 0.0, 500.0]),
+            point("b", "P0", [1000.02, 0.0, 500.0], [1000.002, 0.0, 500.0]),
+            point("c", "P1", [0.0, 800.0, 300.0], [0.0, 800.0, 300.0]),
+            point("d", "P1", [0.0, 800.0, 300.04], [0.0, 800.0, 300.0]),
+        ]);
+        let form = CentresForm {
+            magnify: 250.0,
+            ..CentresForm::default()
+        };
+        assert!(form.relative);
+        let pts = projection_points(&set, &form);
+        let largest = pts
+            .iter()
+            .flat_map(|(p, _)| p.iter())
+            .fold(0.0_f64, |m, v| m.max(v.abs()));
+        // b's deviation before: 0.01 mm from P0's mean = 10 µm; d's 20 µm.
+        assert!((largest - 20.0).abs() < 1e-6, "{largest}");
+        assert!((pts[2].0[0] - 10.0).abs() < 1e-6, "{:?}", pts[2]);
+        assert!((pts[3].0[0] - 1.0).abs() < 1e-6, "after: {:?}", pts[3]);
+        assert_eq!(projection_axis_label(0, true), "Δx (µm)");
+        assert_eq!(projection_axis_label(2, false), "z (mm)");
+        // Not magnified: positions in mm.
+        let plain = CentresForm {
+            relative: false,
+            ..form
+        };
+        assert_eq!(projection_points(&set, &plain)[0].0, [1000.0, 0.0, 500.0]);
+    }
+
+    #[test]
+    fn scale_bar_is_a_round_number_of_micrometres() {
+        // ×250 at 0.5 points per drawn mm: 0.125 points per µm; 60 points
+        // need 480 µm, so 500 µm, 62.5 points.
+        let (um, points) = scale_bar(0.125).unwrap();
+        assert_eq!(um, 500.0);
+        assert!((points - 62.5).abs() < 1e-3);
+        assert!(scale_bar(0.0).is_none());
+        assert_eq!(length_text(um), "500 µm");
+        assert_eq!(length_text(20_000.0), "20 mm");
+        assert_eq!(station_key(12, "V3"), "■\u{a0}V3");
+    }
 }

@@ -7,6 +7,7 @@
 use egui::RichText;
 use egui_plot::{Line, LineStyle, MarkerShape, Plot, PlotPoints, Points};
 
+use super::plots::{DATE_LABEL_GAP, labelled_x, readable_y};
 use super::{AFTER, BAD, MUTED, WARN, labelled_field};
 use crate::app::commands::{Command, FilesCommand, HistoryCommand};
 use crate::app::forms::Forms;
@@ -14,7 +15,10 @@ use crate::app::state::{AppState, DialogPurpose};
 use crate::engine::history::{Drift, Entry, Library, Series, Verdict};
 
 /// Height of one drift plot, points.
-const DRIFT_PLOT_HEIGHT: f32 = 150.0;
+const DRIFT_PLOT_HEIGHT: f32 = 170.0;
+/// Room left of the first and right of the last result on a drift plot's
+/// x axis, in results.
+const DATE_ROOM: f64 = 0.6;
 /// Drift plots per row.
 const PLOTS_PER_ROW: usize = 3;
 /// Most rows of the library table before it scrolls.
@@ -387,18 +391,15 @@ fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[St
             ])
         })
         .collect();
-    let labels = dates.to_vec();
-    Plot::new(("drift", series.name.as_str()))
+    // Half a result of room each side: the first and last dates, centred
+    // on their ticks, stay inside the plot.
+    let last = dates.len().saturating_sub(1) as f64;
+    let plot = Plot::new(("drift", series.name.as_str()))
         .height(DRIFT_PLOT_HEIGHT)
-        .allow_scroll(false)
-        .x_axis_formatter(move |mark, _| {
-            let i = mark.value.round();
-            if (mark.value - i).abs() < 1e-6 && i >= 0.0 {
-                labels.get(i as usize).cloned().unwrap_or_default()
-            } else {
-                String::new()
-            }
-        })
+        .include_x(-DATE_ROOM)
+        .include_x(last + DATE_ROOM)
+        .allow_scroll(false);
+    labelled_x(readable_y(plot), dates.to_vec(), DATE_LABEL_GAP)
         .y_axis_label(series.unit.as_str())
         .show(ui, |p| {
             for pt in &series.points {

@@ -6,6 +6,7 @@ pub mod centres;
 pub mod history;
 pub mod import;
 pub mod plan;
+pub mod plots;
 pub mod results;
 pub mod session;
 pub mod side;
@@ -32,22 +33,67 @@ pub const WARN: Color32 = Color32::from_rgb(230, 170, 40);
 /// Colour of things marked not identifiable.
 pub const MUTED: Color32 = Color32::from_rgb(150, 150, 150);
 
-/// A distinct colour for station number `k`.
+/// Ten colours that print and show apart (matplotlib's tab10).
+const STATION_PALETTE: [Color32; 10] = [
+    Color32::from_rgb(31, 119, 180),
+    Color32::from_rgb(255, 127, 14),
+    Color32::from_rgb(44, 160, 44),
+    Color32::from_rgb(214, 39, 40),
+    Color32::from_rgb(148, 103, 189),
+    Color32::from_rgb(140, 86, 75),
+    Color32::from_rgb(227, 119, 194),
+    Color32::from_rgb(188, 189, 34),
+    Color32::from_rgb(23, 190, 207),
+    Color32::from_rgb(127, 127, 127),
+];
+
+/// The marker shapes of stations, one per ten stations, with the glyph
+/// that stands for each in a key (fillable shapes: before is drawn
+/// hollow, after filled).
+pub const STATION_SHAPES: [(egui_plot::MarkerShape, &str); 4] = [
+    (egui_plot::MarkerShape::Circle, "●"),
+    (egui_plot::MarkerShape::Square, "■"),
+    (egui_plot::MarkerShape::Diamond, "◆"),
+    (egui_plot::MarkerShape::Right, "▶"),
+];
+
+/// How station number `k` is marked: one of ten colours and, by tens,
+/// one of four shapes; from the 41st station on the colours are lighter.
+/// Distinct for the first 80 stations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StationStyle {
+    /// Colour.
+    pub colour: Color32,
+    /// Shape in plots.
+    pub shape: egui_plot::MarkerShape,
+    /// The glyph of the shape, for a key.
+    pub glyph: &'static str,
+}
+
+/// The marker of station number `k` ([`StationStyle`]).
+#[must_use]
+pub fn station_style(k: usize) -> StationStyle {
+    let base = STATION_PALETTE[k % STATION_PALETTE.len()];
+    let tens = k / STATION_PALETTE.len();
+    let (shape, glyph) = STATION_SHAPES[tens % STATION_SHAPES.len()];
+    let lighter = (tens / STATION_SHAPES.len()) % 2 == 1;
+    let colour = if lighter {
+        let up = |c: u8| c + (255 - c) / 2;
+        Color32::from_rgb(up(base.r()), up(base.g()), up(base.b()))
+    } else {
+        base
+    };
+    StationStyle {
+        colour,
+        shape,
+        glyph,
+    }
+}
+
+/// The colour of station number `k` ([`station_style`]).
 #[must_use]
 pub fn station_colour(k: usize) -> Color32 {
-    const PALETTE: [Color32; 10] = [
-        Color32::from_rgb(31, 119, 180),
-        Color32::from_rgb(255, 127, 14),
-        Color32::from_rgb(44, 160, 44),
-        Color32::from_rgb(214, 39, 40),
-        Color32::from_rgb(148, 103, 189),
-        Color32::from_rgb(140, 86, 75),
-        Color32::from_rgb(227, 119, 194),
-        Color32::from_rgb(188, 189, 34),
-        Color32::from_rgb(23, 190, 207),
-        Color32::from_rgb(127, 127, 127),
-    ];
-    PALETTE[k % PALETTE.len()]
+    station_style(k).colour
 }
 
 /// A one-line text field with a visible label tied to it (screen readers
@@ -193,5 +239,28 @@ pub fn log_tick(exponent: f64) -> String {
         format!("{v:.digits$}")
     } else {
         format!("{v:.1e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The issue: with ten colours for 20 stations P0 and V1 shared blue.
+    /// Every one of 80 stations now has its own colour and shape.
+    #[test]
+    fn station_markers_are_distinct() {
+        let styles: Vec<StationStyle> = (0..80).map(station_style).collect();
+        for (a, sa) in styles.iter().enumerate() {
+            for (b, sb) in styles.iter().enumerate().skip(a + 1) {
+                assert!(
+                    (sa.colour, sa.glyph) != (sb.colour, sb.glyph),
+                    "stations {a} and {b} look alike"
+                );
+            }
+        }
+        // P0 (station 0) and V1 (station 10) of the demo: same hue, other shape.
+        assert_eq!(station_style(0).colour, station_style(10).colour);
+        assert_ne!(station_style(0).shape, station_style(10).shape);
     }
 }

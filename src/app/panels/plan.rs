@@ -388,7 +388,7 @@ fn map_ui(ui: &mut egui::Ui, plan: &Plan) {
             .collect()
     };
     let base = plan.robot.base.translation.vector;
-    Plot::new("plan_map")
+    super::plots::readable(Plot::new("plan_map"), false)
         .height(MAP_HEIGHT)
         .data_aspect(1.0)
         .x_axis_label("x (mm)")

@@ -5,11 +5,12 @@
 //! hand-eye before and after, the Table 1 view of the joint errors with
 //! the non-identifiable ones marked, and the export buttons.
 
-use egui::{Rect, RichText};
+use egui::RichText;
 use egui_plot::{
-    HLine, Legend, Line, LineStyle, MarkerShape, Plot, PlotPoint, PlotPoints, Points, Text, VLine,
+    HLine, Legend, Line, LineStyle, MarkerShape, Plot, PlotPoint, PlotPoints, Points, Text,
 };
 
+use super::plots::{readable, spaced_labels};
 use super::side::epsilon_plot_ui;
 use super::{AFTER, BAD, BEFORE, GOOD, MUTED, WARN, labelled_field, ratio_text};
 use crate::app::commands::{Command, FilesCommand, ViewCommand};
@@ -17,7 +18,7 @@ use crate::app::forms::Forms;
 use crate::app::state::{AppState, DialogPurpose, ExportKind};
 use crate::app::view::{HandEyeView, ResultOrigin, ResultView};
 use crate::engine::geometry::{rows_from_isometry, wrap_deg};
-use crate::engine::result_view::Verdict;
+use crate::engine::result_view::{PairDistance, Verdict};
 use crate::engine::robot::{PARAM_NAMES, PARAMS_PER_JOINT};
 use crate::engine::solve::estimate::HAND_EYE_LABELS;
 
@@ -28,41 +29,36 @@ const SOLVER_ENTRY_CHARS: usize = 300;
 /// Singular values with their index.
 type Indexed = Vec<(usize, f64)>;
 
+/// Least gap between two of Fig. 5's station names, points.
+const STATION_LABEL_GAP: f32 = 10.0;
+
 /// Height of each of the four plots, points.
 const PLOT_HEIGHT: f32 = 230.0;
 
-/// The Results view. Returns the screen rectangle of the headline and the
-/// plots (what "Plots PNG" saves).
+/// The Results view.
 pub fn results_ui(
     ui: &mut egui::Ui,
     state: &AppState,
     forms: &mut Forms,
     commands: &mut Vec<Command>,
-) -> Option<Rect> {
+) {
     let Some(view) = &state.result else {
         ui.add_space(20.0);
         ui.label(RichText::new("No result yet.").size(18.0));
         ui.label("Press ▶ Run in the solver panel on the left, or open a result file (path field or Open…) to review it beside its session.");
-        return None;
+        return;
     };
-    let mut plots_rect = None;
     egui::ScrollArea::vertical()
         .auto_shrink([false, false])
         .show(ui, |ui| {
             origin_ui(ui, view);
             export_ui(ui, state, forms, commands);
-            let top = ui.cursor().min;
             headline_ui(ui, view, forms, commands);
             ui.add_space(4.0);
-            let bottom = plots_ui(ui, view);
-            plots_rect = Some(Rect::from_min_max(
-                top,
-                egui::pos2(ui.max_rect().right(), bottom),
-            ));
+            plots_ui(ui, view);
             ui.add_space(8.0);
             tables_ui(ui, view);
         });
-    plots_rect
 }
 
 fn origin_ui(ui: &mut egui::Ui, view: &ResultView) {
@@ -211,8 +207,7 @@ fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
                 kind,
                 ExportKind::ModelJson | ExportKind::ModelCsv | ExportKind::ModelUrdf
             );
-            let enabled = (kind != ExportKind::PlotsPng || !state.busy.screenshot)
-                && !(model && hand_eye_only);
+            let enabled = !(model && hand_eye_only);
             if ui
                 .add_enabled(enabled, egui::Button::new(kind.label()))
                 .on_hover_text(export_hint(kind))
@@ -238,7 +233,9 @@ fn export_hint(kind: ExportKind) -> &'static str {
         ExportKind::DistancesCsv => {
             "reference-distance errors and within-station distances, before and after (mm)"
         }
-        ExportKind::PlotsPng => "an image of the figures on this page",
+        ExportKind::PlotsPng => {
+            "Fig. 5, Fig. 6, ε and the singular values on one white sheet, whole, for print (2 pixels per point)"
+        }
         ExportKind::ReportHtml => {
             "one self-contained HTML file: provenance (SHA-256), settings, stripe quality, figures, hand-eye, joint errors, validation"
         }
@@ -254,8 +251,8 @@ fn export_hint(kind: ExportKind) -> &'static str {
     }
 }
 
-/// The four plots, two by two. Returns the bottom edge.
-fn plots_ui(ui: &mut egui::Ui, view: &ResultView) -> f32 {
+/// The four plots, two by two.
+fn plots_ui(ui: &mut egui::Ui, view: &ResultView) {
     ui.columns(2, |cols| {
         cols[0].label(
             RichText::new(format!(
@@ -290,7 +287,6 @@ fn plots_ui(ui: &mut egui::Ui, view: &ResultView) -> f32 {
         cols[1].label(RichText::new(title).strong());
         singular_ui(&mut cols[1], view);
     });
-    ui.min_rect().bottom()
 }
 
 /// The colour key of the before/after plots (their legends would cover
@@ -353,8 +349,10 @@ fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
         .map(|p| p.before.max(p.after))
         .fold(0.0, f64::max);
     let within = &view.shown.within;
-    Plot::new("fig5")
+    readable(Plot::new("fig5"), true)
         .height(PLOT_HEIGHT)
+        // The wheel scrolls the page, not the plot (drag still pans).
+        .allow_scroll(false)
         .x_axis_label("pair (station by station)")
         .y_axis_label("distance (mm)")
         .include_y(0.0)
@@ -371,31 +369,57 @@ fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
             egui_plot::HoverPosition::Elsewhere { .. } => None,
         })
         .show(ui, |p| {
-            // Station boundaries and names.
-            let mut start = 0;
-            for k in 1..=within.len() {
-                if k == within.len() || within[k].station != within[start].station {
-                    let mid = (start + k + 1) as f64 / 2.0;
-                    p.text(
-                        Text::new(
-                            "",
-                            PlotPoint::new(mid, top * 1.1),
-                            within[start].station.as_str(),
-                        )
-                        .color(MUTED),
-                    );
-                    if k < within.len() {
-                        p.vline(
-                            VLine::new("", k as f64 + 0.5)
-                                .color(MUTED)
-                                .style(LineStyle::dotted_dense()),
-                        );
-                    }
-                    start = k;
-                }
-            }
+            station_bands_ui(p, within, top * 1.1);
             before_after_series(p, before, after);
         });
+}
+
+/// Fig. 5's stations: a dotted line between two (under the names), and each one's name
+/// above its pairs where it does not overlap its neighbour's (at 60
+/// stations every few; hover a point for its station).
+fn station_bands_ui(p: &mut egui_plot::PlotUi<'_>, within: &[PairDistance], y: f64) {
+    // (first pair, one past the last) of each station, 0-based.
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for (k, pair) in within.iter().enumerate() {
+        match runs.last_mut() {
+            Some(r) if within[r.0].station == pair.station => r.1 = k + 1,
+            _ => runs.push((k, k + 1)),
+        }
+    }
+    let x_of = |run: &(usize, usize)| (run.0 + run.1 + 1) as f64 / 2.0;
+    let centres: Vec<f32> = runs
+        .iter()
+        .map(|r| p.screen_from_plot(PlotPoint::new(x_of(r), y)).x)
+        .collect();
+    let font = egui::TextStyle::Small.resolve(&p.ctx().global_style());
+    let widths: Vec<f32> = runs
+        .iter()
+        .map(|r| {
+            p.ctx().fonts_mut(|f| {
+                f.layout_no_wrap(within[r.0].station.clone(), font.clone(), MUTED)
+                    .size()
+                    .x
+            })
+        })
+        .collect();
+    for k in spaced_labels(&centres, &widths, STATION_LABEL_GAP) {
+        let r = &runs[k];
+        p.text(
+            Text::new("", PlotPoint::new(x_of(r), y), within[r.0].station.as_str()).color(MUTED),
+        );
+    }
+    // The separators stop under the names, which stay clear to read.
+    let below_names = y * 0.93;
+    for r in runs.iter().skip(1) {
+        let x = r.0 as f64 + 0.5;
+        p.line(
+            Line::new("", PlotPoints::from(vec![[x, 0.0], [x, below_names]]))
+                .color(MUTED)
+                .width(1.0)
+                .allow_hover(false)
+                .style(LineStyle::dotted_dense()),
+        );
+    }
 }
 
 fn fig6_ui(ui: &mut egui::Ui, view: &ResultView) {
@@ -420,8 +444,10 @@ fn fig6_ui(ui: &mut egui::Ui, view: &ResultView) {
         .map(|(k, d)| [(k + 1) as f64, d.error_after()])
         .collect();
     let distances = &view.shown.distances;
-    Plot::new("fig6")
+    readable(Plot::new("fig6"), true)
         .height(PLOT_HEIGHT)
+        // The wheel scrolls the page, not the plot (drag still pans).
+        .allow_scroll(false)
         .x_axis_label("reference distance no.")
         .y_axis_label("error (mm)")
         .label_formatter(move |pos| match pos {
@@ -849,7 +875,7 @@ fn range_map_ui(ui: &mut egui::Ui, r: &crate::engine::solve::ml::range::RangeErr
         ))
         .color(MUTED),
     );
-    Plot::new("range_map")
+    readable(Plot::new("range_map"), false)
         .height(PLOT_HEIGHT)
         .width(PLOT_HEIGHT * 1.3)
         .data_aspect(1.0)

@@ -27,11 +27,18 @@ pub fn side_ui(
             load_ui(ui, state, forms, commands);
             ui.separator();
             solver_ui(ui, state, forms, commands);
+            // What comes and goes sits below the solver, so that Run and
+            // the ε plot stay where they are (and on screen at 1366×768).
+            notice_ui(ui, state, commands);
+            recent_ui(ui, state, commands);
         });
 }
 
-/// Loading: the current session, the path field with Open…, the demo, the
-/// recent files and the error of the last file that did not load.
+/// Height of the side panel's ε plot, points.
+const SIDE_EPSILON_HEIGHT: f32 = 150.0;
+
+/// Loading: the current session (three lines whatever it is, so that
+/// nothing below moves), the path field with Open… and the demo.
 pub fn load_ui(
     ui: &mut egui::Ui,
     state: &AppState,
@@ -39,14 +46,15 @@ pub fn load_ui(
     commands: &mut Vec<Command>,
 ) {
     ui.heading("Session");
+    let line = |ui: &mut egui::Ui, text: RichText| ui.add(egui::Label::new(text).truncate());
     match &state.loaded {
         Some(l) => {
-            ui.label(RichText::new(&l.session.name).strong());
-            ui.label(RichText::new(l.source.label()).small().weak())
+            name_ui(ui, &l.session.name);
+            line(ui, RichText::new(l.source.label()).small().weak())
                 .on_hover_text(l.source.label());
             let n = l.session.measurements.len();
             let stations = l.station_ids().len();
-            ui.label(format!(
+            let text = format!(
                 "{n} measurements, {stations} station{}, sphere Ø {} mm{}",
                 if stations == 1 { "" } else { "s" },
                 l.session.sphere_diameter,
@@ -55,22 +63,14 @@ pub fn load_ui(
                 } else {
                     ""
                 }
-            ));
+            );
+            line(ui, RichText::new(&text).small()).on_hover_text(text);
         }
         None => {
-            ui.label(RichText::new("no session open").weak());
+            name_ui(ui, "no session open");
+            line(ui, RichText::new(" ").small());
+            line(ui, RichText::new(" ").small());
         }
-    }
-    if let Some(notice) = &state.notice {
-        egui::Frame::group(ui.style())
-            .stroke(egui::Stroke::new(1.5, BAD))
-            .show(ui, |ui| {
-                ui.label(RichText::new(&notice.title).strong().color(BAD));
-                ui.label(&notice.body);
-                if ui.button("Dismiss").clicked() {
-                    commands.push(Command::View(ViewCommand::DismissNotice));
-                }
-            });
     }
     ui.add_space(4.0);
     let width = ui.available_width();
@@ -111,15 +111,69 @@ pub fn load_ui(
             commands.push(Command::Files(FilesCommand::OpenDemo));
         }
     });
-    if state.dialog_empty {
-        ui.label(RichText::new(NO_DIALOG).small().weak());
-    }
-    ui.label(
-        RichText::new("or drop a file onto the window")
-            .small()
-            .weak(),
+    // One line either way: the dialog's note replaces the drop hint.
+    let hint = if state.dialog_empty {
+        NO_DIALOG
+    } else {
+        "or drop a file onto the window"
+    };
+    line(ui, RichText::new(hint).small().weak()).on_hover_text(hint);
+}
+
+/// The session's name in two lines of room whatever its length (wrapped,
+/// cut with … beyond two lines, whole on hover).
+fn name_ui(ui: &mut egui::Ui, name: &str) {
+    let style = egui::TextStyle::Body;
+    let width = ui.available_width();
+    let height = 2.0 * ui.text_style_height(&style);
+    let mut job = egui::text::LayoutJob::single_section(
+        name.to_string(),
+        egui::TextFormat {
+            font_id: style.resolve(ui.style()),
+            color: ui.visuals().strong_text_color(),
+            ..Default::default()
+        },
     );
+    job.wrap = egui::text::TextWrapping {
+        max_width: width,
+        max_rows: 2,
+        break_anywhere: false,
+        overflow_character: Some('…'),
+    };
+    let rect = egui::Rect::from_min_size(ui.cursor().min, egui::vec2(width, height));
+    let used = ui
+        .scope_builder(egui::UiBuilder::new().max_rect(rect), |ui| {
+            ui.add(egui::Label::new(job)).on_hover_text(name);
+        })
+        .response
+        .rect
+        .height();
+    if used < height {
+        ui.add_space(height - used);
+    }
+}
+
+/// The error of the last thing that failed (a file that did not open, an
+/// export not written), until dismissed.
+pub fn notice_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
+    if let Some(notice) = &state.notice {
+        ui.add_space(6.0);
+        egui::Frame::group(ui.style())
+            .stroke(egui::Stroke::new(1.5, BAD))
+            .show(ui, |ui| {
+                ui.label(RichText::new(&notice.title).strong().color(BAD));
+                ui.label(&notice.body);
+                if ui.button("Dismiss").clicked() {
+                    commands.push(Command::View(ViewCommand::DismissNotice));
+                }
+            });
+    }
+}
+
+/// The recent files, newest first.
+pub fn recent_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
     if !state.prefs.recent.is_empty() {
+        ui.add_space(4.0);
         egui::CollapsingHeader::new("Recent files")
             .default_open(true)
             .show(ui, |ui| {
@@ -216,7 +270,7 @@ pub fn solver_ui(
             "live_epsilon",
             &run.epsilons,
             Some(run.threshold),
-            150.0,
+            SIDE_EPSILON_HEIGHT,
         );
     } else if let Some(result) = &state.result {
         ui.label(RichText::new("ε of the result on show").small().weak());
@@ -225,7 +279,7 @@ pub fn solver_ui(
             "last_epsilon",
             &result.epsilons,
             result.threshold,
-            150.0,
+            SIDE_EPSILON_HEIGHT,
         );
         if let Some(stop) = &result.stop_reason {
             ui.label(RichText::new(stop).small());

@@ -206,7 +206,7 @@ fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) 
         ui.vertical(|ui| {
             ui.set_width(width * 0.58);
             ui.label(RichText::new("Stripe in the laser plane (sensor x = 0)").strong());
-            Plot::new("stripe_plot")
+            super::plots::readable(Plot::new("stripe_plot"), false)
                 .data_aspect(1.0)
                 .height(height - 24.0)
                 .x_axis_label("y (mm)")
@@ -274,7 +274,7 @@ fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) 
                 .map(|k| [k as f64, um(k)])
                 .collect();
             let rms = s.fit.rms * 1000.0;
-            Plot::new("residual_plot")
+            super::plots::readable(Plot::new("residual_plot"), true)
                 .height(height - 24.0)
                 .x_axis_label("point")
                 .y_axis_label("residual (µm)")

@@ -1,8 +1,10 @@
 //! What people and other tools read of a calibration: the command line's
 //! text summary, the self-contained HTML report with its SVG figures, and
-//! the calibrated model as JSON, MDH CSV or URDF.
+//! the calibrated model as JSON, MDH CSV or URDF, and the plots on one
+//! sheet for print.
 
 pub mod html;
 pub mod model;
+pub mod sheet;
 pub mod summary;
 pub mod svg;

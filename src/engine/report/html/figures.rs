@@ -6,15 +6,16 @@ use std::fmt::Write as _;
 use super::*;
 use crate::engine::report::svg::{self, Band, Marker, Plot, Rule, Series, escape};
 use crate::engine::result_view::PairDistance;
+use crate::engine::validate::DistanceRecord;
 
 /// Width of a full-width figure, px (the page is about 930 px wide).
-pub(super) const WIDE: f64 = 920.0;
+pub const WIDE: f64 = 920.0;
 
 /// Width of a half-width figure, px.
-pub(super) const HALF: f64 = 450.0;
+pub const HALF: f64 = 450.0;
 
 /// Height of every figure, px.
-pub(super) const FIG_HEIGHT: f64 = 300.0;
+pub const FIG_HEIGHT: f64 = 300.0;
 
 pub(super) fn before_after_series(before: Vec<[f64; 2]>, after: Vec<[f64; 2]>) -> Vec<Series> {
     vec![
@@ -52,6 +53,153 @@ pub(super) fn bands(labels: impl Iterator<Item = String>) -> Vec<Band> {
     out
 }
 
+/// The paper's Fig. 5 as a plot: within-station centre distances per
+/// pair (true value 0), before and after, the stations as bands.
+#[must_use]
+pub fn fig5_plot(within: &[PairDistance], within_of: &str, width: f64) -> Plot {
+    let pts = |f: fn(&PairDistance) -> f64| -> Vec<[f64; 2]> {
+        within
+            .iter()
+            .enumerate()
+            .map(|(k, p)| [(k + 1) as f64, f(p)])
+            .collect()
+    };
+    Plot {
+        title: format!("Centre distances within {within_of} stations, per pair, before and after"),
+        x_label: "pair (station by station)".into(),
+        y_label: "centre distance (mm)".into(),
+        series: before_after_series(pts(|p| p.before), pts(|p| p.after)),
+        bands: bands(within.iter().map(|p| p.station.clone())),
+        include_zero: true,
+        x_integer: true,
+        width,
+        height: FIG_HEIGHT,
+        ..Plot::default()
+    }
+}
+
+/// The paper's Fig. 6 as a plot: each reference distance's error,
+/// measured − reference, before and after, with the zero line.
+#[must_use]
+pub fn fig6_plot(distances: &[DistanceRecord], width: f64) -> Plot {
+    let pts = |f: fn(&DistanceRecord) -> f64| -> Vec<[f64; 2]> {
+        distances
+            .iter()
+            .enumerate()
+            .map(|(k, d)| [(k + 1) as f64, f(d)])
+            .collect()
+    };
+    Plot {
+        title: "Reference-distance errors, measured − reference, before and after".into(),
+        x_label: "reference distance no.".into(),
+        y_label: "error (mm)".into(),
+        series: before_after_series(
+            pts(DistanceRecord::error_before),
+            pts(DistanceRecord::error_after),
+        ),
+        rules: vec![Rule {
+            y: 0.0,
+            colour: svg::MUTED.into(),
+            dashed: false,
+            label: String::new(),
+        }],
+        bands: bands(distances.iter().map(|d| format!("{}→{}", d.from, d.to))),
+        include_zero: true,
+        x_integer: true,
+        width,
+        height: FIG_HEIGHT,
+        ..Plot::default()
+    }
+}
+
+/// ε (mm) after 0, 1, … updates on a log scale, with the threshold.
+#[must_use]
+pub fn epsilon_plot(epsilons: &[f64], threshold: Option<f64>, width: f64) -> Plot {
+    Plot {
+        title: "ε per update".into(),
+        x_label: "update".into(),
+        y_label: "ε (mm, log scale)".into(),
+        series: vec![Series {
+            name: "ε".into(),
+            colour: AFTER_COLOUR.into(),
+            points: epsilons
+                .iter()
+                .enumerate()
+                .map(|(k, e)| [k as f64, *e])
+                .collect(),
+            marker: Marker::Circle,
+            line: true,
+        }],
+        rules: threshold
+            .filter(|t| *t > 0.0)
+            .map(|t| Rule {
+                y: t,
+                colour: BEFORE_COLOUR.into(),
+                dashed: true,
+                label: format!("threshold {t} mm"),
+            })
+            .into_iter()
+            .collect(),
+        y_log: true,
+        x_integer: true,
+        width,
+        height: FIG_HEIGHT,
+        ..Plot::default()
+    }
+}
+
+/// The paper's method's singular values (descending) on a log scale:
+/// the first `kept` kept, the rest dropped, the truncation line at
+/// `svd_tolerance × σ_max`. Zeros are not drawn.
+#[must_use]
+pub fn singular_plot(values: &[f64], kept: usize, svd_tolerance: Option<f64>, width: f64) -> Plot {
+    let smax = values.iter().copied().fold(0.0, f64::max);
+    let cut = svd_tolerance.map(|t| t * smax);
+    let pts = |keep: bool| -> Vec<[f64; 2]> {
+        values
+            .iter()
+            .enumerate()
+            .filter(|(k, v)| (*k < kept) == keep && **v > 0.0)
+            .map(|(k, v)| [(k + 1) as f64, *v])
+            .collect()
+    };
+    Plot {
+        title: "Singular values of the last update".into(),
+        x_label: "index".into(),
+        y_label: "singular value (log scale)".into(),
+        series: vec![
+            Series {
+                name: "kept".into(),
+                colour: AFTER_COLOUR.into(),
+                points: pts(true),
+                marker: Marker::Circle,
+                line: false,
+            },
+            Series {
+                name: "dropped".into(),
+                colour: BAD_COLOUR.into(),
+                points: pts(false),
+                marker: Marker::Cross,
+                line: false,
+            },
+        ],
+        rules: cut
+            .map(|c| Rule {
+                y: c,
+                colour: BEFORE_COLOUR.into(),
+                dashed: true,
+                label: "truncation".into(),
+            })
+            .into_iter()
+            .collect(),
+        y_log: true,
+        x_integer: true,
+        width,
+        height: FIG_HEIGHT,
+        ..Plot::default()
+    }
+}
+
 pub(super) fn figure(h: &mut String, id: &str, svg: &str, caption: &str) {
     let _ = writeln!(
         h,
@@ -69,28 +217,7 @@ pub(super) fn figures(h: &mut String, ctx: &Ctx<'_>) {
             "<p id=\"fig5\">No station has two measurements: no within-station distances.</p>\n",
         );
     } else {
-        let pts = |f: fn(&PairDistance) -> f64| -> Vec<[f64; 2]> {
-            ctx.within
-                .iter()
-                .enumerate()
-                .map(|(k, p)| [(k + 1) as f64, f(p)])
-                .collect()
-        };
-        let plot = Plot {
-            title: format!(
-                "Centre distances within {} stations, per pair, before and after",
-                ctx.within_of
-            ),
-            x_label: "pair (station by station)".into(),
-            y_label: "centre distance (mm)".into(),
-            series: before_after_series(pts(|p| p.before), pts(|p| p.after)),
-            bands: bands(ctx.within.iter().map(|p| p.station.clone())),
-            include_zero: true,
-            x_integer: true,
-            width: WIDE,
-            height: FIG_HEIGHT,
-            ..Plot::default()
-        };
+        let plot = fig5_plot(&ctx.within, ctx.within_of, WIDE);
         let stations = bands(ctx.within.iter().map(|p| p.station.clone())).len();
         figure(
             h,
@@ -120,34 +247,7 @@ pub(super) fn figures(h: &mut String, ctx: &Ctx<'_>) {
             "<p id=\"fig6\" class=\"warn\">{why}: no Fig. 6 (reference-distance errors).</p>"
         );
     } else {
-        let pts = |f: fn(&crate::engine::validate::DistanceRecord) -> f64| -> Vec<[f64; 2]> {
-            distances
-                .iter()
-                .enumerate()
-                .map(|(k, d)| [(k + 1) as f64, f(d)])
-                .collect()
-        };
-        let plot = Plot {
-            title: "Reference-distance errors, measured − reference, before and after".into(),
-            x_label: "distance (reference pair, pose by pose)".into(),
-            y_label: "error (mm)".into(),
-            series: before_after_series(
-                pts(crate::engine::validate::DistanceRecord::error_before),
-                pts(crate::engine::validate::DistanceRecord::error_after),
-            ),
-            rules: vec![Rule {
-                y: 0.0,
-                colour: svg::MUTED.into(),
-                dashed: false,
-                label: String::new(),
-            }],
-            bands: bands(distances.iter().map(|d| format!("{}→{}", d.from, d.to))),
-            include_zero: true,
-            x_integer: true,
-            width: WIDE,
-            height: FIG_HEIGHT,
-            ..Plot::default()
-        };
+        let plot = fig6_plot(distances, WIDE);
         figure(
             h,
             "fig6",
@@ -160,40 +260,8 @@ pub(super) fn figures(h: &mut String, ctx: &Ctx<'_>) {
     }
     // ε, and the singular values of the paper's method.
     h.push_str("<div class=\"grid2\">\n");
-    let eps: Vec<[f64; 2]> = r
-        .iterations
-        .iter()
-        .enumerate()
-        .map(|(k, i)| [k as f64, i.epsilon])
-        .collect();
-    let threshold = ctx.solver().threshold();
-    let plot = Plot {
-        title: "ε per update".into(),
-        x_label: "update".into(),
-        y_label: "ε (mm, log scale)".into(),
-        series: vec![Series {
-            name: "ε".into(),
-            colour: AFTER_COLOUR.into(),
-            points: eps,
-            marker: Marker::Circle,
-            line: true,
-        }],
-        rules: threshold
-            .filter(|t| *t > 0.0)
-            .map(|t| Rule {
-                y: t,
-                colour: BEFORE_COLOUR.into(),
-                dashed: true,
-                label: format!("threshold {t} mm"),
-            })
-            .into_iter()
-            .collect(),
-        y_log: true,
-        x_integer: true,
-        width: HALF,
-        height: FIG_HEIGHT,
-        ..Plot::default()
-    };
+    let eps: Vec<f64> = r.iterations.iter().map(|i| i.epsilon).collect();
+    let plot = epsilon_plot(&eps, ctx.solver().threshold(), HALF);
     figure(
         h,
         "epsilon",
@@ -226,55 +294,11 @@ pub(super) fn singular_values(h: &mut String, ctx: &Ctx<'_>) {
         );
         return;
     }
-    let smax = values.iter().copied().fold(0.0, f64::max);
     let kept = paper
         .and_then(|p| p.kept_directions)
         .unwrap_or(values.len());
-    let cut = paper.and_then(|p| p.svd_tolerance).map(|t| t * smax);
-    let pts = |keep: bool| -> Vec<[f64; 2]> {
-        values
-            .iter()
-            .enumerate()
-            .filter(|(k, v)| (*k < kept) == keep && **v > 0.0)
-            .map(|(k, v)| [(k + 1) as f64, *v])
-            .collect()
-    };
     let zeros = values.iter().filter(|v| **v <= 0.0).count();
-    let plot = Plot {
-        title: "Singular values of the last update".into(),
-        x_label: "index".into(),
-        y_label: "singular value (log scale)".into(),
-        series: vec![
-            Series {
-                name: "kept".into(),
-                colour: AFTER_COLOUR.into(),
-                points: pts(true),
-                marker: Marker::Circle,
-                line: false,
-            },
-            Series {
-                name: "dropped".into(),
-                colour: BAD_COLOUR.into(),
-                points: pts(false),
-                marker: Marker::Cross,
-                line: false,
-            },
-        ],
-        rules: cut
-            .map(|c| Rule {
-                y: c,
-                colour: BEFORE_COLOUR.into(),
-                dashed: true,
-                label: "truncation".into(),
-            })
-            .into_iter()
-            .collect(),
-        y_log: true,
-        x_integer: true,
-        width: HALF,
-        height: FIG_HEIGHT,
-        ..Plot::default()
-    };
+    let plot = singular_plot(&values, kept, paper.and_then(|p| p.svd_tolerance), HALF);
     let zero_note = if zeros > 0 {
         format!(" {zeros} singular value(s) are 0 and not drawn.")
     } else {

@@ -28,7 +28,7 @@
 //! the generation time, so the same input gives the same bytes.
 
 mod css;
-mod figures;
+pub mod figures;
 mod tables;
 mod text;
 
