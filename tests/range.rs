@@ -9,8 +9,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{Isometry3, Point3};
-use spherecal::engine::geometry::kabsch;
 use spherecal::engine::format;
+use spherecal::engine::geometry::kabsch;
 use spherecal::engine::session::{SensorRange, Session, Use};
 use spherecal::engine::simulate::{self, SimConfig, Truth};
 use spherecal::engine::solve::ml::range::{RANGE_GRID, RANGE_POSES};

@@ -5,9 +5,9 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use spherecal::engine::evaluate::planned::planned_range_study;
 use spherecal::engine::evaluate::range::range_score;
 use spherecal::engine::evaluate::study::{STUDY_RANGE, run_scenario, select};
+use spherecal::engine::plan::range_study::planned_range_study;
 use spherecal::engine::plan::{self, PlanConfig, PlanStage};
 use spherecal::engine::robot;
 use spherecal::engine::session::{SensorRange, Use};
@@ -291,10 +291,9 @@ fn the_command_line_spreads_plans_and_scores_the_range() {
         "--spread",
     ]);
     assert_eq!(code, Some(0), "{err}");
-    let truth = simulate::parse_truth(
-        &std::fs::read_to_string(dir.path().join("s.truth.json")).unwrap(),
-    )
-    .unwrap();
+    let truth =
+        simulate::parse_truth(&std::fs::read_to_string(dir.path().join("s.truth.json")).unwrap())
+            .unwrap();
     assert!(truth.config.spread);
     assert_eq!(truth.config.range, Some(RANGE));
     let spread_y = extent(
@@ -322,7 +321,10 @@ fn the_command_line_spreads_plans_and_scores_the_range() {
         "2",
     ]);
     assert_eq!(code, Some(0), "{err}");
-    assert!(out.contains("predicted point error over the range (y -40…40, z -40…40 mm"), "{out}");
+    assert!(
+        out.contains("predicted point error over the range (y -40…40, z -40…40 mm"),
+        "{out}"
+    );
     assert!(out.contains("without the spread: rms"), "{out}");
     assert!(out.contains("error over the range (9 × 9 grid"), "{out}");
     let (code, out, err) = run(&[
@@ -348,5 +350,8 @@ fn the_command_line_spreads_plans_and_scores_the_range() {
 
     let (code, out, err) = run(&["evaluate", "--scenario", "range-spread", "--seeds", "1"]);
     assert_eq!(code, Some(0), "{err}");
-    assert!(out.contains("error over the range (rms over a 9 × 9 grid"), "{out}");
+    assert!(
+        out.contains("error over the range (rms over a 9 × 9 grid"),
+        "{out}"
+    );
 }

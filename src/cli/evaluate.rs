@@ -5,11 +5,11 @@
 use clap::Args;
 
 use super::CliError;
-use crate::engine::evaluate::planned::{
-    planned_range_markdown, planned_range_study, planned_range_text,
-};
 use crate::engine::evaluate::study::{
     StudyError, markdown, range_markdown, run_scenario, select, text,
+};
+use crate::engine::plan::range_study::{
+    planned_range_markdown, planned_range_study, planned_range_text,
 };
 
 /// `spherecal evaluate`.

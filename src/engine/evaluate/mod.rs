@@ -5,7 +5,6 @@
 //! data. Used by the accuracy tests, the `simulate` summary and the
 //! method comparison of the README.
 
-pub mod planned;
 pub mod range;
 pub mod study;
 

@@ -99,6 +99,7 @@ mod config;
 mod export;
 mod order;
 mod predict;
+pub mod range_study;
 mod request;
 mod select;
 

@@ -4,7 +4,7 @@
 //! without it (the same seed, the sphere at the paper's spot, `ln det`),
 //! each plan simulated on true robots with Table 1 and with random
 //! kinematic errors (seeds `1..=N`), calibrated with `ml` and scored over
-//! the range against the truth ([`range_score`](super::range::range_score)):
+//! the range against the truth ([`range_score`](crate::engine::evaluate::range::range_score)):
 //! predicted (from `ml`'s covariance at planning) and realised, against
 //! the floor. The poses are touched up on the true robot (Table 1 errors
 //! move the cut out of the usable band at some planned joints; an
@@ -17,7 +17,7 @@ use crate::engine::robot;
 use crate::engine::simulate::{ErrorModel, PlanExecution};
 use crate::engine::solve::Control;
 
-use super::study::STUDY_RANGE;
+use crate::engine::evaluate::study::STUDY_RANGE;
 
 /// The sphere position of the study's cell (the README's plan example).
 pub const STUDY_SPHERE: [f64; 3] = [1050.0, 0.0, 475.0];
