@@ -42,6 +42,7 @@ fn the_session_view_sets_the_measuring_range_for_the_next_run() {
     assert!(h.query_all_by_label_contains("set: y -40…40").count() > 0);
     // The planner follows it.
     assert_eq!(h.state().forms().plan.request.range, Some(DEFAULT));
+    assert!(h.state().forms().plan.request.spread);
     // The next run predicts the error over it.
     h.get_by_label("▶ Run").click();
     settle(&mut h);

@@ -59,7 +59,9 @@ impl Core {
                     loaded.session.sensor_range = range;
                     self.forms.range_edit = None;
                     if range.is_some() {
+                        // The planner spreads the sphere over a range it is given.
                         self.forms.plan.request.range = range;
+                        self.forms.plan.request.spread = true;
                     }
                 }
             }

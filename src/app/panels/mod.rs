@@ -119,29 +119,38 @@ pub fn labelled_field(
 pub const DEFAULT_RANGE: [f64; 4] = [-40.0, 40.0, -40.0, 40.0];
 
 /// Four fields for a measuring range `[y0, y1, z0, z1]` (mm, laser plane,
-/// sensor frame), each labelled; true when one changed.
-pub fn range_fields(ui: &mut egui::Ui, id: &str, v: &mut [f64; 4]) -> bool {
+/// sensor frame), each labelled, on one line or (`rows`) a line per axis;
+/// true when one changed.
+pub fn range_fields(ui: &mut egui::Ui, id: &str, v: &mut [f64; 4], rows: bool) -> bool {
     let mut changed = false;
-    for (k, label, hint) in [
-        (0, "y from", "along the laser line, smallest (mm)"),
-        (1, "to", "along the laser line, largest (mm)"),
-        (2, "z from", "in depth, smallest (mm)"),
-        (3, "to", "in depth, largest (mm)"),
-    ] {
-        let l = ui.label(label);
-        changed |= ui
-            .push_id((id, k), |ui| {
-                ui.add(
-                    egui::DragValue::new(&mut v[k])
-                        .range(-2000.0..=2000.0)
-                        .speed(0.5)
-                        .suffix(" mm"),
-                )
-                .labelled_by(l.id)
-                .on_hover_text(hint)
-            })
-            .inner
-            .changed();
+    let mut pair = |ui: &mut egui::Ui, first: usize, axis: &str, what: &str| {
+        for (k, label) in [(first, format!("{axis} from")), (first + 1, "to".to_owned())] {
+            let l = ui.label(label);
+            let hint = format!(
+                "{what}, {} (mm, sensor frame)",
+                if k == first { "smallest" } else { "largest" }
+            );
+            changed |= ui
+                .push_id((id, k), |ui| {
+                    ui.add(
+                        egui::DragValue::new(&mut v[k])
+                            .range(-2000.0..=2000.0)
+                            .speed(0.5)
+                            .suffix(" mm"),
+                    )
+                    .labelled_by(l.id)
+                    .on_hover_text(hint)
+                })
+                .inner
+                .changed();
+        }
+    };
+    if rows {
+        ui.horizontal(|ui| pair(ui, 0, "y", "along the laser line"));
+        ui.horizontal(|ui| pair(ui, 2, "z", "in depth"));
+    } else {
+        pair(ui, 0, "y", "along the laser line");
+        pair(ui, 2, "z", "in depth");
     }
     changed
 }

@@ -52,7 +52,7 @@ pub fn plan_ui(
                                  The planner places identify and validate stations around it, solves \
                                  every reachable pose with the laser plane cutting the sphere at the \
                                  cut angle on both sides, picks the poses that determine the parameters \
-                                 best (D-optimal) and orders them for short moves.",
+                                 best (D-optimal; for a measuring range, the smallest predicted error over it) and orders them for short moves.",
                             )
                             .weak(),
                         );
@@ -138,29 +138,27 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
                 .on_hover_text("the same settings and seed give the same plan");
             ui.end_row();
         });
-    ui.horizontal_wrapped(|ui| {
-        let mut known = f.request.range.is_some();
-        if ui
-            .checkbox(&mut known, "plan for the measuring range")
-            .on_hover_text("sensor.range: predict the error over this part of the laser plane and spread the sphere over it")
-            .changed()
+    let mut known = f.request.range.is_some();
+    if ui
+        .checkbox(&mut known, "plan for the measuring range")
+        .on_hover_text("sensor.range: predict the error over this part of the laser plane and spread the sphere over it")
+        .changed()
+    {
+        f.request.range = if known {
+            range_of(&DEFAULT_RANGE).ok()
+        } else {
+            None
+        };
+        f.request.spread = known;
+    }
+    if let Some(r) = f.request.range {
+        let mut v = range_values(&r);
+        if range_fields(ui, "plan_range", &mut v, true)
+            && let Ok(r) = range_of(&v)
         {
-            f.request.range = if known {
-                range_of(&DEFAULT_RANGE).ok()
-            } else {
-                None
-            };
-            f.request.spread = known;
+            f.request.range = Some(r);
         }
-        if let Some(r) = f.request.range {
-            let mut v = range_values(&r);
-            if range_fields(ui, "plan_range", &mut v)
-                && let Ok(r) = range_of(&v)
-            {
-                f.request.range = Some(r);
-            }
-        }
-    });
+    }
     if f.request.range.is_some() {
         ui.checkbox(&mut f.request.spread, "spread the sphere over the range")
             .on_hover_text("identify and validate poses see the sphere anywhere in the range, chosen for the smallest predicted error over it; unticked: the paper's one spot");

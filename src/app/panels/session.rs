@@ -74,7 +74,7 @@ fn range_ui(
         let mut edit = forms
             .range_edit
             .unwrap_or_else(|| current.as_ref().map_or(DEFAULT_RANGE, range_values));
-        if range_fields(ui, "session_range", &mut edit) {
+        if range_fields(ui, "session_range", &mut edit, false) {
             forms.range_edit = Some(edit);
         }
         let parsed = range_of(&edit);
