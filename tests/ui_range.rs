@@ -118,3 +118,50 @@ fn the_plan_view_spreads_the_sphere_over_the_range() {
     let unspread = plan.stats.range_error_unspread.expect("compared").rms_mm;
     assert!(spread < unspread, "{spread} vs {unspread}");
 }
+
+/// The import wizard writes the measuring range into the session it opens.
+#[test]
+fn the_import_wizard_sets_the_measuring_range() {
+    let mut h = demo_app();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (session, _) =
+        spherecal::engine::simulate::simulate(&spherecal::engine::simulate::SimConfig::default())
+            .expect("simulate");
+    let files = spherecal::engine::simulate::import_files(&session).expect("import files");
+    std::fs::write(dir.path().join("joints.csv"), &files.joints_csv).unwrap();
+    std::fs::create_dir_all(dir.path().join("profiles")).unwrap();
+    for (id, text) in &files.profiles {
+        std::fs::write(dir.path().join("profiles").join(format!("{id}.csv")), text).unwrap();
+    }
+    {
+        let form = &mut h.state_mut().forms_mut().import;
+        form.joints = dir.path().join("joints.csv").display().to_string();
+        form.profiles = dir.path().join("profiles").display().to_string();
+    }
+    h.get_by_label("Import").click();
+    h.run();
+    h.get_by_label("known (sensor.range)").click();
+    h.run();
+    assert_eq!(
+        h.state().forms().import.range,
+        Some([-40.0, 40.0, -40.0, 40.0])
+    );
+    // The button is below the fold at 768 px once the range fields show:
+    // the command it sends.
+    let ctx = h.ctx.clone();
+    h.state_mut().command(
+        &ctx,
+        spherecal::app::commands::Command::Import(spherecal::app::commands::ImportCommand::Run),
+    );
+    settle(&mut h);
+    let outcome = h.state().state().import.outcome.clone().expect("outcome");
+    assert!(outcome.is_ok(), "{outcome:?}");
+    let opened = h
+        .state()
+        .state()
+        .loaded
+        .as_ref()
+        .and_then(|l| l.session.sensor_range);
+    assert_eq!(opened, Some(DEFAULT));
+    assert_eq!(h.state().forms().plan.request.range, Some(DEFAULT));
+}

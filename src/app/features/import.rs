@@ -67,8 +67,15 @@ pub fn import_session(form: &ImportForm) -> Result<Imported, JobError> {
             (import::import_poses(&spec)?, spec.poses)
         }
     };
+    let mut session = imported.session;
+    if let Some(v) = form.range {
+        session.sensor_range = Some(
+            crate::app::panels::range_of(&v)
+                .map_err(|why| JobError::ImportForm(format!("measuring range: {why}")))?,
+        );
+    }
     Ok(Imported {
-        loaded: Box::new(analyse(imported.session, Source::Imported(log))),
+        loaded: Box::new(analyse(session, Source::Imported(log))),
         checks: imported.checks,
         notes: imported.notes,
     })

@@ -112,6 +112,9 @@ pub struct ImportForm {
     pub tolerance_mm: f64,
     /// Rotation tolerance of the flange check, deg.
     pub tolerance_deg: f64,
+    /// The sensor's measuring range to write as `sensor.range`, `[y0, y1,
+    /// z0, z1]` mm; `None`: not known.
+    pub range: Option<[f64; 4]>,
 }
 
 impl Default for ImportForm {
@@ -144,6 +147,7 @@ impl Default for ImportForm {
             flange_columns: String::new(),
             tolerance_mm: DEFAULT_POSITION_TOLERANCE_MM,
             tolerance_deg: DEFAULT_ROTATION_TOLERANCE_DEG,
+            range: None,
         }
     }
 }

@@ -9,7 +9,7 @@
 
 use egui::RichText;
 
-use super::{BAD, WARN, labelled_field};
+use super::{BAD, DEFAULT_RANGE, WARN, labelled_field, range_fields, range_of};
 use crate::app::commands::{Command, FilesCommand, ImportCommand};
 use crate::app::forms::Forms;
 use crate::app::forms::import::{CONVENTIONS, ImportForm, LogKind, ProfilesKind};
@@ -317,6 +317,24 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
                     .suffix(" mm"),
             )
             .labelled_by(l.id);
+            ui.end_row();
+            ui.label("Measuring range");
+            ui.vertical(|ui| {
+                let mut known = f.range.is_some();
+                if ui
+                    .checkbox(&mut known, "known (sensor.range)")
+                    .on_hover_text("the part of the laser plane the sensor measures in: ml predicts the error over it, the planner spreads the sphere over it")
+                    .changed()
+                {
+                    f.range = known.then_some(DEFAULT_RANGE);
+                }
+                if let Some(v) = &mut f.range {
+                    range_fields(ui, "import_range", v, true);
+                    if let Err(why) = range_of(v) {
+                        ui.label(RichText::new(why).color(BAD));
+                    }
+                }
+            });
             ui.end_row();
             let l = ui.label("Session name");
             ui.add(

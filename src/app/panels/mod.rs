@@ -124,7 +124,10 @@ pub const DEFAULT_RANGE: [f64; 4] = [-40.0, 40.0, -40.0, 40.0];
 pub fn range_fields(ui: &mut egui::Ui, id: &str, v: &mut [f64; 4], rows: bool) -> bool {
     let mut changed = false;
     let mut pair = |ui: &mut egui::Ui, first: usize, axis: &str, what: &str| {
-        for (k, label) in [(first, format!("{axis} from")), (first + 1, "to".to_owned())] {
+        for (k, label) in [
+            (first, format!("{axis} from")),
+            (first + 1, "to".to_owned()),
+        ] {
             let l = ui.label(label);
             let hint = format!(
                 "{what}, {} (mm, sensor frame)",
