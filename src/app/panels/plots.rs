@@ -126,6 +126,18 @@ pub fn readable_y(plot: Plot<'_>) -> Plot<'_> {
         .y_axis_formatter(|mark, _| tick_label(mark))
 }
 
+/// A plot whose y axis is `log10` of the values, labelled at whole
+/// decades spaced to carry their numbers (1, 2 or 5 decades apart).
+#[must_use]
+pub fn readable_log_y(plot: Plot<'_>) -> Plot<'_> {
+    plot.grid_spacing(egui::Rangef::new(GRID_SPACING_MIN, 300.0))
+        .custom_y_axes(vec![
+            AxisHints::new_y().label_spacing(egui::Rangef::new(Y_FADE.0, Y_FADE.1)),
+        ])
+        .y_grid_spacer(spacer(Y_LABEL_GAP, true))
+        .y_axis_formatter(|mark, _| super::log_tick(mark.value))
+}
+
 /// A plot whose x axis counts positions `0, 1, …` labelled by `labels`
 /// (e.g. dates), thinned to every k-th so that each label fits in `gap`
 /// points.

@@ -499,7 +499,7 @@ fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
             .collect()
     };
     let zeros = view.singular_values.len() - values.len();
-    Plot::new("singular")
+    super::plots::readable_log_y(Plot::new("singular"))
         .height(if zeros > 0 {
             PLOT_HEIGHT - 18.0
         } else {
@@ -507,7 +507,6 @@ fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
         })
         .x_axis_label("index")
         .y_axis_label("σ (log scale)")
-        .y_axis_formatter(|mark, _| super::log_tick(mark.value))
         .legend(Legend::default().position(egui_plot::Corner::LeftBottom))
         .show(ui, |p| {
             p.points(

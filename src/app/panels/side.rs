@@ -369,11 +369,10 @@ pub fn epsilon_plot_ui(
         .enumerate()
         .map(|(k, e)| [k as f64, log(*e)])
         .collect();
-    Plot::new(id)
+    super::plots::readable_log_y(Plot::new(id))
         .height(height)
         .x_axis_label("update")
         .y_axis_label("ε (mm, log)")
-        .y_axis_formatter(|mark, _| super::log_tick(mark.value))
         // Updates are whole numbers: no tick at 0.5.
         .x_axis_formatter(|mark, _| {
             if (mark.value - mark.value.round()).abs() < 1e-9 && mark.value >= 0.0 {
