@@ -140,7 +140,8 @@ fn the_import_wizard_sets_the_measuring_range() {
     }
     h.get_by_label("Import").click();
     h.run();
-    h.get_by_label("known (sensor.range)").click();
+    h.get_by_label("measuring range known (sensor.range)")
+        .click();
     h.run();
     assert_eq!(
         h.state().forms().import.range,

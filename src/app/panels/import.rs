@@ -309,33 +309,35 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
             });
             ui.end_row();
             let l = ui.label("Sphere diameter");
-            ui.add(
-                egui::DragValue::new(&mut f.sphere_diameter)
-                    .range(1.0..=500.0)
-                    .speed(0.01)
-                    .max_decimals(4)
-                    .suffix(" mm"),
-            )
-            .labelled_by(l.id);
-            ui.end_row();
-            ui.label("Measuring range");
-            ui.vertical(|ui| {
+            ui.horizontal(|ui| {
+                ui.add(
+                    egui::DragValue::new(&mut f.sphere_diameter)
+                        .range(1.0..=500.0)
+                        .speed(0.01)
+                        .max_decimals(4)
+                        .suffix(" mm"),
+                )
+                .labelled_by(l.id);
                 let mut known = f.range.is_some();
                 if ui
-                    .checkbox(&mut known, "known (sensor.range)")
+                    .checkbox(&mut known, "measuring range known (sensor.range)")
                     .on_hover_text("the part of the laser plane the sensor measures in: ml predicts the error over it, the planner spreads the sphere over it")
                     .changed()
                 {
                     f.range = known.then_some(DEFAULT_RANGE);
                 }
-                if let Some(v) = &mut f.range {
+            });
+            ui.end_row();
+            if let Some(v) = &mut f.range {
+                ui.label("Measuring range");
+                ui.vertical(|ui| {
                     range_fields(ui, "import_range", v, true);
                     if let Err(why) = range_of(v) {
                         ui.label(RichText::new(why).color(BAD));
                     }
-                }
-            });
-            ui.end_row();
+                });
+                ui.end_row();
+            }
             let l = ui.label("Session name");
             ui.add(
                 egui::TextEdit::singleline(&mut f.name)

@@ -114,6 +114,16 @@ pub fn labelled_field(
     .labelled_by(l.id)
 }
 
+/// A plot's key on one line above it, each entry in its series' colour
+/// (a legend inside the plot would cover data).
+pub fn plot_key(ui: &mut egui::Ui, entries: &[(&str, egui::Color32)]) {
+    ui.horizontal_wrapped(|ui| {
+        for (text, colour) in entries {
+            ui.label(RichText::new(*text).color(*colour).small());
+        }
+    });
+}
+
 /// The default measuring range offered before one is set: 80 × 80 mm
 /// about the sensor origin, `[y0, y1, z0, z1]`.
 pub const DEFAULT_RANGE: [f64; 4] = [-40.0, 40.0, -40.0, 40.0];

@@ -386,12 +386,20 @@ fn map_ui(ui: &mut egui::Ui, plan: &Plan) {
             .collect()
     };
     let base = plan.robot.base.translation.vector;
+    super::plot_key(
+        ui,
+        &[
+            ("◆ P0 (hand-eye groups)", BAD),
+            ("● identify", AFTER),
+            ("■ validate", BEFORE),
+            ("× robot base", MUTED),
+        ],
+    );
     super::plots::readable(Plot::new("plan_map"), false)
         .height(MAP_HEIGHT)
         .data_aspect(1.0)
         .x_axis_label("x (mm)")
         .y_axis_label("y (mm)")
-        .legend(egui_plot::Legend::default().position(egui_plot::Corner::LeftTop))
         .show(ui, |p| {
             p.points(
                 Points::new("robot base", PlotPoints::from(vec![[base.x, base.y]]))

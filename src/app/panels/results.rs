@@ -6,9 +6,7 @@
 //! the non-identifiable ones marked, and the export buttons.
 
 use egui::RichText;
-use egui_plot::{
-    HLine, Legend, Line, LineStyle, MarkerShape, Plot, PlotPoint, PlotPoints, Points, Text,
-};
+use egui_plot::{HLine, Line, LineStyle, MarkerShape, Plot, PlotPoint, PlotPoints, Points, Text};
 
 use super::plots::{readable, spaced_labels};
 use super::side::epsilon_plot_ui;
@@ -292,14 +290,13 @@ fn plots_ui(ui: &mut egui::Ui, view: &ResultView) {
 /// The colour key of the before/after plots (their legends would cover
 /// the data).
 fn key_ui(ui: &mut egui::Ui) {
-    ui.horizontal(|ui| {
-        ui.label(
-            RichText::new("■ before (nominal model, initial hand-eye)")
-                .color(BEFORE)
-                .small(),
-        );
-        ui.label(RichText::new("● after (calibrated)").color(AFTER).small());
-    });
+    super::plot_key(
+        ui,
+        &[
+            ("■ before (nominal model, initial hand-eye)", BEFORE),
+            ("● after (calibrated)", AFTER),
+        ],
+    );
 }
 
 fn before_after_series(p: &mut egui_plot::PlotUi<'_>, before: Vec<[f64; 2]>, after: Vec<[f64; 2]>) {
@@ -499,15 +496,23 @@ fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
             .collect()
     };
     let zeros = view.singular_values.len() - values.len();
+    let mut key = vec![("● kept", AFTER)];
+    if !dropped.is_empty() {
+        key.push(("× dropped", BAD));
+    }
+    if cut.is_some() {
+        key.push(("- - truncation (tolerance × σ_max)", BEFORE));
+    }
+    super::plot_key(ui, &key);
     super::plots::readable_log_y(Plot::new("singular"))
+        // Less the key line, and the zeros' note under the plot.
         .height(if zeros > 0 {
-            PLOT_HEIGHT - 18.0
+            PLOT_HEIGHT - 36.0
         } else {
-            PLOT_HEIGHT
+            PLOT_HEIGHT - 18.0
         })
         .x_axis_label("index")
         .y_axis_label("σ (log scale)")
-        .legend(Legend::default().position(egui_plot::Corner::LeftBottom))
         .show(ui, |p| {
             p.points(
                 Points::new("kept", PlotPoints::from(pts(&kept)))

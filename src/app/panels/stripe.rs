@@ -5,7 +5,7 @@
 use std::f64::consts::TAU;
 
 use egui::RichText;
-use egui_plot::{HLine, Legend, Line, LineStyle, MarkerShape, Plot, PlotPoints, Points};
+use egui_plot::{HLine, Line, LineStyle, MarkerShape, Plot, PlotPoints, Points};
 
 use super::{AFTER, BAD, BEFORE, MUTED, WARN};
 use crate::app::commands::{Command, ViewCommand};
@@ -182,6 +182,9 @@ fn facts_ui(ui: &mut egui::Ui, s: &StripeResult, sphere_radius: f64) {
     }
 }
 
+/// Height of a plot's title and key lines above it, points.
+const KEY_HEIGHT: f32 = 44.0;
+
 fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) {
     let inlier = |k: usize| fit.is_none_or(|s| s.fit.inlier.get(k).copied().unwrap_or(true));
     // Points a raw profile's arc search left out (background, the stand).
@@ -206,12 +209,24 @@ fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) 
         ui.vertical(|ui| {
             ui.set_width(width * 0.58);
             ui.label(RichText::new("Stripe in the laser plane (sensor x = 0)").strong());
+            // The key above the plot, off the data.
+            let mut key = vec![("● stripe points", AFTER)];
+            if fit.is_some() {
+                key.push(("- - fitted circle", BEFORE));
+                key.push(("+ circle centre", BEFORE));
+            }
+            if !rejected.is_empty() {
+                key.push(("× rejected", BAD));
+            }
+            if !dropped.is_empty() {
+                key.push(("• off the arc (dropped)", MUTED));
+            }
+            super::plot_key(ui, &key);
             super::plots::readable(Plot::new("stripe_plot"), false)
                 .data_aspect(1.0)
-                .height(height - 24.0)
+                .height(height - KEY_HEIGHT)
                 .x_axis_label("y (mm)")
                 .y_axis_label("z (mm)")
-                .legend(Legend::default())
                 .show(ui, |p| {
                     if let Some(s) = fit {
                         let [yc, zc] = s.fit.centre;
@@ -274,11 +289,16 @@ fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) 
                 .map(|k| [k as f64, um(k)])
                 .collect();
             let rms = s.fit.rms * 1000.0;
+            let rms_key = format!("- - ± RMS ({rms:.1} µm)");
+            let mut key = vec![("● used", AFTER), (rms_key.as_str(), MUTED)];
+            if !out.is_empty() {
+                key.push(("× rejected", BAD));
+            }
+            super::plot_key(ui, &key);
             super::plots::readable(Plot::new("residual_plot"), true)
-                .height(height - 24.0)
+                .height(height - KEY_HEIGHT)
                 .x_axis_label("point")
                 .y_axis_label("residual (µm)")
-                .legend(Legend::default())
                 .show(ui, |p| {
                     p.points(
                         Points::new("used", PlotPoints::from(used))
