@@ -272,8 +272,13 @@ fn outcome_ui(
             );
             row("condition number", format!("{:.3e}", st.condition));
             if let Some(r) = &st.range_error {
+                let what = if r.region == "sensor.range" {
+                    "predicted error over the range"
+                } else {
+                    "predicted error where the sphere is seen"
+                };
                 row(
-                    "predicted error over the range",
+                    what,
                     format!(
                         "rms {:.3} mm, max {:.3} mm (y {:.0}…{:.0}, z {:.0}…{:.0} mm)",
                         r.rms_mm, r.max_mm, r.y[0], r.y[1], r.z[0], r.z[1]

@@ -715,7 +715,22 @@ pub fn summary(plan: &Plan) -> String {
             "  expected validation std after calibration (ml covariance): {v:.4} mm"
         );
     }
-    if let Some(r) = &st.range_error {
+    if let Some(r) = st
+        .range_error
+        .as_ref()
+        .filter(|r| r.region != "sensor.range")
+    {
+        let _ = writeln!(
+            s,
+            "  predicted point error where the sphere is seen (y {:.0}…{:.0}, z {:.0}…{:.0} mm, ml covariance): rms {:.4} mm; give --range for the sensor's measuring range",
+            r.y[0], r.y[1], r.z[0], r.z[1], r.rms_mm
+        );
+    }
+    if let Some(r) = st
+        .range_error
+        .as_ref()
+        .filter(|r| r.region == "sensor.range")
+    {
         let _ = writeln!(
             s,
             "  predicted point error over the range (y {:.0}…{:.0}, z {:.0}…{:.0} mm, ml covariance): rms {:.4} mm, max {:.4} mm",
