@@ -45,21 +45,14 @@ fn realised_rms(session: &Session, truth: &Truth, cal: &Calibration) -> f64 {
     let true_he = truth.true_hand_eye();
     let mut cal_pts = Vec::new();
     let mut true_pts = Vec::new();
-    let at = |lo: f64, hi: f64, k: usize| lo + (hi - lo) * k as f64 / (RANGE_GRID - 1) as f64;
     for &i in working.iter().step_by(stride) {
         let q = &session.measurements[i].joints;
         let bc: Isometry3<f64> = cal.calibrated.base_from_flange(q) * cal.hand_eye;
         let bt: Isometry3<f64> = true_robot.base_from_flange(q) * true_he;
-        for ky in 0..RANGE_GRID {
-            for kz in 0..RANGE_GRID {
-                let g = Point3::new(
-                    0.0,
-                    at(RANGE.y[0], RANGE.y[1], ky),
-                    at(RANGE.z[0], RANGE.z[1], kz),
-                );
-                cal_pts.push((bc * g).coords);
-                true_pts.push((bt * g).coords);
-            }
+        for [y, z] in RANGE.grid(RANGE_GRID) {
+            let g = Point3::new(0.0, y, z);
+            cal_pts.push((bc * g).coords);
+            true_pts.push((bt * g).coords);
         }
     }
     let n = cal_pts.len() as f64;

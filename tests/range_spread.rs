@@ -305,21 +305,25 @@ fn the_command_line_spreads_plans_and_scores_the_range() {
     );
     assert!(spread_y[1] - spread_y[0] > 50.0, "{spread_y:?}");
 
-    let (code, out, err) = run(&[
-        "plan",
-        "--sphere",
-        "1050,0,475",
-        "--range",
-        "-40,40,-40,40",
-        "--identify-stations",
-        "4",
-        "--validate-stations",
-        "3",
-        "--candidates",
-        "10",
-        "--predict",
-        "2",
-    ]);
+    // A small cell for the command line: 4 identify, 3 validate stations.
+    let plan = |extra: &[&str]| {
+        let mut args = vec![
+            "plan",
+            "--sphere",
+            "1050,0,475",
+            "--range",
+            "-40,40,-40,40",
+            "--identify-stations",
+            "4",
+            "--validate-stations",
+            "3",
+            "--candidates",
+            "10",
+        ];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    let (code, out, err) = plan(&["--predict", "2"]);
     assert_eq!(code, Some(0), "{err}");
     assert!(
         out.contains("predicted point error over the range (y -40…40, z -40…40 mm"),
@@ -327,22 +331,7 @@ fn the_command_line_spreads_plans_and_scores_the_range() {
     );
     assert!(out.contains("without the spread: rms"), "{out}");
     assert!(out.contains("error over the range (9 × 9 grid"), "{out}");
-    let (code, out, err) = run(&[
-        "plan",
-        "--sphere",
-        "1050,0,475",
-        "--range",
-        "-40,40,-40,40",
-        "--no-spread",
-        "--identify-stations",
-        "4",
-        "--validate-stations",
-        "3",
-        "--candidates",
-        "10",
-        "--predict",
-        "0",
-    ]);
+    let (code, out, err) = plan(&["--no-spread", "--predict", "0"]);
     assert_eq!(code, Some(0), "{err}");
     assert!(out.contains("the sphere at one spot"), "{out}");
     let (code, _, err) = run(&["plan", "--sphere", "1050,0,475", "--no-spread"]);

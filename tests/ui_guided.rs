@@ -16,7 +16,7 @@ use spherecal::app::WorkbenchApp;
 use spherecal::app::forms::Tab;
 
 mod ui_support;
-use ui_support::{demo_app, open_path, settle};
+use ui_support::{demo_app, open_path, settle, small_plan};
 
 /// The label of the step bar's step `n` (its mark changes with its state).
 fn step_label(h: &Harness<'_, WorkbenchApp>, name: &str) -> String {
@@ -53,15 +53,7 @@ fn the_step_bar_walks_the_job_in_order() {
     h.get_by_label(&plan).click();
     h.run();
     assert_eq!(h.state().forms().tab, Tab::Plan);
-    {
-        let f = &mut h.state_mut().forms_mut().plan;
-        f.request.n_identify = 4;
-        f.request.identify_poses = 4;
-        f.request.n_validate = 2;
-        f.request.validate_poses = 3;
-        f.request.candidates = 8;
-        f.request.predict_runs = 0;
-    }
+    small_plan(&mut h, 4, 2);
     h.get_by_label("Make plan").click();
     settle(&mut h);
     assert!(step_label(&h, "1. Plan").starts_with('●'), "planned");
@@ -272,15 +264,7 @@ fn the_plan_view_follows_the_open_sessions_robot() {
     assert_eq!(h.state().forms().plan.robot, "ur5e");
     h.get_by_label("Plan").click();
     h.run();
-    {
-        let f = &mut h.state_mut().forms_mut().plan;
-        f.request.n_identify = 3;
-        f.request.identify_poses = 4;
-        f.request.n_validate = 2;
-        f.request.validate_poses = 3;
-        f.request.candidates = 8;
-        f.request.predict_runs = 0;
-    }
+    small_plan(&mut h, 3, 2);
     h.get_by_label("Make plan").click();
     settle(&mut h);
     assert!(h.query_by_label("RAPID module").is_none());

@@ -11,7 +11,7 @@ use spherecal::app::forms::Tab;
 use spherecal::engine::session::SensorRange;
 
 mod ui_support;
-use ui_support::{demo_app, settle};
+use ui_support::{demo_app, settle, small_plan};
 
 const DEFAULT: SensorRange = SensorRange {
     y: [-40.0, 40.0],
@@ -83,16 +83,11 @@ fn the_plan_view_spreads_the_sphere_over_the_range() {
     h.get_by_label("plan for the measuring range").click();
     h.run();
     {
-        let f = &mut h.state_mut().forms_mut().plan;
+        let f = &h.state().forms().plan;
         assert_eq!(f.request.range, Some(DEFAULT));
         assert!(f.request.spread);
-        f.request.n_identify = 4;
-        f.request.identify_poses = 4;
-        f.request.n_validate = 3;
-        f.request.validate_poses = 4;
-        f.request.candidates = 10;
-        f.request.predict_runs = 0;
     }
+    small_plan(&mut h, 4, 3);
     h.get_by_label("Make plan").click();
     settle(&mut h);
     assert!(

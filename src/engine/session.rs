@@ -153,6 +153,25 @@ impl SensorRange {
         (self.y[1] - self.y[0]) * (self.z[1] - self.z[0])
     }
 
+    /// The `n × n` grid of points `[y, z]` spanning the rectangle corner
+    /// to corner, `y` outer: the one grid of the range prediction, the
+    /// planner's criterion and the scoring against the truth.
+    #[must_use]
+    pub fn grid(&self, n: usize) -> Vec<[f64; 2]> {
+        let at = |lo: f64, hi: f64, k: usize| {
+            if n < 2 {
+                (lo + hi) / 2.0
+            } else {
+                lo + (hi - lo) * k as f64 / (n - 1) as f64
+            }
+        };
+        (0..n)
+            .flat_map(|ky| {
+                (0..n).map(move |kz| [at(self.y[0], self.y[1], ky), at(self.z[0], self.z[1], kz)])
+            })
+            .collect()
+    }
+
     /// Whether `(y, z)` lies in the rectangle.
     #[must_use]
     pub fn contains(&self, y: f64, z: f64) -> bool {

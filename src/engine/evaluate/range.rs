@@ -56,17 +56,10 @@ impl RangeScore {
 
 /// The grid points of `range`, sensor frame.
 fn grid(range: &SensorRange) -> Vec<Point3<f64>> {
-    let at = |lo: f64, hi: f64, k: usize| lo + (hi - lo) * k as f64 / (RANGE_SCORE_GRID - 1) as f64;
-    (0..RANGE_SCORE_GRID)
-        .flat_map(|ky| {
-            (0..RANGE_SCORE_GRID).map(move |kz| {
-                Point3::new(
-                    0.0,
-                    at(range.y[0], range.y[1], ky),
-                    at(range.z[0], range.z[1], kz),
-                )
-            })
-        })
+    range
+        .grid(RANGE_SCORE_GRID)
+        .into_iter()
+        .map(|[y, z]| Point3::new(0.0, y, z))
         .collect()
 }
 

@@ -158,11 +158,12 @@ pub(super) enum Objective {
 }
 
 impl Objective {
-    /// The objective at `M = LLᵀ`.
-    pub(super) fn value(&self, chol: &Cholesky<f64, Dyn>) -> f64 {
+    /// The objective at `M = LLᵀ` and its prepared matrix for
+    /// [`StationInfo::gain`] (computed once for both).
+    fn at(&self, chol: &Cholesky<f64, Dyn>) -> (f64, Option<DMatrix<f64>>) {
         match self.prepare(chol) {
-            None => log_det(chol),
-            Some(qt) => -qt.trace(),
+            None => (log_det(chol), None),
+            Some(qt) => (-qt.trace(), Some(qt)),
         }
     }
 
@@ -298,7 +299,7 @@ pub(super) fn greedy_selection(
         let mut swapped = false;
         for (slot, &s) in identify.iter().enumerate() {
             for pos in 0..chosen[slot].len() {
-                let Some(current) = m.clone().cholesky().map(|c| objective.value(&c)) else {
+                let Some((current, _)) = m.clone().cholesky().map(|c| objective.at(&c)) else {
                     continue;
                 };
                 let removed = chosen[slot][pos];
@@ -310,8 +311,7 @@ pub(super) fn greedy_selection(
                 let Some(chol) = m_without.clone().cholesky() else {
                     continue;
                 };
-                let base = objective.value(&chol);
-                let qt = objective.prepare(&chol);
+                let (base, qt) = objective.at(&chol);
                 let side = sites[s].candidates[removed].side;
                 let mut best: Option<(f64, usize)> = None;
                 for (cand, info) in infos[s].iter().enumerate() {

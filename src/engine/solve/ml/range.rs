@@ -147,18 +147,11 @@ impl AlignedGrid {
         scale: &[f64],
         range: &SensorRange,
     ) -> Self {
-        let at = |lo: f64, hi: f64, k: usize| lo + (hi - lo) * k as f64 / (RANGE_GRID - 1) as f64;
         let mut points = Vec::with_capacity(RANGE_GRID * RANGE_GRID * poses.len());
-        for ky in 0..RANGE_GRID {
-            for kz in 0..RANGE_GRID {
-                let (y, z) = (
-                    at(range.y[0], range.y[1], ky),
-                    at(range.z[0], range.z[1], kz),
-                );
-                for s in poses {
-                    let (g, p) = point_rows(est, s, estimated, scale, Vector3::new(0.0, y, z));
-                    points.push(([y, z], g, p));
-                }
+        for [y, z] in range.grid(RANGE_GRID) {
+            for s in poses {
+                let (g, p) = point_rows(est, s, estimated, scale, Vector3::new(0.0, y, z));
+                points.push(([y, z], g, p));
             }
         }
         let k = estimated.len();
