@@ -7,10 +7,11 @@
 //! - a **joint log** ([`import`], [`log`]): one CSV row a pose with its id,
 //!   station, use, side and joint readings, optionally with the flange pose
 //!   the controller reports, checked against the nominal model ([`check`]);
-//! - a **flange-pose log** ([`import_poses`], [`poses`]): the controller's
-//!   flange poses in a vendor convention (ABB, KUKA, FANUC, UR, or 4×4),
-//!   no joints: a pose-only session (FORMAT.md "Additions to version 1"),
-//!   which calibrates the hand-eye and the station centres only.
+//! - a **pose file** ([`import_poses`], [`poses`]): a pose table, a JSON
+//!   list or a robot program (FANUC `.ls`, RAPID, KUKA, URScript; read by
+//!   [`crate::engine::program`]): flange poses give a pose-only session
+//!   (FORMAT.md "Additions to version 1"), which calibrates the hand-eye
+//!   and the station centres only; joint targets a session with joints.
 //!
 //! Profiles ([`profiles`]) come as CSV/TXT or OpenCV YAML/JSON in the
 //! sensor's own axes and units; an axis map puts them in FORMAT.md's laser
@@ -24,11 +25,14 @@
 
 pub mod check;
 mod csv_file;
+pub mod initial;
 pub mod log;
+pub mod pairing;
 pub mod poses;
 pub mod profiles;
 pub mod references;
 pub mod robot_source;
+pub mod side;
 pub mod units;
 
 use std::collections::HashMap;
@@ -40,11 +44,16 @@ pub use self::check::{
     DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG, FlangeCheck, PoseCheck,
 };
 pub use self::log::{ColumnMap, DEFAULT_SIDE_COLUMN, header, preview};
-pub use self::poses::{PoseImportSpec, SideChoice, import_poses};
+pub use self::poses::{
+    Observations, PoseImportSpec, PoseInputs, SideChoice, build_pose_session, import_poses,
+    read_pose_inputs,
+};
 pub use self::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource, RawProfile};
 pub use self::references::{read_references, reference_rows};
 pub use self::robot_source::{RobotSource, load_robot};
+pub use self::side::decide_side;
 pub use self::units::{AngleUnit, LengthUnit};
+pub use crate::engine::program::PoseFormat;
 pub use crate::engine::robot::controller::FlangeConvention;
 
 use self::csv_file::CsvFile;

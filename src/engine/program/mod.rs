@@ -35,6 +35,7 @@ use crate::engine::robot::controller::FlangeConvention;
 use crate::engine::session::Use;
 
 pub use self::scan::MAX_SHOWN_CHARS;
+pub use self::table::Row;
 
 /// Largest pose file read, bytes: a robot program or pose log is
 /// kilobytes to a few megabytes; beyond this it is not one.
@@ -152,6 +153,15 @@ pub fn detect(text: &str, path: &Path) -> PoseFormat {
     {
         return PoseFormat::Rapid;
     }
+    // URScript before KRL: both start with `def`, URScript's line ends in `:`.
+    if scan::contains_ur_pose(text)
+        || text.contains("movej(")
+        || text.contains("movel(")
+        || ext == "script"
+        || ext == "urscript"
+    {
+        return PoseFormat::UrScript;
+    }
     if upper.contains("DEFDAT")
         || upper.contains("E6POS")
         || upper.contains("E6AXIS")
@@ -162,14 +172,13 @@ pub fn detect(text: &str, path: &Path) -> PoseFormat {
     {
         return PoseFormat::Krl;
     }
-    if scan::contains_ur_pose(text)
-        || text.contains("movej(")
-        || ext == "script"
-        || ext == "urscript"
-    {
-        return PoseFormat::UrScript;
-    }
     PoseFormat::Table
+}
+
+/// The last number in a target's name (`P[3]` → 3, `XP12` → 12).
+#[must_use]
+pub fn number_in(name: &str) -> Option<u64> {
+    scan::last_number(name)
 }
 
 /// A target's value as written.
@@ -300,7 +309,7 @@ impl PoseFile {
 
 /// A pose file could not be read: the line and what is wrong.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("line {line}: {message} ({})", path.display())]
+#[error("{}{message} ({})", if *line > 0 { format!("line {line}: ") } else { String::new() }, path.display())]
 pub struct ProgramError {
     /// The file.
     pub path: PathBuf,
@@ -445,6 +454,42 @@ pub fn parse_pose_text(
         warnings,
         text,
     })
+}
+
+/// Reads a table of numbers from `path` (a header optional, any
+/// separator; see the pose tables): the columns `names` (by name under a
+/// header, in order without one) and optionally `id`, `station`, `use`,
+/// `side`. `what` describes the numbers for messages. Used for tables
+/// that are not poses, such as sphere centres reported by a sensor.
+///
+/// # Errors
+/// An unreadable file, no rows, a missing column, a bad cell: naming the
+/// line.
+pub fn read_number_table(
+    path: &Path,
+    names: &[String],
+    names_given: bool,
+    what: &str,
+) -> Result<Vec<Row>, ProgramError> {
+    let fail = |line: usize, message: String| ProgramError {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    let size = std::fs::metadata(path)
+        .map_err(|e| fail(0, format!("cannot be read: {e}")))?
+        .len();
+    if size > MAX_POSE_FILE_BYTES {
+        return Err(fail(
+            0,
+            format!(
+                "{size} bytes is more than a table of this kind (at most {MAX_POSE_FILE_BYTES} bytes are read)"
+            ),
+        ));
+    }
+    let text =
+        std::fs::read_to_string(path).map_err(|e| fail(0, format!("cannot be read: {e}")))?;
+    table::read_rows(&text, names, names_given, what).map_err(|(line, message)| fail(line, message))
 }
 
 /// What a layout's reader returns: the targets, the motion instructions'

@@ -123,23 +123,51 @@ fn rows(text: &str) -> Vec<(usize, Range<usize>)> {
     out
 }
 
-/// Reads a pose table in `convention`, with the pose columns named
-/// `columns` when given.
-pub(super) fn read(
+/// One row of a numeric table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// 1-based line.
+    pub line: usize,
+    /// The row's 1-based ordinal among the data rows.
+    pub ordinal: usize,
+    /// The numbers of the wanted columns, in their order.
+    pub values: Vec<f64>,
+    /// Their byte ranges.
+    pub spans: Vec<Range<usize>>,
+    /// The `id` column, or the leading id of a headerless row.
+    pub id: Option<String>,
+    /// The `station` column.
+    pub station: Option<String>,
+    /// The `use` column.
+    pub usage: Option<Use>,
+    /// The `side` column, when it has a value.
+    pub side: Option<i8>,
+}
+
+/// Reads a table of numbers: the columns `names` (by name when the table
+/// has a header; in order without one, `names_given` then being an error),
+/// and optionally `id`, `station`, `use`, `side`. `what` names the
+/// numbers in messages ("FANUC x, y, z (mm), W, P, R (deg)").
+///
+/// # Errors
+/// No rows, a missing column, a row of another width, a cell that is not
+/// a number: each naming the line.
+pub fn read_rows(
     text: &str,
-    convention: FlangeConvention,
-    columns: Option<&[String]>,
-) -> Result<Parsed, ParseError> {
+    names: &[String],
+    names_given: bool,
+    what: &str,
+) -> Result<Vec<Row>, ParseError> {
     let rows = rows(text);
     let Some((first_line, first)) = rows.first().cloned() else {
-        return Err((0, "the pose table has no rows".to_string()));
+        return Err((0, "the table has no rows".to_string()));
     };
     let sep = Separator::of(&text[first.clone()]);
     let first_fields = fields(text, first, sep);
     let is_number = |r: &Range<usize>| text[r.clone()].parse::<f64>().is_ok();
-    let n = convention.n_columns();
+    let n = names.len();
     // A header has names; a first row whose only text is its first field
-    // with one field more than a pose needs is data with an id first.
+    // with one field more than the numbers need is data with an id first.
     let text_fields: Vec<usize> = (0..first_fields.len())
         .filter(|&i| !is_number(&first_fields[i]))
         .collect();
@@ -150,13 +178,13 @@ pub(super) fn read(
             .iter()
             .map(|r| text[r.clone()].to_string())
             .collect();
-        Layout::named(&header, convention, columns).map_err(|m| (first_line, m))?
+        Layout::named(&header, names, what).map_err(|m| (first_line, m))?
     } else {
-        if columns.is_some() {
+        if names_given {
             return Err((
                 first_line,
                 format!(
-                    "pose columns were named, but the table has no header (its first row is numbers separated by {})",
+                    "columns were named, but the table has no header (its first row is numbers separated by {})",
                     sep.describe()
                 ),
             ));
@@ -168,9 +196,8 @@ pub(super) fn read(
                 return Err((
                     first_line,
                     format!(
-                        "{w} numbers separated by {}: a pose table without a header has {n} a row ({}), or {} with the pose id first",
+                        "{w} numbers separated by {}: a table without a header has {n} a row ({what}), or {} with an id first",
                         sep.describe(),
-                        convention.describe(),
                         n + 1
                     ),
                 ));
@@ -178,7 +205,7 @@ pub(super) fn read(
         }
     };
     let data = if has_header { &rows[1..] } else { &rows[..] };
-    let mut targets = Vec::with_capacity(data.len());
+    let mut out = Vec::with_capacity(data.len());
     for (k, (line, range)) in data.iter().enumerate() {
         let f = fields(text, range.clone(), sep);
         if f.len() != layout.width {
@@ -195,7 +222,7 @@ pub(super) fn read(
         }
         let mut values = Vec::with_capacity(n);
         let mut spans = Vec::with_capacity(n);
-        for (c, &col) in layout.pose.iter().enumerate() {
+        for (c, &col) in layout.numbers.iter().enumerate() {
             let r = f[col].clone();
             let v: f64 = text[r.clone()].parse().map_err(|_| {
                 (
@@ -214,16 +241,8 @@ pub(super) fn read(
             spans.push(r);
         }
         let cell = |c: Option<usize>| c.map(|c| text[f[c].clone()].to_string());
-        let id = cell(layout.id).filter(|s| !s.is_empty());
-        let name = id.clone().unwrap_or_else(|| format!("line {line}"));
-        let mut t = Target::new(name, *line, TargetValue::Pose { values, convention }, spans);
-        if id.is_none() {
-            t.number = Some(k as u64 + 1);
-        }
-        t.id = id;
-        t.station = cell(layout.station).filter(|s| !s.is_empty());
-        if let Some(u) = cell(layout.usage) {
-            t.usage = Some(Use::parse(&u).ok_or_else(|| {
+        let usage = match cell(layout.usage) {
+            Some(u) => Some(Use::parse(&u).ok_or_else(|| {
                 (
                     *line,
                     format!(
@@ -231,13 +250,73 @@ pub(super) fn read(
                         shown(&u)
                     ),
                 )
-            })?);
-        }
-        if let Some(s) = cell(layout.side) {
-            t.side = side_cell(&s).map_err(|m| (*line, format!("column `side`: {m}")))?;
-        }
-        targets.push(t);
+            })?),
+            None => None,
+        };
+        let side = match cell(layout.side) {
+            Some(s) => side_cell(&s).map_err(|m| (*line, format!("column `side`: {m}")))?,
+            None => None,
+        };
+        out.push(Row {
+            line: *line,
+            ordinal: k + 1,
+            values,
+            spans,
+            id: cell(layout.id).filter(|s| !s.is_empty()),
+            station: cell(layout.station).filter(|s| !s.is_empty()),
+            usage,
+            side,
+        });
     }
+    Ok(out)
+}
+
+/// Reads a pose table in `convention`, with the pose columns named
+/// `columns` when given.
+pub(super) fn read(
+    text: &str,
+    convention: FlangeConvention,
+    columns: Option<&[String]>,
+) -> Result<Parsed, ParseError> {
+    let names = columns.map_or_else(|| convention.default_columns(), <[String]>::to_vec);
+    if names.len() != convention.n_columns() {
+        return Err((
+            0,
+            format!(
+                "{} pose columns named, {} needs {}",
+                names.len(),
+                convention.describe(),
+                convention.n_columns()
+            ),
+        ));
+    }
+    let rows = read_rows(text, &names, columns.is_some(), convention.describe())?;
+    let targets = rows
+        .into_iter()
+        .map(|row| {
+            let name = row
+                .id
+                .clone()
+                .unwrap_or_else(|| format!("line {}", row.line));
+            let mut t = Target::new(
+                name,
+                row.line,
+                TargetValue::Pose {
+                    values: row.values,
+                    convention,
+                },
+                row.spans,
+            );
+            if row.id.is_none() {
+                t.number = Some(row.ordinal as u64);
+            }
+            t.id = row.id;
+            t.station = row.station;
+            t.usage = row.usage;
+            t.side = row.side;
+            t
+        })
+        .collect();
     Ok(Parsed {
         targets,
         visits: Vec::new(),
@@ -258,7 +337,7 @@ fn side_cell(s: &str) -> Result<Option<i8>, String> {
 /// Where a table's values are.
 struct Layout {
     width: usize,
-    pose: Vec<usize>,
+    numbers: Vec<usize>,
     names: Vec<String>,
     id: Option<usize>,
     station: Option<usize>,
@@ -270,7 +349,7 @@ impl Layout {
     fn ordered(first: usize, id: Option<usize>, width: usize) -> Self {
         Self {
             width,
-            pose: (first..width).collect(),
+            numbers: (first..width).collect(),
             names: Vec::new(),
             id,
             station: None,
@@ -279,29 +358,15 @@ impl Layout {
         }
     }
 
-    fn named(
-        header: &[String],
-        convention: FlangeConvention,
-        columns: Option<&[String]>,
-    ) -> Result<Self, String> {
-        let names = columns.map_or_else(|| convention.default_columns(), <[String]>::to_vec);
-        if names.len() != convention.n_columns() {
-            return Err(format!(
-                "{} pose columns named, {} needs {}",
-                names.len(),
-                convention.describe(),
-                convention.n_columns()
-            ));
-        }
+    fn named(header: &[String], names: &[String], what: &str) -> Result<Self, String> {
         let find = |n: &str| header.iter().position(|h| h.trim().eq_ignore_ascii_case(n));
-        let pose = names
+        let numbers = names
             .iter()
             .map(|n| {
                 find(n).ok_or_else(|| {
                     format!(
-                        "no column `{n}` (the header has: {}); the pose columns of {} are {} (--pose-columns names others)",
+                        "no column `{n}` (the header has: {}); the columns of {what} are {} (--pose-columns names others)",
                         shown(&header.join(", ")),
-                        convention.describe(),
                         names.join(", ")
                     )
                 })
@@ -309,8 +374,8 @@ impl Layout {
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             width: header.len(),
-            pose,
-            names,
+            numbers,
+            names: names.to_vec(),
             id: find("id"),
             station: find("station"),
             usage: find("use"),
