@@ -22,16 +22,14 @@ use spherecal::engine::session::{Observation, Session, Use};
 use spherecal::engine::simulate::{self, SimConfig, Truth};
 use spherecal::engine::solve::{self, Options};
 
+/// True flange poses, stripes and the truth of a simulated cell.
+type Cell = (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>, Truth);
+
 /// One station of a simulated cell seen from `n_translation` pure
 /// translations and `n_rotation` orientation changes, every centre on
 /// side +1: the true flange poses (where the controller says the flange
 /// is), the stripes, and the truth.
-fn cell(
-    n_translation: usize,
-    n_rotation: usize,
-    noisy: bool,
-    seed: u64,
-) -> (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>, Truth) {
+fn cell(n_translation: usize, n_rotation: usize, noisy: bool, seed: u64) -> Cell {
     let config = SimConfig {
         seed,
         n_translation,
@@ -65,7 +63,7 @@ fn cell(
 /// The 8 poses of one identify station of a noisy simulated cell (the
 /// simulator's noise), the sphere spread over ±20 mm of the laser plane,
 /// every centre on side +1: true flange poses, stripes, truth.
-fn spread_station(seed: u64) -> (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>, Truth) {
+fn spread_station(seed: u64) -> Cell {
     let config = SimConfig {
         seed,
         n_identify: 1,
@@ -603,4 +601,100 @@ proptest! {
             prop_assert!(started.elapsed().as_secs_f64() < 2.0, "{name} took {:?}", started.elapsed());
         }
     }
+}
+
+/// A newcomer's command lines: `--axes -y,x,z` and negative numbers
+/// (`--angle -40`) reach the engine instead of clap's "unexpected
+/// argument"; `-q` quiets `import` and `export-model`.
+#[test]
+fn negative_values_and_quiet_flags_are_taken() {
+    let run = |args: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_spherecal"))
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stdout).into_owned(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (code, _, err) = run(&[
+        "plan",
+        "--sphere",
+        "1050,0,475",
+        "--angle",
+        "-40",
+        "--csv",
+        "/nonexistent/p.csv",
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("cut angle") && !err.contains("unexpected argument"),
+        "{err}"
+    );
+    let (poses, stripes, _) = cell(4, 8, false, 3);
+    let (dir, path) = folder(&stripes, "robot.txt", &headerless_table(&poses));
+    let out = dir.path().join("s.json");
+    let (code, stdout, err) = run(&[
+        "import",
+        "--poses",
+        path.to_str().unwrap(),
+        "--pose-convention",
+        "fanuc",
+        "--profiles",
+        dir.path().to_str().unwrap(),
+        "--axes",
+        "-y,x,z",
+        "--sphere-diameter",
+        "38.1",
+        "--side",
+        "+1",
+        "-q",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    // The profiles are y,z in FORMAT's plane: -y,x,z puts them off it.
+    assert_eq!(code, Some(2), "{stdout}{err}");
+    assert!(err.contains("off the laser plane"), "{err}");
+    let (code, stdout, err) = run(&[
+        "import",
+        "--poses",
+        path.to_str().unwrap(),
+        "--pose-convention",
+        "fanuc",
+        "--profiles",
+        dir.path().to_str().unwrap(),
+        "--sphere-diameter",
+        "38.1",
+        "-q",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{stdout}{err}");
+    assert!(stdout.is_empty(), "quiet: {stdout}");
+    let result = dir.path().join("r.json");
+    let (code, _, err) = run(&[
+        "calibrate",
+        out.to_str().unwrap(),
+        "--out",
+        result.to_str().unwrap(),
+        "-q",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, stdout, err) = run(&[
+        "export-model",
+        result.to_str().unwrap(),
+        "--format",
+        "json",
+        "-q",
+        "--out",
+        dir.path().join("m.json").to_str().unwrap(),
+    ]);
+    // A pose-only result has no model to export: the error still shows.
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        stdout.is_empty() && err.contains("pose-only"),
+        "{stdout}{err}"
+    );
 }

@@ -458,6 +458,10 @@ fn read_centres(
     Ok((ids, out))
 }
 
+/// Pose ids, their profiles in the laser plane, how they were read, and
+/// the pairing in words.
+type Paired = (Vec<String>, Vec<PlaneProfile>, ProfileReport, Vec<String>);
+
 /// Pose ids and their profiles, and the pairing in words: by id when the
 /// log has ids that name profile files, else pose `k` with the `k`-th
 /// profile in the order of their numbers.
@@ -465,7 +469,7 @@ fn pair_profiles(
     spec: &PoseImportSpec,
     source: &ProfileSource,
     records: &[PoseRecord],
-) -> Result<(Vec<String>, Vec<PlaneProfile>, ProfileReport, Vec<String>), ImportError> {
+) -> Result<Paired, ImportError> {
     let ids: Option<Vec<String>> = records.iter().map(|r| r.id.clone()).collect();
     let named = match (&ids, source) {
         (Some(ids), ProfileSource::Folder(dir)) => {
