@@ -15,7 +15,7 @@ pub use atomic::{refuse_inputs, remove_pending, same_file, write_atomic};
 pub use result::{
     ResultFile, load_result, parse_result, result_text_checked, result_to_json, save_result,
 };
-pub use session::{load_session, parse_session, recheck_session, save_session, session_to_json};
+pub use session::{load_session, parse_session, save_session, session_to_json};
 pub use transform::read_transform;
 
 /// The `format` of a session file.

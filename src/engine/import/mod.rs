@@ -1,6 +1,6 @@
 //! Import of real data: a pose log plus stripe profiles become a
-//! [`Session`], validated by a round trip through the session loader so
-//! every FORMAT.md rule is enforced with its own messages.
+//! [`Session`], validated by the same typed rules as the session loader
+//! ([`Session::validate`]), a broken rule blamed on the file it came from.
 //!
 //! Two kinds of pose log:
 //!
@@ -58,7 +58,6 @@ pub use crate::engine::robot::controller::FlangeConvention;
 
 use self::csv_file::CsvFile;
 use crate::engine::format::FileError;
-use crate::engine::format::recheck_session;
 use crate::engine::robot::Robot;
 use crate::engine::session::{
     MIN_STRIPE_POINTS, Measurement, Observation, Session, SolverSettings, Use,
@@ -480,7 +479,7 @@ pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
         .map(|(line, row)| (row[cols.id].as_str(), *line))
         .collect();
     let session = recheck(
-        &session,
+        session,
         &Sources {
             log: &spec.joint_log,
             lines: &lines,
@@ -517,45 +516,38 @@ pub(crate) struct Sources<'a> {
     pub references: Option<&'a Path>,
 }
 
-/// The session checked by every rule of the session loader
-/// ([`recheck_session`]); a broken rule is blamed on its source: a
-/// stripe's on the pose's profile file, a pose's other data on its log
-/// line, a reference distance on its row of the references file, the
-/// rest on the log.
+/// The session checked by every FORMAT.md rule ([`Session::validate`],
+/// the rules the file loader applies too); a broken rule is blamed on its
+/// source by its measurement and key: a stripe's on the pose's profile
+/// file, a pose's other data on its log line, a reference distance on its
+/// row of the references file, the rest on the log.
 ///
 /// # Errors
-/// The loader's message, placed in the file it came from.
-pub(crate) fn recheck(session: &Session, sources: &Sources) -> Result<Session, ImportError> {
-    let e = match recheck_session(session, sources.log) {
-        Ok(s) => return Ok(s),
+/// The rule's message, placed in the file it came from.
+pub(crate) fn recheck(session: Session, sources: &Sources) -> Result<Session, ImportError> {
+    let e = match session.validate() {
+        Ok(()) => return Ok(session),
         Err(e) => e,
     };
-    let FileError::Invalid {
-        measurement,
-        message,
-        ..
-    } = &e
-    else {
-        return Err(e.into());
-    };
-    if let Some(id) = measurement {
+    let key = e.key.as_deref().unwrap_or("");
+    if let Some(id) = &e.measurement {
         let profile = sources.profiles.poses.iter().find(|p| p.id == *id);
-        if let Some(p) = profile.filter(|_| message.contains("stripe")) {
+        if let Some(p) = profile.filter(|_| key.starts_with("stripe")) {
             return Err(ImportError::File {
                 path: p.file.clone(),
-                message: format!("pose {id}: {message}"),
+                message: format!("pose {id}: {}", e.message),
             });
         }
         if let Some(&line) = sources.lines.get(id.as_str()) {
             return Err(ImportError::Csv {
                 path: sources.log.to_path_buf(),
                 line,
-                message: format!("pose {id}: {message}"),
+                message: format!("pose {id}: {}", e.message),
             });
         }
     }
     if let Some(path) = sources.references
-        && let Some(index) = reference_index(message)
+        && let Some(index) = reference_index(key)
     {
         let line = reference_rows(path)
             .ok()
@@ -564,24 +556,27 @@ pub(crate) fn recheck(session: &Session, sources: &Sources) -> Result<Session, I
             Some(line) => ImportError::Csv {
                 path: path.to_path_buf(),
                 line,
-                message: message.clone(),
+                message: e.message,
             },
             None => ImportError::File {
                 path: path.to_path_buf(),
-                message: message.clone(),
+                message: e.message,
             },
         });
     }
     Err(ImportError::File {
         path: sources.log.to_path_buf(),
-        message: message.clone(),
+        message: e.to_string(),
     })
 }
 
-/// `i` of the first `reference_distances[i]` a loader message names.
-fn reference_index(message: &str) -> Option<usize> {
-    let rest = message.split("reference_distances[").nth(1)?;
-    rest.split(']').next()?.parse().ok()
+/// `i` of a key `reference_distances[i]`.
+fn reference_index(key: &str) -> Option<usize> {
+    key.strip_prefix("reference_distances[")?
+        .split(']')
+        .next()?
+        .parse()
+        .ok()
 }
 
 /// A session built by an import: `name` given, the robot (none for a

@@ -682,7 +682,7 @@ pub fn build_pose_session(
         .map(|(id, r)| (id.as_str(), r.line))
         .collect();
     let session = super::recheck(
-        &session,
+        session,
         &super::Sources {
             log: &spec.poses,
             lines: &lines,
