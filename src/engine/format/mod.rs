@@ -10,7 +10,10 @@ mod layout;
 pub mod result;
 pub mod session;
 
-pub use atomic::{refuse_inputs, remove_pending, same_file, write_atomic};
+pub use atomic::{
+    Folders, check_outputs, interrupted, refuse_inputs, remove_pending, same_file,
+    write_all_atomic, write_atomic,
+};
 pub use result::{
     ResultFile, load_result, parse_result, result_text_checked, result_to_json, save_result,
 };

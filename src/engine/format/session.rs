@@ -755,6 +755,8 @@ impl<'a> Ctx<'a> {
         let items: Vec<&'a RawValue> = self.parse(raw, "reference_distances", None)?;
         let validate_stations = session.stations(Use::Validate);
         let mut out = Vec::with_capacity(items.len());
+        // Each pair of stations (in name order): its first entry and distance.
+        let mut pairs: HashMap<(String, String), (usize, f64)> = HashMap::new();
         for (i, item) in items.into_iter().enumerate() {
             let key = format!("reference_distances[{i}]");
             let keys: ReferenceKeys = self.object(item, &key, None)?;
@@ -814,6 +816,28 @@ impl<'a> Ctx<'a> {
                 None,
                 d_raw,
             )?;
+            let pair = if from < to {
+                (from.clone(), to.clone())
+            } else {
+                (to.clone(), from.clone())
+            };
+            match pairs.get(&pair) {
+                Some(&(first, other)) if other != distance => {
+                    return Err(self.invalid(
+                        None,
+                        format!(
+                            "{key}: the pair {from} – {to} is {} mm here and {} mm in reference_distances[{first}]: two distances for one pair contradict each other; keep the right one{}",
+                            show(distance),
+                            show(other),
+                            self.at(d_raw)
+                        ),
+                    ));
+                }
+                Some(_) => {}
+                None => {
+                    pairs.insert(pair, (i, distance));
+                }
+            }
             out.push(ReferenceDistance { from, to, distance });
         }
         Ok(out)

@@ -6,7 +6,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use super::ImportError;
-use crate::engine::table::{Table, TableError};
+use crate::engine::table::{Table, TableError, excerpt};
 
 /// A parsed CSV file: header and data rows with their 1-based lines.
 pub(super) struct CsvFile {
@@ -102,8 +102,9 @@ impl CsvFile {
         self.optional_column(name).ok_or_else(|| ImportError::File {
             path: self.path.clone(),
             message: format!(
-                "no column `{name}` (the header has: {})",
-                self.header.join(", ")
+                "no column `{}` (the header has: {})",
+                excerpt(name),
+                excerpt(&self.header.join(", "))
             ),
         })
     }
@@ -124,8 +125,9 @@ impl CsvFile {
                 path: self.path.clone(),
                 line,
                 message: format!(
-                    "column `{}`: `{s}` is not a finite number",
-                    self.header[col]
+                    "column `{}`: `{}` is not a finite number",
+                    excerpt(&self.header[col]),
+                    excerpt(s)
                 ),
             }),
         }

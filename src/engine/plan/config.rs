@@ -13,6 +13,26 @@ use crate::engine::simulate::SimConfig;
 
 use super::*;
 
+/// Most stations of a plan (identify and validate together). The paper
+/// uses 9 identify and 10 validate stations; a cell's plan rarely needs
+/// more than a few dozen. Planning time grows with the stations (about
+/// 20 ms each in a debug build, a few in release), so 500 stay well
+/// within a minute; beyond, the request is a typo.
+pub const MAX_STATIONS: usize = 500;
+
+/// Most candidate orientations drawn per station (default 24).
+pub const MAX_CANDIDATES: usize = 1000;
+
+/// Most candidate orientations of a whole plan (stations × candidates):
+/// 500 stations at the default 24. The identifiability analysis and the
+/// selection work on every candidate pose (up to 16 a orientation), so
+/// this bounds the plan's time and memory.
+pub const MAX_ORIENTATIONS: usize = 12_000;
+
+/// Most poses of one group (translations, rotations, or the poses of one
+/// identify or validate station): ten times the paper's.
+pub const MAX_GROUP_POSES: usize = 100;
+
 /// Default cut angle, deg: the paper's "about ±40°" (section 4.1), where
 /// its distance errors were smallest.
 pub const DEFAULT_CUT_ANGLE_DEG: f64 = 40.0;
@@ -330,6 +350,40 @@ impl PlanConfig {
         check(self.candidates >= 1, || {
             "at least one candidate orientation per station is needed".to_owned()
         })?;
+        let stations = self.n_identify_stations() + self.n_validate_stations();
+        check(stations <= MAX_STATIONS, || {
+            format!(
+                "{stations} stations asked for ({} identify, {} validate): a plan has at most {MAX_STATIONS}",
+                self.n_identify_stations(),
+                self.n_validate_stations()
+            )
+        })?;
+        check(self.candidates <= MAX_CANDIDATES, || {
+            format!(
+                "{} candidate orientations per station asked for: at most {MAX_CANDIDATES}",
+                self.candidates
+            )
+        })?;
+        check(
+            stations.saturating_mul(self.candidates) <= MAX_ORIENTATIONS,
+            || {
+                format!(
+                    "{stations} stations × {} candidates = {} orientations to solve: a plan has at most {MAX_ORIENTATIONS}; ask for fewer stations or candidates",
+                    self.candidates,
+                    stations.saturating_mul(self.candidates)
+                )
+            },
+        )?;
+        for (name, n) in [
+            ("translation poses", self.n_translation),
+            ("rotation poses", self.n_rotation),
+            ("identify poses per station", self.identify_poses),
+            ("validate poses per station", self.validate_poses),
+        ] {
+            check(n <= MAX_GROUP_POSES, || {
+                format!("{n} {name} asked for: at most {MAX_GROUP_POSES}")
+            })?;
+        }
         check(self.n_rotation != 1, || {
             "the rotation group needs at least 2 poses (eq. 8 uses pairs), or none".to_owned()
         })?;

@@ -287,7 +287,15 @@ pub fn read_stations(path: &Path) -> Result<StationLayout, RequestError> {
             f[c].parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| fail(*line, format!("`{}` is not a finite number", f[c])))
+                .ok_or_else(|| {
+                    fail(
+                        *line,
+                        format!(
+                            "`{}` is not a finite number",
+                            crate::engine::table::excerpt(&f[c])
+                        ),
+                    )
+                })
         };
         let p = [num(x)?, num(y)?, num(z)?];
         match f[u].as_str() {
@@ -296,7 +304,10 @@ pub fn read_stations(path: &Path) -> Result<StationLayout, RequestError> {
             other => {
                 return Err(fail(
                     *line,
-                    format!("use `{other}` is not identify or validate"),
+                    format!(
+                        "use `{}` is not identify or validate",
+                        crate::engine::table::excerpt(other)
+                    ),
                 ));
             }
         }

@@ -16,6 +16,21 @@ pub const RANDOM_ANGLE_SIGMA_DEG: f64 = 0.1;
 /// `error_scale = 1`: Table 1's length errors are within ±0.7 mm.
 pub const RANDOM_LENGTH_SIGMA_MM: f64 = 0.3;
 
+/// Largest σ of the stripe point noise and of the centre noise, mm: ten
+/// times the worst laser-stripe sensor (~1 mm) and a quarter of a small
+/// (38 mm) sphere's radius; beyond it a stripe is no longer an arc and
+/// the points leave the loader's plausible sensor field.
+pub const MAX_SENSOR_NOISE_MM: f64 = 10.0;
+/// Largest σ of the joint reading noise, deg: a thousand times an
+/// encoder's (~0.003°); beyond it readings stop meaning a pose.
+pub const MAX_JOINT_NOISE_DEG: f64 = 3.0;
+/// Largest σ of the laser tracker's reference distances, mm (a tracker
+/// measures to ~0.01 mm).
+pub const MAX_TRACKER_NOISE_MM: f64 = 10.0;
+/// Largest `error_scale`: 100 × Table 1 puts angle errors near 50°, far
+/// beyond any real robot's deviations from its nominal model.
+pub const MAX_ERROR_SCALE: f64 = 100.0;
+
 /// Where the true kinematic model comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -250,6 +265,18 @@ pub(super) fn check(ok: bool, message: impl FnOnce() -> String) -> Result<(), Si
     }
 }
 
+impl SimConfig {
+    /// Checks every setting, as [`simulate`](super::simulate) does before
+    /// any work (so that a caller can refuse options before writing
+    /// anything).
+    ///
+    /// # Errors
+    /// [`SimError::InvalidConfig`] naming the setting and its value.
+    pub fn validate(&self) -> Result<(), SimError> {
+        validate_config(self)
+    }
+}
+
 pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
     let reals = [
         ("error_scale", c.error_scale),
@@ -292,6 +319,29 @@ pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
             format!("{name} must not be negative, found {v}")
         })?;
     }
+    for (name, v, limit, unit) in [
+        ("stripe_noise", c.stripe_noise, MAX_SENSOR_NOISE_MM, "mm"),
+        ("centre_noise", c.centre_noise, MAX_SENSOR_NOISE_MM, "mm"),
+        ("joint_noise", c.joint_noise, MAX_JOINT_NOISE_DEG, "deg"),
+        ("tracker_noise", c.tracker_noise, MAX_TRACKER_NOISE_MM, "mm"),
+        (
+            "error_scale",
+            c.error_scale,
+            MAX_ERROR_SCALE,
+            "(times the errors)",
+        ),
+    ] {
+        check(v.abs() <= limit, || {
+            format!(
+                "{name} {} {unit} is not plausible: at most {limit} (a simulated session must stay one its loader reads)",
+                crate::engine::numeric::show(v)
+            )
+        })?;
+    }
+    check(c.n_identify >= 1, || {
+        "at least one identify station is needed: a session without one cannot be calibrated"
+            .to_owned()
+    })?;
     check((0.0..=1.0).contains(&c.outlier_fraction), || {
         format!(
             "outlier_fraction must be within 0..1, found {}",
