@@ -489,7 +489,7 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
         sayln!(
             "identification: method {}, threshold {} mm, at most {} update(s)",
             options.method.as_str(),
-            options.threshold,
+            crate::engine::numeric::show(options.threshold),
             options.max_iterations
         );
     }
@@ -521,4 +521,45 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 23: a write stopped by a late Ctrl-C ended with status 1
+    /// ("No such file or directory"); it is an interruption (130), and
+    /// every other refused or failed output is status 2.
+    #[test]
+    fn file_errors_have_one_status_each() {
+        let io = |kind: std::io::ErrorKind| FileError::Io {
+            action: "writing",
+            path: PathBuf::from("r.json"),
+            source: std::io::Error::new(kind, "x"),
+        };
+        let interrupted = io(std::io::ErrorKind::Interrupted);
+        assert_eq!(CliError::from_file(&interrupted, false).status, 130);
+        for kind in [
+            std::io::ErrorKind::PermissionDenied,
+            std::io::ErrorKind::NotFound,
+            std::io::ErrorKind::InvalidInput,
+        ] {
+            assert_eq!(CliError::from_file(&io(kind), false).status, 2);
+            assert_eq!(CliError::from_file(&io(kind), true).status, 2);
+        }
+    }
+
+    #[test]
+    fn long_messages_keep_their_start_and_end() {
+        let long = format!("start {} end (file.csv)", "x".repeat(10_000));
+        let short = bounded_message(&long);
+        assert!(
+            short.chars().count() < MAX_MESSAGE_CHARS + 60,
+            "{}",
+            short.len()
+        );
+        assert!(short.starts_with("start ") && short.ends_with("end (file.csv)"));
+        assert!(short.contains("characters left out"));
+        assert_eq!(bounded_message("short"), "short");
+    }
 }

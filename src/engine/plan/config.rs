@@ -6,9 +6,10 @@ use nalgebra::{Isometry3, Vector3};
 
 use crate::engine::cell::sensor;
 use crate::engine::cell::workspace::{self, Workspace};
+use crate::engine::numeric::show;
 use crate::engine::robot::ik::DOF;
 use crate::engine::robot::{JointLimit, Preset, Robot, RobotChoice};
-use crate::engine::session::SensorRange;
+use crate::engine::session::{SensorRange, limits};
 use crate::engine::simulate::SimConfig;
 
 use super::*;
@@ -312,6 +313,37 @@ impl PlanConfig {
             format!(
                 "the sphere diameter must be positive, found {} mm",
                 self.diameter
+            )
+        })?;
+        // The session file's plausibility limits: a plan's numbers end up
+        // in sessions and messages.
+        check(self.diameter <= limits::SPHERE_DIAMETER_MM, || {
+            format!(
+                "the sphere diameter {} mm is not plausible (at most {} mm)",
+                show(self.diameter),
+                limits::SPHERE_DIAMETER_MM
+            )
+        })?;
+        let far = |v: &[f64]| v.iter().any(|x| x.abs() > limits::LENGTH_MM);
+        check(!far(&self.sphere), || {
+            format!(
+                "the sphere position [{}, {}, {}] mm is not plausible (at most {} mm from the base)",
+                show(self.sphere[0]),
+                show(self.sphere[1]),
+                show(self.sphere[2]),
+                limits::LENGTH_MM
+            )
+        })?;
+        let box_far = match &self.stations {
+            StationLayout::Box { size } => far(size),
+            StationLayout::Explicit { identify, validate } => {
+                identify.iter().chain(validate).any(|p| far(p))
+            }
+        };
+        check(!box_far && !far(&[self.translation_step]), || {
+            format!(
+                "station positions, the station box and the translation step must stay within {} mm",
+                limits::LENGTH_MM
             )
         })?;
         check(self.cut_angle > 5.0 && self.cut_angle < 80.0, || {

@@ -269,7 +269,7 @@ pub fn read_stations(path: &Path) -> Result<StationLayout, RequestError> {
         message: format!("line {line}: {m}"),
         path: path.to_path_buf(),
     };
-    let text = std::fs::read_to_string(path).map_err(|e| RequestError::File {
+    let text = crate::engine::table::read_text_file(path).map_err(|e| RequestError::File {
         what: "stations",
         message: format!("reading failed: {e}"),
         path: path.to_path_buf(),

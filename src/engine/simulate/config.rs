@@ -357,6 +357,16 @@ pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
     check(c.diameter > 0.0, || {
         format!("diameter must be positive, found {} mm", c.diameter)
     })?;
+    check(
+        c.diameter <= crate::engine::session::limits::SPHERE_DIAMETER_MM,
+        || {
+            format!(
+                "diameter {} mm is not plausible (at most {} mm)",
+                crate::engine::numeric::show(c.diameter),
+                crate::engine::session::limits::SPHERE_DIAMETER_MM
+            )
+        },
+    )?;
     check(c.point_spacing > 0.0, || {
         format!(
             "point_spacing must be positive, found {} mm",

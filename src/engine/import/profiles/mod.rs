@@ -45,6 +45,7 @@ use super::csv_file::CsvFile;
 use super::{ImportError, LengthUnit};
 use crate::engine::numeric::show;
 use crate::engine::session::limits;
+use crate::engine::table::read_text_file;
 
 /// Names of the sensor's axes, in order.
 const AXIS_NAMES: [&str; 3] = ["x", "y", "z"];
@@ -292,7 +293,7 @@ fn number(text: &str) -> Option<f64> {
 /// An unreadable file, or content that is not a profile (naming the file
 /// and the line or key).
 pub fn read_profile(path: &Path, format: &ProfileFormat) -> Result<RawProfile, ImportError> {
-    let text = fs::read_to_string(path).map_err(|source| ImportError::Io {
+    let text = read_text_file(path).map_err(|source| ImportError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -378,7 +379,7 @@ pub fn read_profile_table(
     pose_column: &str,
     format: &ProfileFormat,
 ) -> Result<(Vec<String>, HashMap<String, RawProfile>), ImportError> {
-    let text = fs::read_to_string(path).map_err(|source| ImportError::Io {
+    let text = read_text_file(path).map_err(|source| ImportError::Io {
         path: path.to_path_buf(),
         source,
     })?;
