@@ -20,6 +20,7 @@
 //!   Leftovers of a process that was killed outright (a dead process id in
 //!   their name) are removed by the next write into the same folder.
 
+use std::collections::HashMap;
 use std::fs;
 use std::io::{self, Write as _};
 use std::path::{Path, PathBuf};
@@ -178,10 +179,13 @@ fn io_error(path: &Path, source: io::Error) -> FileError {
     }
 }
 
-/// Each output's target, checked; two outputs that are one file refused.
+/// Each output's target, checked; two outputs that are one file refused
+/// (by path, the folder canonical, and by device and inode; linear in the
+/// outputs).
 fn plan_targets(paths: &[&Path]) -> Result<Vec<TargetPlan>, FileError> {
     let mut plans: Vec<TargetPlan> = Vec::with_capacity(paths.len());
-    for path in paths {
+    let mut seen: HashMap<Identity, usize> = HashMap::with_capacity(paths.len());
+    for (k, path) in paths.iter().enumerate() {
         let target = resolve_links(path).map_err(|e| io_error(path, e))?;
         check_target(&target).map_err(|e| io_error(path, e))?;
         let Some(name) = target.file_name().map(std::ffi::OsStr::to_os_string) else {
@@ -194,26 +198,53 @@ fn plan_targets(paths: &[&Path]) -> Result<Vec<TargetPlan>, FileError> {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        if let Some((other, _)) = paths
-            .iter()
-            .zip(&plans)
-            .find(|(_, p)| (p.dir == dir && p.name == name) || same_file(&p.target, &target))
-        {
-            return Err(io_error(
-                path,
-                io::Error::new(
-                    io::ErrorKind::InvalidInput,
-                    format!(
-                        "{} is also written as {} (the same file): give each output its own path",
-                        path.display(),
-                        other.display()
+        let canonical = fs::canonicalize(&dir).unwrap_or_else(|_| dir.clone());
+        let mut identities = vec![Identity::Path(canonical.join(&name))];
+        identities.extend(inode(&target));
+        for id in identities {
+            if let Some(&other) = seen.get(&id) {
+                return Err(io_error(
+                    path,
+                    io::Error::new(
+                        io::ErrorKind::InvalidInput,
+                        format!(
+                            "{} is also written as {} (the same file): give each output its own path",
+                            path.display(),
+                            paths[other].display()
+                        ),
                     ),
-                ),
-            ));
+                ));
+            }
+            seen.insert(id, k);
         }
         plans.push(TargetPlan { target, dir, name });
     }
     Ok(plans)
+}
+
+/// What makes two outputs one file.
+#[derive(Debug, PartialEq, Eq, Hash)]
+enum Identity {
+    /// The canonical folder joined with the file name.
+    Path(PathBuf),
+    /// Device and inode of an existing file.
+    Inode(u64, u64),
+}
+
+/// The device and inode of an existing file (Unix).
+fn inode(path: &Path) -> Option<Identity> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt as _;
+        fs::metadata(path)
+            .ok()
+            .map(|m| Identity::Inode(m.dev(), m.ino()))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = path;
+        None
+    }
 }
 
 /// Creates the missing folders of `dir`, recording each one created

@@ -31,6 +31,13 @@ pub const MAX_TRACKER_NOISE_MM: f64 = 10.0;
 /// beyond any real robot's deviations from its nominal model.
 pub const MAX_ERROR_SCALE: f64 = 100.0;
 
+/// Most stations of a simulated session (identify and validate): 60,000
+/// measurements at 6 a station, far beyond any cell's (the workbench's
+/// large-session tests simulate 2,000); each one writes files.
+pub const MAX_STATIONS: usize = 10_000;
+/// Most poses of one group (translations, rotations, or one station's).
+pub const MAX_GROUP_POSES: usize = 100;
+
 /// Where the true kinematic model comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -336,6 +343,20 @@ pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
                 "{name} {} {unit} is not plausible: at most {limit} (a simulated session must stay one its loader reads)",
                 crate::engine::numeric::show(v)
             )
+        })?;
+    }
+    for (name, n, limit) in [
+        (
+            "n_identify + n_validate",
+            c.n_identify + c.n_validate,
+            MAX_STATIONS,
+        ),
+        ("poses_per_station", c.poses_per_station, MAX_GROUP_POSES),
+        ("n_translation", c.n_translation, MAX_GROUP_POSES),
+        ("n_rotation", c.n_rotation, MAX_GROUP_POSES),
+    ] {
+        check(n <= limit, || {
+            format!("{name} is {n}: a simulated session has at most {limit}")
         })?;
     }
     check(c.n_identify >= 1, || {
