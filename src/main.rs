@@ -25,10 +25,15 @@ fn main() -> ExitCode {
         Some(Command::History(args)) => cli::history::run(&args),
         None => gui(None, None),
     };
+    // The text a command printed must have reached its reader.
+    let outcome = outcome.and_then(|()| cli::stdout_result());
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
+        // Interrupted while failing (a write stopped by Ctrl-C): the
+        // interruption is the news, with its status.
+        Err(_) if spherecal::engine::format::interrupted() => ExitCode::from(130),
         Err(e) => {
-            eprintln!("error: {}", e.message);
+            eprintln!("error: {}", cli::bounded_message(&e.message));
             ExitCode::from(u8::try_from(e.status).unwrap_or(1))
         }
     }

@@ -142,13 +142,15 @@ fn unreadable_file_exits_2() {
 }
 
 #[test]
-fn unwritable_output_exits_1_and_leaves_nothing() {
+fn unwritable_output_exits_2_and_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let session = demo_path(dir.path());
-    // The output's folder does not exist: an internal (I/O) failure.
+    // The output's folder does not exist: refused before any work, with
+    // the one status of every refused output (issue 23).
     let out = dir.path().join("no-such-dir").join("r.json");
     let (status, _, stderr) = calibrate(&session, &out);
-    assert_eq!(status, 1, "{stderr}");
+    assert_eq!(status, 2, "{stderr}");
+    assert!(stderr.contains("does not exist"), "{stderr}");
     assert!(stderr.starts_with("error: "), "{stderr}");
     assert_eq!(files_in(dir.path()), vec!["demo.json"]);
 }
@@ -248,7 +250,7 @@ fn special_files_are_refused_and_links_written_through() {
     let session = demo_path(dir.path());
     let s = session.to_str().unwrap();
     let (code, _, err) = run(&["calibrate", s, "--out", "/dev/null", "-q"]);
-    assert_eq!(code, 1, "{err}");
+    assert_eq!(code, 2, "{err}");
     assert!(err.contains("a device"), "{err}");
     assert!(
         !Path::new("/dev/null")
@@ -258,7 +260,7 @@ fn special_files_are_refused_and_links_written_through() {
             .is_file()
     );
     let (code, _, err) = run(&["calibrate", s, "--out", dir.path().to_str().unwrap(), "-q"]);
-    assert_ne!(code, 0);
+    assert_eq!(code, 2, "{err}");
     assert!(err.contains("a folder"), "{err}");
     let target = dir.path().join("target.json");
     std::fs::write(&target, "old").unwrap();
@@ -514,4 +516,193 @@ fn the_report_carries_the_verdict_against_a_tolerance() {
     ]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("STD,MAX"), "{err}");
+}
+
+// Issue 23: nothing accepted silently, nothing left behind.
+
+/// Runs the binary with stdout into `/dev/full` (every write fails with
+/// "No space left on device"); returns (status, stderr).
+#[cfg(target_os = "linux")]
+fn run_into_dev_full(args: &[&str]) -> (i32, String) {
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    let o = spherecal().args(args).stdout(full).output().unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// `history` and `evaluate` into a full disk exited 0 with their text
+/// lost; a closed pipe (`| head`) stays a success.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_standard_output_is_an_error() {
+    let library = Path::new(env!("CARGO_MANIFEST_DIR")).join("sessions/history");
+    let (code, err) = run_into_dev_full(&["history", library.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("writing to standard output failed"), "{err}");
+    let (code, err) = run_into_dev_full(&["evaluate", "--seeds", "1", "--scenario", "paper-like"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("No space left"), "{err}");
+}
+
+/// `simulate --out` refused (a device, a folder) still wrote the truth
+/// file; a failing `--csv-out` left files behind: all files or none.
+#[cfg(unix)]
+#[test]
+fn simulate_writes_all_of_its_files_or_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let truth = d.join("t.json");
+    for out in [Path::new("/dev/null"), d] {
+        let (code, _, err) = run(&[
+            "simulate",
+            "--out",
+            out.to_str().unwrap(),
+            "--truth",
+            truth.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{err}");
+        assert!(!truth.exists(), "no truth file when the session is refused");
+    }
+    assert!(!Path::new("/dev/null.truth.json").exists());
+    // A profile target is a folder: found only once the ids are known,
+    // still before anything is written.
+    let csv = d.join("csv");
+    std::fs::create_dir_all(csv.join("profiles/t1.csv")).unwrap();
+    let s = d.join("s.json");
+    let (code, _, err) = run(&[
+        "simulate",
+        "--out",
+        s.to_str().unwrap(),
+        "--csv-out",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("t1.csv") && err.contains("a folder"), "{err}");
+    assert_eq!(files_in(d), vec!["csv"]);
+    assert_eq!(files_in(&csv), vec!["profiles"]);
+    assert_eq!(files_in(&csv.join("profiles")), vec!["t1.csv"]);
+    // A --csv-out that cannot be created: nothing at all.
+    let blocker = d.join("file");
+    std::fs::write(&blocker, "x").unwrap();
+    let (code, _, err) = run(&[
+        "simulate",
+        "--out",
+        s.to_str().unwrap(),
+        "--csv-out",
+        blocker.join("sub").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(files_in(d), vec!["csv", "file"]);
+    // Written whole: session, truth, joint log, profiles, references.
+    let fresh = d.join("fresh");
+    let (code, _, err) = run(&[
+        "simulate",
+        "--out",
+        s.to_str().unwrap(),
+        "--csv-out",
+        fresh.join("deep").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        files_in(&fresh.join("deep")),
+        vec!["joints.csv", "profiles", "references.csv"]
+    );
+    assert!(d.join("s.truth.json").exists());
+}
+
+/// `simulate --stripe-noise 1e6` or `--identify-stations 0` wrote a
+/// session spherecal then refused to calibrate.
+#[test]
+fn simulate_refuses_options_that_make_a_session_no_one_can_use() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = dir.path().join("s.json");
+    for (flag, value, needle) in [
+        (
+            "--stripe-noise",
+            "1e6",
+            "stripe_noise 1000000 mm is not plausible",
+        ),
+        ("--joint-noise", "1e6", "joint_noise"),
+        ("--identify-stations", "0", "at least one identify station"),
+    ] {
+        let (code, _, err) = run(&["simulate", "--out", s.to_str().unwrap(), flag, value]);
+        assert_eq!(code, 2, "{flag} {value}: {err}");
+        assert!(err.contains(needle), "{err}");
+        assert!(files_in(dir.path()).is_empty(), "{flag}: nothing written");
+    }
+}
+
+/// `plan --rapid` failing on an unwritable path left `plan.csv` behind.
+#[test]
+fn plan_writes_all_of_its_files_or_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("plan.csv");
+    let rapid = dir.path().join("no-such-folder/plan.mod");
+    let (code, _, err) = run(&[
+        "plan",
+        "--sphere",
+        "1050,0,475",
+        "--predict",
+        "0",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--rapid",
+        rapid.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("no-such-folder"), "{err}");
+    assert!(files_in(dir.path()).is_empty(), "no plan.csv left");
+    let (code, _, err) = run(&[
+        "plan",
+        "--sphere",
+        "1050,0,475",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--program",
+        &format!("urscript={}", csv.display()),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("the same file"), "{err}");
+    assert!(files_in(dir.path()).is_empty());
+}
+
+/// A read-only (`chmod 444`) target was replaced; refused with status 2
+/// in every command, as root too (the mode bits are checked).
+#[cfg(unix)]
+#[test]
+fn a_read_only_output_is_refused_by_every_command() {
+    use std::os::unix::fs::PermissionsExt as _;
+    let dir = tempfile::tempdir().unwrap();
+    let session = demo_path(dir.path());
+    let s = session.to_str().unwrap();
+    let locked = dir.path().join("locked.out");
+    std::fs::write(&locked, "keep").unwrap();
+    std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o444)).unwrap();
+    let l = locked.to_str().unwrap();
+    let library = Path::new(env!("CARGO_MANIFEST_DIR")).join("sessions/history");
+    for args in [
+        vec!["calibrate", s, "--out", l, "-q"],
+        vec!["report", s, "--out", l, "-q"],
+        vec!["simulate", "--out", l],
+        vec![
+            "plan",
+            "--sphere",
+            "1050,0,475",
+            "--predict",
+            "0",
+            "--csv",
+            l,
+        ],
+        vec!["history", library.to_str().unwrap(), "--csv", l],
+    ] {
+        let (code, _, err) = run(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains("read-only (mode 0444)"), "{args:?}: {err}");
+        assert_eq!(std::fs::read_to_string(&locked).unwrap(), "keep");
+    }
 }

@@ -154,7 +154,7 @@ fn epsilon_series_follows_the_loop_of_format_md() {
     // A threshold above the starting ε: one entry, no update.
     let prepared = solve::prepare(&session).unwrap();
     let mut options = paper_options(&session);
-    options.threshold = 1e6;
+    options.threshold = 1000.0;
     let cal = solve::run(&session, &prepared, &options, &mut |_| {
         solve::Control::Continue
     })

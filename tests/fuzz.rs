@@ -426,3 +426,249 @@ fn a_joint_log_without_rows_names_the_log() {
         "{msg}"
     );
 }
+
+// Issue 23: every parser of untrusted text (URDF, DH tables, profiles in
+// each layout, sessions, results) ends, quickly, with a robot or an error
+// naming the file, whatever the text; nested or long inputs are refused
+// with a bounded message, in time linear in the input.
+
+/// Longest error message any parser may give, characters (the command
+/// line cuts longer ones; a parser should not need it).
+const MAX_MESSAGE: usize = 1500;
+
+fn robot_text(name: &str) -> String {
+    fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/robots")
+            .join(name),
+    )
+    .unwrap()
+}
+
+/// A simulated profile in one of the layouts the readers take, with the
+/// file extension that selects its reader.
+fn profile_text(layout: usize) -> (&'static str, String) {
+    let (_, profiles) = import_files();
+    let csv = &profiles[0].1;
+    let points: Vec<(f64, f64)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let (y, z) = l.split_once(',').unwrap();
+            (y.parse().unwrap(), z.parse().unwrap())
+        })
+        .collect();
+    let flat: Vec<String> = points
+        .iter()
+        .flat_map(|(y, z)| [format!("{y:?}"), "0.".to_owned(), format!("{z:?}")])
+        .collect();
+    match layout % 4 {
+        0 => ("csv", csv.clone()),
+        1 => (
+            "txt",
+            points
+                .iter()
+                .map(|(y, z)| format!("{y:?} {z:?}\n"))
+                .collect(),
+        ),
+        2 => (
+            "yml",
+            format!("%YAML:1.0\n---\nscan_line: [ {} ]\n", flat.join(",\n    ")),
+        ),
+        _ => ("json", format!("{{\"scan_line\": [{}]}}", flat.join(", "))),
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 64,
+        failure_persistence: None,
+        // Fixed: the same cases on every run, so CI is reproducible.
+        rng_seed: proptest::test_runner::RngSeed::Fixed(SEED),
+        ..ProptestConfig::default()
+    })]
+
+    /// A mutated URDF is a robot within the session's limits, or an error
+    /// naming the file in a bounded message.
+    #[test]
+    fn mutated_urdfs_never_panic(
+        mutations in prop::collection::vec(mutation(), 1..4),
+        which in any::<bool>(),
+    ) {
+        let text = robot_text(if which { "ur5e.urdf" } else { "abb_irb2400.urdf" });
+        let mutated = apply(&text, &mutations);
+        match spherecal::engine::robot::robot_from_urdf(&mutated, Path::new("fuzz.urdf")) {
+            Ok(u) => {
+                let text = format::session_to_json(&Session {
+                    robot: u.robot,
+                    ..small_session().0.clone()
+                });
+                // The robot is one a session may hold (joint count aside).
+                if let Err(e) = format::parse_session(&text, Path::new("x.json")) {
+                    let msg = e.to_string();
+                    prop_assert!(msg.contains("joints") || msg.contains("readings"), "{msg}");
+                }
+            }
+            Err(e) => {
+                let msg = e.to_string();
+                prop_assert!(msg.contains("fuzz.urdf"), "{msg}");
+                prop_assert!(msg.len() < MAX_MESSAGE, "{msg}");
+            }
+        }
+    }
+
+    /// A mutated DH table (either convention) is a robot or an error
+    /// naming the file.
+    #[test]
+    fn mutated_dh_tables_never_panic(
+        mutations in prop::collection::vec(mutation(), 1..4),
+        which in any::<bool>(),
+    ) {
+        use spherecal::engine::robot::{DhConvention, robot_from_dh_csv};
+        let (name, convention) = if which {
+            ("ur5e_dh.csv", DhConvention::Standard)
+        } else {
+            ("abb_irb2400_mdh.csv", DhConvention::Modified)
+        };
+        let mutated = apply(&robot_text(name), &mutations);
+        match robot_from_dh_csv(&mutated, Path::new("fuzz.csv"), convention) {
+            Ok(robot) => prop_assert!(robot
+                .joints
+                .iter()
+                .all(|j| [j.alpha, j.a, j.beta, j.theta, j.d].iter().all(|v| v.abs() <= 1e5))),
+            Err(e) => {
+                let msg = e.to_string();
+                prop_assert!(msg.contains("fuzz.csv"), "{msg}");
+                prop_assert!(msg.len() < MAX_MESSAGE, "{msg}");
+            }
+        }
+    }
+
+    /// A mutated profile in any layout (CSV, TXT, OpenCV YAML and JSON)
+    /// is a profile of finite, plausible points or an error naming it.
+    #[test]
+    fn mutated_profiles_never_panic(
+        mutations in prop::collection::vec(mutation(), 1..4),
+        layout in 0usize..4,
+        no_return in prop::option::of(prop_oneof![Just(0.0), Just(-99999.0)]),
+    ) {
+        let (ext, text) = profile_text(layout);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(format!("p1.{ext}"));
+        fs::write(&path, apply(&text, &mutations)).unwrap();
+        let format = import::ProfileFormat {
+            no_return,
+            ..import::ProfileFormat::default()
+        };
+        match import::profiles::read_profile(&path, &format) {
+            Ok(p) => prop_assert!(p.points.iter().flatten().all(|v| v.is_finite()
+                && v.abs() <= import::profiles::MAX_PROFILE_COORDINATE_MM)),
+            Err(e) => {
+                let msg = e.to_string();
+                prop_assert!(msg.contains(&format!("p1.{ext}")), "{msg}");
+                prop_assert!(msg.len() < MAX_MESSAGE, "{msg}");
+            }
+        }
+    }
+}
+
+/// Runs `f` and returns its value and the seconds it took.
+fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
+    let t = std::time::Instant::now();
+    let v = f();
+    (v, t.elapsed().as_secs_f64())
+}
+
+/// Nesting that overflowed the stack (20,000 levels: abort, exit 134) or
+/// ran for minutes (500,000 unclosed tags), in URDF and JSON: refused at
+/// once, with the line.
+#[test]
+fn deep_nesting_is_refused_at_once() {
+    use spherecal::engine::robot::robot_from_urdf;
+    let n = 20_000;
+    let nested = format!(
+        "<robot name=\"r\">{}{}</robot>",
+        "<a>".repeat(n),
+        "</a>".repeat(n)
+    );
+    let unclosed = format!("<robot name=\"r\">\n{}", "<link>".repeat(500_000));
+    for text in [&nested, &unclosed] {
+        let (e, secs) = timed(|| robot_from_urdf(text, Path::new("deep.urdf")).unwrap_err());
+        let msg = e.to_string();
+        assert!(msg.contains("nested more than 64 levels"), "{msg}");
+        assert!(secs < 2.0, "{secs} s");
+    }
+    let e = robot_from_urdf(&unclosed, Path::new("deep.urdf")).unwrap_err();
+    assert!(e.to_string().contains("(line 2)"), "{e}");
+    // Nesting inside comments, CDATA and attribute values is not nesting.
+    let text = robot_text("abb_irb2400.urdf").replacen(
+        "<robot",
+        &format!(
+            "<!-- {} --><![CDATA[{}]]><robot",
+            "<a>".repeat(100),
+            "<b>".repeat(100)
+        ),
+        1,
+    );
+    let parsed = robot_from_urdf(&text, Path::new("ok.urdf"));
+    assert!(parsed.is_ok(), "{parsed:?}");
+    // JSON sessions and results: serde_json's recursion limit.
+    let deep_json = format!("{}{}", "[".repeat(100_000), "]".repeat(100_000));
+    let (e, secs) =
+        timed(|| format::parse_session(&deep_json, Path::new("deep.json")).unwrap_err());
+    assert!(
+        e.to_string().contains("deep.json") && secs < 2.0,
+        "{e} {secs}"
+    );
+    let (e, secs) = timed(|| format::parse_result(&deep_json, Path::new("deep.json")).unwrap_err());
+    assert!(
+        e.to_string().contains("deep.json") && secs < 2.0,
+        "{e} {secs}"
+    );
+}
+
+/// A file of one enormous line (a gigabyte in the attack; 3 MB here) was
+/// echoed whole in the error. Every reader answers with a short message
+/// naming the file and the line.
+#[test]
+fn one_huge_line_gives_a_short_message() {
+    use spherecal::engine::robot::{DhConvention, load_dh_csv, robot_from_urdf};
+    let dir = tempfile::tempdir().unwrap();
+    let junk = "x".repeat(3 << 20);
+    let mut messages = Vec::new();
+    // A joint log (its header), a DH table, a profile in each layout.
+    let log = dir.path().join("log.csv");
+    fs::write(&log, format!("id,station,use,j1\n{junk}\n")).unwrap();
+    messages.push(("log.csv", import::header(&log).unwrap_err().to_string()));
+    let dh = dir.path().join("dh.csv");
+    fs::write(&dh, format!("a,alpha,d,theta\n1{junk},1,1,1\n")).unwrap();
+    messages.push((
+        "dh.csv",
+        load_dh_csv(&dh, DhConvention::Modified)
+            .unwrap_err()
+            .to_string(),
+    ));
+    for ext in ["csv", "txt", "yml"] {
+        let p = dir.path().join(format!("p.{ext}"));
+        fs::write(&p, format!("y,z\n{junk}\n")).unwrap();
+        let e = import::profiles::read_profile(&p, &import::ProfileFormat::default()).unwrap_err();
+        messages.push(("p.", e.to_string()));
+    }
+    // A URDF with a 3 MB name.
+    let urdf = format!("<robot name=\"r\"><link name=\"{junk}\"/><link name=\"{junk}\"/></robot>");
+    messages.push((
+        "u.urdf",
+        robot_from_urdf(&urdf, Path::new("u.urdf"))
+            .unwrap_err()
+            .to_string(),
+    ));
+    for (file, msg) in messages {
+        assert!(msg.contains(file), "{msg}");
+        assert!(
+            msg.len() < MAX_MESSAGE,
+            "{} characters: {}",
+            msg.len(),
+            &msg[..200]
+        );
+    }
+}

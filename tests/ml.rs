@@ -346,7 +346,7 @@ fn the_loop_of_format_md_holds_for_ml() {
     let prepared = solve::prepare(&session).expect("prepare");
     let mut options = ml_options(&session);
     // A threshold above the starting ε: one entry, no update.
-    options.threshold = 1e6;
+    options.threshold = 1000.0;
     let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue).expect("run");
     assert_eq!(cal.iterations.len(), 1);
     assert_eq!(cal.stop.code(), "threshold");

@@ -626,7 +626,10 @@ fn negative_values_and_quiet_flags_are_taken() {
         "--angle",
         "-40",
         "--csv",
-        "/nonexistent/p.csv",
+        std::env::temp_dir()
+            .join(format!("spherecal-angle-{}.csv", std::process::id()))
+            .to_str()
+            .unwrap(),
     ]);
     assert_eq!(code, Some(2), "{err}");
     assert!(

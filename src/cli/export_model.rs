@@ -64,7 +64,7 @@ pub struct ExportModelArgs {
 ///
 /// # Errors
 /// [`CliError`] with status 2 when the result file cannot be read or is
-/// not a valid result, 1 when the output cannot be written.
+/// not a valid result, or the output is refused or cannot be written.
 pub fn run(args: &ExportModelArgs) -> Result<(), CliError> {
     CliError::guard_output(&args.out, &[&args.result])?;
     let result = format::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;

@@ -41,9 +41,17 @@ pub struct HistoryArgs {
     pub csv: Option<PathBuf>,
 }
 
+/// Largest `--k`: a change beyond 1000 combined σ is no test at all (no
+/// jump could ever be flagged), so a larger k is a typo.
+const MAX_K: f64 = 1000.0;
+
 fn parse_k(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
-        Ok(k) if k.is_finite() && k > 0.0 => Ok(k),
+        Ok(k) if k.is_finite() && k > 0.0 && k <= MAX_K => Ok(k),
+        Ok(k) if k > MAX_K => Err(format!(
+            "k = {} would flag no jump at all: give at most {MAX_K} (σ)",
+            crate::engine::numeric::show(k)
+        )),
         _ => Err(format!("expected a positive number, got `{s}`")),
     }
 }
@@ -52,8 +60,11 @@ fn parse_k(s: &str) -> Result<f64, String> {
 ///
 /// # Errors
 /// Status 2 when the folder cannot be read, the robot or a parameter is
-/// unknown; status 1 when the CSV cannot be written.
+/// unknown, or the CSV is refused or cannot be written.
 pub fn run(args: &HistoryArgs) -> Result<(), CliError> {
+    if let Some(path) = &args.csv {
+        super::check_outputs(&[path], format::Folders::Existing)?;
+    }
     let library = history::scan(&args.folder).map_err(|e| CliError::input(e.to_string()))?;
     let robots: Vec<String> = match &args.robot {
         Some(query) => vec![
@@ -267,7 +278,7 @@ fn drift_text(library: &Library, d: &Drift) -> String {
     let _ = writeln!(
         s,
         "\njumps (|change| > k·sqrt(σ₁² + σ₂²), k = {}): {}",
-        d.k,
+        crate::engine::numeric::show(d.k),
         if jumps.is_empty() {
             "none".to_string()
         } else {

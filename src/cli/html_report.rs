@@ -34,6 +34,9 @@ pub struct ReportArgs {
     /// Acceptance tolerance on the validation after calibration, `STD,MAX` in mm (e.g. `0.2,0.5`): the report then says PASS or FAIL.
     #[arg(long, value_parser = result_view::Tolerance::parse)]
     pub tolerance: Option<result_view::Tolerance>,
+    /// Without --result: report the calibration even when its identify centres still scatter beyond 10 mm (a failed calibration), as `calibrate --accept-implausible`.
+    #[arg(long)]
+    pub accept_implausible: bool,
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
@@ -44,8 +47,8 @@ pub struct ReportArgs {
 ///
 /// # Errors
 /// [`CliError`] with status 2 for bad input (unreadable or invalid files,
-/// a result of another session, a session that cannot be calibrated), 1
-/// when the report cannot be written.
+/// a result of another session, a session that cannot be calibrated, an
+/// output that is refused or cannot be written).
 pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let mut inputs = vec![args.session.as_path()];
     inputs.extend(args.result.as_deref());
@@ -88,6 +91,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
             options.method = args.method;
             let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
                 .map_err(|e| CliError::from_calibration(&e, &args.session))?;
+            super::check_plausible(&session, &cal, args.accept_implausible, &args.session)?;
             format::ResultFile::from_calibration(&session, &cal)
         }
     };

@@ -2,9 +2,11 @@
 //! of the engine; it prints, the engine does not.
 //!
 //! Exit status (FORMAT.md "Command line contract"): 0 on success, 2 on bad
-//! input with one `error:` line on stderr naming the file, the measurement
-//! and the problem, 1 on an internal failure. A result file is written
-//! atomically or not at all.
+//! input or a refused or failed output (a device, a folder, a read-only
+//! file, an unwritable path, a full standard output) with one `error:`
+//! line on stderr naming the file, the measurement and the problem, 1 on
+//! an internal failure, 130 when interrupted (Ctrl-C, SIGTERM). Every
+//! command writes all of its files or none, each atomically.
 
 /// Prints to stdout with a newline, as `println!`, but a closed stdout (the
 /// reader of a pipe went away: `| head`) is not an error: the work is
@@ -44,7 +46,9 @@ use crate::engine::report::summary;
 use crate::engine::session;
 use crate::engine::solve::ml::{Loss, MlOptions};
 use crate::engine::solve::paper::Pairing;
-use crate::engine::solve::{self, Control, HandEyeSource, Method, Options, SolveError};
+use crate::engine::solve::{
+    self, Control, HandEyeSource, Method, Options, SolveError, StopReason, plausible,
+};
 
 /// spherecal: calibrate a robot-mounted laser-stripe sensor (hand-eye and
 /// kinematic errors) against a reference sphere.
@@ -117,18 +121,93 @@ pub enum Command {
     History(history::HistoryArgs),
 }
 
-/// Writes `args` and a newline to stdout, ignoring a closed pipe.
+/// The first error writing to stdout other than a closed pipe (a full
+/// disk, `/dev/full`), reported by [`stdout_result`] when the command ends.
+static STDOUT_ERROR: std::sync::Mutex<Option<std::io::Error>> = std::sync::Mutex::new(None);
+
+/// Remembers a failed write to stdout, unless the reader went away (a
+/// closed pipe is the reader's choice, not a lost output).
+fn note_stdout(result: std::io::Result<()>) {
+    if let Err(e) = result
+        && e.kind() != std::io::ErrorKind::BrokenPipe
+        && let Ok(mut first) = STDOUT_ERROR.lock()
+        && first.is_none()
+    {
+        *first = Some(e);
+    }
+}
+
+/// Writes `args` and a newline to stdout, ignoring a closed pipe (any
+/// other failure is reported by [`stdout_result`]).
 pub fn write_line(args: std::fmt::Arguments<'_>) {
     use std::io::Write as _;
     let mut out = std::io::stdout().lock();
-    let _ = out.write_fmt(args);
-    let _ = out.write_all(b"\n");
+    note_stdout(out.write_fmt(args).and_then(|()| out.write_all(b"\n")));
 }
 
-/// Writes `args` to stdout, ignoring a closed pipe.
+/// Writes `args` to stdout, ignoring a closed pipe (any other failure is
+/// reported by [`stdout_result`]).
 pub fn write_text(args: std::fmt::Arguments<'_>) {
     use std::io::Write as _;
-    let _ = std::io::stdout().lock().write_fmt(args);
+    note_stdout(std::io::stdout().lock().write_fmt(args));
+}
+
+/// Flushes stdout and reports the first failed write of the command's
+/// text (`spherecal history … > /dev/full`): the output is lost, so the
+/// command fails (status 2). A closed pipe is not a failure.
+///
+/// # Errors
+/// [`CliError`] with status 2 naming the write error.
+pub fn stdout_result() -> Result<(), CliError> {
+    use std::io::Write as _;
+    note_stdout(std::io::stdout().lock().flush());
+    let first = STDOUT_ERROR.lock().ok().and_then(|mut e| e.take());
+    match first {
+        Some(e) => Err(CliError::input(format!(
+            "writing to standard output failed: {e}; the command's text is lost"
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// Longest error message printed whole, characters: far beyond any
+/// message of spherecal's own; only one that echoes a hostile input (a
+/// line of a gigabyte) is longer.
+pub const MAX_MESSAGE_CHARS: usize = 2000;
+
+/// `message` cut in the middle to at most [`MAX_MESSAGE_CHARS`]: the
+/// start (what is wrong) and the end (the file) are kept, the middle is
+/// replaced by how many characters were left out.
+#[must_use]
+pub fn bounded_message(message: &str) -> String {
+    let n = message.chars().count();
+    if n <= MAX_MESSAGE_CHARS {
+        return message.to_owned();
+    }
+    let keep = MAX_MESSAGE_CHARS / 2;
+    let head: String = message.chars().take(keep).collect();
+    let tail: String = message.chars().skip(n - keep).collect();
+    format!("{head}… ({} characters left out) …{tail}", n - 2 * keep)
+}
+
+/// Refuses, before any work, outputs that could not be written (a
+/// device, a folder, a read-only file, a missing folder, two outputs that
+/// are one file), with status 2.
+///
+/// # Errors
+/// The refusal, naming the output.
+pub fn check_outputs(paths: &[&Path], folders: format::Folders) -> Result<(), CliError> {
+    format::check_outputs(paths, folders).map_err(|e| CliError::from_file(&e, false))
+}
+
+/// Writes a command's files as one transaction: all of them or none
+/// ([`format::write_all_atomic`]).
+///
+/// # Errors
+/// Status 2 naming the file that could not be written (nothing is
+/// written), 130 when interrupted.
+pub fn write_outputs(files: &[(&Path, &[u8])], folders: format::Folders) -> Result<(), CliError> {
+    format::write_all_atomic(files, folders).map_err(|e| CliError::from_file(&e, false))
 }
 
 /// `spherecal gui`.
@@ -170,9 +249,38 @@ pub struct CalibrateArgs {
     /// Pairing of a station's measurements: `disjoint` (the paper's (1,2),(3,4),(5,6)) or `all`.
     #[arg(long, default_value = "disjoint", value_parser = parse_pairing)]
     pub pairs: Pairing,
+    /// Write the result even when the identify centres still scatter beyond 10 mm after calibration (a failed calibration: wrong pose convention, joint unit, robot model or side), e.g. to study it.
+    #[arg(long)]
+    pub accept_implausible: bool,
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+/// Refuses a finished calibration whose identify centres scatter beyond
+/// any sensor and robot ([`plausible::check_calibration`]), unless
+/// `accept` (then it is a warning on stderr).
+///
+/// # Errors
+/// Status 2 naming the scatter and the likely causes, and the flag that
+/// writes the result anyway.
+pub fn check_plausible(
+    session: &session::Session,
+    cal: &solve::Calibration,
+    accept: bool,
+    path: &Path,
+) -> Result<(), CliError> {
+    match plausible::check_calibration(session, cal) {
+        Ok(()) => Ok(()),
+        Err(e) if accept => {
+            eprintln!("warning: {e} (written anyway: --accept-implausible)");
+            Ok(())
+        }
+        Err(e) => Err(CliError::input(format!(
+            "{e}; nothing is written (--accept-implausible writes it anyway) ({})",
+            path.display()
+        ))),
+    }
 }
 
 /// Settings of the `ml` method (defaults: [`MlOptions::default`]).
@@ -289,7 +397,8 @@ fn parse_pairing(s: &str) -> Result<Pairing, String> {
 /// A failure of a command, with its exit status.
 #[derive(Debug)]
 pub struct CliError {
-    /// 2 for bad input, 1 for an internal failure.
+    /// 2 for bad input or a refused output, 1 for an internal failure,
+    /// 130 when interrupted.
     pub status: i32,
     /// One line, without the `error: ` prefix.
     pub message: String,
@@ -314,24 +423,41 @@ impl CliError {
         }
     }
 
-    /// From a file error: I/O on reading is input, on writing internal.
+    /// Interrupted (Ctrl-C or SIGTERM, exit 130).
+    #[must_use]
+    pub fn interrupted(message: impl Into<String>) -> Self {
+        Self {
+            status: 130,
+            message: message.into(),
+        }
+    }
+
+    /// From a file error: a file that cannot be read, or an output that is
+    /// refused or cannot be written, is the user's to fix (status 2, one
+    /// code for every command); a write stopped by Ctrl-C is 130.
     #[must_use]
     pub fn from_file(e: &FileError, reading: bool) -> Self {
         let message = e.to_string();
         match e {
-            FileError::Invalid { .. } => Self::input(message),
-            FileError::Io { .. } if reading => Self::input(message),
-            FileError::Io { .. } => Self::internal(message),
+            FileError::Io { source, .. }
+                if !reading && source.kind() == std::io::ErrorKind::Interrupted =>
+            {
+                Self::interrupted(message)
+            }
+            FileError::Invalid { .. } | FileError::Io { .. } => Self::input(message),
         }
     }
 
-    /// Refuses an output that is one of the command's inputs (the same
-    /// file: it would be destroyed), with status 2.
+    /// Refuses, before any work, an output that is one of the command's
+    /// inputs (the same file: it would be destroyed) or that could not be
+    /// written ([`check_outputs`]: a device, a folder, a read-only file, a
+    /// missing folder), with status 2.
     ///
     /// # Errors
-    /// The refusal, naming both.
+    /// The refusal, naming the output (and the input it is).
     pub fn guard_output(output: &Path, inputs: &[&Path]) -> Result<(), Self> {
-        format::refuse_inputs(output, inputs).map_err(|e| Self::input(e.to_string()))
+        format::refuse_inputs(output, inputs).map_err(|e| Self::input(e.to_string()))?;
+        check_outputs(&[output], format::Folders::Existing)
     }
 
     /// From a calibration error of the session at `path`.
@@ -401,12 +527,27 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
         sayln!(
             "identification: method {}, threshold {} mm, at most {} update(s)",
             options.method.as_str(),
-            options.threshold,
+            crate::engine::numeric::show(options.threshold),
             options.max_iterations
         );
     }
     let cal = solve::run(&session, &prepared, &options, &mut on_progress)
         .map_err(|e| CliError::from_calibration(&e, &args.session))?;
+    if let StopReason::Converged {
+        epsilon,
+        threshold,
+        updates: 0,
+    } = cal.stop
+    {
+        // Said plainly: a threshold at or above the starting ε calibrates
+        // nothing.
+        eprintln!(
+            "warning: ε = {} mm is already within the threshold {} mm before any update: nothing was identified, the result holds the uncalibrated model and initial hand-eye",
+            crate::engine::numeric::approx(epsilon),
+            crate::engine::numeric::show(threshold)
+        );
+    }
+    check_plausible(&session, &cal, args.accept_implausible, &args.session)?;
     let result = format::ResultFile::from_calibration(&session, &cal);
     format::save_result(&result, &args.out).map_err(|e| CliError::from_file(&e, false))?;
     if !quiet {
@@ -418,4 +559,45 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 23: a write stopped by a late Ctrl-C ended with status 1
+    /// ("No such file or directory"); it is an interruption (130), and
+    /// every other refused or failed output is status 2.
+    #[test]
+    fn file_errors_have_one_status_each() {
+        let io = |kind: std::io::ErrorKind| FileError::Io {
+            action: "writing",
+            path: PathBuf::from("r.json"),
+            source: std::io::Error::new(kind, "x"),
+        };
+        let interrupted = io(std::io::ErrorKind::Interrupted);
+        assert_eq!(CliError::from_file(&interrupted, false).status, 130);
+        for kind in [
+            std::io::ErrorKind::PermissionDenied,
+            std::io::ErrorKind::NotFound,
+            std::io::ErrorKind::InvalidInput,
+        ] {
+            assert_eq!(CliError::from_file(&io(kind), false).status, 2);
+            assert_eq!(CliError::from_file(&io(kind), true).status, 2);
+        }
+    }
+
+    #[test]
+    fn long_messages_keep_their_start_and_end() {
+        let long = format!("start {} end (file.csv)", "x".repeat(10_000));
+        let short = bounded_message(&long);
+        assert!(
+            short.chars().count() < MAX_MESSAGE_CHARS + 60,
+            "{}",
+            short.len()
+        );
+        assert!(short.starts_with("start ") && short.ends_with("end (file.csv)"));
+        assert!(short.contains("characters left out"));
+        assert_eq!(bounded_message("short"), "short");
+    }
 }

@@ -5,7 +5,7 @@
 //! of [`crate::engine::plan`]; every file is written atomically.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use clap::Args;
 
@@ -208,16 +208,65 @@ fn plan_error(e: &PlanError) -> CliError {
     }
 }
 
-fn write(path: &Path, text: &str) -> Result<(), CliError> {
-    format::write_atomic(path, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))
+/// Seconds between progress lines of a long plan (stderr): a plan of the
+/// paper's size takes well under this and prints none.
+const PROGRESS_EVERY: Duration = Duration::from_secs(2);
+
+/// Progress lines of a long plan: at most one every [`PROGRESS_EVERY`].
+struct Ticker {
+    started: Instant,
+    last: Instant,
+}
+
+impl Ticker {
+    fn new(now: Instant) -> Self {
+        Self {
+            started: now,
+            last: now,
+        }
+    }
+
+    /// The line to print for `stage` at `now`, if one is due.
+    fn tick(&mut self, stage: &PlanStage, now: Instant) -> Option<String> {
+        if now.duration_since(self.last) < PROGRESS_EVERY {
+            return None;
+        }
+        let what = match stage {
+            PlanStage::Candidates { done, of } => {
+                format!("candidate poses of {done} of {of} stations solved")
+            }
+            PlanStage::Analysis => "identifiability analysis of the candidate poses".to_owned(),
+            PlanStage::Selection => "selecting the identify poses".to_owned(),
+            PlanStage::Ordering => "ordering the poses".to_owned(),
+            PlanStage::Comparison => "planning without the spread, for comparison".to_owned(),
+        };
+        self.last = now;
+        Some(format!(
+            "  planning: {what} ({:.0} s)",
+            now.duration_since(self.started).as_secs_f64()
+        ))
+    }
+
+    /// The line to print after `done` of `of` simulated calibrations.
+    fn runs(&mut self, done: usize, of: usize, now: Instant) -> Option<String> {
+        if now.duration_since(self.last) < PROGRESS_EVERY {
+            return None;
+        }
+        self.last = now;
+        Some(format!(
+            "  predicting: {done} of {of} simulated calibrations ({:.0} s)",
+            now.duration_since(self.started).as_secs_f64()
+        ))
+    }
 }
 
 /// Runs `spherecal plan`.
 ///
 /// # Errors
 /// [`CliError`] with status 2 for bad input or an impossible request
-/// (unreachable sphere, too few reachable poses, collinear translations),
-/// 1 when a file cannot be written.
+/// (unreachable sphere, too few reachable poses, collinear translations)
+/// or an output that cannot be written (checked before planning; the
+/// files are written all or none).
 pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     let inputs: Vec<&Path> = args
         .hand_eye
@@ -226,9 +275,6 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         .map(PathBuf::as_path)
         .chain(std::iter::once(Path::new(&args.robot)))
         .collect();
-    for out in args.csv.iter().chain(&args.rapid) {
-        CliError::guard_output(out, &inputs)?;
-    }
     let started = Instant::now();
     let mut programs: Vec<(Controller, PathBuf)> = Vec::new();
     if let Some(path) = &args.rapid {
@@ -247,11 +293,25 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         };
         programs.push(p);
     }
+    let outputs: Vec<&Path> = args
+        .csv
+        .iter()
+        .map(PathBuf::as_path)
+        .chain(programs.iter().map(|(_, p)| p.as_path()))
+        .collect();
+    for out in &outputs {
+        CliError::guard_output(out, &inputs)?;
+    }
+    super::check_outputs(&outputs, format::Folders::Existing)?;
     let config = config(args)?;
     let quiet = args.quiet;
     // When each stage began, for the timing line.
     let mut marks: Vec<(&str, Instant)> = vec![("candidates", Instant::now())];
+    let mut ticker = Ticker::new(Instant::now());
     let made = plan::plan(&config, &mut |stage| {
+        if !quiet && let Some(line) = ticker.tick(&stage, Instant::now()) {
+            eprintln!("{line}");
+        }
         let name = match stage {
             PlanStage::Candidates { .. } => None,
             PlanStage::Analysis => Some("identifiability"),
@@ -291,8 +351,14 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
             ..PredictConfig::default()
         };
         let t = Instant::now();
-        let p = plan::predict(&made, &predict, &mut |_, _| Control::Continue)
-            .map_err(|e| plan_error(&e))?;
+        let mut ticker = Ticker::new(t);
+        let p = plan::predict(&made, &predict, &mut |done, of| {
+            if !quiet && let Some(line) = ticker.runs(done, of, Instant::now()) {
+                eprintln!("{line}");
+            }
+            Control::Continue
+        })
+        .map_err(|e| plan_error(&e))?;
         if !quiet {
             sayln!(
                 "  predicted validation std after calibration (ml, {} simulated robots with random errors σ {}°/{} mm, joint noise {}°, stripe noise {} mm): {:.4} ± {:.4} mm",
@@ -322,16 +388,20 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
             }
         }
     }
+    // Every file or none.
+    let mut files: Vec<(&Path, String, String)> = Vec::new();
     if let Some(path) = &args.csv {
-        write(path, &plan::plan_csv(&made))?;
-        if !quiet {
-            sayln!("wrote {} (joint log CSV)", path.display());
-        }
+        files.push((path, plan::plan_csv(&made), "joint log CSV".to_owned()));
     }
     for (controller, path) in &programs {
-        write(path, &controller.render(&made))?;
-        if !quiet {
-            sayln!("wrote {} ({} program)", path.display(), controller.key());
+        let what = format!("{} program", controller.key());
+        files.push((path, controller.render(&made), what));
+    }
+    let bytes: Vec<(&Path, &[u8])> = files.iter().map(|(p, t, _)| (*p, t.as_bytes())).collect();
+    super::write_outputs(&bytes, format::Folders::Existing)?;
+    if !quiet {
+        for (path, _, what) in &files {
+            sayln!("wrote {} ({what})", path.display());
         }
     }
     Ok(())
@@ -402,6 +472,51 @@ mod tests {
                 max: -10.0
             }
         );
+    }
+
+    /// Issue 23: a long plan printed nothing for minutes.
+    #[test]
+    fn a_long_plan_reports_progress_every_few_seconds() {
+        let t0 = Instant::now();
+        let mut ticker = Ticker::new(t0);
+        let stage = PlanStage::Candidates { done: 40, of: 200 };
+        assert_eq!(ticker.tick(&stage, t0 + Duration::from_millis(500)), None);
+        let line = ticker.tick(&stage, t0 + Duration::from_secs(3)).unwrap();
+        assert!(
+            line.contains("40 of 200 stations") && line.contains("(3 s)"),
+            "{line}"
+        );
+        assert_eq!(
+            ticker.tick(&PlanStage::Analysis, t0 + Duration::from_secs(4)),
+            None
+        );
+        let line = ticker
+            .tick(&PlanStage::Analysis, t0 + Duration::from_secs(6))
+            .unwrap();
+        assert!(line.contains("identifiability"), "{line}");
+        let line = ticker.runs(3, 8, t0 + Duration::from_secs(9)).unwrap();
+        assert!(line.contains("3 of 8"), "{line}");
+    }
+
+    /// Issue 23: `--identify-stations 100000` ran for minutes; it is
+    /// refused at once, naming the limit.
+    #[test]
+    fn oversized_plans_are_refused_naming_the_limit() {
+        for (flags, needle) in [
+            (vec!["--identify-stations", "100000"], "at most 500"),
+            (vec!["--candidates", "1000000"], "at most 1000"),
+            (
+                vec!["--identify-stations", "300", "--candidates", "100"],
+                "at most 12000",
+            ),
+            (vec!["--identify-poses", "1000"], "at most 100"),
+        ] {
+            let mut argv = vec!["--sphere", "1050,0,475"];
+            argv.extend(flags.iter().copied());
+            let c = config(&parse(&argv)).unwrap();
+            let e = c.validate().unwrap_err().to_string();
+            assert!(e.contains(needle), "{flags:?}: {e}");
+        }
     }
 
     #[test]

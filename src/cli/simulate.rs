@@ -211,27 +211,20 @@ impl SimulateArgs {
     }
 }
 
-/// Writes the import inputs of `session` into `dir` (created if needed),
-/// each file atomically.
-fn write_import_files(session: &Session, dir: &Path) -> Result<(), CliError> {
+/// The import inputs of `session` as files under `dir`: `joints.csv`,
+/// `profiles/<id>.csv` and `references.csv` (when there are reference
+/// distances).
+fn import_files(session: &Session, dir: &Path) -> Result<Vec<(PathBuf, String)>, CliError> {
     let files = simulate::import_files(session).map_err(|e| CliError::input(e.to_string()))?;
     let profiles = dir.join("profiles");
-    std::fs::create_dir_all(&profiles)
-        .map_err(|e| CliError::input(format!("creating {} failed: {e}", profiles.display())))?;
-    write(&dir.join("joints.csv"), &files.joints_csv)?;
-    for (id, text) in &files.profiles {
-        write(&profiles.join(format!("{id}.csv")), text)?;
+    let mut out = vec![(dir.join("joints.csv"), files.joints_csv)];
+    for (id, text) in files.profiles {
+        out.push((profiles.join(format!("{id}.csv")), text));
     }
-    if let Some(text) = &files.references_csv {
-        write(&dir.join("references.csv"), text)?;
+    if let Some(text) = files.references_csv {
+        out.push((dir.join("references.csv"), text));
     }
-    Ok(())
-}
-
-/// Writes `text` to `path` atomically; a failure is reported with exit
-/// status 2, as every failure of `simulate`.
-fn write(path: &Path, text: &str) -> Result<(), CliError> {
-    format::write_atomic(path, text.as_bytes()).map_err(|e| CliError::input(e.to_string()))
+    Ok(out)
 }
 
 fn default_truth_path(out: &Path) -> PathBuf {
@@ -243,9 +236,10 @@ fn default_truth_path(out: &Path) -> PathBuf {
     out.with_file_name(format!("{stem}.truth.json"))
 }
 
-/// Runs `spherecal simulate`: simulates, writes the truth and then the
-/// session (each atomically: a temporary file renamed into place), and
-/// prints one summary line.
+/// Runs `spherecal simulate`: checks the options and every output, then
+/// simulates and writes the session, the truth and the `--csv-out` files
+/// as one transaction (all of them or none, each through a temporary file
+/// renamed into place), and prints one summary line.
 ///
 /// # Errors
 /// A setting out of range or an unreachable station (the engine's
@@ -268,7 +262,23 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         .collect();
     CliError::guard_output(&args.out, &inputs)?;
     CliError::guard_output(&truth_path, &inputs)?;
+    let mut outputs: Vec<&Path> = vec![&args.out, &truth_path];
+    let csv_targets: Vec<PathBuf> = args
+        .csv_out
+        .iter()
+        .flat_map(|d| [d.join("joints.csv"), d.join("references.csv")])
+        .collect();
+    outputs.extend(csv_targets.iter().map(PathBuf::as_path));
+    let folders = if args.csv_out.is_some() {
+        format::Folders::Create
+    } else {
+        format::Folders::Existing
+    };
+    super::check_outputs(&outputs, folders)?;
     let config = args.to_config();
+    config
+        .validate()
+        .map_err(|e| CliError::input(e.to_string()))?;
     let (mut session, truth) = match &args.plan {
         None => simulate::simulate(&config).map_err(|e| CliError::input(e.to_string()))?,
         Some(path) => {
@@ -298,11 +308,26 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         // for every path.
         session.sensor_range = args.range;
     }
+    // Whatever the options, never write a session spherecal's own loader
+    // refuses.
+    session.validate().map_err(|e| {
+        CliError::input(format!(
+            "the simulated session would not load, nothing is written: {e} ({})",
+            args.out.display()
+        ))
+    })?;
+    let mut files = vec![
+        (args.out.clone(), format::session_to_json(&session)),
+        (truth_path.clone(), simulate::truth_to_json(&truth)),
+    ];
     if let Some(dir) = &args.csv_out {
-        write_import_files(&session, dir)?;
+        files.extend(import_files(&session, dir)?);
     }
-    write(&truth_path, &simulate::truth_to_json(&truth))?;
-    write(&args.out, &format::session_to_json(&session))?;
+    let files: Vec<(&Path, &[u8])> = files
+        .iter()
+        .map(|(p, t)| (p.as_path(), t.as_bytes()))
+        .collect();
+    super::write_outputs(&files, folders)?;
     let count = |usage: Use| session.with_use(usage).count();
     sayln!(
         "simulated {} (seed {}): {} measurements ({} translation, {} rotation, {} identify, {} validate), {} reference distances -> {}, truth {} ({:.0} ms)",

@@ -8,6 +8,82 @@
 //! has one, else a tab when it has one and no comma, else `,`; fields are
 //! trimmed. Column names match case-insensitively.
 
+/// Longest piece of an input (a cell, a name, a line) echoed in a
+/// message, characters: enough to recognise it, bounded whatever the file
+/// holds (a line of a gigabyte).
+pub const MAX_ECHO_CHARS: usize = 80;
+
+/// Longest line of a CSV table, bytes (1 MiB): a row of a joint log,
+/// profile, DH table or plan is at most a few hundred bytes. Longer lines
+/// are refused before they are parsed, so a file of one huge line costs
+/// no more than its text.
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// Largest text table read (joint logs, profiles, profile tables,
+/// reference distances, station lists), bytes (512 MiB): a calibration's
+/// joint log is a few kB, a table of every profile of a thousand poses a
+/// hundred MB. A larger file is refused before it is read, so a hostile
+/// file of gigabytes costs nothing.
+pub const MAX_TEXT_BYTES: u64 = 512 << 20;
+
+/// The text of a table file, refused unread beyond [`MAX_TEXT_BYTES`].
+///
+/// # Errors
+/// The file cannot be read, is not UTF-8, or is too large
+/// ([`std::io::ErrorKind::InvalidData`], saying so).
+pub fn read_text_file(path: &std::path::Path) -> std::io::Result<String> {
+    let size = std::fs::metadata(path)?.len();
+    if size > MAX_TEXT_BYTES {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "the file has {size} bytes, more than the {} MiB a table may have",
+                MAX_TEXT_BYTES >> 20
+            ),
+        ));
+    }
+    std::fs::read_to_string(path)
+}
+
+/// `text` cut to at most `max` characters for a message: the start, then
+/// `…` and how many characters were left out.
+#[must_use]
+pub fn clip(text: &str, max: usize) -> String {
+    match text.char_indices().nth(max) {
+        None => text.to_owned(),
+        Some((cut, _)) => format!(
+            "{}… ({} more characters)",
+            &text[..cut],
+            text[cut..].chars().count()
+        ),
+    }
+}
+
+/// A piece of an input for a message, cut to [`MAX_ECHO_CHARS`].
+#[must_use]
+pub fn excerpt(text: &str) -> String {
+    clip(text, MAX_ECHO_CHARS)
+}
+
+/// The first line of `text` longer than [`MAX_LINE_BYTES`]: its 1-based
+/// number and length in bytes. One linear pass.
+#[must_use]
+pub fn overlong_line(text: &str) -> Option<(usize, usize)> {
+    (1..)
+        .zip(text.as_bytes().split(|&b| b == b'\n'))
+        .find(|(_, chunk)| chunk.len() > MAX_LINE_BYTES)
+        .map(|(line, chunk)| (line, chunk.len()))
+}
+
+/// The error of a line beyond [`MAX_LINE_BYTES`] (see [`overlong_line`]).
+#[must_use]
+pub fn overlong_line_message(length: usize) -> String {
+    format!(
+        "the line has {length} bytes, more than the {} MiB a row may have: not a table of this kind",
+        MAX_LINE_BYTES >> 20
+    )
+}
+
 /// A CSV table as read: header and data rows with their 1-based line
 /// numbers.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -137,13 +213,21 @@ impl Table {
     /// whatever the size of the file (a profile of millions of points).
     ///
     /// # Errors
-    /// A malformed quoted field, or a data row whose field count differs
-    /// from the header's; or the first error `each` returns. No header row
+    /// A line longer than [`MAX_LINE_BYTES`], a malformed quoted field, or
+    /// a data row whose field count differs from the header's; or the
+    /// first error `each` returns. No header row
     /// is not an error here (`each` is then never called).
     pub fn scan<E: From<TableError>>(
         text: &str,
         mut each: impl FnMut(usize, &csv::StringRecord) -> Result<(), E>,
     ) -> Result<(), E> {
+        if let Some((line, length)) = overlong_line(text) {
+            return Err(TableError {
+                line,
+                message: overlong_line_message(length),
+            }
+            .into());
+        }
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(false)
             .flexible(true)

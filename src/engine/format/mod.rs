@@ -11,7 +11,10 @@ pub mod result;
 pub mod session;
 pub mod transform;
 
-pub use atomic::{refuse_inputs, remove_pending, same_file, write_atomic};
+pub use atomic::{
+    Folders, check_outputs, interrupted, refuse_inputs, remove_pending, same_file,
+    write_all_atomic, write_atomic,
+};
 pub use result::{
     ResultFile, load_result, parse_result, result_text_checked, result_to_json, save_result,
 };

@@ -13,8 +13,9 @@ use nalgebra::Isometry3;
 use super::json::{Ctx, UniqueValue, join, read_text, render, render_lossy, settle, some};
 use super::{FORMAT_VERSION, FileError, RESULT_FORMAT, write_atomic};
 use crate::engine::geometry::{isometry_from_rows, rigid_from_rows, rows_from_isometry};
+use crate::engine::numeric::show;
 use crate::engine::robot::{Joint, Robot};
-use crate::engine::session::{Session, Use};
+use crate::engine::session::{Session, Use, limits};
 use crate::engine::solve::Calibration;
 use crate::engine::solve::ml::MlReport;
 use crate::engine::solve::report::{Direction, PaperReport, SolverReport};
@@ -372,7 +373,11 @@ pub fn parse_result(text: &str, path: &Path) -> Result<ResultFile, FileError> {
     ctx.result_objects(&tree.0)?;
     let keys: ResultKeys = ctx.parse(top, "", None)?;
     ctx.check_result(&keys)?;
-    Ok(keys.into_result())
+    let result = keys.into_result();
+    if let Some(message) = implausible_number(&result) {
+        return Err(ctx.invalid(None, message));
+    }
+    Ok(result)
 }
 
 /// Reads and checks a result file (see [`parse_result`]).
@@ -406,6 +411,15 @@ pub fn save_result(result: &ResultFile, path: &Path) -> Result<(), FileError> {
 /// [`FileError::Invalid`] naming the first non-finite number by its key
 /// path; nothing is written.
 pub fn result_text_checked(result: &ResultFile, path: &Path) -> Result<String, FileError> {
+    if let Some(message) = implausible_number(result) {
+        return Err(FileError::Invalid {
+            path: path.to_path_buf(),
+            measurement: None,
+            message: format!(
+                "the result is not written: {message} (the calibration diverged or an input is out of range)"
+            ),
+        });
+    }
     let out = ResultOut::new(result);
     let text = render(&out, path)?;
     if has_bare_null(&text)
@@ -421,6 +435,127 @@ pub fn result_text_checked(result: &ResultFile, path: &Path) -> Result<String, F
         });
     }
     Ok(text)
+}
+
+/// The first finite number of `r` beyond the session file's plausibility
+/// limits ([`limits`]), as its key path, value and limit: a hand-eye of
+/// 1e308 mm or a length of 1e300 mm is not a calibration, and would flow
+/// into every report, export and history table. Checked on reading and
+/// before writing, so that every result spherecal writes loads.
+/// (Numbers that are not finite are [`result_text_checked`]'s.)
+#[must_use]
+pub fn implausible_number(r: &ResultFile) -> Option<String> {
+    let mut f = Finder(None);
+    for (key, t) in [
+        ("hand_eye_initial", &r.hand_eye_initial),
+        ("hand_eye", &r.hand_eye),
+    ] {
+        f.transform(key, t);
+    }
+    if let Some(robot) = &r.robot {
+        f.joints("robot.joints", &robot.joints);
+        f.transform("robot.base", &robot.base);
+        f.transform("robot.flange", &robot.flange);
+    }
+    f.joints("joint_errors", &r.joint_errors);
+    for (i, it) in r.iterations.iter().enumerate() {
+        f.check(
+            || format!("iterations[{i}].epsilon"),
+            it.epsilon,
+            limits::DISTANCE_MM,
+            "mm",
+        );
+    }
+    for (i, c) in r.centres.iter().enumerate() {
+        for k in 0..3 {
+            let limit = limits::SENSOR_COORDINATE_MM;
+            f.check(
+                || format!("centres[{i}].sensor[{k}]"),
+                c.sensor[k],
+                limit,
+                "mm",
+            );
+            let limit = limits::LENGTH_MM;
+            f.check(
+                || format!("centres[{i}].before[{k}]"),
+                c.before[k],
+                limit,
+                "mm",
+            );
+            f.check(
+                || format!("centres[{i}].after[{k}]"),
+                c.after[k],
+                limit,
+                "mm",
+            );
+        }
+    }
+    if let Some(v) = &r.validation {
+        let limit = limits::DISTANCE_MM;
+        for (i, d) in v.distances.iter().enumerate() {
+            for (name, x) in [
+                ("reference", d.reference),
+                ("before", d.before),
+                ("after", d.after),
+            ] {
+                f.check(
+                    || format!("validation.distances[{i}].{name}"),
+                    x,
+                    limit,
+                    "mm",
+                );
+            }
+        }
+        for (key, st) in [
+            ("validation.before", &v.before),
+            ("validation.after", &v.after),
+            ("validation.within_station.before", &v.within_station.before),
+            ("validation.within_station.after", &v.within_station.after),
+        ] {
+            for (name, x) in [("max", st.max), ("std", st.std), ("rms", st.rms)] {
+                f.check(|| format!("{key}.{name}"), x, limit, "mm");
+            }
+        }
+    }
+    f.0
+}
+
+/// The first implausible number found ([`implausible_number`]).
+struct Finder(Option<String>);
+
+impl Finder {
+    /// Notes `v` under `key` when it is finite and beyond `limit`.
+    fn check(&mut self, key: impl FnOnce() -> String, v: f64, limit: f64, unit: &str) {
+        if self.0.is_none() && v.is_finite() && v.abs() > limit {
+            self.0 = Some(format!(
+                "`{}` = {} {unit} is not plausible (at most {limit} {unit})",
+                key(),
+                show(v)
+            ));
+        }
+    }
+
+    /// The translation of a 4×4 matrix written under `key`.
+    fn transform(&mut self, key: &str, t: &Isometry3<f64>) {
+        for (k, v) in t.translation.vector.iter().enumerate() {
+            self.check(|| format!("{key}[{k}][3]"), *v, limits::LENGTH_MM, "mm");
+        }
+    }
+
+    /// MDH joints (or their errors) under `key`.
+    fn joints(&mut self, key: &str, joints: &[Joint]) {
+        for (i, j) in joints.iter().enumerate() {
+            for (name, v, limit, unit) in [
+                ("alpha", j.alpha, limits::ANGLE_DEG, "deg"),
+                ("a", j.a, limits::LENGTH_MM, "mm"),
+                ("beta", j.beta, limits::ANGLE_DEG, "deg"),
+                ("theta", j.theta, limits::ANGLE_DEG, "deg"),
+                ("d", j.d, limits::LENGTH_MM, "mm"),
+            ] {
+                self.check(|| format!("{key}[{i}].{name}"), v, limit, unit);
+            }
+        }
+    }
 }
 
 /// Whether JSON `text` has a `null` outside its strings.

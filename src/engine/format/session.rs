@@ -541,6 +541,7 @@ impl<'a> Ctx<'a> {
     ) -> Result<Vec<ReferenceDistance>, FileError> {
         let items: Vec<&'a RawValue> = self.parse(raw, "reference_distances", None)?;
         let mut out = Vec::with_capacity(items.len());
+        let mut pairs = rules::ReferencePairs::default();
         for (i, item) in items.into_iter().enumerate() {
             let key = format!("reference_distances[{i}]");
             let keys: ReferenceKeys = self.object(item, &key, None)?;
@@ -560,6 +561,9 @@ impl<'a> Ctx<'a> {
                 };
                 self.rule(None, message, at)
             })?;
+            pairs
+                .check(&key, i, &r)
+                .map_err(|message| self.rule(None, message, d_raw))?;
             out.push(r);
         }
         Ok(out)

@@ -2,11 +2,10 @@
 //! byte-order mark, line numbers) with its path, so that every message
 //! names the file and the line.
 
-use std::fs;
 use std::path::{Path, PathBuf};
 
 use super::ImportError;
-use crate::engine::table::{Table, TableError};
+use crate::engine::table::{Table, TableError, excerpt, read_text_file};
 
 /// A parsed CSV file: header and data rows with their 1-based lines.
 pub(super) struct CsvFile {
@@ -21,7 +20,7 @@ pub(super) struct CsvFile {
 impl CsvFile {
     /// Reads and parses `path`.
     pub fn read(path: &Path) -> Result<Self, ImportError> {
-        let text = fs::read_to_string(path).map_err(|source| ImportError::Io {
+        let text = read_text_file(path).map_err(|source| ImportError::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -102,8 +101,9 @@ impl CsvFile {
         self.optional_column(name).ok_or_else(|| ImportError::File {
             path: self.path.clone(),
             message: format!(
-                "no column `{name}` (the header has: {})",
-                self.header.join(", ")
+                "no column `{}` (the header has: {})",
+                excerpt(name),
+                excerpt(&self.header.join(", "))
             ),
         })
     }
@@ -124,8 +124,9 @@ impl CsvFile {
                 path: self.path.clone(),
                 line,
                 message: format!(
-                    "column `{}`: `{s}` is not a finite number",
-                    self.header[col]
+                    "column `{}`: `{}` is not a finite number",
+                    excerpt(&self.header[col]),
+                    excerpt(s)
                 ),
             }),
         }

@@ -65,6 +65,7 @@ pub(super) fn log_columns(
         }
         None => Vec::new(),
     };
+    check_extra_joints(spec, log, dof)?;
     Ok(LogColumns {
         id: log.column(&spec.columns.id)?,
         station: log.column(&spec.columns.station)?,
@@ -83,6 +84,46 @@ pub(super) fn log_columns(
             .map(|c| log.column(c))
             .collect::<Result<_, _>>()?,
         flange,
+    })
+}
+
+/// Refuses a log with a joint column beyond the robot's joints (`j7` for
+/// a 6-joint robot, `j2` for a 1-joint URDF chain) that no mapping uses:
+/// reading only the robot's joints would drop the others silently, and a
+/// log with more joints than the model is a wrong model (a URDF tip too
+/// near the base) or a wrong log.
+fn check_extra_joints(spec: &ImportSpec, log: &CsvFile, dof: usize) -> Result<(), ImportError> {
+    let mapped = |h: &str| {
+        let c = &spec.columns;
+        [&c.id, &c.station, &c.usage]
+            .into_iter()
+            .chain(c.side.as_ref())
+            .chain(&c.joints)
+            .any(|m| m.eq_ignore_ascii_case(h))
+    };
+    let extra: Vec<&String> = log
+        .header
+        .iter()
+        .filter(|h| {
+            let n = h
+                .strip_prefix(['j', 'J'])
+                .and_then(|k| k.parse::<usize>().ok());
+            n.is_some_and(|n| n > dof) && !mapped(h)
+        })
+        .collect();
+    if extra.is_empty() {
+        return Ok(());
+    }
+    Err(ImportError::File {
+        path: log.path.clone(),
+        message: format!(
+            "the joint log has the joint column(s) {} but the robot has {dof} joint(s): its readings would be dropped; check the robot model (a URDF's tip link, a DH table's rows) or map the columns with --map",
+            extra
+                .iter()
+                .map(|h| format!("`{}`", crate::engine::table::excerpt(h)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
     })
 }
 
@@ -152,6 +193,9 @@ pub(super) fn side_cell(cell: &str) -> Result<Option<i8>, String> {
         "" => Ok(None),
         "1" | "+1" | "1.0" | "+1.0" => Ok(Some(1)),
         "-1" | "-1.0" => Ok(Some(-1)),
-        other => Err(format!("side `{other}` is not +1, -1 or blank")),
+        other => Err(format!(
+            "side `{}` is not +1, -1 or blank",
+            crate::engine::table::excerpt(other)
+        )),
     }
 }

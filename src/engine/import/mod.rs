@@ -275,9 +275,20 @@ pub(crate) fn planar(
     let (axes, axes_guessed) = match format.axes {
         Some(m) => (m, false),
         None => {
-            let m = AxisMap::guess(&raws).map_err(|message| ImportError::File {
-                path: raws.first().map_or_else(PathBuf::new, |r| r.source.clone()),
-                message,
+            let m = AxisMap::guess(&raws).map_err(|message| {
+                // Name the profile that breaks the plane the others share.
+                match AxisMap::odd_profile(&raws) {
+                    Some(k) => ImportError::File {
+                        path: raws[k].source.clone(),
+                        message: format!(
+                            "this profile is not in the plane the other profiles lie in: {message}"
+                        ),
+                    },
+                    None => ImportError::File {
+                        path: raws.first().map_or_else(PathBuf::new, |r| r.source.clone()),
+                        message,
+                    },
+                }
             })?;
             (m, true)
         }

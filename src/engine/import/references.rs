@@ -13,7 +13,9 @@ use crate::engine::session::ReferenceDistance;
 ///
 /// # Errors
 /// Unreadable file, missing column, a distance that is not a positive
-/// finite number, an empty station id or no rows at all.
+/// finite number, an empty station id, a pair of stations given twice
+/// (either way round: two distances for one pair contradict, or count it
+/// twice) or no rows at all.
 pub fn read_references(path: &Path) -> Result<Vec<ReferenceDistance>, ImportError> {
     Ok(reference_rows(path)?.into_iter().map(|(_, r)| r).collect())
 }
@@ -28,6 +30,9 @@ pub fn reference_rows(path: &Path) -> Result<Vec<(usize, ReferenceDistance)>, Im
     let to = csv.column("to")?;
     let distance = csv.column("distance")?;
     let mut out = Vec::with_capacity(csv.rows.len());
+    // Each pair of stations (in name order) with its first line and distance.
+    let mut seen: std::collections::HashMap<(String, String), (usize, f64)> =
+        std::collections::HashMap::new();
     for (line, row) in &csv.rows {
         let d = csv.number(*line, row, distance)?;
         let fail = |message: String| ImportError::Csv {
@@ -36,14 +41,42 @@ pub fn reference_rows(path: &Path) -> Result<Vec<(usize, ReferenceDistance)>, Im
             message,
         };
         if d <= 0.0 {
-            return Err(fail(format!("distance {d} mm is not positive")));
+            return Err(fail(format!(
+                "distance {} mm is not positive",
+                crate::engine::numeric::show(d)
+            )));
         }
         if row[from].is_empty() || row[to].is_empty() {
             return Err(fail("empty station id".into()));
         }
         if row[from] == row[to] {
-            return Err(fail(format!("from and to are both `{}`", row[from])));
+            return Err(fail(format!(
+                "from and to are both `{}`",
+                crate::engine::table::excerpt(&row[from])
+            )));
         }
+        let key = if row[from] < row[to] {
+            (row[from].clone(), row[to].clone())
+        } else {
+            (row[to].clone(), row[from].clone())
+        };
+        if let Some(&(first, earlier)) = seen.get(&key) {
+            let verdict = if earlier == d {
+                "the same distance twice would count its pairs twice".to_owned()
+            } else {
+                format!(
+                    "{} mm there against {} mm here: they contradict each other",
+                    crate::engine::numeric::show(earlier),
+                    crate::engine::numeric::show(d)
+                )
+            };
+            return Err(fail(format!(
+                "the pair {} – {} is given a second time (first on line {first}): {verdict}; keep one",
+                crate::engine::table::excerpt(&row[from]),
+                crate::engine::table::excerpt(&row[to])
+            )));
+        }
+        seen.insert(key, (*line, d));
         out.push((
             *line,
             ReferenceDistance {

@@ -143,9 +143,18 @@ pub fn check_joint_unit<'a>(
     ))
 }
 
-/// A warning when every joint reading of a log read in degrees lies
-/// within ±2π: a calibration moves its joints by tens of degrees, so the
-/// log is probably in radians.
+/// Share of a log's readings within ±2π at or above which a log read in
+/// degrees is taken for radians. A log in radians has all its readings
+/// there but for the odd wrist joint beyond a turn (5 of 744 in a real
+/// case); a calibration in degrees moves its joints by tens of degrees, so
+/// nearly all of its readings lie beyond ±6.3°.
+const RADIAN_LIKE_SHARE: f64 = 0.95;
+
+/// A warning when the joint readings of a log read in degrees look like
+/// radians: at least [`RADIAN_LIKE_SHARE`] of them within ±2π and none
+/// beyond two turns in radians (±4π, [`MAX_PLAUSIBLE_JOINT_DEG`] read as
+/// radians). A calibration moves its joints by tens of degrees, so the log
+/// is probably in radians.
 #[must_use]
 pub fn joint_unit_warning(
     unit: AngleUnit,
@@ -154,14 +163,28 @@ pub fn joint_unit_warning(
     if unit != AngleUnit::Deg {
         return None;
     }
-    let (mut count, mut largest) = (0usize, 0.0f64);
+    let tau = std::f64::consts::TAU;
+    let (mut count, mut within, mut largest) = (0usize, 0usize, 0.0f64);
     for v in readings {
         count += 1;
+        if v.abs() <= tau {
+            within += 1;
+        }
         largest = largest.max(v.abs());
     }
-    (count >= 6 && largest <= std::f64::consts::TAU).then(|| {
+    #[allow(clippy::cast_precision_loss, reason = "counts far below 2^52")]
+    let share = within as f64 / count.max(1) as f64;
+    let radian_like =
+        count >= 6 && share >= RADIAN_LIKE_SHARE && largest <= MAX_PLAUSIBLE_JOINT_DEG.to_radians();
+    radian_like.then(|| {
+        let which = if within == count {
+            "every joint reading lies".to_owned()
+        } else {
+            format!("{within} of {count} joint readings lie")
+        };
         format!(
-            "warning: every joint reading lies within ±{}°; if the log is in radians, import again with --joint-unit rad",
+            "warning: {which} within ±{}° (largest {}°); if the log is in radians, import again with --joint-unit rad",
+            crate::engine::numeric::approx(tau),
             crate::engine::numeric::approx(largest)
         )
     })
@@ -218,4 +241,34 @@ pub fn check_profile_unit(
         show(diameter_mm),
         unit.symbol()
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 23: a log in radians with 5 of 744 readings beyond 2π (a
+    /// wrist past a turn) was read as degrees without a word.
+    #[test]
+    fn a_radian_log_with_a_few_readings_past_a_turn_is_warned() {
+        let mut readings: Vec<f64> = (0..744)
+            .map(|k| 2.5 * (f64::from(k) * 0.37).sin())
+            .collect();
+        for v in readings.iter_mut().take(5) {
+            *v = 6.9;
+        }
+        let w = joint_unit_warning(AngleUnit::Deg, readings.iter().copied()).unwrap();
+        assert!(
+            w.contains("739 of 744") && w.contains("--joint-unit rad"),
+            "{w}"
+        );
+        // Read as radians: nothing to say.
+        assert!(joint_unit_warning(AngleUnit::Rad, readings.iter().copied()).is_none());
+        // A log in degrees moves its joints by tens of degrees.
+        let degrees: Vec<f64> = readings.iter().map(|v| v.to_degrees()).collect();
+        assert!(joint_unit_warning(AngleUnit::Deg, degrees).is_none());
+        // Beyond two turns in radians it is not a radian log either.
+        readings[6] = 20.0;
+        assert!(joint_unit_warning(AngleUnit::Deg, readings).is_none());
+    }
 }

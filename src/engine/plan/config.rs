@@ -6,12 +6,33 @@ use nalgebra::{Isometry3, Vector3};
 
 use crate::engine::cell::sensor;
 use crate::engine::cell::workspace::{self, Workspace};
+use crate::engine::numeric::show;
 use crate::engine::robot::ik::DOF;
 use crate::engine::robot::{JointLimit, Preset, Robot, RobotChoice};
-use crate::engine::session::SensorRange;
+use crate::engine::session::{SensorRange, limits};
 use crate::engine::simulate::SimConfig;
 
 use super::*;
+
+/// Most stations of a plan (identify and validate together). The paper
+/// uses 9 identify and 10 validate stations; a cell's plan rarely needs
+/// more than a few dozen. Planning time grows with the stations (about
+/// 20 ms each in a debug build, a few in release), so 500 stay well
+/// within a minute; beyond, the request is a typo.
+pub const MAX_STATIONS: usize = 500;
+
+/// Most candidate orientations drawn per station (default 24).
+pub const MAX_CANDIDATES: usize = 1000;
+
+/// Most candidate orientations of a whole plan (stations × candidates):
+/// 500 stations at the default 24. The identifiability analysis and the
+/// selection work on every candidate pose (up to 16 a orientation), so
+/// this bounds the plan's time and memory.
+pub const MAX_ORIENTATIONS: usize = 12_000;
+
+/// Most poses of one group (translations, rotations, or the poses of one
+/// identify or validate station): ten times the paper's.
+pub const MAX_GROUP_POSES: usize = 100;
 
 /// Default cut angle, deg: the paper's "about ±40°" (section 4.1), where
 /// its distance errors were smallest.
@@ -294,6 +315,37 @@ impl PlanConfig {
                 self.diameter
             )
         })?;
+        // The session file's plausibility limits: a plan's numbers end up
+        // in sessions and messages.
+        check(self.diameter <= limits::SPHERE_DIAMETER_MM, || {
+            format!(
+                "the sphere diameter {} mm is not plausible (at most {} mm)",
+                show(self.diameter),
+                limits::SPHERE_DIAMETER_MM
+            )
+        })?;
+        let far = |v: &[f64]| v.iter().any(|x| x.abs() > limits::LENGTH_MM);
+        check(!far(&self.sphere), || {
+            format!(
+                "the sphere position [{}, {}, {}] mm is not plausible (at most {} mm from the base)",
+                show(self.sphere[0]),
+                show(self.sphere[1]),
+                show(self.sphere[2]),
+                limits::LENGTH_MM
+            )
+        })?;
+        let box_far = match &self.stations {
+            StationLayout::Box { size } => far(size),
+            StationLayout::Explicit { identify, validate } => {
+                identify.iter().chain(validate).any(|p| far(p))
+            }
+        };
+        check(!box_far && !far(&[self.translation_step]), || {
+            format!(
+                "station positions, the station box and the translation step must stay within {} mm",
+                limits::LENGTH_MM
+            )
+        })?;
         check(self.cut_angle > 5.0 && self.cut_angle < 80.0, || {
             format!(
                 "the cut angle must be within (5, 80) deg, found {}",
@@ -330,6 +382,40 @@ impl PlanConfig {
         check(self.candidates >= 1, || {
             "at least one candidate orientation per station is needed".to_owned()
         })?;
+        let stations = self.n_identify_stations() + self.n_validate_stations();
+        check(stations <= MAX_STATIONS, || {
+            format!(
+                "{stations} stations asked for ({} identify, {} validate): a plan has at most {MAX_STATIONS}",
+                self.n_identify_stations(),
+                self.n_validate_stations()
+            )
+        })?;
+        check(self.candidates <= MAX_CANDIDATES, || {
+            format!(
+                "{} candidate orientations per station asked for: at most {MAX_CANDIDATES}",
+                self.candidates
+            )
+        })?;
+        check(
+            stations.saturating_mul(self.candidates) <= MAX_ORIENTATIONS,
+            || {
+                format!(
+                    "{stations} stations × {} candidates = {} orientations to solve: a plan has at most {MAX_ORIENTATIONS}; ask for fewer stations or candidates",
+                    self.candidates,
+                    stations.saturating_mul(self.candidates)
+                )
+            },
+        )?;
+        for (name, n) in [
+            ("translation poses", self.n_translation),
+            ("rotation poses", self.n_rotation),
+            ("identify poses per station", self.identify_poses),
+            ("validate poses per station", self.validate_poses),
+        ] {
+            check(n <= MAX_GROUP_POSES, || {
+                format!("{n} {name} asked for: at most {MAX_GROUP_POSES}")
+            })?;
+        }
         check(self.n_rotation != 1, || {
             "the rotation group needs at least 2 poses (eq. 8 uses pairs), or none".to_owned()
         })?;

@@ -108,7 +108,8 @@ use candidates::*;
 pub use config::{
     DEFAULT_BOX_MM, DEFAULT_CANDIDATES, DEFAULT_CENTRE_SPREAD_MM, DEFAULT_CONE_DEG,
     DEFAULT_CUT_ANGLE_DEG, DEFAULT_MIN_WRIST_DEG, DEFAULT_ROTATION_MAX_DEG,
-    DEFAULT_ROTATION_MIN_DEG, DEFAULT_TRANSLATION_STEP_MM, PlanConfig, Selection, StationLayout,
+    DEFAULT_ROTATION_MIN_DEG, DEFAULT_TRANSLATION_STEP_MM, MAX_CANDIDATES, MAX_GROUP_POSES,
+    MAX_ORIENTATIONS, MAX_STATIONS, PlanConfig, Selection, StationLayout,
 };
 pub use export::{Controller, RAPID_MODULE, plan_csv, rapid_module, read_plan_csv, ur_script};
 use order::{Metric, order_groups};

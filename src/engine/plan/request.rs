@@ -255,7 +255,7 @@ pub fn read_stations(path: &Path) -> Result<StationLayout, RequestError> {
         message: format!("line {line}: {m}"),
         path: path.to_path_buf(),
     };
-    let text = std::fs::read_to_string(path).map_err(|e| RequestError::File {
+    let text = crate::engine::table::read_text_file(path).map_err(|e| RequestError::File {
         what: "stations",
         message: format!("reading failed: {e}"),
         path: path.to_path_buf(),
@@ -273,7 +273,15 @@ pub fn read_stations(path: &Path) -> Result<StationLayout, RequestError> {
             f[c].parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| fail(*line, format!("`{}` is not a finite number", f[c])))
+                .ok_or_else(|| {
+                    fail(
+                        *line,
+                        format!(
+                            "`{}` is not a finite number",
+                            crate::engine::table::excerpt(&f[c])
+                        ),
+                    )
+                })
         };
         let p = [num(x)?, num(y)?, num(z)?];
         match f[u].as_str() {
@@ -282,7 +290,10 @@ pub fn read_stations(path: &Path) -> Result<StationLayout, RequestError> {
             other => {
                 return Err(fail(
                     *line,
-                    format!("use `{other}` is not identify or validate"),
+                    format!(
+                        "use `{}` is not identify or validate",
+                        crate::engine::table::excerpt(other)
+                    ),
                 ));
             }
         }

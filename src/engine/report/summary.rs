@@ -3,11 +3,10 @@
 use std::fmt::Write as _;
 
 use crate::engine::result_view::{HAND_EYE_ONLY, HandEyeStrength, flange_poses};
-use nalgebra::Vector3;
 
-use crate::engine::session::{Session, Use};
+use crate::engine::session::Session;
 use crate::engine::solve::Calibration;
-use crate::engine::validate::scatter_rms;
+use crate::engine::solve::plausible::identify_scatter;
 
 /// A few lines for people: why the loop stopped, what the SVD kept, how
 /// the hand-eye moved, and the before/after validation figures.
@@ -118,25 +117,4 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
         }
     }
     s
-}
-
-/// The 3-D rms scatter of the identify centres about their station means,
-/// before and after ([`scatter_rms`]).
-fn identify_scatter(session: &Session, cal: &Calibration) -> (f64, f64) {
-    let stations = session.stations(Use::Identify);
-    // Measurement index → its centre: linear in the measurements.
-    let by_index: std::collections::HashMap<usize, &_> =
-        cal.centres.iter().map(|c| (c.index, c)).collect();
-    let group = |after: bool| -> Vec<Vec<Vector3<f64>>> {
-        stations
-            .iter()
-            .map(|(_, idx)| {
-                idx.iter()
-                    .filter_map(|&i| by_index.get(&i).copied())
-                    .map(|c| if after { c.after } else { c.before })
-                    .collect()
-            })
-            .collect()
-    };
-    (scatter_rms(&group(false)), scatter_rms(&group(true)))
 }

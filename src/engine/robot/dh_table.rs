@@ -18,8 +18,18 @@
 //!   0 when absent). Lengths are **mm** and angles **degrees**; a unit
 //!   suffix overrides this per column: `a_m`/`d_m` (metres), `a_mm`/`d_mm`,
 //!   `alpha_rad`/`theta_rad`/`beta_rad` (radians), `alpha_deg` etc. A
-//!   `joint`, `name` or `link` column is a label and is ignored; any other
-//!   column is an error.
+//!   `joint`, `name` or `link` column is a label; any other column is an
+//!   error.
+//! - Rows are joints base to flange in file order. When a label column
+//!   numbers them (`1`, `J2`, `joint_3`, …), the numbers must run up by
+//!   one from the first row, so that a table sorted otherwise is an error
+//!   rather than another robot.
+//! - Angles without a unit suffix are degrees; a table whose angles all lie
+//!   within ±2π while an `alpha` is π/2 or π to 0.01 (1.5708, 3.1416: a
+//!   table in radians) is an error that names the suffix to use.
+//! - Every value must be finite and within the session file's plausibility
+//!   limits (lengths 100 m, angles 36,000°); the file at most
+//!   [`MAX_DH_BYTES`].
 //! - Lines starting with `#` are comments, blank lines are skipped, cells
 //!   are trimmed, a UTF-8 byte-order mark is dropped.
 //! - Errors name the file and the 1-based line.
@@ -45,7 +55,17 @@ use nalgebra::Isometry3;
 use super::import_error::RobotImportError;
 use super::kinematics::{Joint, Robot};
 use crate::engine::geometry::{rot_x, trans};
-use crate::engine::table::Table;
+use crate::engine::numeric::show;
+use crate::engine::session::limits;
+use crate::engine::table::{Table, excerpt};
+
+/// Largest DH table read, bytes (1 MiB): a table has a row per joint.
+pub const MAX_DH_BYTES: u64 = 1 << 20;
+
+/// How near π/2 or π (rad) an `alpha` without a unit must be to be taken
+/// for a table in radians: 1.5708 and 3.1416 as tables print them; no
+/// nominal DH table in degrees has an alpha of 1.57° or 3.14°.
+const RADIAN_ALPHA_TOLERANCE: f64 = 0.01;
 
 /// Which DH convention the rows of a table follow.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -62,10 +82,21 @@ pub enum DhConvention {
 /// # Errors
 /// The file cannot be read, or any error of [`robot_from_dh_csv`].
 pub fn load_dh_csv(path: &Path, convention: DhConvention) -> Result<Robot, RobotImportError> {
-    let text = std::fs::read_to_string(path).map_err(|source| RobotImportError::Io {
+    let io = |source| RobotImportError::Io {
         path: path.to_path_buf(),
         source,
-    })?;
+    };
+    let size = std::fs::metadata(path).map_err(io)?.len();
+    if size > MAX_DH_BYTES {
+        return Err(table_error(
+            path,
+            &format!(
+                "the file has {size} bytes, more than the {} MiB a DH table may have",
+                MAX_DH_BYTES >> 20
+            ),
+        ));
+    }
+    let text = std::fs::read_to_string(path).map_err(io)?;
     robot_from_dh_csv(&text, path, convention)
 }
 
@@ -186,9 +217,9 @@ impl Param {
     }
 }
 
-/// One header column: the parameter and the factor to mm/deg, or `None`
-/// for a label column.
-type Column = Option<(Param, f64)>;
+/// One header column: the parameter, the factor to mm/deg and whether
+/// the header names the unit, or `None` for a label column.
+type Column = Option<(Param, f64, bool)>;
 
 /// The parsed header: one entry per CSV column.
 struct Header {
@@ -220,15 +251,22 @@ fn read_rows(
         table.header_line,
         convention,
     )?);
-    let rows = table
+    let kept: Vec<&(usize, Vec<String>)> = table
         .rows
         .iter()
         .filter(|(_, fields)| !fields.iter().all(String::is_empty))
+        .collect();
+    let rows = kept
+        .iter()
         .map(|(line, fields)| match &header {
             Some(h) => parse_row(fields, h, path, *line),
             None => Err(table_error(path, "no header")),
         })
         .collect::<Result<Vec<_>, _>>()?;
+    if let Some(h) = &header {
+        check_labels(&kept, h, path)?;
+        check_radians(&kept, &rows, h, path)?;
+    }
     match (header, rows.is_empty()) {
         (None, _) => Err(table_error(
             path,
@@ -268,8 +306,8 @@ fn parse_header(
     let mut columns: Vec<Column> = Vec::with_capacity(record.len());
     for cell in record {
         let column = parse_column(cell).map_err(err)?;
-        if let Some((param, _)) = column {
-            if columns.iter().flatten().any(|(p, _)| *p == param) {
+        if let Some((param, _, _)) = column {
+            if columns.iter().flatten().any(|(p, _, _)| *p == param) {
                 return Err(err(format!("column `{}` is given twice", param.name())));
             }
             if param == Param::Beta && convention == DhConvention::Standard {
@@ -284,7 +322,7 @@ fn parse_header(
     }
     let missing: Vec<&str> = Param::REQUIRED
         .iter()
-        .filter(|p| !columns.iter().flatten().any(|(q, _)| q == *p))
+        .filter(|p| !columns.iter().flatten().any(|(q, _, _)| q == *p))
         .map(|p| p.name())
         .collect();
     if !missing.is_empty() {
@@ -311,14 +349,15 @@ fn parse_column(cell: &str) -> Result<Column, String> {
     };
     let unknown = || {
         format!(
-            "unknown column `{cell}`: expected a, alpha, d, theta (beta in a modified table), \
+            "unknown column `{}`: expected a, alpha, d, theta (beta in a modified table), \
              optionally with a unit suffix _mm/_m (lengths) or _deg/_rad (angles), \
-             and an optional joint label column"
+             and an optional joint label column",
+            excerpt(cell)
         )
     };
     let param = Param::from_name(base).ok_or_else(unknown)?;
     let factor = param.unit_factor(unit).ok_or_else(unknown)?;
-    Ok(Some((param, factor)))
+    Ok(Some((param, factor, !unit.is_empty())))
 }
 
 /// One table row as a joint in file units.
@@ -342,7 +381,7 @@ fn parse_row(
     }
     let mut joint = Joint::default();
     for ((cell, column), name) in record.iter().zip(&header.columns).zip(&header.names) {
-        let Some((param, factor)) = column else {
+        let Some((param, factor, _)) = column else {
             continue;
         };
         let value = cell
@@ -353,10 +392,125 @@ fn parse_row(
                 line_error(
                     path,
                     line,
-                    format!("column `{name}`: `{cell}` is not a finite number"),
+                    format!(
+                        "column `{}`: `{}` is not a finite number",
+                        excerpt(name),
+                        excerpt(cell)
+                    ),
                 )
             })?;
-        param.set(&mut joint, value * factor);
+        let value = value * factor;
+        let (limit, unit) = if param.is_length() {
+            (limits::LENGTH_MM, "mm")
+        } else {
+            (limits::ANGLE_DEG, "deg")
+        };
+        if value.abs() > limit {
+            return Err(line_error(
+                path,
+                line,
+                format!(
+                    "column `{}`: {} {unit} is not plausible for a robot (at most {limit} {unit})",
+                    excerpt(name),
+                    show(value)
+                ),
+            ));
+        }
+        param.set(&mut joint, value);
     }
     Ok(joint)
+}
+
+/// The number a joint label ends with (`3`, `J3`, `joint_3`), if any.
+fn label_number(label: &str) -> Option<u64> {
+    let digits = label.len() - label.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+    label[label.len() - digits..].parse().ok()
+}
+
+/// Refuses rows whose label column numbers them out of order: the rows
+/// are the joints in file order, and a label saying otherwise means the
+/// table is not what it looks like.
+fn check_labels(
+    rows: &[&(usize, Vec<String>)],
+    header: &Header,
+    path: &Path,
+) -> Result<(), RobotImportError> {
+    for (col, name) in header
+        .columns
+        .iter()
+        .zip(&header.names)
+        .enumerate()
+        .filter_map(|(k, (c, name))| c.is_none().then_some((k, name)))
+    {
+        let numbers: Option<Vec<u64>> = rows
+            .iter()
+            .map(|(_, fields)| fields.get(col).and_then(|l| label_number(l)))
+            .collect();
+        let Some(numbers) = numbers else {
+            continue;
+        };
+        for (k, pair) in numbers.windows(2).enumerate() {
+            if pair[1] != pair[0] + 1 {
+                let (line, fields) = rows[k + 1];
+                return Err(line_error(
+                    path,
+                    *line,
+                    format!(
+                        "column `{}` labels this row `{}` after `{}`: the rows are read as joints base to flange in file order; sort them by joint",
+                        excerpt(name),
+                        excerpt(&fields[col]),
+                        excerpt(&rows[k].1[col])
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a table whose angles (columns without a unit suffix) look like
+/// radians: all within ±2π, with an `alpha` at π/2 or π.
+fn check_radians(
+    rows: &[&(usize, Vec<String>)],
+    joints: &[Joint],
+    header: &Header,
+    path: &Path,
+) -> Result<(), RobotImportError> {
+    let implicit = |p: Param| {
+        header
+            .columns
+            .iter()
+            .flatten()
+            .any(|(q, _, explicit)| *q == p && !explicit)
+    };
+    if !implicit(Param::Alpha) {
+        return Ok(());
+    }
+    let tau = std::f64::consts::TAU;
+    let angles_small = joints.iter().all(|j| {
+        j.alpha.abs() <= tau
+            && (!implicit(Param::Theta) || j.theta.abs() <= tau)
+            && (!implicit(Param::Beta) || j.beta.abs() <= tau)
+    });
+    let radian_like = |a: f64| {
+        [std::f64::consts::FRAC_PI_2, std::f64::consts::PI]
+            .iter()
+            .any(|r| (a.abs() - r).abs() <= RADIAN_ALPHA_TOLERANCE)
+    };
+    let Some((row, joint)) = rows
+        .iter()
+        .zip(joints)
+        .find(|(_, j)| radian_like(j.alpha))
+        .filter(|_| angles_small)
+    else {
+        return Ok(());
+    };
+    Err(line_error(
+        path,
+        row.0,
+        format!(
+            "alpha = {} looks like radians (π/2 or π), and every angle lies within ±2π: a DH table is read in degrees; name the columns alpha_rad, theta_rad (or alpha_deg, theta_deg if these really are degrees)",
+            show(joint.alpha)
+        ),
+    ))
 }

@@ -57,14 +57,29 @@
 //! `q = 0`, so URDF reading = model reading for every joint; forward
 //! kinematics of the two then agree for all `q` (both are products of
 //! rotations about the same axis lines applied to the same zero pose).
+//!
+//! # Limits
+//!
+//! A URDF is untrusted text. Before `urdf-rs` sees it, one linear pass
+//! ([`check_xml_shape`]) refuses elements nested deeper than
+//! [`MAX_URDF_DEPTH`] (`urdf-rs`' XML reader recurses once a level and
+//! slows with the square of the depth: 20,000 levels overflowed the stack,
+//! 500,000 unclosed tags ran for minutes); a file beyond [`MAX_URDF_BYTES`]
+//! is refused unread. Two links or two joints of one name, an origin or
+//! axis that is not finite or beyond the session's plausibility limits
+//! (100 m, 36,000°) are errors naming the joint, and so is a converted
+//! MDH parameter beyond those limits.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 use super::import_error::RobotImportError;
 use super::kinematics::{Joint, JointLimit, Robot};
+use crate::engine::numeric::show;
+use crate::engine::session::limits;
+use crate::engine::table::excerpt;
 
 /// Sine of the angle between consecutive axes below which they are treated
 /// as (nearly) parallel: frame placed with the perpendicular plane, the
@@ -77,6 +92,21 @@ const INTERSECT_MM: f64 = 1e-9;
 /// A `beta` (rad) below this is rounding noise of exactly parallel or
 /// normal axes and set to 0 (it moves a point a metre away by 1e-11 mm).
 const BETA_NOISE: f64 = 1e-14;
+
+/// Deepest element nesting accepted in a URDF. A robot description is
+/// shallow: `robot > link > visual > geometry > mesh` is 5 levels, Gazebo
+/// and `ros2_control` blocks add a few; 64 leaves room for any real file
+/// while keeping `urdf-rs`' recursive reader far from the stack's end and
+/// its time (quadratic in the depth) negligible.
+pub const MAX_URDF_DEPTH: usize = 64;
+
+/// Largest URDF file read, bytes (64 MiB): meshes live in their own files,
+/// and even a xacro-expanded cell of several robots is a few MB.
+pub const MAX_URDF_BYTES: u64 = 64 << 20;
+
+/// Longest message of `urdf-rs` passed on, characters (its messages may
+/// quote the offending text).
+const MAX_PARSER_MESSAGE_CHARS: usize = 400;
 
 /// Which chain to take from a URDF.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -123,11 +153,126 @@ pub struct UrdfRobot {
 /// # Errors
 /// The file cannot be read, or any error of [`robot_from_urdf_with`].
 pub fn load_urdf(path: &Path, options: &UrdfOptions) -> Result<UrdfRobot, RobotImportError> {
-    let text = std::fs::read_to_string(path).map_err(|source| RobotImportError::Io {
+    let io = |source| RobotImportError::Io {
         path: path.to_path_buf(),
         source,
-    })?;
+    };
+    let size = std::fs::metadata(path).map_err(io)?.len();
+    if size > MAX_URDF_BYTES {
+        return Err(too_large(path, size));
+    }
+    let text = std::fs::read_to_string(path).map_err(io)?;
     robot_from_urdf_with(&text, path, options)
+}
+
+/// The error of a URDF beyond [`MAX_URDF_BYTES`].
+fn too_large(path: &Path, size: u64) -> RobotImportError {
+    RobotImportError::UrdfSyntax {
+        path: path.to_path_buf(),
+        message: format!(
+            "the file has {size} bytes, more than the {} MiB a robot description may have",
+            MAX_URDF_BYTES >> 20
+        ),
+    }
+}
+
+/// Checks the element structure of an XML text in one linear pass,
+/// before a parser that recurses sees it: elements nested at most
+/// [`MAX_URDF_DEPTH`] deep. Comments, CDATA, processing instructions,
+/// declarations and quoted attribute values are skipped as XML defines
+/// them; anything else malformed is left to the parser. Returns the
+/// message and the 1-based line of the first element too deep.
+///
+/// # Errors
+/// `(line, message)` of the first element beyond the depth limit.
+pub fn check_xml_shape(text: &str) -> Result<(), (usize, String)> {
+    let b = text.as_bytes();
+    let (mut i, mut line, mut depth) = (0usize, 1usize, 0usize);
+    // Advances `i` past the first `end` from `from`, counting lines; to
+    // the end of the text when there is none.
+    let skip_to = |from: usize, end: &[u8], line: &mut usize| -> usize {
+        let mut j = from;
+        while j < b.len() {
+            if b[j..].starts_with(end) {
+                return j + end.len();
+            }
+            if b[j] == b'\n' {
+                *line += 1;
+            }
+            j += 1;
+        }
+        b.len()
+    };
+    while i < b.len() {
+        match b[i] {
+            b'\n' => {
+                line += 1;
+                i += 1;
+            }
+            b'<' => {
+                let rest = &b[i..];
+                if rest.starts_with(b"<!--") {
+                    i = skip_to(i + 4, b"-->", &mut line);
+                } else if rest.starts_with(b"<![CDATA[") {
+                    i = skip_to(i + 9, b"]]>", &mut line);
+                } else if rest.starts_with(b"<?") {
+                    i = skip_to(i + 2, b"?>", &mut line);
+                } else if rest.starts_with(b"<!") {
+                    // A declaration; its internal subset `[...]` may hold `>`.
+                    let mut j = i + 2;
+                    let mut bracket = 0usize;
+                    while j < b.len() {
+                        match b[j] {
+                            b'[' => bracket += 1,
+                            b']' => bracket = bracket.saturating_sub(1),
+                            b'>' if bracket == 0 => break,
+                            b'\n' => line += 1,
+                            _ => {}
+                        }
+                        j += 1;
+                    }
+                    i = j + 1;
+                } else if rest.starts_with(b"</") {
+                    depth = depth.saturating_sub(1);
+                    i = skip_to(i + 2, b">", &mut line);
+                } else {
+                    // A start tag: to its `>`, outside quoted values.
+                    let start_line = line;
+                    let mut j = i + 1;
+                    let mut quote: Option<u8> = None;
+                    while j < b.len() {
+                        let c = b[j];
+                        if c == b'\n' {
+                            line += 1;
+                        }
+                        match quote {
+                            Some(q) if c == q => quote = None,
+                            Some(_) => {}
+                            None if c == b'"' || c == b'\'' => quote = Some(c),
+                            None if c == b'>' => break,
+                            None => {}
+                        }
+                        j += 1;
+                    }
+                    let empty = j > i + 1 && j < b.len() && b[j - 1] == b'/';
+                    if !empty {
+                        depth += 1;
+                        if depth > MAX_URDF_DEPTH {
+                            return Err((
+                                start_line,
+                                format!(
+                                    "elements nested more than {MAX_URDF_DEPTH} levels deep (line {start_line}): not a robot description"
+                                ),
+                            ));
+                        }
+                    }
+                    i = j + 1;
+                }
+            }
+            _ => i += 1,
+        }
+    }
+    Ok(())
 }
 
 /// The robot of a URDF text with the default chain: from the root link to
@@ -153,9 +298,16 @@ pub fn robot_from_urdf_with(
     source: &Path,
     options: &UrdfOptions,
 ) -> Result<UrdfRobot, RobotImportError> {
+    if text.len() as u64 > MAX_URDF_BYTES {
+        return Err(too_large(source, text.len() as u64));
+    }
+    check_xml_shape(text).map_err(|(_, message)| RobotImportError::UrdfSyntax {
+        path: source.to_path_buf(),
+        message,
+    })?;
     let urdf = urdf_rs::read_from_string(text).map_err(|e| RobotImportError::UrdfSyntax {
         path: source.to_path_buf(),
-        message: e.to_string(),
+        message: crate::engine::table::clip(&e.to_string(), MAX_PARSER_MESSAGE_CHARS),
     })?;
     let tree = Tree::new(&urdf, source)?;
     let tip = match &options.tip {
@@ -170,6 +322,7 @@ pub fn robot_from_urdf_with(
     let geometry = chain_geometry(&chain, source)?;
     check_count(&geometry, options.joints, source, &root, tip)?;
     let mdh = mdh_from_axes(&geometry.axes, &geometry.tip);
+    check_model(&mdh, &geometry.names, source)?;
     let name = if urdf.name.is_empty() {
         file_stem(source)
     } else {
@@ -224,6 +377,8 @@ struct Tree<'a> {
     path: &'a Path,
     /// Link names in file order.
     links: Vec<&'a str>,
+    /// The same names, for lookups in constant time.
+    link_set: HashSet<&'a str>,
     /// Child link → the joint above it.
     parent: HashMap<&'a str, &'a urdf_rs::Joint>,
     /// Parent link → number of joints below it.
@@ -237,16 +392,33 @@ impl<'a> Tree<'a> {
         let mut tree = Self {
             path,
             links: urdf.links.iter().map(|l| l.name.as_str()).collect(),
+            link_set: HashSet::with_capacity(urdf.links.len()),
             parent: HashMap::new(),
             n_children: HashMap::new(),
         };
+        for link in &tree.links {
+            if !tree.link_set.insert(link) {
+                return Err(tree.error(format!(
+                    "two links are named `{}`: every link needs its own name",
+                    excerpt(link)
+                )));
+            }
+        }
+        let mut joint_names: HashSet<&str> = HashSet::with_capacity(urdf.joints.len());
         for joint in &urdf.joints {
+            if !joint_names.insert(&joint.name) {
+                return Err(joint_error(
+                    path,
+                    joint,
+                    "two joints have this name: every joint needs its own name".to_owned(),
+                ));
+            }
             for link in [&joint.parent.link, &joint.child.link] {
-                if !tree.links.contains(&link.as_str()) {
+                if !tree.link_set.contains(link.as_str()) {
                     return Err(joint_error(
                         path,
                         joint,
-                        format!("link `{link}` is not declared"),
+                        format!("link `{}` is not declared", excerpt(link)),
                     ));
                 }
             }
@@ -271,26 +443,24 @@ impl<'a> Tree<'a> {
 
     /// The link called `name`, or an error listing the links.
     fn named_link(&self, name: &str) -> Result<&'a str, RobotImportError> {
-        self.links
-            .iter()
-            .copied()
-            .find(|l| *l == name)
-            .ok_or_else(|| {
-                self.error(format!(
-                    "no link named `{name}` (links: {})",
-                    self.links.join(", ")
-                ))
-            })
+        self.link_set.get(name).copied().ok_or_else(|| {
+            self.error(excerpt(&format!(
+                "no link named `{name}` (links: {})",
+                self.links.join(", ")
+            )))
+        })
     }
 
-    /// The only end link reached through at least one moving joint.
+    /// The only end link reached through at least one moving joint. Each
+    /// link's answer is remembered, so the walk is linear in the links.
     fn default_tip(&self) -> Result<&'a str, RobotImportError> {
+        let mut moving_above: HashMap<&'a str, bool> = HashMap::new();
         let mut ends = Vec::new();
         for link in &self.links {
             if self.n_children.contains_key(link) {
                 continue;
             }
-            if self.chain_to(link)?.iter().any(|j| is_moving(j)) {
+            if self.moving_above(link, &mut moving_above)? {
                 ends.push(*link);
             }
         }
@@ -306,6 +476,42 @@ impl<'a> Tree<'a> {
                     .join(", ")
             ))),
         }
+    }
+
+    /// Whether a moving joint lies between the root and `link`, with the
+    /// answers known so far in `memo` (and the new ones added).
+    fn moving_above(
+        &self,
+        link: &'a str,
+        memo: &mut HashMap<&'a str, bool>,
+    ) -> Result<bool, RobotImportError> {
+        let mut walked: Vec<&'a str> = Vec::new();
+        let mut at = link;
+        let answer = loop {
+            if let Some(&known) = memo.get(at) {
+                break known;
+            }
+            let Some(joint) = self.parent.get(at) else {
+                break false;
+            };
+            if walked.len() > self.parent.len() {
+                return Err(self.error(format!(
+                    "the joints above link `{}` form a loop",
+                    excerpt(link)
+                )));
+            }
+            walked.push(at);
+            if is_moving(joint) {
+                break true;
+            }
+            at = &joint.parent.link;
+        };
+        // Every link walked has the answer of the first one known above it
+        // (a moving joint above a link is above each link below it).
+        for w in walked {
+            memo.insert(w, answer);
+        }
+        Ok(answer)
     }
 
     /// The joints from the root down to `tip`, root first.
@@ -376,6 +582,7 @@ fn chain_geometry(
         tip: Isometry3::identity(),
     };
     for joint in chain {
+        check_origin(joint, path)?;
         pose *= origin_mm(&joint.origin);
         if !revolute_kind(joint, path)? {
             continue;
@@ -390,6 +597,80 @@ fn chain_geometry(
     }
     geometry.tip = pose;
     Ok(geometry)
+}
+
+/// Refuses a joint `<origin>` or `<axis>` with a number that is not
+/// finite or not plausible (translation beyond the session's length
+/// limit, an angle beyond its angle limit): it would not fail later, it
+/// would quietly become a different robot.
+fn check_origin(joint: &urdf_rs::Joint, path: &Path) -> Result<(), RobotImportError> {
+    let [x, y, z] = joint.origin.xyz.0;
+    let [r, p, w] = joint.origin.rpy.0;
+    let length = limits::LENGTH_MM / 1000.0;
+    let angle = limits::ANGLE_DEG.to_radians();
+    let fail = |what: &str, values: [f64; 3], limit: String| {
+        Err(joint_error(
+            path,
+            joint,
+            format!(
+                "{what}=\"{} {} {}\" is not plausible: every value must be finite and at most {limit}",
+                show(values[0]),
+                show(values[1]),
+                show(values[2])
+            ),
+        ))
+    };
+    if ![x, y, z].iter().all(|v| v.is_finite() && v.abs() <= length) {
+        return fail("origin xyz", [x, y, z], format!("{length} m"));
+    }
+    if ![r, p, w].iter().all(|v| v.is_finite() && v.abs() <= angle) {
+        return fail("origin rpy", [r, p, w], format!("{} rad", show(angle)));
+    }
+    let axis = joint.axis.xyz.0;
+    if !axis.iter().all(|v| v.is_finite()) {
+        return fail("axis xyz", axis, "finite".to_owned());
+    }
+    Ok(())
+}
+
+/// Refuses a converted model with a parameter or transform beyond the
+/// session's plausibility limits (a chain that is nearly degenerate can
+/// put a common normal far away), naming the joint.
+fn check_model(mdh: &MdhChain, names: &[String], path: &Path) -> Result<(), RobotImportError> {
+    for (joint, name) in mdh.joints.iter().zip(names) {
+        for (key, v, limit, unit) in [
+            ("alpha", joint.alpha, limits::ANGLE_DEG, "deg"),
+            ("a", joint.a, limits::LENGTH_MM, "mm"),
+            ("beta", joint.beta, limits::ANGLE_DEG, "deg"),
+            ("theta", joint.theta, limits::ANGLE_DEG, "deg"),
+            ("d", joint.d, limits::LENGTH_MM, "mm"),
+        ] {
+            if !(v.is_finite() && v.abs() <= limit) {
+                return Err(RobotImportError::UrdfJoint {
+                    path: path.to_path_buf(),
+                    joint: name.clone(),
+                    message: format!(
+                        "its modified-DH {key} comes out as {} {unit}, beyond the plausible {limit} {unit}: check the joint's origin and axis",
+                        show(v)
+                    ),
+                });
+            }
+        }
+    }
+    for (what, t) in [("base", &mdh.base), ("flange", &mdh.flange)] {
+        let n = t.translation.vector.norm();
+        if !(n.is_finite() && n <= limits::LENGTH_MM) {
+            return Err(RobotImportError::UrdfTree {
+                path: path.to_path_buf(),
+                message: format!(
+                    "the {what} transform of the chain is {} mm long, beyond the plausible {} mm",
+                    show(n),
+                    limits::LENGTH_MM
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// `true` for a revolute or continuous joint, `false` for a fixed one, an
@@ -430,6 +711,13 @@ fn revolute_kind(joint: &urdf_rs::Joint, path: &Path) -> Result<bool, RobotImpor
 fn unit_axis(joint: &urdf_rs::Joint, path: &Path) -> Result<Vector3<f64>, RobotImportError> {
     let [x, y, z] = joint.axis.xyz.0;
     let v = Vector3::new(x, y, z);
+    // Scaled first, so that huge components do not overflow the norm.
+    let largest = v.amax();
+    let v = if largest > 0.0 && largest.is_finite() {
+        v / largest
+    } else {
+        v
+    };
     let norm = v.norm();
     if norm.is_finite() && norm > 1e-12 {
         Ok(v / norm)

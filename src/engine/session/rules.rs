@@ -297,6 +297,41 @@ pub fn reference(
     .map_err(|m| ("distance", m))
 }
 
+/// The reference distances seen so far, by pair of stations (in name
+/// order): two different distances for one pair contradict each other.
+#[derive(Debug, Default)]
+pub struct ReferencePairs {
+    first: std::collections::HashMap<(String, String), (usize, f64)>,
+}
+
+impl ReferencePairs {
+    /// Records `reference_distances[index]` (`key`).
+    ///
+    /// # Errors
+    /// The pair was given before with another distance.
+    pub fn check(&mut self, key: &str, index: usize, r: &ReferenceDistance) -> Result<(), String> {
+        let pair = if r.from < r.to {
+            (r.from.clone(), r.to.clone())
+        } else {
+            (r.to.clone(), r.from.clone())
+        };
+        match self.first.get(&pair) {
+            Some(&(first, other)) if other != r.distance => Err(format!(
+                "{key}: the pair {} – {} is {} mm here and {} mm in reference_distances[{first}]: two distances for one pair contradict each other; keep the right one",
+                r.from,
+                r.to,
+                show(r.distance),
+                show(other)
+            )),
+            Some(_) => Ok(()),
+            None => {
+                self.first.insert(pair, (index, r.distance));
+                Ok(())
+            }
+        }
+    }
+}
+
 /// "gives `joints` but the session has no `robot`…".
 pub const JOINTS_WITHOUT_ROBOT: &str = "gives `joints` but the session has no `robot`: joint readings need the robot model (only a pose-only session, `flange` in every measurement, may leave `robot` out)";
 
@@ -440,9 +475,11 @@ impl Session {
                 });
             }
         }
+        let mut pairs = ReferencePairs::default();
         for (i, r) in self.reference_distances.iter().enumerate() {
             let key = format!("reference_distances[{i}]");
             reference(&key, r, self).map_err(|(_, m)| general(&key, m))?;
+            pairs.check(&key, i, r).map_err(|m| general(&key, m))?;
         }
         self.check_rules()
     }

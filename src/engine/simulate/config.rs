@@ -16,6 +16,28 @@ pub const RANDOM_ANGLE_SIGMA_DEG: f64 = 0.1;
 /// `error_scale = 1`: Table 1's length errors are within ±0.7 mm.
 pub const RANDOM_LENGTH_SIGMA_MM: f64 = 0.3;
 
+/// Largest σ of the stripe point noise and of the centre noise, mm: ten
+/// times the worst laser-stripe sensor (~1 mm) and a quarter of a small
+/// (38 mm) sphere's radius; beyond it a stripe is no longer an arc and
+/// the points leave the loader's plausible sensor field.
+pub const MAX_SENSOR_NOISE_MM: f64 = 10.0;
+/// Largest σ of the joint reading noise, deg: a thousand times an
+/// encoder's (~0.003°); beyond it readings stop meaning a pose.
+pub const MAX_JOINT_NOISE_DEG: f64 = 3.0;
+/// Largest σ of the laser tracker's reference distances, mm (a tracker
+/// measures to ~0.01 mm).
+pub const MAX_TRACKER_NOISE_MM: f64 = 10.0;
+/// Largest `error_scale`: 100 × Table 1 puts angle errors near 50°, far
+/// beyond any real robot's deviations from its nominal model.
+pub const MAX_ERROR_SCALE: f64 = 100.0;
+
+/// Most stations of a simulated session (identify and validate): 60,000
+/// measurements at 6 a station, far beyond any cell's (the workbench's
+/// large-session tests simulate 2,000); each one writes files.
+pub const MAX_STATIONS: usize = 10_000;
+/// Most poses of one group (translations, rotations, or one station's).
+pub const MAX_GROUP_POSES: usize = 100;
+
 /// Where the true kinematic model comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -250,6 +272,18 @@ pub(super) fn check(ok: bool, message: impl FnOnce() -> String) -> Result<(), Si
     }
 }
 
+impl SimConfig {
+    /// Checks every setting, as [`simulate`](super::simulate) does before
+    /// any work (so that a caller can refuse options before writing
+    /// anything).
+    ///
+    /// # Errors
+    /// [`SimError::InvalidConfig`] naming the setting and its value.
+    pub fn validate(&self) -> Result<(), SimError> {
+        validate_config(self)
+    }
+}
+
 pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
     let reals = [
         ("error_scale", c.error_scale),
@@ -292,6 +326,43 @@ pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
             format!("{name} must not be negative, found {v}")
         })?;
     }
+    for (name, v, limit, unit) in [
+        ("stripe_noise", c.stripe_noise, MAX_SENSOR_NOISE_MM, "mm"),
+        ("centre_noise", c.centre_noise, MAX_SENSOR_NOISE_MM, "mm"),
+        ("joint_noise", c.joint_noise, MAX_JOINT_NOISE_DEG, "deg"),
+        ("tracker_noise", c.tracker_noise, MAX_TRACKER_NOISE_MM, "mm"),
+        (
+            "error_scale",
+            c.error_scale,
+            MAX_ERROR_SCALE,
+            "(times the errors)",
+        ),
+    ] {
+        check(v.abs() <= limit, || {
+            format!(
+                "{name} {} {unit} is not plausible: at most {limit} (a simulated session must stay one its loader reads)",
+                crate::engine::numeric::show(v)
+            )
+        })?;
+    }
+    for (name, n, limit) in [
+        (
+            "n_identify + n_validate",
+            c.n_identify + c.n_validate,
+            MAX_STATIONS,
+        ),
+        ("poses_per_station", c.poses_per_station, MAX_GROUP_POSES),
+        ("n_translation", c.n_translation, MAX_GROUP_POSES),
+        ("n_rotation", c.n_rotation, MAX_GROUP_POSES),
+    ] {
+        check(n <= limit, || {
+            format!("{name} is {n}: a simulated session has at most {limit}")
+        })?;
+    }
+    check(c.n_identify >= 1, || {
+        "at least one identify station is needed: a session without one cannot be calibrated"
+            .to_owned()
+    })?;
     check((0.0..=1.0).contains(&c.outlier_fraction), || {
         format!(
             "outlier_fraction must be within 0..1, found {}",
@@ -307,6 +378,16 @@ pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
     check(c.diameter > 0.0, || {
         format!("diameter must be positive, found {} mm", c.diameter)
     })?;
+    check(
+        c.diameter <= crate::engine::session::limits::SPHERE_DIAMETER_MM,
+        || {
+            format!(
+                "diameter {} mm is not plausible (at most {} mm)",
+                crate::engine::numeric::show(c.diameter),
+                crate::engine::session::limits::SPHERE_DIAMETER_MM
+            )
+        },
+    )?;
     check(c.point_spacing > 0.0, || {
         format!(
             "point_spacing must be positive, found {} mm",

@@ -16,6 +16,7 @@
 pub mod estimate;
 pub mod ml;
 pub mod paper;
+pub mod plausible;
 pub mod prepare;
 pub mod report;
 
@@ -23,7 +24,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 
 use crate::engine::handeye::HandEyeError;
 use crate::engine::robot::Robot;
-use crate::engine::session::{Session, Use};
+use crate::engine::session::{Session, Use, limits};
 use crate::engine::stripe::StripeError;
 use crate::engine::validate::{
     BeforeAfter, StationCentres, Stats, Validation, epsilon, validation, within_station_distances,
@@ -538,7 +539,25 @@ pub fn run(
     if !(options.threshold >= 0.0 && options.threshold.is_finite()) {
         return Err(SolveError::InvalidOption(format!(
             "threshold must be a non-negative number of mm, got {}",
-            options.threshold
+            crate::engine::numeric::show(options.threshold)
+        )));
+    }
+    if options.threshold > limits::THRESHOLD_MM {
+        return Err(SolveError::InvalidOption(format!(
+            "threshold {} mm is not plausible: ε of a calibration is a few mm at most, so no update would be made; give at most {} mm",
+            crate::engine::numeric::show(options.threshold),
+            limits::THRESHOLD_MM
+        )));
+    }
+    #[allow(
+        clippy::cast_precision_loss,
+        reason = "compared against a limit far below 2^52"
+    )]
+    if options.max_iterations as f64 > limits::MAX_ITERATIONS {
+        return Err(SolveError::InvalidOption(format!(
+            "max_iterations {} is not plausible: give at most {}",
+            options.max_iterations,
+            limits::MAX_ITERATIONS
         )));
     }
     let stations = prepared.stations(session, Use::Identify);

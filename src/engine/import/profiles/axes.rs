@@ -6,6 +6,7 @@ use std::fmt;
 use nalgebra::Matrix3;
 
 use super::{AXIS_NAMES, PLANE_TOLERANCE_MM, RawProfile};
+use crate::engine::numeric::approx;
 
 /// One axis of an [`AxisMap`]: a sensor axis (0 = x, 1 = y, 2 = z) and a
 /// sign.
@@ -158,14 +159,17 @@ impl AxisMap {
         let spread: Vec<f64> = (0..3).map(|k| hi[k] - lo[k]).collect();
         let Some(normal) = (0..3).find(|&k| spread[k] <= PLANE_TOLERANCE_MM) else {
             return Err(format!(
-                "cannot guess the laser plane: no coordinate is constant (spreads x {:.3}, y {:.3}, z {:.3} mm); give the axis map, e.g. `--axes -y,x,z`",
-                spread[0], spread[1], spread[2]
+                "cannot guess the laser plane: no coordinate is constant (spreads x {}, y {}, z {} mm); give the axis map, e.g. `--axes -y,x,z`",
+                approx(spread[0]),
+                approx(spread[1]),
+                approx(spread[2])
             ));
         };
         if lo[normal].abs() > PLANE_TOLERANCE_MM {
             return Err(format!(
                 "every point has {} = {} mm: the laser plane does not pass through the sensor's origin; FORMAT.md needs the plane at 0",
-                AXIS_NAMES[normal], lo[normal]
+                AXIS_NAMES[normal],
+                crate::engine::numeric::show(lo[normal])
             ));
         }
         let rest: Vec<usize> = (0..3).filter(|&k| k != normal).collect();
@@ -190,6 +194,28 @@ impl AxisMap {
         } else {
             map
         })
+    }
+}
+
+impl AxisMap {
+    /// The profile that keeps [`Self::guess`] from finding the plane, when
+    /// the others agree on it: the sensor axis that is 0 in the most
+    /// profiles is taken for the normal, and the first profile that is not
+    /// on it is the culprit (its index). `None` when no profile lies in a
+    /// plane through the origin.
+    #[must_use]
+    pub fn odd_profile(profiles: &[RawProfile]) -> Option<usize> {
+        let on = |p: &RawProfile, k: usize| {
+            !p.points.is_empty() && p.points.iter().all(|q| q[k].abs() <= PLANE_TOLERANCE_MM)
+        };
+        let counts: [usize; 3] =
+            std::array::from_fn(|k| profiles.iter().filter(|p| on(p, k)).count());
+        let normal = (0..3)
+            .max_by_key(|&k| counts[k])
+            .filter(|&k| counts[k] > 0)?;
+        profiles
+            .iter()
+            .position(|p| !p.points.is_empty() && !on(p, normal))
     }
 }
 

@@ -43,6 +43,9 @@ use std::path::{Path, PathBuf};
 pub use self::axes::AxisMap;
 use super::csv_file::CsvFile;
 use super::{ImportError, LengthUnit};
+use crate::engine::numeric::show;
+use crate::engine::session::limits;
+use crate::engine::table::read_text_file;
 
 /// Names of the sensor's axes, in order.
 const AXIS_NAMES: [&str; 3] = ["x", "y", "z"];
@@ -53,6 +56,14 @@ pub const PROFILE_EXTENSIONS: [&str; 5] = ["csv", "txt", "yml", "yaml", "json"];
 
 /// Keys looked for, in order, in an OpenCV YAML or JSON profile.
 pub const PROFILE_KEYS: [&str; 4] = ["scan_line", "profile", "points", "data"];
+
+/// Largest |coordinate| of a profile point accepted by the readers, mm:
+/// the session's sensor field ([`limits::SENSOR_COORDINATE_MM`], 10 m)
+/// times the thousand of a unit read wrong (µm as mm). Beyond it a value
+/// is nonsense in every unit and is refused with its line; within it a
+/// unit mistake is caught by the profile size check, which names the
+/// `--profile-unit` to give, and a stray point by the session's rules.
+pub const MAX_PROFILE_COORDINATE_MM: f64 = limits::SENSOR_COORDINATE_MM * 1000.0;
 
 /// Largest |coordinate| (mm) along the plane's normal accepted as "on the
 /// plane" after the axis map: rounding of the file's numbers.
@@ -143,7 +154,7 @@ impl RawProfile {
                     message: format!(
                         "point {} lies {} mm off the laser plane under the axis map {map} ({}): the plane's normal is the sensor axis {}; choose another map",
                         i + 1,
-                        q[0],
+                        show(q[0]),
                         map.describe(),
                         AXIS_NAMES[map.normal_axis()]
                     ),
@@ -180,12 +191,13 @@ impl PlaneProfile {
     }
 }
 
-/// Collects points, dropping non-finite ones and the no-return value.
+/// Collects points, dropping non-finite ones and the no-return value,
+/// refusing implausible ones.
 struct Collector<'a> {
     format: &'a ProfileFormat,
+    /// Finite points, file units until [`Self::finish`].
     points: Vec<[f64; 3]>,
     non_finite: usize,
-    no_return: usize,
 }
 
 impl<'a> Collector<'a> {
@@ -194,27 +206,70 @@ impl<'a> Collector<'a> {
             format,
             points: Vec::new(),
             non_finite: 0,
-            no_return: 0,
         }
     }
 
-    /// Adds one point given in file units.
-    fn push(&mut self, p: [f64; 3]) {
+    /// Adds one point given in file units; a point with a NaN or infinite
+    /// coordinate is dropped and counted.
+    ///
+    /// # Errors
+    /// A coordinate (other than the no-return value) beyond
+    /// [`MAX_PROFILE_COORDINATE_MM`]: the message, for the caller to give
+    /// its line or point.
+    fn push(&mut self, p: [f64; 3]) -> Result<(), String> {
         if p.iter().any(|v| !v.is_finite()) {
             self.non_finite += 1;
-        } else if self.format.no_return.is_some_and(|s| p.contains(&s)) {
-            self.no_return += 1;
-        } else {
-            self.points.push(p.map(|v| self.format.unit.to_mm(v)));
+            return Ok(());
         }
+        for (k, &v) in p.iter().enumerate() {
+            let mm = self.format.unit.to_mm(v);
+            if mm.abs() > MAX_PROFILE_COORDINATE_MM && self.format.no_return != Some(v) {
+                return Err(format!(
+                    "{} = {} {} is not plausible for a stripe point in any unit (a sensor sees at most {} mm)",
+                    AXIS_NAMES[k],
+                    show(v),
+                    self.format.unit.symbol(),
+                    limits::SENSOR_COORDINATE_MM
+                ));
+            }
+        }
+        self.points.push(p);
+        Ok(())
     }
 
-    fn finish(self, source: &Path) -> RawProfile {
+    /// The profile: points with the no-return value dropped and counted,
+    /// in mm. The value is looked for only on the measured coordinates: a
+    /// coordinate that is the same in every point (the plane's normal, or
+    /// one the file does not have, 0) is not a reading, so `--no-return 0`
+    /// keeps the points of a profile in the plane `y = 0`.
+    fn finish(mut self, source: &Path) -> RawProfile {
+        let mut no_return = 0;
+        if let Some(sentinel) = self.format.no_return {
+            let constant: [bool; 3] = std::array::from_fn(|k| {
+                self.points
+                    .first()
+                    .is_some_and(|f| self.points.iter().all(|p| p[k] == f[k]))
+            });
+            // A profile of one repeated point has no plane to spare.
+            let constant = if constant.iter().all(|&c| c) {
+                [false; 3]
+            } else {
+                constant
+            };
+            let before = self.points.len();
+            self.points
+                .retain(|p| !(0..3).any(|k| !constant[k] && p[k] == sentinel));
+            no_return = before - self.points.len();
+        }
+        let unit = self.format.unit;
+        for p in &mut self.points {
+            *p = p.map(|v| unit.to_mm(v));
+        }
         RawProfile {
             source: source.to_path_buf(),
             points: self.points,
             non_finite: self.non_finite,
-            no_return: self.no_return,
+            no_return,
         }
     }
 }
@@ -238,7 +293,7 @@ fn number(text: &str) -> Option<f64> {
 /// An unreadable file, or content that is not a profile (naming the file
 /// and the line or key).
 pub fn read_profile(path: &Path, format: &ProfileFormat) -> Result<RawProfile, ImportError> {
-    let text = fs::read_to_string(path).map_err(|source| ImportError::Io {
+    let text = read_text_file(path).map_err(|source| ImportError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -324,7 +379,7 @@ pub fn read_profile_table(
     pose_column: &str,
     format: &ProfileFormat,
 ) -> Result<(Vec<String>, HashMap<String, RawProfile>), ImportError> {
-    let text = fs::read_to_string(path).map_err(|source| ImportError::Io {
+    let text = read_text_file(path).map_err(|source| ImportError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -338,16 +393,21 @@ pub fn read_profile_table(
         };
         let id = row.get(pose).unwrap_or("");
         let p = text::xyz_of(csv, line, row, &columns)?;
-        match collectors.get_mut(id) {
+        let pushed = match collectors.get_mut(id) {
             Some(c) => c.push(p),
             None => {
                 order.push(id.to_string());
                 let mut c = Collector::new(format);
-                c.push(p);
+                let pushed = c.push(p);
                 collectors.insert(id.to_string(), c);
+                pushed
             }
-        }
-        Ok(())
+        };
+        pushed.map_err(|message| ImportError::Csv {
+            path: path.to_path_buf(),
+            line,
+            message,
+        })
     })?;
     if columns.is_none() {
         csv.column(pose_column)?;

@@ -9,24 +9,36 @@ use serde_json::Value;
 
 use super::{Collector, PROFILE_KEYS, ProfileFormat, RawProfile, number};
 use crate::engine::import::ImportError;
+use crate::engine::table::{excerpt, overlong_line, overlong_line_message};
 
 /// The flat numbers of a profile and how many make a point (2 or 3, when
 /// the file says).
 struct NumberList {
     values: Vec<f64>,
     width: Option<usize>,
+    /// The 1-based line where the list starts (YAML; 1 for JSON).
+    line: usize,
 }
 
 /// Points of a flat list: triplets when one coordinate of the triplets is
-/// constant (a plane), else pairs `y, z`.
+/// constant (a plane; a NaN or infinity there, a point the sensor did not
+/// see, does not break it: that point is dropped like any non-finite one),
+/// else pairs `y, z`.
 fn points_of_list(list: &NumberList, path: &Path, key: &str) -> Result<Vec<[f64; 3]>, ImportError> {
     let n = list.values.len();
     let triplets_in_plane = || {
         n.is_multiple_of(3)
             && n > 0
             && (0..3).any(|k| {
-                let first = list.values[k];
-                list.values.iter().skip(k).step_by(3).all(|&v| v == first)
+                let mut finite = list
+                    .values
+                    .iter()
+                    .skip(k)
+                    .step_by(3)
+                    .filter(|v| v.is_finite());
+                finite
+                    .next()
+                    .is_some_and(|&first| finite.all(|&v| v == first))
             })
     };
     let width = match list.width {
@@ -39,7 +51,8 @@ fn points_of_list(list: &NumberList, path: &Path, key: &str) -> Result<Vec<[f64;
         return Err(ImportError::File {
             path: path.to_path_buf(),
             message: format!(
-                "`{key}` holds {n} numbers: not a whole number of points of {width} coordinates"
+                "`{}` holds {n} numbers: not a whole number of points of {width} coordinates",
+                excerpt(key)
             ),
         });
     }
@@ -75,12 +88,12 @@ fn choose_key<'k>(
         message: match &format.key {
             Some(k) => format!(
                 "no key `{k}` with a list of numbers (the file has: {})",
-                keys.join(", ")
+                excerpt(&keys.join(", "))
             ),
             None => format!(
                 "no point list: none of the keys {} (the file has: {}); name the key with --profile-key",
                 PROFILE_KEYS.join(", "),
-                keys.join(", ")
+                excerpt(&keys.join(", "))
             ),
         },
     })
@@ -103,8 +116,12 @@ pub(super) fn read_yaml(
         });
     };
     let mut out = Collector::new(format);
-    for p in points_of_list(list, path, key)? {
-        out.push(p);
+    for (i, p) in points_of_list(list, path, key)?.into_iter().enumerate() {
+        out.push(p).map_err(|message| ImportError::Csv {
+            path: path.to_path_buf(),
+            line: list.line,
+            message: format!("`{}`, point {}: {message}", excerpt(key), i + 1),
+        })?;
     }
     Ok(out.finish(path))
 }
@@ -112,6 +129,13 @@ pub(super) fn read_yaml(
 /// The number lists of an OpenCV YAML file, by top-level key, in file
 /// order.
 fn yaml_lists(text: &str, path: &Path) -> Result<Vec<(String, NumberList)>, ImportError> {
+    if let Some((line, length)) = overlong_line(text) {
+        return Err(ImportError::Csv {
+            path: path.to_path_buf(),
+            line,
+            message: overlong_line_message(length),
+        });
+    }
     let lines: Vec<&str> = text.trim_start_matches('\u{feff}').lines().collect();
     let mut out = Vec::new();
     let mut i = 0;
@@ -132,6 +156,7 @@ fn yaml_lists(text: &str, path: &Path) -> Result<Vec<(String, NumberList)>, Impo
                 NumberList {
                     values: numbers_in(&body, path, &key, i + 1)?,
                     width: None,
+                    line: i + 1,
                 },
             ));
             i = next;
@@ -151,11 +176,11 @@ fn yaml_lists(text: &str, path: &Path) -> Result<Vec<(String, NumberList)>, Impo
                     j += 1;
                 }
             }
-            let Some((values, _)) = data else {
+            let Some((values, data_line)) = data else {
                 return Err(ImportError::Csv {
                     path: path.to_path_buf(),
                     line: i + 1,
-                    message: format!("`{key}` is an opencv-matrix without `data`"),
+                    message: format!("`{}` is an opencv-matrix without `data`", excerpt(&key)),
                 });
             };
             let cols = fields.get("cols").and_then(|c| c.parse::<usize>().ok());
@@ -164,6 +189,7 @@ fn yaml_lists(text: &str, path: &Path) -> Result<Vec<(String, NumberList)>, Impo
                 NumberList {
                     values,
                     width: cols,
+                    line: data_line,
                 },
             ));
             i = j;
@@ -212,7 +238,7 @@ fn numbers_in(body: &str, path: &Path, key: &str, line: usize) -> Result<Vec<f64
             number(s).ok_or_else(|| ImportError::Csv {
                 path: path.to_path_buf(),
                 line,
-                message: format!("`{key}`: `{s}` is not a number"),
+                message: format!("`{}`: `{}` is not a number", excerpt(key), excerpt(s)),
             })
         })
         .collect()
@@ -240,7 +266,7 @@ pub(super) fn read_json(
     let key = choose_key(&keys, format, path)?;
     let bad = |message: String| ImportError::File {
         path: path.to_path_buf(),
-        message: format!("`{key}`: {message}"),
+        message: format!("`{}`: {message}", excerpt(key)),
     };
     let list = match map.get(key) {
         Some(Value::Array(items)) if items.iter().all(Value::is_array) => {
@@ -254,11 +280,16 @@ pub(super) fn read_json(
                 }
                 values.extend(p);
             }
-            NumberList { values, width }
+            NumberList {
+                values,
+                width,
+                line: 1,
+            }
         }
         Some(v @ Value::Array(_)) => NumberList {
             values: json_numbers(v).ok_or_else(|| bad("not a list of numbers".into()))?,
             width: None,
+            line: 1,
         },
         Some(Value::Object(m)) => NumberList {
             values: m
@@ -269,12 +300,14 @@ pub(super) fn read_json(
                 .get("cols")
                 .and_then(Value::as_u64)
                 .and_then(|c| usize::try_from(c).ok()),
+            line: 1,
         },
         _ => return Err(bad("not a list of numbers".into())),
     };
     let mut out = Collector::new(format);
-    for p in points_of_list(&list, path, key)? {
-        out.push(p);
+    for (i, p) in points_of_list(&list, path, key)?.into_iter().enumerate() {
+        out.push(p)
+            .map_err(|message| bad(format!("point {}: {message}", i + 1)))?;
     }
     Ok(out.finish(path))
 }

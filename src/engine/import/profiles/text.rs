@@ -6,6 +6,7 @@ use std::path::Path;
 use super::{AXIS_NAMES, Collector, ProfileFormat, RawProfile, number};
 use crate::engine::import::ImportError;
 use crate::engine::import::csv_file::CsvFile;
+use crate::engine::table::{excerpt, overlong_line, overlong_line_message};
 
 /// A CSV/TXT profile with or without a header.
 pub(super) fn read_text_profile(
@@ -18,6 +19,13 @@ pub(super) fn read_text_profile(
         .lines()
         .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
         .unwrap_or("");
+    if let Some((line, length)) = overlong_line(text) {
+        return Err(ImportError::Csv {
+            path: path.to_path_buf(),
+            line,
+            message: overlong_line_message(length),
+        });
+    }
     let has_header = split_fields(first).iter().any(|f| number(f).is_none());
     let mut out = Collector::new(format);
     if has_header {
@@ -29,8 +37,12 @@ pub(super) fn read_text_profile(
                 Some(c) => c,
                 None => *columns.insert(xyz_columns(csv)?),
             };
-            out.push(xyz_of(csv, line, row, &columns)?);
-            Ok(())
+            out.push(xyz_of(csv, line, row, &columns)?)
+                .map_err(|message| ImportError::Csv {
+                    path: path.to_path_buf(),
+                    line,
+                    message,
+                })
         })
         .and_then(|csv| match columns {
             // A header and no rows: the columns are still checked.
@@ -52,7 +64,7 @@ pub(super) fn read_text_profile(
                 .ok_or_else(|| ImportError::Csv {
                     path: path.to_path_buf(),
                     line: i + 1,
-                    message: format!("`{l}` is not a row of numbers"),
+                    message: format!("`{}` is not a row of numbers", excerpt(l)),
                 })?;
             let w = *width.get_or_insert(values.len());
             if values.len() != w || !(2..=3).contains(&w) {
@@ -69,7 +81,12 @@ pub(super) fn read_text_profile(
                 [0.0, values[0], values[1]]
             } else {
                 [values[0], values[1], values[2]]
-            });
+            })
+            .map_err(|message| ImportError::Csv {
+                path: path.to_path_buf(),
+                line: i + 1,
+                message,
+            })?;
         }
     }
     Ok(out.finish(path))
@@ -90,7 +107,7 @@ pub(super) fn xyz_columns(csv: &CsvFile) -> Result<[Option<usize>; 3], ImportErr
             path: csv.path.clone(),
             message: format!(
                 "a profile needs two or three of the columns x, y, z (the header has: {})",
-                csv.header.join(", ")
+                excerpt(&csv.header.join(", "))
             ),
         });
     }
@@ -112,7 +129,11 @@ pub(super) fn xyz_of(
             *v = number(cell).ok_or_else(|| ImportError::Csv {
                 path: csv.path.clone(),
                 line,
-                message: format!("column `{}`: `{cell}` is not a number", csv.header[c]),
+                message: format!(
+                    "column `{}`: `{}` is not a number",
+                    excerpt(&csv.header[c]),
+                    excerpt(cell)
+                ),
             })?;
         }
     }

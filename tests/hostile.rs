@@ -1,0 +1,471 @@
+//! Issue 23, the third round of attacks: nothing hostile is accepted
+//! silently. Each test is a regression test of one finding — a URDF with
+//! duplicate names or absurd origins, a joint log with more joints than
+//! the robot, DH tables sorted otherwise or in radians, contradicting
+//! reference distances, the OpenCV profile corner cases, implausible
+//! result files, a calibration that "converges" to a scatter no sensor
+//! gives, a threshold that calibrates nothing, a plan of 100,000 stations.
+//! (Parsers' fuzz cases are in `tests/fuzz.rs`; the outputs' all-or-none
+//! in `tests/cli.rs`.)
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use spherecal::engine::format;
+use spherecal::engine::import::{
+    self, AngleUnit, ColumnMap, DEFAULT_SPHERE_DIAMETER, ImportSpec, ProfileFormat, ProfileSource,
+    RobotSource,
+};
+use spherecal::engine::robot::{DhConvention, robot_from_dh_csv, robot_from_urdf};
+
+fn data(name: &str) -> String {
+    fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/robots")
+            .join(name),
+    )
+    .unwrap()
+}
+
+fn urdf_error(text: &str) -> String {
+    robot_from_urdf(text, Path::new("cell.urdf"))
+        .unwrap_err()
+        .to_string()
+}
+
+/// Duplicate link or joint names were ignored; an origin of 1e300 or NaN
+/// became another robot (or an error blamed on joints.csv).
+#[test]
+fn a_urdf_with_duplicate_names_or_absurd_origins_is_refused() {
+    let irb = data("abb_irb2400.urdf");
+    assert!(robot_from_urdf(&irb, Path::new("cell.urdf")).is_ok());
+    let twice = irb.replacen(
+        "<link name=\"link_1\">",
+        "<link name=\"link_1\"/><link name=\"link_1\">",
+        1,
+    );
+    let e = urdf_error(&twice);
+    assert!(e.contains("two links are named `link_1`"), "{e}");
+    let twice = irb.replacen("name=\"joint_2\"", "name=\"joint_1\"", 1);
+    let e = urdf_error(&twice);
+    assert!(e.contains("joint `joint_1`: two joints"), "{e}");
+    // The first joint origin of the file, made absurd.
+    let start = irb.find("<joint ").unwrap();
+    let at = start + irb[start..].find("<origin xyz=\"").unwrap() + "<origin xyz=\"".len();
+    let end = at + irb[at..].find('"').unwrap();
+    for (xyz, needle) in [
+        ("1e300 0 0", "origin xyz=\"1e300 0 0\" is not plausible"),
+        ("nan 0 0", "origin xyz=\"NaN 0 0\""),
+    ] {
+        let mut bad = irb.clone();
+        bad.replace_range(at..end, xyz);
+        let e = urdf_error(&bad);
+        assert!(
+            e.contains("cell.urdf: joint `joint_1`") && e.contains(needle),
+            "{e}"
+        );
+    }
+    // An angle of 1e300 rad is no joint's zero offset either.
+    let bad = irb.replacen(
+        "<joint name=\"joint_1\" type=\"revolute\">\n    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>",
+        "<joint name=\"joint_1\" type=\"revolute\">\n    <origin xyz=\"0 0 0\" rpy=\"0 0 1e300\"/>",
+        1,
+    );
+    assert_ne!(bad, irb);
+    let e = urdf_error(&bad);
+    assert!(
+        e.contains("joint `joint_1`") && e.contains("origin rpy=\"0 0 1e300\""),
+        "{e}"
+    );
+}
+
+/// The import spec of `dir/log.csv` with `robot`.
+fn spec(dir: &Path, robot: RobotSource, joints: usize) -> ImportSpec {
+    ImportSpec {
+        joint_log: dir.join("log.csv"),
+        columns: ColumnMap {
+            id: "id".into(),
+            station: "station".into(),
+            usage: "use".into(),
+            side: None,
+            joints: (1..=joints).map(|k| format!("j{k}")).collect(),
+        },
+        joint_unit: AngleUnit::Deg,
+        profiles: ProfileSource::Folder(dir.join("profiles")),
+        profile_format: ProfileFormat::default(),
+        robot,
+        sphere_diameter: DEFAULT_SPHERE_DIAMETER,
+        name: None,
+        flange: None,
+        references: None,
+    }
+}
+
+/// A 1-joint URDF with a 6-joint log imported and dropped j2-j6.
+#[test]
+fn a_log_with_more_joints_than_the_robot_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = dir.path().join("one.urdf");
+    fs::write(
+        &urdf,
+        r#"<robot name="one">
+  <link name="base"/><link name="tip"/>
+  <joint name="j" type="revolute"><parent link="base"/><child link="tip"/>
+    <origin xyz="0 0 0.5"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+</robot>"#,
+    )
+    .unwrap();
+    fs::write(
+        dir.path().join("log.csv"),
+        "id,station,use,j1,j2,j3,j4,j5,j6\nt1,P0,translation,1,2,3,4,5,6\n",
+    )
+    .unwrap();
+    let robot = RobotSource::Urdf {
+        path: urdf,
+        tip: None,
+    };
+    let e = import::import(&spec(dir.path(), robot, 1))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`j2`") && e.contains("`j6`") && e.contains("1 joint"),
+        "{e}"
+    );
+    assert!(
+        e.ends_with(&format!("({})", dir.path().join("log.csv").display())),
+        "{e}"
+    );
+}
+
+fn dh_error(text: &str, convention: DhConvention) -> String {
+    robot_from_dh_csv(text, Path::new("robot.csv"), convention)
+        .unwrap_err()
+        .to_string()
+}
+
+/// A DH table's joint labels were ignored (rows taken in file order),
+/// angles in radians read as degrees, a length of 1e300 blamed later on
+/// joints.csv.
+#[test]
+fn dh_tables_sorted_otherwise_in_radians_or_absurd_are_refused() {
+    let irb = data("abb_irb2400_mdh.csv");
+    assert!(robot_from_dh_csv(&irb, Path::new("robot.csv"), DhConvention::Modified).is_ok());
+    let swapped = irb.replace(
+        "2,-90,100,0,-90,0\n3,0,705,0,0,0",
+        "3,0,705,0,0,0\n2,-90,100,0,-90,0",
+    );
+    let e = dh_error(&swapped, DhConvention::Modified);
+    assert!(
+        e.contains("robot.csv, line 6") && e.contains("labels this row `3` after `1`"),
+        "{e}"
+    );
+    let labelled = irb.replace("\n1,", "\nJ1,").replace("\n2,", "\nJ2,");
+    assert!(robot_from_dh_csv(&labelled, Path::new("r.csv"), DhConvention::Modified).is_ok());
+    let radians = "joint,a,alpha,d,theta\n1,0,1.5708,162.5,0\n2,-425,0,0,0\n3,-392.2,0,0,0\n4,0,1.5708,133.3,0\n5,0,-1.5708,99.7,0\n6,0,0,99.6,0\n";
+    let e = dh_error(radians, DhConvention::Standard);
+    assert!(
+        e.contains("line 2") && e.contains("looks like radians") && e.contains("alpha_rad"),
+        "{e}"
+    );
+    // Said in the header, radians are read as such.
+    let said = radians.replace("alpha,", "alpha_rad,");
+    let ur = robot_from_dh_csv(&said, Path::new("r.csv"), DhConvention::Standard).unwrap();
+    assert!(
+        (ur.joints[1].alpha - 90.0).abs() < 1e-3,
+        "{:?}",
+        ur.joints[1]
+    );
+    let absurd = irb.replace("3,0,705,0,0,0", "3,0,1e300,0,0,0");
+    let e = dh_error(&absurd, DhConvention::Modified);
+    assert!(
+        e.contains("robot.csv, line 7: column `a`: 1e300 mm is not plausible"),
+        "{e}"
+    );
+}
+
+/// Two contradicting distances for one pair were accepted (the
+/// validation std became 78 mm).
+#[test]
+fn contradicting_reference_distances_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let refs = dir.path().join("references.csv");
+    fs::write(&refs, "from,to,distance\nV1,V2,500\nV3,V4,400\nV2,V1,590\n").unwrap();
+    let e = import::read_references(&refs).unwrap_err().to_string();
+    assert!(
+        e.contains("line 4") && e.contains("first on line 2") && e.contains("contradict"),
+        "{e}"
+    );
+    fs::write(&refs, "from,to,distance\nV1,V2,500\nV1,V2,500\n").unwrap();
+    let e = import::read_references(&refs).unwrap_err().to_string();
+    assert!(e.contains("count its pairs twice"), "{e}");
+    // In a session file too.
+    let mut v: serde_json::Value = serde_json::from_str(spherecal::DEMO_SESSION_JSON).unwrap();
+    let list = v["reference_distances"].as_array_mut().unwrap();
+    let mut copy = list[0].clone();
+    copy["distance"] = serde_json::json!(copy["distance"].as_f64().unwrap() + 78.0);
+    list.push(copy);
+    let e = format::parse_session(&v.to_string(), Path::new("s.json"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("contradict each other") && e.contains("reference_distances[0]"),
+        "{e}"
+    );
+}
+
+fn read(path: &Path, format: &ProfileFormat) -> Result<import::RawProfile, String> {
+    import::profiles::read_profile(path, format).map_err(|e| e.to_string())
+}
+
+/// OpenCV YAML with `.nan` in the plane's normal coordinate was read as
+/// pairs; `--no-return 0` dropped every point of a planar profile; a
+/// 1e300 was reported as `points[3]`; the axis guess blamed the first
+/// profile instead of the odd one.
+#[test]
+fn profile_corner_cases_are_read_right_and_blamed_right() {
+    let dir = tempfile::tempdir().unwrap();
+    let yml = dir.path().join("c1.yml");
+    fs::write(
+        &yml,
+        "%YAML:1.0\n---\nscan_line: [ 1.5, 0., -2., 1.6, .nan, 2.1,\n  1.7, 0., 2.2, 1.8, 0., 2.3 ]\n",
+    )
+    .unwrap();
+    let p = read(&yml, &ProfileFormat::default()).unwrap();
+    assert_eq!(
+        p.points,
+        [[1.5, 0.0, -2.0], [1.7, 0.0, 2.2], [1.8, 0.0, 2.3]]
+    );
+    assert_eq!(p.non_finite, 1);
+    // The no-return value 0 is a reading on x and z, not on the plane's y.
+    let csv = dir.path().join("c2.csv");
+    fs::write(&csv, "x,y,z\n1,0,2\n2,0,0\n3,0,4\n4,0,5\n").unwrap();
+    let zero = ProfileFormat {
+        no_return: Some(0.0),
+        ..ProfileFormat::default()
+    };
+    let p = read(&csv, &zero).unwrap();
+    assert_eq!(
+        p.points,
+        [[1.0, 0.0, 2.0], [3.0, 0.0, 4.0], [4.0, 0.0, 5.0]]
+    );
+    assert_eq!(p.no_return, 1);
+    let pairs = dir.path().join("c3.txt");
+    fs::write(&pairs, "1 2\n3 0\n5 6\n").unwrap();
+    let p = read(&pairs, &zero).unwrap();
+    assert_eq!((p.points.len(), p.no_return), (2, 1));
+    // A value beyond any sensor: its line.
+    fs::write(&csv, "y,z\n1,2\n3,4\n1e300,5\n").unwrap();
+    let e = read(&csv, &ProfileFormat::default()).unwrap_err();
+    assert!(e.contains("line 4: y = 1e300 mm is not plausible"), "{e}");
+    // The odd profile out is named, not the first one.
+    let folder = dir.path().join("profiles");
+    fs::create_dir(&folder).unwrap();
+    let ids: Vec<String> = (1..=3).map(|k| format!("p{k}")).collect();
+    for id in &ids {
+        // p1 and p2 lie in the plane x = 0; p3 tilts out of it.
+        let x = |k: i32| {
+            if id == "p3" {
+                1.0 + 0.1 * f64::from(k)
+            } else {
+                0.0
+            }
+        };
+        let text: String = (0..6)
+            .map(|k| format!("{},{k},{}\n", x(k), k * k))
+            .collect();
+        fs::write(folder.join(format!("{id}.csv")), format!("x,y,z\n{text}")).unwrap();
+    }
+    let e = import::read_profiles(
+        &ProfileSource::Folder(folder.clone()),
+        &ProfileFormat::default(),
+        &ids,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.ends_with(&format!("({})", folder.join("p3.csv").display())),
+        "{e}"
+    );
+    assert!(
+        e.contains("not in the plane the other profiles lie in"),
+        "{e}"
+    );
+}
+
+/// A result with a hand-eye of 1e308 mm or a length of 1e300 mm flowed
+/// into history, report and every export; refused on reading, and never
+/// written.
+#[test]
+fn implausible_result_files_are_refused() {
+    let session =
+        format::parse_session(spherecal::DEMO_SESSION_JSON, Path::new("demo.json")).unwrap();
+    let mut options = spherecal::engine::solve::Options::from_session(&session);
+    options.max_iterations = 2;
+    options.ml.cross_validation = false;
+    let (_, cal) = spherecal::engine::solve::calibrate(&session, &options).unwrap();
+    let result = format::ResultFile::from_calibration(&session, &cal);
+    let text = format::result_to_json(&result);
+    assert!(format::parse_result(&text, Path::new("r.json")).is_ok());
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["hand_eye"][0][3] = serde_json::json!(1e308);
+    let e = format::parse_result(&v.to_string(), Path::new("r.json"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`hand_eye[0][3]` = 1e308 mm is not plausible"),
+        "{e}"
+    );
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["robot"]["joints"][2]["a"] = serde_json::json!(1e300);
+    let e = format::parse_result(&v.to_string(), Path::new("r.json"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`robot.joints[2].a` = 1e300 mm"), "{e}");
+    let mut bad = result.clone();
+    bad.hand_eye.translation.vector.x = 1e308;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.json");
+    let e = format::save_result(&bad, &out).unwrap_err().to_string();
+    assert!(e.contains("the result is not written"), "{e}");
+    assert!(!out.exists());
+}
+
+fn spherecal_cli(args: &[&str]) -> (i32, String, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_spherecal"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// A simulated session (`dir/s.json`).
+fn simulated(dir: &Path) -> PathBuf {
+    let s = dir.join("s.json");
+    let (code, _, err) = spherecal_cli(&["simulate", "--out", s.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    s
+}
+
+/// A log in radians read as degrees calibrated to ε 19 mm, exit 0 (and a
+/// FANUC pose log read as KUKA to a 75 mm scatter): a scatter beyond any
+/// sensor is a failed calibration, written only on request.
+#[test]
+fn a_calibration_that_scatters_beyond_any_sensor_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = simulated(dir.path());
+    let mut v: serde_json::Value = serde_json::from_str(&fs::read_to_string(&s).unwrap()).unwrap();
+    for m in v["measurements"].as_array_mut().unwrap() {
+        for q in m["joints"].as_array_mut().unwrap() {
+            *q = serde_json::json!(q.as_f64().unwrap().to_radians());
+        }
+    }
+    let rad = dir.path().join("rad.json");
+    fs::write(&rad, v.to_string()).unwrap();
+    let out = dir.path().join("r.json");
+    let (r, o) = (rad.to_str().unwrap(), out.to_str().unwrap());
+    let (code, _, err) = spherecal_cli(&["calibrate", r, "--out", o, "-q"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("the calibration failed") && err.contains("--joint-unit"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let (code, _, err) = spherecal_cli(&["calibrate", r, "--out", o, "-q", "--accept-implausible"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("warning: the calibration failed"), "{err}");
+    assert!(out.exists());
+    // The report, which calibrates first, as well.
+    let html = dir.path().join("r.html");
+    let (code, _, err) = spherecal_cli(&["report", r, "--out", html.to_str().unwrap(), "-q"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("the calibration failed") && !html.exists(),
+        "{err}"
+    );
+}
+
+/// `--threshold 1e308`: 0 updates, "converged", the uncalibrated result
+/// written. Refused; a threshold above the starting ε is said plainly.
+#[test]
+fn a_threshold_that_calibrates_nothing_is_refused_or_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = simulated(dir.path());
+    let out = dir.path().join("r.json");
+    let (s, o) = (s.to_str().unwrap(), out.to_str().unwrap());
+    let (code, _, err) = spherecal_cli(&["calibrate", s, "--out", o, "--threshold", "1e308"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("threshold 1e308 mm is not plausible"), "{err}");
+    assert!(!out.exists());
+    let (code, _, err) = spherecal_cli(&["calibrate", s, "--out", o, "--threshold", "500", "-q"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("nothing was identified"), "{err}");
+}
+
+/// `plan --identify-stations 100000` printed nothing for two minutes.
+#[test]
+fn an_oversized_plan_is_refused_at_once() {
+    let started = std::time::Instant::now();
+    let (code, _, err) = spherecal_cli(&[
+        "plan",
+        "--sphere",
+        "1050,0,475",
+        "--identify-stations",
+        "100000",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("100010 stations asked for") && err.contains("at most 500"),
+        "{err}"
+    );
+    assert!(started.elapsed().as_secs_f64() < 10.0);
+}
+
+/// 1e308 in options, history or YAML was printed as 309 digits.
+#[test]
+fn huge_numbers_are_shown_short() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = simulated(dir.path());
+    let o = dir.path().join("r.json");
+    let yml = dir.path().join("p.yml");
+    fs::write(&yml, "scan_line: [ 1e308, 1, 2, 1e308, 3, 4 ]\n").unwrap();
+    let library = Path::new(env!("CARGO_MANIFEST_DIR")).join("sessions/history");
+    let runs = [
+        vec![
+            "calibrate",
+            s.to_str().unwrap(),
+            "--out",
+            o.to_str().unwrap(),
+            "--threshold",
+            "1e308",
+        ],
+        vec!["plan", "--sphere", "1e308,0,0"],
+        vec!["plan", "--sphere", "1050,0,475", "--diameter", "1e308"],
+        vec![
+            "simulate",
+            "--out",
+            o.to_str().unwrap(),
+            "--diameter",
+            "1e308",
+        ],
+        vec!["history", library.to_str().unwrap(), "--k", "1e308"],
+    ];
+    for args in runs {
+        let (code, out, err) = spherecal_cli(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains("1e308"), "{args:?}: {err}");
+        assert!(
+            !format!("{out}{err}").contains("0000000000"),
+            "{args:?}: {out}{err}"
+        );
+    }
+    let e = import::profiles::read_profile(&yml, &ProfileFormat::default()).unwrap_err();
+    assert!(e.to_string().contains("1e308"), "{e}");
+}
