@@ -9,8 +9,10 @@ use crate::engine::session::{Session, Use};
 use crate::engine::solve::Calibration;
 use crate::engine::validate::scatter_rms;
 
-/// A few lines for people: why the loop stopped, what the SVD kept, how
-/// the hand-eye moved, and the before/after validation figures.
+/// A few lines for people: why the loop stopped (and a warning when the
+/// paper's loop made ε worse), what the SVD kept, how the hand-eye moved,
+/// the held-out figure beside the fit's own scatter, and the before/after
+/// validation figures.
 #[must_use]
 pub fn summary(session: &Session, cal: &Calibration) -> String {
     let mut s = String::new();
@@ -21,6 +23,12 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
         cal.epsilon_before(),
         cal.epsilon_after()
     );
+    if let Some(w) = cal
+        .report
+        .epsilon_warning(cal.epsilon_before(), cal.epsilon_after())
+    {
+        let _ = writeln!(s, "warning: {w}");
+    }
     if let Some((p, kept)) = cal
         .report
         .paper()
@@ -61,6 +69,9 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
         s,
         "identify stations, centre scatter about each station's mean (3-D rms): {before:.4} → {after:.4} mm"
     );
+    if let Some(h) = &cal.held_out {
+        let _ = writeln!(s, "{h}");
+    }
     match &cal.validation {
         Some(v) if !v.distances.is_empty() => {
             let _ = writeln!(
