@@ -57,8 +57,14 @@ fn one_gauss_newton_step_matches_exact_refits_and_exceeds_the_fit() {
             seed,
             ..SimConfig::default()
         };
-        cases.push((format!("IRB 2400 seed {seed}"), simulate::simulate(&config).unwrap().0));
-        cases.push((format!("one station, 15 poses, seed {seed}"), one_station(seed, 15, 0.15)));
+        cases.push((
+            format!("IRB 2400 seed {seed}"),
+            simulate::simulate(&config).unwrap().0,
+        ));
+        cases.push((
+            format!("one station, 15 poses, seed {seed}"),
+            one_station(seed, 15, 0.15),
+        ));
     }
     for (name, session) in &cases {
         let mut o = options(session, Method::Ml);
@@ -67,7 +73,11 @@ fn one_gauss_newton_step_matches_exact_refits_and_exceeds_the_fit() {
         let (prepared, cal) = calibrate(session, &o);
         let one = cal.held_out.as_ref().expect("held out");
         assert_eq!(one.scheme, HeldOutScheme::LeaveOnePoseOut);
-        assert!(one.undetermined.is_empty(), "{name}: {:?}", one.undetermined);
+        assert!(
+            one.undetermined.is_empty(),
+            "{name}: {:?}",
+            one.undetermined
+        );
         let exact = exact_held_out(session, &prepared, &o).unwrap();
         let (rel, worst) = compare(one, &exact);
         eprintln!(
@@ -88,7 +98,11 @@ fn paper_without(session: &Session, options: &Options, id: &str) -> f64 {
     let mut less = session.clone();
     less.measurements.retain(|m| m.id != id);
     let (_, cal) = calibrate(&less, options);
-    let i = session.measurements.iter().position(|m| m.id == id).unwrap();
+    let i = session
+        .measurements
+        .iter()
+        .position(|m| m.id == id)
+        .unwrap();
     let station = &session.measurements[i].station;
     let others: Vec<_> = cal
         .centres
@@ -197,7 +211,9 @@ fn the_figure_is_in_the_result_file_the_summary_and_the_report() {
     off.held_out = false;
     let (_, cal) = calibrate(&session, &off);
     assert!(cal.held_out.is_none());
-    assert!(!format::result_to_json(&ResultFile::from_calibration(&session, &cal)).contains("held_out"));
+    assert!(
+        !format::result_to_json(&ResultFile::from_calibration(&session, &cal)).contains("held_out")
+    );
 }
 
 #[test]

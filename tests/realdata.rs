@@ -313,7 +313,10 @@ fn the_real_set_gets_a_held_out_figure_and_the_papers_rise_is_a_warning() {
     // against 0.3418 mm, the worst pose (p3) 0.0099 mm off: leaving it out
     // moves the outlier p5's Huber weight, which the step holds at the
     // solution's (with the squared loss the two agree to 1e-4).
-    assert!((h.rms - exact.rms).abs() < 1e-2 * exact.rms, "{h} vs {exact}");
+    assert!(
+        (h.rms - exact.rms).abs() < 1e-2 * exact.rms,
+        "{h} vs {exact}"
+    );
     for (a, b) in h.measurements.iter().zip(&exact.measurements) {
         assert!((a.held_out - b.held_out).abs() < 0.02, "{a:?} vs {b:?}");
     }
@@ -326,6 +329,12 @@ fn the_real_set_gets_a_held_out_figure_and_the_papers_rise_is_a_warning() {
         "{text}"
     );
     let p = cal.held_out.as_ref().expect("held out");
-    eprintln!("paper: held out rms {:.4} mm, fit's own {:.4} mm", p.rms, p.fit_rms);
-    assert!(p.rms > h.rms, "ml predicts the poses it has not seen better");
+    eprintln!(
+        "paper: held out rms {:.4} mm, fit's own {:.4} mm",
+        p.rms, p.fit_rms
+    );
+    assert!(
+        p.rms > h.rms,
+        "ml predicts the poses it has not seen better"
+    );
 }

@@ -15,9 +15,9 @@ use super::{FORMAT_VERSION, FileError, RESULT_FORMAT, write_atomic};
 use crate::engine::geometry::{isometry_from_rows, rigid_from_rows, rows_from_isometry};
 use crate::engine::robot::{Joint, Robot};
 use crate::engine::session::{Session, Use};
-use crate::engine::solve::{Calibration, HeldOut};
 use crate::engine::solve::ml::MlReport;
 use crate::engine::solve::report::{Direction, PaperReport, SolverReport};
+use crate::engine::solve::{Calibration, HeldOut};
 use crate::engine::validate::Validation;
 
 /// A result (FORMAT.md "Result file") as the engine holds it: transforms

@@ -214,7 +214,11 @@ impl Phase {
             }
             Self::Outliers => "outliers and variance factor".to_string(),
             Self::HeldOut { scheme, done, of } => {
-                format!("held out ({}): {done} of {of} {}", scheme.label(of), scheme.unit())
+                format!(
+                    "held out ({}): {done} of {of} {}",
+                    scheme.label(of),
+                    scheme.unit()
+                )
             }
         }
     }

@@ -46,7 +46,9 @@ pub const EPSILON_RISE_MM: f64 = 1e-4;
 /// failed on this data.
 #[must_use]
 pub fn epsilon_rise_warning(pairs: Option<&str>, before: f64, after: f64) -> Option<String> {
-    if !(after - before > EPSILON_RISE_MM) {
+    // A NaN compares false: no warning.
+    let rose = after - before > EPSILON_RISE_MM;
+    if !rose {
         return None;
     }
     let (fits, instead) = if pairs == Some(Pairing::All.as_str()) {
@@ -367,9 +369,15 @@ mod tests {
     fn a_rise_of_epsilon_is_a_warning_naming_the_other_methods() {
         let w = epsilon_rise_warning(Some("disjoint"), 0.3699, 0.3757).unwrap();
         assert!(w.contains("ε rose from 0.3699 mm to 0.3757 mm"), "{w}");
-        assert!(w.contains("`--method ml`") && w.contains("`--pairs all`"), "{w}");
+        assert!(
+            w.contains("`--method ml`") && w.contains("`--pairs all`"),
+            "{w}"
+        );
         let w = epsilon_rise_warning(Some("all"), 0.3, 0.4).unwrap();
-        assert!(w.contains("`--method ml`") && !w.contains("--pairs all"), "{w}");
+        assert!(
+            w.contains("`--method ml`") && !w.contains("--pairs all"),
+            "{w}"
+        );
         // A fall, no change, and a rise within rounding: no warning.
         assert!(epsilon_rise_warning(None, 0.37, 0.35).is_none());
         assert!(epsilon_rise_warning(None, 0.37, 0.37).is_none());

@@ -108,8 +108,8 @@ use super::estimate::unknown_scale;
 use super::estimate::{Estimate, Station};
 use super::prepare::Prepared;
 use super::{
-    Control, HeldOut, HeldOutRecord, HeldOutScheme, Options, Phase, SolveError, SolverReport,
-    Step, StopReason, Update,
+    Control, HeldOut, HeldOutRecord, HeldOutScheme, Options, Phase, SolveError, SolverReport, Step,
+    StopReason, Update,
 };
 use crate::engine::session::{Session, Use};
 use crate::engine::validate::epsilon;
@@ -502,9 +502,7 @@ pub fn exact_held_out(
     let predictions = (0..problem.obs.len())
         .map(|i| {
             let o = &problem.obs[i];
-            let refit = problem
-                .without(i)
-                .solve_from(&update.state, MAX_LM_STEPS);
+            let refit = problem.without(i).solve_from(&update.state, MAX_LM_STEPS);
             let held = (refit.est.centre_in_base(&o.sighting) - refit.centres[o.station]).norm();
             let fit = (update.state.est.centre_in_base(&o.sighting)
                 - update.state.centres[o.station])
