@@ -92,8 +92,9 @@ fn one_gauss_newton_step_matches_exact_refits_and_exceeds_the_fit() {
 }
 
 /// The paper's refit without measurement `id`, made by hand: the session
-/// without it, the paper's method from the same start; its centre against
-/// the mean of its station's other centres.
+/// without it, the paper's method from the same start for as many updates
+/// as `options` allow; its centre against the mean of its station's other
+/// centres.
 fn paper_without(session: &Session, options: &Options, id: &str) -> f64 {
     let mut less = session.clone();
     less.measurements.retain(|m| m.id != id);
@@ -132,10 +133,18 @@ fn the_papers_figure_is_its_own_method_rerun_without_the_measurement() {
     assert_eq!((h.scheme, h.folds), (HeldOutScheme::LeaveOnePoseOut, 15));
     assert_eq!(h.measurements.len(), 15);
     assert!(h.rms > h.fit_rms, "{h}");
+    // Each refit makes as many updates as the run made.
+    let updates = cal.iterations.len() - 1;
+    assert!(updates >= 1);
+    let same_updates = Options {
+        threshold: 0.0,
+        max_iterations: updates,
+        ..o
+    };
     for r in h.measurements.iter().step_by(7) {
-        let by_hand = paper_without(&session, &o, &r.measurement);
+        let by_hand = paper_without(&session, &same_updates, &r.measurement);
         assert!(
-            (r.held_out - by_hand).abs() < 1e-9,
+            (r.held_out - by_hand).abs() < 1e-7,
             "{}: {} vs {by_hand}",
             r.measurement,
             r.held_out

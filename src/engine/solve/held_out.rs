@@ -32,10 +32,14 @@
 //! - **`paper`: exact refits of the paper's method.** The paper's update is
 //!   a truncated SVD of paired differences with no station centres and no
 //!   weights; an `ml` step on its result would score `ml`'s refit, not the
-//!   paper's. So each refit runs the paper's own loop (same pairing, SVD
-//!   tolerance, threshold and bound) from the same start on the session
-//!   without the held-out measurements, and the station centre is the mean
-//!   of the other measurements' centres under it. Leave-one-pose-out up to
+//!   paper's. So each refit is the paper's own update (same pairing and SVD
+//!   tolerance) made from the same start on the session without the
+//!   held-out measurements, as many times as the run made it, and the
+//!   station centre is the mean of the other measurements' centres under
+//!   it. The count is the run's, not the loop's stop rule again: a refit
+//!   that stopped at the threshold after other updates than the run would
+//!   score a different procedure, and one that missed the threshold would
+//!   make all 20 updates (40 × the run's cost on the demo instead of 10 ×). Leave-one-pose-out up to
 //!   [`PAPER_LEAVE_ONE_OUT_MAX`] identify measurements, else
 //!   [`PAPER_FOLDS`]-fold (measurement `k` of the stations in file order
 //!   goes to fold `k mod K`, so that two measurements of a station share
@@ -49,7 +53,7 @@ use serde::{Deserialize, Serialize};
 
 use super::estimate::{Estimate, Station};
 use super::paper::PaperUpdate;
-use super::{Control, Options, Phase, Update, iterate};
+use super::{Control, Options, Phase, Step, Update};
 use crate::engine::validate::Stats;
 
 /// Up to this many identify measurements the paper's held-out figure is
@@ -241,12 +245,13 @@ fn mean(points: &[Vector3<f64>]) -> Option<Vector3<f64>> {
     (!points.is_empty()).then(|| points.iter().sum::<Vector3<f64>>() / points.len() as f64)
 }
 
-/// The paper's held-out figure: its own loop rerun from `start` without
-/// each fold of the identify `stations` (see the module docs), scored
-/// against the fit `fitted`. `None` when `phase` cancelled.
+/// The paper's held-out figure: its update made `updates` times from
+/// `start` without each fold of the identify `stations` (see the module
+/// docs), scored against the fit `fitted`. `None` when `phase` cancelled.
 pub(super) fn paper_refits(
     start: &Estimate,
     fitted: &Estimate,
+    updates: usize,
     stations: &[Station],
     options: &Options,
     phase: &mut dyn FnMut(Phase) -> Control,
@@ -297,26 +302,28 @@ pub(super) fn paper_refits(
             })
             .collect();
         let mut update = PaperUpdate::new(start.clone(), training.clone(), options);
-        let mut cancelled = false;
-        let looped = iterate(&mut update, &training, options, &mut |_| {
+        let mut failed = false;
+        for u in 1..=updates {
+            let mut inner = |_: Phase| Control::Continue;
+            match update.update(u, &mut inner) {
+                Ok(Step::Moved) => {}
+                // A fold whose rest cannot be calibrated (no pair left)
+                // predicts nothing: its measurements stay undetermined.
+                Ok(_) | Err(_) => {
+                    failed = true;
+                    break;
+                }
+            }
             if phase(Phase::HeldOut {
                 scheme,
                 done: f,
                 of: folds,
             }) == Control::Cancel
             {
-                cancelled = true;
-                Control::Cancel
-            } else {
-                Control::Continue
+                return None;
             }
-        });
-        if cancelled {
-            return None;
         }
-        // A fold whose rest cannot be calibrated (no pair left) predicts
-        // nothing: its measurements stay undetermined.
-        if looped.is_err() {
+        if failed {
             continue;
         }
         let refit = update.estimate();
@@ -352,7 +359,7 @@ pub(super) fn paper_refits(
         }
     }
     let refit = format!(
-        "the paper's method rerun from the same start without the held-out measurements ({}, same pairing, SVD tolerance, threshold and bound); the station centre is the mean of its other measurements' centres under that refit",
+        "the paper's update made {updates} time(s), as in the run, from the same start without the held-out measurements ({}, same pairing and SVD tolerance); the station centre is the mean of its other measurements' centres under that refit",
         scheme.label(folds)
     );
     Some(HeldOut::new(scheme, folds, refit, rows, undetermined))

@@ -63,7 +63,7 @@ pub fn epsilon_rise_warning(pairs: Option<&str>, before: f64, after: f64) -> Opt
         )
     };
     Some(format!(
-        "ε rose from {before:.4} mm to {after:.4} mm: the paper's updates left the identify centres scattering more than the start did (its update fits {fits}, not ε); this result is worse than no calibration: {instead}"
+        "ε rose from {before:.4} mm to {after:.4} mm: the paper's updates left the identify centres scattering more than the start did (its update fits {fits}, not ε); {instead}"
     ))
 }
 
@@ -290,6 +290,8 @@ pub struct PaperUpdate {
     stations: Vec<Station>,
     options: Options,
     last: Option<UpdateInfo>,
+    /// Updates made.
+    updates: usize,
 }
 
 impl PaperUpdate {
@@ -302,6 +304,7 @@ impl PaperUpdate {
             stations,
             options: *options,
             last: None,
+            updates: 0,
         }
     }
 }
@@ -322,12 +325,20 @@ impl Update for PaperUpdate {
         }
         self.est = self.est.updated(&info.delta);
         self.last = Some(info);
+        self.updates += 1;
         Ok(Step::Moved)
     }
 
     /// Exact refits of the paper's own loop ([`held_out`](super::held_out)).
     fn held_out(&self, phase: &mut dyn FnMut(Phase) -> Control) -> Option<HeldOut> {
-        super::held_out::paper_refits(&self.start, &self.est, &self.stations, &self.options, phase)
+        super::held_out::paper_refits(
+            &self.start,
+            &self.est,
+            self.updates,
+            &self.stations,
+            &self.options,
+            phase,
+        )
     }
 
     fn report(
