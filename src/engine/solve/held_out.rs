@@ -256,8 +256,11 @@ pub(super) fn paper_refits(
     options: &Options,
     phase: &mut dyn FnMut(Phase) -> Control,
 ) -> Option<HeldOut> {
-    let stations: Vec<&Station> = stations.iter().filter(|s| s.sightings.len() >= 2).collect();
-    let owned: Vec<Station> = stations.iter().map(|s| (*s).clone()).collect();
+    let owned: Vec<Station> = stations
+        .iter()
+        .filter(|s| s.sightings.len() >= 2)
+        .cloned()
+        .collect();
     let n: usize = owned.iter().map(|s| s.sightings.len()).sum();
     let (scheme, folds) = if n <= PAPER_LEAVE_ONE_OUT_MAX {
         (HeldOutScheme::LeaveOnePoseOut, n)
@@ -278,13 +281,16 @@ pub(super) fn paper_refits(
         .iter()
         .map(|s| vec![None; s.sightings.len()])
         .collect();
-    for f in 0..folds {
-        if phase(Phase::HeldOut {
+    let mut cancel = |done: usize| {
+        phase(Phase::HeldOut {
             scheme,
-            done: f,
+            done,
             of: folds,
         }) == Control::Cancel
-        {
+    };
+    for f in 0..folds {
+        // With no update to make, once a fold (the progress is still told).
+        if updates == 0 && cancel(f) {
             return None;
         }
         let training: Vec<Station> = owned
@@ -304,6 +310,10 @@ pub(super) fn paper_refits(
         let mut update = PaperUpdate::new(start.clone(), training.clone(), options);
         let mut failed = false;
         for u in 1..=updates {
+            // Before every update: one fold of a large session is a run.
+            if cancel(f) {
+                return None;
+            }
             let mut inner = |_: Phase| Control::Continue;
             match update.update(u, &mut inner) {
                 Ok(Step::Moved) => {}
@@ -313,14 +323,6 @@ pub(super) fn paper_refits(
                     failed = true;
                     break;
                 }
-            }
-            if phase(Phase::HeldOut {
-                scheme,
-                done: f,
-                of: folds,
-            }) == Control::Cancel
-            {
-                return None;
             }
         }
         if failed {
