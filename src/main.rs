@@ -3,7 +3,6 @@
 
 use std::process::ExitCode;
 
-use clap::Parser;
 use spherecal::cli::{self, Cli, CliError, Command};
 
 fn main() -> ExitCode {
@@ -13,7 +12,7 @@ fn main() -> ExitCode {
         spherecal::engine::format::remove_pending();
         std::process::exit(130);
     });
-    let parsed = Cli::parse();
+    let parsed = Cli::parse_args();
     let outcome = match parsed.command {
         Some(Command::Calibrate(args)) => cli::calibrate_command(&args),
         Some(Command::Simulate(args)) => cli::simulate::run(&args),

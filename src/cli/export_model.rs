@@ -55,6 +55,9 @@ pub struct ExportModelArgs {
     /// Where to write the model.
     #[arg(long, short)]
     pub out: PathBuf,
+    /// Print only errors.
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 /// Loads the result, exports its model and writes it atomically.
@@ -69,6 +72,9 @@ pub fn run(args: &ExportModelArgs) -> Result<(), CliError> {
     let text = model::export(&result, args.format.into(), &source)
         .map_err(|e| CliError::input(format!("{e} ({source})")))?;
     format::write_atomic(&args.out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
+    if args.quiet {
+        return Ok(());
+    }
     sayln!(
         "wrote the {} model of {} to {}",
         args.format.name(),

@@ -13,8 +13,8 @@ use crate::engine::format;
 use crate::engine::import::{
     self, AngleUnit, AxisMap, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM,
     DEFAULT_ROTATION_TOLERANCE_DEG, DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention,
-    ImportError, ImportSpec, Imported, LengthUnit, PoseImportSpec, ProfileFormat, ProfileSource,
-    RobotSource, SideChoice,
+    ImportError, ImportSpec, Imported, LengthUnit, Observations, PoseFormat, PoseImportSpec,
+    ProfileFormat, ProfileSource, RobotSource, SideChoice,
 };
 
 use super::CliError;
@@ -26,18 +26,27 @@ pub struct ImportArgs {
     /// The joint log CSV: one row a pose, with id, station, use and joint columns.
     #[arg(long)]
     pub joints: Option<PathBuf>,
-    /// A flange-pose log instead of joints (pose-only session): JSON or RobCalibrator `.rob` (a list of poses), or CSV with the convention's columns and optional id, station, use, side.
-    #[arg(long, requires = "pose_convention")]
+    /// A pose file instead of a joint log: a table (header optional; commas, semicolons, tabs or spaces), a JSON list (RobCalibrator `.rob`), or a robot program (FANUC .ls, ABB RAPID, KUKA .dat/.src, URScript); the layout is detected from the content and printed. Flange poses give a pose-only session; joint targets need --robot.
+    #[arg(long)]
     pub poses: Option<PathBuf>,
-    /// How the pose log writes a pose: ABB (x y z q1..q4), KUKA (x y z A B C), FANUC (x y z W P R), UR (x y z m, rotation vector) or matrix (16 numbers row-major).
+    /// Force the pose file's layout: table, json, fanuc-ls, rapid, krl or urscript (default: detected from the content).
+    #[arg(long, value_parser = parse_pose_format)]
+    pub pose_format: Option<PoseFormat>,
+    /// How a pose table or JSON list writes a pose: ABB (x y z q1..q4), KUKA (x y z A B C), FANUC (x y z W P R), UR (x y z m, rotation vector) or matrix (16 numbers row-major). A robot program's language fixes its own.
     #[arg(long, value_parser = parse_convention)]
     pub pose_convention: Option<FlangeConvention>,
     /// The pose columns of a CSV pose log, in the convention's order (default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44).
     #[arg(long, value_delimiter = ',')]
     pub pose_columns: Vec<String>,
-    /// A folder of stripe profiles (`<id>.csv|txt|yml|yaml|json`, or for a pose log without ids every profile file in natural order) or one CSV with a pose column.
+    /// A folder of stripe profiles (`<id>.csv|txt|yml|yaml|json`; for a pose log without ids the files named alike, in the order of the number in their names: p7.yml, 7_3C_line.yml, scan_007.csv; other files, the pose file among them, are skipped and listed) or one CSV with a pose column.
+    #[arg(long, required_unless_present = "centres", conflicts_with = "centres")]
+    pub profiles: Option<PathBuf>,
+    /// Sphere centres the sensor reported, instead of profiles: a table with one `x y z` a pose (sensor frame, mm; any separator, header optional, an `id` column optional), paired with the poses in order.
+    #[arg(long, requires = "poses")]
+    pub centres: Option<PathBuf>,
+    /// A hand-eye guess to start from instead of computing one: a JSON 4x4 matrix (rows, mm), or a session or result file (its `hand_eye`).
     #[arg(long)]
-    pub profiles: PathBuf,
+    pub hand_eye: Option<PathBuf>,
     /// Column of the pose id in a single profile file.
     #[arg(long, default_value = "pose")]
     pub pose_column: String,
@@ -51,7 +60,7 @@ pub struct ImportArgs {
     #[arg(long, value_parser = super::parse_dh)]
     pub dh: Option<crate::engine::robot::DhConvention>,
     /// Axis map from the sensor's axes to spherecal's (laser plane x = 0): `auto` (the constant coordinate is the plane's normal) or e.g. `-y,x,z` (spherecal x = -y, y = x, z = z). A mirroring map is refused.
-    #[arg(long, default_value = "auto")]
+    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
     pub axes: String,
     /// The sensor's no-return value in the profiles (file units), dropped like NaN.
     #[arg(long, allow_hyphen_values = true)]
@@ -102,6 +111,15 @@ pub struct ImportArgs {
     /// Print the first N rows with the mapping applied and exit without writing.
     #[arg(long)]
     pub preview: Option<usize>,
+    /// Print only errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+fn parse_pose_format(s: &str) -> Result<PoseFormat, String> {
+    PoseFormat::parse(s).ok_or_else(|| {
+        format!("unknown pose format `{s}`, expected table, json, fanuc-ls, rapid, krl or urscript")
+    })
 }
 
 fn parse_angle_unit(s: &str) -> Result<AngleUnit, String> {
@@ -145,30 +163,43 @@ fn profile_format(args: &ImportArgs) -> Result<ProfileFormat, CliError> {
 }
 
 /// Where the profiles are, from the flag.
-fn profile_source(args: &ImportArgs) -> ProfileSource {
-    if args.profiles.is_dir() {
-        ProfileSource::Folder(args.profiles.clone())
+fn profile_source(args: &ImportArgs) -> Result<ProfileSource, CliError> {
+    let Some(profiles) = &args.profiles else {
+        return Err(CliError::input("--profiles DIR|FILE is needed here"));
+    };
+    Ok(if profiles.is_dir() {
+        ProfileSource::Folder(profiles.clone())
     } else {
         ProfileSource::File {
-            path: args.profiles.clone(),
+            path: profiles.clone(),
             pose_column: args.pose_column.clone(),
         }
-    }
+    })
 }
 
-/// The engine's spec of a flange-pose log from the flags.
+/// The engine's spec of a pose file from the flags.
 ///
 /// # Errors
-/// [`CliError`] (status 2) for a missing convention or a bad axis map.
+/// [`CliError`] (status 2) for a bad axis map or an unreadable hand-eye.
 pub fn pose_spec(args: &ImportArgs, poses: &std::path::Path) -> Result<PoseImportSpec, CliError> {
-    let convention = args.pose_convention.ok_or_else(|| {
-        CliError::input("--poses needs --pose-convention (abb, kuka, fanuc, ur or matrix)")
-    })?;
+    let observations = match &args.centres {
+        Some(c) => Observations::Centres(c.clone()),
+        None => Observations::Profiles(profile_source(args)?),
+    };
+    let hand_eye = args
+        .hand_eye
+        .as_ref()
+        .map(|p| {
+            format::read_transform(p, "hand_eye")
+                .map_err(|m| CliError::input(format!("--hand-eye: {m} ({})", p.display())))
+        })
+        .transpose()?;
     Ok(PoseImportSpec {
         poses: poses.to_path_buf(),
-        convention,
+        format: args.pose_format,
+        convention: args.pose_convention,
         pose_columns: (!args.pose_columns.is_empty()).then(|| args.pose_columns.clone()),
-        profiles: profile_source(args),
+        observations,
         profile_format: profile_format(args)?,
         robot: args
             .robot
@@ -177,6 +208,7 @@ pub fn pose_spec(args: &ImportArgs, poses: &std::path::Path) -> Result<PoseImpor
             .transpose()?,
         sphere_diameter: args.sphere_diameter,
         side: args.side,
+        hand_eye,
         name: args.name.clone(),
         references: args.references.clone(),
     })
@@ -236,7 +268,7 @@ pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
             }
         }
     }
-    let profiles = profile_source(args);
+    let profiles = profile_source(args)?;
     let flange = args.flange_poses.map(|convention| {
         let mut check = FlangeCheck::new(convention);
         if !args.flange_columns.is_empty() {
@@ -277,12 +309,15 @@ fn out_path(args: &ImportArgs) -> Result<PathBuf, CliError> {
     if let Some(r) = &args.robot {
         inputs.push(PathBuf::from(r));
     }
-    if args.profiles.is_dir() {
-        if let Ok(files) = crate::engine::import::profiles::profile_files(&args.profiles) {
-            inputs.extend(files);
+    inputs.extend(args.centres.iter().chain(&args.hand_eye).cloned());
+    if let Some(profiles) = &args.profiles {
+        if profiles.is_dir() {
+            if let Ok(files) = crate::engine::import::profiles::profile_files(profiles) {
+                inputs.extend(files);
+            }
+        } else {
+            inputs.push(profiles.clone());
         }
-    } else {
-        inputs.push(args.profiles.clone());
     }
     let inputs: Vec<&std::path::Path> = inputs.iter().map(PathBuf::as_path).collect();
     CliError::guard_output(&out, &inputs)?;
@@ -301,7 +336,24 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         }
         let spec = pose_spec(args, poses)?;
         let out = out_path(args)?;
-        (import::import_poses(&spec).map_err(|e| input(&e))?, out)
+        // Read and pair every input once; then the side, given or decided
+        // from the data (a step of its own, which calibrates both sides).
+        let inputs = import::read_pose_inputs(&spec).map_err(|e| input(&e))?;
+        let imported = match spec.side {
+            SideChoice::Auto if !inputs.all_sides_given() && !inputs.centres() => {
+                if !args.quiet {
+                    sayln!("deciding the side of the laser plane from the data (both calibrated)…");
+                }
+                import::decide_side(&spec, &inputs)
+            }
+            choice => import::build_pose_session(
+                &spec,
+                &inputs,
+                if choice == SideChoice::Minus { -1 } else { 1 },
+            ),
+        }
+        .map_err(|e| input(&e))?;
+        (imported, out)
     } else {
         let spec = spec(args)?;
         if let Some(n) = args.preview {
@@ -326,6 +378,9 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
     let out = &out;
     let text = format::session_to_json(&session);
     format::write_atomic(out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
+    if args.quiet {
+        return Ok(());
+    }
     if !session.reference_distances.is_empty() {
         sayln!(
             "{} reference distances between validate stations",

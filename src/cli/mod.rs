@@ -56,6 +56,44 @@ pub struct Cli {
     pub command: Option<Command>,
 }
 
+impl Cli {
+    /// Parses the process's arguments; every option that takes a value
+    /// also takes a negative number (`--angle -40`, `--range -40,40,…`),
+    /// which clap would otherwise read as an unknown flag. Bad arguments
+    /// print clap's message and exit with status 2.
+    #[must_use]
+    pub fn parse_args() -> Self {
+        Self::parse_from_args(std::env::args_os())
+    }
+
+    /// [`Self::parse_args`] of the given arguments (the first is the
+    /// program name).
+    #[must_use]
+    pub fn parse_from_args<I, T>(args: I) -> Self
+    where
+        I: IntoIterator<Item = T>,
+        T: Into<std::ffi::OsString> + Clone,
+    {
+        use clap::{CommandFactory, FromArgMatches};
+        let matches = negative_numbers(Self::command()).get_matches_from(args);
+        Self::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
+    }
+}
+
+/// `command` with every value-taking option accepting negative numbers,
+/// in every subcommand.
+fn negative_numbers(command: clap::Command) -> clap::Command {
+    command
+        .mut_args(|a| {
+            if a.get_action().takes_values() {
+                a.allow_negative_numbers(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(negative_numbers)
+}
+
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {

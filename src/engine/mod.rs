@@ -31,6 +31,7 @@ pub mod history;
 pub mod import;
 pub mod numeric;
 pub mod plan;
+pub mod program;
 pub mod report;
 pub mod result_view;
 pub mod robot;

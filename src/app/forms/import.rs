@@ -8,8 +8,8 @@ use std::path::PathBuf;
 
 use crate::engine::import::{
     AngleUnit, AxisMap, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
-    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit, PoseImportSpec,
-    ProfileFormat, ProfileSource, RobotSource, SideChoice,
+    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit, Observations,
+    PoseImportSpec, ProfileFormat, ProfileSource, RobotSource, SideChoice,
 };
 use crate::engine::robot::DhConvention;
 
@@ -223,15 +223,17 @@ impl ImportForm {
         let references = self.references.trim();
         Ok(PoseImportSpec {
             poses: PathBuf::from(poses),
-            convention: self.pose_convention,
+            format: None,
+            convention: Some(self.pose_convention),
             pose_columns: None,
-            profiles,
+            observations: Observations::Profiles(profiles),
             profile_format,
             robot: (!self.robot_file.trim().is_empty())
                 .then(|| self.robot_source())
                 .transpose()?,
             sphere_diameter: self.sphere_diameter,
             side: self.side,
+            hand_eye: None,
             name: (!name.is_empty()).then(|| name.to_string()),
             references: (!references.is_empty()).then(|| PathBuf::from(references)),
         })

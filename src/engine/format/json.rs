@@ -152,10 +152,6 @@ impl<'de> Visitor<'de> for UniqueVisitor {
 pub(super) struct Ctx<'a> {
     pub(super) text: &'a str,
     pub(super) path: &'a Path,
-    /// Whether messages give the line and column: not for a text the
-    /// engine generated itself (an import's session), whose positions mean
-    /// nothing to the user.
-    pub(super) placed: bool,
 }
 
 /// `parent: ` or nothing, to start a message about a key of `parent`.
@@ -208,11 +204,7 @@ impl<'a> Ctx<'a> {
     pub(super) fn new(text: &'a str, path: &'a Path) -> Self {
         // A UTF-8 byte-order mark is not JSON but some editors write one.
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        Self {
-            text,
-            path,
-            placed: true,
-        }
+        Self { text, path }
     }
 
     pub(super) fn invalid(
@@ -229,9 +221,6 @@ impl<'a> Ctx<'a> {
 
     /// Line and column (1-based) of the start of `raw` in the text.
     pub(super) fn line_column(&self, raw: &RawValue) -> Option<(usize, usize)> {
-        if !self.placed {
-            return None;
-        }
         let offset = (raw.get().as_ptr() as usize).checked_sub(self.text.as_ptr() as usize)?;
         let before = self.text.get(..offset)?;
         let line = before.bytes().filter(|&b| b == b'\n').count() + 1;
@@ -407,18 +396,8 @@ impl<'a> Ctx<'a> {
         }
         let iso = isometry_from_rows(&rows)
             .map_err(|e| self.invalid(measurement, format!("{key}: {e}{}", self.at(raw))))?;
-        let limit = crate::engine::session::limits::LENGTH_MM;
-        if let Some(v) = rows[..3].iter().map(|r| r[3]).find(|v| v.abs() > limit) {
-            return Err(self.invalid(
-                measurement,
-                format!(
-                    "{key}: a translation of {} mm is not plausible for a sphere calibration (at most {} mm){}",
-                    crate::engine::numeric::show(v),
-                    crate::engine::numeric::show(limit),
-                    self.at(raw)
-                ),
-            ));
-        }
+        crate::engine::session::rules::transform(key, &iso)
+            .map_err(|e| self.invalid(measurement, format!("{e}{}", self.at(raw))))?;
         Ok(settle(&rows, iso))
     }
 

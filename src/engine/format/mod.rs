@@ -9,12 +9,14 @@ mod json;
 mod layout;
 pub mod result;
 pub mod session;
+pub mod transform;
 
 pub use atomic::{refuse_inputs, remove_pending, same_file, write_atomic};
 pub use result::{
     ResultFile, load_result, parse_result, result_text_checked, result_to_json, save_result,
 };
-pub use session::{load_session, parse_session, recheck_session, save_session, session_to_json};
+pub use session::{load_session, parse_session, save_session, session_to_json};
+pub use transform::read_transform;
 
 /// The `format` of a session file.
 pub const SESSION_FORMAT: &str = "spherecal-session";

@@ -57,18 +57,12 @@ use super::FORMAT_VERSION;
 use super::json::{Ctx, join, keys_struct, prefix, present, read_text, render, render_lossy};
 use super::{FileError, SESSION_FORMAT, write_atomic};
 use crate::engine::geometry::rows_from_isometry;
-use crate::engine::numeric::show;
 use crate::engine::robot::{Joint, Robot};
 use crate::engine::session::{
-    DEFAULT_MAX_ITERATIONS, DEFAULT_THRESHOLD, MIN_STRIPE_POINTS, Measurement, Observation,
-    ReferenceDistance, SensorRange, Session, SolverSettings, Use, limits,
+    DEFAULT_MAX_ITERATIONS, DEFAULT_THRESHOLD, Measurement, Observation, ReferenceDistance,
+    SensorRange, Session, SolverSettings, Use, rules,
 };
-use crate::engine::stripe::StripeError;
 use nalgebra::Vector3;
-
-/// Largest `max_iterations` accepted: 2^53, the largest integer an `f64`
-/// (JSON number) holds exactly. Any real value is far below.
-const MAX_ITERATIONS_LIMIT: f64 = 9_007_199_254_740_992.0;
 
 /// Reads and validates a session file (FORMAT.md "Session file").
 ///
@@ -100,23 +94,6 @@ pub fn parse_session(text: &str, path: &Path) -> Result<Session, FileError> {
             other?
         }
     };
-    ctx.session(top, keys)
-}
-
-/// Checks a session the engine built (an import) against every rule of
-/// the loader, by writing it and reading it back; messages name the key
-/// and the measurement but no line or column (the JSON is not the user's
-/// file; `path` is the file the caller blames).
-///
-/// # Errors
-/// [`FileError::Invalid`] as [`parse_session`], without positions.
-pub fn recheck_session(session: &Session, path: &Path) -> Result<Session, FileError> {
-    let text = session_to_json(session);
-    let mut ctx = Ctx::new(&text, path);
-    ctx.placed = false;
-    let top = ctx.document()?;
-    ctx.header(top, SESSION_FORMAT)?;
-    let keys: SessionKeys = ctx.object(top, "", None)?;
     ctx.session(top, keys)
 }
 
@@ -222,8 +199,8 @@ impl<'a> Ctx<'a> {
                 return Err(self.invalid(
                     Some(&m.id),
                     format!(
-                        "id `{}` is used by measurements[{first}] and measurements[{index}]; ids must be unique{}",
-                        m.id,
+                        "{}{}",
+                        rules::duplicate_id(&m.id, first, index),
                         self.at(raw)
                     ),
                 ));
@@ -277,22 +254,7 @@ impl<'a> Ctx<'a> {
             .enumerate()
             .map(|(i, item)| {
                 let joint = self.object::<Joint>(item, &format!("robot.joints[{i}]"), None)?;
-                for (name, v, limit, unit) in [
-                    ("alpha", joint.alpha, limits::ANGLE_DEG, "deg"),
-                    ("a", joint.a, limits::LENGTH_MM, "mm"),
-                    ("beta", joint.beta, limits::ANGLE_DEG, "deg"),
-                    ("theta", joint.theta, limits::ANGLE_DEG, "deg"),
-                    ("d", joint.d, limits::LENGTH_MM, "mm"),
-                ] {
-                    self.plausible(
-                        v,
-                        limit,
-                        &format!("robot.joints[{i}].{name}"),
-                        unit,
-                        None,
-                        item,
-                    )?;
-                }
+                rules::joint(i, &joint).map_err(|m| self.rule(None, m, item))?;
                 Ok(joint)
             })
             .collect::<Result<Vec<_>, FileError>>()?;
@@ -332,48 +294,16 @@ impl<'a> Ctx<'a> {
             z: [f64; 2],
         }
         let r: RangeKeys = self.object(raw, "sensor.range", None)?;
-        for (name, v) in [("y", r.y), ("z", r.z)] {
-            let key = format!("sensor.range.{name}");
-            for x in v {
-                self.plausible(x, limits::SENSOR_COORDINATE_MM, &key, "mm", None, raw)?;
-            }
-            if v[0] >= v[1] {
-                return Err(self.invalid(
-                    None,
-                    format!(
-                        "{key} must be [min, max] with min < max (mm), found [{}, {}]{}",
-                        show(v[0]),
-                        show(v[1]),
-                        self.at(raw)
-                    ),
-                ));
-            }
-        }
-        Ok(SensorRange { y: r.y, z: r.z })
+        let range = SensorRange { y: r.y, z: r.z };
+        rules::range(&range).map_err(|m| self.rule(None, m, raw))?;
+        Ok(range)
     }
 
     fn sphere(&self, raw: &'a RawValue) -> Result<f64, FileError> {
         let keys: SphereKeys = self.object(raw, "sphere", None)?;
         let d_raw = self.required(keys.diameter, raw, "sphere", "diameter", None)?;
         let diameter: f64 = self.parse(d_raw, "sphere.diameter", None)?;
-        if !(diameter > 0.0 && diameter.is_finite()) {
-            return Err(self.invalid(
-                None,
-                format!(
-                    "sphere.diameter must be positive (mm), found {}{}",
-                    show(diameter),
-                    self.at(d_raw)
-                ),
-            ));
-        }
-        self.plausible(
-            diameter,
-            limits::SPHERE_DIAMETER_MM,
-            "sphere.diameter",
-            "mm",
-            None,
-            d_raw,
-        )?;
+        rules::sphere_diameter(diameter).map_err(|m| self.rule(None, m, d_raw))?;
         Ok(diameter)
     }
 
@@ -382,79 +312,21 @@ impl<'a> Ctx<'a> {
         let mut solver = SolverSettings::default();
         if let Some(t_raw) = keys.threshold {
             let threshold: f64 = self.parse(t_raw, "solver.threshold", None)?;
-            if !(threshold >= 0.0 && threshold.is_finite()) {
-                return Err(self.invalid(
-                    None,
-                    format!(
-                        "solver.threshold must be zero or positive (mm), found {}{}",
-                        show(threshold),
-                        self.at(t_raw)
-                    ),
-                ));
-            }
-            self.plausible(
-                threshold,
-                limits::THRESHOLD_MM,
-                "solver.threshold",
-                "mm",
-                None,
-                t_raw,
-            )?;
+            rules::threshold(threshold).map_err(|m| self.rule(None, m, t_raw))?;
             solver.threshold = threshold;
         }
         if let Some(n_raw) = keys.max_iterations {
             let n: f64 = self.parse(n_raw, "solver.max_iterations", None)?;
-            if !(n >= 0.0 && n.fract() == 0.0 && n <= MAX_ITERATIONS_LIMIT) {
-                return Err(self.invalid(
-                    None,
-                    format!(
-                        "solver.max_iterations must be a non-negative integer, found {}{}",
-                        show(n),
-                        self.at(n_raw)
-                    ),
-                ));
-            }
-            self.plausible(
-                n,
-                limits::MAX_ITERATIONS,
-                "solver.max_iterations",
-                "",
-                None,
-                n_raw,
-            )?;
+            rules::max_iterations(n).map_err(|m| self.rule(None, m, n_raw))?;
             // Exact: an integer in [0, 2^53].
             solver.max_iterations = n as usize;
         }
         Ok(solver)
     }
 
-    /// Refuses `|value| > limit` (a [`limits`] constant) as not plausible.
-    fn plausible(
-        &self,
-        value: f64,
-        limit: f64,
-        key: &str,
-        unit: &str,
-        m: Option<&str>,
-        raw: &'a RawValue,
-    ) -> Result<(), FileError> {
-        if value.abs() <= limit {
-            return Ok(());
-        }
-        let unit = if unit.is_empty() {
-            String::new()
-        } else {
-            format!(" {unit}")
-        };
-        Err(self.invalid(
-            m,
-            format!(
-                "{key} = {}{unit} is not plausible for a sphere calibration (at most {}{unit}){}",
-                show(value),
-                show(limit),
-                self.at(raw)
-            ),
-        ))
+    /// A broken rule ([`rules`]) of the value `raw`, with its position.
+    fn rule(&self, m: Option<&str>, message: String, raw: &'a RawValue) -> FileError {
+        self.invalid(m, format!("{message}{}", self.at(raw)))
     }
 
     /// Every measurement gives `joints`, or every one gives `flange`
@@ -465,26 +337,10 @@ impl<'a> Ctx<'a> {
         m: &Measurement,
         raw: &'a RawValue,
     ) -> Result<(), FileError> {
-        let kind = |m: &Measurement| {
-            if m.flange.is_some() {
-                "flange"
-            } else {
-                "joints"
-            }
-        };
-        if kind(first) == kind(m) {
-            return Ok(());
+        match rules::mixed_pose_kind(first, m) {
+            None => Ok(()),
+            Some(message) => Err(self.rule(Some(&m.id), message, raw)),
         }
-        Err(self.invalid(
-            Some(&m.id),
-            format!(
-                "gives `{}` but measurement {} gives `{}`: a session uses `joints` in every measurement or `flange` in every measurement, not both{}",
-                kind(m),
-                first.id,
-                kind(first),
-                self.at(raw)
-            ),
-        ))
     }
 
     fn measurement(
@@ -530,30 +386,13 @@ impl<'a> Ctx<'a> {
 
         let id_raw = self.required(keys.id, raw, &scope, "id", m)?;
         let id: String = self.parse(id_raw, &join(&scope, "id"), m)?;
-        if id.is_empty() {
-            return Err(self.invalid(
-                m,
-                format!(
-                    "{} must not be empty{}",
-                    join(&scope, "id"),
-                    self.at(id_raw)
-                ),
-            ));
-        }
+        rules::non_empty(&join(&scope, "id"), &id).map_err(|e| self.rule(m, e, id_raw))?;
         let m = Some(id.as_str());
 
         let station_raw = self.required(keys.station, raw, &scope, "station", m)?;
         let station: String = self.parse(station_raw, &join(&scope, "station"), m)?;
-        if station.is_empty() {
-            return Err(self.invalid(
-                m,
-                format!(
-                    "{} must not be empty{}",
-                    join(&scope, "station"),
-                    self.at(station_raw)
-                ),
-            ));
-        }
+        rules::non_empty(&join(&scope, "station"), &station)
+            .map_err(|e| self.rule(m, e, station_raw))?;
 
         let use_raw = self.required(keys.usage, raw, &scope, "use", m)?;
         let use_text: String = self.parse(use_raw, &join(&scope, "use"), m)?;
@@ -600,13 +439,10 @@ impl<'a> Ctx<'a> {
             }
             (Some(joints_raw), None) => {
                 if !robot_given {
-                    return Err(self.invalid(
+                    return Err(self.rule(
                         m,
-                        format!(
-                            "{}gives `joints` but the session has no `robot`: joint readings need the robot model (only a pose-only session, `flange` in every measurement, may leave `robot` out){}",
-                            prefix(&scope),
-                            self.at(joints_raw)
-                        ),
+                        format!("{}{}", prefix(&scope), rules::JOINTS_WITHOUT_ROBOT),
+                        joints_raw,
                     ));
                 }
                 (self.joints(joints_raw, &scope, m, robot_joints)?, None)
@@ -655,50 +491,20 @@ impl<'a> Ctx<'a> {
                             .collect::<Result<Vec<_>, _>>()?
                     }
                 };
-                if let Some((i, p)) = points
-                    .iter()
-                    .enumerate()
-                    .find(|(_, p)| p.iter().any(|v| v.abs() > limits::SENSOR_COORDINATE_MM))
-                {
-                    let v = if p[0].abs() > limits::SENSOR_COORDINATE_MM {
-                        p[0]
-                    } else {
-                        p[1]
-                    };
-                    self.plausible(
-                        v,
-                        limits::SENSOR_COORDINATE_MM,
-                        &format!("{points_key}[{i}]"),
-                        "mm",
-                        m,
-                        points_raw,
-                    )?;
-                }
-                if points.len() < MIN_STRIPE_POINTS {
-                    let problem = StripeError::TooFewPoints {
-                        found: points.len(),
-                        needed: MIN_STRIPE_POINTS,
-                    };
-                    return Err(self.invalid(
-                        m,
-                        format!("{}{problem}{}", prefix(&scope), self.at(points_raw)),
-                    ));
-                }
+                rules::stripe_points(&points_key, &prefix(&scope), &points)
+                    .map_err(|e| self.rule(m, e, points_raw))?;
                 Observation::Stripe(points)
             }
             (None, Some(centre_raw)) => {
-                let c = self.numbers::<3>(centre_raw, &join(&scope, "centre"), " [x, y, z]", m)?;
-                for v in c {
-                    self.plausible(
-                        v,
-                        limits::SENSOR_COORDINATE_MM,
-                        &join(&scope, "centre"),
-                        "mm",
-                        m,
-                        centre_raw,
-                    )?;
-                }
-                Observation::Centre(Vector3::from(c))
+                let c = Vector3::from(self.numbers::<3>(
+                    centre_raw,
+                    &join(&scope, "centre"),
+                    " [x, y, z]",
+                    m,
+                )?);
+                rules::centre(&join(&scope, "centre"), &c)
+                    .map_err(|e| self.rule(m, e, centre_raw))?;
+                Observation::Centre(c)
             }
         };
 
@@ -723,27 +529,8 @@ impl<'a> Ctx<'a> {
         robot_joints: usize,
     ) -> Result<Vec<f64>, FileError> {
         let joints: Vec<f64> = self.array(raw, &join(scope, "joints"), m)?;
-        for (k, q) in joints.iter().enumerate() {
-            self.plausible(
-                *q,
-                limits::ANGLE_DEG,
-                &format!("{}[{k}]", join(scope, "joints")),
-                "deg",
-                m,
-                raw,
-            )?;
-        }
-        if joints.len() != robot_joints {
-            return Err(self.invalid(
-                m,
-                format!(
-                    "{} has {} readings, the robot has {robot_joints} joints{}",
-                    join(scope, "joints"),
-                    joints.len(),
-                    self.at(raw)
-                ),
-            ));
-        }
+        rules::joints(&join(scope, "joints"), &joints, robot_joints)
+            .map_err(|e| self.rule(m, e, raw))?;
         Ok(joints)
     }
 
@@ -753,68 +540,27 @@ impl<'a> Ctx<'a> {
         session: &Session,
     ) -> Result<Vec<ReferenceDistance>, FileError> {
         let items: Vec<&'a RawValue> = self.parse(raw, "reference_distances", None)?;
-        let validate_stations = session.stations(Use::Validate);
         let mut out = Vec::with_capacity(items.len());
         for (i, item) in items.into_iter().enumerate() {
             let key = format!("reference_distances[{i}]");
             let keys: ReferenceKeys = self.object(item, &key, None)?;
-            let station = |field: &str, value: Option<&'a RawValue>| -> Result<String, FileError> {
-                let v_raw = self.required(value, item, &key, field, None)?;
-                let id: String = self.parse(v_raw, &join(&key, field), None)?;
-                if validate_stations.iter().any(|(s, _)| *s == id) {
-                    return Ok(id);
-                }
-                let other: Vec<&str> = session
-                    .measurements
-                    .iter()
-                    .filter(|m| m.station == id)
-                    .map(|m| m.usage.as_str())
-                    .collect();
-                let detail = match other.first() {
-                    Some(u) => format!(" (it has {u} measurements)"),
-                    None => " (no measurement has this station)".to_owned(),
-                };
-                Err(self.invalid(
-                    None,
-                    format!(
-                        "{}: station `{id}` has no validate measurements{detail}; reference distances may only name validate stations{}",
-                        join(&key, field),
-                        self.at(v_raw)
-                    ),
-                ))
-            };
-            let from = station("from", keys.from)?;
-            let to = station("to", keys.to)?;
-            if from == to {
-                return Err(self.invalid(
-                    None,
-                    format!(
-                        "{key}: from and to are the same station `{from}`{}",
-                        self.at(item)
-                    ),
-                ));
-            }
+            let from_raw = self.required(keys.from, item, &key, "from", None)?;
+            let from: String = self.parse(from_raw, &join(&key, "from"), None)?;
+            let to_raw = self.required(keys.to, item, &key, "to", None)?;
+            let to: String = self.parse(to_raw, &join(&key, "to"), None)?;
             let d_raw = self.required(keys.distance, item, &key, "distance", None)?;
             let distance: f64 = self.parse(d_raw, &join(&key, "distance"), None)?;
-            if !(distance > 0.0 && distance.is_finite()) {
-                return Err(self.invalid(
-                    None,
-                    format!(
-                        "{key}.distance must be positive (mm), found {}{}",
-                        show(distance),
-                        self.at(d_raw)
-                    ),
-                ));
-            }
-            self.plausible(
-                distance,
-                limits::DISTANCE_MM,
-                &format!("{key}.distance"),
-                "mm",
-                None,
-                d_raw,
-            )?;
-            out.push(ReferenceDistance { from, to, distance });
+            let r = ReferenceDistance { from, to, distance };
+            rules::reference(&key, &r, session).map_err(|(field, message)| {
+                let at = match field {
+                    "from" => from_raw,
+                    "to" => to_raw,
+                    "distance" => d_raw,
+                    _ => item,
+                };
+                self.rule(None, message, at)
+            })?;
+            out.push(r);
         }
         Ok(out)
     }

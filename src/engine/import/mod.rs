@@ -1,16 +1,17 @@
 //! Import of real data: a pose log plus stripe profiles become a
-//! [`Session`], validated by a round trip through the session loader so
-//! every FORMAT.md rule is enforced with its own messages.
+//! [`Session`], validated by the same typed rules as the session loader
+//! ([`Session::validate`]), a broken rule blamed on the file it came from.
 //!
 //! Two kinds of pose log:
 //!
 //! - a **joint log** ([`import`], [`log`]): one CSV row a pose with its id,
 //!   station, use, side and joint readings, optionally with the flange pose
 //!   the controller reports, checked against the nominal model ([`check`]);
-//! - a **flange-pose log** ([`import_poses`], [`poses`]): the controller's
-//!   flange poses in a vendor convention (ABB, KUKA, FANUC, UR, or 4×4),
-//!   no joints: a pose-only session (FORMAT.md "Additions to version 1"),
-//!   which calibrates the hand-eye and the station centres only.
+//! - a **pose file** ([`import_poses`], [`poses`]): a pose table, a JSON
+//!   list or a robot program (FANUC `.ls`, RAPID, KUKA, URScript; read by
+//!   [`crate::engine::program`]): flange poses give a pose-only session
+//!   (FORMAT.md "Additions to version 1"), which calibrates the hand-eye
+//!   and the station centres only; joint targets a session with joints.
 //!
 //! Profiles ([`profiles`]) come as CSV/TXT or OpenCV YAML/JSON in the
 //! sensor's own axes and units; an axis map puts them in FORMAT.md's laser
@@ -24,11 +25,14 @@
 
 pub mod check;
 mod csv_file;
+pub mod initial;
 pub mod log;
+pub mod pairing;
 pub mod poses;
 pub mod profiles;
 pub mod references;
 pub mod robot_source;
+pub mod side;
 pub mod units;
 
 use std::collections::HashMap;
@@ -40,16 +44,20 @@ pub use self::check::{
     DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG, FlangeCheck, PoseCheck,
 };
 pub use self::log::{ColumnMap, DEFAULT_SIDE_COLUMN, header, preview};
-pub use self::poses::{PoseImportSpec, SideChoice, import_poses};
+pub use self::poses::{
+    Observations, PoseImportSpec, PoseInputs, SideChoice, build_pose_session, import_poses,
+    read_pose_inputs,
+};
 pub use self::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource, RawProfile};
 pub use self::references::{read_references, reference_rows};
 pub use self::robot_source::{RobotSource, load_robot};
+pub use self::side::decide_side;
 pub use self::units::{AngleUnit, LengthUnit};
+pub use crate::engine::program::PoseFormat;
 pub use crate::engine::robot::controller::FlangeConvention;
 
 use self::csv_file::CsvFile;
 use crate::engine::format::FileError;
-use crate::engine::format::recheck_session;
 use crate::engine::robot::Robot;
 use crate::engine::session::{
     MIN_STRIPE_POINTS, Measurement, Observation, Session, SolverSettings, Use,
@@ -471,7 +479,7 @@ pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
         .map(|(line, row)| (row[cols.id].as_str(), *line))
         .collect();
     let session = recheck(
-        &session,
+        session,
         &Sources {
             log: &spec.joint_log,
             lines: &lines,
@@ -508,45 +516,38 @@ pub(crate) struct Sources<'a> {
     pub references: Option<&'a Path>,
 }
 
-/// The session checked by every rule of the session loader
-/// ([`recheck_session`]); a broken rule is blamed on its source: a
-/// stripe's on the pose's profile file, a pose's other data on its log
-/// line, a reference distance on its row of the references file, the
-/// rest on the log.
+/// The session checked by every FORMAT.md rule ([`Session::validate`],
+/// the rules the file loader applies too); a broken rule is blamed on its
+/// source by its measurement and key: a stripe's on the pose's profile
+/// file, a pose's other data on its log line, a reference distance on its
+/// row of the references file, the rest on the log.
 ///
 /// # Errors
-/// The loader's message, placed in the file it came from.
-pub(crate) fn recheck(session: &Session, sources: &Sources) -> Result<Session, ImportError> {
-    let e = match recheck_session(session, sources.log) {
-        Ok(s) => return Ok(s),
+/// The rule's message, placed in the file it came from.
+pub(crate) fn recheck(session: Session, sources: &Sources) -> Result<Session, ImportError> {
+    let e = match session.validate() {
+        Ok(()) => return Ok(session),
         Err(e) => e,
     };
-    let FileError::Invalid {
-        measurement,
-        message,
-        ..
-    } = &e
-    else {
-        return Err(e.into());
-    };
-    if let Some(id) = measurement {
+    let key = e.key.as_deref().unwrap_or("");
+    if let Some(id) = &e.measurement {
         let profile = sources.profiles.poses.iter().find(|p| p.id == *id);
-        if let Some(p) = profile.filter(|_| message.contains("stripe")) {
+        if let Some(p) = profile.filter(|_| key.starts_with("stripe")) {
             return Err(ImportError::File {
                 path: p.file.clone(),
-                message: format!("pose {id}: {message}"),
+                message: format!("pose {id}: {}", e.message),
             });
         }
         if let Some(&line) = sources.lines.get(id.as_str()) {
             return Err(ImportError::Csv {
                 path: sources.log.to_path_buf(),
                 line,
-                message: format!("pose {id}: {message}"),
+                message: format!("pose {id}: {}", e.message),
             });
         }
     }
     if let Some(path) = sources.references
-        && let Some(index) = reference_index(message)
+        && let Some(index) = reference_index(key)
     {
         let line = reference_rows(path)
             .ok()
@@ -555,24 +556,27 @@ pub(crate) fn recheck(session: &Session, sources: &Sources) -> Result<Session, I
             Some(line) => ImportError::Csv {
                 path: path.to_path_buf(),
                 line,
-                message: message.clone(),
+                message: e.message,
             },
             None => ImportError::File {
                 path: path.to_path_buf(),
-                message: message.clone(),
+                message: e.message,
             },
         });
     }
     Err(ImportError::File {
         path: sources.log.to_path_buf(),
-        message: message.clone(),
+        message: e.to_string(),
     })
 }
 
-/// `i` of the first `reference_distances[i]` a loader message names.
-fn reference_index(message: &str) -> Option<usize> {
-    let rest = message.split("reference_distances[").nth(1)?;
-    rest.split(']').next()?.parse().ok()
+/// `i` of a key `reference_distances[i]`.
+fn reference_index(key: &str) -> Option<usize> {
+    key.strip_prefix("reference_distances[")?
+        .split(']')
+        .next()?
+        .parse()
+        .ok()
 }
 
 /// A session built by an import: `name` given, the robot (none for a

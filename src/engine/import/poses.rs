@@ -1,59 +1,53 @@
-//! Flange-pose logs: the flange poses a controller reports (no joint
-//! readings) plus one profile a pose become a **pose-only** session
-//! (FORMAT.md "Additions to version 1": `measurements[].flange`). Such a
-//! session calibrates the hand-eye and the station centres; no kinematic
-//! parameter can be identified from it.
+//! Pose files as cells write them, plus one observation a pose (a stripe
+//! profile or a sphere centre), become a session.
 //!
-//! # Pose logs
+//! # Pose files
 //!
-//! - JSON (`.json`, RobCalibrator's `.rob`): a list of poses, top level or
-//!   under a key (`RobPoses`, or the only list), each a list of the
-//!   convention's numbers (a matrix also as 4 rows of 4).
-//! - CSV: the convention's columns ([`FlangeConvention::default_columns`]
-//!   or as named), and optionally `id`, `station`, `use`, `side`.
+//! Read by [`crate::engine::program`], the layout detected from the
+//! content: pose tables with or without a header (any separator), JSON
+//! lists (RobCalibrator's `.rob`), FANUC `.ls`, ABB RAPID, KUKA
+//! `.dat`/`.src`, URScript. Cartesian targets give a **pose-only**
+//! session (FORMAT.md "Additions to version 1": `measurements[].flange`),
+//! which calibrates the hand-eye and the station centres; joint targets
+//! (a RAPID `jointtarget`, FANUC `J1=…` positions, URScript joint lists)
+//! give a session with joints, which needs the nominal robot (`robot`).
 //!
-//! Poses without ids are paired with the profile files of the folder in
-//! the natural order of the file names (`p1`, `p2`, …, `p10`), and take
-//! their ids from the file names; poses with ids find `<id>.<ext>`.
+//! # Observations
+//!
+//! - Profiles: a folder ([`super::pairing`]: the pose file and other
+//!   files in it skipped and listed, the profiles in the order of the
+//!   number in their names, pose `k` paired with profile `k`; or
+//!   `<id>.<ext>` when the log has ids), or one CSV with a pose column.
+//! - Centres ([`Observations::Centres`]): a table of sphere centres the
+//!   sensor reported, one `x y z` a pose (sensor frame, mm), giving
+//!   `centre` measurements.
 //!
 //! # What the import decides, and says
 //!
-//! - **Stations**: the log's `station` column, else one station `S1` (one
-//!   fixed sphere).
-//! - **Uses**: the log's `use` column; else the initial hand-eye is made
-//!   here, by the paper's eq. 6-9 on the flange poses: the poses sharing
-//!   the most common orientation (within [`SAME_ORIENTATION_DEG`]) form the
-//!   translation group, the others the rotation group. The session then
-//!   holds that hand-eye as its `hand_eye` and every pose as `identify`,
-//!   so that all of them serve the calibration.
-//! - **Side**: the log's `side` column, or the side given; or, with
-//!   [`SideChoice::Auto`], both sides are calibrated and the one with the
-//!   clearly smaller scatter (ε at least [`SIDE_EVIDENCE_RATIO`] times
-//!   smaller) is chosen; when the data cannot tell, the import refuses and
-//!   says why.
+//! - **Stations**: the table's `station` column, else one station `S1`.
+//! - **Uses and the initial hand-eye** ([`super::initial`]): the table's
+//!   `use` column, else every pose `identify` with an initial hand-eye
+//!   written into the session: the one given (`hand_eye`), else the
+//!   paper's eq. 6-9 when the poses hold a group of one orientation, else
+//!   the general solution of [`crate::engine::handeye::general`]; both
+//!   are printed when both can be had.
+//! - **Side**: the table's `side` column, or the side given; with
+//!   [`SideChoice::Auto`], [`super::side::decide_side`] (a step of its
+//!   own, run by the caller) calibrates both and keeps the clearly better.
 
 use std::collections::HashMap;
-use std::fs;
 use std::path::{Path, PathBuf};
 
-use nalgebra::Isometry3;
-use serde_json::Value;
+use nalgebra::{Isometry3, Vector3};
 
-use super::csv_file::CsvFile;
-use super::profiles::{self, PlaneProfile, ProfileFormat, ProfileSource};
-use super::{FlangeConvention, ImportError, Imported, ProfileReport, RobotSource, load_robot, log};
+use super::pairing::{FolderListing, list_profiles};
+use super::profiles::{self, AxisMap, PlaneProfile, ProfileFormat, ProfileSource};
+use super::{FlangeConvention, ImportError, Imported, ProfileReport, RobotSource, load_robot};
+use crate::engine::program::{
+    self, PoseFile, PoseFormat, ProgramError, ReadSpec, TargetValue, read_number_table,
+};
 use crate::engine::robot::Robot;
-use crate::engine::session::{Measurement, Observation, Session, Use};
-use crate::engine::solve::{self, Options};
-
-/// Largest orientation difference (deg) between poses counted as "the
-/// same orientation" when the translation group is found: controllers
-/// report a kept orientation to a few thousandths of a degree.
-pub const SAME_ORIENTATION_DEG: f64 = 0.1;
-
-/// How many times smaller the scatter ε of one side must be than the
-/// other's for [`SideChoice::Auto`] to choose it.
-pub const SIDE_EVIDENCE_RATIO: f64 = 1.5;
+use crate::engine::session::{Measurement, Observation, Use};
 
 /// The station of a log without a `station` column.
 pub const DEFAULT_STATION: &str = "S1";
@@ -66,7 +60,7 @@ pub enum SideChoice {
     /// `x < 0` (side −1).
     Minus,
     /// Decided from the data: both are calibrated, the clearly better
-    /// one is chosen.
+    /// one is chosen ([`super::side::decide_side`]).
     Auto,
 }
 
@@ -83,268 +77,457 @@ impl SideChoice {
     }
 }
 
-/// Everything the import of a flange-pose log needs.
+/// What the sensor gave for each pose.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Observations {
+    /// Stripe profiles.
+    Profiles(ProfileSource),
+    /// A table of sphere centres, one `x y z` a pose (sensor frame, mm),
+    /// header optional (columns `x`, `y`, `z`, optionally `id`).
+    Centres(PathBuf),
+}
+
+/// Everything the import of a pose file needs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PoseImportSpec {
-    /// The pose log (JSON, `.rob` or CSV).
+    /// The pose file.
     pub poses: PathBuf,
-    /// How the controller writes a pose.
-    pub convention: FlangeConvention,
-    /// The pose columns of a CSV log, in the convention's order; `None`:
-    /// [`FlangeConvention::default_columns`].
+    /// Its layout; `None`: detected from the content.
+    pub format: Option<PoseFormat>,
+    /// How a table's or JSON list's numbers make a pose (a program's
+    /// language fixes its own; given, it must agree).
+    pub convention: Option<FlangeConvention>,
+    /// A table's pose columns, in the convention's order; `None`: the
+    /// convention's default names, or the columns in order without a
+    /// header.
     pub pose_columns: Option<Vec<String>>,
-    /// The stripe profiles.
-    pub profiles: ProfileSource,
-    /// How to read the profiles.
+    /// The sensor's observations.
+    pub observations: Observations,
+    /// How to read profiles.
     pub profile_format: ProfileFormat,
-    /// A robot model to keep in the session (not needed: none is
-    /// identified).
+    /// The nominal robot: needed for joint targets; kept in a pose-only
+    /// session otherwise.
     pub robot: Option<RobotSource>,
     /// Sphere diameter, mm.
     pub sphere_diameter: f64,
     /// Side of the sphere centres when the log has no `side` column.
     pub side: SideChoice,
-    /// Session name; `None` gives the pose log's file stem.
+    /// A guess of the hand-eye `eT_s` to start from instead of computing
+    /// one (written into the session).
+    pub hand_eye: Option<Isometry3<f64>>,
+    /// Session name; `None` gives the pose file's stem.
     pub name: Option<String>,
     /// Optional reference distances between validate stations.
     pub references: Option<PathBuf>,
 }
 
-/// One pose of a log.
+/// Where a pose was, as the pose file gave it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PoseValue {
+    /// The flange pose `bT_e` (mm).
+    Flange(Isometry3<f64>),
+    /// Joint readings, deg.
+    Joints(Vec<f64>),
+}
+
+/// One pose of the file, in the order the robot went to them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PoseRecord {
-    /// Its id, when the log has an id column.
+    /// Its name in the file (`P[3]`, `p10`, `line 4`).
+    pub name: String,
+    /// Its id, when the table has an id column.
     pub id: Option<String>,
-    /// Its station, when the log has a station column.
+    /// Its station, when the table has a station column.
     pub station: Option<String>,
-    /// Its use, when the log has a use column.
+    /// Its use, when the table has a use column.
     pub usage: Option<Use>,
-    /// Its side, when the log has a side column with a value.
+    /// Its side, when the table has a side column with a value.
     pub side: Option<i8>,
-    /// The flange pose `bT_e`, mm.
-    pub pose: Isometry3<f64>,
-    /// Where it is, for messages: "line 12" or "pose 3".
-    pub at: String,
+    /// The pose.
+    pub value: PoseValue,
+    /// 1-based line in the pose file.
+    pub line: usize,
 }
 
-/// Reads a pose log: JSON (`.json`, `.rob`) or CSV, by extension.
+/// The pose file and the observations, read and paired: everything a
+/// session is built from, with no decision taken yet.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoseInputs {
+    /// The poses, in order.
+    pub records: Vec<PoseRecord>,
+    /// Measurement ids, one a pose.
+    pub ids: Vec<String>,
+    /// One observation a pose.
+    pub observations: Vec<Observation>,
+    /// How the profiles were read (empty for centres).
+    pub report: ProfileReport,
+    /// The nominal robot, when given.
+    pub robot: Option<Robot>,
+    /// What was read and how, in words.
+    pub notes: Vec<String>,
+}
+
+impl PoseInputs {
+    /// Whether the poses are joint readings.
+    #[must_use]
+    pub fn joints(&self) -> bool {
+        self.records
+            .iter()
+            .any(|r| matches!(r.value, PoseValue::Joints(_)))
+    }
+
+    /// Whether every pose has its side from the file.
+    #[must_use]
+    pub fn all_sides_given(&self) -> bool {
+        self.records.iter().all(|r| r.side.is_some())
+    }
+
+    /// Whether the sensor gave centres (no side to decide).
+    #[must_use]
+    pub fn centres(&self) -> bool {
+        self.observations
+            .iter()
+            .all(|o| matches!(o, Observation::Centre(_)))
+    }
+}
+
+/// A pose file error as an import error, naming the file and the line.
+fn program_error(e: ProgramError) -> ImportError {
+    if e.line == 0 {
+        ImportError::File {
+            path: e.path,
+            message: e.message,
+        }
+    } else {
+        ImportError::Csv {
+            path: e.path,
+            line: e.line,
+            message: e.message,
+        }
+    }
+}
+
+/// Reads a pose file: its layout detected (or forced) and printed, its
+/// targets in the order the robot went to them.
 ///
 /// # Errors
-/// An unreadable file, a pose with the wrong count of numbers or not a
-/// rigid transform (naming the file and the line or pose), an empty log.
+/// An unreadable file, an unknown layout, a target that is not a pose
+/// (naming the line), targets that mix joints and Cartesian poses.
 pub fn read_pose_log(
     path: &Path,
-    convention: FlangeConvention,
+    format: Option<PoseFormat>,
+    convention: Option<FlangeConvention>,
     columns: Option<&[String]>,
-) -> Result<Vec<PoseRecord>, ImportError> {
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    let records = if ext == "json" || ext == "rob" {
-        let text = fs::read_to_string(path).map_err(|source| ImportError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        json_poses(&text, path, convention)?
-    } else {
-        csv_poses(path, convention, columns)?
-    };
-    if records.is_empty() {
-        return Err(ImportError::File {
-            path: path.to_path_buf(),
-            message: "the pose log has no poses".into(),
-        });
-    }
-    Ok(records)
-}
-
-/// The poses of a JSON log.
-fn json_poses(
-    text: &str,
-    path: &Path,
-    convention: FlangeConvention,
-) -> Result<Vec<PoseRecord>, ImportError> {
-    let value = super::json_value(text, path)?;
-    let file_error = |message: String| ImportError::File {
-        path: path.to_path_buf(),
-        message,
-    };
-    let list = match &value {
-        Value::Array(items) => items,
-        Value::Object(map) => {
-            let arrays: Vec<(&String, &Vec<Value>)> = map
-                .iter()
-                .filter_map(|(k, v)| v.as_array().map(|a| (k, a)))
-                .collect();
-            let chosen = arrays
-                .iter()
-                .find(|(k, _)| {
-                    k.eq_ignore_ascii_case("RobPoses") || k.eq_ignore_ascii_case("poses")
-                })
-                .or_else(|| (arrays.len() == 1).then(|| &arrays[0]));
-            match chosen {
-                Some((_, a)) => *a,
-                None => {
-                    let keys: Vec<&str> = map.keys().map(String::as_str).collect();
-                    return Err(file_error(format!(
-                        "no pose list: expected a key `RobPoses` or `poses`, or one list (the file has: {})",
-                        keys.join(", ")
-                    )));
-                }
-            }
-        }
-        _ => return Err(file_error("expected a JSON list of poses".into())),
-    };
-    list.iter()
-        .enumerate()
-        .map(|(i, item)| {
-            let at = format!("pose {}", i + 1);
-            let values = flat_numbers(item).ok_or_else(|| {
-                file_error(format!(
-                    "{at}: not a list of numbers ({})",
-                    convention.describe()
-                ))
-            })?;
-            let pose = convention
-                .pose_from_values(&values)
-                .map_err(|m| file_error(format!("{at}: {m} ({})", convention.describe())))?;
-            Ok(PoseRecord {
-                id: None,
-                station: None,
-                usage: None,
-                side: None,
-                pose,
-                at,
-            })
-        })
-        .collect()
-}
-
-/// The numbers of a JSON pose: a list of numbers, or a list of rows.
-fn flat_numbers(v: &Value) -> Option<Vec<f64>> {
-    let items = v.as_array()?;
-    let mut out = Vec::new();
-    for x in items {
-        match x {
-            Value::Number(n) => out.push(n.as_f64()?),
-            Value::Array(_) => out.extend(flat_numbers(x)?),
-            _ => return None,
-        }
-    }
-    Some(out)
-}
-
-/// The poses of a CSV log.
-fn csv_poses(
-    path: &Path,
-    convention: FlangeConvention,
-    columns: Option<&[String]>,
-) -> Result<Vec<PoseRecord>, ImportError> {
-    let csv = CsvFile::read(path)?;
-    let names = columns.map_or_else(|| convention.default_columns(), <[String]>::to_vec);
-    if names.len() != convention.n_columns() {
-        return Err(ImportError::Spec(format!(
-            "{} pose columns given, {} needs {}",
-            names.len(),
-            convention.describe(),
-            convention.n_columns()
-        )));
-    }
-    let pose_cols: Vec<usize> = names
-        .iter()
-        .map(|n| csv.column(n))
-        .collect::<Result<_, _>>()?;
-    let id = csv.optional_column("id");
-    let station = csv.optional_column("station");
-    let usage = csv.optional_column("use");
-    let side = csv.optional_column(log::DEFAULT_SIDE_COLUMN);
-    let mut out = Vec::with_capacity(csv.rows.len());
-    for (line, row) in &csv.rows {
+) -> Result<(Vec<PoseRecord>, Vec<String>), ImportError> {
+    let file: PoseFile = program::read_pose_file(
+        path,
+        &ReadSpec {
+            format,
+            convention,
+            columns: columns.map(<[String]>::to_vec),
+        },
+    )
+    .map_err(program_error)?;
+    let mut notes = vec![format!(
+        "pose file: {} ({}); {}",
+        file.format.describe(),
+        if file.detected {
+            "detected from its content; --pose-format forces another"
+        } else {
+            "as given by --pose-format"
+        },
+        file.order_note
+    )];
+    notes.extend(file.warnings.iter().map(|w| format!("warning: {w}")));
+    let mut records = Vec::with_capacity(file.order.len());
+    let (mut poses, mut joints) = (0, 0);
+    for t in file.ordered() {
         let fail = |message: String| ImportError::Csv {
             path: path.to_path_buf(),
-            line: *line,
-            message,
+            line: t.line,
+            message: format!("{}: {message}", t.name),
         };
-        let values: Vec<f64> = pose_cols
-            .iter()
-            .map(|&c| csv.number(*line, row, c))
-            .collect::<Result<_, _>>()?;
-        let pose = convention
-            .pose_from_values(&values)
-            .map_err(|m| fail(format!("flange pose: {m} ({})", convention.describe())))?;
-        let usage = match usage {
-            Some(c) => Some(Use::parse(&row[c]).ok_or_else(|| {
-                fail(format!(
-                    "column `use`: `{}` is not translation, rotation, identify or validate",
-                    row[c]
-                ))
-            })?),
-            None => None,
+        let value = match &t.value {
+            TargetValue::Pose { values, convention } => {
+                poses += 1;
+                let pose = convention
+                    .pose_from_values(values)
+                    .map_err(|m| fail(format!("{m} ({})", convention.describe())))?;
+                PoseValue::Flange(pose)
+            }
+            TargetValue::Joints { deg, .. } => {
+                joints += 1;
+                if deg.iter().any(|v| !v.is_finite()) {
+                    return Err(fail("a joint value is not a finite number".to_string()));
+                }
+                PoseValue::Joints(deg.clone())
+            }
         };
-        let side = match side {
-            Some(c) => log::side_cell(&row[c]).map_err(|m| fail(format!("column `side`: {m}")))?,
-            None => None,
-        };
-        out.push(PoseRecord {
-            id: id.map(|c| row[c].clone()),
-            station: station.map(|c| row[c].clone()),
-            usage,
-            side,
-            pose,
-            at: format!("line {line}"),
+        records.push(PoseRecord {
+            name: t.name.clone(),
+            id: t.id.clone(),
+            station: t.station.clone(),
+            usage: t.usage,
+            side: t.side,
+            value,
+            line: t.line,
         });
     }
-    Ok(out)
-}
-
-/// Pose ids and their profiles: by id when the log has ids, else the
-/// profile files in natural order.
-fn pair_profiles(
-    spec: &PoseImportSpec,
-    records: &[PoseRecord],
-) -> Result<(Vec<String>, Vec<PlaneProfile>, ProfileReport), ImportError> {
-    let with_ids = records.iter().all(|r| r.id.is_some());
-    if with_ids {
-        let ids: Vec<String> = records.iter().filter_map(|r| r.id.clone()).collect();
-        let mut first: HashMap<&str, &str> = HashMap::new();
-        for (r, id) in records.iter().zip(&ids) {
-            if let Some(at) = first.insert(id, &r.at) {
-                return Err(ImportError::File {
-                    path: spec.poses.clone(),
-                    message: format!("{}: pose id `{id}` is used twice (first at {at})", r.at),
-                });
-            }
-        }
-        let (planes, report) = super::read_profiles(&spec.profiles, &spec.profile_format, &ids)?;
-        return Ok((ids, planes, report));
-    }
-    let raws = match &spec.profiles {
-        ProfileSource::Folder(dir) => profiles::profile_files(dir)?
-            .iter()
-            .map(|p| profiles::read_profile(p, &spec.profile_format))
-            .collect::<Result<Vec<_>, _>>()?,
-        ProfileSource::File { path, pose_column } => {
-            let (order, mut by_id) =
-                profiles::read_profile_table(path, pose_column, &spec.profile_format)?;
-            order.iter().filter_map(|id| by_id.remove(id)).collect()
-        }
-    };
-    if raws.len() != records.len() {
-        let where_ = match &spec.profiles {
-            ProfileSource::Folder(dir) => dir.clone(),
-            ProfileSource::File { path, .. } => path.clone(),
-        };
+    if poses > 0 && joints > 0 {
         return Err(ImportError::File {
-            path: where_,
+            path: path.to_path_buf(),
             message: format!(
-                "{} profiles for {} poses of {}: a log without ids pairs pose k with the k-th profile file (natural order of names), so the counts must match",
-                raws.len(),
-                records.len(),
-                spec.poses.display()
+                "the file mixes {poses} Cartesian poses and {joints} joint targets: a session takes one kind"
             ),
         });
     }
+    Ok((records, notes))
+}
+
+/// A measurement id for a record without one: `pose<k>` for a table row
+/// or list entry, else its name without brackets or spaces (`P[3]` → `P3`).
+fn record_id(record: &PoseRecord, ordinal: usize) -> String {
+    if record.name.starts_with("line ") || record.name.starts_with("pose ") {
+        return format!("pose{ordinal}");
+    }
+    let id: String = record
+        .name
+        .chars()
+        .filter(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
+        .collect();
+    if id.is_empty() {
+        format!("pose{ordinal}")
+    } else {
+        id
+    }
+}
+
+/// The file name of a path, for messages.
+fn file_name(p: &Path) -> String {
+    p.file_name().map_or_else(
+        || p.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
+}
+
+/// Reads the pose file and the observations and pairs them: every input
+/// read once, nothing decided yet.
+///
+/// # Errors
+/// [`ImportError`] naming the file and the line, pose or key: unreadable
+/// files, poses that are not rigid transforms, missing or unusable
+/// profiles, counts of poses and profiles that differ (both named).
+pub fn read_pose_inputs(spec: &PoseImportSpec) -> Result<PoseInputs, ImportError> {
+    super::check_sphere_diameter(spec.sphere_diameter)?;
+    let (records, mut notes) = read_pose_log(
+        &spec.poses,
+        spec.format,
+        spec.convention,
+        spec.pose_columns.as_deref(),
+    )?;
+    let robot = spec.robot.as_ref().map(load_robot).transpose()?;
+    if let Some(r) = records.iter().find_map(|r| match &r.value {
+        PoseValue::Joints(q) => Some((r, q.len())),
+        PoseValue::Flange(_) => None,
+    }) {
+        let Some(robot) = &robot else {
+            return Err(ImportError::Spec(format!(
+                "{} holds joint targets ({} at line {}): give the nominal robot (--robot) to place them",
+                spec.poses.display(),
+                r.0.name,
+                r.0.line
+            )));
+        };
+        if r.1 != robot.dof() {
+            return Err(ImportError::Csv {
+                path: spec.poses.clone(),
+                line: r.0.line,
+                message: format!(
+                    "{}: {} joint values, the robot {} has {} joints",
+                    r.0.name,
+                    r.1,
+                    robot.name,
+                    robot.dof()
+                ),
+            });
+        }
+    }
+    let (ids, observations, report) = match &spec.observations {
+        Observations::Centres(path) => {
+            let (ids, centres) = read_centres(path, &records, &spec.poses)?;
+            notes.push(format!(
+                "sphere centres from {} (sensor frame, mm): {} poses, paired in order",
+                path.display(),
+                centres.len()
+            ));
+            (
+                ids,
+                centres.into_iter().map(Observation::Centre).collect(),
+                ProfileReport {
+                    axes: AxisMap::IDENTITY,
+                    axes_guessed: false,
+                    poses: Vec::new(),
+                },
+            )
+        }
+        Observations::Profiles(source) => {
+            let (ids, planes, report, pairing) = pair_profiles(spec, source, &records)?;
+            super::check_profile_size(&planes, &spec.profile_format, spec.sphere_diameter)?;
+            notes.extend(pairing);
+            notes.push(report.summary());
+            (
+                ids,
+                planes
+                    .into_iter()
+                    .map(|p| Observation::Stripe(p.points))
+                    .collect(),
+                report,
+            )
+        }
+    };
+    Ok(PoseInputs {
+        records,
+        ids,
+        observations,
+        report,
+        robot,
+        notes,
+    })
+}
+
+/// The centres of a centres table, paired with the records: by id when
+/// both have ids, else in order (the counts must match).
+fn read_centres(
+    path: &Path,
+    records: &[PoseRecord],
+    poses: &Path,
+) -> Result<(Vec<String>, Vec<Vector3<f64>>), ImportError> {
+    let names: Vec<String> = ["x", "y", "z"].iter().map(|s| (*s).to_string()).collect();
+    let rows = read_number_table(path, &names, false, "x, y, z (sensor frame, mm)")
+        .map_err(program_error)?;
+    let record_ids: Vec<Option<&String>> = records.iter().map(|r| r.id.as_ref()).collect();
+    let by_id = rows.iter().all(|r| r.id.is_some()) && record_ids.iter().all(Option::is_some);
+    let mut out = Vec::with_capacity(records.len());
+    let mut ids = Vec::with_capacity(records.len());
+    if by_id {
+        let index: HashMap<&str, &program::Row> = rows
+            .iter()
+            .filter_map(|r| r.id.as_deref().map(|i| (i, r)))
+            .collect();
+        for r in records {
+            let id = r.id.clone().unwrap_or_default();
+            let row = index.get(id.as_str()).ok_or_else(|| ImportError::File {
+                path: path.to_path_buf(),
+                message: format!("no centre for pose `{id}` of {}", poses.display()),
+            })?;
+            out.push(Vector3::new(row.values[0], row.values[1], row.values[2]));
+            ids.push(id);
+        }
+    } else {
+        if rows.len() != records.len() {
+            return Err(ImportError::File {
+                path: path.to_path_buf(),
+                message: format!(
+                    "{} centres for {} poses of {}: without ids on both sides, pose k takes the k-th centre, so the counts must match",
+                    rows.len(),
+                    records.len(),
+                    poses.display()
+                ),
+            });
+        }
+        for (k, (row, r)) in rows.iter().zip(records).enumerate() {
+            out.push(Vector3::new(row.values[0], row.values[1], row.values[2]));
+            ids.push(
+                r.id.clone()
+                    .or_else(|| row.id.clone())
+                    .unwrap_or_else(|| record_id(r, k + 1)),
+            );
+        }
+    }
+    if let Some((k, c)) = out
+        .iter()
+        .enumerate()
+        .find(|(_, c)| c.iter().any(|v| !v.is_finite()))
+    {
+        return Err(ImportError::Csv {
+            path: path.to_path_buf(),
+            line: rows.get(k).map_or(0, |r| r.line),
+            message: format!("centre {:?} is not finite", c.as_slice()),
+        });
+    }
+    Ok((ids, out))
+}
+
+/// Pose ids, their profiles in the laser plane, how they were read, and
+/// the pairing in words.
+type Paired = (Vec<String>, Vec<PlaneProfile>, ProfileReport, Vec<String>);
+
+/// Pose ids and their profiles, and the pairing in words: by id when the
+/// log has ids that name profile files, else pose `k` with the `k`-th
+/// profile in the order of their numbers.
+fn pair_profiles(
+    spec: &PoseImportSpec,
+    source: &ProfileSource,
+    records: &[PoseRecord],
+) -> Result<Paired, ImportError> {
+    let ids: Option<Vec<String>> = records.iter().map(|r| r.id.clone()).collect();
+    let named = match (&ids, source) {
+        (Some(ids), ProfileSource::Folder(dir)) => {
+            ids.iter().all(|id| profiles::file_of(dir, id).is_some())
+        }
+        (Some(_), ProfileSource::File { .. }) => true,
+        (None, _) => false,
+    };
+    if let (true, Some(ids)) = (named, ids) {
+        let mut first: HashMap<&str, usize> = HashMap::new();
+        for (r, id) in records.iter().zip(&ids) {
+            if let Some(line) = first.insert(id, r.line) {
+                return Err(ImportError::Csv {
+                    path: spec.poses.clone(),
+                    line: r.line,
+                    message: format!("pose id `{id}` is used twice (first at line {line})"),
+                });
+            }
+        }
+        let (planes, report) = super::read_profiles(source, &spec.profile_format, &ids)?;
+        return Ok((
+            ids,
+            planes,
+            report,
+            vec!["profiles paired by pose id".to_string()],
+        ));
+    }
+    let (raws, listing) = match source {
+        ProfileSource::Folder(dir) => {
+            let listing = list_profiles(dir, &[spec.poses.as_path()], Some(records.len()))?;
+            check_count(spec, dir, &listing, records)?;
+            let raws = listing
+                .profiles
+                .iter()
+                .map(|p| profiles::read_profile(p, &spec.profile_format))
+                .collect::<Result<Vec<_>, _>>()?;
+            (raws, Some(listing))
+        }
+        ProfileSource::File { path, pose_column } => {
+            let (order, mut by_id) =
+                profiles::read_profile_table(path, pose_column, &spec.profile_format)?;
+            if order.len() != records.len() {
+                return Err(ImportError::File {
+                    path: path.clone(),
+                    message: format!(
+                        "{} profiles for {} poses of {}: a log without ids pairs pose k with the k-th profile, so the counts must match",
+                        order.len(),
+                        records.len(),
+                        spec.poses.display()
+                    ),
+                });
+            }
+            (
+                order.iter().filter_map(|id| by_id.remove(id)).collect(),
+                None,
+            )
+        }
+    };
     let ids: Vec<String> = raws
         .iter()
         .map(|r| {
@@ -353,109 +536,110 @@ fn pair_profiles(
                 .map_or_else(|| "pose".into(), |s| s.to_string_lossy().into_owned())
         })
         .collect();
-    let (planes, report) = super::planar(raws, &spec.profile_format, &ids)?;
-    Ok((ids, planes, report))
-}
-
-/// The translation group: the poses sharing the most common orientation
-/// (within [`SAME_ORIENTATION_DEG`]), in log order.
-fn translation_group(records: &[PoseRecord]) -> Vec<usize> {
-    let mut best: Vec<usize> = Vec::new();
-    for a in records {
-        let group: Vec<usize> = records
-            .iter()
-            .enumerate()
-            .filter(|(_, b)| {
-                a.pose.rotation.angle_to(&b.pose.rotation).to_degrees() <= SAME_ORIENTATION_DEG
-            })
-            .map(|(i, _)| i)
-            .collect();
-        if group.len() > best.len() {
-            best = group;
-        }
-    }
-    best
-}
-
-/// The session before the initial hand-eye is settled: every measurement
-/// with its use (given, or translation/rotation by orientation) and side.
-struct Draft {
-    session: Session,
-    /// Whether the uses were found by orientation (the import then makes
-    /// the initial hand-eye and turns every pose into `identify`).
-    auto_uses: bool,
-    /// What was decided, in words.
-    notes: Vec<String>,
-}
-
-fn draft(
-    spec: &PoseImportSpec,
-    records: &[PoseRecord],
-    ids: Vec<String>,
-    planes: Vec<PlaneProfile>,
-    robot: Option<Robot>,
-    side: i8,
-) -> Result<Draft, ImportError> {
-    super::check_profile_size(&planes, &spec.profile_format, spec.sphere_diameter)?;
     let mut notes = Vec::new();
-    let given_uses = records.iter().filter(|r| r.usage.is_some()).count();
-    if given_uses != 0 && given_uses != records.len() {
+    if let Some(listing) = &listing {
+        notes.push(listing.summary());
+        notes.push(pairing_note(records, listing));
+    }
+    let (planes, report) = super::planar(raws, &spec.profile_format, &ids)?;
+    Ok((ids, planes, report, notes))
+}
+
+/// The count of profiles must be the count of poses: else both are named.
+fn check_count(
+    spec: &PoseImportSpec,
+    dir: &Path,
+    listing: &FolderListing,
+    records: &[PoseRecord],
+) -> Result<(), ImportError> {
+    if listing.profiles.len() == records.len() {
+        return Ok(());
+    }
+    Err(ImportError::File {
+        path: dir.to_path_buf(),
+        message: format!(
+            "{} profiles for {} poses of {}: pose k is paired with the k-th profile in the order of the number in their names, so the counts must match ({})",
+            listing.profiles.len(),
+            records.len(),
+            spec.poses.display(),
+            listing.summary()
+        ),
+    })
+}
+
+/// "pairing: P[1] ↔ p1.yml, …", with a warning when numbers differ.
+fn pairing_note(records: &[PoseRecord], listing: &FolderListing) -> String {
+    let pairs: Vec<String> = records
+        .iter()
+        .zip(&listing.profiles)
+        .map(|(r, p)| format!("{} ↔ {}", r.name, file_name(p)))
+        .collect();
+    let shown = if pairs.len() > 6 {
+        format!(
+            "{}, …, {}",
+            pairs[..3].join(", "),
+            pairs[pairs.len() - 2..].join(", ")
+        )
+    } else {
+        pairs.join(", ")
+    };
+    let numbers_differ = records.iter().zip(&listing.numbers).any(|(r, n)| {
+        let pose_number = crate::engine::program::number_in(&r.name);
+        pose_number.is_some() && n.is_some() && pose_number != *n
+    });
+    format!(
+        "pairing (pose order ↔ profile number): {shown}{}",
+        if numbers_differ {
+            "; warning: some pose numbers differ from their profile's number: check the order"
+        } else {
+            ""
+        }
+    )
+}
+
+/// The session of `inputs` with every measurement on side `side` (unless
+/// the file gave one), its uses and initial hand-eye settled
+/// ([`super::initial::settle`]). Runs no calibration.
+///
+/// # Errors
+/// The initial hand-eye cannot be had (naming why), or the session breaks
+/// a FORMAT.md rule (naming the file and line it came from).
+pub fn build_pose_session(
+    spec: &PoseImportSpec,
+    inputs: &PoseInputs,
+    side: i8,
+) -> Result<Imported, ImportError> {
+    let given_uses = inputs.records.iter().filter(|r| r.usage.is_some()).count();
+    if given_uses != 0 && given_uses != inputs.records.len() {
         return Err(ImportError::File {
             path: spec.poses.clone(),
             message: "some poses have a use and some not: give every pose a use, or none".into(),
         });
     }
     let auto_uses = given_uses == 0;
-    let mut uses: Vec<Use> = records
+    let measurements: Vec<Measurement> = inputs
+        .records
         .iter()
-        .map(|r| r.usage.unwrap_or(Use::Rotation))
-        .collect();
-    if auto_uses {
-        let group = translation_group(records);
-        if group.len() < 3 || records.len() - group.len() < 2 {
-            return Err(ImportError::File {
-                path: spec.poses.clone(),
-                message: format!(
-                    "cannot find the initial hand-eye's pose groups: the largest set of poses with one orientation (within {SAME_ORIENTATION_DEG}°) has {} poses and {} others change orientation; eq. 6-9 need at least 3 of the one and 2 of the other (or give a `use` column)",
-                    group.len(),
-                    records.len() - group.len()
-                ),
-            });
-        }
-        for &i in &group {
-            uses[i] = Use::Translation;
-        }
-        let names = |u: Use| -> String {
-            ids.iter()
-                .zip(&uses)
-                .filter(|(_, x)| **x == u)
-                .map(|(id, _)| id.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        notes.push(format!(
-            "initial hand-eye groups (paper eq. 6-9): translation {} (one orientation), rotation {}",
-            names(Use::Translation),
-            names(Use::Rotation)
-        ));
-    }
-    let measurements = records
-        .iter()
-        .zip(ids)
-        .zip(planes)
-        .zip(&uses)
-        .map(|(((r, id), plane), &usage)| Measurement {
-            id,
-            station: r
-                .station
-                .clone()
-                .unwrap_or_else(|| DEFAULT_STATION.to_string()),
-            usage,
-            side_given: r.side,
-            side: r.side.unwrap_or(side),
-            joints: Vec::new(),
-            flange: Some(r.pose),
-            observation: Observation::Stripe(plane.points),
+        .zip(&inputs.ids)
+        .zip(&inputs.observations)
+        .map(|((r, id), observation)| {
+            let (joints, flange) = match &r.value {
+                PoseValue::Flange(pose) => (Vec::new(), Some(*pose)),
+                PoseValue::Joints(q) => (q.clone(), None),
+            };
+            Measurement {
+                id: id.clone(),
+                station: r
+                    .station
+                    .clone()
+                    .unwrap_or_else(|| DEFAULT_STATION.to_string()),
+                usage: r.usage.unwrap_or(Use::Identify),
+                side_given: r.side,
+                side: r.side.unwrap_or(side),
+                joints,
+                flange,
+                observation: observation.clone(),
+            }
         })
         .collect();
     let name = spec.name.clone().unwrap_or_else(|| {
@@ -465,157 +649,74 @@ fn draft(
     });
     let session = super::new_session(
         name,
-        robot,
+        inputs.robot.clone(),
         spec.sphere_diameter,
-        Some(side),
+        (!inputs.centres()).then_some(side),
         spec.references.as_deref(),
         measurements,
     )?;
-    Ok(Draft {
+    let (session, hand_eye_notes) = super::initial::settle(
         session,
         auto_uses,
-        notes,
-    })
-}
-
-/// With uses found by orientation: the initial hand-eye by eq. 6-9 on the
-/// draft, written into the session, and every pose turned `identify`.
-fn settle_hand_eye(mut draft: Draft, path: &Path) -> Result<Draft, ImportError> {
-    if !draft.auto_uses {
-        return Ok(draft);
-    }
-    let analysis = solve::analyse(&draft.session);
-    let (hand_eye, _) = analysis.hand_eye.map_err(|e| ImportError::File {
-        path: path.to_path_buf(),
-        message: format!("the initial hand-eye (paper eq. 6-9 on the flange poses) failed: {e}"),
-    })?;
-    draft.session.hand_eye = Some(hand_eye);
-    for m in &mut draft.session.measurements {
-        m.usage = Use::Identify;
-    }
-    let t = hand_eye.translation.vector;
-    draft.notes.push(format!(
-        "initial hand-eye written to the session (translation [{:.2}, {:.2}, {:.2}] mm); every pose is `identify`",
-        t.x, t.y, t.z
-    ));
-    Ok(draft)
-}
-
-/// The side with the clearly smaller scatter, or why none can be told.
-fn decide_side(
-    spec: &PoseImportSpec,
-    records: &[PoseRecord],
-    ids: &[String],
-    planes: &[PlaneProfile],
-    robot: Option<&Robot>,
-) -> Result<(Draft, String), ImportError> {
-    let mut tried = Vec::new();
-    for side in [1_i8, -1] {
-        let d = draft(
-            spec,
-            records,
-            ids.to_vec(),
-            planes.to_vec(),
-            robot.cloned(),
-            side,
-        )
-        .and_then(|d| settle_hand_eye(d, &spec.poses));
-        let epsilon = d.as_ref().ok().and_then(|d| {
-            let options = Options::from_session(&d.session);
-            solve::calibrate(&d.session, &options)
-                .ok()
-                .map(|(_, cal)| cal.epsilon_after())
-        });
-        tried.push((side, d, epsilon));
-    }
-    let text =
-        |e: Option<f64>| e.map_or_else(|| "no calibration".to_string(), |v| format!("ε {v:.3} mm"));
-    let evidence = format!(
-        "side +1: {}, side −1: {}",
-        text(tried[0].2),
-        text(tried[1].2)
-    );
-    let (plus, minus) = (tried[0].2, tried[1].2);
-    let choice = match (plus, minus) {
-        (Some(p), Some(m)) if m * SIDE_EVIDENCE_RATIO <= p => Some(1),
-        (Some(p), Some(m)) if p * SIDE_EVIDENCE_RATIO <= m => Some(0),
-        (Some(_), None) => Some(0),
-        (None, Some(_)) => Some(1),
-        _ => None,
-    };
-    let Some(k) = choice else {
-        return Err(ImportError::File {
-            path: spec.poses.clone(),
-            message: format!(
-                "cannot tell from the data on which side of the laser plane the sphere lies ({evidence}; one must be {SIDE_EVIDENCE_RATIO}× smaller): give the side (--side +1 or --side -1)"
-            ),
-        });
-    };
-    let (side, d, _) = tried.swap_remove(k);
-    let d = d?;
-    Ok((
-        d,
+        spec.hand_eye,
+        &spec.poses,
+        &inputs.report,
+    )?;
+    let mut notes = inputs.notes.clone();
+    notes.push(if inputs.joints() {
         format!(
-            "side {} chosen from the data ({evidence})",
-            if side > 0 { "+1" } else { "−1" }
-        ),
-    ))
-}
-
-/// Builds the pose-only session of a flange-pose log.
-///
-/// # Errors
-/// [`ImportError`] naming the file and the line, pose or key: unreadable
-/// files, poses that are not rigid transforms, missing or unusable
-/// profiles, pose groups that cannot give the initial hand-eye, a side the
-/// data cannot tell.
-pub fn import_poses(spec: &PoseImportSpec) -> Result<Imported, ImportError> {
-    super::check_sphere_diameter(spec.sphere_diameter)?;
-    let records = read_pose_log(&spec.poses, spec.convention, spec.pose_columns.as_deref())?;
-    let robot = spec.robot.as_ref().map(load_robot).transpose()?;
-    let (ids, planes, report) = pair_profiles(spec, &records)?;
-    let all_sides_given = records.iter().all(|r| r.side.is_some());
-    let (draft, side_note) = match spec.side {
-        SideChoice::Auto if !all_sides_given => {
-            let (d, note) = decide_side(spec, &records, &ids, &planes, robot.as_ref())?;
-            (d, Some(note))
-        }
-        choice => {
-            let side = if choice == SideChoice::Minus { -1 } else { 1 };
-            let d = draft(spec, &records, ids, planes, robot, side)?;
-            (settle_hand_eye(d, &spec.poses)?, None)
-        }
-    };
-    let mut notes = vec![report.summary()];
-    notes.push(format!(
-        "{} flange poses ({}), pose-only: only the hand-eye and the station centres are calibrated, no kinematic parameter",
-        records.len(),
-        spec.convention.describe()
-    ));
-    notes.extend(draft.notes);
-    notes.extend(side_note);
-    let lines: HashMap<&str, usize> = records
+            "{} joint targets: the robot's kinematic errors are identified with the hand-eye",
+            inputs.records.len()
+        )
+    } else {
+        format!(
+            "{} flange poses, pose-only: only the hand-eye and the station centres are calibrated, no kinematic parameter",
+            inputs.records.len()
+        )
+    });
+    notes.extend(hand_eye_notes);
+    let lines: HashMap<&str, usize> = inputs
+        .ids
         .iter()
-        .filter_map(|r| {
-            let line = r.at.strip_prefix("line ")?.parse().ok()?;
-            Some((r.id.as_deref()?, line))
-        })
+        .zip(&inputs.records)
+        .map(|(id, r)| (id.as_str(), r.line))
         .collect();
     let session = super::recheck(
-        &draft.session,
+        session,
         &super::Sources {
             log: &spec.poses,
             lines: &lines,
-            profiles: &report,
+            profiles: &inputs.report,
             references: spec.references.as_deref(),
         },
     )?;
     Ok(Imported {
         session,
         checks: Vec::new(),
-        profiles: report,
+        profiles: inputs.report.clone(),
         notes,
     })
+}
+
+/// The whole import of a pose file: [`read_pose_inputs`], then the side
+/// given, or with [`SideChoice::Auto`] (and no side column, and no
+/// centres) [`super::side::decide_side`], which calibrates both sides.
+///
+/// # Errors
+/// As [`read_pose_inputs`], [`build_pose_session`] and
+/// [`super::side::decide_side`].
+pub fn import_poses(spec: &PoseImportSpec) -> Result<Imported, ImportError> {
+    let inputs = read_pose_inputs(spec)?;
+    match spec.side {
+        SideChoice::Auto if !inputs.all_sides_given() && !inputs.centres() => {
+            super::side::decide_side(spec, &inputs)
+        }
+        choice => build_pose_session(
+            spec,
+            &inputs,
+            if choice == SideChoice::Minus { -1 } else { 1 },
+        ),
+    }
 }
 
 #[cfg(test)]
@@ -623,28 +724,26 @@ mod tests {
     use super::*;
 
     #[test]
-    fn robcalibrator_style_json_is_read() {
-        let text = r#"{ "RobPoses": [ [ -195.8, 1363.305, 524.812, -179.924, 0.889, 179.635 ],
-            [ -185.745, 1363.314, 524.772, -179.923, 0.889, 179.636 ] ] }"#;
-        let poses =
-            json_poses(text, Path::new("RobPoses.rob"), FlangeConvention::FanucWpr).unwrap();
-        assert_eq!(poses.len(), 2);
-        assert!((poses[0].pose.translation.vector.x + 195.8).abs() < 1e-12);
-        let e = json_poses(
-            r#"{"RobPoses": [[1, 2, 3, 4, 5]]}"#,
-            Path::new("bad.rob"),
-            FlangeConvention::FanucWpr,
-        )
-        .unwrap_err()
-        .to_string();
-        assert!(e.contains("pose 1") && e.contains("5 values"), "{e}");
-    }
-
-    #[test]
     fn sides_parse() {
         assert_eq!(SideChoice::parse("+1"), Some(SideChoice::Plus));
         assert_eq!(SideChoice::parse("-1"), Some(SideChoice::Minus));
         assert_eq!(SideChoice::parse("AUTO"), Some(SideChoice::Auto));
         assert_eq!(SideChoice::parse("2"), None);
+    }
+
+    #[test]
+    fn ids_of_records_without_one() {
+        let r = |name: &str| PoseRecord {
+            name: name.to_string(),
+            id: None,
+            station: None,
+            usage: None,
+            side: None,
+            value: PoseValue::Joints(vec![]),
+            line: 1,
+        };
+        assert_eq!(record_id(&r("P[3]"), 3), "P3");
+        assert_eq!(record_id(&r("line 4"), 2), "pose2");
+        assert_eq!(record_id(&r("XP12"), 1), "XP12");
     }
 }

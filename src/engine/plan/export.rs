@@ -277,7 +277,7 @@ pub fn rapid_module(plan: &Plan) -> String {
     let _ = writeln!(out);
     let _ = writeln!(out, "    PERS speeddata vPlan := [200, 100, 5000, 1000];");
     for p in &plan.poses {
-        let joints: Vec<String> = p.joints.iter().map(|q| format!("{q:.4}")).collect();
+        let joints: Vec<String> = p.joints.iter().map(|q| format!("{q:.10}")).collect();
         let _ = writeln!(
             out,
             "    CONST jointtarget jt_{} := [[{}], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]]; ! station {}, {}, side {:+}",
@@ -347,7 +347,7 @@ pub fn ur_script(plan: &Plan) -> String {
         let joints: Vec<String> = p
             .joints
             .iter()
-            .map(|q| format!("{:.6}", q.to_radians()))
+            .map(|q| format!("{:.12}", q.to_radians()))
             .collect();
         let _ = writeln!(
             out,

@@ -6,7 +6,6 @@
 use std::path::{Path, PathBuf};
 
 use nalgebra::Isometry3;
-use serde_json::Value;
 
 use super::config::{
     DEFAULT_CANDIDATES, DEFAULT_CONE_DEG, DEFAULT_CUT_ANGLE_DEG, PlanConfig, Selection,
@@ -14,7 +13,6 @@ use super::config::{
 };
 use super::predict::PredictConfig;
 use crate::engine::cell::workspace;
-use crate::engine::geometry::isometry_from_rows;
 use crate::engine::import::{RobotSource, load_robot};
 use crate::engine::robot::{self, JointLimit};
 use crate::engine::session::SensorRange;
@@ -239,23 +237,11 @@ impl PlanRequest {
 /// # Errors
 /// [`RequestError::File`] naming the file and what is wrong.
 pub fn read_hand_eye(path: &Path) -> Result<Isometry3<f64>, RequestError> {
-    let fail = |message: String| RequestError::File {
+    crate::engine::format::read_transform(path, "hand_eye").map_err(|message| RequestError::File {
         what: "hand-eye",
         message,
         path: path.to_path_buf(),
-    };
-    let text = std::fs::read_to_string(path).map_err(|e| fail(format!("reading failed: {e}")))?;
-    let value: Value = serde_json::from_str(&text).map_err(|e| fail(e.to_string()))?;
-    let matrix = match &value {
-        Value::Object(map) => map
-            .get("hand_eye")
-            .cloned()
-            .ok_or_else(|| fail("the file has no `hand_eye`".to_owned()))?,
-        other => other.clone(),
-    };
-    let rows: [[f64; 4]; 4] = serde_json::from_value(matrix)
-        .map_err(|e| fail(format!("expected a 4x4 matrix of numbers: {e}")))?;
-    isometry_from_rows(&rows).map_err(|e| fail(e.to_string()))
+    })
 }
 
 /// Explicit stations from a CSV with columns `use` (identify or validate),

@@ -8,6 +8,8 @@ use nalgebra::{Isometry3, Vector3};
 
 use crate::engine::robot::Robot;
 
+pub mod rules;
+
 /// FORMAT.md default for `solver.threshold` (mm): the paper's value.
 pub const DEFAULT_THRESHOLD: f64 = 0.15;
 /// FORMAT.md default for `solver.max_iterations`.
@@ -204,6 +206,10 @@ impl Default for SolverSettings {
 pub struct RuleError {
     /// The measurement to blame, if one is.
     pub measurement: Option<String>,
+    /// The key at fault, when one is: relative to the measurement
+    /// (`joints`, `stripe.points`) or to the file (`sphere.diameter`,
+    /// `reference_distances[2]`).
+    pub key: Option<String>,
     /// What is wrong.
     pub message: String,
 }
@@ -212,6 +218,7 @@ impl RuleError {
     fn at(measurement: &str, message: String) -> Self {
         Self {
             measurement: Some(measurement.to_string()),
+            key: None,
             message,
         }
     }
@@ -219,6 +226,7 @@ impl RuleError {
     fn general(message: String) -> Self {
         Self {
             measurement: None,
+            key: None,
             message,
         }
     }

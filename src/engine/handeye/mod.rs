@@ -11,6 +11,11 @@
 //!   (eq. 8), stacked over all pairs `i < j` and solved by least squares (eq. 9).
 //!
 //! Degenerate sets are detected before solving and reported with the ids.
+//!
+//! Beyond the paper, [`general`] solves the fixed-sphere constraint for
+//! any pose set at once, for cells that publish no pure translations.
+
+pub mod general;
 
 use nalgebra::{DMatrix, DVector, Isometry3, Matrix3, SVD, Translation3, UnitQuaternion, Vector3};
 
@@ -66,6 +71,30 @@ pub enum HandEyeError {
         usage: &'static str,
         /// The stations found.
         stations: Vec<String>,
+    },
+    /// Too few sightings for the general hand-eye ([`general`]): it needs
+    /// 4 more than the stations it sees.
+    #[error(
+        "the general initial hand-eye needs at least 4 poses more than stations: {found} poses of {stations} station(s){}",
+        list_ids(ids)
+    )]
+    TooFewPoses {
+        /// Sightings given.
+        found: usize,
+        /// Stations they see.
+        stations: usize,
+        /// Their ids.
+        ids: Vec<String>,
+    },
+    /// The flange orientations do not determine the hand-eye ([`general`]).
+    #[error(
+        "the flange orientations span too little to determine the hand-eye (largest difference {span_deg:.1}°): {detail}"
+    )]
+    OrientationsSpanTooLittle {
+        /// Largest angle between two orientations of one station, deg.
+        span_deg: f64,
+        /// What is undetermined, and what to do.
+        detail: String,
     },
     /// The poses or centres give numbers that are not finite (far beyond
     /// any cell's size): no hand-eye can be computed.

@@ -1,0 +1,284 @@
+//! Profile folders as cells publish them, and the pairing of their files
+//! with the poses of a log that has no ids.
+//!
+//! A folder holds the profiles and often more: the pose file itself, the
+//! sensor vendor's or another tool's calibration output, notes. The
+//! profiles are the files named alike (`p1.yml` … `p15.yml`,
+//! `1_3C_line.yml` … `10_3C_line.yml`, `scan_001.csv` …): names are
+//! grouped by their shape (digit runs as `#`), and the group of profile
+//! files (the one with as many files as there are poses, else the
+//! largest) is kept; every other file is skipped and listed with why.
+//!
+//! The pose number is the digit run that tells the files apart, wherever
+//! it is in the name (`p7`, `7_3C_line`, `scan_007`); the profiles are in
+//! that number's order, and pose `k` of the log (in its order) is paired
+//! with profile `k`.
+
+use std::collections::{BTreeMap, HashSet};
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use super::ImportError;
+use super::profiles::PROFILE_EXTENSIONS;
+
+/// The profile files of a folder and what was left out.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FolderListing {
+    /// The profiles, in the order of their number.
+    pub profiles: Vec<PathBuf>,
+    /// Each profile's number (`None` for a name with no digits).
+    pub numbers: Vec<Option<u64>>,
+    /// Files of the folder that are not profiles, with the reason.
+    pub skipped: Vec<(PathBuf, String)>,
+}
+
+impl FolderListing {
+    /// One line: how many profiles, their first and last name, the skipped files.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let name = |p: &PathBuf| {
+            p.file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+        };
+        let range = match (self.profiles.first(), self.profiles.last()) {
+            (Some(a), Some(b)) if self.profiles.len() > 1 => format!("{} … {}", name(a), name(b)),
+            (Some(a), _) => name(a),
+            _ => String::new(),
+        };
+        let mut out = format!(
+            "profile files: {} ({range}) in the order of the number in their names",
+            self.profiles.len()
+        );
+        if !self.skipped.is_empty() {
+            let skipped: Vec<String> = self
+                .skipped
+                .iter()
+                .map(|(p, why)| format!("{} ({why})", name(p)))
+                .collect();
+            out.push_str(&format!("; skipped: {}", skipped.join(", ")));
+        }
+        out
+    }
+}
+
+/// A file name's shape: lower case, each digit run as `#`.
+fn shape(name: &str) -> String {
+    let mut out = String::new();
+    let mut in_digits = false;
+    for c in name.chars() {
+        if c.is_ascii_digit() {
+            if !in_digits {
+                out.push('#');
+            }
+            in_digits = true;
+        } else {
+            out.extend(c.to_lowercase());
+            in_digits = false;
+        }
+    }
+    out
+}
+
+/// The digit runs of a name, as numbers (saturating).
+fn digit_runs(name: &str) -> Vec<u64> {
+    let mut out = Vec::new();
+    let mut current: Option<u64> = None;
+    for c in name.chars() {
+        if let Some(d) = c.to_digit(10) {
+            current = Some(
+                current
+                    .unwrap_or(0)
+                    .saturating_mul(10)
+                    .saturating_add(u64::from(d)),
+            );
+        } else if let Some(v) = current.take() {
+            out.push(v);
+        }
+    }
+    out.extend(current);
+    out
+}
+
+/// Whether two paths name the same file.
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (fs::canonicalize(a), fs::canonicalize(b)) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
+}
+
+/// The profile files of `dir`: files of a profile extension named alike,
+/// in the order of their number; `exclude` (the pose file) and the rest
+/// skipped. With `expected` (the count of poses), the group of that size
+/// is chosen when there is one.
+///
+/// # Errors
+/// The folder cannot be read, or holds no profile file.
+pub fn list_profiles(
+    dir: &Path,
+    exclude: &[&Path],
+    expected: Option<usize>,
+) -> Result<FolderListing, ImportError> {
+    let entries = fs::read_dir(dir).map_err(|source| ImportError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let mut skipped = Vec::new();
+    let mut groups: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.is_file())
+        .collect();
+    files.sort();
+    for path in files {
+        let name = path
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+        if exclude.iter().any(|e| same_file(e, &path)) {
+            skipped.push((path, "the pose file".to_string()));
+            continue;
+        }
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        if !PROFILE_EXTENSIONS.contains(&ext.as_str()) {
+            skipped.push((path, format!("not a profile file (.{ext})")));
+            continue;
+        }
+        groups.entry(shape(&name)).or_default().push(path);
+    }
+    if groups.is_empty() {
+        return Err(ImportError::File {
+            path: dir.to_path_buf(),
+            message: format!(
+                "no profile file in the folder (profiles are .{} files){}",
+                PROFILE_EXTENSIONS.join(", ."),
+                if skipped.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "; it holds {}",
+                        skipped
+                            .iter()
+                            .filter_map(|(p, _)| p
+                                .file_name()
+                                .map(|n| n.to_string_lossy().into_owned()))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                }
+            ),
+        });
+    }
+    // The group of profiles: as many files as poses, else the largest
+    // (ties: the first shape in order).
+    let chosen = expected
+        .and_then(|n| {
+            let sized: Vec<&String> = groups
+                .iter()
+                .filter(|(_, v)| v.len() == n)
+                .map(|(k, _)| k)
+                .collect();
+            (sized.len() == 1).then(|| sized[0].clone())
+        })
+        .or_else(|| {
+            groups
+                .iter()
+                .max_by(|a, b| a.1.len().cmp(&b.1.len()).then_with(|| b.0.cmp(a.0)))
+                .map(|(k, _)| k.clone())
+        })
+        .unwrap_or_default();
+    let mut profiles = groups.remove(&chosen).unwrap_or_default();
+    for (shape, paths) in groups {
+        for p in paths {
+            skipped.push((
+                p,
+                format!("not named like the profiles ({shape} vs {chosen})"),
+            ));
+        }
+    }
+    // The varying digit run is the pose number.
+    let runs: Vec<Vec<u64>> = profiles
+        .iter()
+        .map(|p| {
+            digit_runs(
+                &p.file_stem()
+                    .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+            )
+        })
+        .collect();
+    let width = runs.iter().map(Vec::len).min().unwrap_or(0);
+    let column = (0..width).find(|&k| {
+        let values: HashSet<u64> = runs.iter().map(|r| r[k]).collect();
+        values.len() == runs.len()
+    });
+    let numbers: Vec<Option<u64>> = runs.iter().map(|r| column.map(|k| r[k])).collect();
+    let mut order: Vec<usize> = (0..profiles.len()).collect();
+    order.sort_by(|&a, &b| {
+        numbers[a]
+            .cmp(&numbers[b])
+            .then_with(|| profiles[a].cmp(&profiles[b]))
+    });
+    let numbers = order.iter().map(|&i| numbers[i]).collect();
+    let sorted: Vec<PathBuf> = order
+        .iter()
+        .map(|&i| std::mem::take(&mut profiles[i]))
+        .collect();
+    skipped.sort();
+    Ok(FolderListing {
+        profiles: sorted,
+        numbers,
+        skipped,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shapes_and_runs() {
+        assert_eq!(shape("7_3C_line.yml"), "#_#c_line.yml");
+        assert_eq!(shape("P12.YML"), "p#.yml");
+        assert_eq!(digit_runs("7_3C_line"), vec![7, 3]);
+        assert_eq!(digit_runs("scan_007"), vec![7]);
+    }
+
+    #[test]
+    fn folders_as_published() {
+        let dir = tempfile::tempdir().unwrap();
+        let touch = |n: &str| fs::write(dir.path().join(n), "1 2\n").unwrap();
+        for k in [1, 2, 10, 3] {
+            touch(&format!("{k}_3C_line.yml"));
+        }
+        touch("robpose.txt");
+        touch("calibration.sec");
+        touch("notes.txt");
+        let pose_file = dir.path().join("robpose.txt");
+        let l = list_profiles(dir.path(), &[&pose_file], Some(4)).unwrap();
+        let names: Vec<String> = l
+            .profiles
+            .iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(
+            names,
+            [
+                "1_3C_line.yml",
+                "2_3C_line.yml",
+                "3_3C_line.yml",
+                "10_3C_line.yml"
+            ]
+        );
+        assert_eq!(l.numbers, vec![Some(1), Some(2), Some(3), Some(10)]);
+        assert_eq!(l.skipped.len(), 3, "{:?}", l.skipped);
+        let s = l.summary();
+        assert!(
+            s.contains("robpose.txt (the pose file)") && s.contains("calibration.sec"),
+            "{s}"
+        );
+        assert!(s.contains("notes.txt (not named like the profiles"), "{s}");
+    }
+}
