@@ -39,12 +39,13 @@
 //!   it. The count is the run's, not the loop's stop rule again: a refit
 //!   that stopped at the threshold after other updates than the run would
 //!   score a different procedure, and one that missed the threshold would
-//!   make all 20 updates (40 × the run's cost on the demo instead of 10 ×). Leave-one-pose-out up to
+//!   make every update the bound allows (on the demo the folds then cost
+//!   41 times the run instead of 13). Leave-one-pose-out up to
 //!   [`PAPER_LEAVE_ONE_OUT_MAX`] identify measurements, else
 //!   [`PAPER_FOLDS`]-fold (measurement `k` of the stations in file order
 //!   goes to fold `k mod K`, so that two measurements of a station share
-//!   a fold only when it has more than `K`): the cost stays at `K` paper
-//!   runs, linear in the measurements.
+//!   a fold only when it has more than `K`): the cost stays at `K` times
+//!   the run's updates, linear in the measurements.
 
 use std::fmt;
 
