@@ -1,6 +1,7 @@
 //! Whole-calibration benchmarks on the embedded demo session: centres
 //! from the stripes plus the initial hand-eye (`prepare`), and the
-//! identification loop (`run`) of each method.
+//! identification loop (`run`) of each method, without and with the
+//! held-out figure.
 
 // A benchmark aborts on data it cannot load: there is nothing to recover.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -30,13 +31,25 @@ fn bench(c: &mut Criterion) {
     });
     let prepared = solve::prepare(&session).expect("prepare");
     for method in Method::ALL {
-        let mut options = Options::from_session(&session);
-        options.method = method;
-        group.bench_function(format!("identify, method {}", method.as_str()), |b| {
-            b.iter(|| {
-                solve::run(&session, &prepared, &options, &mut |_| Control::Continue).expect("run")
+        for held_out in [false, true] {
+            let mut options = Options::from_session(&session);
+            options.method = method;
+            options.held_out = held_out;
+            let name = if held_out {
+                format!(
+                    "identify and the held-out figure, method {}",
+                    method.as_str()
+                )
+            } else {
+                format!("identify, method {}", method.as_str())
+            };
+            group.bench_function(name, |b| {
+                b.iter(|| {
+                    solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
+                        .expect("run")
+                });
             });
-        });
+        }
     }
     group.bench_function("whole calibration, default options", |b| {
         b.iter(|| solve::calibrate(&session, &Options::from_session(&session)).expect("calibrate"));

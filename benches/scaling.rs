@@ -29,6 +29,9 @@ fn bench(c: &mut Criterion) {
         for method in [Method::Ml, Method::Paper] {
             let mut options = Options::from_session(&session);
             options.method = method;
+            // Identification only: the held-out figure is timed on its own
+            // (benches/calibrate.rs, README "Held-out figure").
+            options.held_out = false;
             group.bench_with_input(
                 BenchmarkId::new(format!("run {}", method.as_str()), n),
                 &options,

@@ -83,6 +83,9 @@ fn origin_ui(ui: &mut egui::Ui, view: &ResultView) {
     if let Some(stop) = &view.stop_reason {
         ui.label(RichText::new(stop).small());
     }
+    for w in &view.shown.warnings {
+        ui.label(RichText::new(format!("warning: {w}")).color(WARN));
+    }
     for n in &view.notes {
         ui.label(RichText::new(format!("note: {n}")).color(WARN));
     }
@@ -125,7 +128,47 @@ fn headline_ui(ui: &mut egui::Ui, view: &ResultView, forms: &Forms, commands: &m
         ui.label(format!(
             "identify centres about their station's mean (3-D rms): {b:.3} → {a:.3} mm"
         ));
+        held_out_ui(ui, view);
     });
+}
+
+/// The held-out figure beside the fit's own scatter: each identify centre
+/// predicted by a calibration made without it.
+fn held_out_ui(ui: &mut egui::Ui, view: &ResultView) {
+    let Some(h) = &view.shown.held_out else {
+        ui.label(
+            RichText::new("held out: not in this result (written before spherecal computed it, or with --no-held-out)")
+                .color(MUTED),
+        );
+        return;
+    };
+    ui.horizontal_wrapped(|ui| {
+        ui.label(RichText::new(format!("held out ({})", h.label())).strong());
+        ui.label(
+            RichText::new(format!("rms {:.3} mm, max {:.3} mm", h.rms, h.max))
+                .size(16.0)
+                .strong(),
+        )
+        .on_hover_text(format!(
+            "each identify centre predicted by a calibration made without it, against its station's centre from the other measurements; largest: {}. Refit: {}",
+            h.max_measurement, h.refit
+        ));
+        ui.label(format!(
+            "· fit's own scatter rms {:.3} mm, max {:.3} mm ({:.2}× the fit's own)",
+            h.fit_rms,
+            h.fit_max,
+            h.ratio()
+        ));
+    });
+    if !h.undetermined.is_empty() {
+        ui.label(
+            RichText::new(format!(
+                "not predictable without themselves: {}",
+                h.undetermined.join(", ")
+            ))
+            .color(WARN),
+        );
+    }
 }
 
 /// PASS / FAIL in large type against the tolerance, which is edited

@@ -16,9 +16,9 @@ use crate::engine::geometry::{isometry_from_rows, rigid_from_rows, rows_from_iso
 use crate::engine::numeric::show;
 use crate::engine::robot::{Joint, Robot};
 use crate::engine::session::{Session, Use, limits};
-use crate::engine::solve::Calibration;
 use crate::engine::solve::ml::MlReport;
 use crate::engine::solve::report::{Direction, PaperReport, SolverReport};
+use crate::engine::solve::{Calibration, HeldOut};
 use crate::engine::validate::Validation;
 
 /// A result (FORMAT.md "Result file") as the engine holds it: transforms
@@ -58,6 +58,10 @@ pub struct ResultFile {
     pub centres: Vec<CentreRecord>,
     /// Present when the session has validate measurements.
     pub validation: Option<Validation>,
+    /// Each identify measurement predicted by a calibration made without
+    /// it (the top-level `held_out` key, README "Held-out figure"); absent
+    /// from results written before it existed.
+    pub held_out: Option<HeldOut>,
 }
 
 impl PartialEq for ResultFile {
@@ -82,6 +86,7 @@ impl PartialEq for ResultFile {
             && self.epsilon_after == other.epsilon_after
             && self.centres == other.centres
             && self.validation == other.validation
+            && self.held_out == other.held_out
     }
 }
 
@@ -127,6 +132,7 @@ impl ResultFile {
                 })
                 .collect(),
             validation: cal.validation.clone(),
+            held_out: cal.held_out.clone(),
         }
     }
 
@@ -625,6 +631,8 @@ const RESULT_OBJECTS: &[&str] = &[
     "validation.within_station",
     "validation.within_station.before",
     "validation.within_station.after",
+    "held_out",
+    "held_out.measurements[]",
 ];
 
 /// The result file as read: [`ResultFile`] plus `format` and `version`
@@ -653,6 +661,8 @@ struct ResultKeys {
     centres: Vec<CentreWire>,
     #[serde(default, deserialize_with = "some")]
     validation: Option<Validation>,
+    #[serde(default, deserialize_with = "some")]
+    held_out: Option<HeldOut>,
 }
 
 /// The transform of checked file rows, settled so that it survives its
@@ -706,6 +716,7 @@ impl ResultKeys {
                 })
                 .collect(),
             validation: self.validation,
+            held_out: self.held_out,
         }
     }
 }
@@ -871,6 +882,8 @@ struct ResultOut<'a> {
     centres: Vec<CentreWire>,
     #[serde(skip_serializing_if = "Option::is_none")]
     validation: Option<&'a Validation>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    held_out: Option<&'a HeldOut>,
 }
 
 /// Serialises the `solver` block with `method` first, then the other keys.
@@ -916,6 +929,7 @@ impl<'a> ResultOut<'a> {
                 })
                 .collect(),
             validation: r.validation.as_ref(),
+            held_out: r.held_out.as_ref(),
         }
     }
 }

@@ -44,6 +44,7 @@ pub fn decide_side(spec: &PoseImportSpec, inputs: &PoseInputs) -> Result<Importe
                 Ok(i) => {
                     let mut options = Options::from_session(&i.session);
                     options.ml.cross_validation = false;
+                    options.held_out = false;
                     solve::calibrate(&i.session, &options)
                         .map(|(_, cal)| cal.epsilon_after())
                         .map_err(|e| {

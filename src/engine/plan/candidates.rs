@@ -589,6 +589,7 @@ impl Planner<'_> {
                 cross_validation: false,
                 ..MlOptions::default()
             },
+            held_out: false,
         };
         ml::analyse(session, prepared, &options).map_err(|e| PlanError::Analysis(e.to_string()))
     }

@@ -177,6 +177,7 @@ pub fn predict(
         }
         let mut options = Options::from_session(&session);
         options.ml.cross_validation = false;
+        options.held_out = false;
         let prepared = solve::prepare(&session).map_err(|e| fail(e.to_string()))?;
         let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
             .map_err(|e| fail(e.to_string()))?;

@@ -8,8 +8,10 @@ use crate::engine::session::Session;
 use crate::engine::solve::Calibration;
 use crate::engine::solve::plausible::identify_scatter;
 
-/// A few lines for people: why the loop stopped, what the SVD kept, how
-/// the hand-eye moved, and the before/after validation figures.
+/// A few lines for people: why the loop stopped (and a warning when the
+/// paper's loop made ε worse), what the SVD kept, how the hand-eye moved,
+/// the held-out figure beside the fit's own scatter, and the before/after
+/// validation figures.
 #[must_use]
 pub fn summary(session: &Session, cal: &Calibration) -> String {
     let mut s = String::new();
@@ -20,6 +22,12 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
         cal.epsilon_before(),
         cal.epsilon_after()
     );
+    if let Some(w) = cal
+        .report
+        .epsilon_warning(cal.epsilon_before(), cal.epsilon_after())
+    {
+        let _ = writeln!(s, "warning: {w}");
+    }
     if let Some((p, kept)) = cal
         .report
         .paper()
@@ -60,6 +68,9 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
         s,
         "identify stations, centre scatter about each station's mean (3-D rms): {before:.4} → {after:.4} mm"
     );
+    if let Some(h) = &cal.held_out {
+        let _ = writeln!(s, "{h}");
+    }
     match &cal.validation {
         Some(v) if !v.distances.is_empty() => {
             let _ = writeln!(

@@ -1,8 +1,9 @@
 //! What every reader shows of a result, computed once from the typed
 //! [`ResultFile`]: the headline figures, the within-station centre
 //! distances (paper Fig. 5) with their pairs, the hand-eye as translation
-//! and roll/pitch/yaw, each parameter's σ, and which parameters the data
-//! could not identify. The workbench, the HTML report, history and the
+//! and roll/pitch/yaw, each parameter's σ, which parameters the data
+//! could not identify, the held-out figure beside the fit's own scatter,
+//! and the warnings about the run (the paper's loop making ε worse). The workbench, the HTML report, history and the
 //! planner read these; none of them looks into the solver block itself.
 //! Also here: whether a result belongs to a session, and how well a
 //! hand-eye-only result determined the hand-eye ([`strength`]), and the
@@ -18,7 +19,7 @@ use nalgebra::{Isometry3, Vector3};
 use crate::engine::format::result::{CentreRecord, ResultFile};
 use crate::engine::geometry::roll_pitch_yaw_deg;
 use crate::engine::session::{Session, Use};
-use crate::engine::solve::{Prepared, SolverReport};
+use crate::engine::solve::{HeldOut, Prepared, SolverReport};
 use crate::engine::validate::{
     BeforeAfter, DistanceRecord, Stats, scatter_rms, within_station_distances,
 };
@@ -254,6 +255,13 @@ pub struct ResultView {
     /// covariance of the sensor-frame perturbation (`None` without one,
     /// or when a hand-eye direction was held fixed).
     pub hand_eye_sigma: Option<[f64; 6]>,
+    /// Each identify measurement predicted by a calibration made without
+    /// it, beside the fit's own scatter (`None` for a result written
+    /// without it).
+    pub held_out: Option<HeldOut>,
+    /// Warnings about the run itself: the paper's loop ending with ε above
+    /// its start ([`SolverReport::epsilon_warning`]).
+    pub warnings: Vec<String>,
 }
 
 impl ResultView {
@@ -325,6 +333,12 @@ impl ResultView {
                 .solver
                 .ml()
                 .and_then(|ml| hand_eye_sigma(&result.hand_eye, &ml.covariance)),
+            held_out: result.held_out.clone(),
+            warnings: result
+                .solver
+                .epsilon_warning(result.epsilon_before, result.epsilon_after)
+                .into_iter()
+                .collect(),
         }
     }
 }

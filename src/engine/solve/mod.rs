@@ -14,6 +14,7 @@
 //! method's typed report ([`SolverReport`]).
 
 pub mod estimate;
+pub mod held_out;
 pub mod ml;
 pub mod paper;
 pub mod plausible;
@@ -29,7 +30,8 @@ use crate::engine::stripe::StripeError;
 use crate::engine::validate::{
     BeforeAfter, StationCentres, Stats, Validation, epsilon, validation, within_station_distances,
 };
-use estimate::Estimate;
+use estimate::{Estimate, Station};
+pub use held_out::{HeldOut, HeldOutRecord, HeldOutScheme};
 use paper::PaperOptions;
 pub use prepare::{Analysis, HandEyeSource, Prepared, PreparedMeasurement, analyse, prepare};
 pub use report::{LoopRecord, SolverReport};
@@ -124,6 +126,10 @@ pub struct Options {
     pub paper: PaperOptions,
     /// Settings of the `ml` method.
     pub ml: ml::MlOptions,
+    /// Whether to compute the held-out figure after the loop
+    /// ([`held_out`]): each identify measurement predicted by a
+    /// calibration made without it.
+    pub held_out: bool,
 }
 
 impl Options {
@@ -138,6 +144,7 @@ impl Options {
             max_iterations: session.solver.max_iterations,
             paper: PaperOptions::default(),
             ml: ml::MlOptions::default(),
+            held_out: true,
         }
     }
 }
@@ -182,6 +189,16 @@ pub enum Phase {
     },
     /// `ml`: residuals, outliers and the variance factor.
     Outliers,
+    /// The held-out figure ([`held_out`]): `done` of `of` refits made
+    /// (measurements for leave-one-pose-out, folds for k-fold).
+    HeldOut {
+        /// How the refits are made.
+        scheme: HeldOutScheme,
+        /// Refits done.
+        done: usize,
+        /// Refits in all.
+        of: usize,
+    },
 }
 
 impl Phase {
@@ -197,6 +214,13 @@ impl Phase {
                 format!("leave-one-station-out: {done} of {of} stations")
             }
             Self::Outliers => "outliers and variance factor".to_string(),
+            Self::HeldOut { scheme, done, of } => {
+                format!(
+                    "held out ({}): {done} of {of} {}",
+                    scheme.label(of),
+                    scheme.unit()
+                )
+            }
         }
     }
 
@@ -204,7 +228,9 @@ impl Phase {
     #[must_use]
     pub fn fraction(&self) -> Option<f64> {
         match *self {
-            Self::CrossValidation { done, of } if of > 0 => Some(done as f64 / of as f64),
+            Self::CrossValidation { done, of } | Self::HeldOut { done, of, .. } if of > 0 => {
+                Some(done as f64 / of as f64)
+            }
             _ => None,
         }
     }
@@ -455,6 +481,9 @@ pub struct Calibration {
     pub identify_within: BeforeAfter,
     /// Validation block, when the session has validate measurements.
     pub validation: Option<Validation>,
+    /// Each identify measurement predicted by a calibration made without
+    /// it ([`held_out`]); `None` when not asked for ([`Options::held_out`]).
+    pub held_out: Option<HeldOut>,
 }
 
 impl Calibration {
@@ -510,6 +539,12 @@ pub trait Update {
         update: usize,
         phase: &mut dyn FnMut(Phase) -> Control,
     ) -> Result<Step, SolveError>;
+
+    /// The held-out figure at the estimate the loop ended with: each
+    /// identify measurement's centre predicted by a calibration made
+    /// without it ([`held_out`]), telling `phase` of the refits; `None`
+    /// when `phase` cancelled.
+    fn held_out(&self, phase: &mut dyn FnMut(Phase) -> Control) -> Option<HeldOut>;
 
     /// The method's report on the run that stopped for `stop` (a method
     /// leaves out its costly diagnostics after a cancel), telling `phase`
@@ -588,7 +623,131 @@ pub fn run(
             options,
         )?),
     };
-    let eps_of = |est: &Estimate| epsilon(&est.station_centres(&stations));
+    let looped = iterate(method.as_mut(), &stations, options, progress)?;
+    let mut stop = looped.stop(options);
+    let (updates, eps) = (looped.iterations.len() - 1, stop_epsilon(&stop));
+    let est = method.estimate().clone();
+    let mut after = |phase: Phase| {
+        progress(&Progress {
+            updates,
+            epsilon: eps,
+            max_iterations: options.max_iterations,
+            threshold: options.threshold,
+            phase,
+        })
+    };
+    let mut held_out = None;
+    if options.held_out && !stop.is_cancelled() {
+        match method.held_out(&mut after) {
+            Some(h) => held_out = Some(h),
+            None => stop = stop.cancelled(),
+        }
+    }
+    let (report, cancelled_late) = method.report(&stop, &mut after);
+    if cancelled_late {
+        stop = stop.cancelled();
+    }
+    let mut cal = finish(
+        session,
+        prepared,
+        options,
+        &start,
+        est,
+        looped.iterations,
+        stop,
+        report,
+    );
+    cal.held_out = held_out;
+    Ok(cal)
+}
+
+/// The final ε a stop reason records, mm.
+fn stop_epsilon(stop: &StopReason) -> f64 {
+    match *stop {
+        StopReason::Converged { epsilon, .. }
+        | StopReason::IterationLimit { epsilon, .. }
+        | StopReason::SolverConverged { epsilon, .. }
+        | StopReason::LevelledOff { epsilon, .. }
+        | StopReason::Cancelled { epsilon, .. } => epsilon,
+    }
+}
+
+/// What the loop did: every ε and how it ended.
+struct Looped {
+    /// ε after 0, 1, … updates, mm.
+    iterations: Vec<f64>,
+    /// The caller cancelled.
+    cancelled: bool,
+    /// The method converged (its last relative cost change).
+    converged: Option<f64>,
+    /// Updates in a row over which ε did not change.
+    levelled: usize,
+}
+
+impl Looped {
+    /// Why the loop stopped.
+    fn stop(&self, options: &Options) -> StopReason {
+        let n = self.iterations.len();
+        let updates = n - 1;
+        let eps = self.iterations[n - 1];
+        let threshold = options.threshold;
+        let last_change = if n >= 2 {
+            (self.iterations[n - 1] - self.iterations[n - 2]).abs()
+        } else {
+            f64::INFINITY
+        };
+        if self.cancelled {
+            StopReason::Cancelled {
+                epsilon: eps,
+                threshold,
+                updates,
+            }
+        } else if eps <= threshold {
+            StopReason::Converged {
+                epsilon: eps,
+                threshold,
+                updates,
+            }
+        } else if let Some(relative_change) = self.converged {
+            StopReason::SolverConverged {
+                epsilon: eps,
+                threshold,
+                updates,
+                relative_change,
+            }
+        } else if self.levelled >= LEVELLED_OFF_UPDATES {
+            StopReason::LevelledOff {
+                epsilon: eps,
+                threshold,
+                updates,
+                last_change,
+            }
+        } else {
+            StopReason::IterationLimit {
+                epsilon: eps,
+                threshold,
+                updates,
+                last_change,
+            }
+        }
+    }
+}
+
+/// The loop of FORMAT.md "The iteration" around `method` over the
+/// identify `stations`: compute ε; while ε > threshold, fewer than
+/// `max_iterations` updates were made, the method has not converged and ε
+/// has not levelled off, update and compute ε again. `progress` hears of
+/// every ε and every inner step, and may cancel.
+///
+/// # Errors
+/// As the method's update, or a non-finite ε.
+fn iterate(
+    method: &mut dyn Update,
+    stations: &[Station],
+    options: &Options,
+    progress: &mut dyn FnMut(&Progress) -> Control,
+) -> Result<Looped, SolveError> {
+    let eps_of = |est: &Estimate| epsilon(&est.station_centres(stations));
     let mut eps = eps_of(method.estimate());
     let mut iterations = vec![eps];
     let report = |updates: usize, epsilon: f64, phase: Phase| Progress {
@@ -635,56 +794,12 @@ pub fn run(
         };
         cancelled = progress(&report(updates, eps, Phase::Loop)) == Control::Cancel;
     }
-    let updates = iterations.len() - 1;
-    let n = iterations.len();
-    let last_change = if n >= 2 {
-        (iterations[n - 1] - iterations[n - 2]).abs()
-    } else {
-        f64::INFINITY
-    };
-    let mut stop = if cancelled {
-        StopReason::Cancelled {
-            epsilon: eps,
-            threshold: options.threshold,
-            updates,
-        }
-    } else if eps <= options.threshold {
-        StopReason::Converged {
-            epsilon: eps,
-            threshold: options.threshold,
-            updates,
-        }
-    } else if let Some(relative_change) = converged {
-        StopReason::SolverConverged {
-            epsilon: eps,
-            threshold: options.threshold,
-            updates,
-            relative_change,
-        }
-    } else if levelled >= LEVELLED_OFF_UPDATES {
-        StopReason::LevelledOff {
-            epsilon: eps,
-            threshold: options.threshold,
-            updates,
-            last_change,
-        }
-    } else {
-        StopReason::IterationLimit {
-            epsilon: eps,
-            threshold: options.threshold,
-            updates,
-            last_change,
-        }
-    };
-    let est = method.estimate().clone();
-    let mut after = |phase: Phase| progress(&report(updates, eps, phase));
-    let (report, cancelled_late) = method.report(&stop, &mut after);
-    if cancelled_late {
-        stop = stop.cancelled();
-    }
-    Ok(finish(
-        session, prepared, options, &start, est, iterations, stop, report,
-    ))
+    Ok(Looped {
+        iterations,
+        cancelled,
+        converged,
+        levelled,
+    })
 }
 
 /// The centres and statistics of a finished run.
@@ -752,6 +867,7 @@ fn finish(
         centres,
         identify_within,
         validation,
+        held_out: None,
     }
 }
 

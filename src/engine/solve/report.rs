@@ -77,6 +77,17 @@ impl SolverReport {
         }
     }
 
+    /// The warning a method gives about the ε of its loop, from `before`
+    /// to `after` (mm): the paper's method when ε rose
+    /// ([`epsilon_rise_warning`](super::paper::epsilon_rise_warning)).
+    #[must_use]
+    pub fn epsilon_warning(&self, before: f64, after: f64) -> Option<String> {
+        match self {
+            Self::Paper(p) => super::paper::epsilon_rise_warning(p.pairs.as_deref(), before, after),
+            Self::Ml(_) | Self::Other { .. } => None,
+        }
+    }
+
     /// Parameters the method held fixed at their start (`ml`'s fixed set;
     /// empty for a method that does not fix parameters).
     #[must_use]

@@ -8,7 +8,9 @@
 //! - notes when the result does not match the session;
 //! - summary: the validation figures before → after (std, max, rms of the
 //!   reference-distance errors; within-station distances), the identify
-//!   stations' within-station distances, ε, the stop reason;
+//!   stations' within-station distances, ε, the stop reason (and a warning
+//!   when the paper's loop made ε worse), the held-out figure beside the
+//!   fit's own scatter;
 //! - settings: every scalar of the result's `solver` block and where the
 //!   initial hand-eye came from;
 //! - stripe quality: fitted radii, arc spans, cut angles, fit RMS
@@ -46,7 +48,7 @@ use crate::engine::result_view::{
 };
 use crate::engine::session::Session;
 use crate::engine::solve::ml::MlReport;
-use crate::engine::solve::{self, Prepared, SolverReport};
+use crate::engine::solve::{self, HeldOut, Prepared, SolverReport};
 use crate::engine::validate::BeforeAfter;
 use css::CSS;
 use figures::figures;
@@ -211,6 +213,10 @@ struct Ctx<'a> {
     verdict: Option<(Verdict, Tolerance)>,
     /// 1σ of the hand-eye as tabled (flange-frame x, y, z; roll, pitch, yaw).
     hand_eye_sigma: Option<[f64; 6]>,
+    /// The held-out figure, when the result has one.
+    held_out: Option<HeldOut>,
+    /// Warnings about the run (the paper's loop making ε worse).
+    warnings: Vec<String>,
 }
 
 impl<'a> Ctx<'a> {
@@ -231,6 +237,8 @@ impl<'a> Ctx<'a> {
             identify_scatter: view.identify_scatter,
             excluded: excluded_measurements(input.session, result),
             hand_eye_sigma: view.hand_eye_sigma,
+            held_out: view.held_out,
+            warnings: view.warnings,
             verdict: input
                 .tolerance
                 .map(|t| (Verdict::of(view.headline.as_ref(), &t), t)),

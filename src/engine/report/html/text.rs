@@ -255,6 +255,14 @@ pub(super) fn summary(h: &mut String, ctx: &Ctx<'_>) {
             .map(|s| format!(" Stop: {}.", escape(s)))
             .unwrap_or_default()
     );
+    for w in &ctx.warnings {
+        let _ = writeln!(
+            h,
+            "<p class=\"warn\" id=\"epsilon-warning\">Warning: {}</p>",
+            escape(w)
+        );
+    }
+    held_out(h, ctx);
     h.push_str("</div>\n<table class=\"keep\">\n");
     head_row(h, &["figure (mm)", "#before", "#after", "#change"]);
     if let Some(v) = &r.validation {
@@ -284,6 +292,42 @@ pub(super) fn summary(h: &mut String, ctx: &Ctx<'_>) {
     );
     h.push_str("</table>\n<p class=\"muted\">Before: nominal model and initial hand-eye. After: calibrated model and hand-eye. Within-station distances have the true value 0. Statistics as in FORMAT.md: std with divisor n − 1, max of |e|, rms.</p>\n");
     end_section(h);
+}
+
+/// The held-out figure beside the fit's own scatter, or why there is none.
+fn held_out(h: &mut String, ctx: &Ctx<'_>) {
+    let Some(ho) = &ctx.held_out else {
+        h.push_str("<p class=\"muted\" id=\"held-out\">No held-out figure in this result (written before spherecal computed one, or with --no-held-out).</p>\n");
+        return;
+    };
+    let _ = writeln!(
+        h,
+        "<p id=\"held-out\">Held out ({}), each identify centre predicted without itself: <span class=\"big\">rms {} mm</span>, max {} mm{}; the fit's own scatter: rms {} mm, max {} mm ({}× the fit's own rms over {} measurements).</p>",
+        escape(&ho.label()),
+        num(ho.rms, 3),
+        num(ho.max, 3),
+        if ho.max_measurement.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", escape(&ho.max_measurement))
+        },
+        num(ho.fit_rms, 3),
+        num(ho.fit_max, 3),
+        num(ho.ratio(), 2),
+        ho.measurements.len()
+    );
+    if !ho.undetermined.is_empty() {
+        let _ = writeln!(
+            h,
+            "<p class=\"warn\">Not predictable without themselves (each alone determined a direction): {}</p>",
+            escape(&ho.undetermined.join(", "))
+        );
+    }
+    let _ = writeln!(
+        h,
+        "<p class=\"muted\">Held out: the distance from a measurement's centre, under a calibration made without it, to its station's centre as that calibration estimates it from the station's other measurements. The fit's own scatter flatters: the fit has seen each point. Refit: {}.</p>",
+        escape(&ho.refit)
+    );
 }
 
 /// `v` to 6 significant digits, without trailing zeros (1e-7 stays 1e-7).

@@ -92,7 +92,10 @@
 //! deviation of any centre-to-centre distance, both as an RMS error and
 //! as the expected std over a set of distances (the common part removed,
 //! as the validation std removes it). Leave-one-station-out
-//! cross-validation estimates accuracy without a laser tracker.
+//! cross-validation estimates accuracy without a laser tracker, and so
+//! does leave-one-pose-out, by one Gauss-Newton step per measurement on
+//! the same blocks ([`held_out`](super::held_out)): the one figure a set
+//! of a single station has.
 
 mod diagnostics;
 pub mod identifiability;
@@ -107,7 +110,10 @@ use nalgebra::Vector3;
 use super::estimate::unknown_scale;
 use super::estimate::{Estimate, Station};
 use super::prepare::Prepared;
-use super::{Control, Options, Phase, SolveError, SolverReport, Step, StopReason, Update};
+use super::{
+    Control, HeldOut, HeldOutRecord, HeldOutScheme, Options, Phase, SolveError, SolverReport, Step,
+    StopReason, Update,
+};
 use crate::engine::session::{Session, Use};
 use crate::engine::validate::epsilon;
 pub use identifiability::Inseparable;
@@ -118,7 +124,7 @@ use noise::{
     base_covariance, chi3_quantile, sensor_covariance, whitening,
 };
 use prior::{DEFAULT_PRIOR_ANGLE_DEG, DEFAULT_PRIOR_LENGTH_MM, chart_prior};
-use problem::{LAMBDA_START, Obs, Problem, State};
+use problem::{HeldOutPrediction, LAMBDA_START, Obs, Problem, State};
 pub use report::{
     CrossStation, CrossValidation, DistanceStd, IterationRecord, LabelledMatrix, MlReport,
     OutlierRecord, ParameterRecord,
@@ -354,7 +360,37 @@ impl<'a> MlUpdate<'a> {
     fn last_relative_change(&self) -> f64 {
         self.history.last().map_or(0.0, |h| h.relative_decrease)
     }
+
+    /// The held-out figure of per-observation predictions (problem order).
+    fn held_out_of(&self, predictions: Vec<HeldOutPrediction>, refit: &str) -> HeldOut {
+        let mut rows = Vec::with_capacity(predictions.len());
+        let mut undetermined = Vec::new();
+        for (o, (held, fit)) in self.problem.obs.iter().zip(predictions) {
+            match held {
+                Some(held_out) => rows.push(HeldOutRecord {
+                    measurement: o.sighting.id.clone(),
+                    station: self.problem.stations[o.station].clone(),
+                    held_out,
+                    fit,
+                }),
+                None => undetermined.push(o.sighting.id.clone()),
+            }
+        }
+        HeldOut::new(
+            HeldOutScheme::LeaveOnePoseOut,
+            self.problem.obs.len(),
+            refit.to_string(),
+            rows,
+            undetermined,
+        )
+    }
 }
+
+/// How `ml`'s held-out refits are made, as the result says.
+const ONE_STEP_REFIT: &str = "one Gauss-Newton step from the solution with the measurement's rows removed (a rank-3 downdate of its station block; the PRESS residual (I − w·M_i)⁻¹·r_i, M_i its hat block); the station centre is the refit's estimate from the station's other measurements";
+
+/// How [`exact_held_out`]'s refits are made.
+const EXACT_REFIT: &str = "a complete Levenberg-Marquardt solve from the solution without the measurement; the station centre is the refit's estimate from the station's other measurements";
 
 impl Update for MlUpdate<'_> {
     fn estimate(&self) -> &Estimate {
@@ -399,6 +435,13 @@ impl Update for MlUpdate<'_> {
         Ok(Step::Moved)
     }
 
+    /// Leave-one-pose-out by one Gauss-Newton step each
+    /// ([`held_out`](super::held_out)).
+    fn held_out(&self, phase: &mut dyn FnMut(Phase) -> Control) -> Option<HeldOut> {
+        let predictions = self.problem.held_out(&self.state, phase)?;
+        Some(self.held_out_of(predictions, ONE_STEP_REFIT))
+    }
+
     fn report(
         self: Box<Self>,
         stop: &StopReason,
@@ -433,4 +476,42 @@ pub fn analyse(
         last_change: f64::INFINITY,
     };
     Ok(diagnostics::report(&update, &stop, &mut |_| Control::Continue).0)
+}
+
+/// `ml`'s leave-one-pose-out figure by **exact** refits: the loop of
+/// [`run`](super::run) with `options` (it ends where `run` ends), then for
+/// each identify measurement a complete Levenberg-Marquardt solve without
+/// it, started at that solution, and its centre against the refit's
+/// station centre. The reference that the one-step figure `run` computes
+/// ([`Options::held_out`]) is tested against; one LM solve over all the
+/// measurements per measurement makes it quadratic in the measurements,
+/// so nothing but tests and benchmarks calls it.
+///
+/// # Errors
+/// As [`run`](super::run).
+pub fn exact_held_out(
+    session: &Session,
+    prepared: &Prepared,
+    options: &Options,
+) -> Result<HeldOut, SolveError> {
+    let start = Estimate {
+        robot: session.solver_robot(),
+        flange_from_sensor: prepared.hand_eye_initial,
+    };
+    let stations = prepared.stations(session, Use::Identify);
+    let mut update = MlUpdate::new(session, prepared, &start, stations.clone(), options)?;
+    super::iterate(&mut update, &stations, options, &mut |_| Control::Continue)?;
+    let problem = &update.problem;
+    let predictions = (0..problem.obs.len())
+        .map(|i| {
+            let o = &problem.obs[i];
+            let refit = problem.without(i).solve_from(&update.state, MAX_LM_STEPS);
+            let held = (refit.est.centre_in_base(&o.sighting) - refit.centres[o.station]).norm();
+            let fit = (update.state.est.centre_in_base(&o.sighting)
+                - update.state.centres[o.station])
+                .norm();
+            (Some(held), fit)
+        })
+        .collect();
+    Ok(update.held_out_of(predictions, EXACT_REFIT))
 }
