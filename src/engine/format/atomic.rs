@@ -38,6 +38,22 @@ static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// # Errors
 /// [`FileError::Io`] with action "writing" and the target path.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
+    write_atomic_with(path, |file| file.write_all(bytes))
+}
+
+/// As [`write_atomic`], with the content streamed by `write` into the
+/// temporary file (opened for reading and writing, so that a writer may
+/// seek back and read, as an E57 writer does): a large output (a point
+/// cloud) is never held in memory whole. An error of `write` removes the
+/// temporary file and leaves `path` as it was.
+///
+/// # Errors
+/// [`FileError::Io`] with action "writing" and the target path, carrying
+/// `write`'s error when it failed.
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut fs::File) -> io::Result<()>,
+) -> Result<(), FileError> {
     let io_error = |source: io::Error| FileError::Io {
         action: "writing",
         path: path.to_path_buf(),
@@ -58,7 +74,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
     remove_stale(&dir, file_name);
     let (temp_path, mut file) = create_temp(&dir, file_name).map_err(io_error)?;
     let written = (|| {
-        file.write_all(bytes)?;
+        write(&mut file)?;
         if let Ok(meta) = fs::metadata(&target) {
             // Best effort: a read-only target stays read-only after a save.
             let _ = file.set_permissions(meta.permissions());
@@ -233,6 +249,7 @@ fn create_temp(dir: &Path, file_name: &std::ffi::OsStr) -> io::Result<(PathBuf, 
         let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
         let temp = dir.join(temp_name(file_name, std::process::id(), n));
         match fs::OpenOptions::new()
+            .read(true)
             .write(true)
             .create_new(true)
             .open(&temp)

@@ -10,7 +10,7 @@ mod layout;
 pub mod result;
 pub mod session;
 
-pub use atomic::{refuse_inputs, remove_pending, same_file, write_atomic};
+pub use atomic::{refuse_inputs, remove_pending, same_file, write_atomic, write_atomic_with};
 pub use result::{
     ResultFile, load_result, parse_result, result_text_checked, result_to_json, save_result,
 };
