@@ -162,30 +162,31 @@ impl Cloud {
         })
     }
 
-    /// At most `max_points` points spread evenly over the cloud (every
-    /// `⌈n / max_points⌉`-th point, in order): a view of a cloud of
-    /// millions for drawing. Costs the points returned, not the cloud.
+    /// `min(max_points, n)` points spread evenly over the cloud's `n`
+    /// (point `⌊k·n / max_points⌋` for `k = 0, 1, …`, in order): a view of a
+    /// cloud of millions for drawing. Costs the points returned (and a step
+    /// per pose), not the cloud.
     #[must_use]
     pub fn decimated(&self, max_points: usize) -> Vec<CloudPoint> {
         let n = self.len();
-        if max_points == 0 || n == 0 {
-            return Vec::new();
-        }
-        let stride = n.div_ceil(max_points);
-        let mut out = Vec::with_capacity(n / stride + 1);
-        // Global index of the next point to take.
-        let mut next = 0usize;
+        let take = max_points.min(n);
+        let mut out = Vec::with_capacity(take);
+        // Index of the k-th point taken.
+        let at = |k: usize| {
+            usize::try_from(k as u128 * n as u128 / take.max(1) as u128).unwrap_or(usize::MAX)
+        };
+        let mut k = 0usize;
         let mut start = 0usize;
         for (i, pose) in self.poses.iter().enumerate() {
             let end = start + pose.points.len();
-            while next < end {
-                let p = pose.points[next - start];
+            while k < take && at(k) < end {
+                let p = pose.points[at(k) - start];
                 out.push(CloudPoint {
                     pose: i,
                     position: pose.position(p),
                     sigma_mm: pose.sigma_mm(p),
                 });
-                next += stride;
+                k += 1;
             }
             start = end;
         }

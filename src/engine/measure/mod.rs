@@ -64,7 +64,9 @@ use nalgebra::Isometry3;
 
 pub use cloud::{Cloud, CloudPoint, CloudPose, FrameLabel, SigmaStats};
 pub use model::{CellModel, JointRange, ModelChoice, OutOfRange, covariance_of};
-pub use scan::{Dropped, Placement, Scan, ScanColumns, ScanFiles, ScanLog, ScanPose, scan_from_files};
+pub use scan::{
+    Dropped, Placement, Scan, ScanColumns, ScanFiles, ScanLog, ScanPose, scan_from_files,
+};
 pub use selfcheck::{SelfValidation, self_validate};
 pub use sigma::SigmaForm;
 pub use write::{CloudFormat, Provenance, write_cloud};
@@ -149,7 +151,8 @@ pub struct Measured {
 /// 1e-6, last row `0 0 0 1`).
 pub fn load_frame(path: &Path) -> Result<Isometry3<f64>, MeasureError> {
     let fail = |what: String| MeasureError::Input(format!("{what} ({})", path.display()));
-    let text = std::fs::read_to_string(path).map_err(|e| fail(format!("reading the frame failed: {e}")))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| fail(format!("reading the frame failed: {e}")))?;
     let value: serde_json::Value = serde_json::from_str(text.trim_start_matches('\u{feff}'))
         .map_err(|e| fail(format!("the frame is not valid JSON: {e}")))?;
     let matrix = match &value {
@@ -160,8 +163,7 @@ pub fn load_frame(path: &Path) -> Result<Isometry3<f64>, MeasureError> {
     };
     let rows: [[f64; 4]; 4] = serde_json::from_value(matrix)
         .map_err(|_| fail("the frame is not a 4x4 matrix (4 rows of 4 numbers, mm)".into()))?;
-    isometry_from_rows(&rows)
-        .map_err(|e| fail(format!("the frame is not a rigid transform: {e}")))
+    isometry_from_rows(&rows).map_err(|e| fail(format!("the frame is not a rigid transform: {e}")))
 }
 
 /// Measures `scan` with `result` (module doc): checks that the scan
@@ -188,7 +190,8 @@ pub fn measure(
     let covariance = if options.sigma {
         if options.model == ModelChoice::Nominal {
             return Err(MeasureError::Input(
-                "σ is the calibrated model's; the nominal model has none (measure it without σ)".into(),
+                "σ is the calibrated model's; the nominal model has none (measure it without σ)"
+                    .into(),
             ));
         }
         Some(covariance_of(result)?.ok_or_else(|| {
@@ -280,7 +283,9 @@ pub fn measure(
             frame: options
                 .frame
                 .as_ref()
-                .map_or(FrameLabel::Base, |(_, label)| FrameLabel::Workpiece(label.clone())),
+                .map_or(FrameLabel::Base, |(_, label)| {
+                    FrameLabel::Workpiece(label.clone())
+                }),
             model: options.model.as_str(),
         },
         warnings,

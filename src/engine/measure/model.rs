@@ -230,10 +230,7 @@ fn different_robot(a: &Robot, b: &Robot) -> Option<String> {
         for (p, name) in PARAM_NAMES.iter().enumerate() {
             let (va, vb) = (ja.get(p), jb.get(p));
             if (va - vb).abs() > SAME_NOMINAL_TOLERANCE {
-                return Some(format!(
-                    "nominal {name}{} is {va} against {vb}",
-                    i + 1
-                ));
+                return Some(format!("nominal {name}{} is {va} against {vb}", i + 1));
             }
         }
     }

@@ -296,10 +296,11 @@ pub fn scan_from_files(spec: &ScanFiles) -> Result<Scan, ImportError> {
             },
         });
     }
-    let name = spec.log.path().file_name().map_or_else(
-        || "scan".to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    );
+    let name = spec
+        .log
+        .path()
+        .file_name()
+        .map_or_else(|| "scan".to_string(), |n| n.to_string_lossy().into_owned());
     Ok(Scan {
         name,
         robot: spec.robot.clone(),
@@ -342,7 +343,11 @@ fn joint_log(
         path: path.to_path_buf(),
         message,
     };
-    let column = |name: &str| table.column(name).ok_or_else(|| file_error(table.no_column(name)));
+    let column = |name: &str| {
+        table
+            .column(name)
+            .ok_or_else(|| file_error(table.no_column(name)))
+    };
     let id = column(&columns.id)?;
     let joints: Vec<usize> = columns
         .joints
@@ -352,7 +357,9 @@ fn joint_log(
     let station = table.column(&columns.station);
     let usage = table.column(&columns.usage);
     if table.rows.is_empty() {
-        return Err(file_error("the joint log has a header but no pose rows".into()));
+        return Err(file_error(
+            "the joint log has a header but no pose rows".into(),
+        ));
     }
     let mut raw_rows: Vec<(usize, String, Vec<f64>)> = Vec::with_capacity(table.rows.len());
     let mut out = Vec::with_capacity(table.rows.len());
@@ -422,12 +429,11 @@ fn pair_profiles(
             ProfileSource::Folder(dir) => ids
                 .iter()
                 .map(|id| {
-                    let file = profiles::file_of(dir, id).ok_or_else(|| {
-                        ImportError::MissingProfile {
+                    let file =
+                        profiles::file_of(dir, id).ok_or_else(|| ImportError::MissingProfile {
                             id: id.clone(),
                             path: dir.join(format!("{id}.csv")),
-                        }
-                    })?;
+                        })?;
                     profiles::read_profile(&file, &spec.profile_format)
                 })
                 .collect::<Result<Vec<_>, _>>()?,

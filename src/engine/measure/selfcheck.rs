@@ -101,7 +101,11 @@ impl ModelCheck {
             sum += s.spread_rms * s.spread_rms * s.pose_centres.len() as f64;
             n += s.pose_centres.len();
         }
-        let max = self.stations.iter().map(|s| s.spread_max).fold(0.0, f64::max);
+        let max = self
+            .stations
+            .iter()
+            .map(|s| s.spread_max)
+            .fold(0.0, f64::max);
         ((sum / n.max(1) as f64).sqrt(), max)
     }
 
@@ -266,8 +270,18 @@ impl SelfValidation {
                 b.0, b.1, a.0, a.1
             );
         };
-        row(&mut s, "size error (diameter)", self.before.size(), self.after.size());
-        row(&mut s, "form error (range of radial residuals)", self.before.form(), self.after.form());
+        row(
+            &mut s,
+            "size error (diameter)",
+            self.before.size(),
+            self.after.size(),
+        );
+        row(
+            &mut s,
+            "form error (range of radial residuals)",
+            self.before.form(),
+            self.after.form(),
+        );
         row(
             &mut s,
             "position spread (each pose's centre)",
@@ -275,7 +289,12 @@ impl SelfValidation {
             self.after.spread(),
         );
         if let (Some(b), Some(a)) = (self.before.spacing_error(), self.after.spacing_error()) {
-            let n = self.after.spacings.iter().filter(|x| x.reference.is_some()).count();
+            let n = self
+                .after
+                .spacings
+                .iter()
+                .filter(|x| x.reference.is_some())
+                .count();
             row(
                 &mut s,
                 &format!("spacing error ({n} reference distances)"),

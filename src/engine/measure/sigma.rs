@@ -95,7 +95,11 @@ pub(super) struct SigmaPose<'a> {
 }
 
 /// `G₀, G₁, G₂` of a pose (3 × k each, file units; module doc).
-fn pose_rows(est: &Estimate, cov: &ParameterCovariance, placement: &Placement) -> [DMatrix<f64>; 3] {
+fn pose_rows(
+    est: &Estimate,
+    cov: &ParameterCovariance,
+    placement: &Placement,
+) -> [DMatrix<f64>; 3] {
     let (joints, flange) = match placement {
         Placement::Joints(q) => (q.clone(), None),
         Placement::Flange(pose) => (Vec::new(), Some(*pose)),
@@ -173,7 +177,11 @@ pub(super) fn sigma_forms(
     let mut count = 0.0;
     for p in poses {
         let m = &p.moments.0;
-        let r = p.base_from_sensor.rotation.to_rotation_matrix().into_inner();
+        let r = p
+            .base_from_sensor
+            .rotation
+            .to_rotation_matrix()
+            .into_inner();
         let t = p.base_from_sensor.translation.vector;
         sum += t * m[(0, 0)] + r.column(1) * m[(0, 1)] + r.column(2) * m[(0, 2)];
         count += m[(0, 0)];
@@ -282,7 +290,9 @@ mod tests {
             .iter()
             .zip(&points)
             .map(|(pl, pts)| {
-                let Placement::Joints(q) = pl else { unreachable!() };
+                let Placement::Joints(q) = pl else {
+                    unreachable!()
+                };
                 SigmaPose {
                     placement: pl,
                     base_from_sensor: est.robot.base_from_flange(q) * est.flange_from_sensor,
@@ -294,7 +304,9 @@ mod tests {
         // Direct: per point G (3 × k) and X, the rigid fit, H, tr(H C Hᵀ).
         let mut rows: Vec<(DMatrix<f64>, Vector3<f64>)> = Vec::new();
         for (pl, pts) in placements.iter().zip(&points) {
-            let Placement::Joints(q) = pl else { unreachable!() };
+            let Placement::Joints(q) = pl else {
+                unreachable!()
+            };
             let s = Sighting {
                 id: String::new(),
                 joints: q.clone(),
@@ -304,7 +316,8 @@ mod tests {
             let ps = PoseSensitivity::new(&est, &s);
             for &[y, z] in pts {
                 let (x, a) = ps.at(&est, &Vector3::new(0.0, y, z));
-                let g = DMatrix::from_fn(3, k, |r, c| a[(r, unknowns[c])] * cov.raw_per_file_unit[c]);
+                let g =
+                    DMatrix::from_fn(3, k, |r, c| a[(r, unknowns[c])] * cov.raw_per_file_unit[c]);
                 rows.push((g, x));
             }
         }

@@ -164,12 +164,11 @@ mod tests {
                 let t = i as f64 / n as f64;
                 let polar = cap * (0.1 + 0.9 * t);
                 let azimuth = 2.399_963 * i as f64; // golden angle
-                c + r
-                    * Vector3::new(
-                        polar.sin() * azimuth.cos(),
-                        polar.sin() * azimuth.sin(),
-                        polar.cos(),
-                    )
+                c + r * Vector3::new(
+                    polar.sin() * azimuth.cos(),
+                    polar.sin() * azimuth.sin(),
+                    polar.cos(),
+                )
             })
             .collect()
     }

@@ -10,9 +10,8 @@ pub const HEADER: &str = "id,x,y,z,sigma_mm";
 /// `id` as a CSV field: quoted (quotes doubled) when it holds a
 /// separator, a quote, a line break or surrounding spaces.
 fn field(id: &str) -> String {
-    let plain = !id.contains([',', '"', '\n', '\r', ';', '\t'])
-        && id.trim() == id
-        && !id.starts_with('#');
+    let plain =
+        !id.contains([',', '"', '\n', '\r', ';', '\t']) && id.trim() == id && !id.starts_with('#');
     if plain {
         id.to_string()
     } else {

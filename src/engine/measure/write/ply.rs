@@ -13,9 +13,17 @@ pub const VERTEX_BYTES: usize = 3 * 8 + 4 + 4;
 pub fn header(cloud: &Cloud, provenance: &Provenance) -> String {
     use std::fmt::Write as _;
     let mut h = String::from("ply\nformat binary_little_endian 1.0\n");
-    let _ = writeln!(h, "comment spherecal measure: result {}", one_line(&provenance.result));
+    let _ = writeln!(
+        h,
+        "comment spherecal measure: result {}",
+        one_line(&provenance.result)
+    );
     let _ = writeln!(h, "comment scan {}", one_line(&provenance.scan));
-    let _ = writeln!(h, "comment model {} (robot model and hand-eye of the result)", cloud.model);
+    let _ = writeln!(
+        h,
+        "comment model {} (robot model and hand-eye of the result)",
+        cloud.model
+    );
     let _ = writeln!(h, "comment frame {}", one_line(&cloud.frame.to_string()));
     let _ = writeln!(
         h,
