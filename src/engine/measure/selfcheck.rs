@@ -23,8 +23,60 @@ use nalgebra::{Point3, Vector3};
 
 use super::cloud::CloudPose;
 use super::model::CellModel;
+use super::scan::{Placement, ScanPose};
 use super::sphere::{SphereFit, fit_sphere, fit_sphere_radius};
 use crate::engine::session::{ReferenceDistance, Use};
+
+/// A pose that may have seen a sphere station: a scan's pose or a
+/// cloud's (the self-validation runs on either, e.g. beside the
+/// measurement on another thread).
+pub trait Sighted {
+    /// Its station, if any.
+    fn station(&self) -> Option<&str>;
+    /// Its `use`, if any.
+    fn usage(&self) -> Option<Use>;
+    /// Where the robot was.
+    fn placement(&self) -> &Placement;
+    /// Its profile points `[y, z]`, mm, sensor frame.
+    fn points(&self) -> &[[f64; 2]];
+}
+
+impl Sighted for ScanPose {
+    fn station(&self) -> Option<&str> {
+        self.station.as_deref()
+    }
+    fn usage(&self) -> Option<Use> {
+        self.usage
+    }
+    fn placement(&self) -> &Placement {
+        &self.placement
+    }
+    fn points(&self) -> &[[f64; 2]] {
+        &self.points
+    }
+}
+
+impl Sighted for CloudPose {
+    fn station(&self) -> Option<&str> {
+        self.station.as_deref()
+    }
+    fn usage(&self) -> Option<Use> {
+        self.usage
+    }
+    fn placement(&self) -> &Placement {
+        &self.placement
+    }
+    fn points(&self) -> &[[f64; 2]] {
+        &self.points
+    }
+}
+
+/// Whether the self-validation looks at `pose`: it saw a station and is
+/// used `validate` (or has no use: a raw scan).
+#[must_use]
+pub fn checks(pose: &impl Sighted) -> bool {
+    pose.station().is_some() && matches!(pose.usage(), Some(Use::Validate) | None)
+}
 
 /// One station's sphere under one model, base frame, mm.
 #[derive(Debug, Clone, PartialEq)]
@@ -133,21 +185,17 @@ pub struct SelfValidation {
     pub after: ModelCheck,
 }
 
-/// The poses of `poses` that saw a sphere station to check: those used
-/// `validate`, or in a raw scan without uses, those with a station; by
+/// The poses of `poses` the self-validation looks at ([`checks`]), by
 /// station in order of first appearance.
-fn stations(poses: &[CloudPose]) -> Vec<(String, Vec<&CloudPose>)> {
-    let mut order: Vec<(String, Vec<&CloudPose>)> = Vec::new();
-    let mut index: HashMap<&str, usize> = HashMap::new();
+fn stations<P: Sighted>(poses: &[P]) -> Vec<(String, Vec<&P>)> {
+    let mut order: Vec<(String, Vec<&P>)> = Vec::new();
+    let mut index: HashMap<String, usize> = HashMap::new();
     for p in poses {
-        let Some(station) = &p.station else {
+        let Some(station) = p.station().filter(|_| checks(p)) else {
             continue;
         };
-        if !matches!(p.usage, Some(Use::Validate) | None) {
-            continue;
-        }
-        let slot = *index.entry(station.as_str()).or_insert_with(|| {
-            order.push((station.clone(), Vec::new()));
+        let slot = *index.entry(station.to_string()).or_insert_with(|| {
+            order.push((station.to_string(), Vec::new()));
             order.len() - 1
         });
         order[slot].1.push(p);
@@ -156,8 +204,8 @@ fn stations(poses: &[CloudPose]) -> Vec<(String, Vec<&CloudPose>)> {
 }
 
 /// One model's check of the stations (module doc).
-fn check(
-    stations: &[(String, Vec<&CloudPose>)],
+fn check<P: Sighted>(
+    stations: &[(String, Vec<&P>)],
     model: &CellModel,
     diameter: f64,
     references: &[ReferenceDistance],
@@ -168,9 +216,9 @@ fn check(
         let per_pose: Vec<Vec<Vector3<f64>>> = poses
             .iter()
             .filter_map(|p| {
-                let t = model.base_from_sensor(&p.placement)?;
+                let t = model.base_from_sensor(p.placement())?;
                 Some(
-                    p.points
+                    p.points()
                         .iter()
                         .map(|&[y, z]| (t * Point3::new(0.0, y, z)).coords)
                         .collect(),
@@ -231,8 +279,8 @@ fn check(
 /// The self-validation of the sphere stations among `poses` (module doc)
 /// under `before` and `after`; `None` when no station has a sphere fit.
 #[must_use]
-pub fn self_validate(
-    poses: &[CloudPose],
+pub fn self_validate<P: Sighted>(
+    poses: &[P],
     before: &CellModel,
     after: &CellModel,
     diameter: f64,

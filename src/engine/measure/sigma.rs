@@ -187,9 +187,11 @@ pub(super) fn sigma_forms(
         count += m[(0, 0)];
     }
     let centroid = if count > 0.0 { sum / count } else { sum };
-    // Pass 1: Σ RᵀR and Σ RᵀG from each pose's moments.
+    // Pass 1: Σ RᵀR and Σ RᵀG from each pose's moments; each pose's G
+    // kept for pass 2 (9·k numbers a pose).
     let mut rtr = Matrix6::zeros();
     let mut rtg = DMatrix::zeros(6, k);
+    let mut rows = Vec::with_capacity(poses.len());
     for (i, p) in poses.iter().enumerate() {
         let g = pose_rows(est, cov, p.placement);
         let r = rigid_rows(&p.base_from_sensor, &centroid);
@@ -202,6 +204,7 @@ pub(super) fn sigma_forms(
             rtr += w * r[b];
             rtg += w * &g[b];
         }
+        rows.push(g);
         if progress(i + 1, total) == Control::Cancel {
             return None;
         }
@@ -217,8 +220,7 @@ pub(super) fn sigma_forms(
     let ml = pinv * rtg * &l;
     // Pass 2: Kₐ = Gₐ·L − Rₐ·(M·L), and the six inner products.
     let mut forms = Vec::with_capacity(poses.len());
-    for (i, p) in poses.iter().enumerate() {
-        let g = pose_rows(est, cov, p.placement);
+    for (i, (p, g)) in poses.iter().zip(&rows).enumerate() {
         let r = rigid_rows(&p.base_from_sensor, &centroid);
         let kk: Vec<DMatrix<f64>> = (0..3)
             .map(|a| &g[a] * &l - DMatrix::from_fn(3, 6, |x, y| r[a][(x, y)]) * &ml)
