@@ -211,18 +211,15 @@ fn reference_distances(
     (reference, truth)
 }
 
-/// The preset of `config`'s robot, the true robot (nominal plus the
-/// kinematic errors of the errors stream) and the errors: the same for a
-/// session and a scan of the same seed, robot and error model, so that a
-/// simulated scan is measured by the calibration of a simulated session.
-pub(crate) fn true_cell(
+/// The true robot of `config` on `nominal`: nominal plus the kinematic
+/// errors drawn from the errors stream, and the errors.
+pub(crate) fn with_errors(
     config: &SimConfig,
-) -> Result<(robot::Preset, robot::Robot, Vec<Joint>), SimError> {
-    let preset = robot::preset(config.robot.key())
-        .ok_or_else(|| SimError::InvalidConfig(format!("unknown robot {}", config.robot.key())))?;
+    nominal: &robot::Robot,
+) -> (robot::Robot, Vec<Joint>) {
     let mut rng_errors = stream(config.seed, STREAM_ERRORS);
-    let errors = kinematic_errors(config, preset.robot.dof(), &mut rng_errors);
-    let mut true_robot = preset.robot.clone();
+    let errors = kinematic_errors(config, nominal.dof(), &mut rng_errors);
+    let mut true_robot = nominal.clone();
     for (joint, e) in true_robot.joints.iter_mut().zip(&errors) {
         joint.alpha += e.alpha;
         joint.a += e.a;
@@ -230,6 +227,19 @@ pub(crate) fn true_cell(
         joint.theta += e.theta;
         joint.d += e.d;
     }
+    (true_robot, errors)
+}
+
+/// The preset of `config`'s robot, the true robot and the errors
+/// ([`with_errors`]): the same for a session and a scan of the same seed,
+/// robot and error model, so that a simulated scan is measured by the
+/// calibration of a simulated session.
+pub(crate) fn true_cell(
+    config: &SimConfig,
+) -> Result<(robot::Preset, robot::Robot, Vec<Joint>), SimError> {
+    let preset = robot::preset(config.robot.key())
+        .ok_or_else(|| SimError::InvalidConfig(format!("unknown robot {}", config.robot.key())))?;
+    let (true_robot, errors) = with_errors(config, &preset.robot);
     Ok((preset, true_robot, errors))
 }
 
