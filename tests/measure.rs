@@ -701,6 +701,13 @@ fn bad_input_is_refused_and_nothing_is_written() {
         .success()
     );
     assert!(csv_cloud(&csv).iter().all(|(_, _, sigma)| sigma.is_nan()));
+    // A session of given centres has no profile to measure.
+    let centres = concat!(env!("CARGO_MANIFEST_DIR"), "/sessions/centres-irb2400.json");
+    refused(
+        &["measure", centres, "--result", r, "--out", o],
+        &out,
+        "nothing to measure",
+    );
     // Output = input; an unknown extension.
     refused(
         &["measure", s, "--result", r, "--out", r],
@@ -887,4 +894,91 @@ fn raw_scans_of_parts_measure_their_true_geometry() {
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn simulate_writes_a_raw_scan_and_its_truth() {
+    let dir = temp_dir("simscan");
+    let truth = dir.join("scan.truth.json");
+    let o = run(&[
+        "simulate",
+        "--seed",
+        "5",
+        "--scan",
+        "spheres",
+        "--scan-poses",
+        "3",
+        "--csv-out",
+        dir.to_str().unwrap(),
+        "--out",
+        truth.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let t = simulate::scan::parse_scan_truth(&std::fs::read_to_string(&truth).unwrap()).unwrap();
+    assert_eq!(t.poses.len(), 9, "3 poses at each of 3 spheres");
+    assert!(matches!(t.part, simulate::Part::Spheres { .. }));
+    for id in ["s1", "s9"] {
+        assert!(dir.join("profiles").join(format!("{id}.csv")).is_file());
+    }
+    let refs = std::fs::read_to_string(dir.join("references.csv")).unwrap();
+    assert!(refs.starts_with("from,to,distance\nA,B,300"), "{refs}");
+    // The same seed's cell: the scan's true robot is the session's.
+    let (_, session_truth) = simulate::simulate(&seed(5)).unwrap();
+    assert_eq!(t.robot, session_truth.robot);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn pose_only_results_measure_with_the_given_flange_poses() {
+    // A session turned pose-only: each flange pose the true robot's.
+    let (mut session, truth) = simulate::simulate(&seed(9)).unwrap();
+    let joints_session = session.clone();
+    let robot = truth.true_robot();
+    for m in &mut session.measurements {
+        m.flange = Some(robot.base_from_flange(&m.joints));
+        m.joints.clear();
+    }
+    session.robot_given = false;
+    session.robot = spherecal::engine::robot::Robot::new(String::new(), Vec::new());
+    let mut options = Options::from_session(&session);
+    options.ml.cross_validation = false;
+    let (_, cal) = solve::calibrate(&session, &options).unwrap();
+    let result = ResultFile::from_calibration(&session, &cal);
+    assert!(result.hand_eye_only());
+    let measured = measure::measure(
+        Scan::from_session(session.clone(), &[]),
+        &result,
+        &MeasureOptions {
+            sigma: true,
+            ..MeasureOptions::default()
+        },
+        None,
+        &mut |_| Control::Continue,
+    )
+    .unwrap();
+    let mut points = measured.cloud.points();
+    for m in &session.measurements {
+        let t = m.flange.unwrap() * result.hand_eye;
+        let spherecal::engine::session::Observation::Stripe(stripe) = &m.observation else {
+            panic!()
+        };
+        for &[y, z] in stripe {
+            let p = points.next().unwrap();
+            assert!(
+                (Vector3::from(p.position) - (t * Point3::new(0.0, y, z)).coords).norm() < 1e-9
+            );
+            assert!(p.sigma_mm > 0.0 && p.sigma_mm < 0.5, "{}", p.sigma_mm);
+        }
+    }
+    // Joint readings cannot be measured with a hand-eye-only result.
+    let e = measure::measure(
+        Scan::from_session(joints_session, &[]),
+        &result,
+        &MeasureOptions::default(),
+        None,
+        &mut |_| Control::Continue,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("pose-only") && e.contains("--poses"), "{e}");
 }

@@ -337,6 +337,22 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
         measure::scan_from_files(&scan_files(args, dof)?)
             .map_err(|e| CliError::input(e.to_string()))?
     };
+    if scan.poses.is_empty() {
+        return Err(CliError::input(format!(
+            "nothing to measure: no pose with a profile{} ({})",
+            if scan.skipped.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " (the {} measurements give sphere centres)",
+                    scan.skipped.len()
+                )
+            },
+            args.session
+                .as_ref()
+                .map_or_else(|| scan.name.clone(), |p| p.display().to_string())
+        )));
+    }
     let loaded = started.elapsed().as_secs_f64();
     let sigma = !args.no_sigma && args.model == ModelChoice::Calibrated;
     let options = MeasureOptions {
@@ -436,10 +452,16 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
         dropped.no_return
     );
     if !skipped.is_empty() {
+        let more = skipped.len().saturating_sub(LISTED_POSES);
         sayln!(
-            "  {} measurement(s) give a sphere centre, no profile: not in the cloud ({})",
+            "  {} measurement(s) give a sphere centre, no profile: not in the cloud ({}{})",
             skipped.len(),
-            skipped.join(", ")
+            skipped[..skipped.len().min(LISTED_POSES)].join(", "),
+            if more > 0 {
+                format!(", … and {more} more")
+            } else {
+                String::new()
+            }
         );
     }
     match cloud.sigma_stats() {
