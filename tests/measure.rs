@@ -394,6 +394,34 @@ fn sigma_agrees_with_the_realised_model_error() {
     );
 }
 
+#[test]
+fn sigma_follows_a_noisier_cell_through_the_variance_factor() {
+    // Joints 3× noisier than ml's noise model assumes (0.01° against
+    // 0.003°): the covariance as written is too small by about that much,
+    // the variance factor (≈ 10) restores it.
+    let (mut sigma_sq, mut written_sq, mut error_sq) = (0.0, 0.0, 0.0);
+    for s in [1_u64, 2, 3] {
+        let config = SimConfig {
+            joint_noise: 0.01,
+            ..seed(s)
+        };
+        let (session, truth, result) = calibrated(&config, Method::Ml);
+        let vf = measure::variance_factor(&result);
+        assert!(vf > 4.0, "variance factor {vf}");
+        let (sigma, errors) = sigma_and_error(&session, &truth, &result);
+        sigma_sq += sigma.iter().map(|x| x * x).sum::<f64>();
+        written_sq += sigma.iter().map(|x| x * x / vf).sum::<f64>();
+        error_sq += errors.iter().map(|x| x * x).sum::<f64>();
+    }
+    let ratio = (error_sq / sigma_sq).sqrt();
+    let as_written = (error_sq / written_sq).sqrt();
+    eprintln!(
+        "noisier joints: realised / σ = {ratio:.3}, with the covariance as written {as_written:.3}"
+    );
+    assert!((0.5..=2.0).contains(&ratio), "{ratio}");
+    assert!(as_written > ratio, "{as_written} vs {ratio}");
+}
+
 /// The result with its covariance times `factor`.
 fn scaled(result: &ResultFile, factor: f64) -> ResultFile {
     let mut out = result.clone();
@@ -970,6 +998,25 @@ fn pose_only_results_measure_with_the_given_flange_poses() {
             assert!(p.sigma_mm > 0.0 && p.sigma_mm < 0.5, "{}", p.sigma_mm);
         }
     }
+    // With the robot kept in the pose-only session, the result keeps it
+    // unchanged: the scan's robot is the result's.
+    let mut with_robot = session.clone();
+    with_robot.robot = joints_session.robot.clone();
+    with_robot.robot_given = true;
+    let (_, cal) = solve::calibrate(&with_robot, &options).unwrap();
+    let kept = ResultFile::from_calibration(&with_robot, &cal);
+    assert!(kept.hand_eye_only() && kept.robot.is_some());
+    measure::measure(
+        Scan::from_session(with_robot, &[]),
+        &kept,
+        &MeasureOptions {
+            sigma: true,
+            ..MeasureOptions::default()
+        },
+        None,
+        &mut |_| Control::Continue,
+    )
+    .unwrap();
     // Joint readings cannot be measured with a hand-eye-only result.
     let e = measure::measure(
         Scan::from_session(joints_session, &[]),

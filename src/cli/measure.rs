@@ -50,6 +50,9 @@ pub struct MeasureArgs {
     /// The sensor's own noise: 1σ of each in-plane coordinate of a profile point, mm, added to σ in quadrature (2·s²).
     #[arg(long, default_value_t = 0.0)]
     pub sensor_noise: f64,
+    /// Use the result's parameter covariance as written, not scaled by its variance factor (`solver.variance_factor`, ≈ 1 when ml's noise model fits the data).
+    #[arg(long)]
+    pub covariance_as_written: bool,
     /// Which model of the result: `calibrated` (default) or `nominal` (the nominal model and the initial hand-eye: the cell before calibration; no σ).
     #[arg(long, default_value = "calibrated", value_parser = parse_model)]
     pub model: ModelChoice,
@@ -360,6 +363,7 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
         frame,
         sigma,
         sensor_noise_mm: args.sensor_noise,
+        covariance_as_written: args.covariance_as_written,
     };
     let sphere = scan.sphere_diameter;
     let references = scan.reference_distances.clone();
@@ -466,7 +470,12 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
     }
     match cloud.sigma_stats() {
         Some(s) => sayln!(
-            "σ of a point (3-D, after the cloud's best rigid alignment{}): median {:.4} mm, rms {:.4} mm, max {:.4} mm",
+            "σ of a point (3-D, after the cloud's best rigid alignment; covariance {}{}): median {:.4} mm, rms {:.4} mm, max {:.4} mm",
+            if args.covariance_as_written {
+                "as written".to_string()
+            } else {
+                format!("× variance factor {:.3}", measure::variance_factor(&result))
+            },
             if args.sensor_noise > 0.0 {
                 format!(", sensor noise {} mm", args.sensor_noise)
             } else {

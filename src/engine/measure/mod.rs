@@ -24,7 +24,11 @@
 //! `sigma_mm` is the 1σ of the point's 3-D position (the square root of
 //! the trace of its 3 × 3 covariance) propagated from the covariance of
 //! the calibrated parameters that `ml` writes (`solver.covariance`: the
-//! hand-eye and the identifiable MDH parameters), to first order. The
+//! hand-eye and the identifiable MDH parameters), to first order, scaled
+//! by the result's a posteriori variance factor (`solver.variance_factor`,
+//! ≈ 1 when `ml`'s noise model fits the data; a cell whose joints or
+//! stripes are noisier than the model assumed has a larger one, and its
+//! parameters are that much less certain). The
 //! base frame itself is **not identifiable from a sphere**: moving the
 //! whole cell rigidly moves every sphere centre alike and changes no
 //! distance, so no calibration against a sphere knows where the base is
@@ -109,6 +113,9 @@ pub struct MeasureOptions {
     /// The sensor's own noise: 1σ of each in-plane coordinate of a profile
     /// point, mm (0: not added).
     pub sensor_noise_mm: f64,
+    /// Use `solver.covariance` as written; by default it is scaled by the
+    /// result's variance factor (module doc).
+    pub covariance_as_written: bool,
 }
 
 /// What a measurement is doing, for a progress display.
@@ -140,6 +147,21 @@ pub struct Measured {
     pub warnings: Vec<String>,
     /// Scan poses outside the joint range the calibration saw.
     pub out_of_range: Vec<OutOfRange>,
+}
+
+/// The result's a posteriori variance factor (`ml`'s `variance_factor`,
+/// Σ r² / (residuals − unknowns) of the whitened residuals: 1 when the
+/// noise model fits), 1 when it has none or it is not a positive number.
+#[must_use]
+pub fn variance_factor(result: &ResultFile) -> f64 {
+    match &result.solver {
+        crate::engine::solve::SolverReport::Ml(r)
+            if r.variance_factor.is_finite() && r.variance_factor > 0.0 =>
+        {
+            r.variance_factor
+        }
+        _ => 1.0,
+    }
 }
 
 /// Reads a workpiece frame: a JSON 4×4 matrix (four rows of four numbers,
@@ -194,12 +216,16 @@ pub fn measure(
                     .into(),
             ));
         }
-        Some(covariance_of(result)?.ok_or_else(|| {
+        let mut cov = covariance_of(result)?.ok_or_else(|| {
             MeasureError::Input(format!(
                 "the result (method {}) has no parameter covariance, so no point σ: calibrate with --method ml, or measure without σ (--no-sigma)",
                 result.solver.method()
             ))
-        })?)
+        })?;
+        if !options.covariance_as_written {
+            cov.matrix *= variance_factor(result);
+        }
+        Some(cov)
     } else {
         None
     };

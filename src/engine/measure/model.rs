@@ -63,7 +63,7 @@ impl CellModel {
                 flange_from_sensor: result.hand_eye,
             },
             ModelChoice::Nominal => Self {
-                robot: result.nominal(),
+                robot: nominal_robot(result),
                 flange_from_sensor: result.hand_eye_initial,
             },
         }
@@ -79,6 +79,18 @@ impl CellModel {
             Placement::Joints(q) => self.robot.as_ref()?.base_from_flange(q),
         };
         Some(base_from_flange * self.flange_from_sensor)
+    }
+}
+
+/// The result's nominal robot: the calibrated one minus the joint errors,
+/// or for a result that calibrated the hand-eye only (pose-only, no joint
+/// errors) its robot as given.
+#[must_use]
+pub fn nominal_robot(result: &ResultFile) -> Option<Robot> {
+    if result.hand_eye_only() {
+        result.robot.clone()
+    } else {
+        result.nominal()
     }
 }
 
@@ -199,7 +211,7 @@ pub fn check_scan(scan: &Scan, result: &ResultFile) -> Result<Vec<String>, Measu
             "the scan gives the controller's flange poses: only the calibrated hand-eye applies, not the calibrated kinematic model".to_string(),
         );
     }
-    if let (Some(scan_robot), Some(nominal)) = (&scan.robot, result.nominal()) {
+    if let (Some(scan_robot), Some(nominal)) = (&scan.robot, nominal_robot(result)) {
         if let Some(why) = different_robot(scan_robot, &nominal) {
             return Err(MeasureError::Input(format!(
                 "the scan's robot {:?} is not the result's {:?}: {why}; measure with the result of this robot's calibration",
