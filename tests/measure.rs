@@ -9,8 +9,7 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
 use nalgebra::{Isometry3, Matrix4, Point3, Vector3, Vector4};
 use serde_json::Value;
@@ -23,46 +22,8 @@ use spherecal::engine::session::{Session, Use};
 use spherecal::engine::simulate::{self, SimConfig, Truth};
 use spherecal::engine::solve::{self, Control, Method, Options, SolverReport};
 
-fn bin() -> &'static str {
-    env!("CARGO_BIN_EXE_spherecal")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("spherecal-measure-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// A simulated session, its truth and its result (`ml` unless `method`).
-fn calibrated(config: &SimConfig, method: Method) -> (Session, Truth, ResultFile) {
-    let (session, truth) = simulate::simulate(config).unwrap();
-    let mut options = Options::from_session(&session);
-    options.method = method;
-    options.ml.cross_validation = false;
-    let (_, cal) = solve::calibrate(&session, &options).unwrap();
-    let result = ResultFile::from_calibration(&session, &cal);
-    (session, truth, result)
-}
-
-fn seed(seed: u64) -> SimConfig {
-    SimConfig {
-        seed,
-        ..SimConfig::default()
-    }
-}
-
-/// Writes a session and its result, returns their paths.
-fn files(dir: &Path, session: &Session, result: &ResultFile) -> (PathBuf, PathBuf) {
-    let (s, r) = (dir.join("s.json"), dir.join("r.json"));
-    format::save_session(session, &s).unwrap();
-    format::save_result(result, &r).unwrap();
-    (s, r)
-}
-
-fn run(args: &[&str]) -> std::process::Output {
-    Command::new(bin()).args(args).output().unwrap()
-}
+mod measure_support;
+use measure_support::{calibrated, csv_cloud, files, rms, run, seed, temp_dir};
 
 // ---------------------------------------------------------------------
 // The model applied, from FORMAT.md, on the files' JSON (no engine code).
@@ -136,22 +97,6 @@ fn expected_cloud(session: &Path, result: &Path) -> Vec<(String, [f64; 3])> {
         }
     }
     out
-}
-
-fn csv_cloud(path: &Path) -> Vec<(String, [f64; 3], f64)> {
-    let mut reader = csv::Reader::from_path(path).unwrap();
-    assert_eq!(
-        reader.headers().unwrap().iter().collect::<Vec<_>>(),
-        ["id", "x", "y", "z", "sigma_mm"]
-    );
-    reader
-        .records()
-        .map(|r| {
-            let r = r.unwrap();
-            let f = |k: usize| r[k].parse::<f64>().unwrap();
-            (r[0].to_string(), [f(1), f(2), f(3)], f(4))
-        })
-        .collect()
 }
 
 fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -335,10 +280,6 @@ fn sigma_and_error(session: &Session, truth: &Truth, result: &ResultFile) -> (Ve
     .unwrap();
     let sigma = measured.cloud.points().map(|p| p.sigma_mm).collect();
     (sigma, errors)
-}
-
-fn rms(v: &[f64]) -> f64 {
-    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
 
 #[test]
@@ -770,189 +711,6 @@ fn bad_input_is_refused_and_nothing_is_written() {
         "{err}"
     );
     assert!(out.exists());
-    let _ = std::fs::remove_dir_all(&dir);
-}
-
-// ---------------------------------------------------------------------
-// Raw scans of parts with a known geometry (simulate --scan).
-
-/// The profile points of a simulated profile's text, NaN rows dropped,
-/// and how many were NaN.
-fn profile_points(text: &str) -> (Vec<[f64; 2]>, usize) {
-    let mut points = Vec::new();
-    let mut nan = 0;
-    for line in text.lines().skip(1) {
-        let (y, z) = line.split_once(',').unwrap();
-        let (y, z): (f64, f64) = (y.parse().unwrap(), z.parse().unwrap());
-        if y.is_nan() || z.is_nan() {
-            nan += 1;
-        } else {
-            points.push([y, z]);
-        }
-    }
-    (points, nan)
-}
-
-/// RMS and largest distance (mm) of a measured raw-scan cloud from the
-/// true part, after the best rigid alignment of the cloud onto the same
-/// sensor points placed by the true robot at the actual joints (the base
-/// frame is not identifiable from a sphere: θ1 of Table 1 turns the whole
-/// cell by 1.9° that no sphere calibration sees).
-fn part_error(cloud: &[(String, [f64; 3], f64)], sim: &simulate::SimulatedScan) -> (f64, f64) {
-    let truth = &sim.truth;
-    let robot = truth.robot.to_robot();
-    let he = spherecal::engine::geometry::rigid_from_rows(&truth.hand_eye);
-    let mut exact = Vec::new();
-    for (id, text) in &sim.profiles {
-        let q = truth.poses.get(id).unwrap();
-        let t = robot.base_from_flange(q) * he;
-        for [y, z] in profile_points(text).0 {
-            exact.push((t * Point3::new(0.0, y, z)).coords);
-        }
-    }
-    let measured: Vec<Vector3<f64>> = cloud.iter().map(|(_, x, _)| Vector3::from(*x)).collect();
-    assert_eq!(measured.len(), exact.len());
-    let fit = kabsch(&measured, &exact).unwrap();
-    let d: Vec<f64> = measured
-        .iter()
-        .map(|m| truth.part.distance(&(fit * Point3::from(*m)).coords))
-        .collect();
-    (rms(&d), d.iter().copied().fold(0.0, f64::max))
-}
-
-#[test]
-fn raw_scans_of_parts_measure_their_true_geometry() {
-    use spherecal::engine::simulate::{PartKind, ScanConfig};
-    let dir = temp_dir("scans");
-    let config = seed(8);
-    let (session, _, result) = calibrated(&config, Method::Ml);
-    let (s, r) = files(&dir, &session, &result);
-    for part in [PartKind::Plane, PartKind::Steps, PartKind::Spheres] {
-        let sim = simulate::simulate_scan(
-            &config,
-            &ScanConfig {
-                part,
-                poses: 8,
-                ..ScanConfig::default()
-            },
-        )
-        .unwrap();
-        let d = dir.join(format!("{part:?}"));
-        std::fs::create_dir_all(d.join("profiles")).unwrap();
-        std::fs::write(d.join("joints.csv"), &sim.joints_csv).unwrap();
-        let mut nan = 0;
-        for (id, text) in &sim.profiles {
-            std::fs::write(d.join("profiles").join(format!("{id}.csv")), text).unwrap();
-            nan += profile_points(text).1;
-        }
-        let joints = d.join("joints.csv");
-        let profiles = d.join("profiles");
-        let mut args = vec![
-            "measure".to_string(),
-            "--joints".into(),
-            joints.display().to_string(),
-            "--profiles".into(),
-            profiles.display().to_string(),
-            "--robot".into(),
-            "irb2400".into(),
-            "--result".into(),
-            r.display().to_string(),
-            "--calibration".into(),
-            s.display().to_string(),
-        ];
-        if let Some(refs) = &sim.references_csv {
-            std::fs::write(d.join("references.csv"), refs).unwrap();
-            args.extend([
-                "--sphere-diameter".into(),
-                "38.1".into(),
-                "--references".into(),
-                d.join("references.csv").display().to_string(),
-            ]);
-        }
-        let out_of = |model: &str| {
-            let out = d.join(format!("{model}.csv"));
-            let mut a = args.clone();
-            a.extend([
-                "--out".into(),
-                out.display().to_string(),
-                "--model".into(),
-                model.into(),
-            ]);
-            let o = Command::new(bin()).args(&a).output().unwrap();
-            assert!(
-                o.status.success(),
-                "{part:?}: {}",
-                String::from_utf8_lossy(&o.stderr)
-            );
-            (
-                csv_cloud(&out),
-                String::from_utf8_lossy(&o.stdout).into_owned(),
-            )
-        };
-        let (after, text) = out_of("calibrated");
-        let (before, _) = out_of("nominal");
-        assert!(
-            text.contains(&format!("dropped {nan} non-finite")),
-            "{part:?}: {text}"
-        );
-        let (a, b) = (part_error(&after, &sim), part_error(&before, &sim));
-        eprintln!(
-            "{part:?}: {} points, {nan} rays missed; distance from the true part rms/max {:.4}/{:.4} mm calibrated, {:.4}/{:.4} nominal",
-            after.len(),
-            a.0,
-            a.1,
-            b.0,
-            b.1
-        );
-        // Stripe noise 0.02 mm a coordinate and the joint noise set the
-        // floor; the calibrated model adds its own error (σ ~0.01-0.1 mm).
-        assert!(a.0 < 0.1, "{part:?}: {a:?}");
-        assert!(after.iter().all(|(_, _, s)| *s > 0.0 && *s < 0.5));
-        // Over a small plane the nominal model's error is nearly rigid and
-        // the alignment takes it out; across steps and spheres seen from a
-        // cone of directions it is not.
-        if part != PartKind::Plane {
-            assert!(b.0 > 3.0 * a.0, "{part:?}: {a:?} vs {b:?}");
-        }
-        if part == PartKind::Spheres {
-            assert!(
-                text.contains("self-validation") && text.contains("2 reference distances"),
-                "{text}"
-            );
-        }
-    }
-    let _ = std::fs::remove_dir_all(&dir);
-}
-
-#[test]
-fn simulate_writes_a_raw_scan_and_its_truth() {
-    let dir = temp_dir("simscan");
-    let truth = dir.join("scan.truth.json");
-    let o = run(&[
-        "simulate",
-        "--seed",
-        "5",
-        "--scan",
-        "spheres",
-        "--scan-poses",
-        "3",
-        "--csv-out",
-        dir.to_str().unwrap(),
-        "--out",
-        truth.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let t = simulate::scan::parse_scan_truth(&std::fs::read_to_string(&truth).unwrap()).unwrap();
-    assert_eq!(t.poses.len(), 9, "3 poses at each of 3 spheres");
-    assert!(matches!(t.part, simulate::Part::Spheres { .. }));
-    for id in ["s1", "s9"] {
-        assert!(dir.join("profiles").join(format!("{id}.csv")).is_file());
-    }
-    let refs = std::fs::read_to_string(dir.join("references.csv")).unwrap();
-    assert!(refs.starts_with("from,to,distance\nA,B,300"), "{refs}");
-    // The same seed's cell: the scan's true robot is the session's.
-    let (_, session_truth) = simulate::simulate(&seed(5)).unwrap();
-    assert_eq!(t.robot, session_truth.robot);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
