@@ -20,6 +20,7 @@ fn main() -> ExitCode {
         Some(Command::Evaluate(args)) => cli::evaluate::run(&args),
         Some(Command::ExportModel(args)) => cli::export_model::run(&args),
         Some(Command::Import(args)) => cli::import::run(&args),
+        Some(Command::Measure(args)) => cli::measure::run(&args),
         Some(Command::Plan(args)) => cli::plan::run(&args),
         Some(Command::Report(args)) => cli::html_report::run(&args),
         Some(Command::History(args)) => cli::history::run(&args),

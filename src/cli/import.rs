@@ -116,7 +116,7 @@ pub struct ImportArgs {
     pub quiet: bool,
 }
 
-fn parse_pose_format(s: &str) -> Result<PoseFormat, String> {
+pub(super) fn parse_pose_format(s: &str) -> Result<PoseFormat, String> {
     PoseFormat::parse(s).ok_or_else(|| {
         format!("unknown pose format `{s}`, expected table, json, fanuc-ls, rapid, krl or urscript")
     })

@@ -1,4 +1,4 @@
-//! The command line: `spherecal calibrate | simulate | gui`. A thin caller
+//! The command line: `spherecal calibrate | simulate | measure | gui | …`. A thin caller
 //! of the engine; it prints, the engine does not.
 //!
 //! Exit status (FORMAT.md "Command line contract"): 0 on success, 2 on bad
@@ -32,6 +32,7 @@ pub mod export_model;
 pub mod history;
 pub mod html_report;
 pub mod import;
+pub mod measure;
 pub mod plan;
 pub mod simulate;
 
@@ -117,6 +118,8 @@ pub enum Command {
     Plan(plan::PlanArgs),
     /// Write a self-contained HTML report (figures as inline SVG): calibrates the session first, or reports `--result` as it is.
     Report(html_report::ReportArgs),
+    /// Measure with the calibrated cell: a session's stripes or a raw scan (pose log and profiles) into a point cloud in the base (or a workpiece) frame through a result's model and hand-eye, each point with its σ (PLY, E57 or CSV by extension); the sphere self-validation before and after calibration.
+    Measure(measure::MeasureArgs),
     /// Library of a folder of sessions and results: per robot the drift of the hand-eye and kinematic deviations over time, jumps beyond k combined σ flagged.
     History(history::HistoryArgs),
 }

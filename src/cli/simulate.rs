@@ -18,7 +18,7 @@ use crate::engine::plan;
 use crate::engine::robot::{self, RobotChoice};
 use crate::engine::session::{Session, Use};
 use crate::engine::simulate::{
-    self, ErrorModel, InitialHandEye, PlanExecution, SideChoice, SimConfig,
+    self, ErrorModel, InitialHandEye, PartKind, PlanExecution, ScanConfig, SideChoice, SimConfig,
 };
 
 /// Robot preset (`--robot`).
@@ -88,7 +88,7 @@ impl From<SideArg> for SideChoice {
 /// demos and what-if studies. Defaults give the paper-like demo.
 #[derive(Debug, Clone, clap::Args)]
 pub struct SimulateArgs {
-    /// Where to write the session file (FORMAT.md `spherecal-session`).
+    /// Where to write the session file (FORMAT.md `spherecal-session`); with --scan, the scan's truth.
     #[arg(long, short)]
     pub out: PathBuf,
     /// The sensor's measuring range to write as `sensor.range`: `Y0,Y1,Z0,Z1` in mm (laser plane, sensor frame), e.g. `-40,40,-40,40`; ml then predicts the error over it.
@@ -155,6 +155,9 @@ pub struct SimulateArgs {
     /// Sphere diameter, mm.
     #[arg(long, default_value_t = 38.1)]
     pub diameter: f64,
+    /// Spacing of the stripe points along the arc, mm (0.5: ~57 points a stripe; 0.1: ~280, as the demo session).
+    #[arg(long, default_value_t = 0.5)]
+    pub point_spacing: f64,
     /// Simulate the poses of a plan CSV (`spherecal plan --csv`) on the --robot preset with --errors, instead of generating poses: the robot goes to the plan's joints, the sphere stands where it then sees the planned centres on average.
     #[arg(long)]
     pub plan: Option<PathBuf>,
@@ -167,6 +170,17 @@ pub struct SimulateArgs {
     /// Also write what `spherecal import` reads: DIR/joints.csv (joint log with the nominal ABB flange pose), DIR/profiles/<id>.csv (y,z mm) and DIR/references.csv (from,to,distance mm).
     #[arg(long)]
     pub csv_out: Option<PathBuf>,
+    /// Simulate a raw scan of a part instead of a session, with the cell of the same seed, robot and errors: `plane`, `spheres` (three spheres of --diameter: a sphere artefact) or `steps` (a stepped block on a table). Writes the joint log and profiles (`nan,nan` where a ray meets nothing) into --csv-out and the scan's truth (`spherecal-scan-truth`: the part in the base frame, the true robot, hand-eye and actual joints) to --out.
+    #[arg(long, value_parser = parse_part, requires = "csv_out", conflicts_with_all = ["plan", "centres", "spread"])]
+    pub scan: Option<PartKind>,
+    /// With --scan: poses along the path (per sphere for `spheres`; default 40).
+    #[arg(long, requires = "scan")]
+    pub scan_poses: Option<usize>,
+}
+
+fn parse_part(s: &str) -> Result<PartKind, String> {
+    PartKind::parse(s)
+        .ok_or_else(|| format!("unknown part `{s}`, expected plane, spheres or steps"))
 }
 
 impl SimulateArgs {
@@ -195,6 +209,7 @@ impl SimulateArgs {
             side: self.side.into(),
             tracker_noise: self.tracker_noise,
             diameter: self.diameter,
+            point_spacing: self.point_spacing,
             range: self.range,
             spread: self.spread,
             ..SimConfig::default()
@@ -227,6 +242,51 @@ fn import_files(session: &Session, dir: &Path) -> Result<Vec<(PathBuf, String)>,
     Ok(out)
 }
 
+/// `simulate --scan`: the raw scan's files into `dir`, its truth to `--out`.
+fn run_scan(
+    args: &SimulateArgs,
+    part: PartKind,
+    dir: &Path,
+    started: Instant,
+) -> Result<(), CliError> {
+    let defaults = ScanConfig::default();
+    let scan = ScanConfig {
+        part,
+        poses: args.scan_poses.unwrap_or(defaults.poses),
+        range: args.range.unwrap_or(defaults.range),
+    };
+    let sim = simulate::simulate_scan(&args.to_config(), &scan)
+        .map_err(|e| CliError::input(e.to_string()))?;
+    let truth = serde_json::to_string_pretty(&sim.truth)
+        .map_err(|e| CliError::internal(format!("the scan truth: {e}")))?;
+    let truth = format!("{truth}\n");
+    // Every file or none, as the session's outputs.
+    let profiles = dir.join("profiles");
+    let mut files: Vec<(PathBuf, &str)> = vec![(dir.join("joints.csv"), &sim.joints_csv)];
+    for (id, text) in &sim.profiles {
+        files.push((profiles.join(format!("{id}.csv")), text));
+    }
+    if let Some(text) = &sim.references_csv {
+        files.push((dir.join("references.csv"), text));
+    }
+    files.push((args.out.clone(), &truth));
+    let files: Vec<(&Path, &[u8])> = files
+        .iter()
+        .map(|(p, t)| (p.as_path(), t.as_bytes()))
+        .collect();
+    super::write_outputs(&files, format::Folders::Create)?;
+    sayln!(
+        "simulated a scan of a {part:?} part (seed {}): {} poses -> {}/joints.csv, {}/profiles/, truth {} ({:.0} ms)",
+        args.seed,
+        sim.profiles.len(),
+        dir.display(),
+        dir.display(),
+        args.out.display(),
+        started.elapsed().as_secs_f64() * 1e3,
+    );
+    Ok(())
+}
+
 fn default_truth_path(out: &Path) -> PathBuf {
     let name = out
         .file_name()
@@ -247,6 +307,9 @@ fn default_truth_path(out: &Path) -> PathBuf {
 /// written (naming it).
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let started = Instant::now();
+    if let (Some(part), Some(dir)) = (args.scan, &args.csv_out) {
+        return run_scan(args, part, dir, started);
+    }
     let truth_path = args.truth_path();
     if truth_path == args.out {
         return Err(CliError::input(format!(

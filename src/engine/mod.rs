@@ -17,6 +17,7 @@
 //! | [`report`] | text summary, HTML report with SVG figures, model export |
 //! | [`cell`] | what the simulator and the planner share about a cell: sensor, workspace, approach cones, joint logs, seeded streams |
 //! | [`import`] | joint logs and profiles into a session |
+//! | [`measure`] | scans into base-frame point clouds through a result, each point with its σ; sphere self-validation; PLY, E57, CSV |
 //! | [`simulate`] | simulated sessions with their truth |
 //! | [`evaluate`] | scoring against the truth; the method comparison study |
 //! | [`plan`] | pose plans and their predicted accuracy |
@@ -29,6 +30,7 @@ pub mod geometry;
 pub mod handeye;
 pub mod history;
 pub mod import;
+pub mod measure;
 pub mod numeric;
 pub mod plan;
 pub mod program;

@@ -73,6 +73,37 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
     write_all_atomic(&[(path, bytes)], Folders::Existing)
 }
 
+/// As [`write_atomic`], with the content streamed by `write` into the
+/// temporary file (opened for reading and writing, so that a writer may
+/// seek back and read, as an E57 writer does): a large output (a point
+/// cloud) is never held in memory whole. An error of `write` removes the
+/// temporary file and leaves `path` as it was.
+///
+/// # Errors
+/// [`FileError::Io`] with action "writing" and the target path, carrying
+/// `write`'s error when it failed.
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut fs::File) -> io::Result<()>,
+) -> Result<(), FileError> {
+    let plans = plan_targets(&[path])?;
+    let plan = &plans[0];
+    remove_stale(&plan.dir);
+    let temp = stage_with(plan, write).map_err(|e| io_error(path, e))?;
+    let temps = [temp];
+    let guard = lock_pending();
+    if let Err((_, e)) = commit(&plans, &temps, &INTERRUPTED, &guard) {
+        drop(guard);
+        let _ = fs::remove_file(&temps[0]);
+        forget(&temps[0]);
+        return Err(io_error(path, e));
+    }
+    drop(guard);
+    forget(&temps[0]);
+    sync_dir(&plan.dir);
+    Ok(())
+}
+
 /// Refuses, before any work is done, outputs that [`write_all_atomic`]
 /// would refuse: a target that is not a regular file or is read-only, two
 /// outputs that are the same file, an output whose folder does not exist
@@ -285,9 +316,17 @@ fn remove_folders(created: &[PathBuf]) {
 /// Writes `bytes` to a new temporary file beside the plan's target,
 /// flushed to disk, with the target's permissions; returns its path.
 fn stage(plan: &TargetPlan, bytes: &[u8]) -> io::Result<PathBuf> {
+    stage_with(plan, |file| file.write_all(bytes))
+}
+
+/// As [`stage`], the content streamed into the temporary file by `write`.
+fn stage_with(
+    plan: &TargetPlan,
+    write: impl FnOnce(&mut fs::File) -> io::Result<()>,
+) -> io::Result<PathBuf> {
     let (temp, mut file) = create_temp(&plan.dir, &plan.name)?;
     let written = (|| {
-        file.write_all(bytes)?;
+        write(&mut file)?;
         if let Ok(meta) = fs::metadata(&plan.target) {
             let _ = file.set_permissions(meta.permissions());
         }
@@ -597,7 +636,9 @@ fn create_temp(dir: &Path, file_name: &std::ffi::OsStr) -> io::Result<(PathBuf, 
     for _ in 0..100 {
         let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
         let temp = dir.join(temp_name(file_name, std::process::id(), n));
+        // Read as well: a streaming writer may seek back and read (E57).
         match fs::OpenOptions::new()
+            .read(true)
             .write(true)
             .create_new(true)
             .open(&temp)

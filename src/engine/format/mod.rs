@@ -13,7 +13,7 @@ pub mod transform;
 
 pub use atomic::{
     Folders, check_outputs, interrupted, refuse_inputs, remove_pending, same_file,
-    write_all_atomic, write_atomic,
+    write_all_atomic, write_atomic, write_atomic_with,
 };
 pub use result::{
     ResultFile, load_result, parse_result, result_text_checked, result_to_json, save_result,

@@ -9,7 +9,7 @@ use super::config::{InitialHandEye, check, validate_config};
 use super::config::{SimConfig, SimError};
 use super::poses::{IK_CHECK_TOLERANCE, Pose};
 use super::truth::{OrderedMap, TRUTH_FORMAT, TRUTH_VERSION, Truth, TruthRobot};
-use super::{STREAM_ERRORS, STREAM_NOISE, kinematic_errors, record, reference_distances};
+use super::{STREAM_NOISE, record, reference_distances};
 use crate::engine::cell::random::stream;
 use crate::engine::cell::sensor::paper_initial_hand_eye;
 use crate::engine::geometry::rows_from_isometry;
@@ -132,17 +132,8 @@ pub fn simulate_plan(
             format!("pose {}: the planned centre is not finite", p.id)
         })?;
     }
-    let mut rng_errors = stream(config.seed, STREAM_ERRORS);
     let mut rng_noise = stream(config.seed, STREAM_NOISE);
-    let errors = kinematic_errors(config, dof, &mut rng_errors);
-    let mut true_robot = nominal.clone();
-    for (joint, e) in true_robot.joints.iter_mut().zip(&errors) {
-        joint.alpha += e.alpha;
-        joint.a += e.a;
-        joint.beta += e.beta;
-        joint.theta += e.theta;
-        joint.d += e.d;
-    }
+    let (true_robot, errors) = super::with_errors(config, nominal);
     let base_from_sensor = |q: &[f64]| true_robot.base_from_flange(q) * flange_from_sensor;
     // Each station: the mean of where the true robot sees the planned centres.
     let stations: Vec<(String, Vector3<f64>)> = per_station

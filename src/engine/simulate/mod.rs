@@ -44,12 +44,14 @@ pub mod config;
 pub mod from_plan;
 pub mod import_files;
 mod poses;
+pub mod scan;
 mod stripe;
 pub mod truth;
 
 pub use config::{ErrorModel, InitialHandEye, SideChoice, SimConfig, SimError};
 pub use from_plan::{PlanExecution, PlanPose, simulate_plan};
 pub use import_files::{ImportFiles, import_files};
+pub use scan::{Part, PartKind, ScanConfig, ScanTruth, SimulatedScan, simulate_scan};
 pub use truth::{Truth, TruthError, load_truth, parse_truth, truth_to_json};
 
 use nalgebra::Vector3;
@@ -209,25 +211,14 @@ fn reference_distances(
     (reference, truth)
 }
 
-/// Simulates a session and its ground truth (see the module docs).
-///
-/// # Errors
-/// [`SimError::InvalidConfig`] for a setting out of range,
-/// [`SimError::Unreachable`] when a station cannot be seen from the cone.
-pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
-    validate_config(config)?;
-    let preset = robot::preset(config.robot.key())
-        .ok_or_else(|| SimError::InvalidConfig(format!("unknown robot {}", config.robot.key())))?;
-    let nominal = preset.robot;
-    let dof = nominal.dof();
-    let workspace = config
-        .workspace
-        .unwrap_or_else(|| Workspace::for_robot(config.robot));
-    let mut rng_geometry = stream(config.seed, STREAM_GEOMETRY);
+/// The true robot of `config` on `nominal`: nominal plus the kinematic
+/// errors drawn from the errors stream, and the errors.
+pub(crate) fn with_errors(
+    config: &SimConfig,
+    nominal: &robot::Robot,
+) -> (robot::Robot, Vec<Joint>) {
     let mut rng_errors = stream(config.seed, STREAM_ERRORS);
-    let mut rng_noise = stream(config.seed, STREAM_NOISE);
-
-    let errors = kinematic_errors(config, dof, &mut rng_errors);
+    let errors = kinematic_errors(config, nominal.dof(), &mut rng_errors);
     let mut true_robot = nominal.clone();
     for (joint, e) in true_robot.joints.iter_mut().zip(&errors) {
         joint.alpha += e.alpha;
@@ -236,6 +227,37 @@ pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
         joint.theta += e.theta;
         joint.d += e.d;
     }
+    (true_robot, errors)
+}
+
+/// The preset of `config`'s robot, the true robot and the errors
+/// ([`with_errors`]): the same for a session and a scan of the same seed,
+/// robot and error model, so that a simulated scan is measured by the
+/// calibration of a simulated session.
+pub(crate) fn true_cell(
+    config: &SimConfig,
+) -> Result<(robot::Preset, robot::Robot, Vec<Joint>), SimError> {
+    let preset = robot::preset(config.robot.key())
+        .ok_or_else(|| SimError::InvalidConfig(format!("unknown robot {}", config.robot.key())))?;
+    let (true_robot, errors) = with_errors(config, &preset.robot);
+    Ok((preset, true_robot, errors))
+}
+
+/// Simulates a session and its ground truth (see the module docs).
+///
+/// # Errors
+/// [`SimError::InvalidConfig`] for a setting out of range,
+/// [`SimError::Unreachable`] when a station cannot be seen from the cone.
+pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
+    validate_config(config)?;
+    let (preset, true_robot, errors) = true_cell(config)?;
+    let nominal = preset.robot.clone();
+    let dof = nominal.dof();
+    let workspace = config
+        .workspace
+        .unwrap_or_else(|| Workspace::for_robot(config.robot));
+    let mut rng_geometry = stream(config.seed, STREAM_GEOMETRY);
+    let mut rng_noise = stream(config.seed, STREAM_NOISE);
     let hand_eye_rows = paper_hand_eye_rows();
     let flange_from_sensor = rigid_from_rows(&hand_eye_rows);
 

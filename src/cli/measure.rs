@@ -1,0 +1,517 @@
+//! `spherecal measure`: a session's stripes, or a raw scan (the import's
+//! pose log and profiles), into a point cloud in the robot base frame (or
+//! a workpiece frame) through a result's calibrated model and hand-eye,
+//! each point with its σ; the sphere self-validation; PLY, E57 or CSV by
+//! the output's extension. A thin caller of [`crate::engine::measure`].
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+
+use super::CliError;
+use crate::engine::format;
+use crate::engine::import::{
+    self, AngleUnit, AxisMap, FlangeConvention, LengthUnit, ProfileFormat, ProfileSource,
+    RobotSource,
+};
+use crate::engine::measure::{
+    self, CellModel, CloudFormat, JointRange, MeasureError, MeasureOptions, ModelChoice,
+    Provenance, Scan, ScanColumns, ScanFiles, ScanLog, ScanPose, selfcheck,
+};
+use crate::engine::session::Use;
+use crate::engine::solve::Control;
+
+/// Poses outside the calibrated joint range listed by name at most (a
+/// scan of thousands of poses would bury the summary).
+const LISTED_POSES: usize = 20;
+
+/// `spherecal measure`.
+#[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("input").required(true).args(["session", "joints", "poses"])))]
+pub struct MeasureArgs {
+    /// A session file: its stripes are measured as they are (every point of every stripe of the measurements chosen by --use).
+    pub session: Option<PathBuf>,
+    /// The result file whose calibrated model and hand-eye place the sensor (σ needs an `ml` result).
+    #[arg(long)]
+    pub result: PathBuf,
+    /// The cloud to write: `.ply` (binary: x y z double mm, sigma_mm float, pose uint), `.e57` (one scan a pose) or `.csv` (id,x,y,z,sigma_mm).
+    #[arg(long, short)]
+    pub out: PathBuf,
+    /// Which measurements of a session: `all` (default) or a list of translation, rotation, identify, validate.
+    #[arg(long = "use", value_delimiter = ',', default_value = "all")]
+    pub usage: Vec<String>,
+    /// Write the cloud in this workpiece frame: a JSON 4x4 `base_from_workpiece` (4 rows of 4 numbers, mm; bare or under that key); default the robot base frame.
+    #[arg(long)]
+    pub frame: Option<PathBuf>,
+    /// Write no σ (sigma_mm NaN in PLY and CSV, left out of E57): for a result without covariance (`--method paper`).
+    #[arg(long)]
+    pub no_sigma: bool,
+    /// The sensor's own noise: 1σ of each in-plane coordinate of a profile point, mm, added to σ in quadrature (2·s²).
+    #[arg(long, default_value_t = 0.0)]
+    pub sensor_noise: f64,
+    /// Use the result's parameter covariance as written, not scaled by its variance factor (`solver.variance_factor`, ≈ 1 when ml's noise model fits the data).
+    #[arg(long)]
+    pub covariance_as_written: bool,
+    /// Which model of the result: `calibrated` (default) or `nominal` (the nominal model and the initial hand-eye: the cell before calibration; no σ).
+    #[arg(long, default_value = "calibrated", value_parser = parse_model)]
+    pub model: ModelChoice,
+    /// The session the result was calibrated from: its identify poses give the joint range the calibration saw (default: the measured session itself; a raw scan without it is not checked).
+    #[arg(long)]
+    pub calibration: Option<PathBuf>,
+    /// Raw scan: a joint log CSV (columns id and j1..jn, optional station and use; see --map).
+    #[arg(long, conflicts_with = "poses")]
+    pub joints: Option<PathBuf>,
+    /// Raw scan: a pose file instead of a joint log, as the import reads it (a table with or without header, a JSON list, or a robot program: FANUC .ls, RAPID, KUKA .dat/.src, URScript; layout detected). Flange poses: only the hand-eye applies.
+    #[arg(long)]
+    pub poses: Option<PathBuf>,
+    /// Force the pose file's layout: table, json, fanuc-ls, rapid, krl or urscript.
+    #[arg(long, value_parser = super::import::parse_pose_format)]
+    pub pose_format: Option<crate::engine::import::PoseFormat>,
+    /// How a pose table or JSON list writes a pose: ABB, KUKA, FANUC, UR or matrix (a robot program fixes its own).
+    #[arg(long, value_parser = parse_convention)]
+    pub pose_convention: Option<FlangeConvention>,
+    /// The pose columns of a CSV pose log, in the convention's order.
+    #[arg(long, value_delimiter = ',')]
+    pub pose_columns: Vec<String>,
+    /// Raw scan: a folder of profiles (`<id>.csv|txt|yml|yaml|json`, or in natural order for a log without ids) or one CSV with a pose column.
+    #[arg(long)]
+    pub profiles: Option<PathBuf>,
+    /// Column of the pose id in a single profile file.
+    #[arg(long, default_value = "pose")]
+    pub pose_column: String,
+    /// Raw scan: the nominal robot it was taken with (a preset key, a session/result file, a URDF or a DH table), checked against the result's.
+    #[arg(long)]
+    pub robot: Option<String>,
+    /// The tip link of a URDF robot.
+    #[arg(long)]
+    pub urdf_tip: Option<String>,
+    /// The convention of a DH table robot: standard or modified.
+    #[arg(long, value_parser = super::parse_dh)]
+    pub dh: Option<crate::engine::robot::DhConvention>,
+    /// Axis map from the sensor's axes to spherecal's (laser plane x = 0): `auto` or e.g. `-y,x,z`.
+    #[arg(long, default_value = "auto")]
+    pub axes: String,
+    /// The sensor's no-return value in the profiles (file units), dropped and counted like NaN.
+    #[arg(long, allow_hyphen_values = true)]
+    pub no_return: Option<f64>,
+    /// Key of the point list in OpenCV YAML/JSON profiles.
+    #[arg(long)]
+    pub profile_key: Option<String>,
+    /// Unit of the joint columns: deg or rad.
+    #[arg(long, default_value = "deg", value_parser = parse_angle_unit)]
+    pub joint_unit: AngleUnit,
+    /// Unit of the profile coordinates: mm, um or m.
+    #[arg(long, default_value = "mm", value_parser = parse_length_unit)]
+    pub profile_unit: LengthUnit,
+    /// Joint-log columns, e.g. `id=Pose,j1=A1,...,station=Sphere,use=Use` (defaults: id, j1..jn, station, use).
+    #[arg(long, value_delimiter = ',')]
+    pub map: Vec<String>,
+    /// Raw scan of a sphere artefact: the spheres' diameter (mm), for the self-validation of the poses' stations.
+    #[arg(long)]
+    pub sphere_diameter: Option<f64>,
+    /// Raw scan of a sphere artefact: reference distances between its stations (CSV from,to,distance, mm).
+    #[arg(long)]
+    pub references: Option<PathBuf>,
+    /// Print nothing but errors and warnings.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+fn parse_model(s: &str) -> Result<ModelChoice, String> {
+    match s {
+        "calibrated" => Ok(ModelChoice::Calibrated),
+        "nominal" => Ok(ModelChoice::Nominal),
+        _ => Err(format!(
+            "unknown model `{s}`, expected calibrated or nominal"
+        )),
+    }
+}
+
+fn parse_angle_unit(s: &str) -> Result<AngleUnit, String> {
+    AngleUnit::parse(s).ok_or_else(|| format!("unknown joint unit `{s}`, expected `deg` or `rad`"))
+}
+
+fn parse_length_unit(s: &str) -> Result<LengthUnit, String> {
+    LengthUnit::parse(s)
+        .ok_or_else(|| format!("unknown profile unit `{s}`, expected `mm`, `um` or `m`"))
+}
+
+fn parse_convention(s: &str) -> Result<FlangeConvention, String> {
+    FlangeConvention::parse(s).ok_or_else(|| {
+        format!("unknown pose convention `{s}`, expected ABB, KUKA, FANUC, UR or matrix")
+    })
+}
+
+/// The uses `--use` names; empty for all.
+fn uses(args: &MeasureArgs) -> Result<Vec<Use>, CliError> {
+    if args.usage.iter().any(|u| u.eq_ignore_ascii_case("all")) {
+        return Ok(Vec::new());
+    }
+    args.usage
+        .iter()
+        .map(|u| {
+            Use::parse(u.trim()).ok_or_else(|| {
+                CliError::input(format!(
+                    "--use `{u}`: expected all, or translation, rotation, identify, validate"
+                ))
+            })
+        })
+        .collect()
+}
+
+fn from_measure(e: &MeasureError) -> CliError {
+    match e {
+        MeasureError::Cancelled => CliError::internal(e.to_string()),
+        MeasureError::File(f) => CliError::from_file(f, true),
+        MeasureError::Input(_) | MeasureError::Import(_) => CliError::input(e.to_string()),
+    }
+}
+
+/// The raw scan's spec from the flags.
+fn scan_files(args: &MeasureArgs, dof: usize) -> Result<ScanFiles, CliError> {
+    let profiles = args.profiles.clone().ok_or_else(|| {
+        CliError::input("a raw scan needs its profiles: --profiles DIR or --profiles FILE.csv")
+    })?;
+    let profiles = if profiles.is_dir() {
+        ProfileSource::Folder(profiles)
+    } else {
+        ProfileSource::File {
+            path: profiles,
+            pose_column: args.pose_column.clone(),
+        }
+    };
+    let axes = if args.axes.trim().eq_ignore_ascii_case("auto") {
+        None
+    } else {
+        Some(AxisMap::parse(&args.axes).map_err(|e| CliError::input(format!("--axes: {e}")))?)
+    };
+    let log = match (&args.joints, &args.poses) {
+        (Some(path), _) => {
+            let mut columns = ScanColumns::new(dof);
+            for entry in &args.map {
+                let Some((key, col)) = entry.split_once('=') else {
+                    return Err(CliError::input(format!(
+                        "--map entry `{entry}` is not KEY=Column"
+                    )));
+                };
+                let col = col.trim().to_string();
+                match key.trim() {
+                    "id" => columns.id = col,
+                    "station" => columns.station = col,
+                    "use" => columns.usage = col,
+                    k => {
+                        let slot = k
+                            .strip_prefix('j')
+                            .and_then(|n| n.parse::<usize>().ok())
+                            .filter(|n| (1..=dof).contains(n))
+                            .ok_or_else(|| {
+                                CliError::input(format!(
+                                    "--map key `{k}` is not id, station, use or j1..j{dof}"
+                                ))
+                            })?;
+                        columns.joints[slot - 1] = col;
+                    }
+                }
+            }
+            ScanLog::Joints {
+                path: path.clone(),
+                columns,
+                unit: args.joint_unit,
+            }
+        }
+        (None, Some(path)) => ScanLog::Poses {
+            path: path.clone(),
+            format: args.pose_format,
+            convention: args.pose_convention,
+            columns: (!args.pose_columns.is_empty()).then(|| args.pose_columns.clone()),
+        },
+        (None, None) => {
+            return Err(CliError::input(
+                "give a session, or --joints/--poses with --profiles",
+            ));
+        }
+    };
+    let robot = args
+        .robot
+        .as_deref()
+        .map(|text| {
+            let source = RobotSource::from_text(text, args.urdf_tip.clone(), args.dh)
+                .map_err(CliError::input)?;
+            import::load_robot(&source).map_err(|e| CliError::input(e.to_string()))
+        })
+        .transpose()?;
+    Ok(ScanFiles {
+        log,
+        profiles,
+        profile_format: ProfileFormat {
+            unit: args.profile_unit,
+            axes,
+            no_return: args.no_return,
+            key: args.profile_key.clone(),
+        },
+        robot,
+        sphere_diameter: args.sphere_diameter,
+        references: args.references.clone(),
+    })
+}
+
+/// Every input file of the command, to refuse an output that is one.
+fn inputs(args: &MeasureArgs) -> Vec<PathBuf> {
+    let mut inputs: Vec<PathBuf> = [
+        &args.session,
+        &Some(args.result.clone()),
+        &args.frame,
+        &args.calibration,
+        &args.joints,
+        &args.poses,
+        &args.references,
+    ]
+    .into_iter()
+    .flatten()
+    .cloned()
+    .collect();
+    if let Some(r) = &args.robot {
+        inputs.push(PathBuf::from(r));
+    }
+    if let Some(p) = &args.profiles {
+        if p.is_dir() {
+            inputs.extend(import::profiles::profile_files(p).unwrap_or_default());
+        } else {
+            inputs.push(p.clone());
+        }
+    }
+    inputs
+}
+
+/// Seconds and points per second, for the timing line.
+fn rate(points: usize, seconds: f64) -> String {
+    format!(
+        "{:.3} s ({:.1} M points/s)",
+        seconds,
+        points as f64 / seconds.max(1e-9) / 1e6
+    )
+}
+
+/// Runs `spherecal measure`.
+///
+/// # Errors
+/// [`CliError`] with status 2 for bad input (nothing written), 1 when the
+/// cloud cannot be written.
+pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
+    let started = Instant::now();
+    let input_files = inputs(args);
+    let input_refs: Vec<&Path> = input_files.iter().map(PathBuf::as_path).collect();
+    CliError::guard_output(&args.out, &input_refs)?;
+    let format = CloudFormat::of_path(&args.out).ok_or_else(|| {
+        CliError::input(format!(
+            "--out {}: the extension chooses the format: .ply, .e57 or .csv",
+            args.out.display()
+        ))
+    })?;
+    if !(args.sensor_noise.is_finite() && args.sensor_noise >= 0.0) {
+        return Err(CliError::input(
+            "--sensor-noise must be a finite number ≥ 0 (mm)",
+        ));
+    }
+    let result = format::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;
+    let frame = args
+        .frame
+        .as_ref()
+        .map(|path| {
+            measure::load_frame(path)
+                .map(|w| (w, path.display().to_string()))
+                .map_err(|e| from_measure(&e))
+        })
+        .transpose()?;
+    let mut joint_range = match &args.calibration {
+        Some(path) => {
+            let s = format::load_session(path).map_err(|e| CliError::from_file(&e, true))?;
+            JointRange::of_session(&s)
+        }
+        None => None,
+    };
+    let scan = if let Some(path) = &args.session {
+        let session = format::load_session(path).map_err(|e| CliError::from_file(&e, true))?;
+        if args.calibration.is_none() {
+            joint_range = JointRange::of_session(&session);
+        }
+        Scan::from_session(session, &uses(args)?)
+    } else {
+        let dof = result.robot.as_ref().map_or(0, |r| r.dof());
+        measure::scan_from_files(&scan_files(args, dof)?)
+            .map_err(|e| CliError::input(e.to_string()))?
+    };
+    if scan.poses.is_empty() {
+        return Err(CliError::input(format!(
+            "nothing to measure: no pose with a profile{} ({})",
+            if scan.skipped.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " (the {} measurements give sphere centres)",
+                    scan.skipped.len()
+                )
+            },
+            args.session
+                .as_ref()
+                .map_or_else(|| scan.name.clone(), |p| p.display().to_string())
+        )));
+    }
+    let loaded = started.elapsed().as_secs_f64();
+    let sigma = !args.no_sigma && args.model == ModelChoice::Calibrated;
+    let options = MeasureOptions {
+        model: args.model,
+        frame,
+        sigma,
+        sensor_noise_mm: args.sensor_noise,
+        covariance_as_written: args.covariance_as_written,
+    };
+    let sphere = scan.sphere_diameter;
+    let references = scan.reference_distances.clone();
+    let (scan_name, notes, skipped) = (scan.name.clone(), scan.notes.clone(), scan.skipped.clone());
+    // The self-validation runs on its own thread beside the measurement
+    // and the write, on a copy of the poses it looks at.
+    let checked: Vec<ScanPose> = match sphere {
+        Some(_) => scan
+            .poses
+            .iter()
+            .filter(|p| selfcheck::checks(*p))
+            .cloned()
+            .collect(),
+        None => Vec::new(),
+    };
+    let (nominal, calibrated) = (
+        CellModel::of_result(&result, ModelChoice::Nominal),
+        CellModel::of_result(&result, ModelChoice::Calibrated),
+    );
+    let self_validation = || {
+        let t = Instant::now();
+        let check = sphere
+            .and_then(|d| measure::self_validate(&checked, &nominal, &calibrated, d, &references));
+        (check, t.elapsed().as_secs_f64())
+    };
+    let provenance = Provenance {
+        result: args.result.display().to_string(),
+        scan: args
+            .session
+            .as_ref()
+            .map_or_else(|| scan_name.clone(), |p| p.display().to_string()),
+    };
+    let (measured, (check, checked_secs), placed, written) = std::thread::scope(|s| {
+        let worker = std::thread::Builder::new()
+            .name("self-validation".into())
+            .spawn_scoped(s, self_validation);
+        let t0 = Instant::now();
+        let measured = measure::measure(scan, &result, &options, joint_range.as_ref(), &mut |_| {
+            Control::Continue
+        })
+        .map_err(|e| from_measure(&e))?;
+        let placed = t0.elapsed().as_secs_f64();
+        let t1 = Instant::now();
+        measure::write_cloud(&measured.cloud, &args.out, format, &provenance)
+            .map_err(|e| CliError::from_file(&e, false))?;
+        let written = t1.elapsed().as_secs_f64();
+        let check = match worker {
+            Ok(handle) => handle
+                .join()
+                .map_err(|_| CliError::internal("the self-validation thread failed"))?,
+            Err(_) => self_validation(),
+        };
+        Ok::<_, CliError>((measured, check, placed, written))
+    })?;
+    let cloud = &measured.cloud;
+    for w in &measured.warnings {
+        eprintln!("warning: {w}");
+    }
+    if !measured.out_of_range.is_empty() {
+        eprintln!(
+            "warning: {} pose(s) outside the joint range the calibration saw (the model was not checked there):",
+            measured.out_of_range.len()
+        );
+        for o in measured.out_of_range.iter().take(LISTED_POSES) {
+            eprintln!("  {o}");
+        }
+        if measured.out_of_range.len() > LISTED_POSES {
+            eprintln!(
+                "  … and {} more",
+                measured.out_of_range.len() - LISTED_POSES
+            );
+        }
+    }
+    if args.quiet {
+        return Ok(());
+    }
+    let n = cloud.len();
+    let dropped = cloud.dropped();
+    for note in &notes {
+        sayln!("{note}");
+    }
+    sayln!(
+        "measured {} points of {} poses ({} model of {}, {}); dropped {} non-finite and {} no-return points",
+        n,
+        cloud.poses.len(),
+        cloud.model,
+        args.result.display(),
+        cloud.frame,
+        dropped.non_finite,
+        dropped.no_return
+    );
+    if !skipped.is_empty() {
+        let more = skipped.len().saturating_sub(LISTED_POSES);
+        sayln!(
+            "  {} measurement(s) give a sphere centre, no profile: not in the cloud ({}{})",
+            skipped.len(),
+            skipped[..skipped.len().min(LISTED_POSES)].join(", "),
+            if more > 0 {
+                format!(", … and {more} more")
+            } else {
+                String::new()
+            }
+        );
+    }
+    match cloud.sigma_stats() {
+        Some(s) => sayln!(
+            "σ of a point (3-D, after the cloud's best rigid alignment; covariance {}{}): median {:.4} mm, rms {:.4} mm, max {:.4} mm",
+            if args.covariance_as_written {
+                "as written".to_string()
+            } else {
+                format!("× variance factor {:.3}", measure::variance_factor(&result))
+            },
+            if args.sensor_noise > 0.0 {
+                format!(", sensor noise {} mm", args.sensor_noise)
+            } else {
+                String::new()
+            },
+            s.median,
+            s.rms,
+            s.max
+        ),
+        None => sayln!(
+            "σ: not computed (sigma_mm written as NaN{})",
+            if format == CloudFormat::E57 {
+                "; left out of E57"
+            } else {
+                ""
+            }
+        ),
+    }
+    if args.session.is_none() && args.calibration.is_none() {
+        sayln!(
+            "joint range: not checked (give --calibration SESSION, the session the result was calibrated from)"
+        );
+    }
+    if let Some(c) = &check {
+        say!("{}", c.summary());
+    }
+    sayln!(
+        "wrote {} ({:.0} ms): load {:.3} s, transform and σ {}, write {}; self-validation {:.3} s beside them",
+        args.out.display(),
+        started.elapsed().as_secs_f64() * 1e3,
+        loaded,
+        rate(n, placed),
+        rate(n, written),
+        checked_secs
+    );
+    Ok(())
+}
