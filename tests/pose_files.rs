@@ -423,7 +423,7 @@ fn profile_names_with_the_number_anywhere_pair_in_numeric_order() {
     assert_eq!(imported.session.measurements[9].id, "10_3C_line");
     let notes = imported.notes.join("\n");
     assert!(
-        notes.contains("calibration.sec (not a profile file"),
+        notes.contains("calibration.sec (not a profile file: .sec)"),
         "{notes}"
     );
     assert!(notes.contains("line 12 ↔ 12_3C_line.txt"), "{notes}");

@@ -144,7 +144,12 @@ pub fn list_profiles(
             .map(|e| e.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
         if !PROFILE_EXTENSIONS.contains(&ext.as_str()) {
-            skipped.push((path, format!("not a profile file (.{ext})")));
+            let why = if ext.is_empty() {
+                "not a profile file: no extension".to_string()
+            } else {
+                format!("not a profile file: .{ext}")
+            };
+            skipped.push((path, why));
             continue;
         }
         groups.entry(shape(&name)).or_default().push(path);
