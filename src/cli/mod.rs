@@ -25,6 +25,7 @@ macro_rules! say {
     };
 }
 
+pub mod compensate;
 pub mod evaluate;
 pub mod export_model;
 pub mod history;
@@ -77,6 +78,8 @@ pub enum Command {
     Report(html_report::ReportArgs),
     /// Library of a folder of sessions and results: per robot the drift of the hand-eye and kinematic deviations over time, jumps beyond k combined σ flagged.
     History(history::HistoryArgs),
+    /// Compensate robot targets through a calibration: a pose table or a robot program (RAPID, KUKA KRL, FANUC .ls, URScript) rewritten so that a controller running the nominal model drives the TCP onto each target; prints the calibrated hand-eye as the controller's tool data.
+    Compensate(compensate::CompensateArgs),
 }
 
 /// Writes `args` and a newline to stdout, ignoring a closed pipe.

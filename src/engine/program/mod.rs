@@ -24,6 +24,7 @@ mod json;
 mod krl;
 mod rapid;
 mod scan;
+pub mod style;
 mod table;
 mod urscript;
 
@@ -276,6 +277,21 @@ impl PoseFile {
     /// A target index out of range or a count of numbers that does not
     /// match the target's spans.
     pub fn rewritten(&self, edits: &[(usize, Vec<String>)]) -> Result<String, String> {
+        self.rewritten_with_config(edits, &[])
+    }
+
+    /// As [`Self::rewritten`], and each target of `configs` with its
+    /// configuration ([`Target::config`], its byte range) replaced by the
+    /// text given. Every other byte is kept.
+    ///
+    /// # Errors
+    /// As [`Self::rewritten`], and a target without a configuration in
+    /// `configs`.
+    pub fn rewritten_with_config(
+        &self,
+        edits: &[(usize, Vec<String>)],
+        configs: &[(usize, String)],
+    ) -> Result<String, String> {
         let mut replacements: Vec<(Range<usize>, &str)> = Vec::new();
         for (index, numbers) in edits {
             let target = self
@@ -293,6 +309,14 @@ impl PoseFile {
             for (span, n) in target.spans.iter().zip(numbers) {
                 replacements.push((span.clone(), n.as_str()));
             }
+        }
+        for (index, text) in configs {
+            let (_, range) = self
+                .targets
+                .get(*index)
+                .and_then(|t| t.config.as_ref())
+                .ok_or_else(|| format!("target {index} has no configuration"))?;
+            replacements.push((range.clone(), text.as_str()));
         }
         Ok(scan::replace_ranges(&self.text, replacements))
     }
