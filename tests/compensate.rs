@@ -43,7 +43,6 @@ fn path(p: &Path) -> &str {
 /// A simulated session, its truth and its calibration, through the CLI.
 struct Cell {
     dir: PathBuf,
-    session: PathBuf,
     result: ResultFile,
     result_path: PathBuf,
     truth: Truth,
@@ -75,7 +74,6 @@ fn cell(dir: &Path, seed: u64) -> Cell {
     assert_eq!(status, 0, "{err}");
     Cell {
         dir: dir.to_path_buf(),
-        session,
         result: format::load_result(&result_path).unwrap(),
         result_path,
         truth: simulate::load_truth(&truth_path).unwrap(),
@@ -230,133 +228,483 @@ fn a_nominal_controller_reaches_compensated_table_targets() {
     }
 }
 
+/// The same model, TRUE: a result whose calibrated model and hand-eye are
+/// the truth compensates exactly (no alignment needed, its base frame is
+/// the true one), through the engine as the workbench calls it.
 #[test]
-#[ignore]
-fn debug_per_target() {
+fn with_the_true_model_compensation_is_exact() {
+    use spherecal::engine::compensate::{self, Model, Options, Tcp};
+    use spherecal::engine::program::{ReadSpec, parse_pose_text};
+    use spherecal::engine::solve::Control;
     let dir = tempfile::tempdir().unwrap();
-    let seed: u64 = std::env::var("SEED").map_or(23, |s| s.parse().unwrap());
-    let spread: f64 = std::env::var("SPREAD").map_or(3.0, |s| s.parse().unwrap());
-    let cell = cell(dir.path(), seed);
-    let targets = targets_near_validate(&cell, spread, seed);
-    let t_csv = cell.dir.join("T.csv");
-    let c_csv = cell.dir.join("C.csv");
+    let c = cell(dir.path(), 5);
+    let mut result = c.result.clone();
+    let true_robot = c.truth.true_robot();
+    result.joint_errors = true_robot.joint_errors(&c.truth.nominal_robot());
+    result.robot = Some(true_robot.clone());
+    result.hand_eye = c.truth.true_hand_eye();
+    let model = Model::new(&result, None, Tcp::Sensor).unwrap();
+    let targets = targets_near_validate(&c, 3.0, 5);
+    let spec = ReadSpec {
+        convention: Some(FlangeConvention::AbbQuaternion),
+        ..ReadSpec::default()
+    };
+    let file = parse_pose_text(table(&targets), Path::new("T.csv"), &spec).unwrap();
+    let mut seen = 0;
+    let done = compensate::compensate(&model, &file, &Options::default(), &mut |p| {
+        seen = p.done;
+        Control::Continue
+    })
+    .unwrap();
+    assert_eq!(seen, targets.len());
+    let nominal = c.truth.nominal_robot();
+    for (t, r) in targets.iter().zip(&done.targets) {
+        let q = nominal
+            .inverse_kinematics(&(r.commanded * result.hand_eye.inverse()), &t.joints, None)
+            .unwrap();
+        let reached = true_robot.base_from_flange(&q) * result.hand_eye;
+        let miss = (reached.translation.vector - t.pose.translation.vector).norm();
+        assert!(miss < 1e-6, "{}: {miss} mm", t.id);
+        assert!(reached.rotation.angle_to(&t.pose.rotation) < 1e-9);
+        // The controller drives exactly the calibrated solution.
+        let same = |a: &f64, b: &f64| spherecal::engine::geometry::wrap_deg(a - b).abs() < 1e-6;
+        assert!(
+            q.iter().zip(&r.joints).all(|(a, b)| same(a, b)),
+            "{q:?} {:?}",
+            r.joints
+        );
+    }
+    // A cancelled run returns no file.
+    let cancelled =
+        compensate::compensate(&model, &file, &Options::default(), &mut |_| Control::Cancel);
+    assert_eq!(cancelled, Err(compensate::CompensateError::Cancelled));
+}
+
+/// A program in one robot language, built from the targets with the
+/// language's usual precision, and the same numbers as a table in that
+/// language's convention.
+struct Program {
+    name: &'static str,
+    file: &'static str,
+    convention: FlangeConvention,
+    text: String,
+    table: String,
+}
+
+/// `v` with `d` decimals.
+fn fixed(v: f64, d: usize) -> String {
+    format!("{v:.d$}")
+}
+
+fn programs(targets: &[Target], model: &spherecal::engine::compensate::Model) -> Vec<Program> {
+    use spherecal::engine::compensate::config::{Vendor, posture};
+    let branch = |t: &Target| {
+        let flange = t.pose * model.tool.inverse();
+        let (q, _) = model.arms.nominal_branch(&flange, None).unwrap();
+        q
+    };
+    let values = |c: FlangeConvention, t: &Target, d: &[usize]| -> Vec<String> {
+        c.values_from_pose(&t.pose)
+            .iter()
+            .zip(d)
+            .map(|(v, d)| fixed(*v, *d))
+            .collect()
+    };
+    let table_of = |c: FlangeConvention, rows: &[Vec<String>]| {
+        let mut s = format!("id,{}\n", c.default_columns().join(","));
+        for (t, r) in targets.iter().zip(rows) {
+            let _ = writeln!(s, "{},{}", t.id, r.join(","));
+        }
+        s
+    };
+    let mut out = Vec::new();
+    // ABB RAPID.
+    let c = FlangeConvention::AbbQuaternion;
+    let rows: Vec<Vec<String>> = targets
+        .iter()
+        .map(|t| values(c, t, &[3, 3, 3, 6, 6, 6, 6]))
+        .collect();
+    let mut text = String::from(
+        "MODULE Compensated\n  ! targets of a sensor path\n  PERS tooldata tSensor := [TRUE,[[0,0,100],[1,0,0,0]],[1,[0,0,1],[1,0,0,0],0,0,0]];\n",
+    );
+    for (t, r) in targets.iter().zip(&rows) {
+        let q = branch(t);
+        let cf = Vendor::Abb.config(&q, posture(&model.arms.nominal, &q));
+        let _ = writeln!(
+            text,
+            "  CONST robtarget p{} := [[{},{},{}],[{},{},{},{}],{cf},[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];",
+            t.id, r[0], r[1], r[2], r[3], r[4], r[5], r[6]
+        );
+    }
+    text.push_str("  PROC main()\n");
+    for t in targets {
+        let _ = writeln!(text, "    MoveL p{}, v100, fine, tSensor;", t.id);
+    }
+    text.push_str("  ENDPROC\nENDMODULE\n");
+    out.push(Program {
+        name: "RAPID",
+        file: "path.mod",
+        convention: c,
+        table: table_of(c, &rows),
+        text,
+    });
+    // KUKA .dat.
+    let c = FlangeConvention::KukaAbc;
+    let rows: Vec<Vec<String>> = targets
+        .iter()
+        .map(|t| values(c, t, &[3, 3, 3, 4, 4, 4]))
+        .collect();
+    let mut text = String::from("&ACCESS RVP\nDEFDAT  PATH\n;FOLD EXTERNAL DECLARATIONS\n");
+    for (t, r) in targets.iter().zip(&rows) {
+        let q = branch(t);
+        let spherecal::engine::compensate::config::Config::Kuka { s: st, t: tt } =
+            Vendor::Kuka.config(&q, posture(&model.arms.nominal, &q))
+        else {
+            unreachable!()
+        };
+        let _ = writeln!(
+            text,
+            "DECL E6POS X{}={{X {},Y {},Z {},A {},B {},C {},S {st},T {tt},E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0}}\nDECL FDAT F{}={{TOOL_NO 1,BASE_NO 0,IPO_FRAME #BASE}}",
+            t.id, r[0], r[1], r[2], r[3], r[4], r[5], t.id
+        );
+    }
+    text.push_str("ENDDAT\n");
+    out.push(Program {
+        name: "KRL",
+        file: "path.dat",
+        convention: c,
+        table: table_of(c, &rows),
+        text,
+    });
+    // FANUC .ls.
+    let c = FlangeConvention::FanucWpr;
+    let rows: Vec<Vec<String>> = targets.iter().map(|t| values(c, t, &[3; 6])).collect();
+    let mut text = String::from("/PROG  PATH\n/ATTR\nOWNER\t\t= MNEDITOR;\n/MN\n");
+    for (k, _) in targets.iter().enumerate() {
+        let _ = writeln!(text, "{:>4}:L P[{}] 100mm/sec FINE    ;", k + 1, k + 1);
+    }
+    text.push_str("/POS\n");
+    for (k, (t, r)) in targets.iter().zip(&rows).enumerate() {
+        let q = branch(t);
+        let cfg = Vendor::Fanuc
+            .config(&q, posture(&model.arms.nominal, &q))
+            .to_string();
+        let _ = write!(
+            text,
+            "P[{}]{{\n   GP1:\n\tUF : 0, UT : 1,\t\tCONFIG : {cfg},\n\tX = {:>10} mm,\tY = {:>10} mm,\tZ = {:>10} mm,\n\tW = {:>10} deg,\tP = {:>10} deg,\tR = {:>10} deg\n}};\n",
+            k + 1,
+            r[0],
+            r[1],
+            r[2],
+            r[3],
+            r[4],
+            r[5]
+        );
+    }
+    text.push_str("/END\n");
+    out.push(Program {
+        name: "FANUC",
+        file: "path.ls",
+        convention: c,
+        table: table_of(c, &rows),
+        text,
+    });
+    // URScript.
+    let c = FlangeConvention::UrRotationVector;
+    let rows: Vec<Vec<String>> = targets.iter().map(|t| values(c, t, &[6; 6])).collect();
+    let mut text = String::from("def path():\n  set_tcp(p[0, 0, 0.1, 0, 0, 0])  # the sensor\n");
+    for r in &rows {
+        let _ = writeln!(
+            text,
+            "  movel(p[{}, {}, {}, {}, {}, {}], a=1.2, v=0.25)",
+            r[0], r[1], r[2], r[3], r[4], r[5]
+        );
+    }
+    text.push_str("end\n");
+    out.push(Program {
+        name: "URScript",
+        file: "path.script",
+        convention: c,
+        table: table_of(c, &rows),
+        text,
+    });
+    out
+}
+
+/// `text` with the numbers of every target and every configuration read
+/// from it replaced by `#`: what must not change.
+fn skeleton(text: &str, file_name: &str) -> String {
+    let file = spherecal::engine::program::parse_pose_text(
+        text.to_string(),
+        Path::new(file_name),
+        &spherecal::engine::program::ReadSpec::default(),
+    )
+    .unwrap();
+    let mut ranges: Vec<std::ops::Range<usize>> = file
+        .targets
+        .iter()
+        .flat_map(|t| {
+            t.spans
+                .iter()
+                .cloned()
+                .chain(t.config.iter().map(|(_, r)| r.clone()))
+        })
+        .collect();
+    ranges.sort_by_key(|r| r.start);
+    let mut out = String::new();
+    let mut at = 0;
+    for r in ranges {
+        out.push_str(&text[at..r.start]);
+        out.push('#');
+        at = r.end;
+    }
+    out.push_str(&text[at..]);
+    out
+}
+
+/// Poses of a file's targets in their order.
+fn poses_of(
+    text: &str,
+    file_name: &str,
+    convention: Option<FlangeConvention>,
+) -> Vec<Isometry3<f64>> {
+    use spherecal::engine::program::{ReadSpec, TargetValue, parse_pose_text};
+    let spec = ReadSpec {
+        convention,
+        ..ReadSpec::default()
+    };
+    let file = parse_pose_text(text.to_string(), Path::new(file_name), &spec).unwrap();
+    file.ordered()
+        .map(|t| match &t.value {
+            TargetValue::Pose { values, convention } => {
+                convention.pose_from_values(values).unwrap()
+            }
+            TargetValue::Joints { .. } => panic!("a pose expected"),
+        })
+        .collect()
+}
+
+#[test]
+fn programs_in_four_languages_keep_every_other_byte_and_match_the_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = cell(dir.path(), 7);
+    let targets: Vec<Target> = targets_near_validate(&c, 3.0, 7)
+        .into_iter()
+        .take(12)
+        .collect();
+    let model = spherecal::engine::compensate::Model::new(
+        &c.result,
+        None,
+        spherecal::engine::compensate::Tcp::Sensor,
+    )
+    .unwrap();
+    for p in programs(&targets, &model) {
+        let input = dir.path().join(p.file);
+        let output = dir.path().join(format!("out-{}", p.file));
+        std::fs::write(&input, &p.text).unwrap();
+        let (status, out, err) = run(&[
+            "compensate",
+            "--result",
+            path(&c.result_path),
+            "--targets",
+            path(&input),
+            "--out",
+            path(&output),
+        ]);
+        assert_eq!(status, 0, "{}: {out}{err}", p.name);
+        let written = std::fs::read_to_string(&output).unwrap();
+        assert_ne!(written, p.text, "{}: the positions change", p.name);
+        assert_eq!(
+            skeleton(&written, p.file),
+            skeleton(&p.text, p.file),
+            "{}: every other byte kept",
+            p.name
+        );
+        // The table path with the same numbers.
+        let t_in = dir.path().join(format!("{}.csv", p.name));
+        let t_out = dir.path().join(format!("{}-out.csv", p.name));
+        std::fs::write(&t_in, &p.table).unwrap();
+        let (status, out, err) = run(&[
+            "compensate",
+            "--result",
+            path(&c.result_path),
+            "--targets",
+            path(&t_in),
+            "--pose-convention",
+            p.convention.key(),
+            "--out",
+            path(&t_out),
+        ]);
+        assert_eq!(status, 0, "{}: {out}{err}", p.name);
+        let from_table = poses_of(
+            &std::fs::read_to_string(&t_out).unwrap(),
+            "t.csv",
+            Some(p.convention),
+        );
+        let from_program = poses_of(&written, p.file, None);
+        assert_eq!(from_table.len(), targets.len());
+        for (k, (a, b)) in from_program.iter().zip(&from_table).enumerate() {
+            let dp = (a.translation.vector - b.translation.vector).norm();
+            let dr = a.rotation.angle_to(&b.rotation);
+            // Programs write 3 decimals of mm, FANUC 3 of its degrees.
+            assert!(
+                dp < 2e-3 && dr < 3e-5,
+                "{} target {k}: {dp} mm, {dr} rad",
+                p.name
+            );
+        }
+        if p.name == "RAPID" {
+            assert!(out.contains("PERS tooldata tSpherecal"), "{out}");
+        }
+    }
+}
+
+#[test]
+fn far_targets_are_flagged_and_unreachable_ones_are_errors_with_nothing_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = cell(dir.path(), 7);
+    let mut targets: Vec<Target> = targets_near_validate(&c, 3.0, 7)
+        .into_iter()
+        .take(3)
+        .collect();
+    // The arm turned to its side, the wrist rolled: far from every pose
+    // the calibration saw.
+    let q_far = [95.0, -20.0, 40.0, 120.0, -70.0, 60.0];
+    targets.push(Target {
+        id: "Tfar".into(),
+        joints: q_far,
+        pose: c.truth.true_robot().base_from_flange(&q_far) * c.truth.true_hand_eye(),
+    });
+    let t_csv = dir.path().join("T.csv");
+    let c_csv = dir.path().join("C.csv");
     std::fs::write(&t_csv, table(&targets)).unwrap();
-    let with_session = std::env::var("WITH_SESSION").is_ok();
-    let mut args = vec![
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "compensate",
+            "--result",
+            path(&c.result_path),
+            "--targets",
+            path(&t_csv),
+            "--pose-convention",
+            "abb",
+            "--out",
+            path(&c_csv),
+        ];
+        a.extend_from_slice(extra);
+        run(&a)
+    };
+    // Flagged: compensated, written and listed, with why.
+    let (status, out, err) = args(&[]);
+    assert_eq!(status, 0, "{out}{err}");
+    let flagged_line = out
+        .lines()
+        .find(|l| l.contains("Tfar (line 5):"))
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(flagged_line.contains("outside the box"), "{flagged_line}");
+    assert!(
+        out.contains("1 flagged outside what the calibration saw"),
+        "{out}"
+    );
+    let back = read_table(&std::fs::read_to_string(&c_csv).unwrap());
+    let moved = (back[3].1.translation.vector - targets[3].pose.translation.vector).norm();
+    assert!(moved > 1.0, "the far target is compensated too: {moved}");
+    // --strict refuses it and leaves the old output as it was.
+    std::fs::write(&c_csv, "old\n").unwrap();
+    let (status, _, err) = args(&["--strict"]);
+    assert_eq!(status, 2, "{err}");
+    assert!(
+        err.starts_with("error: ") && err.contains("Tfar") && err.contains("T.csv"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&c_csv).unwrap(), "old\n");
+    // An unreachable target is an error naming it (and its line); nothing
+    // is written.
+    let mut text = table(&targets);
+    text.push_str("Tgone,5000,0,500,1,0,0,0\n");
+    std::fs::write(&t_csv, text).unwrap();
+    std::fs::remove_file(&c_csv).unwrap();
+    let (status, _, err) = args(&[]);
+    assert_eq!(status, 2, "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("target Tgone (line 6)")
+            && err.contains("out of reach")
+            && err.contains("T.csv"),
+        "{err}"
+    );
+    assert!(!c_csv.exists());
+}
+
+#[test]
+fn joint_targets_are_compensated_or_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = cell(dir.path(), 7);
+    let q = [5.0, 25.0, 15.0, -20.0, 50.0, 10.0];
+    let text = format!(
+        "MODULE J\n  CONST jointtarget j1 := [[{}],[9E9,9E9,9E9,9E9,9E9,9E9]];\n  PROC main()\n    MoveAbsJ j1, v100, fine, tool0;\n  ENDPROC\nENDMODULE\n",
+        q.map(|v| format!("{v:.3}")).join(",")
+    );
+    let input = dir.path().join("j.mod");
+    let output = dir.path().join("j-out.mod");
+    std::fs::write(&input, &text).unwrap();
+    let (status, out, err) = run(&[
         "compensate",
         "--result",
-        path(&cell.result_path),
+        path(&c.result_path),
         "--targets",
-        path(&t_csv),
-        "--pose-convention",
-        "abb",
+        path(&input),
         "--out",
-        path(&c_csv),
-    ];
-    if with_session {
-        args.extend(["--session", path(&cell.session)]);
-    }
-    let (_s, out, err) = run(&args);
-    println!("{}{err}", out.lines().last().unwrap_or(""));
-    let back = read_table(&std::fs::read_to_string(&c_csv).unwrap());
-    let nominal = cell.result.nominal().unwrap();
-    let tool = cell.result.hand_eye;
-    let wanted: Vec<Isometry3<f64>> = targets.iter().map(|t| t.pose).collect();
-    let after: Vec<Isometry3<f64>> = targets
-        .iter()
-        .zip(&back)
-        .map(|(t, (_, p))| reached(&cell, &nominal, &tool, p, &t.joints))
-        .collect();
-    let from: Vec<Vector3<f64>> = after.iter().map(|p| p.translation.vector).collect();
-    let to: Vec<Vector3<f64>> = wanted.iter().map(|p| p.translation.vector).collect();
-    let fit = kabsch(&from, &to).unwrap();
-    for (i, t) in targets.iter().enumerate() {
-        let e = (fit * nalgebra::Point3::from(from[i]) - nalgebra::Point3::from(to[i])).norm();
-        let q = nominal
-            .inverse_kinematics(&(back[i].1 * tool.inverse()), &t.joints, None)
-            .unwrap();
-        println!(
-            "{} err {e:.4} q {:?} gen {:?}",
-            t.id,
-            q.iter()
-                .map(|v| (v * 100.0).round() / 100.0)
-                .collect::<Vec<_>>(),
-            t.joints
-                .iter()
-                .map(|v| (v * 100.0).round() / 100.0)
-                .collect::<Vec<_>>()
-        );
-    }
-    println!("aligned rms {}", aligned_rms(&after, &wanted));
-    let te = cell.truth.joint_errors.clone();
-    println!(
-        "true errors {te:?}\ncal errors {:?}",
-        cell.result.joint_errors
+        path(&output),
+    ]);
+    assert_eq!(status, 0, "{out}{err}");
+    let written = std::fs::read_to_string(&output).unwrap();
+    let file = spherecal::engine::program::parse_pose_text(
+        written,
+        Path::new("j.mod"),
+        &Default::default(),
+    )
+    .unwrap();
+    let spherecal::engine::program::TargetValue::Joints { deg, .. } = &file.targets[0].value else {
+        panic!("a joint target")
+    };
+    // The calibrated model at the joints written reaches the pose the
+    // nominal model gives the joints taught (to the 4 decimals written).
+    let calibrated = c.result.robot.clone().unwrap();
+    let wanted = c.result.nominal().unwrap().base_from_flange(&q) * c.result.hand_eye;
+    let got = calibrated.base_from_flange(deg) * c.result.hand_eye;
+    let miss = (got.translation.vector - wanted.translation.vector).norm();
+    assert!(miss < 5e-3, "{miss} mm");
+    assert!(
+        deg.iter().zip(&q).any(|(a, b)| (a - b).abs() > 0.05),
+        "{deg:?}"
     );
+    // Kept as taught.
+    let (status, out, err) = run(&[
+        "compensate",
+        "--result",
+        path(&c.result_path),
+        "--targets",
+        path(&input),
+        "--out",
+        path(&output),
+        "--joint-targets",
+        "keep",
+    ]);
+    assert_eq!(status, 0, "{out}{err}");
+    assert_eq!(std::fs::read_to_string(&output).unwrap(), text);
+    assert!(out.contains("kept"), "{out}");
 }
 
 #[test]
-#[ignore]
-fn debug_study() {
-    let seed: u64 = std::env::var("SEED").map_or(23, |s| s.parse().unwrap());
-    let s = spherecal::engine::compensate::study::run_seed(seed).unwrap();
-    let mut rows: Vec<_> = s.targets.iter().collect();
-    rows.sort_by(|a, b| a.nearest_deg.total_cmp(&b.nearest_deg));
-    for t in rows {
-        println!(
-            "{} near {:6.1}° σ {:.3} out {:6.0} flag {} before {:.3} after {:.3}",
-            if t.near { "N" } else { "F" },
-            t.nearest_deg,
-            t.sigma_mm,
-            t.outside_mm,
-            t.flagged,
-            t.before_mm,
-            t.after_mm
-        );
-    }
-    println!("iso near {:?}\niso far {:?}", s.iso_near, s.iso_far);
-}
-
-#[test]
-#[ignore]
-fn debug_study_stats() {
-    for seed in 1..=6u64 {
-        let s = spherecal::engine::compensate::study::run_seed(seed).unwrap();
-        let near: Vec<_> = s.targets.iter().filter(|t| t.near).collect();
-        let far: Vec<_> = s.targets.iter().filter(|t| !t.near).collect();
-        let rms =
-            |v: &[&spherecal::engine::compensate::study::StudyTarget],
-             f: fn(&spherecal::engine::compensate::study::StudyTarget) -> f64| {
-                (v.iter().map(|t| f(t).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
-            };
-        let max =
-            |v: &[&spherecal::engine::compensate::study::StudyTarget],
-             f: fn(&spherecal::engine::compensate::study::StudyTarget) -> f64| {
-                v.iter().map(|t| f(t)).fold(0.0, f64::max)
-            };
-        let min =
-            |v: &[&spherecal::engine::compensate::study::StudyTarget],
-             f: fn(&spherecal::engine::compensate::study::StudyTarget) -> f64| {
-                v.iter().map(|t| f(t)).fold(f64::INFINITY, f64::min)
-            };
-        println!(
-            "seed {seed}: near before {:.3} after {:.4} ({:.2}%) max σ {:.3} max out {:.0} max dist {:.0} | far n {} before {:.2} after {:.3} min σ {:.3} min out {:.0}; far after>0.25 with σ<0.25: {} | iso {:?} {:?}",
-            rms(&near, |t| t.before_mm),
-            rms(&near, |t| t.after_mm),
-            100.0 * rms(&near, |t| t.after_mm) / rms(&near, |t| t.before_mm),
-            max(&near, |t| t.sigma_mm),
-            max(&near, |t| t.outside_mm),
-            max(&near, |t| t.nearest_deg),
-            far.len(),
-            rms(&far, |t| t.before_mm),
-            rms(&far, |t| t.after_mm),
-            min(&far, |t| t.sigma_mm),
-            min(&far, |t| t.outside_mm),
-            far.iter()
-                .filter(|t| t.after_mm > 0.25 && t.sigma_mm < 0.25 && t.outside_mm < 100.0)
-                .count(),
-            s.iso_near,
-            s.iso_far
-        );
-    }
+fn results_record_the_joints_of_their_poses() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = cell(dir.path(), 7);
+    let session = format::load_session(&dir.path().join("s7.json")).unwrap();
+    let expected: Vec<(String, Vec<f64>)> = session
+        .measurements
+        .iter()
+        .filter(|m| matches!(m.usage, Use::Identify | Use::Validate))
+        .map(|m| (m.id.clone(), m.joints.clone()))
+        .collect();
+    assert_eq!(c.result.pose_joints, expected);
 }

@@ -5,7 +5,9 @@
 //! (the calibrated model differs by tenths of a degree and millimetre, so
 //! the step stays in the branch's basin).
 //!
-//! **Which branch.** A target that names its configuration (RAPID `cf`,
+//! **Which branch.** Of the nominal solutions, those within the joint
+//! limits (widened by [`MAX_BRANCH_CHANGE_DEG`]) count, unless none is.
+//! A target that names its configuration (RAPID `cf`,
 //! KUKA `S`/`T`, FANUC `CONFIG`) takes the solution with that
 //! configuration ([`super::config`]). A target without one, or whose
 //! configuration no solution has, takes
@@ -27,7 +29,7 @@ use super::config::{self, Config, Vendor};
 use crate::engine::cell::branch;
 use crate::engine::cell::workspace::cell_limits;
 use crate::engine::geometry::wrap_deg;
-use crate::engine::robot::ik::{Chain, DOF};
+use crate::engine::robot::ik::{Chain, DOF, within_limits};
 use crate::engine::robot::{JointLimit, Robot, RobotChoice, presets};
 
 /// Smallest `|q5|` (deg) of the preferred branch: the simulator's default
@@ -42,6 +44,10 @@ const PREFERRED_MIN_WRIST_DEG: f64 = 10.0;
 /// near a singularity.
 pub const MAX_BRANCH_CHANGE_DEG: f64 = 10.0;
 
+/// Two solutions of one pose closer than this (deg, joint-space norm) are
+/// the same branch: branches differ by tens of degrees.
+const SAME_BRANCH_DEG: f64 = 1.0;
+
 /// Two joint models of nominal parameters closer than this (deg, mm) are
 /// the same preset.
 const SAME_PRESET: f64 = 1e-6;
@@ -51,6 +57,10 @@ const SAME_PRESET: f64 = 1e-6;
 pub enum BranchRule {
     /// The target's written configuration.
     Configuration,
+    /// The target's written configuration, which names another branch
+    /// than the one nearest the calibration's poses (the nearest pose's
+    /// id): followed, with a note.
+    ConfigurationElsewhere(String),
     /// The nearest pose of the session (its id, the joint distance in deg).
     NearestPose(String, f64),
     /// The branch a cell teaches (the simulator's).
@@ -67,6 +77,9 @@ impl BranchRule {
     pub fn describe(&self) -> String {
         match self {
             Self::Configuration => "its configuration".to_string(),
+            Self::ConfigurationElsewhere(id) => format!(
+                "its configuration, which names another branch than the calibration's pose {id} (the nearest): check that spherecal's reading of the controller's configuration fits the robot model"
+            ),
             Self::NearestPose(id, d) => format!("the session's pose {id} ({d:.1}° away)"),
             Self::Preferred => "the branch a cell teaches (elbow up, least forearm roll)".into(),
             Self::First => "the first solution found".to_string(),
@@ -208,7 +221,34 @@ impl Arms {
         base_from_flange: &Isometry3<f64>,
         written: Option<(Vendor, Config)>,
     ) -> Option<([f64; DOF], BranchRule)> {
-        let solutions = self.nominal_solutions(base_from_flange);
+        // Solutions within the limits (widened by what the calibrated
+        // solution may move) first: another branch is for a pose none of
+        // those reach.
+        let all = self.nominal_solutions(base_from_flange);
+        let widened: Vec<JointLimit> = self
+            .limits_or_none()
+            .iter()
+            .map(|l| JointLimit {
+                min: l.min - MAX_BRANCH_CHANGE_DEG,
+                max: l.max + MAX_BRANCH_CHANGE_DEG,
+            })
+            .collect();
+        let inside: Vec<[f64; DOF]> = all
+            .iter()
+            .copied()
+            .filter(|q| within_limits(q, &widened))
+            .collect();
+        let solutions = if inside.is_empty() { all } else { inside };
+        let nearest = solutions
+            .iter()
+            .filter_map(|q| {
+                self.poses
+                    .iter()
+                    .map(|(id, p)| (id, joint_distance(q, p)))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|(id, d)| (*q, id.clone(), d))
+            })
+            .min_by(|a, b| a.2.total_cmp(&b.2));
         if let Some((vendor, config)) = written {
             let limits = self.limits_or_none();
             let matching = solutions
@@ -216,23 +256,17 @@ impl Arms {
                 .flat_map(|q| turn_variants(q, &limits))
                 .find(|q| vendor.config(q, config::posture(&self.nominal, q)) == config);
             if let Some(q) = matching {
-                return Some((q, BranchRule::Configuration));
+                let rule = match &nearest {
+                    Some((n, id, _)) if joint_distance(n, &q) > SAME_BRANCH_DEG => {
+                        BranchRule::ConfigurationElsewhere(id.clone())
+                    }
+                    _ => BranchRule::Configuration,
+                };
+                return Some((q, rule));
             }
         }
-        if !self.poses.is_empty() {
-            let nearest = solutions
-                .iter()
-                .filter_map(|q| {
-                    self.poses
-                        .iter()
-                        .map(|(id, p)| (id, joint_distance(q, p)))
-                        .min_by(|a, b| a.1.total_cmp(&b.1))
-                        .map(|(id, d)| (*q, id.clone(), d))
-                })
-                .min_by(|a, b| a.2.total_cmp(&b.2));
-            if let Some((q, id, d)) = nearest {
-                return Some((q, BranchRule::NearestPose(id, d)));
-            }
+        if let Some((q, id, d)) = nearest {
+            return Some((q, BranchRule::NearestPose(id, d)));
         }
         if let Some(q) = self.preferred(base_from_flange) {
             return Some((q, BranchRule::Preferred));

@@ -63,7 +63,8 @@ impl Region {
     /// How far (mm) the working point of a TCP at `base_from_tcp` lies
     /// outside the identify box; 0 inside (and without identify centres).
     pub(super) fn outside(&self, base_from_tcp: &Isometry3<f64>) -> f64 {
-        if !(self.lo.x <= self.hi.x) {
+        // No identify centre: the box is empty (lo above hi).
+        if self.lo.x > self.hi.x || self.lo.x.is_nan() {
             return 0.0;
         }
         let p = (base_from_tcp * Point3::from(self.working_point)).coords;

@@ -258,21 +258,18 @@ fn random_joints(rng: &mut ChaCha8Rng, limits: &[JointLimit]) -> [f64; DOF] {
     q
 }
 
+/// The TRUE TCP positions commanded as written and as compensated, and
+/// the compensation's reports.
+type Driven = (
+    Vec<Vector3<f64>>,
+    Vec<Vector3<f64>>,
+    Vec<super::TargetReport>,
+);
+
 /// Compensates `targets` as an ABB pose table and drives the nominal
 /// controller to each as written and as compensated: the TRUE TCP
 /// positions (before, after) and the reports.
-fn drive(
-    model: &Model,
-    truth: &Truth,
-    targets: &[&Made],
-) -> Result<
-    (
-        Vec<Vector3<f64>>,
-        Vec<Vector3<f64>>,
-        Vec<super::TargetReport>,
-    ),
-    String,
-> {
+fn drive(model: &Model, truth: &Truth, targets: &[&Made]) -> Result<Driven, String> {
     let mut text = String::from("id,x,y,z,q1,q2,q3,q4\n");
     for (i, t) in targets.iter().enumerate() {
         let v = FlangeConvention::AbbQuaternion.values_from_pose(&t.pose);

@@ -101,6 +101,9 @@ pub(super) fn compensate_target(
                     )),
                 }
             }
+            if matches!(branch, super::arms::BranchRule::ConfigurationElsewhere(_)) {
+                notes.push(format!("branch by {}", branch.describe()));
+            }
             (false, true, qn, qc, branch, wanted, new)
         }
         TargetValue::Joints { deg, radians } => {

@@ -146,6 +146,12 @@ pub fn detect(text: &str, path: &Path) -> PoseFormat {
     if upper_head.starts_with("/PROG") || text.contains("\n/POS") || ext == "ls" {
         return PoseFormat::FanucLs;
     }
+    // URScript's `def name():` would read as KRL's `DEF name( )`: the
+    // colon that ends a Python-like header tells them apart.
+    let first_line = body.lines().next().unwrap_or("").trim();
+    if first_line.to_ascii_lowercase().starts_with("def ") && first_line.ends_with(':') {
+        return PoseFormat::UrScript;
+    }
     let upper = text.to_uppercase();
     if upper.contains("ROBTARGET")
         || upper.contains("JOINTTARGET")
@@ -483,3 +489,16 @@ struct Parsed {
 
 /// A reader's failure: the 1-based line and what is wrong.
 type ParseError = (usize, String);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn urscript_def_is_not_krl_def() {
+        let ur = "def path():\n  movel(p[0.4, 0, 0.3, 3.14, 0, 0], a=1.2, v=0.25)\nend\n";
+        assert_eq!(detect(ur, Path::new("a.txt")), PoseFormat::UrScript);
+        let krl = "DEF calib( )\nPTP {A1 0,A2 -90,A3 90,A4 0,A5 0,A6 0}\nEND\n";
+        assert_eq!(detect(krl, Path::new("a.txt")), PoseFormat::Krl);
+    }
+}
