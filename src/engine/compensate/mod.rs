@@ -78,8 +78,7 @@ pub use self::report::Summary;
 /// residual exceeds it is flagged. Measured with [`study`] over seeds 1-6
 /// (paper-like cells): targets within ±3° of the validate poses had σ up
 /// to 0.20 mm; random targets over the arm's range with σ below 0.25 mm
-/// all reached within 0.25 mm, and beyond it the realised error followed
-/// σ up to 2 mm.
+/// all reached within 0.25 mm, and those above it within 1.5 σ.
 pub const DEFAULT_SIGMA_TOLERANCE_MM: f64 = 0.25;
 
 /// Default largest joint-space distance (deg, norm over the six joints,
