@@ -51,7 +51,7 @@ pub struct CompensateArgs {
     /// The TCP the targets are poses of: `sensor` (the calibrated hand-eye, printed as tool data to set on the controller), `flange`, or a JSON file with a 4x4 matrix `flange_from_tcp` (rows, mm).
     #[arg(long, default_value = "sensor")]
     pub tcp: String,
-    /// The result's session: its poses choose the branch of a target without a configuration (the nearest pose's) and flag targets far in joint space from every identify pose.
+    /// The result's session, for results that do not record the joints of their poses (`pose_joints`: older results): the poses choose the branch of a target without a configuration (the nearest pose's) and flag targets far in joint space from every identify pose.
     #[arg(long)]
     pub session: Option<PathBuf>,
     /// What a joint target (jointtarget, movej joints, E6AXIS, a FANUC position in joints) means.
@@ -60,10 +60,10 @@ pub struct CompensateArgs {
     /// Flag a target whose predicted 1σ residual (ml covariance) exceeds this, mm.
     #[arg(long, default_value_t = compensate::DEFAULT_SIGMA_TOLERANCE_MM)]
     pub sigma_tolerance: f64,
-    /// Flag a target farther than this from every identify pose (joint-space norm, deg; with --session).
+    /// Flag a target farther than this from every identify pose (joint-space norm, deg; when the joints of the poses are known).
     #[arg(long, default_value_t = compensate::DEFAULT_FAR_JOINTS_DEG)]
     pub far_joints: f64,
-    /// Flag a target whose working point lies farther than this outside the box of the identify sphere positions, mm.
+    /// Flag a target whose working point lies farther than this outside the box of the working points at the identify poses (for the sensor: the identify sphere positions), mm.
     #[arg(long, default_value_t = compensate::DEFAULT_REGION_MARGIN_MM)]
     pub region_margin: f64,
     /// Refuse (exit 2, nothing written) when a target is flagged, instead of compensating and listing it.

@@ -4,8 +4,8 @@
 //! a program). For each target, the TCP pose wanted in the base frame:
 //!
 //! 1. the **nominal solution** `q_n` on the branch the target means
-//!    ([`arms`]: its written configuration, else the branch the session
-//!    saw or a cell teaches);
+//!    ([`arms`]: its written configuration, else the branch of the
+//!    nearest pose the calibration saw, else the one a cell teaches);
 //! 2. the **calibrated solution** `q_c`: the joints the calibrated model
 //!    needs for the pose, `FK_cal(q_c)·tool = target`, by Newton from
 //!    `q_n` (same branch);
@@ -34,9 +34,9 @@
 //! command is from the target, mm and deg), the predicted 1σ residual
 //! from `ml`'s covariance ([`uncertainty`]), and flags when the target
 //! lies outside what the calibration saw ([`Flag`]): joints far from every
-//! identify pose of the session (with the session), the TCP's working
-//! point outside the box of the identify sphere positions (from the
-//! result alone), or σ above a tolerance. Flagged targets are compensated
+//! identify pose, the TCP's working point outside the box of the working
+//! points at the identify poses (for the sensor, the identify sphere
+//! positions), or σ above a tolerance. Flagged targets are compensated
 //! and written like the others (the calibrated model is still the best
 //! estimate there, and the correction is still most of the error) and
 //! are listed; the command line's `--strict` refuses them. An unreachable
@@ -47,6 +47,11 @@
 //! identified), so compensated targets are exact up to the one rigid
 //! motion between the nominal and the real base frame, which a workpiece
 //! frame (taught or measured) takes out anyway.
+//!
+//! **Where the calibration saw the robot**: the joints of its identify
+//! and validate poses, which result files record (`pose_joints`), or the
+//! session's for older results. Without them the branch is the one a
+//! cell teaches, σ is not aligned and the joint-space flag is not raised.
 //!
 //! [`compensate`] runs over every target with a progress callback that
 //! may cancel (a workbench job); [`study`] is the validation in
@@ -89,8 +94,9 @@ pub const DEFAULT_SIGMA_TOLERANCE_MM: f64 = 0.25;
 /// is the sharper criterion, this one catches other arm configurations.
 pub const DEFAULT_FAR_JOINTS_DEG: f64 = 90.0;
 
-/// Default margin (mm) around the box of the identify sphere positions:
-/// a TCP working point farther out than this is flagged. The identify
+/// Default margin (mm) around the box of the working points at the
+/// identify poses (for the sensor: the identify sphere positions): a TCP
+/// working point farther out than this is flagged. The identify
 /// stations of a paper-like cell span ~320 × 480 × 360 mm; targets near
 /// its validate poses came up to 142 mm outside that box (seeds 1-6 of
 /// [`study`]), random targets over the arm's range mostly hundreds.
@@ -140,7 +146,7 @@ pub struct Options {
     /// Flag a target farther than this from every identify pose, deg.
     pub far_joints_deg: f64,
     /// Flag a target whose working point is farther than this outside the
-    /// box of the identify sphere positions, mm.
+    /// box of the working points at the identify poses, mm.
     pub region_margin_mm: f64,
 }
 
@@ -207,7 +213,7 @@ impl Flag {
                 format!("joints {d:.1}° from every identify pose (limit {l}°)")
             }
             Self::OutsideRegion(d, l) => format!(
-                "working point {d:.0} mm outside the box of the identify sphere positions (margin {l} mm)"
+                "working point {d:.0} mm outside the box of the identify poses' working points (margin {l} mm)"
             ),
             Self::Uncertain(s, l) => format!("predicted σ {s:.3} mm above {l} mm"),
         }
@@ -245,7 +251,7 @@ pub struct TargetReport {
     pub joint_change_deg: f64,
     /// Predicted 1σ of the TCP position after compensation, mm (`ml`).
     pub sigma_mm: Option<f64>,
-    /// Joint distance to the nearest identify pose, deg (with a session).
+    /// Joint distance to the nearest identify pose, deg (when their joints are known).
     pub nearest_identify_deg: Option<f64>,
     /// How far the working point lies outside the identify box, mm (0 inside).
     pub outside_mm: f64,
@@ -421,7 +427,33 @@ impl Model {
             }
             _ => Vector3::zeros(),
         };
-        let region = Region::new(result, identify, working_point);
+        // The box of the working points the calibration saw: at the
+        // identify poses when their joints are known, else (for the
+        // sensor) the identify sphere positions themselves.
+        let seen: Vec<Vector3<f64>> = if identify.is_empty() {
+            if tcp == Tcp::Sensor {
+                result
+                    .centres
+                    .iter()
+                    .filter(|c| c.usage == Use::Identify)
+                    .map(|c| Vector3::from(c.after))
+                    .collect()
+            } else {
+                notes.push(
+                    "the region is not checked in the base frame: without the joints of the calibration's poses, where a TCP other than the sensor was is not known".to_string(),
+                );
+                Vec::new()
+            }
+        } else {
+            identify
+                .iter()
+                .map(|(_, q)| {
+                    (calibrated.base_from_flange(q) * tool * nalgebra::Point3::from(working_point))
+                        .coords
+                })
+                .collect()
+        };
+        let region = Region::new(identify, &seen, working_point);
         Ok(Self {
             arms,
             tcp,
@@ -432,7 +464,8 @@ impl Model {
         })
     }
 
-    /// Whether the joint-space check is available (a session was given).
+    /// Whether the joints of the identify poses are known (recorded in the
+    /// result or from the session): the joint-space check is then made.
     #[must_use]
     pub fn has_identify_joints(&self) -> bool {
         self.region.has_joints()
@@ -486,7 +519,7 @@ pub fn compensate(
     let mut notes = model.notes.clone();
     if !model.has_identify_joints() {
         notes.push(
-            "the result records no joints of its poses (written before spherecal recorded them, or pose-only) and no session was given (--session): the branch is the one a cell teaches, the joints are not checked against the identify poses, and the working point is checked against the box of the identify sphere positions".to_string(),
+            "the result records no joints of its poses (written before spherecal recorded them, or pose-only) and no session was given (--session): the branch is the one a cell teaches, the joints are not checked against the identify poses, and the working point is checked against the box of the identify sphere positions (for the sensor)".to_string(),
         );
     }
     if file.order.len() < file.targets.len() {

@@ -1,23 +1,23 @@
 //! The region the calibration saw, and how far a target lies outside it:
-//! in joint space, the distance to the nearest identify pose (the
-//! session's joints, when given); in the base frame, how far the TCP's
-//! working point (for the sensor: where it saw the sphere, the mean
-//! sensor-frame identify centre) lies outside the box of the identify
-//! sphere positions (the result's `after` centres, always available).
+//! in joint space, the distance to the nearest identify pose (the joints
+//! the result records, or the session's); in the base frame, how far the
+//! TCP's working point (for the sensor: where it saw the sphere, the mean
+//! sensor-frame identify centre; else the TCP origin) lies outside the
+//! box of the working points at the identify poses (for the sensor
+//! without joints: the identify sphere positions, the result's `after`
+//! centres).
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::arms::joint_distance;
-use crate::engine::format::ResultFile;
 use crate::engine::robot::ik::DOF;
-use crate::engine::session::Use;
 
 /// The region of one calibration.
 #[derive(Debug, Clone)]
 pub(super) struct Region {
     /// Identify poses (id, joints deg), when the session was given.
     identify: Vec<(String, [f64; DOF])>,
-    /// Box of the identify sphere positions, base frame, mm.
+    /// Box of the working points at the identify poses, base frame, mm.
     lo: Vector3<f64>,
     hi: Vector3<f64>,
     /// The working point in the TCP frame, mm.
@@ -25,19 +25,19 @@ pub(super) struct Region {
 }
 
 impl Region {
-    /// The region of `result`, with the identify poses' joints `identify`
-    /// (may be empty) and the TCP frame's working point (mm).
+    /// The region of the identify poses `identify` (joints deg, may be
+    /// empty), the working points `seen` there (base frame, mm; their box)
+    /// and the TCP frame's working point (mm).
     pub(super) fn new(
-        result: &ResultFile,
         identify: Vec<(String, [f64; DOF])>,
+        seen: &[Vector3<f64>],
         working_point: Vector3<f64>,
     ) -> Self {
         let mut lo = Vector3::repeat(f64::INFINITY);
         let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-        for c in result.centres.iter().filter(|c| c.usage == Use::Identify) {
-            let p = Vector3::from(c.after);
-            lo = lo.inf(&p);
-            hi = hi.sup(&p);
+        for p in seen {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
         }
         Self {
             identify,
@@ -61,7 +61,7 @@ impl Region {
     }
 
     /// How far (mm) the working point of a TCP at `base_from_tcp` lies
-    /// outside the identify box; 0 inside (and without identify centres).
+    /// outside the box; 0 inside (and without a box).
     pub(super) fn outside(&self, base_from_tcp: &Isometry3<f64>) -> f64 {
         // No identify centre: the box is empty (lo above hi).
         if self.lo.x > self.hi.x || self.lo.x.is_nan() {
