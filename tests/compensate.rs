@@ -708,3 +708,81 @@ fn results_record_the_joints_of_their_poses() {
         .collect();
     assert_eq!(c.result.pose_joints, expected);
 }
+
+/// An older result, without `pose_joints`: `--session` gives the poses
+/// and the same compensation; without it the branch is the one a cell
+/// teaches, and the output says what is not checked.
+#[test]
+fn older_results_take_the_poses_from_the_session() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = cell(dir.path(), 11);
+    let targets = targets_near_validate(&c, 3.0, 11);
+    let t_csv = dir.path().join("T.csv");
+    std::fs::write(&t_csv, table(&targets)).unwrap();
+    let mut value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&c.result_path).unwrap()).unwrap();
+    assert!(
+        value
+            .as_object_mut()
+            .unwrap()
+            .remove("pose_joints")
+            .is_some()
+    );
+    let old = dir.path().join("old.result.json");
+    std::fs::write(&old, serde_json::to_string_pretty(&value).unwrap()).unwrap();
+    let compensated = |result: &Path, session: Option<&Path>| {
+        let out = dir.path().join("C.csv");
+        let mut a = vec![
+            "compensate",
+            "--result",
+            path(result),
+            "--targets",
+            path(&t_csv),
+            "--pose-convention",
+            "abb",
+            "--out",
+            path(&out),
+        ];
+        if let Some(s) = session {
+            a.extend(["--session", path(s)]);
+        }
+        let (status, stdout, err) = run(&a);
+        assert_eq!(status, 0, "{stdout}{err}");
+        (std::fs::read_to_string(&out).unwrap(), stdout)
+    };
+    let (recorded, _) = compensated(&c.result_path, None);
+    let (from_session, _) = compensated(&old, Some(&dir.path().join("s11.json")));
+    assert_eq!(from_session, recorded);
+    let (_, stdout) = compensated(&old, None);
+    assert!(stdout.contains("records no joints"), "{stdout}");
+    // A session that is not the result's is refused.
+    let other = dir.path().join("other.json");
+    let (status, _, err) = run(&[
+        "simulate",
+        "--out",
+        path(&other),
+        "--seed",
+        "3",
+        "--robot",
+        "ur5e",
+    ]);
+    assert_eq!(status, 0, "{err}");
+    let (status, _, err) = run(&[
+        "compensate",
+        "--result",
+        path(&old),
+        "--targets",
+        path(&t_csv),
+        "--pose-convention",
+        "abb",
+        "--out",
+        path(&dir.path().join("D.csv")),
+        "--session",
+        path(&other),
+    ]);
+    assert_eq!(status, 2, "{err}");
+    assert!(
+        err.contains("not the session the result was calibrated from"),
+        "{err}"
+    );
+}

@@ -102,6 +102,11 @@ pub const DEFAULT_FAR_JOINTS_DEG: f64 = 90.0;
 /// [`study`]), random targets over the arm's range mostly hundreds.
 pub const DEFAULT_REGION_MARGIN_MM: f64 = 200.0;
 
+/// A session's joints give back the result's base-frame centres (through
+/// the calibrated model and hand-eye) to the rounding of the files, far
+/// below this (mm); another session's do not, by millimetres at least.
+const SAME_SESSION_MM: f64 = 1e-3;
+
 /// The tool point (TCP) the targets are poses of.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Tcp {
@@ -351,10 +356,29 @@ impl Model {
                     ))
                 })
                 .collect();
-            if from_session.is_empty() {
+            // The session's joints, the calibrated model and hand-eye must
+            // give back the result's own base-frame centres.
+            let worst = from_session
+                .iter()
+                .filter_map(|(id, q)| {
+                    let c = result.centres.iter().find(|c| c.measurement == *id)?;
+                    let seen = calibrated.base_from_flange(q)
+                        * result.hand_eye
+                        * nalgebra::Point3::from(Vector3::from(c.sensor));
+                    Some((seen.coords - Vector3::from(c.after)).norm())
+                })
+                .fold(0.0, f64::max);
+            if from_session.is_empty() || worst > SAME_SESSION_MM {
                 return Err(CompensateError::Session(format!(
-                    "the session {:?} has none of the result's measurements with joints: it is not the session the result was calibrated from",
-                    s.name
+                    "the session {:?} {}: it is not the session the result was calibrated from",
+                    s.name,
+                    if from_session.is_empty() {
+                        "has none of the result's measurements with joints".to_string()
+                    } else {
+                        format!(
+                            "does not give back the result's centres (its joints put one {worst:.3} mm away)"
+                        )
+                    }
                 )));
             }
             let same = s.robot.joints.len() == nominal.joints.len()
