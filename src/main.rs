@@ -24,6 +24,7 @@ fn main() -> ExitCode {
         Some(Command::Plan(args)) => cli::plan::run(&args),
         Some(Command::Report(args)) => cli::html_report::run(&args),
         Some(Command::History(args)) => cli::history::run(&args),
+        Some(Command::Compensate(args)) => cli::compensate::run(&args),
         None => gui(None, None),
     };
     // The text a command printed must have reached its reader.

@@ -28,6 +28,9 @@ pub struct EvaluateArgs {
     /// Instead of the scenarios: the IRB 2400 cell planned for an 80 × 80 mm range with and without spreading the sphere over it, simulated with Table 1 and random errors, the error over the range predicted and realised against the floor.
     #[arg(long)]
     pub planned_range: bool,
+    /// Instead of the scenarios: target compensation validated in simulation (seeds 1..=N, paper-like IRB 2400 cells): targets near the validate poses and far from them, and ISO 9283 poses, driven by a nominal controller before and after `spherecal compensate`, scored on the true robot (the README table, Markdown).
+    #[arg(long)]
+    pub compensation: bool,
 }
 
 /// `spherecal evaluate`.
@@ -37,6 +40,18 @@ pub struct EvaluateArgs {
 pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
     if args.seeds == 0 {
         return Err(CliError::input("--seeds must be at least 1"));
+    }
+    if args.compensation {
+        let mut studies = Vec::new();
+        for seed in 1..=args.seeds {
+            eprintln!("compensation study, seed {seed}…");
+            studies.push(
+                crate::engine::compensate::study::run_seed(seed)
+                    .map_err(|e| CliError::internal(e.to_string()))?,
+            );
+        }
+        say!("{}", crate::engine::compensate::study::markdown(&studies));
+        return Ok(());
     }
     if args.planned_range {
         if !args.markdown {

@@ -27,6 +27,7 @@ macro_rules! say {
     };
 }
 
+pub mod compensate;
 pub mod evaluate;
 pub mod export_model;
 pub mod history;
@@ -122,6 +123,8 @@ pub enum Command {
     Measure(measure::MeasureArgs),
     /// Library of a folder of sessions and results: per robot the drift of the hand-eye and kinematic deviations over time, jumps beyond k combined σ flagged.
     History(history::HistoryArgs),
+    /// Compensate robot targets through a calibration: a pose table or a robot program (RAPID, KUKA KRL, FANUC .ls, URScript) rewritten so that a controller running the nominal model drives the TCP onto each target; prints the calibrated hand-eye as the controller's tool data.
+    Compensate(compensate::CompensateArgs),
 }
 
 /// The first error writing to stdout other than a closed pipe (a full

@@ -22,8 +22,10 @@
 //! | [`evaluate`] | scoring against the truth; the method comparison study |
 //! | [`plan`] | pose plans and their predicted accuracy |
 //! | [`history`] | a library of results, drift over time |
+//! | [`compensate`] | robot targets and programs compensated through a calibration: IK on the calibrated model, tool data per controller, per-target corrections and flags |
 
 pub mod cell;
+pub mod compensate;
 pub mod evaluate;
 pub mod format;
 pub mod geometry;

@@ -62,6 +62,12 @@ pub struct ResultFile {
     /// it (the top-level `held_out` key, README "Held-out figure"); absent
     /// from results written before it existed.
     pub held_out: Option<HeldOut>,
+    /// The joint readings (deg) of each identify and validate measurement
+    /// that has them, by id, in `centres` order: where the calibration saw
+    /// the robot (`pose_joints`, a key of the engine's own; target
+    /// compensation takes the branch and the calibrated region from it).
+    /// Empty for a pose-only session and for results written before it.
+    pub pose_joints: Vec<(String, Vec<f64>)>,
 }
 
 impl PartialEq for ResultFile {
@@ -87,6 +93,7 @@ impl PartialEq for ResultFile {
             && self.centres == other.centres
             && self.validation == other.validation
             && self.held_out == other.held_out
+            && self.pose_joints == other.pose_joints
     }
 }
 
@@ -133,6 +140,15 @@ impl ResultFile {
                 .collect(),
             validation: cal.validation.clone(),
             held_out: cal.held_out.clone(),
+            pose_joints: cal
+                .centres
+                .iter()
+                .map(|c| &session.measurements[c.index])
+                .filter(|m| {
+                    matches!(m.usage, Use::Identify | Use::Validate) && !m.joints.is_empty()
+                })
+                .map(|m| (m.id.clone(), m.joints.clone()))
+                .collect(),
         }
     }
 
@@ -663,6 +679,8 @@ struct ResultKeys {
     validation: Option<Validation>,
     #[serde(default, deserialize_with = "some")]
     held_out: Option<HeldOut>,
+    #[serde(default)]
+    pose_joints: Option<Map<String, Value>>,
 }
 
 /// The transform of checked file rows, settled so that it survives its
@@ -685,9 +703,25 @@ fn same_transform(a: &Isometry3<f64>, b: &Isometry3<f64>) -> bool {
     })
 }
 
+/// The `pose_joints` read, in `centres` order (`ids`): entries that are
+/// not lists of finite numbers are left out (the key is the engine's own
+/// and optional; a reader that cannot use an entry does without it).
+fn pose_joints(map: Option<&Map<String, Value>>, ids: &[String]) -> Vec<(String, Vec<f64>)> {
+    let Some(map) = map else {
+        return Vec::new();
+    };
+    ids.iter()
+        .filter_map(|id| {
+            let q: Vec<f64> = serde_json::from_value(map.get(id)?.clone()).ok()?;
+            q.iter().all(|v| v.is_finite()).then(|| (id.clone(), q))
+        })
+        .collect()
+}
+
 impl ResultKeys {
     /// The typed result of keys that passed [`Ctx::check_result`].
     fn into_result(self) -> ResultFile {
+        let ids: Vec<String> = self.centres.iter().map(|c| c.measurement.clone()).collect();
         ResultFile {
             session: self.session,
             hand_eye_initial: transform(&self.hand_eye_initial),
@@ -717,6 +751,7 @@ impl ResultKeys {
                 .collect(),
             validation: self.validation,
             held_out: self.held_out,
+            pose_joints: pose_joints(self.pose_joints.as_ref(), &ids),
         }
     }
 }
@@ -884,6 +919,8 @@ struct ResultOut<'a> {
     validation: Option<&'a Validation>,
     #[serde(skip_serializing_if = "Option::is_none")]
     held_out: Option<&'a HeldOut>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pose_joints: Option<Map<String, Value>>,
 }
 
 /// Serialises the `solver` block with `method` first, then the other keys.
@@ -930,6 +967,12 @@ impl<'a> ResultOut<'a> {
                 .collect(),
             validation: r.validation.as_ref(),
             held_out: r.held_out.as_ref(),
+            pose_joints: (!r.pose_joints.is_empty()).then(|| {
+                r.pose_joints
+                    .iter()
+                    .map(|(id, q)| (id.clone(), Value::from(q.clone())))
+                    .collect()
+            }),
         }
     }
 }

@@ -24,6 +24,7 @@ mod json;
 mod krl;
 mod rapid;
 mod scan;
+pub mod style;
 mod table;
 mod urscript;
 
@@ -146,6 +147,12 @@ pub fn detect(text: &str, path: &Path) -> PoseFormat {
     if upper_head.starts_with("/PROG") || text.contains("\n/POS") || ext == "ls" {
         return PoseFormat::FanucLs;
     }
+    // URScript's `def name():` would read as KRL's `DEF name( )`: the
+    // colon that ends a Python-like header tells them apart.
+    let first_line = body.lines().next().unwrap_or("").trim();
+    if first_line.to_ascii_lowercase().starts_with("def ") && first_line.ends_with(':') {
+        return PoseFormat::UrScript;
+    }
     let upper = text.to_uppercase();
     if upper.contains("ROBTARGET")
         || upper.contains("JOINTTARGET")
@@ -153,7 +160,8 @@ pub fn detect(text: &str, path: &Path) -> PoseFormat {
     {
         return PoseFormat::Rapid;
     }
-    // URScript before KRL: both start with `def`, URScript's line ends in `:`.
+    // URScript by its pose literals or move calls (before KRL, whose
+    // programs have neither).
     if scan::contains_ur_pose(text)
         || text.contains("movej(")
         || text.contains("movel(")
@@ -285,6 +293,21 @@ impl PoseFile {
     /// A target index out of range or a count of numbers that does not
     /// match the target's spans.
     pub fn rewritten(&self, edits: &[(usize, Vec<String>)]) -> Result<String, String> {
+        self.rewritten_with_config(edits, &[])
+    }
+
+    /// As [`Self::rewritten`], and each target of `configs` with its
+    /// configuration ([`Target::config`], its byte range) replaced by the
+    /// text given. Every other byte is kept.
+    ///
+    /// # Errors
+    /// As [`Self::rewritten`], and a target without a configuration in
+    /// `configs`.
+    pub fn rewritten_with_config(
+        &self,
+        edits: &[(usize, Vec<String>)],
+        configs: &[(usize, String)],
+    ) -> Result<String, String> {
         let mut replacements: Vec<(Range<usize>, &str)> = Vec::new();
         for (index, numbers) in edits {
             let target = self
@@ -302,6 +325,14 @@ impl PoseFile {
             for (span, n) in target.spans.iter().zip(numbers) {
                 replacements.push((span.clone(), n.as_str()));
             }
+        }
+        for (index, text) in configs {
+            let (_, range) = self
+                .targets
+                .get(*index)
+                .and_then(|t| t.config.as_ref())
+                .ok_or_else(|| format!("target {index} has no configuration"))?;
+            replacements.push((range.clone(), text.as_str()));
         }
         Ok(scan::replace_ranges(&self.text, replacements))
     }
@@ -504,3 +535,16 @@ struct Parsed {
 
 /// A reader's failure: the 1-based line and what is wrong.
 type ParseError = (usize, String);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn urscript_def_is_not_krl_def() {
+        let ur = "def path():\n  movel(p[0.4, 0, 0.3, 3.14, 0, 0], a=1.2, v=0.25)\nend\n";
+        assert_eq!(detect(ur, Path::new("a.txt")), PoseFormat::UrScript);
+        let krl = "DEF calib( )\nPTP {A1 0,A2 -90,A3 90,A4 0,A5 0,A6 0}\nEND\n";
+        assert_eq!(detect(krl, Path::new("a.txt")), PoseFormat::Krl);
+    }
+}

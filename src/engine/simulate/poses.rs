@@ -12,6 +12,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::config::{SideChoice, SimConfig, SimError};
 use crate::engine::cell::approach::{direction_in_cone, random_orientation};
+use crate::engine::cell::branch;
 use crate::engine::cell::random::uniform;
 use crate::engine::cell::workspace::{Workspace, identify_stations, validate_stations};
 use crate::engine::geometry::wrap_deg;
@@ -130,38 +131,16 @@ impl Planner<'_> {
         }
     }
 
-    /// Arm guesses `(q1, q2, q3)` (deg) for a flange target: per-preset
-    /// elbow-up configurations, joint 1 turned toward the target.
+    /// Arm guesses `(q1, q2, q3)` (deg) for a flange target: the cell's
+    /// ([`branch::arm_guesses`]).
     fn arm_guesses(&self, target: &Isometry3<f64>) -> Vec<[f64; 3]> {
-        let p = target.translation.vector;
-        let heading = p.y.atan2(p.x).to_degrees();
-        // The ABB arms point along +x at q1 = 0, the UR5e along −x.
-        let (q1_offset, arms): (f64, &[[f64; 2]]) = match self.choice {
-            RobotChoice::Irb2400 | RobotChoice::Irb120 => {
-                (0.0, &[[20.0, 20.0], [40.0, 0.0], [0.0, 45.0], [50.0, 30.0]])
-            }
-            RobotChoice::Ur5e => (
-                180.0,
-                &[
-                    [-90.0, 90.0],
-                    [-50.0, 100.0],
-                    [-120.0, 110.0],
-                    [-60.0, 140.0],
-                ],
-            ),
-        };
-        let q1 = wrap_deg(heading + q1_offset);
-        arms.iter().map(|a| [q1, a[0], a[1]]).collect()
+        branch::arm_guesses(self.choice, target)
     }
 
-    /// How much a wrist solution is disliked (lower first): the wrist a
-    /// cell would teach. ABB wrists: the least forearm roll `|q4|` (less
-    /// cable wind-up); the UR5e: its tool-down configuration, `q5 < 0`.
+    /// How much a wrist solution is disliked (lower first): the cell's
+    /// ([`branch::wrist_dislike`]).
     fn wrist_dislike(&self, q: &[f64; DOF]) -> f64 {
-        match self.choice {
-            RobotChoice::Irb2400 | RobotChoice::Irb120 => wrap_deg(q[3]).abs(),
-            RobotChoice::Ur5e => (q[4] + self.wrist_offset).signum(),
-        }
+        branch::wrist_dislike(self.choice, q, self.wrist_offset)
     }
 
     /// Joint angles (deg) that put the sphere at `station` (base) and at

@@ -1,0 +1,213 @@
+//! `spherecal compensate`: the targets of a pose table or a robot program
+//! compensated through a calibration, written in the same layout with
+//! every other byte kept. A thin caller of [`crate::engine::compensate`].
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+
+use super::CliError;
+use crate::engine::compensate::{
+    self, CompensateError, JointTargets, Model, Options, Tcp, report, tool,
+};
+use crate::engine::format;
+use crate::engine::program::{self, PoseFormat, ReadSpec};
+use crate::engine::robot::controller::FlangeConvention;
+use crate::engine::solve::Control;
+
+/// Rows of the target table printed without `--all`.
+const TABLE_ROWS: usize = 20;
+
+/// `--joint-targets`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum JointTargetsArg {
+    /// The pose the nominal model gives the joints is the pose wanted (offline-programmed targets).
+    Compensate,
+    /// Leave joint targets as written (taught on the robot).
+    Keep,
+}
+
+/// `spherecal compensate`.
+#[derive(Debug, Args)]
+pub struct CompensateArgs {
+    /// Result file of the calibration (FORMAT.md `spherecal-result`): its calibrated model, its nominal model (calibrated minus joint errors) and hand-eye.
+    #[arg(long)]
+    pub result: PathBuf,
+    /// The targets: TCP poses in the base frame, as a pose table (`id,x,y,z,…`, a header optional, any separator), a JSON pose list, or a robot program (ABB RAPID module, KUKA .src/.dat, FANUC .ls, URScript).
+    #[arg(long)]
+    pub targets: PathBuf,
+    /// Where to write the compensated targets: the same layout, positions replaced, every other byte kept.
+    #[arg(long, short)]
+    pub out: PathBuf,
+    /// How a table or JSON list writes a pose: abb (x y z mm, q1..q4 quaternion w first), kuka (x y z, A B C deg), fanuc (x y z, W P R deg), ur (x y z m, rotation vector rad) or matrix (16 numbers row-major, mm). A program's language fixes its own.
+    #[arg(long, value_parser = parse_convention)]
+    pub pose_convention: Option<FlangeConvention>,
+    /// The layout, when not detected from the content: table, json, fanuc-ls, rapid, krl or urscript.
+    #[arg(long, value_parser = parse_format)]
+    pub pose_format: Option<PoseFormat>,
+    /// The pose columns of a table, in the convention's order (default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44).
+    #[arg(long, value_delimiter = ',')]
+    pub pose_columns: Vec<String>,
+    /// The TCP the targets are poses of: `sensor` (the calibrated hand-eye, printed as tool data to set on the controller), `flange`, or a JSON file with a 4x4 matrix `flange_from_tcp` (rows, mm).
+    #[arg(long, default_value = "sensor")]
+    pub tcp: String,
+    /// The result's session, for results that do not record the joints of their poses (`pose_joints`: older results): the poses choose the branch of a target without a configuration (the nearest pose's) and flag targets far in joint space from every identify pose.
+    #[arg(long)]
+    pub session: Option<PathBuf>,
+    /// What a joint target (jointtarget, movej joints, E6AXIS, a FANUC position in joints) means.
+    #[arg(long, value_enum, default_value = "compensate")]
+    pub joint_targets: JointTargetsArg,
+    /// Flag a target whose predicted 1σ residual (ml covariance) exceeds this, mm.
+    #[arg(long, default_value_t = compensate::DEFAULT_SIGMA_TOLERANCE_MM)]
+    pub sigma_tolerance: f64,
+    /// Flag a target farther than this from every identify pose (joint-space norm, deg; when the joints of the poses are known).
+    #[arg(long, default_value_t = compensate::DEFAULT_FAR_JOINTS_DEG)]
+    pub far_joints: f64,
+    /// Flag a target whose working point lies farther than this outside the box of the working points at the identify poses (for the sensor: the identify sphere positions), mm.
+    #[arg(long, default_value_t = compensate::DEFAULT_REGION_MARGIN_MM)]
+    pub region_margin: f64,
+    /// Refuse (exit 2, nothing written) when a target is flagged, instead of compensating and listing it.
+    #[arg(long)]
+    pub strict: bool,
+    /// List every target (default: the 20 largest corrections).
+    #[arg(long)]
+    pub all: bool,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+fn parse_convention(s: &str) -> Result<FlangeConvention, String> {
+    FlangeConvention::parse(s).ok_or_else(|| {
+        format!("unknown pose convention `{s}`, expected abb, kuka, fanuc, ur or matrix")
+    })
+}
+
+fn parse_format(s: &str) -> Result<PoseFormat, String> {
+    PoseFormat::parse(s).ok_or_else(|| {
+        let keys: Vec<&str> = PoseFormat::ALL.iter().map(|f| f.key()).collect();
+        format!(
+            "unknown pose format `{s}`, expected one of: {}",
+            keys.join(", ")
+        )
+    })
+}
+
+/// Reads everything, compensates, writes the file atomically, prints the
+/// tool data, the targets, the flagged ones and the summary.
+///
+/// # Errors
+/// [`CliError`] with status 2 for bad input (an unreadable or invalid
+/// file, an unreachable target, a flagged one with `--strict`), 1 when
+/// the output cannot be written. Nothing is written on any error.
+pub fn run(args: &CompensateArgs) -> Result<(), CliError> {
+    let mut inputs = vec![args.result.as_path(), args.targets.as_path()];
+    if let Some(s) = &args.session {
+        inputs.push(s.as_path());
+    }
+    CliError::guard_output(&args.out, &inputs)?;
+    let result = format::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;
+    let session = match &args.session {
+        Some(p) => Some(format::load_session(p).map_err(|e| CliError::from_file(&e, true))?),
+        None => None,
+    };
+    let tcp = match args.tcp.as_str() {
+        "sensor" => Tcp::Sensor,
+        "flange" => Tcp::Flange,
+        path => Tcp::Tool(tool::read_tool(std::path::Path::new(path)).map_err(CliError::input)?),
+    };
+    let spec = ReadSpec {
+        format: args.pose_format,
+        convention: args.pose_convention,
+        columns: (!args.pose_columns.is_empty()).then(|| args.pose_columns.clone()),
+    };
+    let file = program::read_pose_file(&args.targets, &spec)
+        .map_err(|e| CliError::input(e.to_string()))?;
+    let model = Model::new(&result, session.as_ref(), tcp).map_err(|e| {
+        CliError::input(format!(
+            "{e} ({})",
+            args.session.as_ref().unwrap_or(&args.result).display()
+        ))
+    })?;
+    let options = Options {
+        joint_targets: match args.joint_targets {
+            JointTargetsArg::Compensate => JointTargets::Compensate,
+            JointTargetsArg::Keep => JointTargets::Keep,
+        },
+        sigma_tolerance_mm: args.sigma_tolerance,
+        far_joints_deg: args.far_joints,
+        region_margin_mm: args.region_margin,
+    };
+    let done = compensate::compensate(&model, &file, &options, &mut |_| Control::Continue)
+        .map_err(|e| match e {
+            CompensateError::Rewrite(_) | CompensateError::Cancelled => {
+                CliError::internal(format!("{e} ({})", args.targets.display()))
+            }
+            _ => CliError::input(format!("{e} ({})", args.targets.display())),
+        })?;
+    if args.strict && done.summary.flagged > 0 {
+        return Err(CliError::input(format!(
+            "{} target(s) lie outside what the calibration saw (--strict), nothing written: {} ({})",
+            done.summary.flagged,
+            report::flagged(&done.targets).trim().replace('\n', "; "),
+            args.targets.display()
+        )));
+    }
+    format::write_atomic(&args.out, done.text.as_bytes())
+        .map_err(|e| CliError::from_file(&e, false))?;
+    if args.quiet {
+        return Ok(());
+    }
+    sayln!(
+        "{} {}: {} ({})",
+        file.format.describe(),
+        args.targets.display(),
+        file.order_note,
+        if file.detected {
+            "layout detected"
+        } else {
+            "layout given"
+        }
+    );
+    for w in &file.warnings {
+        sayln!("  warning: {w}");
+    }
+    sayln!("TCP: {}", model.tcp.describe());
+    if model.tcp == Tcp::Sensor {
+        let controllers: Vec<tool::Controller> = match file
+            .format
+            .convention()
+            .or(args.pose_convention)
+            .map(tool::Controller::of)
+        {
+            Some(Some(c)) => vec![c],
+            _ => tool::Controller::ALL.to_vec(),
+        };
+        for c in controllers {
+            sayln!("tool data to set on the controller ({}):", c.describe());
+            for line in c.tool_data(&model.tool, "tSpherecal").lines() {
+                sayln!("  {line}");
+            }
+        }
+    }
+    say!(
+        "{}",
+        report::table(&done.targets, (!args.all).then_some(TABLE_ROWS))
+    );
+    let flagged = report::flagged(&done.targets);
+    if !flagged.is_empty() {
+        sayln!("flagged (compensated and written; --strict refuses them):");
+        say!("{flagged}");
+    }
+    for t in done.targets.iter().filter(|t| !t.notes.is_empty()) {
+        for n in &t.notes {
+            sayln!("  note: {} (line {}): {n}", t.name, t.line);
+        }
+    }
+    for n in &done.notes {
+        sayln!("note: {n}");
+    }
+    sayln!("{}", done.summary.line());
+    sayln!("wrote {}", args.out.display());
+    Ok(())
+}
