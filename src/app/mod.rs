@@ -9,8 +9,13 @@
 //!   result file both go through the FORMAT.md result);
 //! - [`forms`]: the fields widgets edit in place, with the import wizard's
 //!   and the planner's forms and the engine requests they build;
+//! - [`provenance`]: the one staleness mechanism: what each derived
+//!   output (plan, result, report, every file written of them) was made
+//!   from, and whether it still holds (read there how to add an output);
 //! - [`state`]: what the app knows ([`state::AppState`], changed only by
 //!   commands and job messages);
+//! - [`inputs`]: the readings of the inputs (session, left-out
+//!   measurements, solver settings, Plan form, tolerance) each frame;
 //! - [`commands`]: what the panels ask for, by feature;
 //! - [`error`]: why a job failed ([`error::JobError`], the engine's error
 //!   as its source);
@@ -31,8 +36,10 @@ pub mod commands;
 pub mod error;
 pub mod features;
 pub mod forms;
+pub mod inputs;
 pub mod jobs;
 pub mod panels;
+pub mod provenance;
 pub mod state;
 pub mod view;
 pub mod workbench;

@@ -137,6 +137,7 @@ impl WorkbenchApp {
         for message in self.core.jobs.drain() {
             self.core.on_message(ctx, message);
         }
+        self.core.observe();
     }
 
     /// One frame: drain job messages, draw everything, apply the commands.
@@ -177,6 +178,8 @@ impl WorkbenchApp {
         for c in commands {
             self.core.apply(&ctx, c);
         }
+        // Fields edited this frame mark what they feed stale at once.
+        self.core.observe();
     }
 }
 

@@ -54,8 +54,16 @@ impl Core {
         }
     }
 
+    /// Reads every input into the provenance (each frame, and before each
+    /// command, so that a job stamps the inputs as they are).
+    pub fn observe(&mut self) {
+        let readings = crate::app::inputs::readings(&self.state, &self.forms);
+        self.state.provenance.observe(readings);
+    }
+
     /// Hands a command to its feature.
     pub fn apply(&mut self, ctx: &egui::Context, command: Command) {
+        self.observe();
         match command {
             Command::Files(c) => self.files(ctx, c),
             Command::View(c) => self.view(c),

@@ -17,6 +17,7 @@ pub mod estimate;
 pub mod ml;
 pub mod paper;
 pub mod prepare;
+pub mod progress;
 pub mod report;
 
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -31,6 +32,7 @@ use crate::engine::validate::{
 use estimate::Estimate;
 use paper::PaperOptions;
 pub use prepare::{Analysis, HandEyeSource, Prepared, PreparedMeasurement, analyse, prepare};
+pub use progress::{Control, Phase, Progress};
 pub use report::{LoopRecord, SolverReport};
 
 /// Why a calibration of a loaded session could not run, or failed.
@@ -141,83 +143,6 @@ impl Options {
     }
 }
 
-/// Reported after every ε evaluation.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Progress {
-    /// Updates made so far (0 for the starting ε).
-    pub updates: usize,
-    /// ε after that many updates, mm.
-    pub epsilon: f64,
-    /// The iteration bound.
-    pub max_iterations: usize,
-    /// The threshold, mm.
-    pub threshold: f64,
-    /// What the run is doing: a new ε of the loop, or a phase inside an
-    /// update or after the loop.
-    pub phase: Phase,
-}
-
-/// What a run is doing, for progress reports.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Phase {
-    /// The loop computed ε after `updates` updates.
-    Loop,
-    /// Inside update `updates + 1`: the method's inner step `step` (`ml`:
-    /// a Levenberg-Marquardt step) was taken.
-    Step {
-        /// Inner steps taken in this update.
-        step: usize,
-    },
-    /// `ml`: the parameter covariance and the leverages.
-    Covariance,
-    /// `ml`: the predicted σ of the distances.
-    Prediction,
-    /// `ml`: leave-one-station-out refits, `done` of `of` stations.
-    CrossValidation {
-        /// Stations done.
-        done: usize,
-        /// Stations in all.
-        of: usize,
-    },
-    /// `ml`: residuals, outliers and the variance factor.
-    Outliers,
-}
-
-impl Phase {
-    /// In words, with the count done where there is one.
-    #[must_use]
-    pub fn describe(&self, updates: usize) -> String {
-        match *self {
-            Self::Loop => format!("update {updates}"),
-            Self::Step { step } => format!("update {}: solver step {step}", updates + 1),
-            Self::Covariance => "covariance and leverages".to_string(),
-            Self::Prediction => "predicted distance σ".to_string(),
-            Self::CrossValidation { done, of } => {
-                format!("leave-one-station-out: {done} of {of} stations")
-            }
-            Self::Outliers => "outliers and variance factor".to_string(),
-        }
-    }
-
-    /// The fraction of the phase done, when it has one.
-    #[must_use]
-    pub fn fraction(&self) -> Option<f64> {
-        match *self {
-            Self::CrossValidation { done, of } if of > 0 => Some(done as f64 / of as f64),
-            _ => None,
-        }
-    }
-}
-
-/// What the progress callback asks for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Control {
-    /// Go on.
-    Continue,
-    /// Stop now: the run ends with [`StopReason::Cancelled`].
-    Cancel,
-}
-
 /// Why the loop stopped, with the measured value beside the threshold.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum StopReason {
@@ -268,7 +193,8 @@ pub enum StopReason {
         last_change: f64,
     },
     /// The caller cancelled the run (the estimate is the one reached so
-    /// far, and a method's costly diagnostics are left out).
+    /// far, and a method's costly diagnostics are left out, unless the
+    /// cancel came in the last phase, [`Phase::Finishing`], after them).
     Cancelled {
         /// ε when cancelled, mm.
         epsilon: f64,
@@ -555,23 +481,6 @@ pub fn run(
         robot: session.solver_robot(),
         flange_from_sensor: prepared.hand_eye_initial,
     };
-    let mut method: Box<dyn Update> = match options.method {
-        Method::Paper => Box::new(paper::PaperUpdate::new(
-            start.clone(),
-            stations.clone(),
-            options,
-        )),
-        Method::Ml => Box::new(ml::MlUpdate::new(
-            session,
-            prepared,
-            &start,
-            stations.clone(),
-            options,
-        )?),
-    };
-    let eps_of = |est: &Estimate| epsilon(&est.station_centres(&stations));
-    let mut eps = eps_of(method.estimate());
-    let mut iterations = vec![eps];
     let report = |updates: usize, epsilon: f64, phase: Phase| Progress {
         updates,
         epsilon,
@@ -579,7 +488,44 @@ pub fn run(
         threshold: options.threshold,
         phase,
     };
-    let mut cancelled = progress(&report(0, eps, Phase::Loop)) == Control::Cancel;
+    // The paper's update sets up at once; `ml` looks at the cancel while
+    // it builds its problem.
+    let cancelled_early = progress(&report(0, f64::NAN, Phase::Setup)) == Control::Cancel;
+    let mut method: Box<dyn Update> = match options.method {
+        Method::Paper => Box::new(paper::PaperUpdate::new(
+            start.clone(),
+            stations.clone(),
+            options,
+        )),
+        Method::Ml if cancelled_early => {
+            return Ok(cancelled_in_setup(
+                session, prepared, options, &start, &stations,
+            ));
+        }
+        Method::Ml => {
+            let mut setup = |phase: Phase| progress(&report(0, f64::NAN, phase));
+            match ml::MlUpdate::new(
+                session,
+                prepared,
+                &start,
+                stations.clone(),
+                options,
+                &mut setup,
+            )? {
+                Some(m) => Box::new(m),
+                None => {
+                    return Ok(cancelled_in_setup(
+                        session, prepared, options, &start, &stations,
+                    ));
+                }
+            }
+        }
+    };
+    let eps_of = |est: &Estimate| epsilon(&est.station_centres(&stations));
+    let mut eps = eps_of(method.estimate());
+    let mut iterations = vec![eps];
+    let mut cancelled =
+        cancelled_early || progress(&report(0, eps, Phase::Loop)) == Control::Cancel;
     let mut converged = None;
     let mut levelled = 0_usize;
     while !cancelled
@@ -660,12 +606,43 @@ pub fn run(
     let est = method.estimate().clone();
     let mut after = |phase: Phase| progress(&report(updates, eps, phase));
     let (report, cancelled_late) = method.report(&stop, &mut after);
-    if cancelled_late {
+    if cancelled_late || (!stop.is_cancelled() && after(Phase::Finishing) == Control::Cancel) {
         stop = stop.cancelled();
     }
     Ok(finish(
         session, prepared, options, &start, est, iterations, stop, report,
     ))
+}
+
+/// The run cancelled before its method was set up: the start, ε of the
+/// start, and a report of the settings only.
+fn cancelled_in_setup(
+    session: &Session,
+    prepared: &Prepared,
+    options: &Options,
+    start: &Estimate,
+    stations: &[estimate::Station],
+) -> Calibration {
+    let eps = epsilon(&start.station_centres(stations));
+    let stop = StopReason::Cancelled {
+        epsilon: eps,
+        threshold: options.threshold,
+        updates: 0,
+    };
+    let report = SolverReport::Ml(Box::new(ml::MlReport {
+        stop: stop.record(options),
+        ..ml::MlReport::default()
+    }));
+    finish(
+        session,
+        prepared,
+        options,
+        start,
+        start.clone(),
+        vec![eps],
+        stop,
+        report,
+    )
 }
 
 /// The centres and statistics of a finished run.
