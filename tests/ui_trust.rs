@@ -213,9 +213,16 @@ fn cancel_always_wins_and_the_previous_result_stays() {
             h.step();
             std::thread::sleep(Duration::from_millis(5));
         }
+        // A frame drawn with the state as it is now.
+        h.step();
         let Some(phase) = h.state().state().run.as_ref().map(|r| r.phase.clone()) else {
             continue;
         };
+        // The phase by name over the run's progress bar.
+        assert!(
+            h.query_all_by_label_contains(&phase).next().is_some(),
+            "the side panel names the phase {phase}"
+        );
         h.get_by_label("Cancel").click();
         h.step();
         let state = h.state().state();

@@ -109,7 +109,12 @@ impl Core {
     pub(super) fn stop_run(&mut self) -> Option<RunState> {
         let run = self.state.run.take()?;
         run.cancel.store(true, Ordering::Relaxed);
-        self.state.stopping.insert(run.id);
+        if self.arrived.as_ref().is_some_and(|(id, _)| *id == run.id) {
+            // Its thread has ended: what it sent is dropped.
+            self.arrived = None;
+        } else {
+            self.state.stopping.insert(run.id);
+        }
         Some(run)
     }
 
@@ -156,6 +161,52 @@ impl Core {
         }
     }
 
+    /// Shows the outcome of the run that arrived this frame, unless the
+    /// run was cancelled in the frame (the workbench calls this after the
+    /// frame's commands).
+    pub fn finish_run(&mut self) {
+        let Some((id, outcome)) = self.arrived.take() else {
+            return;
+        };
+        let Some(run) = self.state.run.take_if(|r| r.id == id) else {
+            return;
+        };
+        let seconds = run.started.elapsed().as_secs_f64();
+        match outcome {
+            Ok(mut view) => {
+                let stop = view.stop_reason.clone().unwrap_or_default();
+                // One wall time for the header and the status line.
+                if let ResultOrigin::Run { seconds: s, .. } = &mut view.origin {
+                    *s = seconds;
+                }
+                self.forms.centres.magnify = view.centres.suggested_magnify;
+                self.state.result = Some(*view);
+                self.state.reported = None;
+                self.state.outliers_seen = false;
+                self.state.provenance.record(Output::Result, run.stamp);
+                self.state.provenance.forget(Output::Report);
+                // The operator stays where they are; the status line and
+                // the Results tab say a result is ready.
+                self.state.result_unseen = self.forms.tab != Tab::Results;
+                self.state.say(
+                    Level::Info,
+                    format!("results ready (Results view): calibrated in {seconds:.2} s: {stop}"),
+                );
+            }
+            Err(RunFailure::Cancelled(n)) => self.state.say(
+                Level::Warning,
+                format!("run cancelled after {n} update(s) ({seconds:.2} s); nothing was changed"),
+            ),
+            Err(RunFailure::Failed(e)) => {
+                self.state.say(Level::Error, "the calibration failed");
+                self.state.notice = Some(Notice {
+                    title: "The calibration failed".to_string(),
+                    body: e.to_string(),
+                });
+            }
+        }
+    }
+
     /// Handles a [`RunMessage`].
     pub(super) fn on_run(&mut self, message: RunMessage) {
         match message {
@@ -177,46 +228,8 @@ impl Core {
                 if self.state.stopping.remove(&id) {
                     return;
                 }
-                let Some(run) = self.state.run.take_if(|r| r.id == id) else {
-                    return;
-                };
-                let seconds = run.started.elapsed().as_secs_f64();
-                match outcome {
-                    Ok(mut view) => {
-                        let stop = view.stop_reason.clone().unwrap_or_default();
-                        // One wall time for the header and the status line.
-                        if let ResultOrigin::Run { seconds: s, .. } = &mut view.origin {
-                            *s = seconds;
-                        }
-                        self.forms.centres.magnify = view.centres.suggested_magnify;
-                        self.state.result = Some(*view);
-                        self.state.reported = None;
-                        self.state.outliers_seen = false;
-                        self.state.provenance.record(Output::Result, run.stamp);
-                        self.state.provenance.forget(Output::Report);
-                        // The operator stays where they are; the status
-                        // line and the Results tab say a result is ready.
-                        self.state.result_unseen = self.forms.tab != Tab::Results;
-                        self.state.say(
-                            Level::Info,
-                            format!(
-                                "results ready (Results view): calibrated in {seconds:.2} s: {stop}"
-                            ),
-                        );
-                    }
-                    Err(RunFailure::Cancelled(n)) => self.state.say(
-                        Level::Warning,
-                        format!(
-                            "run cancelled after {n} update(s) ({seconds:.2} s); nothing was changed"
-                        ),
-                    ),
-                    Err(RunFailure::Failed(e)) => {
-                        self.state.say(Level::Error, "the calibration failed");
-                        self.state.notice = Some(Notice {
-                            title: "The calibration failed".to_string(),
-                            body: e.to_string(),
-                        });
-                    }
+                if self.state.run.as_ref().is_some_and(|r| r.id == id) {
+                    self.arrived = Some((id, outcome));
                 }
             }
         }

@@ -360,3 +360,19 @@ fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) 
         });
     });
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The issue: one rejected point of 783 µm set the residual scale and
+    /// flattened residuals of ±10 µm. The scale is the used points'.
+    #[test]
+    fn the_residual_scale_is_the_used_points() {
+        let used = [[0.0, 9.0], [1.0, -10.0], [2.0, 4.0]];
+        let limit = residual_limit(&used, 3.0);
+        assert!((limit - 10.0 * RESIDUAL_MARGIN).abs() < 1e-9, "{limit}");
+        // At least twice the RMS when the points are all small.
+        assert!((residual_limit(&[[0.0, 1.0]], 6.0) - 12.0 * RESIDUAL_MARGIN).abs() < 1e-9);
+    }
+}

@@ -246,20 +246,15 @@ fn key_ui(ui: &mut egui::Ui, set: &CentreSet) {
         });
 }
 
-fn markers(set: &CentreSet, f: &CentresForm) -> Vec<Marker> {
+/// Every marker to draw, before and after as the form shows them, each
+/// placed by `place(centre, its station's mean, the station's mean
+/// before)`.
+fn placed_markers(
+    set: &CentreSet,
+    f: &CentresForm,
+    place: impl Fn([f64; 3], [f64; 3], [f64; 3]) -> [f64; 3],
+) -> Vec<Marker> {
     let mut out = Vec::new();
-    let place = |p: [f64; 3], own_mean: [f64; 3], anchor: [f64; 3]| -> [f64; 3] {
-        if f.relative {
-            let k = f64::from(f.magnify);
-            [
-                anchor[0] + k * (p[0] - own_mean[0]),
-                anchor[1] + k * (p[1] - own_mean[1]),
-                anchor[2] + k * (p[2] - own_mean[2]),
-            ]
-        } else {
-            p
-        }
-    };
     for (i, p) in set.points.iter().enumerate() {
         let s = set.station_of.get(i).copied().unwrap_or(0);
         let (mean_before, mean_after) = set.means.get(s).copied().unwrap_or(([0.0; 3], [0.0; 3]));
@@ -285,6 +280,20 @@ fn markers(set: &CentreSet, f: &CentresForm) -> Vec<Marker> {
         }
     }
     out
+}
+
+/// The markers of the 3D view: the centres, or in relative mode each
+/// centre's deviation from its station's mean magnified about the
+/// station's mean before.
+fn markers(set: &CentreSet, f: &CentresForm) -> Vec<Marker> {
+    let k = f64::from(f.magnify);
+    placed_markers(set, f, |p, own_mean, anchor| {
+        if f.relative {
+            std::array::from_fn(|c| anchor[c] + k * (p[c] - own_mean[c]))
+        } else {
+            p
+        }
+    })
 }
 
 /// Micrometres in a millimetre.
@@ -334,35 +343,9 @@ fn projection_markers(set: &CentreSet, f: &CentresForm, unit: ProjectionUnit) ->
         return markers(set, f);
     }
     let scale = unit.per_mm();
-    let dev = |p: [f64; 3], mean: [f64; 3]| -> [f64; 3] {
-        std::array::from_fn(|k| (p[k] - mean[k]) * scale)
-    };
-    let mut out = Vec::new();
-    for (i, p) in set.points.iter().enumerate() {
-        let s = set.station_of.get(i).copied().unwrap_or(0);
-        let (mean_before, mean_after) = set.means.get(s).copied().unwrap_or(([0.0; 3], [0.0; 3]));
-        if f.show_before {
-            out.push(Marker {
-                pos: dev(p.before, mean_before),
-                point: i,
-                index: p.index,
-                station: s,
-                after: false,
-            });
-        }
-        if f.show_after
-            && let Some(a) = p.after
-        {
-            out.push(Marker {
-                pos: dev(a, mean_after),
-                point: i,
-                index: p.index,
-                station: s,
-                after: true,
-            });
-        }
-    }
-    out
+    placed_markers(set, f, |p, own_mean, _| {
+        std::array::from_fn(|c| (p[c] - own_mean[c]) * scale)
+    })
 }
 
 /// The label of projection axis `k` (0 x, 1 y, 2 z) in `unit`: position

@@ -235,14 +235,19 @@ pub(super) fn orbit_ui(
     if let Some(pointer) = response.hover_pos()
         && let Some(m) = hit(pointer)
     {
-        let label = tooltip(set, m);
-        painter.text(
-            pointer + Vec2::new(12.0, 12.0),
-            egui::Align2::LEFT_TOP,
-            label,
+        // On a dark plate: readable over any marker.
+        let galley = painter.layout_no_wrap(
+            tooltip(set, m),
             egui::FontId::proportional(13.0),
             ui.visuals().strong_text_color(),
         );
+        let at = pointer + Vec2::new(12.0, 12.0);
+        painter.rect_filled(
+            Rect::from_min_size(at, galley.size()).expand(3.0),
+            3.0,
+            Color32::from_black_alpha(200),
+        );
+        painter.galley(at, galley, Color32::WHITE);
     }
     if response.clicked() {
         return response

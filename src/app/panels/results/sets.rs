@@ -91,7 +91,7 @@ fn table_ui(ui: &mut egui::Ui, sets: &[ErrorSet]) {
 #[must_use]
 pub fn histogram(values: &[f64], width: f64, bins: usize) -> Vec<f64> {
     let mut counts = vec![0.0; bins];
-    if values.is_empty() || !(width > 0.0) || bins == 0 {
+    if values.is_empty() || width.is_nan() || width <= 0.0 || bins == 0 {
         return counts;
     }
     for v in values {
