@@ -453,8 +453,11 @@ fn reference_fit(session: &Session, prepared: &Prepared, truth: &Truth) -> Truth
     options.ml.prior = false;
     options.ml.loss = Loss::Squared;
     let stations = prepared.stations(session, Use::Identify);
-    let mut update =
-        MlUpdate::new(session, prepared, &start, stations, &options).expect("reference problem");
+    let mut update = MlUpdate::new(session, prepared, &start, stations, &options, &mut |_| {
+        Control::Continue
+    })
+    .expect("reference problem")
+    .expect("not cancelled");
     for n in 1..=options.max_iterations {
         if update.update(n, &mut |_| Control::Continue).expect("LM") != Step::Moved {
             break;
@@ -531,4 +534,56 @@ fn a_cancel_in_the_diagnostics_ends_the_run_as_cancelled() {
             .iter()
             .any(|p| matches!(p, solve::Phase::Step { .. }))
     );
+}
+
+/// Issue 22: every phase of a run looks at the cancel when it starts, the
+/// last one included: a cancel at the first report of any phase ends the
+/// run as cancelled at once, with no report after it (the app's Cancel
+/// then never waits for a phase to finish).
+#[test]
+fn every_phase_of_a_run_polls_the_cancel() {
+    use solve::Phase;
+    let (session, _) = simulate(&SimConfig::default());
+    let prepared = solve::prepare(&session).expect("prepare");
+    let options = ml_options(&session);
+    let kind = |p: &Phase| -> u8 {
+        match p {
+            Phase::Setup => 0,
+            Phase::Loop => 1,
+            Phase::Step { .. } => 2,
+            Phase::Covariance => 3,
+            Phase::Outliers => 4,
+            Phase::Prediction => 5,
+            Phase::RangeError => 6,
+            Phase::CrossValidation { .. } => 7,
+            Phase::Finishing => 8,
+            Phase::HeldOut { .. } => 9,
+        }
+    };
+    for target in 0..=9 {
+        let mut cancelled = false;
+        let mut after = Vec::new();
+        let cal = solve::run(&session, &prepared, &options, &mut |p| {
+            if cancelled {
+                after.push(p.phase);
+                Control::Continue
+            } else if kind(&p.phase) == target {
+                cancelled = true;
+                Control::Cancel
+            } else {
+                Control::Continue
+            }
+        })
+        .expect("run");
+        assert!(cancelled, "phase {target} was never reported");
+        assert!(
+            cal.stop.is_cancelled(),
+            "phase {target}: {}",
+            cal.stop.describe()
+        );
+        assert!(
+            after.is_empty(),
+            "phase {target}: reports after the cancel: {after:?}"
+        );
+    }
 }

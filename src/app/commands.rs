@@ -80,6 +80,9 @@ pub enum ViewCommand {
     SetSensorRange(Option<crate::engine::session::SensorRange>),
     /// Set the acceptance tolerance (remembered for the session's robot).
     SetTolerance(crate::engine::result_view::Tolerance),
+    /// After a FAIL: show the measurements the solver flagged as
+    /// outliers (Results view, its "after a FAIL" box).
+    ShowOutliers,
 }
 
 /// The calibration run.
@@ -127,4 +130,7 @@ pub enum PlanCommand {
     Export(PlanExport),
     /// Simulate a session of the plan and open it.
     Simulate,
+    /// After a FAIL: open the Plan view set for the open session's robot
+    /// with more identify stations than the session has.
+    MoreStations,
 }

@@ -13,6 +13,7 @@ use crate::engine::solve::Progress;
 
 use super::error::JobError;
 use super::forms::ImportForm;
+use super::provenance::Stamp;
 use super::state::{DialogPurpose, ExportKind, LoadedSession, PlanExport, PlanOutcome};
 use super::view::ResultView;
 
@@ -83,13 +84,56 @@ pub enum FilesMessage {
     },
 }
 
-/// What the solver job reports.
+/// Where a run job is: a phase of the engine's run, or the workbench's
+/// own last step (the result file and its views).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RunStage {
+    /// The engine's progress report.
+    Solver(Progress),
+    /// The engine is done: the result file and the views of it are
+    /// being built.
+    Views,
+}
+
+impl RunStage {
+    /// What the run is doing, in words that name the phase.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        match self {
+            Self::Solver(p) => p.phase.describe(p.updates),
+            Self::Views => "the result file and its views".to_string(),
+        }
+    }
+
+    /// The fraction of the whole run done, phases weighted
+    /// ([`Progress::run_fraction`]; the views take the rest of the bar).
+    #[must_use]
+    pub fn fraction(&self) -> f64 {
+        match self {
+            Self::Solver(p) => p.run_fraction(),
+            Self::Views => crate::engine::solve::progress::RUN_END,
+        }
+    }
+}
+
+/// What the solver job reports, each message with the number of its run
+/// (a cancelled run's messages are dropped: Cancel always wins).
 #[derive(Debug)]
 pub enum RunMessage {
-    /// The solver computed another ε.
-    Progress(Progress),
+    /// The run reached another phase (or the solver computed another ε).
+    Progress {
+        /// Which run.
+        run: u64,
+        /// Where it is.
+        stage: RunStage,
+    },
     /// The run ended.
-    Finished(Result<Box<ResultView>, RunFailure>),
+    Finished {
+        /// Which run.
+        run: u64,
+        /// Its result, or why there is none.
+        outcome: Result<Box<ResultView>, RunFailure>,
+    },
 }
 
 /// What the export jobs report.
@@ -103,6 +147,9 @@ pub enum ExportMessage {
         path: PathBuf,
         /// Success or why not.
         outcome: Result<(), JobError>,
+        /// The inputs of what it was written from (for a report: the
+        /// result's and the tolerance it judged by).
+        stamp: Stamp,
     },
 }
 
@@ -174,6 +221,8 @@ pub enum PlanMessage {
         path: PathBuf,
         /// Success or why not.
         outcome: Result<(), JobError>,
+        /// The inputs of the plan it was written from.
+        stamp: Stamp,
     },
     /// A session simulated from the plan, or why not.
     Simulated(Result<Box<LoadedSession>, JobError>),

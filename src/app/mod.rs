@@ -9,8 +9,13 @@
 //!   result file both go through the FORMAT.md result);
 //! - [`forms`]: the fields widgets edit in place, with the import wizard's
 //!   and the planner's forms and the engine requests they build;
+//! - [`provenance`]: the one staleness mechanism: what each derived
+//!   output (plan, result, report, every file written of them) was made
+//!   from, and whether it still holds (read there how to add an output);
 //! - [`state`]: what the app knows ([`state::AppState`], changed only by
 //!   commands and job messages);
+//! - [`inputs`]: the readings of the inputs (session, left-out
+//!   measurements, solver settings, Plan form, tolerance) each frame;
 //! - [`commands`]: what the panels ask for, by feature;
 //! - [`error`]: why a job failed ([`error::JobError`], the engine's error
 //!   as its source);
@@ -23,6 +28,32 @@
 //!   that reads the state, edits the forms and pushes commands;
 //! - [`workbench`]: the frame loop that ties them together.
 //!
+//! **Staleness: one mechanism.** Everything derived (the plan, the
+//! result with its verdict and views, the report, every file written of
+//! them) is recorded in [`provenance::Provenance`] (in the state) with a
+//! [`provenance::Stamp`]: the readings of the inputs it was made from
+//! ([`provenance::Input`]: session, left-out measurements, solver
+//! settings, Plan form, tolerance), taken by [`inputs::readings`] every
+//! frame. When an input reads otherwise, the output is stale at once; the
+//! step bar, the views and the export handlers all ask the provenance,
+//! none keeps a flag of its own. To register a new derived output (a
+//! Measure step's point clouds, a Compensate view's programs):
+//!
+//! 1. if it depends on an input not listed, add it to
+//!    [`provenance::Input`] (and [`provenance::Input::ALL`]) and read it in
+//!    [`inputs::readings`] (its fields in words, a fingerprint of all of
+//!    it);
+//! 2. add a variant to [`provenance::Output`] with its
+//!    [`provenance::Output::inputs`] and [`provenance::Output::name`];
+//! 3. when its job starts, take `state.provenance.stamp(Output::X)` and
+//!    carry it with the job; when the job's output arrives,
+//!    `record(Output::X, stamp)`; when it is cleared, `forget(Output::X)`;
+//! 4. before writing any of its files, `check(Output::X)` and refuse with
+//!    the error's text; after writing one, `wrote(what, path,
+//!    Output::X, stamp)`;
+//! 5. where it is on show, `stale(Output::X)` gives what changed (the
+//!    views show it with `panels::stale_banner_ui`).
+//!
 //! Layout of the window, for an operator at 1366×768: the load and solver
 //! panel on the left, the Session, Stripe, Centres and Results views in the
 //! middle, a status bar at the bottom.
@@ -31,8 +62,10 @@ pub mod commands;
 pub mod error;
 pub mod features;
 pub mod forms;
+pub mod inputs;
 pub mod jobs;
 pub mod panels;
+pub mod provenance;
 pub mod state;
 pub mod view;
 pub mod workbench;

@@ -22,6 +22,7 @@ use crate::engine::solve::{Analysis, SolveError};
 use crate::engine::stripe::{StripeError, StripeResult};
 
 use super::forms::{Forms, Grouping};
+use super::provenance::{Provenance, Stamp};
 use super::view::{CentreSet, ResultView};
 
 /// How many recent files the start list keeps.
@@ -151,12 +152,14 @@ impl LoadedSession {
         }
     }
 
-    /// Station ids in order of first appearance (all uses).
+    /// Station ids in order of first appearance (all uses); one pass, so
+    /// that a session of 3,000 stations draws in a frame.
     #[must_use]
     pub fn station_ids(&self) -> Vec<String> {
+        let mut seen: std::collections::HashSet<&str> = std::collections::HashSet::new();
         let mut out: Vec<String> = Vec::new();
         for m in &self.session.measurements {
-            if !out.contains(&m.station) {
+            if seen.insert(m.station.as_str()) {
                 out.push(m.station.clone());
             }
         }
@@ -167,23 +170,28 @@ impl LoadedSession {
 /// A run on the background thread.
 #[derive(Debug, Clone)]
 pub struct RunState {
+    /// Its number (messages of other runs are not its own).
+    pub id: u64,
     /// ε after 0, 1, … updates as reported so far, mm.
     pub epsilons: Vec<f64>,
     /// Threshold of this run, mm.
     pub threshold: f64,
     /// Iteration bound of this run.
     pub max_iterations: usize,
-    /// Set to ask the solver to stop at its next ε.
+    /// Set to ask the solver to stop at the start of its next phase.
     pub cancel: Arc<AtomicBool>,
-    /// True once Cancel was pressed.
-    pub cancelling: bool,
     /// When the run started.
     pub started: Instant,
     /// Measurements left out of this run.
     pub excluded: usize,
-    /// What the solver is doing now (a phase after or inside an update),
-    /// with the fraction done when there is one.
-    pub phase: Option<(String, Option<f64>)>,
+    /// What the run is doing now, naming its phase (setting up, an
+    /// update or its inner step, a diagnostic, the result's views).
+    pub phase: String,
+    /// The fraction of the whole run done, phases weighted by their
+    /// usual share of the time (the job's `RunStage::fraction`).
+    pub fraction: f64,
+    /// The inputs the run was started from (its result's provenance).
+    pub stamp: Stamp,
 }
 
 /// How serious a status line is.
@@ -364,6 +372,8 @@ pub struct PlanView {
     pub outcome: Option<Result<PlanOutcome, String>>,
     /// Plan files being written or a plan being simulated.
     pub writing: usize,
+    /// The inputs the planning job in flight started from.
+    pub pending: Option<Stamp>,
 }
 
 /// What the History view shows.
@@ -420,6 +430,8 @@ impl Prefs {
 pub struct Busy {
     /// Session or result files being read.
     pub loading: usize,
+    /// The file being opened, for people ("sessions/big.json").
+    pub opening: Option<String>,
     /// A file dialog is open.
     pub dialog: bool,
     /// The edited session is being written.
@@ -430,6 +442,16 @@ pub struct Busy {
     pub importing: usize,
     /// A library folder is being scanned.
     pub scanning: bool,
+}
+
+impl Busy {
+    /// A file finished loading (or failed to).
+    pub fn done_loading(&mut self) {
+        self.loading = self.loading.saturating_sub(1);
+        if self.loading == 0 {
+            self.opening = None;
+        }
+    }
 }
 
 /// Everything the workbench shows. Changed only by commands and job
@@ -444,6 +466,11 @@ pub struct AppState {
     pub selected: Option<usize>,
     /// The run in progress.
     pub run: Option<RunState>,
+    /// Runs started so far (each run's number).
+    pub runs_started: u64,
+    /// Cancelled runs whose thread has not ended yet: forgotten by the
+    /// workbench at the Cancel, their messages dropped when they come.
+    pub stopping: BTreeSet<u64>,
     /// The result on show (from a run or a reviewed file).
     pub result: Option<ResultView>,
     /// A run finished while another view was on show: the Results tab
@@ -455,8 +482,9 @@ pub struct AppState {
     pub status: Option<Status>,
     /// An error shown until dismissed.
     pub notice: Option<Notice>,
-    /// The last file dialog returned nothing (cancelled or unavailable).
-    pub dialog_empty: bool,
+    /// The last file dialog returned nothing (cancelled or unavailable):
+    /// what it was for, so that the note shows beside its Browse button.
+    pub dialog_empty: Option<DialogPurpose>,
     /// "Save as" would overwrite this existing file: a second click confirms.
     pub confirm_overwrite: Option<PathBuf>,
     /// Background work in flight.
@@ -471,6 +499,14 @@ pub struct AppState {
     pub history: HistoryView,
     /// The plan on show and the planning job.
     pub plan: PlanView,
+    /// What every derived output was made from: whether it is stale.
+    pub provenance: Provenance,
+    /// Sessions opened so far (a new one makes everything of the last
+    /// stale, even under the same name).
+    pub session_loads: u64,
+    /// The operator has been shown the outliers of the result on show
+    /// (after a FAIL the next step is then the planner).
+    pub outliers_seen: bool,
 }
 
 impl AppState {
@@ -486,6 +522,7 @@ impl AppState {
     #[must_use]
     pub fn is_busy(&self) -> bool {
         self.run.is_some()
+            || !self.stopping.is_empty()
             || self.busy.loading > 0
             || self.busy.dialog
             || self.busy.saving
@@ -534,8 +571,13 @@ impl AppState {
         match forms.group {
             Grouping::None => {}
             Grouping::Station => {
-                let order = loaded.station_ids();
-                rows.sort_by_key(|&i| order.iter().position(|s| *s == ms[i].station));
+                let order: std::collections::HashMap<String, usize> = loaded
+                    .station_ids()
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, s)| (s, k))
+                    .collect();
+                rows.sort_by_key(|&i| order.get(&ms[i].station).copied());
             }
             Grouping::Use => rows.sort_by_key(|&i| ms[i].usage),
         }

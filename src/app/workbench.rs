@@ -1,6 +1,8 @@
 //! The workbench: owns the [`Core`] (state, forms, job runner). Each frame
-//! it drains the job messages, draws the panels (which push commands) and
-//! then hands the commands to their features.
+//! it drains the job messages, draws the panels (which push commands),
+//! hands the commands to their features, and only then shows a run's
+//! outcome that arrived in the frame (so that Cancel, clicked while the
+//! run was on screen, always wins).
 
 use std::path::PathBuf;
 
@@ -137,6 +139,7 @@ impl WorkbenchApp {
         for message in self.core.jobs.drain() {
             self.core.on_message(ctx, message);
         }
+        self.core.observe();
     }
 
     /// One frame: drain job messages, draw everything, apply the commands.
@@ -177,6 +180,11 @@ impl WorkbenchApp {
         for c in commands {
             self.core.apply(&ctx, c);
         }
+        // A run's outcome is shown after the frame's commands: a Cancel
+        // clicked in the frame it arrived in wins.
+        self.core.finish_run();
+        // Fields edited this frame mark what they feed stale at once.
+        self.core.observe();
     }
 }
 

@@ -6,6 +6,7 @@
 use std::time::Duration;
 
 use egui_kittest::Harness;
+use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
 use spherecal::app::state::Prefs;
 
@@ -64,4 +65,64 @@ pub fn small_plan(h: &mut Harness<'_, WorkbenchApp>, n_identify: usize, n_valida
     r.validate_poses = 3;
     r.candidates = 8;
     r.predict_runs = 0;
+}
+
+/// The label of the step bar's step `name` (e.g. "4. Calibrated"), with
+/// its mark first (● done, ! attention or stale, – skipped, … under way,
+/// ○ to do).
+pub fn step_label(h: &Harness<'_, WorkbenchApp>, name: &str) -> String {
+    let labels: Vec<String> = h
+        .query_all_by_label_contains(name)
+        .filter_map(|n| {
+            let a = n.accesskit_node();
+            a.label().or_else(|| a.value())
+        })
+        .filter(|l| l.ends_with(name) && l.len() < name.len() + 8)
+        .collect();
+    assert_eq!(labels.len(), 1, "one step {name}: {labels:?}");
+    labels[0].clone()
+}
+
+/// The status line's text.
+pub fn status(h: &Harness<'_, WorkbenchApp>) -> String {
+    h.state()
+        .state()
+        .status
+        .as_ref()
+        .map(|s| s.text.clone())
+        .unwrap_or_default()
+}
+
+/// A simulated session written to `dir/name` (as `spherecal simulate`
+/// does), for tests that need a session of a given size.
+pub fn simulated(
+    dir: &std::path::Path,
+    name: &str,
+    config: &spherecal::engine::simulate::SimConfig,
+) -> std::path::PathBuf {
+    let (session, _) = spherecal::engine::simulate::simulate(config).expect("simulate");
+    let path = dir.join(name);
+    spherecal::engine::format::save_session(&session, &path).expect("save");
+    path
+}
+
+/// Scrolls the view under `at` down (the wheel, 200 points a turn) until
+/// a widget whose label contains `text` is laid out on screen; false
+/// when none comes within 40 turns.
+pub fn scroll_to(h: &mut Harness<'_, WorkbenchApp>, at: egui::Pos2, text: &str) -> bool {
+    for _ in 0..40 {
+        if h.query_all_by_label_contains(text).next().is_some() {
+            return true;
+        }
+        h.hover_at(at);
+        h.event(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Point,
+            delta: egui::vec2(0.0, -200.0),
+            phase: egui::TouchPhase::Move,
+            source: egui::MouseWheelSource::Unknown,
+            modifiers: egui::Modifiers::NONE,
+        });
+        h.run();
+    }
+    h.query_all_by_label_contains(text).next().is_some()
 }

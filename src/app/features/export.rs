@@ -20,7 +20,8 @@ use crate::engine::result_view::{self, Tolerance};
 use super::Core;
 use crate::app::error::JobError;
 use crate::app::jobs::{ExportMessage, JobMessage};
-use crate::app::state::{ExportKind, Level, LoadedSession};
+use crate::app::provenance::{Input, Output};
+use crate::app::state::{ExportKind, Level, LoadedSession, Notice};
 use crate::app::view::{ResultOrigin, ResultView};
 
 /// CSV of every sphere centre: sensor frame and base frame before and
@@ -271,7 +272,30 @@ impl Core {
             );
             return;
         };
+        // A stale result is never written as if it were current.
+        if let Err(why) = self.state.provenance.check(Output::Result) {
+            self.state
+                .say(Level::Warning, format!("{} not written", kind.label()));
+            self.state.notice = Some(Notice {
+                title: format!("{} not written", kind.label()),
+                body: format!("{why}: run the calibration again, then export"),
+            });
+            return;
+        }
         let view = view.clone();
+        let mut stamp = self
+            .state
+            .provenance
+            .made(Output::Result)
+            .cloned()
+            .unwrap_or_default();
+        if kind == ExportKind::ReportHtml {
+            // The report judges by the tolerance: it is an input of it.
+            stamp = stamp.with(
+                Input::Tolerance,
+                self.state.provenance.reading(Input::Tolerance),
+            );
+        }
         let Some(dir) = self.export_folder() else {
             return;
         };
@@ -300,6 +324,7 @@ impl Core {
                 kind,
                 path,
                 outcome,
+                stamp,
             }));
         });
         if started {
@@ -314,10 +339,20 @@ impl Core {
                 kind,
                 path,
                 outcome,
+                stamp,
             } => {
                 self.state.busy.exporting = self.state.busy.exporting.saturating_sub(1);
-                if kind == ExportKind::ReportHtml && outcome.is_ok() {
-                    self.state.reported = Some(path.clone());
+                if outcome.is_ok() {
+                    let from = if kind == ExportKind::ReportHtml {
+                        self.state.reported = Some(path.clone());
+                        self.state.provenance.record(Output::Report, stamp.clone());
+                        Output::Report
+                    } else {
+                        Output::Result
+                    };
+                    self.state
+                        .provenance
+                        .wrote(kind.label(), path.clone(), from, stamp);
                 }
                 self.say_written(kind.label(), &path, outcome);
             }

@@ -6,7 +6,6 @@
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::Ordering;
 
 use crate::engine::format::{
     FileError, RESULT_FORMAT, ResultFile, parse_result, parse_session, session_to_json,
@@ -20,6 +19,7 @@ use crate::app::commands::FilesCommand;
 use crate::app::error::JobError;
 use crate::app::forms::{ProfilesKind, SolverForm, Tab};
 use crate::app::jobs::{FilesMessage, JobMessage};
+use crate::app::provenance::{Input, Output};
 use crate::app::state::{DialogPurpose, Level, LoadedSession, NO_DIALOG, Notice, Source};
 use crate::app::view::{CentrePoint, CentreSet, ResultOrigin, ResultView};
 
@@ -176,6 +176,7 @@ impl Core {
         });
         if started {
             self.state.busy.loading += 1;
+            self.state.busy.opening = Some(crate::DEMO_SESSION_NAME.to_string());
         }
     }
 
@@ -191,6 +192,7 @@ impl Core {
         self.state
             .say(Level::Info, format!("opening {}…", path.display()));
         let session = self.state.loaded.as_ref().map(|l| l.session.clone());
+        let shown = path.display().to_string();
         let started = self.spawn(ctx, "load", move |rep| {
             let message = match open_path(&path) {
                 Ok(Opened::Session(l)) => FilesMessage::SessionLoaded(l),
@@ -214,6 +216,7 @@ impl Core {
         });
         if started {
             self.state.busy.loading += 1;
+            self.state.busy.opening = Some(shown);
         }
     }
 
@@ -323,16 +326,26 @@ impl Core {
     pub(super) fn on_files(&mut self, ctx: &egui::Context, message: FilesMessage) {
         match message {
             FilesMessage::SessionLoaded(loaded) => {
-                self.state.busy.loading = self.state.busy.loading.saturating_sub(1);
+                self.state.busy.done_loading();
                 self.on_session(ctx, *loaded);
             }
             FilesMessage::ResultLoaded { path, view } => {
-                self.state.busy.loading = self.state.busy.loading.saturating_sub(1);
+                self.state.busy.done_loading();
                 self.state.prefs.remember(&path);
                 let notes = view.notes.join("; ");
                 self.forms.centres.magnify = view.centres.suggested_magnify;
                 self.state.result = Some(*view);
                 self.state.reported = None;
+                self.state.result_unseen = false;
+                self.state.outliers_seen = false;
+                // Made elsewhere: not with this window's solver settings.
+                let stamp = self
+                    .state
+                    .provenance
+                    .stamp(Output::Result)
+                    .without(Input::Solver);
+                self.state.provenance.record(Output::Result, stamp);
+                self.state.provenance.forget(Output::Report);
                 self.forms.tab = Tab::Results;
                 if notes.is_empty() {
                     self.state.say(
@@ -350,7 +363,7 @@ impl Core {
                 }
             }
             FilesMessage::LoadFailed { what, error } => {
-                self.state.busy.loading = self.state.busy.loading.saturating_sub(1);
+                self.state.busy.done_loading();
                 self.state
                     .say(Level::Error, format!("could not open {what}"));
                 self.state.notice = Some(Notice {
@@ -389,7 +402,7 @@ impl Core {
 
     fn on_dialog(&mut self, ctx: &egui::Context, purpose: DialogPurpose, path: Option<PathBuf>) {
         self.state.busy.dialog = false;
-        self.state.dialog_empty = path.is_none();
+        self.state.dialog_empty = path.is_none().then_some(purpose);
         let Some(path) = path else {
             self.state.say(Level::Warning, NO_DIALOG);
             return;
@@ -430,10 +443,8 @@ impl Core {
     /// forms and the selection, says what was found, and opens the result
     /// waiting for it.
     pub(super) fn on_session(&mut self, ctx: &egui::Context, loaded: LoadedSession) {
-        if let Some(run) = self.state.run.take() {
-            // The run was of the previous session: stop it, forget it.
-            run.cancel.store(true, Ordering::Relaxed);
-        }
+        // A run of the previous session: stopped and forgotten.
+        let _ = self.stop_run();
         if let Some(p) = loaded.source.path() {
             self.state.prefs.remember(p);
             self.forms.open_path = p.display().to_string();
@@ -482,8 +493,12 @@ impl Core {
         self.state.confirm_overwrite = None;
         self.state.selected = (!loaded.session.measurements.is_empty()).then_some(0);
         self.state.result = None;
+        self.state.result_unseen = false;
         self.state.reported = None;
         self.state.notice = None;
+        self.state.session_loads += 1;
+        self.state.provenance.forget(Output::Result);
+        self.state.provenance.forget(Output::Report);
         let (level, text) = opened_line(&loaded);
         self.state.say(level, text);
         if let Ok(set) = &loaded.before {

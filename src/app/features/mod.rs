@@ -29,8 +29,9 @@ use std::path::{Path, PathBuf};
 use super::commands::Command;
 use super::error::JobError;
 use super::forms::Forms;
-use super::jobs::{JobMessage, Jobs, Reporter};
+use super::jobs::{JobMessage, Jobs, Reporter, RunFailure};
 use super::state::{AppState, Level, Notice};
+use super::view::ResultView;
 
 /// The state, the forms and the job runner, with every feature's
 /// handlers. The workbench owns one and draws the panels from it.
@@ -41,6 +42,10 @@ pub struct Core {
     pub forms: Forms,
     /// The job runner.
     pub jobs: Jobs,
+    /// The outcome of the run in flight, arrived this frame: shown by
+    /// [`Core::finish_run`] once the frame's commands are applied, so that
+    /// a Cancel clicked in the frame it arrives in still wins.
+    arrived: Option<(u64, Result<Box<ResultView>, RunFailure>)>,
 }
 
 impl Core {
@@ -51,11 +56,20 @@ impl Core {
             state,
             forms,
             jobs: Jobs::default(),
+            arrived: None,
         }
+    }
+
+    /// Reads every input into the provenance (each frame, and before each
+    /// command, so that a job stamps the inputs as they are).
+    pub fn observe(&mut self) {
+        let readings = crate::app::inputs::readings(&self.state, &self.forms);
+        self.state.provenance.observe(readings);
     }
 
     /// Hands a command to its feature.
     pub fn apply(&mut self, ctx: &egui::Context, command: Command) {
+        self.observe();
         match command {
             Command::Files(c) => self.files(ctx, c),
             Command::View(c) => self.view(c),

@@ -13,7 +13,7 @@ use crate::engine::plan::{
     self, Plan, PlanConfig, PlanError, PlanStage, PredictConfig, RequestError,
 };
 use crate::engine::robot::RobotChoice;
-use crate::engine::session::Session;
+use crate::engine::session::{Session, Use};
 use crate::engine::simulate::{self, PlanExecution, SimConfig};
 use crate::engine::solve::Control;
 
@@ -21,7 +21,10 @@ use super::Core;
 use super::files::analyse;
 use crate::app::commands::PlanCommand;
 use crate::app::error::JobError;
+use crate::app::forms::Tab;
+use crate::app::inputs::plan_hand_eye;
 use crate::app::jobs::{JobMessage, PlanMessage};
+use crate::app::provenance::{Output, Stamp};
 use crate::app::state::{Level, Notice, PlanExport, PlanOutcome, Source};
 
 /// Plans and predicts, reporting each stage in words; `cancel` stops at
@@ -114,6 +117,19 @@ pub fn simulate_plan(plan: &Plan, robot: &str, seed: u64) -> Result<Session, Job
     Ok(session)
 }
 
+/// Most identify stations the Plan form offers.
+pub const MAX_IDENTIFY_STATIONS: usize = 30;
+
+/// How many identify stations to plan after a FAIL with `have`: half as
+/// many again, at least three more (more stations determine the
+/// parameters better: README, Evidence), at most
+/// [`MAX_IDENTIFY_STATIONS`] unless the session already had more.
+#[must_use]
+pub fn more_stations(have: usize) -> usize {
+    let want = (have + have.div_ceil(2)).max(have + 3);
+    want.min(MAX_IDENTIFY_STATIONS.max(have))
+}
+
 /// The planner's error in the Plan view's words.
 fn plan_error_text(e: &JobError) -> String {
     match e {
@@ -135,23 +151,38 @@ impl Core {
             }
             PlanCommand::Export(kind) => self.plan_export(ctx, kind),
             PlanCommand::Simulate => self.plan_simulate(ctx),
+            PlanCommand::MoreStations => self.more_stations(),
         }
+    }
+
+    /// After a FAIL: the Plan view, set for the open session's robot with
+    /// more identify stations than the session has ([`more_stations`]).
+    fn more_stations(&mut self) {
+        self.forms.tab = Tab::Plan;
+        let Some(loaded) = &self.state.loaded else {
+            return;
+        };
+        let have = loaded.session.stations(Use::Identify).len();
+        let want = more_stations(have);
+        self.forms.plan.request.n_identify = want;
+        self.state.say(
+            Level::Info,
+            format!(
+                "the Plan form asks for {want} identify stations (the session has {have}): press Make plan, then measure the new poses"
+            ),
+        );
     }
 
     fn plan_make(&mut self, ctx: &egui::Context) {
         if self.state.plan.cancel.is_some() {
             return;
         }
-        let session_hand_eye = self
-            .state
-            .result
-            .as_ref()
-            .map(|v| v.file.hand_eye)
-            .or_else(|| self.state.loaded.as_ref().and_then(|l| l.session.hand_eye));
+        let session_hand_eye = plan_hand_eye(&self.state);
         let config = match self.forms.plan.config(session_hand_eye) {
             Ok(c) => c,
             Err(e) => {
                 self.state.plan.outcome = Some(Err(e.clone()));
+                self.state.provenance.forget(Output::Plan);
                 self.state.say(Level::Warning, e);
                 return;
             }
@@ -169,23 +200,38 @@ impl Core {
         });
         if started {
             self.state.plan.cancel = Some(cancel);
+            self.state.plan.pending = Some(self.state.provenance.stamp(Output::Plan));
             self.state.plan.progress = Some("planning…".to_string());
             self.state.say(Level::Info, "planning the poses…");
         }
     }
 
-    fn current_plan(&mut self) -> Option<Plan> {
-        match &self.state.plan.outcome {
-            Some(Ok(o)) => Some((*o.plan).clone()),
+    /// The plan on show and its stamp, when it is current; otherwise
+    /// `None`, and the operator is told why nothing is written (a stale
+    /// plan is never written as another robot's program).
+    fn current_plan(&mut self, what: &str) -> Option<(Plan, Stamp)> {
+        let plan = match &self.state.plan.outcome {
+            Some(Ok(o)) => (*o.plan).clone(),
             _ => {
                 self.state.say(Level::Warning, "make a plan first");
-                None
+                return None;
             }
+        };
+        if let Err(why) = self.state.provenance.check(Output::Plan) {
+            self.state
+                .say(Level::Warning, format!("{what} refused: {why}"));
+            self.state.notice = Some(Notice {
+                title: format!("{what} refused"),
+                body: format!("{why}: press Make plan again"),
+            });
+            return None;
         }
+        let stamp = self.state.provenance.made(Output::Plan).cloned()?;
+        Some((plan, stamp))
     }
 
     fn plan_export(&mut self, ctx: &egui::Context, kind: PlanExport) {
-        let Some(plan) = self.current_plan() else {
+        let Some((plan, stamp)) = self.current_plan(kind.label()) else {
             return;
         };
         let Some(dir) = self.export_folder() else {
@@ -202,6 +248,7 @@ impl Core {
                 kind,
                 path,
                 outcome,
+                stamp,
             }));
         });
         if started {
@@ -210,7 +257,7 @@ impl Core {
     }
 
     fn plan_simulate(&mut self, ctx: &egui::Context) {
-        let Some(plan) = self.current_plan() else {
+        let Some((plan, _)) = self.current_plan("Simulate and open") else {
             return;
         };
         let robot = self.forms.plan.robot.clone();
@@ -238,6 +285,12 @@ impl Core {
             PlanMessage::Finished(outcome) => {
                 self.state.plan.cancel = None;
                 self.state.plan.progress = None;
+                let stamp = self.state.plan.pending.take().unwrap_or_default();
+                if outcome.is_ok() {
+                    self.state.provenance.record(Output::Plan, stamp);
+                } else {
+                    self.state.provenance.forget(Output::Plan);
+                }
                 match &outcome {
                     Ok(o) => {
                         let line = match &o.prediction {
@@ -264,8 +317,14 @@ impl Core {
                 kind,
                 path,
                 outcome,
+                stamp,
             } => {
                 self.state.plan.writing = self.state.plan.writing.saturating_sub(1);
+                if outcome.is_ok() {
+                    self.state
+                        .provenance
+                        .wrote(kind.label(), path.clone(), Output::Plan, stamp);
+                }
                 self.say_written(kind.label(), &path, outcome);
             }
             PlanMessage::Simulated(outcome) => {

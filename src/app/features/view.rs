@@ -52,6 +52,12 @@ impl Core {
                 self.state.excluded.clear();
                 self.say_excluded();
             }
+            ViewCommand::ShowOutliers => {
+                self.forms.tab = Tab::Results;
+                self.forms.focus_after_fail = true;
+                self.state.result_unseen = false;
+                self.state.outliers_seen = true;
+            }
             ViewCommand::DismissNotice => self.state.notice = None,
             ViewCommand::DismissIntro => self.state.prefs.intro_dismissed = true,
             ViewCommand::SetSensorRange(range) => {

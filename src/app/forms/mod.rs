@@ -233,6 +233,9 @@ pub struct Forms {
     /// The acceptance tolerance the headline's PASS/FAIL and the report
     /// use (remembered per robot in the preferences).
     pub tolerance: crate::engine::result_view::Tolerance,
+    /// Scroll the Results view to its "after a FAIL" box once (set by
+    /// Next's "Look at the outliers").
+    pub focus_after_fail: bool,
 }
 
 impl Default for Forms {
@@ -254,6 +257,7 @@ impl Default for Forms {
             history: HistoryForm::default(),
             plan: PlanForm::default(),
             tolerance: crate::engine::result_view::Tolerance::default(),
+            focus_after_fail: false,
         }
     }
 }

@@ -65,6 +65,7 @@ pub fn history_ui(
                     ui.spinner();
                 }
             });
+            super::dialog_note_ui(ui, state, &[DialogPurpose::HistoryFolder]);
             match &state.history.library {
                 None => {
                     ui.label(

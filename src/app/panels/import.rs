@@ -47,6 +47,16 @@ fn import_form_ui(
         .auto_shrink([false, false])
         .show(ui, |ui| {
             ui.heading("Import a pose log and stripe profiles");
+            super::dialog_note_ui(
+                ui,
+                state,
+                &[
+                    DialogPurpose::ImportJoints,
+                    DialogPurpose::ImportPoses,
+                    DialogPurpose::ImportProfiles,
+                    DialogPurpose::ImportReferences,
+                ],
+            );
             ui.label(
                 RichText::new(
                     "A joint log (one row per pose: id, station, use, joints) or the controller's flange poses \

@@ -18,7 +18,7 @@ use egui::{Color32, RichText};
 
 use super::commands::{Command, ViewCommand};
 use super::forms::{Forms, Tab};
-use super::state::AppState;
+use super::state::{AppState, DialogPurpose, NO_DIALOG};
 
 /// Colour of "before calibration" series (nominal model, initial hand-eye).
 pub const BEFORE: Color32 = Color32::from_rgb(230, 120, 40);
@@ -114,6 +114,108 @@ pub fn labelled_field(
     .labelled_by(l.id)
 }
 
+/// A number that is typed, never dragged (a sideways drag over it
+/// changes nothing): a text field labelled `label`, showing `value` with
+/// `unit` beside it, that takes what is typed on Enter or when it loses
+/// focus, if it is a number in `range` (shown in red while it is not).
+/// Returns the new value once taken, when it differs.
+pub fn number_field(
+    ui: &mut egui::Ui,
+    id_salt: &str,
+    label: &str,
+    value: f64,
+    range: std::ops::RangeInclusive<f64>,
+    unit: &str,
+) -> Option<f64> {
+    let id = ui.make_persistent_id(("number_field", id_salt));
+    let shown = plots::tick_label(egui_plot::GridMark {
+        value,
+        step_size: NUMBER_FIELD_RESOLUTION,
+    });
+    let typed: Option<String> = ui.data(|d| d.get_temp(id));
+    let mut text = typed.clone().unwrap_or_else(|| shown.clone());
+    let parse = |t: &str| {
+        t.trim()
+            .trim_end_matches(unit)
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && range.contains(v))
+    };
+    let l = ui.label(label);
+    let valid = parse(&text).is_some();
+    let mut edit = egui::TextEdit::singleline(&mut text)
+        .id_salt(id)
+        .desired_width(NUMBER_FIELD_WIDTH);
+    if !valid {
+        edit = edit.text_color(BAD);
+    }
+    let response = ui.add(edit).labelled_by(l.id).on_hover_text(format!(
+        "type a number of {unit} ({} to {}), then Enter",
+        range.start(),
+        range.end()
+    ));
+    ui.label(unit);
+    let mut taken = None;
+    if response.has_focus() {
+        ui.data_mut(|d| d.insert_temp(id, text));
+    } else {
+        if response.lost_focus() || typed.is_some() {
+            taken = parse(&text).filter(|v| (*v - value).abs() > 0.0);
+        }
+        ui.data_mut(|d| d.remove::<String>(id));
+    }
+    taken
+}
+
+/// Decimals a [`number_field`] shows: steps of a micrometre.
+const NUMBER_FIELD_RESOLUTION: f64 = 0.001;
+
+/// Width of a [`number_field`], points.
+const NUMBER_FIELD_WIDTH: f32 = 56.0;
+
+/// What a view says with no session: that one is being opened (with a
+/// spinner), else how to open one.
+pub fn no_session_ui(ui: &mut egui::Ui, state: &AppState) {
+    match &state.busy.opening {
+        Some(what) => {
+            ui.horizontal(|ui| {
+                ui.spinner();
+                ui.label(format!("Opening {what}…"));
+            });
+        }
+        None => {
+            ui.label("No session open: type a path on the left, press Open…, or drop a file here.");
+        }
+    }
+}
+
+/// The note that the last file dialog for one of `purposes` chose
+/// nothing (or none is available), beside that dialog's Browse button.
+pub fn dialog_note_ui(ui: &mut egui::Ui, state: &AppState, purposes: &[DialogPurpose]) {
+    if state.dialog_empty.is_some_and(|p| purposes.contains(&p)) {
+        ui.label(RichText::new(NO_DIALOG).small().color(WARN));
+    }
+}
+
+/// The mark over a stale output: what changed since it was made, and
+/// what to do; its exports are refused (the buttons say why).
+pub fn stale_banner_ui(ui: &mut egui::Ui, stale: &crate::app::provenance::Stale, todo: &str) {
+    egui::Frame::group(ui.style())
+        .stroke(egui::Stroke::new(2.0, WARN))
+        .show(ui, |ui| {
+            ui.set_width(ui.available_width());
+            ui.horizontal_wrapped(|ui| {
+                ui.label(RichText::new("STALE").strong().size(18.0).color(WARN));
+                ui.label(
+                    RichText::new(format!("{stale}. {todo}"))
+                        .color(WARN)
+                        .strong(),
+                );
+            });
+        });
+}
+
 /// A plot's key on one line above it, each entry in its series' colour
 /// (a legend inside the plot would cover data).
 pub fn plot_key(ui: &mut egui::Ui, entries: &[(&str, egui::Color32)]) {
@@ -190,7 +292,7 @@ pub fn range_values(r: &crate::engine::session::SensorRange) -> [f64; 4] {
 pub fn tabs_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mut Vec<Command>) {
     ui.horizontal(|ui| {
         for tab in Tab::ALL {
-            let unseen = tab == Tab::Results && state.result_unseen;
+            let unseen = tab == Tab::Results && state.result_unseen && state.result.is_some();
             let label = if unseen {
                 format!("{} ●", tab.label())
             } else {
@@ -251,17 +353,24 @@ pub fn ratio_text(before: f64, after: f64) -> String {
     }
 }
 
-/// The label of a log-scale tick at `log10(v) = exponent`: `v` with two
-/// significant digits.
+/// The label of a log-scale tick at `log10(v) = exponent`: `v` with the
+/// fewest decimals that give it to 1e-6 of itself (ticks sit on round
+/// values: 0.1, 0.365, 20), at most four significant digits; outside
+/// 0.001 … 10,000 in scientific notation.
 #[must_use]
 pub fn log_tick(exponent: f64) -> String {
     let v = 10f64.powf(exponent);
-    if (1e-3..1e4).contains(&v) {
-        let digits = (1.0 - v.log10().floor()).max(0.0) as usize;
-        format!("{v:.digits$}")
-    } else {
-        format!("{v:.1e}")
+    if !(1e-3..1e4).contains(&v) {
+        return format!("{v:.1e}");
     }
+    let most = (3.0 - v.log10().floor()).max(0.0) as usize;
+    let decimals = (0..=most)
+        .find(|&d| {
+            let scale = 10f64.powi(d as i32);
+            ((v * scale).round() / scale - v).abs() <= v * 1e-6
+        })
+        .unwrap_or(most);
+    format!("{v:.decimals$}")
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@ use super::{
 };
 use crate::app::commands::{Command, FilesCommand, PlanCommand};
 use crate::app::forms::{Forms, plan::default_sphere};
+use crate::app::provenance::Output;
 use crate::app::state::{AppState, DialogPurpose, PlanExport, PlanOutcome};
 use crate::engine::plan::{Plan, StationRole};
 use crate::engine::robot;
@@ -204,6 +205,14 @@ fn outcome_ui(
 ) {
     let plan = &o.plan;
     let st = &plan.stats;
+    let stale = state.provenance.stale(Output::Plan);
+    if let Some(s) = &stale {
+        super::stale_banner_ui(
+            ui,
+            s,
+            "Its program, CSV and simulation are refused until you press Make plan.",
+        );
+    }
     let stations = |role| plan.stations.iter().filter(|s| s.role == role).count();
     ui.label(
         RichText::new(format!(
@@ -329,6 +338,10 @@ fn outcome_ui(
             });
     }
     ui.separator();
+    let refused = stale.as_ref().map_or_else(
+        || "a file is being written".to_string(),
+        |s| format!("refused: {s}; press Make plan"),
+    );
     ui.horizontal_wrapped(|ui| {
         labelled_field(
             ui,
@@ -359,21 +372,30 @@ fn outcome_ui(
                 PlanExport::Program(crate::engine::plan::Controller::UrScript) => "a URScript program for a Universal Robots controller: one movej per pose (rad), a popup per station, a measure hook",
             };
             if ui
-                .add_enabled(state.plan.writing == 0, egui::Button::new(kind.label()))
+                .add_enabled(
+                    state.plan.writing == 0 && stale.is_none(),
+                    egui::Button::new(kind.label()),
+                )
                 .on_hover_text(hint)
+                .on_disabled_hover_text(&refused)
                 .clicked()
             {
                 commands.push(Command::Plan(PlanCommand::Export(kind)));
             }
         }
         if ui
-            .add_enabled(state.plan.writing == 0, egui::Button::new("Simulate and open"))
+            .add_enabled(
+                state.plan.writing == 0 && stale.is_none(),
+                egui::Button::new("Simulate and open"),
+            )
             .on_hover_text("a session of this plan on a simulated robot with kinematic errors, each pose touched up as when teaching: try the calibration before going to the cell")
+            .on_disabled_hover_text(&refused)
             .clicked()
         {
             commands.push(Command::Plan(PlanCommand::Simulate));
         }
     });
+    super::dialog_note_ui(ui, state, &[DialogPurpose::ExportFolder]);
     ui.separator();
     ui.label(RichText::new("Stations seen from above (base frame x, y in mm)").strong());
     map_ui(ui, plan);
@@ -391,18 +413,24 @@ fn map_ui(ui: &mut egui::Ui, plan: &Plan) {
             .collect()
     };
     let base = plan.robot.base.translation.vector;
-    super::plot_key(
-        ui,
-        &[
-            ("◆ P0 (hand-eye groups)", BAD),
-            ("● identify", AFTER),
-            ("■ validate", BEFORE),
-            ("× robot base", MUTED),
-        ],
-    );
+    // The key names only what is drawn.
+    let mut key = Vec::new();
+    for (text, colour, role) in [
+        ("◆ P0 (hand-eye groups)", BAD, StationRole::HandEye),
+        ("● identify", AFTER, StationRole::Identify),
+        ("■ validate", BEFORE, StationRole::Validate),
+    ] {
+        if !of(role).is_empty() {
+            key.push((text, colour));
+        }
+    }
+    key.push(("× robot base", MUTED));
+    super::plot_key(ui, &key);
     super::plots::readable(Plot::new("plan_map"), false)
         .height(MAP_HEIGHT)
         .data_aspect(1.0)
+        // The wheel scrolls the view, not the map (drag still pans).
+        .allow_scroll(false)
         .x_axis_label("x (mm)")
         .y_axis_label("y (mm)")
         .show(ui, |p| {

@@ -126,15 +126,98 @@ pub fn readable_y(plot: Plot<'_>) -> Plot<'_> {
         .y_axis_formatter(|mark, _| tick_label(mark))
 }
 
-/// A plot whose y axis is `log10` of the values, labelled at whole
-/// decades spaced to carry their numbers (1, 2 or 5 decades apart).
+/// Mantissas tried, finest last, when whole decades leave fewer than two
+/// labels on a log axis.
+const LOG_MANTISSAS: [&[f64]; 2] = [
+    &[1.0, 2.0, 5.0],
+    &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
+];
+
+/// The ticks of a `log10` axis over `bounds` (log units) drawn at
+/// `units_per_point` log units per point, each label `gap` points from
+/// the next: whole decades (1, 2 or 5 apart) when two or more fit, else
+/// 1-2-5 or 1…9 times a decade, else round values spaced evenly (a span
+/// within one decade, e.g. ε from 0.37 to 0.36 mm, still carries at
+/// least two numbers).
+#[must_use]
+pub fn log_ticks(bounds: (f64, f64), units_per_point: f64, gap: f64) -> Vec<GridMark> {
+    if !(bounds.0.is_finite() && bounds.1.is_finite() && units_per_point.is_finite()) {
+        return Vec::new();
+    }
+    let (lo, hi) = (bounds.0.min(bounds.1), bounds.0.max(bounds.1));
+    if hi - lo >= 1000.0 {
+        return Vec::new();
+    }
+    let decades = ticks((lo, hi), units_per_point, gap, true);
+    if decades.len() >= 2 {
+        return decades;
+    }
+    let least = units_per_point * gap;
+    // Kept greedily from the bottom, each `least` above the last.
+    let spaced = |values: Vec<f64>| -> Vec<f64> {
+        let mut kept: Vec<f64> = Vec::new();
+        for v in values {
+            if kept.last().is_none_or(|last| v - last >= least) {
+                kept.push(v);
+            }
+        }
+        kept
+    };
+    let marks = |kept: Vec<f64>| -> Vec<GridMark> {
+        let step = kept
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .fold(f64::INFINITY, f64::min);
+        let step = if step.is_finite() { step } else { least };
+        kept.into_iter()
+            .map(|value| GridMark {
+                value,
+                step_size: step,
+            })
+            .collect()
+    };
+    for mantissas in LOG_MANTISSAS {
+        let mut values = Vec::new();
+        let mut d = lo.floor();
+        while d <= hi.ceil() {
+            for m in mantissas {
+                let v = d + m.log10();
+                if v >= lo && v <= hi {
+                    values.push(v);
+                }
+            }
+            d += 1.0;
+        }
+        let kept = spaced(values);
+        if kept.len() >= 2 {
+            return marks(kept);
+        }
+    }
+    // Within one decade: round values of the quantity itself.
+    let (a, b) = (10f64.powf(lo), 10f64.powf(hi));
+    let labels = ((hi - lo) / least).floor().max(1.0);
+    let step = nice_step((b - a) / labels, false);
+    let mut values = Vec::new();
+    let mut k = (a / step).ceil();
+    while k * step <= b && values.len() < 100 {
+        values.push((k * step).log10());
+        k += 1.0;
+    }
+    marks(spaced(values))
+}
+
+/// A plot whose y axis is `log10` of the values, labelled by
+/// [`log_ticks`] with the value itself ([`super::log_tick`]).
 #[must_use]
 pub fn readable_log_y(plot: Plot<'_>) -> Plot<'_> {
     plot.grid_spacing(egui::Rangef::new(GRID_SPACING_MIN, 300.0))
         .custom_y_axes(vec![
             AxisHints::new_y().label_spacing(egui::Rangef::new(Y_FADE.0, Y_FADE.1)),
         ])
-        .y_grid_spacer(spacer(Y_LABEL_GAP, true))
+        .y_grid_spacer(|input: GridInput| {
+            let units_per_point = input.base_step_size / f64::from(GRID_SPACING_MIN);
+            log_ticks(input.bounds, units_per_point, Y_LABEL_GAP)
+        })
         .y_axis_formatter(|mark, _| super::log_tick(mark.value))
 }
 
@@ -241,6 +324,42 @@ mod tests {
         );
         assert!(ticks((0.0, 1e9), 1e-9, 30.0, false).is_empty());
         assert!(ticks((f64::NAN, 1.0), 0.1, 30.0, false).is_empty());
+    }
+
+    fn log_labels(bounds: (f64, f64), points: f64) -> Vec<String> {
+        log_ticks(bounds, (bounds.1 - bounds.0) / points, Y_LABEL_GAP)
+            .into_iter()
+            .map(|m| crate::app::panels::log_tick(m.value))
+            .collect()
+    }
+
+    /// The issue: ε of the real set (0.37 → 0.36 mm) had no number on
+    /// its axis, and the demo's 0.1 none; every log axis now carries two
+    /// or more, spaced.
+    #[test]
+    fn a_log_axis_within_a_decade_carries_numbers() {
+        // 0.355…0.375 mm over 110 points.
+        let l = log_labels((0.355_f64.log10(), 0.375_f64.log10()), 110.0);
+        assert!(l.len() >= 2, "{l:?}");
+        assert!(l.iter().all(|s| s.starts_with("0.3")), "{l:?}");
+        let distinct: std::collections::BTreeSet<_> = l.iter().collect();
+        assert_eq!(distinct.len(), l.len(), "{l:?}");
+        // The demo: ε from 6.3 to 0.08 mm over 110 points: 0.1 and 1.
+        let l = log_labels((0.08_f64.log10(), 6.3_f64.log10()), 110.0);
+        assert!(
+            l.contains(&"0.1".to_string()) && l.contains(&"1".to_string()),
+            "{l:?}"
+        );
+        // Many decades: whole decades, spaced.
+        let t = log_ticks((-9.0, 1.0), 10.0 / 110.0, Y_LABEL_GAP);
+        assert!(
+            t.len() >= 2 && t.iter().all(|m| m.value.fract() == 0.0),
+            "{t:?}"
+        );
+        for w in t.windows(2) {
+            assert!((w[1].value - w[0].value) / (10.0 / 110.0) >= Y_LABEL_GAP - 1e-9);
+        }
+        assert!(log_ticks((f64::NAN, 1.0), 0.1, 26.0).is_empty());
     }
 
     /// Fig. 5 of 60 stations on a 500-point plot: 8 points a station;

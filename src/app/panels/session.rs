@@ -29,7 +29,7 @@ pub fn session_ui(
     commands: &mut Vec<Command>,
 ) {
     let Some(loaded) = &state.loaded else {
-        ui.label("No session open: type a path on the left, press Open…, or drop a file here.");
+        super::no_session_ui(ui, state);
         return;
     };
     filters_ui(ui, loaded, forms, commands);
@@ -54,6 +54,7 @@ pub fn session_ui(
     });
     range_ui(ui, loaded, forms, commands);
     save_ui(ui, state, forms, commands);
+    super::dialog_note_ui(ui, state, &[DialogPurpose::SaveSession]);
     ui.separator();
     table_ui(ui, state, loaded, forms, commands);
 }
@@ -427,18 +428,97 @@ fn item_row(
                 ui.label(dim(format!("{:+.1}", s.sphere.cut_angle_deg)));
             });
             row.col(|ui| {
-                if let Some(first) = s.warnings.first() {
-                    let text = if s.warnings.len() > 1 {
-                        format!("({}) {first}", s.warnings.len())
-                    } else {
-                        first.clone()
-                    };
-                    ui.label(RichText::new(text).color(WARN))
-                        .on_hover_text(s.warnings.join("\n"));
-                } else {
+                if s.warnings.is_empty() {
                     ui.label(RichText::new("ok").color(Color32::from_rgb(90, 170, 90)));
+                } else {
+                    // Every warning named, in a few words each (the whole
+                    // text on hover and in the Stripe view).
+                    ui.add(
+                        egui::Label::new(RichText::new(warnings_cell(&s.warnings)).color(WARN))
+                            .extend(),
+                    )
+                    .on_hover_text(s.warnings.join("\n"));
                 }
             });
         }
+    }
+}
+
+/// Longest tag of a warning without a recognised opening, characters.
+const TAG_CHARS: usize = 32;
+
+/// A stripe warning in a few words, for the table: what it is about
+/// ("raw profile", "3 points rejected", "short arc", "high fit RMS",
+/// "centre on the laser plane", "cut angle 72.3° is above 60°").
+#[must_use]
+pub fn warning_tag(warning: &str) -> String {
+    let before_colon = warning.split(':').next().unwrap_or(warning).trim();
+    if warning.starts_with("raw profile") {
+        "raw profile".to_string()
+    } else if let Some(n) = warning
+        .find(" stripe points rejected")
+        .and_then(|at| warning[..at].split(" of ").next())
+    {
+        format!("{n} points rejected")
+    } else if warning.starts_with("short arc") {
+        "short arc".to_string()
+    } else if warning.starts_with("high circle-fit RMS") {
+        "high fit RMS".to_string()
+    } else if warning.starts_with("stripe radius") {
+        "centre on the laser plane".to_string()
+    } else if warning.starts_with("cut angle") {
+        before_colon.to_string()
+    } else {
+        let mut tag: String = before_colon.chars().take(TAG_CHARS).collect();
+        if before_colon.chars().count() > TAG_CHARS {
+            tag.push('…');
+        }
+        tag
+    }
+}
+
+/// Every warning of a measurement, tagged, in one line.
+#[must_use]
+pub fn warnings_cell(warnings: &[String]) -> String {
+    warnings
+        .iter()
+        .map(|w| warning_tag(w))
+        .collect::<Vec<_>>()
+        .join(" · ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The issue: "(2) raw profile, …" hid the cut-angle warning behind
+    /// the count and cut the rest with "…". Every warning is named.
+    #[test]
+    fn every_warning_is_named_in_a_few_words() {
+        let ws = vec![
+            "raw profile, the sphere's arc: 412 of 800 points, 38.1° to 141.9°".to_string(),
+            "cut angle 66.2° is above 60°: the laser plane is near the sphere's pole and the stripe circle is small (r = 16.2 mm); about ±40° is best".to_string(),
+        ];
+        assert_eq!(
+            warnings_cell(&ws),
+            "raw profile · cut angle 66.2° is above 60°"
+        );
+        assert_eq!(
+            warning_tag("3 of 120 stripe points rejected as outliers (largest residual 0.300 mm)"),
+            "3 points rejected"
+        );
+        assert_eq!(
+            warning_tag("short arc: the stripe spans 12.0° of its circle"),
+            "short arc"
+        );
+        assert_eq!(
+            warning_tag("high circle-fit RMS: 0.2 mm over 9 points"),
+            "high fit RMS"
+        );
+        assert_eq!(
+            warning_tag("stripe radius r = 19.1 mm exceeds the sphere radius"),
+            "centre on the laser plane"
+        );
+        assert!(warning_tag(&"x".repeat(80)).ends_with('…'));
     }
 }

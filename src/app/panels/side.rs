@@ -11,6 +11,7 @@ use crate::engine::solve::paper::Pairing;
 use super::{AFTER, BAD, BEFORE, labelled_field};
 use crate::app::commands::{Command, FilesCommand, RunCommand, ViewCommand};
 use crate::app::forms::Forms;
+use crate::app::provenance::Output;
 use crate::app::state::{AppState, DialogPurpose, NO_DIALOG};
 
 /// The whole left panel.
@@ -47,11 +48,12 @@ pub fn load_ui(
 ) {
     ui.heading("Session");
     let line = |ui: &mut egui::Ui, text: RichText| ui.add(egui::Label::new(text).truncate());
+    // Whole, wrapped: a cut path or count hides what is open.
+    let whole = |ui: &mut egui::Ui, text: RichText| ui.add(egui::Label::new(text).wrap());
     match &state.loaded {
         Some(l) => {
             name_ui(ui, &l.session.name);
-            line(ui, RichText::new(l.source.label()).small().weak())
-                .on_hover_text(l.source.label());
+            whole(ui, RichText::new(l.source.label()).small().weak());
             let n = l.session.measurements.len();
             let stations = l.station_ids().len();
             let text = format!(
@@ -64,10 +66,13 @@ pub fn load_ui(
                     ""
                 }
             );
-            line(ui, RichText::new(&text).small()).on_hover_text(text);
+            whole(ui, RichText::new(text).small());
         }
         None => {
-            name_ui(ui, "no session open");
+            match &state.busy.opening {
+                Some(what) => name_ui(ui, &format!("opening {what}…")),
+                None => name_ui(ui, "no session open"),
+            }
             line(ui, RichText::new(" ").small());
             line(ui, RichText::new(" ").small());
         }
@@ -112,7 +117,7 @@ pub fn load_ui(
         }
     });
     // One line either way: the dialog's note replaces the drop hint.
-    let hint = if state.dialog_empty {
+    let hint = if state.dialog_empty == Some(DialogPurpose::Open) {
         NO_DIALOG
     } else {
         "or drop a file onto the window"
@@ -224,11 +229,11 @@ pub fn solver_ui(
             commands.push(Command::Run(RunCommand::Start));
         }
         let cancel = ui.add_enabled(
-            running && !state.run.as_ref().is_some_and(|r| r.cancelling),
+            running,
             egui::Button::new(RichText::new("Cancel").size(16.0)).min_size(Vec2::new(80.0, 32.0)),
         );
         if cancel
-            .on_hover_text("stop the solver at its next iteration")
+            .on_hover_text("stop the run now: the result on show stays")
             .clicked()
         {
             commands.push(Command::Run(RunCommand::Cancel));
@@ -250,21 +255,21 @@ pub fn solver_ui(
         ui.label(RichText::new(format!("{excluded} measurement(s) will be left out")).small());
     }
     if let Some(run) = &state.run {
+        // Always the phase by name and the whole run's fraction: the bar
+        // never sits still without saying what the run is doing.
         ui.horizontal(|ui| {
             ui.spinner();
-            let updates = run.epsilons.len().saturating_sub(1);
-            match (&run.phase, run.epsilons.last()) {
-                (Some((what, _)), _) => ui.label(what),
-                (None, Some(eps)) => ui.label(format!(
-                    "update {updates} of ≤ {}: ε = {eps:.4} mm",
-                    run.max_iterations
-                )),
-                (None, None) => ui.label("preparing: stripe fits and initial hand-eye…"),
+            let text = {
+                match run.epsilons.last() {
+                    Some(eps) if run.phase.starts_with("update") && !run.phase.contains(':') => {
+                        format!("{} of ≤ {}: ε = {eps:.4} mm", run.phase, run.max_iterations)
+                    }
+                    _ => run.phase.clone(),
+                }
             };
+            ui.add(egui::Label::new(text).wrap());
         });
-        if let Some((_, Some(fraction))) = &run.phase {
-            ui.add(egui::ProgressBar::new(*fraction as f32).show_percentage());
-        }
+        ui.add(egui::ProgressBar::new(run.fraction as f32).show_percentage());
         epsilon_plot_ui(
             ui,
             "live_epsilon",
@@ -273,7 +278,16 @@ pub fn solver_ui(
             SIDE_EPSILON_HEIGHT,
         );
     } else if let Some(result) = &state.result {
-        ui.label(RichText::new("ε of the result on show").small().weak());
+        match state.provenance.stale(Output::Result) {
+            Some(s) => ui
+                .label(
+                    RichText::new("ε of the result on show (stale)")
+                        .small()
+                        .color(super::WARN),
+                )
+                .on_hover_text(s.to_string()),
+            None => ui.label(RichText::new("ε of the result on show").small().weak()),
+        };
         epsilon_plot_ui(
             ui,
             "last_epsilon",
@@ -351,6 +365,10 @@ fn settings_ui(ui: &mut egui::Ui, forms: &mut Forms) {
         });
 }
 
+/// From this span (decades) on, the ε axis reaches the whole decades
+/// around the data.
+const WHOLE_DECADES_FROM: f64 = 0.7;
+
 /// ε is drawn on a log scale; values below this (mm) are drawn at it.
 const EPSILON_FLOOR_MM: f64 = 1e-9;
 
@@ -369,8 +387,26 @@ pub fn epsilon_plot_ui(
         .enumerate()
         .map(|(k, e)| [k as f64, log(*e)])
         .collect();
-    super::plots::readable_log_y(Plot::new(id))
-        .height(height)
+    // Over a decade or more the axis reaches the whole decades around the
+    // data, so that each carries its number (the demo's 0.1); within one
+    // the data fill it, labelled by round values (0.36, 0.37).
+    let (lo, hi) = pts
+        .iter()
+        .map(|p| p[1])
+        .chain(threshold.map(log))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    let decades = if hi - lo >= WHOLE_DECADES_FROM {
+        vec![lo.floor(), hi.ceil()]
+    } else {
+        Vec::new()
+    };
+    let mut plot = super::plots::readable_log_y(Plot::new(id));
+    for d in decades {
+        plot = plot.include_y(d);
+    }
+    plot.height(height)
         .x_axis_label("update")
         .y_axis_label("ε (mm, log)")
         // Updates are whole numbers: no tick at 0.5.

@@ -19,8 +19,9 @@ pub fn status_ui(ui: &mut egui::Ui, state: &AppState) {
                 Level::Warning => text.color(WARN),
                 Level::Error => text.color(BAD),
             };
-            ui.add(egui::Label::new(text).truncate())
-                .on_hover_text(&s.text);
+            // Whole, on as many lines as it takes: a cut status hides
+            // what happened.
+            ui.add(egui::Label::new(text).wrap());
         }
     });
 }

@@ -1,24 +1,52 @@
 //! The step bar: the operator's job in order (plan → data in → stripes
 //! checked → calibrated → validated → reported), where the open session
-//! stands, and the next action as one button.
+//! stands, and the next action as one button, with an action in every
+//! state: a stale step is done again, a FAIL leads to the outliers and
+//! then to the planner, a session without validate measurements skips
+//! the validation and goes on to the report. Whether a step is stale
+//! comes from the one [`provenance`](crate::app::provenance) of the
+//! state, never from a flag of its own.
 
 use egui::RichText;
 
 use super::{AFTER, BAD, GOOD, MUTED, WARN};
-use crate::app::commands::{Command, RunCommand, ViewCommand};
+use crate::app::commands::{Command, PlanCommand, RunCommand, ViewCommand};
 use crate::app::forms::{Forms, Tab};
+use crate::app::provenance::Output;
 use crate::app::state::{AppState, ExportKind};
 use crate::engine::result_view::Verdict;
 
 /// Where one step stands.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub enum StepState {
-    /// Done.
+    /// Done, and made from the inputs as they are.
     Done,
-    /// Done, but with something to look at (failed stripes, a FAIL).
+    /// Done, with something to look at (stripe warnings, a FAIL).
     Attention,
+    /// Done, but an input it was made from has changed since: what
+    /// changed, in words.
+    Stale(String),
+    /// Not needed for this session (no validate measurements).
+    Skipped,
+    /// Under way (a run, a file being opened).
+    Running,
     /// Not done yet.
     Todo,
+}
+
+impl StepState {
+    /// The mark on the bar: ● done, ! attention or stale, – skipped,
+    /// … under way, ○ to do.
+    #[must_use]
+    pub fn mark(&self) -> &'static str {
+        match self {
+            Self::Done => "●",
+            Self::Attention | Self::Stale(_) => "!",
+            Self::Skipped => "–",
+            Self::Running => "…",
+            Self::Todo => "○",
+        }
+    }
 }
 
 /// One step of the job.
@@ -31,112 +59,278 @@ pub struct Step {
     /// A few words on its state (hover text).
     pub detail: String,
     /// The button that does or shows it, and its command.
-    pub action: (&'static str, Command),
+    pub action: (String, Command),
+}
+
+fn show(tab: Tab) -> Command {
+    Command::View(ViewCommand::ShowTab(tab))
+}
+
+/// The verdict of the result on show against the form's tolerance.
+#[must_use]
+pub fn verdict(state: &AppState, forms: &Forms) -> Option<Verdict> {
+    state
+        .result
+        .as_ref()
+        .map(|r| Verdict::of(r.shown.headline.as_ref(), &forms.tolerance))
+}
+
+/// Measurements `ml` listed as outliers in the result on show.
+fn outliers(state: &AppState) -> usize {
+    state
+        .result
+        .as_ref()
+        .and_then(|r| r.file.solver.ml())
+        .map_or(0, |m| m.outliers.len())
 }
 
 /// The six steps of the job for the current state.
 #[must_use]
 pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
+    let prov = &state.provenance;
     let planned = state.plan.outcome.as_ref().is_some_and(Result::is_ok);
+    let plan_stale = prov.stale(Output::Plan);
     let loaded = state.loaded.as_ref();
     let failed = loaded.map_or(0, |l| l.analysis.failures().count());
-    let verdict = state
-        .result
-        .as_ref()
-        .map(|r| Verdict::of(r.shown.headline.as_ref(), &forms.tolerance));
-    let show = |tab| Command::View(ViewCommand::ShowTab(tab));
+    let warned = loaded.map_or(0, |l| l.analysis.warnings.len());
+    let result_stale = prov.stale(Output::Result);
+    let running = state.run.is_some();
+    let verdict = verdict(state, forms);
+    let report_stale = prov.stale(Output::Report);
+    let reported = state.reported.is_some() && prov.made(Output::Report).is_some();
     vec![
         Step {
             name: "Plan",
-            state: if planned || loaded.is_some() {
-                StepState::Done
-            } else {
-                StepState::Todo
+            state: match (&plan_stale, planned, loaded.is_some()) {
+                (Some(s), true, _) => StepState::Stale(s.what_changed()),
+                (_, true, _) | (_, false, true) => StepState::Done,
+                _ => StepState::Todo,
             },
-            detail: if planned {
-                "a pose plan is made".into()
-            } else if loaded.is_some() {
-                "a session is open (its poses were planned elsewhere)".into()
-            } else {
-                "plan the poses for the robot and the sphere".into()
+            detail: match (&plan_stale, planned, loaded.is_some()) {
+                (Some(s), true, _) => format!("{s}: make it again before writing its program"),
+                (_, true, _) => "a pose plan is made".into(),
+                (_, false, true) => "a session is open (its poses were planned elsewhere)".into(),
+                _ => "plan the poses for the robot and the sphere".into(),
             },
-            action: ("Plan the poses", show(Tab::Plan)),
+            action: (
+                if plan_stale.is_some() {
+                    "Make the plan again".into()
+                } else {
+                    "Plan the poses".into()
+                },
+                show(Tab::Plan),
+            ),
         },
         Step {
             name: "Data in",
-            state: if loaded.is_some() {
+            state: if state.busy.loading > 0 {
+                StepState::Running
+            } else if loaded.is_some() {
                 StepState::Done
             } else {
                 StepState::Todo
             },
-            detail: loaded.map_or_else(
-                || "import the robot's log and the sensor's profiles, or open a session".into(),
-                |l| {
-                    format!(
-                        "{} measurements in \"{}\"",
-                        l.session.measurements.len(),
-                        l.session.name
-                    )
-                },
-            ),
-            action: ("Import data", show(Tab::Import)),
+            detail: if state.busy.loading > 0 {
+                state.busy.opening.as_ref().map_or_else(
+                    || "opening a file…".to_string(),
+                    |w| format!("opening {w}…"),
+                )
+            } else {
+                loaded.map_or_else(
+                    || "import the robot's log and the sensor's profiles, or open a session".into(),
+                    |l| {
+                        format!(
+                            "{} measurements in \"{}\"",
+                            l.session.measurements.len(),
+                            l.session.name
+                        )
+                    },
+                )
+            },
+            action: ("Import data".into(), show(Tab::Import)),
         },
         Step {
             name: "Stripes checked",
             state: match loaded {
                 None => StepState::Todo,
-                Some(_) if failed > 0 => StepState::Attention,
+                Some(_) if failed + warned > 0 => StepState::Attention,
                 Some(_) => StepState::Done,
             },
             detail: match loaded {
                 None => "no session yet".into(),
-                Some(_) if failed > 0 => format!(
-                    "{failed} stripe(s) cannot be fitted: look at them in Stripe, leave them out in Session"
+                Some(_) if failed + warned > 0 => format!(
+                    "{failed} stripe(s) cannot be fitted, {warned} with warnings: look at them in Stripe (Session: only warnings and failures), leave out what is wrong"
                 ),
-                Some(_) => "every stripe fits a circle".into(),
+                Some(_) => "every stripe fits a circle, no warnings".into(),
             },
-            action: ("Check the stripes", show(Tab::Stripe)),
+            action: ("Check the stripes".into(), show(Tab::Stripe)),
         },
         Step {
             name: "Calibrated",
-            state: if state.result.is_some() {
-                StepState::Done
-            } else {
-                StepState::Todo
+            state: match (&result_stale, running, &state.result) {
+                (_, true, _) => StepState::Running,
+                (Some(s), _, Some(_)) => StepState::Stale(s.what_changed()),
+                (_, _, Some(_)) => StepState::Done,
+                _ => StepState::Todo,
             },
-            detail: state.result.as_ref().map_or_else(
-                || "run the calibration".into(),
-                |r| format!("method {}", r.method),
+            detail: match (&result_stale, &state.run, &state.result) {
+                (_, Some(run), _) => format!("calibrating: {}", run.phase),
+                (Some(s), _, Some(_)) => format!("{s}: run again"),
+                (_, _, Some(r)) => format!("method {}", r.method),
+                _ => "run the calibration".into(),
+            },
+            action: (
+                if result_stale.is_some() {
+                    "▶ Run again".into()
+                } else {
+                    "▶ Run the calibration".into()
+                },
+                Command::Run(RunCommand::Start),
             ),
-            action: ("▶ Run the calibration", Command::Run(RunCommand::Start)),
         },
         Step {
             name: "Validated",
-            state: match &verdict {
-                None | Some(Verdict::NotChecked) => StepState::Todo,
-                Some(Verdict::Pass) => StepState::Done,
-                Some(Verdict::Fail(_)) => StepState::Attention,
+            state: match (&result_stale, running, &verdict) {
+                (_, true, _) | (_, _, None) => StepState::Todo,
+                (Some(s), _, Some(_)) => StepState::Stale(s.what_changed()),
+                (_, _, Some(Verdict::Pass)) => StepState::Done,
+                (_, _, Some(Verdict::Fail(_))) => StepState::Attention,
+                (_, _, Some(Verdict::NotChecked)) => StepState::Skipped,
             },
-            detail: verdict.as_ref().map_or_else(
-                || "calibrate first".into(),
-                |v| v.describe(&forms.tolerance),
-            ),
-            action: ("See the verdict", show(Tab::Results)),
+            detail: match (&result_stale, &verdict) {
+                (_, None) => "calibrate first".into(),
+                (Some(s), Some(_)) => format!("{s}: its verdict no longer holds"),
+                (_, Some(Verdict::NotChecked)) => {
+                    "skipped: no validate data (the session has no validate measurements)".into()
+                }
+                (_, Some(v)) => v.describe(&forms.tolerance),
+            },
+            action: ("See the verdict".into(), show(Tab::Results)),
         },
         Step {
             name: "Reported",
-            state: if state.reported.is_some() {
-                StepState::Done
-            } else {
-                StepState::Todo
+            state: match (&report_stale, reported) {
+                (Some(s), true) => StepState::Stale(s.what_changed()),
+                (_, true) => StepState::Done,
+                _ => StepState::Todo,
             },
-            detail: state.reported.as_ref().map_or_else(
-                || "write the HTML report".into(),
-                |p| format!("report written: {}", p.display()),
+            detail: match (&report_stale, &state.reported) {
+                (Some(s), Some(p)) => format!(
+                    "{s}: the report at {} no longer says what is on show; write it again",
+                    p.display()
+                ),
+                (_, Some(p)) if reported => format!("report written: {}", p.display()),
+                _ => "write the HTML report".into(),
+            },
+            action: (
+                if report_stale.is_some() {
+                    "Write the report again".into()
+                } else {
+                    "Write the report".into()
+                },
+                Command::Export(ExportKind::ReportHtml),
             ),
-            action: ("Write the report", Command::Export(ExportKind::ReportHtml)),
         },
     ]
+}
+
+/// What the Next button offers: its text, its command (`None`: shown
+/// disabled, e.g. while a run is under way), why, and other ways on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NextAction {
+    /// The button text after "Next: ".
+    pub label: String,
+    /// Its command; `None` while something is under way.
+    pub command: Option<Command>,
+    /// Why this is next (hover text).
+    pub why: String,
+    /// Other ways on, as smaller buttons ("or: write the report").
+    pub others: Vec<(String, Command)>,
+}
+
+/// The next action in the current state; `None` when every step is done
+/// (and nothing failed).
+#[must_use]
+pub fn next_action(state: &AppState, forms: &Forms, all: &[Step]) -> Option<NextAction> {
+    let simple = |k: usize| {
+        let step: &Step = &all[k];
+        Some(NextAction {
+            label: step.action.0.clone(),
+            command: Some(step.action.1.clone()),
+            why: step.detail.clone(),
+            others: Vec::new(),
+        })
+    };
+    if let Some(run) = &state.run {
+        return Some(NextAction {
+            label: format!("calibrating… {:.0} %", run.fraction * 100.0),
+            command: None,
+            why: format!(
+                "{}: wait for the run, or press Cancel in the solver panel (the result on show stays)",
+                run.phase
+            ),
+            others: Vec::new(),
+        });
+    }
+    if state.busy.loading > 0 {
+        return Some(NextAction {
+            label: "opening…".into(),
+            command: None,
+            why: all[1].detail.clone(),
+            others: Vec::new(),
+        });
+    }
+    if state.loaded.is_none() {
+        // Plan (again) or bring the data in.
+        let k = usize::from(!matches!(
+            all[0].state,
+            StepState::Todo | StepState::Stale(_)
+        ));
+        return simple(k);
+    }
+    // A missing or stale result: run (again).
+    if matches!(all[3].state, StepState::Todo | StepState::Stale(_)) {
+        return simple(3);
+    }
+    let report = &all[5];
+    let report_todo = !matches!(report.state, StepState::Done);
+    if let Some(Verdict::Fail(reasons)) = verdict(state, forms) {
+        let n = outliers(state);
+        let mut others = Vec::new();
+        if report_todo {
+            others.push((
+                "write the report (FAIL)".to_string(),
+                report.action.1.clone(),
+            ));
+        }
+        let why = format!("FAIL: {}", reasons.join(", "));
+        if n > 0 && !state.outliers_seen {
+            others.insert(
+                0,
+                (
+                    "plan more stations".to_string(),
+                    Command::Plan(PlanCommand::MoreStations),
+                ),
+            );
+            return Some(NextAction {
+                label: format!("Look at the {n} outlier(s)"),
+                command: Some(Command::View(ViewCommand::ShowOutliers)),
+                why: format!(
+                    "{why}: see which measurements the solver flagged, leave out what is wrong, run again"
+                ),
+                others,
+            });
+        }
+        return Some(NextAction {
+            label: "Plan more stations".into(),
+            command: Some(Command::Plan(PlanCommand::MoreStations)),
+            why: format!(
+                "{why}: more identify stations determine the parameters better; the planner opens with more of them"
+            ),
+            others,
+        });
+    }
+    report_todo.then(|| simple(5)).flatten()
 }
 
 /// The first-start "what to do", on the demo until dismissed.
@@ -164,53 +358,92 @@ fn intro_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
     });
 }
 
-/// The bar: each step with its mark, then the next action's button.
+/// The colour of a step's mark and name.
+fn colour(step: &Step) -> egui::Color32 {
+    match step.state {
+        StepState::Done => GOOD,
+        StepState::Attention if step.name == "Validated" => BAD,
+        StepState::Attention | StepState::Stale(_) => WARN,
+        StepState::Running => AFTER,
+        StepState::Skipped | StepState::Todo => MUTED,
+    }
+}
+
+/// The bar: each step with its mark, then the next action's button and
+/// the other ways on.
 pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mut Vec<Command>) {
     intro_ui(ui, state, commands);
     let all = steps(state, forms);
-    // The next step: the first not done, else a step that needs attention.
-    let next = all
-        .iter()
-        .position(|s| s.state == StepState::Todo)
-        .or_else(|| all.iter().position(|s| s.state == StepState::Attention));
+    let next = next_action(state, forms, &all);
     ui.horizontal_wrapped(|ui| {
         for (k, step) in all.iter().enumerate() {
             if k > 0 {
                 ui.label(RichText::new("›").color(MUTED));
             }
-            let (mark, colour) = match step.state {
-                StepState::Done => ("●", GOOD),
-                StepState::Attention => ("!", if step.name == "Validated" { BAD } else { WARN }),
-                StepState::Todo => ("○", MUTED),
-            };
-            let mut text = RichText::new(format!("{mark} {}. {}", k + 1, step.name))
+            let text = RichText::new(format!("{} {}. {}", step.state.mark(), k + 1, step.name))
                 .size(14.0)
-                .color(colour);
-            if Some(k) == next {
-                text = text.strong();
-            }
+                .color(colour(step));
             // A step is a link to its view (or does its action).
             let busy = state.run.is_some() && matches!(step.action.1, Command::Run(_));
+            let hover = match &step.state {
+                StepState::Stale(_) => format!("stale: {} ({})", step.detail, step.action.0),
+                _ => format!("{} ({})", step.detail, step.action.0),
+            };
             if ui
                 .add_enabled(!busy, egui::Button::new(text).frame(false))
-                .on_hover_text(format!("{} ({})", step.detail, step.action.0))
+                .on_hover_text(hover)
                 .clicked()
             {
                 commands.push(step.action.1.clone());
             }
         }
-        if let Some(k) = next {
-            ui.add_space(12.0);
-            let (label, command) = &all[k].action;
-            let busy = state.run.is_some() && matches!(command, Command::Run(_));
-            let button = egui::Button::new(RichText::new(format!("Next: {label}")).color(AFTER));
-            if ui
-                .add_enabled(!busy, button)
-                .on_hover_text(&all[k].detail)
-                .clicked()
-            {
-                commands.push(command.clone());
+        match &next {
+            Some(n) => {
+                ui.add_space(12.0);
+                let button =
+                    egui::Button::new(RichText::new(format!("Next: {}", n.label)).color(AFTER));
+                if ui
+                    .add_enabled(n.command.is_some(), button)
+                    .on_hover_text(&n.why)
+                    .on_disabled_hover_text(&n.why)
+                    .clicked()
+                    && let Some(c) = &n.command
+                {
+                    commands.push(c.clone());
+                }
+                for (label, command) in &n.others {
+                    if ui
+                        .small_button(format!("or: {label}"))
+                        .on_hover_text(&n.why)
+                        .clicked()
+                    {
+                        commands.push(command.clone());
+                    }
+                }
             }
+            None if state.loaded.is_some() => {
+                ui.add_space(12.0);
+                ui.label(RichText::new("● every step is done").color(GOOD));
+            }
+            None => {}
         }
     });
+    // What changed, in words, under the bar: the stale steps, by cause.
+    let mut causes: Vec<(&str, Vec<String>)> = Vec::new();
+    for (k, step) in all.iter().enumerate() {
+        if let StepState::Stale(what) = &step.state {
+            let name = format!("{}. {}", k + 1, step.name);
+            match causes.iter_mut().find(|(w, _)| *w == what.as_str()) {
+                Some((_, names)) => names.push(name),
+                None => causes.push((what, vec![name])),
+            }
+        }
+    }
+    for (what, names) in causes {
+        ui.label(
+            RichText::new(format!("! stale: {} — {what}", names.join(", ")))
+                .small()
+                .color(WARN),
+        );
+    }
 }

@@ -26,7 +26,7 @@ pub fn stripe_ui(
     commands: &mut Vec<Command>,
 ) {
     let Some(loaded) = &state.loaded else {
-        ui.label("No session open.");
+        super::no_session_ui(ui, state);
         return;
     };
     let rows = state.visible_rows(forms);
@@ -182,6 +182,18 @@ fn facts_ui(ui: &mut egui::Ui, s: &StripeResult, sphere_radius: f64) {
     }
 }
 
+/// The residual plot's scale above the used points, as a fraction.
+const RESIDUAL_MARGIN: f64 = 1.15;
+
+/// How far the residual plot reaches (µm, each side of 0): the largest
+/// used residual or twice the RMS, with a margin; never the rejected
+/// points'.
+#[must_use]
+pub fn residual_limit(used: &[[f64; 2]], rms_um: f64) -> f64 {
+    let largest = used.iter().fold(0.0_f64, |m, p| m.max(p[1].abs()));
+    (largest.max(2.0 * rms_um) * RESIDUAL_MARGIN).max(1e-3)
+}
+
 /// Height of a plot's title and key lines above it, points.
 const KEY_HEIGHT: f32 = 44.0;
 
@@ -283,22 +295,41 @@ fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) 
                 .filter(|&k| inlier(k))
                 .map(|k| [k as f64, um(k)])
                 .collect();
+            let rms = s.fit.rms * 1000.0;
+            // The scale is the used points' (and ±RMS): a rejected point
+            // of 783 µm must not flatten residuals of ±10 µm. Rejected
+            // points beyond it are drawn at its edge.
+            let limit = residual_limit(&used, rms);
             // Points off the arc are far from the circle: not plotted here.
-            let out: Vec<[f64; 2]> = (0..points.len())
+            let rejected_um: Vec<[f64; 2]> = (0..points.len())
                 .filter(|&k| !inlier(k) && !off_arc(k))
                 .map(|k| [k as f64, um(k)])
                 .collect();
-            let rms = s.fit.rms * 1000.0;
+            let beyond = rejected_um.iter().filter(|p| p[1].abs() > limit).count();
+            let largest = rejected_um.iter().fold(0.0_f64, |m, p| m.max(p[1].abs()));
+            let out: Vec<[f64; 2]> = rejected_um
+                .iter()
+                .map(|p| [p[0], p[1].clamp(-limit, limit)])
+                .collect();
             let rms_key = format!("- - ± RMS ({rms:.1} µm)");
+            let rejected_key = if beyond > 0 {
+                format!(
+                    "× rejected ({beyond} beyond ±{limit:.0} µm drawn at the edge; largest {largest:.0} µm)"
+                )
+            } else {
+                "× rejected".to_string()
+            };
             let mut key = vec![("● used", AFTER), (rms_key.as_str(), MUTED)];
             if !out.is_empty() {
-                key.push(("× rejected", BAD));
+                key.push((rejected_key.as_str(), BAD));
             }
             super::plot_key(ui, &key);
             super::plots::readable(Plot::new("residual_plot"), true)
                 .height(height - KEY_HEIGHT)
                 .x_axis_label("point")
                 .y_axis_label("residual (µm)")
+                .include_y(-limit)
+                .include_y(limit)
                 .show(ui, |p| {
                     p.points(
                         Points::new("used", PlotPoints::from(used))
@@ -328,4 +359,20 @@ fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) 
                 });
         });
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The issue: one rejected point of 783 µm set the residual scale and
+    /// flattened residuals of ±10 µm. The scale is the used points'.
+    #[test]
+    fn the_residual_scale_is_the_used_points() {
+        let used = [[0.0, 9.0], [1.0, -10.0], [2.0, 4.0]];
+        let limit = residual_limit(&used, 3.0);
+        assert!((limit - 10.0 * RESIDUAL_MARGIN).abs() < 1e-9, "{limit}");
+        // At least twice the RMS when the points are all small.
+        assert!((residual_limit(&[[0.0, 1.0]], 6.0) - 12.0 * RESIDUAL_MARGIN).abs() < 1e-9);
+    }
 }

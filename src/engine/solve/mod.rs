@@ -19,6 +19,7 @@ pub mod ml;
 pub mod paper;
 pub mod plausible;
 pub mod prepare;
+pub mod progress;
 pub mod report;
 
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -34,6 +35,7 @@ use estimate::{Estimate, Station};
 pub use held_out::{HeldOut, HeldOutRecord, HeldOutScheme};
 use paper::PaperOptions;
 pub use prepare::{Analysis, HandEyeSource, Prepared, PreparedMeasurement, analyse, prepare};
+pub use progress::{Control, Phase, Progress};
 pub use report::{LoopRecord, SolverReport};
 
 /// Why a calibration of a loaded session could not run, or failed.
@@ -149,102 +151,6 @@ impl Options {
     }
 }
 
-/// Reported after every ε evaluation.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Progress {
-    /// Updates made so far (0 for the starting ε).
-    pub updates: usize,
-    /// ε after that many updates, mm.
-    pub epsilon: f64,
-    /// The iteration bound.
-    pub max_iterations: usize,
-    /// The threshold, mm.
-    pub threshold: f64,
-    /// What the run is doing: a new ε of the loop, or a phase inside an
-    /// update or after the loop.
-    pub phase: Phase,
-}
-
-/// What a run is doing, for progress reports.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Phase {
-    /// The loop computed ε after `updates` updates.
-    Loop,
-    /// Inside update `updates + 1`: the method's inner step `step` (`ml`:
-    /// a Levenberg-Marquardt step) was taken.
-    Step {
-        /// Inner steps taken in this update.
-        step: usize,
-    },
-    /// `ml`: the parameter covariance and the leverages.
-    Covariance,
-    /// `ml`: the predicted σ of the distances.
-    Prediction,
-    /// `ml`: leave-one-station-out refits, `done` of `of` stations.
-    CrossValidation {
-        /// Stations done.
-        done: usize,
-        /// Stations in all.
-        of: usize,
-    },
-    /// `ml`: residuals, outliers and the variance factor.
-    Outliers,
-    /// The held-out figure ([`held_out`]): `done` of `of` refits made
-    /// (measurements for leave-one-pose-out, folds for k-fold).
-    HeldOut {
-        /// How the refits are made.
-        scheme: HeldOutScheme,
-        /// Refits done.
-        done: usize,
-        /// Refits in all.
-        of: usize,
-    },
-}
-
-impl Phase {
-    /// In words, with the count done where there is one.
-    #[must_use]
-    pub fn describe(&self, updates: usize) -> String {
-        match *self {
-            Self::Loop => format!("update {updates}"),
-            Self::Step { step } => format!("update {}: solver step {step}", updates + 1),
-            Self::Covariance => "covariance and leverages".to_string(),
-            Self::Prediction => "predicted distance σ".to_string(),
-            Self::CrossValidation { done, of } => {
-                format!("leave-one-station-out: {done} of {of} stations")
-            }
-            Self::Outliers => "outliers and variance factor".to_string(),
-            Self::HeldOut { scheme, done, of } => {
-                format!(
-                    "held out ({}): {done} of {of} {}",
-                    scheme.label(of),
-                    scheme.unit()
-                )
-            }
-        }
-    }
-
-    /// The fraction of the phase done, when it has one.
-    #[must_use]
-    pub fn fraction(&self) -> Option<f64> {
-        match *self {
-            Self::CrossValidation { done, of } | Self::HeldOut { done, of, .. } if of > 0 => {
-                Some(done as f64 / of as f64)
-            }
-            _ => None,
-        }
-    }
-}
-
-/// What the progress callback asks for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Control {
-    /// Go on.
-    Continue,
-    /// Stop now: the run ends with [`StopReason::Cancelled`].
-    Cancel,
-}
-
 /// Why the loop stopped, with the measured value beside the threshold.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum StopReason {
@@ -295,7 +201,8 @@ pub enum StopReason {
         last_change: f64,
     },
     /// The caller cancelled the run (the estimate is the one reached so
-    /// far, and a method's costly diagnostics are left out).
+    /// far, and a method's costly diagnostics are left out, unless the
+    /// cancel came in the last phase, [`Phase::Finishing`], after them).
     Cancelled {
         /// ε when cancelled, mm.
         epsilon: f64,
@@ -609,33 +516,57 @@ pub fn run(
         robot: session.solver_robot(),
         flange_from_sensor: prepared.hand_eye_initial,
     };
+    let report = |updates: usize, epsilon: f64, phase: Phase| Progress {
+        updates,
+        epsilon,
+        max_iterations: options.max_iterations,
+        threshold: options.threshold,
+        phase,
+    };
+    // The paper's update sets up at once; `ml` looks at the cancel while
+    // it builds its problem.
+    let cancelled_early = progress(&report(0, f64::NAN, Phase::Setup)) == Control::Cancel;
     let mut method: Box<dyn Update> = match options.method {
         Method::Paper => Box::new(paper::PaperUpdate::new(
             start.clone(),
             stations.clone(),
             options,
         )),
-        Method::Ml => Box::new(ml::MlUpdate::new(
-            session,
-            prepared,
-            &start,
-            stations.clone(),
-            options,
-        )?),
+        Method::Ml if cancelled_early => {
+            return Ok(cancelled_in_setup(
+                session, prepared, options, &start, &stations,
+            ));
+        }
+        Method::Ml => {
+            let mut setup = |phase: Phase| progress(&report(0, f64::NAN, phase));
+            match ml::MlUpdate::new(
+                session,
+                prepared,
+                &start,
+                stations.clone(),
+                options,
+                &mut setup,
+            )? {
+                Some(m) => Box::new(m),
+                None => {
+                    return Ok(cancelled_in_setup(
+                        session, prepared, options, &start, &stations,
+                    ));
+                }
+            }
+        }
     };
-    let looped = iterate(method.as_mut(), &stations, options, progress)?;
+    let looped = iterate(
+        method.as_mut(),
+        &stations,
+        options,
+        cancelled_early,
+        progress,
+    )?;
     let mut stop = looped.stop(options);
     let (updates, eps) = (looped.iterations.len() - 1, stop_epsilon(&stop));
     let est = method.estimate().clone();
-    let mut after = |phase: Phase| {
-        progress(&Progress {
-            updates,
-            epsilon: eps,
-            max_iterations: options.max_iterations,
-            threshold: options.threshold,
-            phase,
-        })
-    };
+    let mut after = |phase: Phase| progress(&report(updates, eps, phase));
     let mut held_out = None;
     if options.held_out && !stop.is_cancelled() {
         match method.held_out(&mut after) {
@@ -644,7 +575,7 @@ pub fn run(
         }
     }
     let (report, cancelled_late) = method.report(&stop, &mut after);
-    if cancelled_late {
+    if cancelled_late || (!stop.is_cancelled() && after(Phase::Finishing) == Control::Cancel) {
         stop = stop.cancelled();
     }
     let mut cal = finish(
@@ -737,7 +668,8 @@ impl Looped {
 /// identify `stations`: compute ε; while ε > threshold, fewer than
 /// `max_iterations` updates were made, the method has not converged and ε
 /// has not levelled off, update and compute ε again. `progress` hears of
-/// every ε and every inner step, and may cancel.
+/// every ε and every inner step, and may cancel (`cancelled`: it did
+/// already, while the method was set up).
 ///
 /// # Errors
 /// As the method's update, or a non-finite ε.
@@ -745,6 +677,7 @@ fn iterate(
     method: &mut dyn Update,
     stations: &[Station],
     options: &Options,
+    cancelled: bool,
     progress: &mut dyn FnMut(&Progress) -> Control,
 ) -> Result<Looped, SolveError> {
     let eps_of = |est: &Estimate| epsilon(&est.station_centres(stations));
@@ -757,7 +690,7 @@ fn iterate(
         threshold: options.threshold,
         phase,
     };
-    let mut cancelled = progress(&report(0, eps, Phase::Loop)) == Control::Cancel;
+    let mut cancelled = cancelled || progress(&report(0, eps, Phase::Loop)) == Control::Cancel;
     let mut converged = None;
     let mut levelled = 0_usize;
     while !cancelled
@@ -800,6 +733,37 @@ fn iterate(
         converged,
         levelled,
     })
+}
+
+/// The run cancelled before its method was set up: the start, ε of the
+/// start, and a report of the settings only.
+fn cancelled_in_setup(
+    session: &Session,
+    prepared: &Prepared,
+    options: &Options,
+    start: &Estimate,
+    stations: &[estimate::Station],
+) -> Calibration {
+    let eps = epsilon(&start.station_centres(stations));
+    let stop = StopReason::Cancelled {
+        epsilon: eps,
+        threshold: options.threshold,
+        updates: 0,
+    };
+    let report = SolverReport::Ml(Box::new(ml::MlReport {
+        stop: stop.record(options),
+        ..ml::MlReport::default()
+    }));
+    finish(
+        session,
+        prepared,
+        options,
+        start,
+        start.clone(),
+        vec![eps],
+        stop,
+        report,
+    )
 }
 
 /// The centres and statistics of a finished run.

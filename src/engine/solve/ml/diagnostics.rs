@@ -341,6 +341,9 @@ pub(super) fn report(
     let predicted_validate =
         (!vpairs.is_empty()).then(|| distance_std(problem, &state.est, &cov_scaled, &vpairs));
     let predicted_identify = distance_std(problem, &state.est, &cov_scaled, &ipairs);
+    if phase(Phase::RangeError) == Control::Cancel {
+        return cancelled(solver);
+    }
     let range_error =
         super::range::range_error(session, prepared, problem, &state.est, &cov_scaled);
     // Leave-one-station-out.

@@ -161,6 +161,9 @@ fn pose_sigma_at(start: &Estimate, stations: &[Station]) -> f64 {
     (sum / dof as f64).sqrt().max(MIN_POSE_SIGMA_MM)
 }
 
+/// Stations between two looks at the cancel while the problem is set up.
+pub const SETUP_CHECK: usize = 128;
+
 /// LM steps in one update of the loop. From the nominal model LM takes
 /// 5-10 steps; 100 only guards against a pathological session.
 const MAX_LM_STEPS: usize = 100;
@@ -266,6 +269,9 @@ impl<'a> MlUpdate<'a> {
     /// The problem of `session` from the start `start`: observations
     /// whitened by the noise model at the start, the identifiable set, the
     /// prior, and every station centre at the mean of its sightings.
+    /// `phase` is told [`Phase::Setup`] every [`SETUP_CHECK`] measurements
+    /// and stations and at each pivot of the identifiable set; `Ok(None)`
+    /// when it cancels.
     ///
     /// # Errors
     /// A bad `ml` option, a noise model that is not positive definite, or
@@ -276,8 +282,10 @@ impl<'a> MlUpdate<'a> {
         start: &Estimate,
         stations: Vec<Station>,
         options: &Options,
-    ) -> Result<Self, SolveError> {
+        phase: &mut dyn FnMut(Phase) -> Control,
+    ) -> Result<Option<Self>, SolveError> {
         options.ml.validate()?;
+        let mut go_on = || phase(Phase::Setup) == Control::Continue;
         let mut options = *options;
         if session.pose_only() {
             let estimated = pose_sigma_at(start, &stations);
@@ -291,6 +299,9 @@ impl<'a> MlUpdate<'a> {
             .collect();
         let mut obs = Vec::new();
         for (s, (_, idx)) in groups.iter().enumerate() {
+            if s % SETUP_CHECK == 0 && !go_on() {
+                return Ok(None);
+            }
             for &i in idx {
                 let sighting = prepared.sighting(session, i);
                 let cov = base_covariance(
@@ -319,7 +330,15 @@ impl<'a> MlUpdate<'a> {
             });
         }
         let station_ids: Vec<String> = groups.into_iter().map(|(id, _)| id).collect();
-        let ident = identifiability(&obs, station_ids.len(), start, mo.rank_tolerance);
+        let Some(ident) = identifiability(
+            &obs,
+            station_ids.len(),
+            start,
+            mo.rank_tolerance,
+            &mut go_on,
+        ) else {
+            return Ok(None);
+        };
         let n_unknowns = 6 + start.robot.n_params();
         let scale = ident.estimated.iter().map(|&u| unknown_scale(u)).collect();
         let prior = chart_prior(&ident, &session.robot.params(), mo);
@@ -340,7 +359,7 @@ impl<'a> MlUpdate<'a> {
             sums[o.station].1 += 1.0;
         }
         let centres = sums.iter().map(|(s, n)| s / *n).collect();
-        Ok(Self {
+        Ok(Some(Self {
             session,
             prepared,
             options,
@@ -353,7 +372,7 @@ impl<'a> MlUpdate<'a> {
             },
             lambda: LAMBDA_START,
             history: Vec::new(),
-        })
+        }))
     }
 
     /// Relative cost decrease of the last LM step (0 when none was taken).
@@ -468,7 +487,15 @@ pub fn analyse(
         flange_from_sensor: prepared.hand_eye_initial,
     };
     let stations = prepared.stations(session, Use::Identify);
-    let update = MlUpdate::new(session, prepared, &start, stations.clone(), options)?;
+    let update = MlUpdate::new(
+        session,
+        prepared,
+        &start,
+        stations.clone(),
+        options,
+        &mut |_| Control::Continue,
+    )?
+    .ok_or_else(|| SolveError::InvalidOption("the analysis was cancelled".to_string()))?;
     let stop = StopReason::IterationLimit {
         epsilon: epsilon(&start.station_centres(&stations)),
         threshold: options.threshold,
@@ -499,8 +526,18 @@ pub fn exact_held_out(
         flange_from_sensor: prepared.hand_eye_initial,
     };
     let stations = prepared.stations(session, Use::Identify);
-    let mut update = MlUpdate::new(session, prepared, &start, stations.clone(), options)?;
-    super::iterate(&mut update, &stations, options, &mut |_| Control::Continue)?;
+    let mut update = MlUpdate::new(
+        session,
+        prepared,
+        &start,
+        stations.clone(),
+        options,
+        &mut |_| Control::Continue,
+    )?
+    .ok_or_else(|| SolveError::InvalidOption("the refits were cancelled".to_string()))?;
+    super::iterate(&mut update, &stations, options, false, &mut |_| {
+        Control::Continue
+    })?;
     let problem = &update.problem;
     let predictions = (0..problem.obs.len())
         .map(|i| {
