@@ -45,13 +45,13 @@ pub use self::check::{
 };
 pub use self::log::{ColumnMap, DEFAULT_SIDE_COLUMN, header, preview};
 pub use self::poses::{
-    Observations, PoseImportSpec, PoseInputs, SideChoice, build_pose_session, import_poses,
+    Observations, PoseImportSpec, PoseInputs, SideChoice, build_pose_session,
     read_pose_inputs,
 };
 pub use self::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource, RawProfile};
 pub use self::references::{read_references, reference_rows};
 pub use self::robot_source::{RobotSource, load_robot};
-pub use self::side::decide_side;
+pub use self::side::{decide_side, import_poses};
 pub use self::units::{AngleUnit, LengthUnit};
 pub use crate::engine::program::PoseFormat;
 pub use crate::engine::robot::controller::FlangeConvention;

@@ -698,27 +698,6 @@ pub fn build_pose_session(
     })
 }
 
-/// The whole import of a pose file: [`read_pose_inputs`], then the side
-/// given, or with [`SideChoice::Auto`] (and no side column, and no
-/// centres) [`super::side::decide_side`], which calibrates both sides.
-///
-/// # Errors
-/// As [`read_pose_inputs`], [`build_pose_session`] and
-/// [`super::side::decide_side`].
-pub fn import_poses(spec: &PoseImportSpec) -> Result<Imported, ImportError> {
-    let inputs = read_pose_inputs(spec)?;
-    match spec.side {
-        SideChoice::Auto if !inputs.all_sides_given() && !inputs.centres() => {
-            super::side::decide_side(spec, &inputs)
-        }
-        choice => build_pose_session(
-            spec,
-            &inputs,
-            if choice == SideChoice::Minus { -1 } else { 1 },
-        ),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

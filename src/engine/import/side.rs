@@ -8,7 +8,7 @@
 //! calibrated, or the two are too close to tell, the error says why,
 //! with both sides' outcome.
 
-use super::poses::{PoseImportSpec, PoseInputs, build_pose_session};
+use super::poses::{PoseImportSpec, PoseInputs, SideChoice, build_pose_session, read_pose_inputs};
 use super::{ImportError, Imported};
 use crate::engine::solve::{self, Options};
 
@@ -127,3 +127,25 @@ pub fn decide_side(spec: &PoseImportSpec, inputs: &PoseInputs) -> Result<Importe
     ));
     Ok(imported)
 }
+
+/// The whole import of a pose file: [`read_pose_inputs`], then the side
+/// given, or with [`SideChoice::Auto`] (and no side column, and no
+/// centres) [`decide_side`], which calibrates both sides.
+///
+/// # Errors
+/// As [`read_pose_inputs`], [`build_pose_session`] and
+/// [`decide_side`].
+pub fn import_poses(spec: &PoseImportSpec) -> Result<Imported, ImportError> {
+    let inputs = read_pose_inputs(spec)?;
+    match spec.side {
+        SideChoice::Auto if !inputs.all_sides_given() && !inputs.centres() => {
+            decide_side(spec, &inputs)
+        }
+        choice => build_pose_session(
+            spec,
+            &inputs,
+            if choice == SideChoice::Minus { -1 } else { 1 },
+        ),
+    }
+}
+

@@ -2,7 +2,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::stripe::stripe_point_count;
 use crate::engine::cell::workspace::Workspace;
 use crate::engine::robot::RobotChoice;
 use crate::engine::session::{DEFAULT_MAX_ITERATIONS, DEFAULT_THRESHOLD};
@@ -517,3 +516,14 @@ pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
     }
     Ok(())
 }
+
+/// Points on an arc of radius `r` (mm), half-angle `half_angle_deg`, one
+/// every `spacing` mm.
+pub(super) fn stripe_point_count(r: f64, half_angle_deg: f64, spacing: f64) -> usize {
+    let arc = 2.0 * half_angle_deg.to_radians() * r;
+    // Truncation intended: whole points that fit on the arc.
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let n = (arc / spacing).floor().max(0.0) as usize;
+    n + 1
+}
+

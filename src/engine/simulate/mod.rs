@@ -352,7 +352,7 @@ pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
 mod tests {
     use super::*;
     use crate::engine::simulate::poses::station_sides;
-    use crate::engine::simulate::stripe::stripe_point_count;
+    use crate::engine::simulate::config::stripe_point_count;
 
     #[test]
     fn stripe_point_counts() {

@@ -5,19 +5,9 @@ use nalgebra::Vector3;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-use super::config::SimConfig;
+use super::config::{SimConfig, stripe_point_count};
 use crate::engine::cell::random::{normal, uniform};
 use crate::engine::numeric::round_to;
-
-/// Points on an arc of radius `r` (mm), half-angle `half_angle_deg`, one
-/// every `spacing` mm.
-pub(super) fn stripe_point_count(r: f64, half_angle_deg: f64, spacing: f64) -> usize {
-    let arc = 2.0 * half_angle_deg.to_radians() * r;
-    // Truncation intended: whole points that fit on the arc.
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-    let n = (arc / spacing).floor().max(0.0) as usize;
-    n + 1
-}
 
 /// The stripe of a sensor-frame centre: the arc of the cut circle facing
 /// the camera at `(0, 0, view_z)`, noise on both coordinates, outliers

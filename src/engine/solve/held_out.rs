@@ -53,8 +53,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::estimate::{Estimate, Station};
-use super::paper::PaperUpdate;
-use super::{Control, Options, Phase, Step, Update};
+use super::{Control, Phase, Step, Update};
 use crate::engine::validate::Stats;
 
 /// Up to this many identify measurements the paper's held-out figure is
@@ -246,15 +245,15 @@ fn mean(points: &[Vector3<f64>]) -> Option<Vector3<f64>> {
     (!points.is_empty()).then(|| points.iter().sum::<Vector3<f64>>() / points.len() as f64)
 }
 
-/// The paper's held-out figure: its update made `updates` times from
-/// `start` without each fold of the identify `stations` (see the module
+/// The paper's held-out figure: its update (a fresh one from the run's
+/// start for each training set, made by `refit_from`) made `updates`
+/// times without each fold of the identify `stations` (see the module
 /// docs), scored against the fit `fitted`. `None` when `phase` cancelled.
 pub(super) fn paper_refits(
-    start: &Estimate,
+    refit_from: &dyn Fn(Vec<Station>) -> Box<dyn Update>,
     fitted: &Estimate,
     updates: usize,
     stations: &[Station],
-    options: &Options,
     phase: &mut dyn FnMut(Phase) -> Control,
 ) -> Option<HeldOut> {
     let owned: Vec<Station> = stations
@@ -308,7 +307,7 @@ pub(super) fn paper_refits(
                     .collect(),
             })
             .collect();
-        let mut update = PaperUpdate::new(start.clone(), training.clone(), options);
+        let mut update = refit_from(training.clone());
         let mut failed = false;
         for u in 1..=updates {
             // Before every update: one fold of a large session is a run.

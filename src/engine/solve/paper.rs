@@ -31,89 +31,7 @@ use super::estimate::{
 /// rotation, high enough to drop the rigid-motion directions of joint 1.
 pub const DEFAULT_SVD_TOLERANCE: f64 = 1e-3;
 
-/// A rise of ε over the paper's loop up to this (mm) is rounding, not a
-/// worse calibration: a tenth of a micrometre, below any stripe sensor's
-/// resolution.
-pub const EPSILON_RISE_MM: f64 = 1e-4;
-
-/// The warning when the paper's loop ended with ε above its start (by
-/// more than [`EPSILON_RISE_MM`]), naming what to run instead; `pairs` is
-/// the pairing the run used (`disjoint`, `all`, or unknown). The result
-/// keeps the loop's last update, as FORMAT.md's loop defines it (every
-/// update is reported and `epsilon_after` is the last ε): on a one-station
-/// pose-only set the best iterate is often the start itself, and handing
-/// the initial hand-eye back as "calibrated" would hide that the method
-/// failed on this data.
-#[must_use]
-pub fn epsilon_rise_warning(pairs: Option<&str>, before: f64, after: f64) -> Option<String> {
-    // A NaN compares false: no warning.
-    let rose = after - before > EPSILON_RISE_MM;
-    if !rose {
-        return None;
-    }
-    let (fits, instead) = if pairs == Some(Pairing::All.as_str()) {
-        (
-            "the differences of every pair",
-            "rerun with `--method ml` (maximum likelihood: every measurement once against its station's centre, weighted by its noise; the workbench's Method ml)",
-        )
-    } else {
-        (
-            "the differences of its disjoint pairs (1,2), (3,4), …",
-            "rerun with `--method ml` (maximum likelihood: every measurement once against its station's centre, weighted by its noise) or `--pairs all` (every pair of a station's measurements); in the workbench, Method ml or Pairs all",
-        )
-    };
-    Some(format!(
-        "ε rose from {before:.4} mm to {after:.4} mm: the paper's updates left the identify centres scattering more than the start did (its update fits {fits}, not ε); {instead}"
-    ))
-}
-
-/// How the measurements of a station are paired into eq. 17 rows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Pairing {
-    /// The paper's: consecutive disjoint pairs (1,2), (3,4), (5,6) in file
-    /// order; an odd last measurement is paired with the first.
-    Disjoint,
-    /// Every pair `i < j`.
-    All,
-}
-
-impl Pairing {
-    /// The name written in the result's `solver.pairs`.
-    #[must_use]
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Self::Disjoint => "disjoint",
-            Self::All => "all",
-        }
-    }
-
-    /// Parses `disjoint` or `all`.
-    #[must_use]
-    pub fn parse(s: &str) -> Option<Self> {
-        match s {
-            "disjoint" => Some(Self::Disjoint),
-            "all" => Some(Self::All),
-            _ => None,
-        }
-    }
-
-    /// The index pairs for a station of `n` measurements.
-    #[must_use]
-    pub fn pairs(self, n: usize) -> Vec<(usize, usize)> {
-        match self {
-            Self::All => (0..n)
-                .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
-                .collect(),
-            Self::Disjoint => {
-                let mut out: Vec<(usize, usize)> = (0..n / 2).map(|k| (2 * k, 2 * k + 1)).collect();
-                if n % 2 == 1 && n >= 3 {
-                    out.push((n - 1, 0));
-                }
-                out
-            }
-        }
-    }
-}
+pub use super::report::{EPSILON_RISE_MM, Pairing, epsilon_rise_warning};
 
 /// Settings of the paper's update.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -331,14 +249,14 @@ impl Update for PaperUpdate {
 
     /// Exact refits of the paper's own loop ([`held_out`](super::held_out)).
     fn held_out(&self, phase: &mut dyn FnMut(Phase) -> Control) -> Option<HeldOut> {
-        super::held_out::paper_refits(
-            &self.start,
-            &self.est,
-            self.updates,
-            &self.stations,
-            &self.options,
-            phase,
-        )
+        let refit_from = |training: Vec<Station>| -> Box<dyn Update> {
+            Box::new(PaperUpdate::new(
+                self.start.clone(),
+                training,
+                &self.options,
+            ))
+        };
+        super::held_out::paper_refits(&refit_from, &self.est, self.updates, &self.stations, phase)
     }
 
     fn report(

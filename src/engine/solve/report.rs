@@ -6,10 +6,94 @@
 use std::fmt;
 use std::str::FromStr;
 
-use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
 use super::ml::MlReport;
+pub use super::record::LoopRecord;
+
+/// A rise of ε over the paper's loop up to this (mm) is rounding, not a
+/// worse calibration: a tenth of a micrometre, below any stripe sensor's
+/// resolution.
+pub const EPSILON_RISE_MM: f64 = 1e-4;
+
+/// The warning when the paper's loop ended with ε above its start (by
+/// more than [`EPSILON_RISE_MM`]), naming what to run instead; `pairs` is
+/// the pairing the run used (`disjoint`, `all`, or unknown). The result
+/// keeps the loop's last update, as FORMAT.md's loop defines it (every
+/// update is reported and `epsilon_after` is the last ε): on a one-station
+/// pose-only set the best iterate is often the start itself, and handing
+/// the initial hand-eye back as "calibrated" would hide that the method
+/// failed on this data.
+#[must_use]
+pub fn epsilon_rise_warning(pairs: Option<&str>, before: f64, after: f64) -> Option<String> {
+    // A NaN compares false: no warning.
+    let rose = after - before > EPSILON_RISE_MM;
+    if !rose {
+        return None;
+    }
+    let (fits, instead) = if pairs == Some(Pairing::All.as_str()) {
+        (
+            "the differences of every pair",
+            "rerun with `--method ml` (maximum likelihood: every measurement once against its station's centre, weighted by its noise; the workbench's Method ml)",
+        )
+    } else {
+        (
+            "the differences of its disjoint pairs (1,2), (3,4), …",
+            "rerun with `--method ml` (maximum likelihood: every measurement once against its station's centre, weighted by its noise) or `--pairs all` (every pair of a station's measurements); in the workbench, Method ml or Pairs all",
+        )
+    };
+    Some(format!(
+        "ε rose from {before:.4} mm to {after:.4} mm: the paper's updates left the identify centres scattering more than the start did (its update fits {fits}, not ε); {instead}"
+    ))
+}
+
+/// How the measurements of a station are paired into eq. 17 rows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pairing {
+    /// The paper's: consecutive disjoint pairs (1,2), (3,4), (5,6) in file
+    /// order; an odd last measurement is paired with the first.
+    Disjoint,
+    /// Every pair `i < j`.
+    All,
+}
+
+impl Pairing {
+    /// The name written in the result's `solver.pairs`.
+    #[must_use]
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Disjoint => "disjoint",
+            Self::All => "all",
+        }
+    }
+
+    /// Parses `disjoint` or `all`.
+    #[must_use]
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "disjoint" => Some(Self::Disjoint),
+            "all" => Some(Self::All),
+            _ => None,
+        }
+    }
+
+    /// The index pairs for a station of `n` measurements.
+    #[must_use]
+    pub fn pairs(self, n: usize) -> Vec<(usize, usize)> {
+        match self {
+            Self::All => (0..n)
+                .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+                .collect(),
+            Self::Disjoint => {
+                let mut out: Vec<(usize, usize)> = (0..n / 2).map(|k| (2 * k, 2 * k + 1)).collect();
+                if n % 2 == 1 && n >= 3 {
+                    out.push((n - 1, 0));
+                }
+                out
+            }
+        }
+    }
+}
 
 /// The solver block of a result: the paper's method, `ml`, or a method this
 /// build does not know (a later version's result, kept as read).
@@ -79,11 +163,11 @@ impl SolverReport {
 
     /// The warning a method gives about the ε of its loop, from `before`
     /// to `after` (mm): the paper's method when ε rose
-    /// ([`epsilon_rise_warning`](super::paper::epsilon_rise_warning)).
+    /// ([`epsilon_rise_warning`](epsilon_rise_warning)).
     #[must_use]
     pub fn epsilon_warning(&self, before: f64, after: f64) -> Option<String> {
         match self {
-            Self::Paper(p) => super::paper::epsilon_rise_warning(p.pairs.as_deref(), before, after),
+            Self::Paper(p) => epsilon_rise_warning(p.pairs.as_deref(), before, after),
             Self::Ml(_) | Self::Other { .. } => None,
         }
     }
@@ -107,20 +191,6 @@ impl SolverReport {
             _ => &[],
         }
     }
-}
-
-/// The loop of FORMAT.md "The iteration" as a result records it.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(default)]
-pub struct LoopRecord {
-    /// Threshold on ε, mm.
-    pub threshold: f64,
-    /// Most updates.
-    pub max_iterations: usize,
-    /// Stop code (`threshold`, `converged`, `max_iterations`, `cancelled`).
-    pub stop: String,
-    /// Why the loop stopped, in words, with ε beside the threshold.
-    pub stop_reason: String,
 }
 
 /// The paper's method as reported. Every key is optional: a run fills

@@ -9,7 +9,7 @@ use serde_json::{Map, Value};
 
 use super::identifiability::Inseparable;
 use super::noise::Loss;
-use crate::engine::solve::report::LoopRecord;
+use crate::engine::solve::record::LoopRecord;
 
 /// What one accepted LM step did (the `iterations` of the solver block).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
