@@ -9,10 +9,10 @@
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use spherecal::engine::format::parse_session;
-use spherecal::engine::solve::{self, Control, Method, Options};
+use spherecal::engine::calibrate::solve::{self, Control, Method, Options};
+use spherecal::engine::files::format::parse_session;
 
-fn demo() -> spherecal::engine::session::Session {
+fn demo() -> spherecal::engine::base::session::Session {
     parse_session(
         spherecal::DEMO_SESSION_JSON,
         Path::new(spherecal::DEMO_SESSION_NAME),
@@ -55,23 +55,24 @@ fn bench(c: &mut Criterion) {
         b.iter(|| solve::calibrate(&session, &Options::from_session(&session)).expect("calibrate"));
     });
     let (_, cal) = solve::calibrate(&session, &Options::from_session(&session)).expect("calibrate");
-    let file = spherecal::engine::format::ResultFile::from_calibration(&session, &cal);
+    let file = spherecal::engine::files::format::ResultFile::from_calibration(&session, &cal);
     group.bench_function("result file text (write)", |b| {
-        b.iter(|| spherecal::engine::format::result_to_json(&file));
+        b.iter(|| spherecal::engine::files::format::result_to_json(&file));
     });
     group.bench_function(
         "result file text, checked (finite numbers, loads back)",
         |b| {
             b.iter(|| {
-                spherecal::engine::format::result_text_checked(&file, Path::new("r.json"))
+                spherecal::engine::files::format::result_text_checked(&file, Path::new("r.json"))
                     .expect("checked")
             });
         },
     );
-    let text = spherecal::engine::format::result_to_json(&file);
+    let text = spherecal::engine::files::format::result_to_json(&file);
     group.bench_function("result file load", |b| {
         b.iter(|| {
-            spherecal::engine::format::parse_result(&text, Path::new("r.json")).expect("loads")
+            spherecal::engine::files::format::parse_result(&text, Path::new("r.json"))
+                .expect("loads")
         });
     });
     group.finish();

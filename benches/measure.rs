@@ -8,13 +8,13 @@
 use std::path::Path;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use spherecal::engine::format::{ResultFile, parse_session};
-use spherecal::engine::measure::{
+use spherecal::engine::calibrate::solve::{self, Control, Options};
+use spherecal::engine::files::format::{ResultFile, parse_session};
+use spherecal::engine::uses::measure::{
     self, CellModel, MeasureOptions, ModelChoice, Provenance, Scan, write,
 };
-use spherecal::engine::solve::{self, Control, Options};
 
-fn demo() -> spherecal::engine::session::Session {
+fn demo() -> spherecal::engine::base::session::Session {
     parse_session(
         spherecal::DEMO_SESSION_JSON,
         Path::new(spherecal::DEMO_SESSION_NAME),

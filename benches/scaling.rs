@@ -9,8 +9,8 @@
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use spherecal::engine::simulate::{self, SimConfig};
-use spherecal::engine::solve::{self, Control, Method, Options};
+use spherecal::engine::calibrate::solve::{self, Control, Method, Options};
+use spherecal::engine::tools::simulate::{self, SimConfig};
 
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("scaling");

@@ -13,8 +13,8 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use spherecal::engine::stripe::fit_circle;
-use spherecal::engine::stripe::segment::find_arc;
+use spherecal::engine::calibrate::stripe::fit_circle;
+use spherecal::engine::calibrate::stripe::segment::find_arc;
 
 const R: f64 = 40.0;
 const PITCH: f64 = 0.03;

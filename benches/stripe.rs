@@ -10,7 +10,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use spherecal::engine::stripe::{centre_from_stripe, fit_circle};
+use spherecal::engine::calibrate::stripe::{centre_from_stripe, fit_circle};
 
 /// Points in the benchmarked stripe.
 const POINTS: usize = 60;

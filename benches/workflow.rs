@@ -11,13 +11,13 @@ use std::path::Path;
 use std::time::{Duration, UNIX_EPOCH};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use spherecal::engine::format::ResultFile;
-use spherecal::engine::format::parse_session;
-use spherecal::engine::history::{self, DriftOptions};
-use spherecal::engine::plan::{self, PlanConfig, PredictConfig};
-use spherecal::engine::report::html::{self, ReportInput, ReportMeta};
-use spherecal::engine::robot;
-use spherecal::engine::solve::{self, Control, Options};
+use spherecal::engine::base::robot;
+use spherecal::engine::calibrate::solve::{self, Control, Options};
+use spherecal::engine::files::format::ResultFile;
+use spherecal::engine::files::format::parse_session;
+use spherecal::engine::tools::history::{self, DriftOptions};
+use spherecal::engine::tools::plan::{self, PlanConfig, PredictConfig};
+use spherecal::engine::tools::report::html::{self, ReportInput, ReportMeta};
 
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("workflow");

@@ -27,10 +27,10 @@ use std::path::PathBuf;
 
 use anyhow::Context as _;
 use nalgebra::Vector3;
-use spherecal::engine::format;
-use spherecal::engine::session::{Observation, Session};
-use spherecal::engine::simulate::{self, SimConfig};
-use spherecal::engine::solve::{self, Options};
+use spherecal::engine::base::session::{Observation, Session};
+use spherecal::engine::calibrate::solve::{self, Options};
+use spherecal::engine::files::format;
+use spherecal::engine::tools::simulate::{self, SimConfig};
 
 /// Sensor displacement along its own y axis after the April remount, mm:
 /// large against the ~0.013 mm σ `ml` reports for the hand-eye x and y

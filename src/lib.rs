@@ -16,7 +16,7 @@
 //!   Transforms are named `target_from_source`; `flange_from_sensor` is the
 //!   hand-eye `eT_s`.
 //! - **Units**: files hold millimetres and degrees. Inside the engine
-//!   lengths are mm and angles are radians, except [`engine::robot::Joint`]
+//!   lengths are mm and angles are radians, except [`engine::base::robot::Joint`]
 //!   and joint readings, which stay in degrees as in the files.
 //! - **Numbers**: `f64` throughout.
 //! - **The laser plane** is the sensor's `x = 0` plane; stripe points are
@@ -27,18 +27,18 @@
 //!   `Rx(alpha)·Tx(a)·Ry(beta)·Rz(q + theta)·Tz(d)` (FORMAT.md).
 //! - **Twists** (differential motions, paper eq. 13-16): `[Δx, Δy, Δz, δx, δy, δz]`,
 //!   translation first; a point `X` moves by `Δ + δ × X`; the rigid motion of
-//!   a twist is [`engine::geometry::isometry_from_twist`].
+//!   a twist is [`engine::base::geometry::isometry_from_twist`].
 //! - **Hand-eye perturbation**: an update of the hand-eye is a right twist
 //!   in the sensor frame, `eT_s ← eT_s · exp(ΔX)`; the unknowns of both
 //!   methods are these 6 numbers followed by the `5·n` kinematic errors
-//!   ([`engine::solve::estimate`]). Hand-eye σs and correlations in a
+//!   ([`engine::calibrate::solve::estimate`]). Hand-eye σs and correlations in a
 //!   result refer to these directions.
 //! - **Roll, pitch, yaw** (degrees, wherever a rotation is shown: workbench,
 //!   report, history, model export): `R = Rz(yaw) · Ry(pitch) · Rx(roll)`,
-//!   pitch in [−90°, 90°] ([`engine::geometry::roll_pitch_yaw_deg`] and its
-//!   inverse [`engine::geometry::rotation_from_rpy_deg`]).
+//!   pitch in [−90°, 90°] ([`engine::base::geometry::roll_pitch_yaw_deg`] and its
+//!   inverse [`engine::base::geometry::rotation_from_rpy_deg`]).
 //! - **Angles shown** are wrapped to (−180°, 180°]
-//!   ([`engine::geometry::wrap_deg`]).
+//!   ([`engine::base::geometry::wrap_deg`]).
 
 pub mod cli;
 pub mod engine;

@@ -9,7 +9,7 @@ fn main() -> ExitCode {
     // Ctrl-C or a kill: remove the temporary file of a write under way
     // (the target keeps its old content), then end as interrupted.
     let _ = ctrlc::set_handler(|| {
-        spherecal::engine::format::remove_pending();
+        spherecal::engine::files::format::remove_pending();
         std::process::exit(130);
     });
     let parsed = Cli::parse_args();
@@ -33,7 +33,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         // Interrupted while failing (a write stopped by Ctrl-C): the
         // interruption is the news, with its status.
-        Err(_) if spherecal::engine::format::interrupted() => ExitCode::from(130),
+        Err(_) if spherecal::engine::files::format::interrupted() => ExitCode::from(130),
         Err(e) => {
             eprintln!("error: {}", cli::bounded_message(&e.message));
             ExitCode::from(u8::try_from(e.status).unwrap_or(1))

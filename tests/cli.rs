@@ -52,7 +52,7 @@ fn calibrate_demo_writes_a_result_that_loads() {
     assert_eq!(status, 0, "{stderr}");
     assert!(stdout.contains("ε after  0 update(s)"), "{stdout}");
     assert!(stdout.contains("validation"), "{stdout}");
-    let result = spherecal::engine::format::load_result(&out).unwrap();
+    let result = spherecal::engine::files::format::load_result(&out).unwrap();
     assert!(result.epsilon_after < result.epsilon_before);
     let v = result.validation.expect("the demo has validate stations");
     assert!(
@@ -479,7 +479,7 @@ fn the_paper_loop_stops_when_epsilon_levels_off() {
     );
     assert_eq!(code, 0, "{err}");
     assert!(stdout.contains("levelled off"), "{stdout}");
-    let result = spherecal::engine::format::load_result(&out).unwrap();
+    let result = spherecal::engine::files::format::load_result(&out).unwrap();
     assert!(result.iterations.len() < 100, "{}", result.iterations.len());
 }
 

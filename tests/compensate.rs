@@ -15,12 +15,12 @@ use std::process::Command;
 use nalgebra::{Isometry3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use spherecal::engine::format::{self, ResultFile};
-use spherecal::engine::geometry::kabsch;
-use spherecal::engine::robot::Robot;
-use spherecal::engine::robot::controller::FlangeConvention;
-use spherecal::engine::session::Use;
-use spherecal::engine::simulate::{self, Truth};
+use spherecal::engine::base::geometry::kabsch;
+use spherecal::engine::base::robot::Robot;
+use spherecal::engine::base::robot::controller::FlangeConvention;
+use spherecal::engine::base::session::Use;
+use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::tools::simulate::{self, Truth};
 
 fn spherecal() -> Command {
     Command::new(env!("CARGO_BIN_EXE_spherecal"))
@@ -95,7 +95,7 @@ fn targets_near_validate(cell: &Cell, spread: f64, seed: u64) -> Vec<Target> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let robot = cell.truth.true_robot();
     let hand_eye = cell.truth.true_hand_eye();
-    let limits = spherecal::engine::robot::irb2400().limits;
+    let limits = spherecal::engine::base::robot::irb2400().limits;
     cell.truth
         .measurements
         .iter()
@@ -233,9 +233,9 @@ fn a_nominal_controller_reaches_compensated_table_targets() {
 /// the true one), through the engine as the workbench calls it.
 #[test]
 fn with_the_true_model_compensation_is_exact() {
-    use spherecal::engine::compensate::{self, Model, Options, Tcp};
-    use spherecal::engine::program::{ReadSpec, parse_pose_text};
-    use spherecal::engine::solve::Control;
+    use spherecal::engine::calibrate::solve::Control;
+    use spherecal::engine::files::program::{ReadSpec, parse_pose_text};
+    use spherecal::engine::uses::compensate::{self, Model, Options, Tcp};
     let dir = tempfile::tempdir().unwrap();
     let c = cell(dir.path(), 5);
     let mut result = c.result.clone();
@@ -267,7 +267,8 @@ fn with_the_true_model_compensation_is_exact() {
         assert!(miss < 1e-6, "{}: {miss} mm", t.id);
         assert!(reached.rotation.angle_to(&t.pose.rotation) < 1e-9);
         // The controller drives exactly the calibrated solution.
-        let same = |a: &f64, b: &f64| spherecal::engine::geometry::wrap_deg(a - b).abs() < 1e-6;
+        let same =
+            |a: &f64, b: &f64| spherecal::engine::base::geometry::wrap_deg(a - b).abs() < 1e-6;
         assert!(
             q.iter().zip(&r.joints).all(|(a, b)| same(a, b)),
             "{q:?} {:?}",
@@ -296,8 +297,11 @@ fn fixed(v: f64, d: usize) -> String {
     format!("{v:.d$}")
 }
 
-fn programs(targets: &[Target], model: &spherecal::engine::compensate::Model) -> Vec<Program> {
-    use spherecal::engine::compensate::config::{Vendor, posture};
+fn programs(
+    targets: &[Target],
+    model: &spherecal::engine::uses::compensate::Model,
+) -> Vec<Program> {
+    use spherecal::engine::uses::compensate::config::{Vendor, posture};
     let branch = |t: &Target| {
         let flange = t.pose * model.tool.inverse();
         let (q, _) = model.arms.nominal_branch(&flange, None).unwrap();
@@ -357,7 +361,7 @@ fn programs(targets: &[Target], model: &spherecal::engine::compensate::Model) ->
     let mut text = String::from("&ACCESS RVP\nDEFDAT  PATH\n;FOLD EXTERNAL DECLARATIONS\n");
     for (t, r) in targets.iter().zip(&rows) {
         let q = branch(t);
-        let spherecal::engine::compensate::config::Config::Kuka { s: st, t: tt } =
+        let spherecal::engine::uses::compensate::config::Config::Kuka { s: st, t: tt } =
             Vendor::Kuka.config(&q, posture(&model.arms.nominal, &q))
         else {
             unreachable!()
@@ -434,10 +438,10 @@ fn programs(targets: &[Target], model: &spherecal::engine::compensate::Model) ->
 /// `text` with the numbers of every target and every configuration read
 /// from it replaced by `#`: what must not change.
 fn skeleton(text: &str, file_name: &str) -> String {
-    let file = spherecal::engine::program::parse_pose_text(
+    let file = spherecal::engine::files::program::parse_pose_text(
         text.to_string(),
         Path::new(file_name),
-        &spherecal::engine::program::ReadSpec::default(),
+        &spherecal::engine::files::program::ReadSpec::default(),
     )
     .unwrap();
     let mut ranges: Vec<std::ops::Range<usize>> = file
@@ -468,7 +472,7 @@ fn poses_of(
     file_name: &str,
     convention: Option<FlangeConvention>,
 ) -> Vec<Isometry3<f64>> {
-    use spherecal::engine::program::{ReadSpec, TargetValue, parse_pose_text};
+    use spherecal::engine::files::program::{ReadSpec, TargetValue, parse_pose_text};
     let spec = ReadSpec {
         convention,
         ..ReadSpec::default()
@@ -492,10 +496,10 @@ fn programs_in_four_languages_keep_every_other_byte_and_match_the_table() {
         .into_iter()
         .take(12)
         .collect();
-    let model = spherecal::engine::compensate::Model::new(
+    let model = spherecal::engine::uses::compensate::Model::new(
         &c.result,
         None,
-        spherecal::engine::compensate::Tcp::Sensor,
+        spherecal::engine::uses::compensate::Tcp::Sensor,
     )
     .unwrap();
     for p in programs(&targets, &model) {
@@ -658,13 +662,14 @@ fn joint_targets_are_compensated_or_kept() {
     ]);
     assert_eq!(status, 0, "{out}{err}");
     let written = std::fs::read_to_string(&output).unwrap();
-    let file = spherecal::engine::program::parse_pose_text(
+    let file = spherecal::engine::files::program::parse_pose_text(
         written,
         Path::new("j.mod"),
         &Default::default(),
     )
     .unwrap();
-    let spherecal::engine::program::TargetValue::Joints { deg, .. } = &file.targets[0].value else {
+    let spherecal::engine::files::program::TargetValue::Joints { deg, .. } = &file.targets[0].value
+    else {
         panic!("a joint target")
     };
     // The calibrated model at the joints written reaches the pose the

@@ -5,11 +5,11 @@
 // Test helpers may panic: a panic is a test failure with its message.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use spherecal::engine::evaluate;
-use spherecal::engine::robot::Robot;
-use spherecal::engine::session::{Session, Use};
-use spherecal::engine::simulate::{self, SimConfig, Truth};
-use spherecal::engine::solve::{self, Method, Options, Prepared};
+use spherecal::engine::base::robot::Robot;
+use spherecal::engine::base::session::{Session, Use};
+use spherecal::engine::calibrate::solve::{self, Method, Options, Prepared};
+use spherecal::engine::tools::evaluate;
+use spherecal::engine::tools::simulate::{self, SimConfig, Truth};
 
 /// The paper's method: these tests are its baseline (the `ml` method,
 /// the default, has its own in `tests/ml.rs`).

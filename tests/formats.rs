@@ -14,13 +14,13 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use spherecal::engine::format::FileError;
-use spherecal::engine::format::{
+use spherecal::engine::base::session::MIN_STRIPE_POINTS;
+use spherecal::engine::base::session::{Observation, Session, Use};
+use spherecal::engine::files::format::FileError;
+use spherecal::engine::files::format::{
     load_result, load_session, parse_result, parse_session, result_to_json, save_result,
     save_session, session_to_json, write_atomic,
 };
-use spherecal::engine::session::MIN_STRIPE_POINTS;
-use spherecal::engine::session::{Observation, Session, Use};
 
 fn data(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -831,7 +831,7 @@ fn a_result_with_a_non_finite_number_is_not_written() {
     let dir = tempfile::tempdir().unwrap();
     let good = load_result(&data("v1/result.json")).unwrap();
     let path = dir.path().join("r.json");
-    type Spoil = Box<dyn Fn(&mut spherecal::engine::format::ResultFile)>;
+    type Spoil = Box<dyn Fn(&mut spherecal::engine::files::format::ResultFile)>;
     let cases: Vec<(Spoil, &str)> = vec![
         (Box::new(|r| r.epsilon_after = f64::NAN), "epsilon_after"),
         (
@@ -962,11 +962,13 @@ fn write_atomic_without_a_file_name_fails() {
 /// rule), the loader adding only the position.
 #[test]
 fn typed_rules_and_the_loader_agree() {
-    let (base, _) = spherecal::engine::simulate::simulate(&spherecal::engine::simulate::SimConfig {
-        n_identify: 2,
-        n_validate: 2,
-        ..spherecal::engine::simulate::SimConfig::default()
-    })
+    let (base, _) = spherecal::engine::tools::simulate::simulate(
+        &spherecal::engine::tools::simulate::SimConfig {
+            n_identify: 2,
+            n_validate: 2,
+            ..spherecal::engine::tools::simulate::SimConfig::default()
+        },
+    )
     .unwrap();
     assert_eq!(base.validate(), Ok(()));
     type Break = Box<dyn Fn(&mut Session)>;

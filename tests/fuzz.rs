@@ -17,18 +17,18 @@ use std::path::Path;
 use std::time::SystemTime;
 
 use proptest::prelude::*;
-use spherecal::engine::format::{self, ResultFile};
-use spherecal::engine::history;
-use spherecal::engine::import::{
+use spherecal::engine::base::robot::RobotChoice;
+use spherecal::engine::base::session::{Observation, Session};
+use spherecal::engine::base::table::Table;
+use spherecal::engine::calibrate::solve::{self, Method, Options};
+use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::files::import::{
     self, AngleUnit, ColumnMap, DEFAULT_SPHERE_DIAMETER, ImportSpec, ProfileSource, RobotSource,
 };
-use spherecal::engine::report::html::{self, ReportInput, ReportMeta};
-use spherecal::engine::report::model::{self, ModelFormat};
-use spherecal::engine::robot::RobotChoice;
-use spherecal::engine::session::{Observation, Session};
-use spherecal::engine::simulate::{self, SimConfig};
-use spherecal::engine::solve::{self, Method, Options};
-use spherecal::engine::table::Table;
+use spherecal::engine::tools::history;
+use spherecal::engine::tools::report::html::{self, ReportInput, ReportMeta};
+use spherecal::engine::tools::report::model::{self, ModelFormat};
+use spherecal::engine::tools::simulate::{self, SimConfig};
 
 /// The seed of every property test here (a fixed sequence of cases; a
 /// run with another seed explores others: change it locally).
@@ -497,7 +497,7 @@ proptest! {
     ) {
         let text = robot_text(if which { "ur5e.urdf" } else { "abb_irb2400.urdf" });
         let mutated = apply(&text, &mutations);
-        match spherecal::engine::robot::robot_from_urdf(&mutated, Path::new("fuzz.urdf")) {
+        match spherecal::engine::base::robot::robot_from_urdf(&mutated, Path::new("fuzz.urdf")) {
             Ok(u) => {
                 let text = format::session_to_json(&Session {
                     robot: u.robot,
@@ -524,7 +524,7 @@ proptest! {
         mutations in prop::collection::vec(mutation(), 1..4),
         which in any::<bool>(),
     ) {
-        use spherecal::engine::robot::{DhConvention, robot_from_dh_csv};
+        use spherecal::engine::base::robot::{DhConvention, robot_from_dh_csv};
         let (name, convention) = if which {
             ("ur5e_dh.csv", DhConvention::Standard)
         } else {
@@ -584,7 +584,7 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 /// once, with the line.
 #[test]
 fn deep_nesting_is_refused_at_once() {
-    use spherecal::engine::robot::robot_from_urdf;
+    use spherecal::engine::base::robot::robot_from_urdf;
     let n = 20_000;
     let nested = format!(
         "<robot name=\"r\">{}{}</robot>",
@@ -632,7 +632,7 @@ fn deep_nesting_is_refused_at_once() {
 /// naming the file and the line.
 #[test]
 fn one_huge_line_gives_a_short_message() {
-    use spherecal::engine::robot::{DhConvention, load_dh_csv, robot_from_urdf};
+    use spherecal::engine::base::robot::{DhConvention, load_dh_csv, robot_from_urdf};
     let dir = tempfile::tempdir().unwrap();
     let junk = "x".repeat(3 << 20);
     let mut messages = Vec::new();

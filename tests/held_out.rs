@@ -7,17 +7,17 @@
 use std::path::Path;
 use std::time::UNIX_EPOCH;
 
-use spherecal::engine::format::{self, ResultFile};
-use spherecal::engine::report::html::{self, ReportInput, ReportMeta};
-use spherecal::engine::report::summary::summary;
-use spherecal::engine::result_view::ResultView;
-use spherecal::engine::session::{Session, Use};
-use spherecal::engine::simulate::{self, SimConfig};
-use spherecal::engine::solve::ml::exact_held_out;
-use spherecal::engine::solve::paper::Pairing;
-use spherecal::engine::solve::{
+use spherecal::engine::base::session::{Session, Use};
+use spherecal::engine::calibrate::solve::ml::exact_held_out;
+use spherecal::engine::calibrate::solve::paper::Pairing;
+use spherecal::engine::calibrate::solve::{
     self, Control, HeldOut, HeldOutScheme, Method, Options, Phase, Prepared,
 };
+use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::tools::report::html::{self, ReportInput, ReportMeta};
+use spherecal::engine::tools::report::summary::summary;
+use spherecal::engine::tools::result_view::ResultView;
+use spherecal::engine::tools::simulate::{self, SimConfig};
 
 mod one_station;
 use one_station::{best_scatter_start, one_station};

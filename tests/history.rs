@@ -16,18 +16,18 @@ use std::sync::OnceLock;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use nalgebra::Vector3;
-use spherecal::engine::format::{self, ResultFile};
-use spherecal::engine::history::{
+use spherecal::engine::base::robot::RobotChoice;
+use spherecal::engine::base::session::{Observation, Session};
+use spherecal::engine::calibrate::solve::SolverReport;
+use spherecal::engine::calibrate::solve::ml::identifiability::Partner;
+use spherecal::engine::calibrate::solve::ml::{Inseparable, MlReport};
+use spherecal::engine::calibrate::solve::{self, Method, Options};
+use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::tools::history::{
     self, DEFAULT_K, DateSource, Drift, DriftOptions, HAND_EYE_NAMES, Library, SeriesKind, Status,
     Timestamp, Verdict,
 };
-use spherecal::engine::robot::RobotChoice;
-use spherecal::engine::session::{Observation, Session};
-use spherecal::engine::simulate::{self, SimConfig};
-use spherecal::engine::solve::SolverReport;
-use spherecal::engine::solve::ml::identifiability::Partner;
-use spherecal::engine::solve::ml::{Inseparable, MlReport};
-use spherecal::engine::solve::{self, Method, Options};
+use spherecal::engine::tools::simulate::{self, SimConfig};
 
 const IRB: &str = "ABB IRB 2400/16";
 /// The sensor moves this far along its own y axis (mm) on 2026-06-01.

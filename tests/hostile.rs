@@ -14,12 +14,12 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use spherecal::engine::format;
-use spherecal::engine::import::{
+use spherecal::engine::base::robot::{DhConvention, robot_from_dh_csv, robot_from_urdf};
+use spherecal::engine::files::format;
+use spherecal::engine::files::import::{
     self, AngleUnit, ColumnMap, DEFAULT_SPHERE_DIAMETER, ImportSpec, ProfileFormat, ProfileSource,
     RobotSource,
 };
-use spherecal::engine::robot::{DhConvention, robot_from_dh_csv, robot_from_urdf};
 
 fn data(name: &str) -> String {
     fs::read_to_string(
@@ -303,10 +303,10 @@ fn profile_corner_cases_are_read_right_and_blamed_right() {
 fn implausible_result_files_are_refused() {
     let session =
         format::parse_session(spherecal::DEMO_SESSION_JSON, Path::new("demo.json")).unwrap();
-    let mut options = spherecal::engine::solve::Options::from_session(&session);
+    let mut options = spherecal::engine::calibrate::solve::Options::from_session(&session);
     options.max_iterations = 2;
     options.ml.cross_validation = false;
-    let (_, cal) = spherecal::engine::solve::calibrate(&session, &options).unwrap();
+    let (_, cal) = spherecal::engine::calibrate::solve::calibrate(&session, &options).unwrap();
     let result = format::ResultFile::from_calibration(&session, &cal);
     let text = format::result_to_json(&result);
     assert!(format::parse_result(&text, Path::new("r.json")).is_ok());

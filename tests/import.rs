@@ -10,14 +10,14 @@ use std::fmt::Write as _;
 use std::fs;
 use std::path::Path;
 
-use spherecal::engine::import::{
+use spherecal::engine::base::robot;
+use spherecal::engine::base::session::{Observation, Session};
+use spherecal::engine::calibrate::solve::{self, Options};
+use spherecal::engine::files::import::{
     self, AngleUnit, ColumnMap, DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention,
     ImportError, ImportSpec, LengthUnit, ProfileSource, RobotSource,
 };
-use spherecal::engine::robot;
-use spherecal::engine::session::{Observation, Session};
-use spherecal::engine::simulate::{self, SimConfig};
-use spherecal::engine::solve::{self, Options};
+use spherecal::engine::tools::simulate::{self, SimConfig};
 
 const CONVENTIONS: [FlangeConvention; 4] = [
     FlangeConvention::AbbQuaternion,

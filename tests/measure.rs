@@ -13,14 +13,14 @@ use std::path::Path;
 
 use nalgebra::{Isometry3, Matrix4, Point3, Vector3, Vector4};
 use serde_json::Value;
-use spherecal::engine::format::{self, ResultFile};
-use spherecal::engine::geometry::kabsch;
-use spherecal::engine::measure::{
+use spherecal::engine::base::geometry::kabsch;
+use spherecal::engine::base::session::{Session, Use};
+use spherecal::engine::calibrate::solve::{self, Control, Method, Options, SolverReport};
+use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::tools::simulate::{self, SimConfig, Truth};
+use spherecal::engine::uses::measure::{
     self, CellModel, MeasureOptions, ModelChoice, Scan, model::covariance_of,
 };
-use spherecal::engine::session::{Session, Use};
-use spherecal::engine::simulate::{self, SimConfig, Truth};
-use spherecal::engine::solve::{self, Control, Method, Options, SolverReport};
 
 mod measure_support;
 use measure_support::{calibrated, csv_cloud, files, rms, run, seed, temp_dir};
@@ -252,7 +252,7 @@ fn sigma_and_error(session: &Session, truth: &Truth, result: &ResultFile) -> (Ve
         let q = &truth.measurement(&m.id).unwrap().joints_actual;
         let bc: Isometry3<f64> = calibrated.base_from_flange(q) * result.hand_eye;
         let bt: Isometry3<f64> = true_robot.base_from_flange(q) * true_he;
-        let spherecal::engine::session::Observation::Stripe(points) = &m.observation else {
+        let spherecal::engine::base::session::Observation::Stripe(points) = &m.observation else {
             panic!()
         };
         for &[y, z] in points {
@@ -465,7 +465,7 @@ fn frames_models_and_decimation() {
         Vector3::new(0.1, -0.2, 0.7),
     );
     let frame = dir.join("frame.json");
-    let rows = spherecal::engine::geometry::rows_from_isometry(&w);
+    let rows = spherecal::engine::base::geometry::rows_from_isometry(&w);
     std::fs::write(&frame, serde_json::to_string(&rows).unwrap()).unwrap();
     let (base_csv, part_csv) = (dir.join("base.csv"), dir.join("part.csv"));
     assert!(
@@ -593,7 +593,7 @@ fn bad_input_is_refused_and_nothing_is_written() {
     let o = out.to_str().unwrap();
     // A result of another robot.
     let ur = SimConfig {
-        robot: spherecal::engine::robot::RobotChoice::Ur5e,
+        robot: spherecal::engine::base::robot::RobotChoice::Ur5e,
         ..seed(6)
     };
     let (ur_session, _, ur_result) = calibrated(&ur, Method::Paper);
@@ -725,7 +725,7 @@ fn pose_only_results_measure_with_the_given_flange_poses() {
         m.joints.clear();
     }
     session.robot_given = false;
-    session.robot = spherecal::engine::robot::Robot::new(String::new(), Vec::new());
+    session.robot = spherecal::engine::base::robot::Robot::new(String::new(), Vec::new());
     let mut options = Options::from_session(&session);
     options.ml.cross_validation = false;
     let (_, cal) = solve::calibrate(&session, &options).unwrap();
@@ -745,7 +745,7 @@ fn pose_only_results_measure_with_the_given_flange_poses() {
     let mut points = measured.cloud.points();
     for m in &session.measurements {
         let t = m.flange.unwrap() * result.hand_eye;
-        let spherecal::engine::session::Observation::Stripe(stripe) = &m.observation else {
+        let spherecal::engine::base::session::Observation::Stripe(stripe) = &m.observation else {
             panic!()
         };
         for &[y, z] in stripe {

@@ -7,9 +7,9 @@
 use std::process::Command;
 
 use nalgebra::{Point3, Vector3};
-use spherecal::engine::geometry::kabsch;
-use spherecal::engine::simulate;
-use spherecal::engine::solve::Method;
+use spherecal::engine::base::geometry::kabsch;
+use spherecal::engine::calibrate::solve::Method;
+use spherecal::engine::tools::simulate;
 
 mod measure_support;
 use measure_support::{bin, calibrated, csv_cloud, files, rms, run, seed, temp_dir};
@@ -42,7 +42,7 @@ fn profile_points(text: &str) -> (Vec<[f64; 2]>, usize) {
 fn part_error(cloud: &[(String, [f64; 3], f64)], sim: &simulate::SimulatedScan) -> (f64, f64) {
     let truth = &sim.truth;
     let robot = truth.robot.to_robot();
-    let he = spherecal::engine::geometry::rigid_from_rows(&truth.hand_eye);
+    let he = spherecal::engine::base::geometry::rigid_from_rows(&truth.hand_eye);
     let mut exact = Vec::new();
     for (id, text) in &sim.profiles {
         let q = truth.poses.get(id).unwrap();
@@ -63,7 +63,7 @@ fn part_error(cloud: &[(String, [f64; 3], f64)], sim: &simulate::SimulatedScan) 
 
 #[test]
 fn raw_scans_of_parts_measure_their_true_geometry() {
-    use spherecal::engine::simulate::{PartKind, ScanConfig};
+    use spherecal::engine::tools::simulate::{PartKind, ScanConfig};
     let dir = temp_dir("scans");
     let config = seed(8);
     let (session, _, result) = calibrated(&config, Method::Ml);

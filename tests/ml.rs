@@ -8,18 +8,18 @@
 // message (clippy.toml allows this only inside `#[test]` functions).
 #![allow(clippy::expect_used)]
 
-use spherecal::engine::evaluate::study as evaluate;
-use spherecal::engine::evaluate::{TruthScore, score, validation_errors};
-use spherecal::engine::format::result::solver_block;
-use spherecal::engine::format::{self, ResultFile};
-use spherecal::engine::session::{self, ExcludeError};
-use spherecal::engine::session::{Observation, Session, Use};
-use spherecal::engine::simulate::{self, SimConfig, Truth};
-use spherecal::engine::solve::estimate::Estimate;
-use spherecal::engine::solve::ml::{Loss, MlReport, MlUpdate};
-use spherecal::engine::solve::{
+use spherecal::engine::base::session::{self, ExcludeError};
+use spherecal::engine::base::session::{Observation, Session, Use};
+use spherecal::engine::calibrate::solve::estimate::Estimate;
+use spherecal::engine::calibrate::solve::ml::{Loss, MlReport, MlUpdate};
+use spherecal::engine::calibrate::solve::{
     self, Calibration, Control, Method, Options, Prepared, Step, Update,
 };
+use spherecal::engine::files::format::result::solver_block;
+use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::tools::evaluate::study as evaluate;
+use spherecal::engine::tools::evaluate::{TruthScore, score, validation_errors};
+use spherecal::engine::tools::simulate::{self, SimConfig, Truth};
 
 fn simulate(config: &SimConfig) -> (Session, Truth) {
     simulate::simulate(config).expect("simulation")

@@ -10,10 +10,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion};
-use spherecal::engine::format::{self, ResultFile};
-use spherecal::engine::geometry::rows_from_isometry;
-use spherecal::engine::report::model::{self, CSV_HEADER};
-use spherecal::engine::robot::Robot;
+use spherecal::engine::base::geometry::rows_from_isometry;
+use spherecal::engine::base::robot::Robot;
+use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::tools::report::model::{self, CSV_HEADER};
 
 const RESULT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/v1/result.json");
 const BASE_SESSION: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/base.json");
@@ -143,7 +143,7 @@ fn locked_result() -> ResultFile {
     r.robot.as_mut().unwrap().joints[1].theta = -90.0;
     r.robot.as_mut().unwrap().joints[1].beta = 0.0;
     r.robot.as_mut().unwrap().joints[3].theta = 90.0 + 1e-7;
-    r.robot.as_mut().unwrap().flange = spherecal::engine::geometry::isometry_from_rows(&[
+    r.robot.as_mut().unwrap().flange = spherecal::engine::base::geometry::isometry_from_rows(&[
         [0.0, 0.0, 1.0, 1.5],
         [0.0, 1.0, 0.0, -2.0],
         [-1.0, 0.0, 0.0, 12.5],

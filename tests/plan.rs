@@ -13,19 +13,19 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use nalgebra::{Point3, Vector3};
-use spherecal::engine::evaluate;
-use spherecal::engine::format;
-use spherecal::engine::import::{
+use spherecal::engine::base::robot;
+use spherecal::engine::base::session::{Session, Use};
+use spherecal::engine::calibrate::solve::{self, Control, Method, Options};
+use spherecal::engine::files::format;
+use spherecal::engine::files::import::{
     self, AngleUnit, ColumnMap, FlangeCheck, FlangeConvention, ImportSpec, ProfileSource,
     RobotSource,
 };
-use spherecal::engine::plan::{
+use spherecal::engine::tools::evaluate;
+use spherecal::engine::tools::plan::{
     self, Controller, Plan, PlanConfig, PlanError, PredictConfig, Selection, StationRole,
 };
-use spherecal::engine::robot;
-use spherecal::engine::session::{Session, Use};
-use spherecal::engine::simulate::{self, ErrorModel, PlanExecution, SimConfig, Truth};
-use spherecal::engine::solve::{self, Control, Method, Options};
+use spherecal::engine::tools::simulate::{self, ErrorModel, PlanExecution, SimConfig, Truth};
 
 /// The paper's cell, scaled down so a debug build plans it in well under
 /// a second: 4 identify stations × 6 poses, 4 validate stations × 4 poses,

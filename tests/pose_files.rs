@@ -13,14 +13,14 @@ use std::process::Command;
 
 use nalgebra::{Isometry3, Point3};
 use proptest::prelude::*;
-use spherecal::engine::geometry::rigid_from_rows;
-use spherecal::engine::import::{
+use spherecal::engine::base::geometry::rigid_from_rows;
+use spherecal::engine::base::session::{Observation, Session, Use};
+use spherecal::engine::calibrate::solve::{self, Options};
+use spherecal::engine::files::import::{
     self, FlangeConvention, Observations, PoseImportSpec, ProfileFormat, ProfileSource, SideChoice,
 };
-use spherecal::engine::program::{self, PoseFormat, ReadSpec};
-use spherecal::engine::session::{Observation, Session, Use};
-use spherecal::engine::simulate::{self, SimConfig, Truth};
-use spherecal::engine::solve::{self, Options};
+use spherecal::engine::files::program::{self, PoseFormat, ReadSpec};
+use spherecal::engine::tools::simulate::{self, SimConfig, Truth};
 
 /// True flange poses, stripes and the truth of a simulated cell.
 type Cell = (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>, Truth);
@@ -70,7 +70,7 @@ fn spread_station(seed: u64) -> Cell {
         n_validate: 0,
         poses_per_station: 8,
         side: simulate::SideChoice::Plus,
-        range: Some(spherecal::engine::session::SensorRange {
+        range: Some(spherecal::engine::base::session::SensorRange {
             y: [-20.0, 20.0],
             z: [-20.0, 20.0],
         }),
@@ -436,11 +436,11 @@ fn profile_names_with_the_number_anywhere_pair_in_numeric_order() {
 /// The planner's programs import back to the planned flange poses.
 #[test]
 fn plan_programs_import_back_to_the_planned_poses() {
-    use spherecal::engine::cell::workspace::Workspace;
-    use spherecal::engine::plan::{self, Controller, PlanConfig};
-    use spherecal::engine::robot;
-    use spherecal::engine::robot::RobotChoice;
-    use spherecal::engine::solve::Control;
+    use spherecal::engine::base::cell::workspace::Workspace;
+    use spherecal::engine::base::robot;
+    use spherecal::engine::base::robot::RobotChoice;
+    use spherecal::engine::calibrate::solve::Control;
+    use spherecal::engine::tools::plan::{self, Controller, PlanConfig};
     for (key, preset, controller) in [
         ("irb2400", robot::irb2400(), Controller::AbbRapid),
         ("ur5e", robot::ur5e(), Controller::UrScript),

@@ -6,10 +6,10 @@
 use std::path::Path;
 
 use nalgebra::Isometry3;
-use spherecal::engine::format::{self, ResultFile};
-use spherecal::engine::session::Session;
-use spherecal::engine::simulate::{self, ErrorModel, SimConfig, Truth};
-use spherecal::engine::solve::{self, Method, Options};
+use spherecal::engine::base::session::Session;
+use spherecal::engine::calibrate::solve::{self, Method, Options};
+use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::tools::simulate::{self, ErrorModel, SimConfig, Truth};
 
 /// A simulated session turned pose-only: each measurement's flange pose is
 /// the true robot's (the controller reports where the flange really is),
@@ -22,7 +22,7 @@ fn pose_only(config: &SimConfig) -> (Session, Truth) {
         m.joints.clear();
     }
     session.robot_given = false;
-    session.robot = spherecal::engine::robot::Robot::new(String::new(), Vec::new());
+    session.robot = spherecal::engine::base::robot::Robot::new(String::new(), Vec::new());
     session.base_given = false;
     session.flange_given = false;
     (session, truth)
@@ -146,13 +146,14 @@ fn with_noise_the_hand_eye_error_is_at_the_noise_floor() {
     assert!(dt < 0.3 && dr < 0.6, "{dt} mm, {dr} deg");
     // The calibrated within-station scatter against the floor: the true
     // hand-eye on the same noisy data.
-    let floor_est = spherecal::engine::solve::estimate::Estimate {
+    let floor_est = spherecal::engine::calibrate::solve::estimate::Estimate {
         robot: session.solver_robot(),
         flange_from_sensor: truth.true_hand_eye(),
     };
     let (prepared, _) = solve::calibrate(&session, &Options::from_session(&session)).unwrap();
-    let stations = prepared.stations(&session, spherecal::engine::session::Use::Identify);
-    let floor = spherecal::engine::validate::epsilon(&floor_est.station_centres(&stations));
+    let stations = prepared.stations(&session, spherecal::engine::base::session::Use::Identify);
+    let floor =
+        spherecal::engine::calibrate::validate::epsilon(&floor_est.station_centres(&stations));
     let after = cal.epsilon_after();
     // ml weighs by its noise model rather than minimising ε itself, so ε
     // may sit a little above the floor.

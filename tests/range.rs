@@ -9,12 +9,12 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{Isometry3, Point3};
-use spherecal::engine::format;
-use spherecal::engine::geometry::kabsch;
-use spherecal::engine::session::{SensorRange, Session, Use};
-use spherecal::engine::simulate::{self, SimConfig, Truth};
-use spherecal::engine::solve::ml::range::{RANGE_GRID, RANGE_POSES};
-use spherecal::engine::solve::{self, Calibration, Options};
+use spherecal::engine::base::geometry::kabsch;
+use spherecal::engine::base::session::{SensorRange, Session, Use};
+use spherecal::engine::calibrate::solve::ml::range::{RANGE_GRID, RANGE_POSES};
+use spherecal::engine::calibrate::solve::{self, Calibration, Options};
+use spherecal::engine::files::format;
+use spherecal::engine::tools::simulate::{self, SimConfig, Truth};
 
 const RANGE: SensorRange = SensorRange {
     y: [-40.0, 40.0],

@@ -5,14 +5,14 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use spherecal::engine::evaluate::range::range_score;
-use spherecal::engine::evaluate::study::{STUDY_RANGE, run_scenario, select};
-use spherecal::engine::plan::range_study::planned_range_study;
-use spherecal::engine::plan::{self, PlanConfig, PlanStage};
-use spherecal::engine::robot;
-use spherecal::engine::session::{SensorRange, Use};
-use spherecal::engine::simulate::{self, SimConfig, SimError};
-use spherecal::engine::solve::{self, Control, Options};
+use spherecal::engine::base::robot;
+use spherecal::engine::base::session::{SensorRange, Use};
+use spherecal::engine::calibrate::solve::{self, Control, Options};
+use spherecal::engine::tools::evaluate::range::range_score;
+use spherecal::engine::tools::evaluate::study::{STUDY_RANGE, run_scenario, select};
+use spherecal::engine::tools::plan::range_study::planned_range_study;
+use spherecal::engine::tools::plan::{self, PlanConfig, PlanStage};
+use spherecal::engine::tools::simulate::{self, SimConfig, SimError};
 
 const RANGE: SensorRange = SensorRange {
     y: [-40.0, 40.0],

@@ -14,14 +14,14 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion};
-use spherecal::engine::format::{self, ResultFile};
-use spherecal::engine::import::{
+use spherecal::engine::base::session::Use;
+use spherecal::engine::calibrate::solve::{self, Options};
+use spherecal::engine::calibrate::validate::scatter_rms;
+use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::files::import::{
     self, AxisMap, DEFAULT_SPHERE_DIAMETER, FlangeConvention, Observations, PoseImportSpec,
     ProfileFormat, ProfileSource, SideChoice,
 };
-use spherecal::engine::session::Use;
-use spherecal::engine::solve::{self, Options};
-use spherecal::engine::validate::scatter_rms;
 
 /// The data folder, or `None` (after a loud message) when it is absent
 /// and not required.
@@ -133,7 +133,7 @@ fn robcalibrator_data_calibrates_below_the_reference_scatter() {
     // data leave weak.
     let file = ResultFile::from_calibration(session, &cal);
     assert!(file.robot.is_none() && file.joint_errors.is_empty());
-    let text = spherecal::engine::report::summary::summary(session, &cal);
+    let text = spherecal::engine::tools::report::summary::summary(session, &cal);
     assert!(
         text.contains("no kinematic parameter was identified"),
         "{text}"
@@ -298,7 +298,7 @@ fn the_real_set_gets_a_held_out_figure_and_the_papers_rise_is_a_warning() {
     let session = import::import_poses(&spec(&dir)).unwrap().session;
     let mut options = Options::from_session(&session);
     let (prepared, cal) = solve::calibrate(&session, &options).unwrap();
-    let text = spherecal::engine::report::summary::summary(&session, &cal);
+    let text = spherecal::engine::tools::report::summary::summary(&session, &cal);
     let h = cal.held_out.as_ref().expect("held out");
     assert_eq!(h.measurements.len(), 15);
     assert!(
@@ -325,7 +325,7 @@ fn the_real_set_gets_a_held_out_figure_and_the_papers_rise_is_a_warning() {
     options.method = solve::Method::Paper;
     let (_, cal) = solve::calibrate(&session, &options).unwrap();
     assert!(cal.epsilon_after() > cal.epsilon_before());
-    let text = spherecal::engine::report::summary::summary(&session, &cal);
+    let text = spherecal::engine::tools::report::summary::summary(&session, &cal);
     assert!(
         text.contains("warning: ε rose from") && text.contains("`--method ml`"),
         "{text}"

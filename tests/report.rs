@@ -13,13 +13,17 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use serde_json::Value;
 use sha2::{Digest, Sha256};
-use spherecal::engine::format::{self, ResultFile};
-use spherecal::engine::report::html::{self, ReportInput, ReportMeta, format_utc, sha256_hex};
-use spherecal::engine::result_view::{self, ReportError, check_result, excluded_measurements};
-use spherecal::engine::robot::PARAM_NAMES;
-use spherecal::engine::session::{self, Session};
-use spherecal::engine::solve::estimate::HAND_EYE_LABELS;
-use spherecal::engine::solve::{self, Method, Options};
+use spherecal::engine::base::robot::PARAM_NAMES;
+use spherecal::engine::base::session::{self, Session};
+use spherecal::engine::calibrate::solve::estimate::HAND_EYE_LABELS;
+use spherecal::engine::calibrate::solve::{self, Method, Options};
+use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::tools::report::html::{
+    self, ReportInput, ReportMeta, format_utc, sha256_hex,
+};
+use spherecal::engine::tools::result_view::{
+    self, ReportError, check_result, excluded_measurements,
+};
 
 /// 2023-11-14 22:13:20 UTC.
 const WHEN: u64 = 1_700_000_000;

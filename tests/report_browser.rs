@@ -18,7 +18,7 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use serde_json::Value;
-use spherecal::engine::report::html::{AFTER_COLOUR, BEFORE_COLOUR};
+use spherecal::engine::tools::report::html::{AFTER_COLOUR, BEFORE_COLOUR};
 
 /// Longest a Chromium run may take before the test fails (it takes 1-3 s;
 /// a loaded CI machine may be much slower).
@@ -416,7 +416,7 @@ fn plan_to_browser_rendered_report_through_the_csv_import() {
     ]);
     assert!(out.contains("0 flagged"), "{out}");
     spherecal(&["calibrate", &session, "--out", &result]);
-    let r = spherecal::engine::format::load_result(Path::new(&result)).unwrap();
+    let r = spherecal::engine::files::format::load_result(Path::new(&result)).unwrap();
     let v = r
         .validation
         .as_ref()
@@ -435,7 +435,7 @@ fn plan_to_browser_rendered_report_through_the_csv_import() {
     assert!(dom.contains("cell 3 from the plan, 2026-11-22"));
     let bytes = std::fs::read(&session).unwrap();
     assert!(
-        dom.contains(&spherecal::engine::report::html::sha256_hex(&bytes)),
+        dom.contains(&spherecal::engine::tools::report::html::sha256_hex(&bytes)),
         "the session's SHA-256 is on the page"
     );
     assert_eq!(

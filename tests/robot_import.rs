@@ -1,4 +1,4 @@
-//! Robot import from URDF and DH tables (`engine::robot::{urdf, dh_table}`):
+//! Robot import from URDF and DH tables (`engine::base::robot::{urdf, dh_table}`):
 //! the imported model's forward kinematics against an independent model of
 //! the same file (the URDF chain composed directly, the standard DH
 //! product written out) and against spherecal's presets, over hundreds of
@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use spherecal::engine::robot::{
+use spherecal::engine::base::robot::{
     DhConvention, JointLimit, Robot, RobotImportError, UrdfOptions, irb2400, load_dh_csv,
     load_urdf, robot_from_dh_csv, robot_from_urdf, robot_from_urdf_with, ur5e,
 };

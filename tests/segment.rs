@@ -10,10 +10,10 @@ use std::path::PathBuf;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use spherecal::engine::session::Observation;
-use spherecal::engine::simulate::{SimConfig, simulate};
-use spherecal::engine::stripe::fit_circle;
-use spherecal::engine::stripe::segment::{MIN_ARC_POINTS, SegmentError, find_arc};
+use spherecal::engine::base::session::Observation;
+use spherecal::engine::calibrate::stripe::fit_circle;
+use spherecal::engine::calibrate::stripe::segment::{MIN_ARC_POINTS, SegmentError, find_arc};
+use spherecal::engine::tools::simulate::{SimConfig, simulate};
 
 /// Sphere radius of the synthetic profiles and of the real data, mm.
 const R: f64 = 40.0;

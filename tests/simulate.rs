@@ -10,11 +10,13 @@ use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, Point3, Vector3};
-use spherecal::engine::cell::sensor;
-use spherecal::engine::format;
-use spherecal::engine::robot::{self, RobotChoice};
-use spherecal::engine::session::{Observation, Session, Use};
-use spherecal::engine::simulate::{self, ErrorModel, InitialHandEye, SideChoice, SimConfig, Truth};
+use spherecal::engine::base::cell::sensor;
+use spherecal::engine::base::robot::{self, RobotChoice};
+use spherecal::engine::base::session::{Observation, Session, Use};
+use spherecal::engine::files::format;
+use spherecal::engine::tools::simulate::{
+    self, ErrorModel, InitialHandEye, SideChoice, SimConfig, Truth,
+};
 
 fn simulate(config: &SimConfig) -> (Session, Truth) {
     simulate::simulate(config).expect("simulation")

@@ -9,8 +9,8 @@ use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use spherecal::engine::stripe::StripeError;
-use spherecal::engine::stripe::{
+use spherecal::engine::calibrate::stripe::StripeError;
+use spherecal::engine::calibrate::stripe::{
     CircleFit, MIN_POINTS, MIN_POINTS_TO_TRIM, RADIUS_TOLERANCE, centre_from_stripe, fit_circle,
     on_plane_x_variance, sphere_centre,
 };

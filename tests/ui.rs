@@ -12,9 +12,9 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
 use spherecal::app::forms::Tab;
-use spherecal::engine::format::parse_session;
-use spherecal::engine::report::model::{self, ModelFormat};
-use spherecal::engine::solve::{Options, calibrate};
+use spherecal::engine::calibrate::solve::{Options, calibrate};
+use spherecal::engine::files::format::parse_session;
+use spherecal::engine::tools::report::model::{self, ModelFormat};
 
 mod ui_support;
 use ui_support::{demo_app, open_path, settle};
@@ -214,14 +214,15 @@ fn cancel_stops_a_run() {
     // Without a working Cancel the run ends with a result and the test
     // fails.
     let dir = tempfile::tempdir().expect("temp dir");
-    let (session, _) =
-        spherecal::engine::simulate::simulate(&spherecal::engine::simulate::SimConfig {
+    let (session, _) = spherecal::engine::tools::simulate::simulate(
+        &spherecal::engine::tools::simulate::SimConfig {
             n_identify: 400,
-            ..spherecal::engine::simulate::SimConfig::default()
-        })
-        .expect("simulate");
+            ..spherecal::engine::tools::simulate::SimConfig::default()
+        },
+    )
+    .expect("simulate");
     let path = dir.path().join("big.json");
-    spherecal::engine::format::save_session(&session, &path).expect("save");
+    spherecal::engine::files::format::save_session(&session, &path).expect("save");
     open_path(&mut h, path);
     assert_eq!(
         h.state()
@@ -264,7 +265,7 @@ fn left_out_measurements_are_saved_and_a_bad_exclusion_is_refused() {
     // Show the last measurement's station only, then leave the measurement
     // out by unticking its checkbox.
     let last = session.measurements.last().expect("measurements");
-    assert_eq!(last.usage, spherecal::engine::session::Use::Validate);
+    assert_eq!(last.usage, spherecal::engine::base::session::Use::Validate);
     h.state_mut().forms_mut().filter_station = Some(last.station.clone());
     h.run();
     h.get_by_label(&last.id).click();
@@ -273,7 +274,8 @@ fn left_out_measurements_are_saved_and_a_bad_exclusion_is_refused() {
     h.state_mut().forms_mut().save_path = target.display().to_string();
     h.get_by_label("Save").click();
     settle(&mut h);
-    let saved = spherecal::engine::format::load_session(&target).expect("the saved file loads");
+    let saved =
+        spherecal::engine::files::format::load_session(&target).expect("the saved file loads");
     assert_eq!(saved.measurements.len(), session.measurements.len() - 1);
     assert!(saved.measurements.iter().all(|m| m.id != last.id));
 
@@ -281,7 +283,7 @@ fn left_out_measurements_are_saved_and_a_bad_exclusion_is_refused() {
     let rotation_station = session
         .measurements
         .iter()
-        .find(|m| m.usage == spherecal::engine::session::Use::Rotation)
+        .find(|m| m.usage == spherecal::engine::base::session::Use::Rotation)
         .expect("rotation")
         .station
         .clone();
@@ -327,10 +329,10 @@ fn a_result_file_is_reviewed_without_running_the_solver() {
     )
     .expect("demo parses");
     let (_, cal) = calibrate(&session, &Options::from_session(&session)).expect("calibrates");
-    let file = spherecal::engine::format::ResultFile::from_calibration(&session, &cal);
+    let file = spherecal::engine::files::format::ResultFile::from_calibration(&session, &cal);
     let dir = tempfile::tempdir().expect("temp dir");
     let path = dir.path().join("demo-result.json");
-    spherecal::engine::format::save_result(&file, &path).expect("saves");
+    spherecal::engine::files::format::save_result(&file, &path).expect("saves");
 
     h.get_by_label("Session or result file").click();
     h.run();
@@ -388,9 +390,10 @@ fn exports_are_written_to_the_chosen_folder() {
         settle(&mut h);
     }
     let stem = "demo-irb2400";
-    let result =
-        spherecal::engine::format::load_result(&dir.path().join(format!("{stem}-result.json")))
-            .expect("the exported result loads");
+    let result = spherecal::engine::files::format::load_result(
+        &dir.path().join(format!("{stem}-result.json")),
+    )
+    .expect("the exported result loads");
     let shown = h.state().state().result.as_ref().expect("result");
     assert_eq!(result, shown.file, "the export is the result on show");
     let centres =
@@ -415,7 +418,8 @@ fn exports_are_written_to_the_chosen_folder() {
     }
     let report =
         std::fs::read_to_string(dir.path().join(format!("{stem}-report.html"))).expect("report");
-    let sha = spherecal::engine::report::html::sha256_hex(spherecal::DEMO_SESSION_JSON.as_bytes());
+    let sha =
+        spherecal::engine::tools::report::html::sha256_hex(spherecal::DEMO_SESSION_JSON.as_bytes());
     assert!(report.starts_with("<!DOCTYPE html>"));
     assert!(
         report.contains(&sha),
@@ -479,7 +483,7 @@ fn clicking_a_centre_in_the_3d_view_selects_its_measurement() {
 
 /// Writes the demo session's poses as a KUKA-style joint log (`Pose`,
 /// `Sphere`, `Use`, `Side`, `A1`..`A6`) and one profile CSV per pose.
-fn write_import_files(dir: &Path) -> spherecal::engine::session::Session {
+fn write_import_files(dir: &Path) -> spherecal::engine::base::session::Session {
     use std::fmt::Write as _;
     let session = parse_session(
         spherecal::DEMO_SESSION_JSON,
@@ -503,7 +507,7 @@ fn write_import_files(dir: &Path) -> spherecal::engine::session::Session {
             write!(log, ",{q}").unwrap();
         }
         log.push('\n');
-        let spherecal::engine::session::Observation::Stripe(points) = &m.observation else {
+        let spherecal::engine::base::session::Observation::Stripe(points) = &m.observation else {
             panic!("the demo has stripes");
         };
         let mut p = String::from("y,z\n");
@@ -734,7 +738,7 @@ fn a_missing_library_folder_is_reported() {
 #[test]
 fn a_plan_is_made_exported_simulated_and_calibrated() {
     use spherecal::app::state::Source;
-    use spherecal::engine::plan;
+    use spherecal::engine::tools::plan;
     let mut h = demo_app();
     h.get_by_label("Plan").click();
     h.run();
@@ -826,7 +830,7 @@ fn the_wizard_imports_flange_poses_and_the_run_calibrates_the_hand_eye_only() {
         form.log_kind = spherecal::app::forms::import::LogKind::FlangePoses;
         form.poses = dir.join("RobPoses.rob").display().to_string();
         form.profiles = dir.display().to_string();
-        form.pose_convention = spherecal::engine::import::FlangeConvention::FanucWpr;
+        form.pose_convention = spherecal::engine::files::import::FlangeConvention::FanucWpr;
         form.sphere_diameter = 80.0;
     }
     h.run();

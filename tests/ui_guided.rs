@@ -56,7 +56,7 @@ fn the_step_bar_walks_the_job_in_order() {
     assert!(step_label(&h, "4. Calibrated").starts_with('●'));
 
     // 5. Validate: the step shows the verdict in the Results view.
-    h.state_mut().forms_mut().tolerance = spherecal::engine::result_view::Tolerance {
+    h.state_mut().forms_mut().tolerance = spherecal::engine::tools::result_view::Tolerance {
         std_mm: 5.0,
         max_mm: 10.0,
     };
@@ -107,7 +107,7 @@ fn the_headline_says_pass_or_fail_against_the_tolerance() {
         (after.std / 2.0, after.max * 2.0, "FAIL"),
         (after.std * 2.0, after.max / 2.0, "FAIL"),
     ] {
-        let t = spherecal::engine::result_view::Tolerance { std_mm, max_mm };
+        let t = spherecal::engine::tools::result_view::Tolerance { std_mm, max_mm };
         h.state_mut().command(
             &ctx,
             spherecal::app::commands::Command::View(
@@ -139,14 +139,15 @@ fn the_headline_says_pass_or_fail_against_the_tolerance() {
 fn cancel_in_the_last_phase_keeps_the_previous_result() {
     let mut h = demo_app();
     let dir = tempfile::tempdir().expect("temp dir");
-    let (session, _) =
-        spherecal::engine::simulate::simulate(&spherecal::engine::simulate::SimConfig {
+    let (session, _) = spherecal::engine::tools::simulate::simulate(
+        &spherecal::engine::tools::simulate::SimConfig {
             n_identify: 2000,
-            ..spherecal::engine::simulate::SimConfig::default()
-        })
-        .expect("simulate");
+            ..spherecal::engine::tools::simulate::SimConfig::default()
+        },
+    )
+    .expect("simulate");
     let path = dir.path().join("big.json");
-    spherecal::engine::format::save_session(&session, &path).expect("save");
+    spherecal::engine::files::format::save_session(&session, &path).expect("save");
     open_path(&mut h, path);
     // A first, whole run: the result on show.
     h.get_by_label("▶ Run").click();
@@ -266,15 +267,16 @@ fn the_plan_view_follows_the_open_sessions_robot() {
 fn the_results_view_maps_the_predicted_error_over_the_range() {
     let mut h = demo_app();
     let dir = tempfile::tempdir().expect("temp dir");
-    let (mut session, _) =
-        spherecal::engine::simulate::simulate(&spherecal::engine::simulate::SimConfig::default())
-            .expect("simulate");
-    session.sensor_range = Some(spherecal::engine::session::SensorRange {
+    let (mut session, _) = spherecal::engine::tools::simulate::simulate(
+        &spherecal::engine::tools::simulate::SimConfig::default(),
+    )
+    .expect("simulate");
+    session.sensor_range = Some(spherecal::engine::base::session::SensorRange {
         y: [-40.0, 40.0],
         z: [-40.0, 40.0],
     });
     let path = dir.path().join("ranged.json");
-    spherecal::engine::format::save_session(&session, &path).expect("save");
+    spherecal::engine::files::format::save_session(&session, &path).expect("save");
     open_path(&mut h, path);
     h.get_by_label("▶ Run").click();
     settle(&mut h);
@@ -445,7 +447,7 @@ fn the_plots_png_is_whole_and_light() {
         "a light background"
     );
     // Nothing within the margin's inner half of the edges.
-    let edge = (spherecal::engine::report::sheet::SHEET_MARGIN * scale / 2.0) as u32;
+    let edge = (spherecal::engine::tools::report::sheet::SHEET_MARGIN * scale / 2.0) as u32;
     for (x, y, p) in png.enumerate_pixels() {
         let inside = x >= edge && y >= edge && x < png.width() - edge && y < png.height() - edge;
         assert!(
@@ -455,7 +457,7 @@ fn the_plots_png_is_whole_and_light() {
     }
     // Each figure's rotated y-axis label (the first 24 px of its box):
     // ink in the band of Fig. 5, Fig. 6 and ε.
-    let margin = spherecal::engine::report::sheet::SHEET_MARGIN * scale;
+    let margin = spherecal::engine::tools::report::sheet::SHEET_MARGIN * scale;
     let band = |y0: f64, y1: f64| {
         (y0 as u32..y1 as u32)
             .flat_map(|y| (margin as u32..(margin + 20.0 * scale) as u32).map(move |x| (x, y)))

@@ -11,8 +11,8 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
 use spherecal::app::forms::Tab;
-use spherecal::engine::format::{parse_session, save_session};
-use spherecal::engine::solve::{Method, Options, calibrate};
+use spherecal::engine::calibrate::solve::{Method, Options, calibrate};
+use spherecal::engine::files::format::{parse_session, save_session};
 
 mod ui_support;
 use ui_support::{demo_app, open_path, settle};

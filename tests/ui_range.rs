@@ -8,7 +8,7 @@
 
 use egui_kittest::kittest::Queryable as _;
 use spherecal::app::forms::Tab;
-use spherecal::engine::session::SensorRange;
+use spherecal::engine::base::session::SensorRange;
 
 mod ui_support;
 use ui_support::{demo_app, settle, small_plan};
@@ -119,10 +119,11 @@ fn the_plan_view_spreads_the_sphere_over_the_range() {
 fn the_import_wizard_sets_the_measuring_range() {
     let mut h = demo_app();
     let dir = tempfile::tempdir().expect("temp dir");
-    let (session, _) =
-        spherecal::engine::simulate::simulate(&spherecal::engine::simulate::SimConfig::default())
-            .expect("simulate");
-    let files = spherecal::engine::simulate::import_files(&session).expect("import files");
+    let (session, _) = spherecal::engine::tools::simulate::simulate(
+        &spherecal::engine::tools::simulate::SimConfig::default(),
+    )
+    .expect("simulate");
+    let files = spherecal::engine::tools::simulate::import_files(&session).expect("import files");
     std::fs::write(dir.path().join("joints.csv"), &files.joints_csv).unwrap();
     std::fs::create_dir_all(dir.path().join("profiles")).unwrap();
     for (id, text) in &files.profiles {

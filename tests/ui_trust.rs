@@ -20,10 +20,10 @@ use spherecal::app::features::run::calibrate_session;
 use spherecal::app::forms::Tab;
 use spherecal::app::jobs::{RunFailure, RunStage};
 use spherecal::app::state::PlanExport;
-use spherecal::engine::plan::Controller;
-use spherecal::engine::result_view::Tolerance;
-use spherecal::engine::simulate::SimConfig;
-use spherecal::engine::solve::{Options, Phase};
+use spherecal::engine::calibrate::solve::{Options, Phase};
+use spherecal::engine::tools::plan::Controller;
+use spherecal::engine::tools::result_view::Tolerance;
+use spherecal::engine::tools::simulate::SimConfig;
 
 mod ui_support;
 use ui_support::{
@@ -409,7 +409,7 @@ fn the_centres_of_3000_stations_are_readable() {
 /// flags an outlier: a simulated cell that reports sphere centres, one of
 /// them moved by 1.5 mm.
 fn failing_session(dir: &std::path::Path) -> std::path::PathBuf {
-    let (mut session, _) = spherecal::engine::simulate::simulate(&SimConfig {
+    let (mut session, _) = spherecal::engine::tools::simulate::simulate(&SimConfig {
         centres: true,
         ..SimConfig::default()
     })
@@ -417,13 +417,13 @@ fn failing_session(dir: &std::path::Path) -> std::path::PathBuf {
     let m = session
         .measurements
         .iter_mut()
-        .find(|m| m.usage == spherecal::engine::session::Use::Identify)
+        .find(|m| m.usage == spherecal::engine::base::session::Use::Identify)
         .expect("an identify measurement");
-    if let spherecal::engine::session::Observation::Centre(c) = &mut m.observation {
+    if let spherecal::engine::base::session::Observation::Centre(c) = &mut m.observation {
         c.y += 1.5;
     }
     let path = dir.join("outlier.json");
-    spherecal::engine::format::save_session(&session, &path).expect("save");
+    spherecal::engine::files::format::save_session(&session, &path).expect("save");
     path
 }
 
@@ -662,12 +662,12 @@ fn the_predicted_error_map_has_an_absolute_colour_bar() {
     let mut h = demo_app();
     let dir = tempfile::tempdir().expect("temp dir");
     let mut session = h.state().state().loaded.as_ref().unwrap().session.clone();
-    session.sensor_range = Some(spherecal::engine::session::SensorRange {
+    session.sensor_range = Some(spherecal::engine::base::session::SensorRange {
         y: [-40.0, 40.0],
         z: [-40.0, 40.0],
     });
     let path = dir.path().join("ranged.json");
-    spherecal::engine::format::save_session(&session, &path).expect("save");
+    spherecal::engine::files::format::save_session(&session, &path).expect("save");
     open_path(&mut h, path);
     h.get_by_label("▶ Run").click();
     settle(&mut h);

@@ -77,9 +77,9 @@ pub enum ViewCommand {
     DismissIntro,
     /// Set or clear the open session's measuring range (`sensor.range`);
     /// kept with the session when it is saved, used by the next run.
-    SetSensorRange(Option<crate::engine::session::SensorRange>),
+    SetSensorRange(Option<crate::engine::base::session::SensorRange>),
     /// Set the acceptance tolerance (remembered for the session's robot).
-    SetTolerance(crate::engine::result_view::Tolerance),
+    SetTolerance(crate::engine::tools::result_view::Tolerance),
     /// After a FAIL: show the measurements the solver flagged as
     /// outliers (Results view, its "after a FAIL" box).
     ShowOutliers,

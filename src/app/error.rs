@@ -5,15 +5,15 @@
 
 use std::path::PathBuf;
 
-use crate::engine::format::FileError;
-use crate::engine::history::HistoryError;
-use crate::engine::import::ImportError;
-use crate::engine::plan::{PlanError, RequestError};
-use crate::engine::report::model::ExportError;
-use crate::engine::result_view::ReportError;
-use crate::engine::session::ExcludeError;
-use crate::engine::simulate::SimError;
-use crate::engine::solve::SolveError;
+use crate::engine::base::session::ExcludeError;
+use crate::engine::calibrate::solve::SolveError;
+use crate::engine::files::format::FileError;
+use crate::engine::files::import::ImportError;
+use crate::engine::tools::history::HistoryError;
+use crate::engine::tools::plan::{PlanError, RequestError};
+use crate::engine::tools::report::model::ExportError;
+use crate::engine::tools::result_view::ReportError;
+use crate::engine::tools::simulate::SimError;
 
 /// A failed job.
 #[derive(Debug, thiserror::Error)]

@@ -12,9 +12,9 @@ use nalgebra::Isometry3;
 use super::forms::{Forms, PlanForm, SolverForm};
 use super::provenance::{Input, Reading};
 use super::state::AppState;
-use crate::engine::result_view::Tolerance;
-use crate::engine::session::SensorRange;
-use crate::engine::solve::Method;
+use crate::engine::base::session::SensorRange;
+use crate::engine::calibrate::solve::Method;
+use crate::engine::tools::result_view::Tolerance;
 
 /// Left-out ids named in a reading; more are counted.
 const IDS_SHOWN: usize = 3;

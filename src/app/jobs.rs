@@ -7,9 +7,9 @@
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
 
-use crate::engine::history::{Drift, Library};
-use crate::engine::import::PoseCheck;
-use crate::engine::solve::Progress;
+use crate::engine::calibrate::solve::Progress;
+use crate::engine::files::import::PoseCheck;
+use crate::engine::tools::history::{Drift, Library};
 
 use super::error::JobError;
 use super::forms::ImportForm;
@@ -111,7 +111,7 @@ impl RunStage {
     pub fn fraction(&self) -> f64 {
         match self {
             Self::Solver(p) => p.run_fraction(),
-            Self::Views => crate::engine::solve::progress::RUN_END,
+            Self::Views => crate::engine::calibrate::solve::progress::RUN_END,
         }
     }
 }

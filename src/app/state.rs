@@ -12,14 +12,14 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::engine::history::{Drift, Library};
-use crate::engine::import::PoseCheck;
-use crate::engine::plan::Controller;
-use crate::engine::plan::{Plan, PlanError, Prediction};
-use crate::engine::result_view::Tolerance;
-use crate::engine::session::Session;
-use crate::engine::solve::{Analysis, SolveError};
-use crate::engine::stripe::{StripeError, StripeResult};
+use crate::engine::base::session::Session;
+use crate::engine::calibrate::solve::{Analysis, SolveError};
+use crate::engine::calibrate::stripe::{StripeError, StripeResult};
+use crate::engine::files::import::PoseCheck;
+use crate::engine::tools::history::{Drift, Library};
+use crate::engine::tools::plan::Controller;
+use crate::engine::tools::plan::{Plan, PlanError, Prediction};
+use crate::engine::tools::result_view::Tolerance;
 
 use super::forms::{Forms, Grouping};
 use super::provenance::{Provenance, Stamp};
@@ -147,8 +147,8 @@ impl LoadedSession {
     #[must_use]
     pub fn points(&self, i: usize) -> Option<usize> {
         match &self.session.measurements.get(i)?.observation {
-            crate::engine::session::Observation::Stripe(p) => Some(p.len()),
-            crate::engine::session::Observation::Centre(_) => None,
+            crate::engine::base::session::Observation::Stripe(p) => Some(p.len()),
+            crate::engine::base::session::Observation::Centre(_) => None,
         }
     }
 

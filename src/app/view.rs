@@ -1,7 +1,7 @@
 //! View models built once, off the UI thread, from engine outputs: the
 //! [`ResultView`] of a result (from a run or a reviewed file alike, both
 //! the typed [`ResultFile`]), around the engine's shared
-//! [`result_view`](crate::engine::result_view), and the [`CentreSet`] of
+//! [`result_view`](crate::engine::tools::result_view), and the [`CentreSet`] of
 //! the centres view. The `*_ui` functions only draw them.
 
 use std::collections::HashMap;
@@ -10,11 +10,11 @@ use std::path::PathBuf;
 use nalgebra::Vector3;
 use serde_json::Value;
 
-use crate::engine::format::ResultFile;
-use crate::engine::format::result::solver_block;
-use crate::engine::result_view::within_pairs;
-pub use crate::engine::result_view::{HandEyeView, ResultView as Shown};
-use crate::engine::session::{Session, Use};
+use crate::engine::base::session::{Session, Use};
+use crate::engine::files::format::ResultFile;
+use crate::engine::files::format::result::solver_block;
+use crate::engine::tools::result_view::within_pairs;
+pub use crate::engine::tools::result_view::{HandEyeView, ResultView as Shown};
 
 /// Where a result on show came from.
 #[derive(Debug, Clone, PartialEq)]
@@ -176,7 +176,7 @@ impl Summary {
         if n == 0 {
             return Self::default();
         }
-        let stats = crate::engine::validate::Stats::of(errors);
+        let stats = crate::engine::calibrate::validate::Stats::of(errors);
         Self {
             n,
             mean: errors.iter().sum::<f64>() / n as f64,
@@ -329,7 +329,7 @@ impl ResultView {
             .collect();
 
         let mut notes = Vec::new();
-        let ids = session.map(crate::engine::result_view::measurement_index);
+        let ids = session.map(crate::engine::tools::result_view::measurement_index);
         let index_of =
             |id: &str| -> Option<usize> { ids.as_ref().and_then(|m| m.get(id).copied()) };
         if let Some(s) = session {
@@ -390,7 +390,7 @@ impl ResultView {
             solver_entries,
             centres: CentreSet::new(points),
             notes,
-            hand_eye_only: crate::engine::result_view::hand_eye_only_lines(&file, session),
+            hand_eye_only: crate::engine::tools::result_view::hand_eye_only_lines(&file, session),
             file,
         }
     }

@@ -1,19 +1,19 @@
 //! `spherecal compensate`: the targets of a pose table or a robot program
 //! compensated through a calibration, written in the same layout with
-//! every other byte kept. A thin caller of [`crate::engine::compensate`].
+//! every other byte kept. A thin caller of [`crate::engine::uses::compensate`].
 
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 
 use super::CliError;
-use crate::engine::compensate::{
+use crate::engine::base::robot::controller::FlangeConvention;
+use crate::engine::calibrate::solve::Control;
+use crate::engine::files::format;
+use crate::engine::files::program::{self, PoseFormat, ReadSpec};
+use crate::engine::uses::compensate::{
     self, CompensateError, JointTargets, Model, Options, Tcp, report, tool,
 };
-use crate::engine::format;
-use crate::engine::program::{self, PoseFormat, ReadSpec};
-use crate::engine::robot::controller::FlangeConvention;
-use crate::engine::solve::Control;
 
 /// Rows of the target table printed without `--all`.
 const TABLE_ROWS: usize = 20;

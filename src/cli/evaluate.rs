@@ -1,14 +1,14 @@
 //! `spherecal evaluate`: the evidence for the `ml` method (the study is
-//! [`crate::engine::evaluate::study`]); prints the text report or the
+//! [`crate::engine::tools::evaluate::study`]); prints the text report or the
 //! README's Markdown table.
 
 use clap::Args;
 
 use super::CliError;
-use crate::engine::evaluate::study::{
+use crate::engine::tools::evaluate::study::{
     StudyError, markdown, range_markdown, run_scenario, select, text,
 };
-use crate::engine::plan::range_study::{
+use crate::engine::tools::plan::range_study::{
     planned_range_markdown, planned_range_study, planned_range_text,
 };
 
@@ -46,11 +46,14 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
         for seed in 1..=args.seeds {
             eprintln!("compensation study, seed {seed}…");
             studies.push(
-                crate::engine::compensate::study::run_seed(seed)
+                crate::engine::uses::compensate::study::run_seed(seed)
                     .map_err(|e| CliError::internal(e.to_string()))?,
             );
         }
-        say!("{}", crate::engine::compensate::study::markdown(&studies));
+        say!(
+            "{}",
+            crate::engine::uses::compensate::study::markdown(&studies)
+        );
         return Ok(());
     }
     if args.planned_range {

@@ -1,15 +1,15 @@
 //! `spherecal export-model`: writes the calibrated model of a result file
 //! as the FORMAT.md `robot` block (JSON), a CSV table of MDH parameters or
 //! a URDF fragment, atomically. A thin caller of
-//! [`crate::engine::report::model`].
+//! [`crate::engine::tools::report::model`].
 
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 
 use super::CliError;
-use crate::engine::format;
-use crate::engine::report::model::{self, ModelFormat};
+use crate::engine::files::format;
+use crate::engine::tools::report::model::{self, ModelFormat};
 
 /// Output format (`--format`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -1,13 +1,13 @@
 //! `spherecal history FOLDER`: the library table of a folder of sessions
 //! and results, then per robot the drift of the hand-eye and of the main
 //! kinematic deviations, and the jumps beyond `k` combined σ. A thin caller
-//! of [`crate::engine::history`]; it prints, the engine does not.
+//! of [`crate::engine::tools::history`]; it prints, the engine does not.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::engine::format;
-use crate::engine::history::{
+use crate::engine::files::format;
+use crate::engine::tools::history::{
     self, DEFAULT_K, DEFAULT_TOP, Drift, DriftOptions, Entry, Library, Series, SeriesKind, Verdict,
 };
 
@@ -50,7 +50,7 @@ fn parse_k(s: &str) -> Result<f64, String> {
         Ok(k) if k.is_finite() && k > 0.0 && k <= MAX_K => Ok(k),
         Ok(k) if k > MAX_K => Err(format!(
             "k = {} would flag no jump at all: give at most {MAX_K} (σ)",
-            crate::engine::numeric::show(k)
+            crate::engine::base::numeric::show(k)
         )),
         _ => Err(format!("expected a positive number, got `{s}`")),
     }
@@ -278,7 +278,7 @@ fn drift_text(library: &Library, d: &Drift) -> String {
     let _ = writeln!(
         s,
         "\njumps (|change| > k·sqrt(σ₁² + σ₂²), k = {}): {}",
-        crate::engine::numeric::show(d.k),
+        crate::engine::base::numeric::show(d.k),
         if jumps.is_empty() {
             "none".to_string()
         } else {

@@ -1,5 +1,5 @@
 //! `spherecal report`: the self-contained HTML report of a calibration
-//! ([`crate::engine::report::html`]). The module is `html_report` because
+//! ([`crate::engine::tools::report::html`]). The module is `html_report` because
 //! `cli` already imports the engine's result-file module as `report`.
 //! Without `--result` the session is calibrated first, as `spherecal
 //! calibrate` does with its defaults (the session's threshold and iteration
@@ -12,10 +12,10 @@ use std::time::{Instant, SystemTime};
 use clap::Args;
 
 use super::{CliError, parse_method};
-use crate::engine::format::{self, FileError};
-use crate::engine::report::html::{self, ReportInput, ReportMeta};
-use crate::engine::result_view;
-use crate::engine::solve::{self, Control, Method, Options};
+use crate::engine::calibrate::solve::{self, Control, Method, Options};
+use crate::engine::files::format::{self, FileError};
+use crate::engine::tools::report::html::{self, ReportInput, ReportMeta};
+use crate::engine::tools::result_view;
 
 /// `spherecal report`.
 #[derive(Debug, Args)]

@@ -3,14 +3,14 @@
 //! with joint readings, with an optional check of the controller's flange
 //! poses against the nominal model; a flange-pose log (`--poses`, e.g.
 //! RobCalibrator's `RobPoses.rob`) gives a pose-only session. A thin
-//! caller of [`crate::engine::import`].
+//! caller of [`crate::engine::files::import`].
 
 use std::path::PathBuf;
 
 use clap::Args;
 
-use crate::engine::format;
-use crate::engine::import::{
+use crate::engine::files::format;
+use crate::engine::files::import::{
     self, AngleUnit, AxisMap, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM,
     DEFAULT_ROTATION_TOLERANCE_DEG, DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention,
     ImportError, ImportSpec, Imported, LengthUnit, Observations, PoseFormat, PoseImportSpec,
@@ -58,7 +58,7 @@ pub struct ImportArgs {
     pub urdf_tip: Option<String>,
     /// The convention of a DH table robot: standard or modified.
     #[arg(long, value_parser = super::parse_dh)]
-    pub dh: Option<crate::engine::robot::DhConvention>,
+    pub dh: Option<crate::engine::base::robot::DhConvention>,
     /// Axis map from the sensor's axes to spherecal's (laser plane x = 0): `auto` (the constant coordinate is the plane's normal) or e.g. `-y,x,z` (spherecal x = -y, y = x, z = z). A mirroring map is refused.
     #[arg(long, default_value = "auto", allow_hyphen_values = true)]
     pub axes: String,
@@ -89,7 +89,7 @@ pub struct ImportArgs {
     pub sphere_diameter: f64,
     /// The sensor's measuring range to write as `sensor.range`: `Y0,Y1,Z0,Z1` in mm (laser plane, sensor frame), e.g. `-40,40,-40,40`; ml then predicts the error over it.
     #[arg(long, allow_hyphen_values = true, value_parser = super::parse_range)]
-    pub range: Option<crate::engine::session::SensorRange>,
+    pub range: Option<crate::engine::base::session::SensorRange>,
     /// Session name (default: the joint log's file name).
     #[arg(long)]
     pub name: Option<String>,
@@ -312,7 +312,7 @@ fn out_path(args: &ImportArgs) -> Result<PathBuf, CliError> {
     inputs.extend(args.centres.iter().chain(&args.hand_eye).cloned());
     if let Some(profiles) = &args.profiles {
         if profiles.is_dir() {
-            if let Ok(files) = crate::engine::import::profiles::profile_files(profiles) {
+            if let Ok(files) = crate::engine::files::import::profiles::profile_files(profiles) {
                 inputs.extend(files);
             }
         } else {

@@ -2,7 +2,7 @@
 //! pose log and profiles), into a point cloud in the robot base frame (or
 //! a workpiece frame) through a result's calibrated model and hand-eye,
 //! each point with its σ; the sphere self-validation; PLY, E57 or CSV by
-//! the output's extension. A thin caller of [`crate::engine::measure`].
+//! the output's extension. A thin caller of [`crate::engine::uses::measure`].
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -10,17 +10,17 @@ use std::time::Instant;
 use clap::Args;
 
 use super::CliError;
-use crate::engine::format;
-use crate::engine::import::{
+use crate::engine::base::session::Use;
+use crate::engine::calibrate::solve::Control;
+use crate::engine::files::format;
+use crate::engine::files::import::{
     self, AngleUnit, AxisMap, FlangeConvention, LengthUnit, ProfileFormat, ProfileSource,
     RobotSource,
 };
-use crate::engine::measure::{
+use crate::engine::uses::measure::{
     self, CellModel, CloudFormat, JointRange, MeasureError, MeasureOptions, ModelChoice,
     Provenance, Scan, ScanColumns, ScanFiles, ScanLog, ScanPose, selfcheck,
 };
-use crate::engine::session::Use;
-use crate::engine::solve::Control;
 
 /// Poses outside the calibrated joint range listed by name at most (a
 /// scan of thousands of poses would bury the summary).
@@ -67,7 +67,7 @@ pub struct MeasureArgs {
     pub poses: Option<PathBuf>,
     /// Force the pose file's layout: table, json, fanuc-ls, rapid, krl or urscript.
     #[arg(long, value_parser = super::import::parse_pose_format)]
-    pub pose_format: Option<crate::engine::import::PoseFormat>,
+    pub pose_format: Option<crate::engine::files::import::PoseFormat>,
     /// How a pose table or JSON list writes a pose: ABB, KUKA, FANUC, UR or matrix (a robot program fixes its own).
     #[arg(long, value_parser = parse_convention)]
     pub pose_convention: Option<FlangeConvention>,
@@ -88,7 +88,7 @@ pub struct MeasureArgs {
     pub urdf_tip: Option<String>,
     /// The convention of a DH table robot: standard or modified.
     #[arg(long, value_parser = super::parse_dh)]
-    pub dh: Option<crate::engine::robot::DhConvention>,
+    pub dh: Option<crate::engine::base::robot::DhConvention>,
     /// Axis map from the sensor's axes to spherecal's (laser plane x = 0): `auto` or e.g. `-y,x,z`.
     #[arg(long, default_value = "auto")]
     pub axes: String,

@@ -42,15 +42,15 @@ use std::time::Instant;
 
 use clap::{Args, Parser, Subcommand};
 
-use crate::engine::format;
-use crate::engine::format::FileError;
-use crate::engine::report::summary;
-use crate::engine::session;
-use crate::engine::solve::ml::{Loss, MlOptions};
-use crate::engine::solve::paper::Pairing;
-use crate::engine::solve::{
+use crate::engine::base::session;
+use crate::engine::calibrate::solve::ml::{Loss, MlOptions};
+use crate::engine::calibrate::solve::paper::Pairing;
+use crate::engine::calibrate::solve::{
     self, Control, HandEyeSource, Method, Options, SolveError, StopReason, plausible,
 };
+use crate::engine::files::format;
+use crate::engine::files::format::FileError;
+use crate::engine::tools::report::summary;
 
 /// spherecal: calibrate a robot-mounted laser-stripe sensor (hand-eye and
 /// kinematic errors) against a reference sphere.
@@ -250,7 +250,7 @@ pub struct CalibrateArgs {
     #[arg(long)]
     pub max_iterations: Option<usize>,
     /// Relative SVD tolerance of the paper's method (fraction of the largest singular value).
-    #[arg(long, default_value_t = crate::engine::solve::paper::DEFAULT_SVD_TOLERANCE)]
+    #[arg(long, default_value_t = crate::engine::calibrate::solve::paper::DEFAULT_SVD_TOLERANCE)]
     pub svd_tolerance: f64,
     /// Pairing of a station's measurements: `disjoint` (the paper's (1,2),(3,4),(5,6)) or `all`.
     #[arg(long, default_value = "disjoint", value_parser = parse_pairing)]
@@ -352,10 +352,10 @@ impl MlArgs {
 }
 
 /// `standard` or `modified` (a DH table's convention).
-fn parse_dh(s: &str) -> Result<crate::engine::robot::DhConvention, String> {
+fn parse_dh(s: &str) -> Result<crate::engine::base::robot::DhConvention, String> {
     match s.to_ascii_lowercase().as_str() {
-        "standard" | "dh" => Ok(crate::engine::robot::DhConvention::Standard),
-        "modified" | "mdh" => Ok(crate::engine::robot::DhConvention::Modified),
+        "standard" | "dh" => Ok(crate::engine::base::robot::DhConvention::Standard),
+        "modified" | "mdh" => Ok(crate::engine::base::robot::DhConvention::Modified),
         _ => Err(format!(
             "unknown DH convention `{s}`, expected standard or modified"
         )),
@@ -371,7 +371,7 @@ fn parse_loss(s: &str) -> Result<Loss, String> {
 ///
 /// # Errors
 /// Not four finite numbers with `Y0 < Y1` and `Z0 < Z1`.
-pub fn parse_range(s: &str) -> Result<crate::engine::session::SensorRange, String> {
+pub fn parse_range(s: &str) -> Result<crate::engine::base::session::SensorRange, String> {
     let v: Vec<f64> = s
         .split(',')
         .map(|t| t.trim().parse::<f64>())
@@ -383,7 +383,7 @@ pub fn parse_range(s: &str) -> Result<crate::engine::session::SensorRange, Strin
     if !(v.iter().all(|x| x.is_finite()) && y0 < y1 && z0 < z1) {
         return Err(format!("`{s}`: need Y0 < Y1 and Z0 < Z1 (mm)"));
     }
-    Ok(crate::engine::session::SensorRange {
+    Ok(crate::engine::base::session::SensorRange {
         y: [*y0, *y1],
         z: [*z0, *z1],
     })
@@ -537,7 +537,7 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
         sayln!(
             "identification: method {}, threshold {} mm, at most {} update(s)",
             options.method.as_str(),
-            crate::engine::numeric::show(options.threshold),
+            crate::engine::base::numeric::show(options.threshold),
             options.max_iterations
         );
     }
@@ -553,8 +553,8 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
         // nothing.
         eprintln!(
             "warning: ε = {} mm is already within the threshold {} mm before any update: nothing was identified, the result holds the uncalibrated model and initial hand-eye",
-            crate::engine::numeric::approx(epsilon),
-            crate::engine::numeric::show(threshold)
+            crate::engine::base::numeric::approx(epsilon),
+            crate::engine::base::numeric::show(threshold)
         );
     }
     check_plausible(&session, &cal, args.accept_implausible, &args.session)?;

@@ -2,7 +2,7 @@
 //! rough sphere position and the sensor's hand-eye guess; optionally the
 //! plan's predicted accuracy by simulation, and its exports (the joint log
 //! CSV that `spherecal import` reads, controller programs). A thin caller
-//! of [`crate::engine::plan`]; every file is written atomically.
+//! of [`crate::engine::tools::plan`]; every file is written atomically.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -10,15 +10,15 @@ use std::time::{Duration, Instant};
 use clap::Args;
 
 use super::CliError;
-use crate::engine::format;
-use crate::engine::import::RobotSource;
-use crate::engine::plan::{
+use crate::engine::base::robot::{self, JointLimit};
+use crate::engine::calibrate::solve::Control;
+use crate::engine::files::format;
+use crate::engine::files::import::RobotSource;
+use crate::engine::tools::plan::{
     self, Controller, PlanConfig, PlanError, PlanRequest, PlanStage, PredictConfig, RequestError,
     Selection, defaults, read_hand_eye, read_stations,
 };
-use crate::engine::robot::{self, JointLimit};
-use crate::engine::simulate;
-use crate::engine::solve::Control;
+use crate::engine::tools::simulate;
 
 /// `spherecal plan`.
 #[derive(Debug, Args)]
@@ -31,7 +31,7 @@ pub struct PlanArgs {
     pub urdf_tip: Option<String>,
     /// The convention of a DH table robot: standard or modified.
     #[arg(long, value_parser = super::parse_dh)]
-    pub dh: Option<crate::engine::robot::DhConvention>,
+    pub dh: Option<crate::engine::base::robot::DhConvention>,
     /// Joint limits, deg, `min:max` per joint, comma-separated (default: the preset's; a robot from a file needs them unless it is named like a preset).
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub limits: Vec<String>,
@@ -79,7 +79,7 @@ pub struct PlanArgs {
     pub candidates: usize,
     /// The sensor's measuring range `Y0,Y1,Z0,Z1` (mm, laser plane, sensor frame), e.g. `-40,40,-40,40`: the plan spreads the sphere over it (identify and validate poses see the sphere anywhere in the range, identify poses chosen for the smallest predicted error over it), compares with the plan without the spread, and --predict scores the error over it.
     #[arg(long, allow_hyphen_values = true, value_parser = super::parse_range)]
-    pub range: Option<crate::engine::session::SensorRange>,
+    pub range: Option<crate::engine::base::session::SensorRange>,
     /// With --range: keep the sphere at the paper's one spot (±2, ±3 mm) and choose by ln det; the range is only predicted.
     #[arg(long, requires = "range")]
     pub no_spread: bool,
@@ -411,7 +411,7 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
     use super::*;
-    use crate::engine::plan::StationLayout;
+    use crate::engine::tools::plan::StationLayout;
     use clap::Parser;
 
     #[derive(Debug, Parser)]

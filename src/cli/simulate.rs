@@ -4,7 +4,7 @@
 //! (`spherecal plan --csv`) instead of the simulator's own generation;
 //! with `--csv-out DIR` it also writes the joint log, stripe profiles and
 //! reference distances that `spherecal import` reads. A thin caller of
-//! [`crate::engine::simulate`].
+//! [`crate::engine::tools::simulate`].
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -12,12 +12,12 @@ use std::time::Instant;
 use clap::ValueEnum;
 
 use super::CliError;
-use crate::engine::cell::sensor;
-use crate::engine::format;
-use crate::engine::plan;
-use crate::engine::robot::{self, RobotChoice};
-use crate::engine::session::{Session, Use};
-use crate::engine::simulate::{
+use crate::engine::base::cell::sensor;
+use crate::engine::base::robot::{self, RobotChoice};
+use crate::engine::base::session::{Session, Use};
+use crate::engine::files::format;
+use crate::engine::tools::plan;
+use crate::engine::tools::simulate::{
     self, ErrorModel, InitialHandEye, PartKind, PlanExecution, ScanConfig, SideChoice, SimConfig,
 };
 
@@ -93,7 +93,7 @@ pub struct SimulateArgs {
     pub out: PathBuf,
     /// The sensor's measuring range to write as `sensor.range`: `Y0,Y1,Z0,Z1` in mm (laser plane, sensor frame), e.g. `-40,40,-40,40`; ml then predicts the error over it.
     #[arg(long, allow_hyphen_values = true, value_parser = super::parse_range)]
-    pub range: Option<crate::engine::session::SensorRange>,
+    pub range: Option<crate::engine::base::session::SensorRange>,
     /// Spread the sphere over --range: identify and validate measurements
     /// see the sphere centre anywhere in the range (uniform along the line
     /// and in depth) instead of the paper's ±2, ±3 mm spot.

@@ -1,47 +1,29 @@
 //! The headless calibration engine. It never imports egui, eframe or rfd;
 //! the command line and the workbench are two thin callers of it.
 //!
-//! The units are listed in pipeline order; each uses only units above it.
+//! Five layers, in the order of their use: each uses only the layers
+//! above it, and inside a layer each unit uses only the units above it
+//! (each layer's own doc lists its units in that order).
 //!
-//! | unit | holds |
-//! |---|---|
-//! | [`geometry`], [`numeric`] | rigid transforms, twists, roll/pitch/yaw; rounding, medians |
-//! | [`robot`] | the MDH model, forward kinematics and Jacobians (eq. 1-2, 16), presets, inverse kinematics |
-//! | [`session`] | the in-memory session every function takes, its rules, leaving measurements out |
-//! | [`stripe`] | circle fit of a stripe, the sphere centre (eq. 21) |
-//! | [`handeye`] | the initial hand-eye (eq. 3-9) |
-//! | [`validate`] | ε (eq. 20), statistics, Fig. 5 and 6 distances |
-//! | [`solve`] | prepare (each stripe fitted once), the one loop of Fig. 2 around a step: the paper's update (eq. 10-19) or `ml`'s |
-//! | [`format`](mod@format) | session and result files (typed both ways), JSON text, atomic writes |
-//! | [`result_view`] | one view of a result: headline, within-station pairs, roll/pitch/yaw, identifiability marks |
-//! | [`report`] | text summary, HTML report with SVG figures, model export |
-//! | [`cell`] | what the simulator and the planner share about a cell: sensor, workspace, approach cones, joint logs, seeded streams |
-//! | [`import`] | joint logs and profiles into a session |
-//! | [`measure`] | scans into base-frame point clouds through a result, each point with its σ; sphere self-validation; PLY, E57, CSV |
-//! | [`simulate`] | simulated sessions with their truth |
-//! | [`evaluate`] | scoring against the truth; the method comparison study |
-//! | [`plan`] | pose plans and their predicted accuracy |
-//! | [`history`] | a library of results, drift over time |
-//! | [`compensate`] | robot targets and programs compensated through a calibration: IK on the calibrated model, tool data per controller, per-target corrections and flags |
+//! | layer | holds | units |
+//! |---|---|---|
+//! | [`base`] | numbers, frames, the robot's MDH model, the session | numeric, geometry, table, limits, robot, session, cell |
+//! | [`calibrate`] | the paper's method in the order it runs (eq. 21, 3-9, 20, 10-19) | stripe, handeye, validate, solve |
+//! | [`files`] | the doors: FORMAT.md files, robot programs, the import of real cells | format, program, import |
+//! | [`tools`] | around the method: views, reports, history, simulation, scoring, planning | result_view, report, history, simulate, evaluate, plan |
+//! | [`uses`] | using a calibration: measuring parts, compensating robot programs | measure, compensate |
+//!
+//! Why this order: the paper's core needs only the model and the session,
+//! so it sits alone right after them; the files come after it because a
+//! result file carries the solver's report and the import decides the
+//! stripe side by calibrating; the tools use the files (a simulated
+//! session is written as one, a plan as a program); measuring and
+//! compensating use a result and the tools' simulator for their checks.
+//! The layers' names sort in this order, so the tree reads as the
+//! pipeline.
 
-pub mod cell;
-pub mod compensate;
-pub mod evaluate;
-pub mod format;
-pub mod geometry;
-pub mod handeye;
-pub mod history;
-pub mod import;
-pub mod measure;
-pub mod numeric;
-pub mod plan;
-pub mod program;
-pub mod report;
-pub mod result_view;
-pub mod robot;
-pub mod session;
-pub mod simulate;
-pub mod solve;
-pub mod stripe;
-pub mod table;
-pub mod validate;
+pub mod base;
+pub mod calibrate;
+pub mod files;
+pub mod tools;
+pub mod uses;

@@ -6,10 +6,10 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use spherecal::engine::format::{self, ResultFile};
-use spherecal::engine::session::Session;
-use spherecal::engine::simulate::{self, SimConfig, Truth};
-use spherecal::engine::solve::{self, Method, Options};
+use spherecal::engine::base::session::Session;
+use spherecal::engine::calibrate::solve::{self, Method, Options};
+use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::tools::simulate::{self, SimConfig, Truth};
 
 pub fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_spherecal")

@@ -5,10 +5,10 @@
 
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use spherecal::engine::session::{Session, Use};
-use spherecal::engine::simulate::{self, SimConfig};
-use spherecal::engine::solve::paper::Pairing;
-use spherecal::engine::solve::{self, Method, Options};
+use spherecal::engine::base::session::{Session, Use};
+use spherecal::engine::calibrate::solve::paper::Pairing;
+use spherecal::engine::calibrate::solve::{self, Method, Options};
+use spherecal::engine::tools::simulate::{self, SimConfig};
 
 /// A pose-only session of one sphere station seen from `poses` flange
 /// poses, each reported with an error of σ `pose_sigma` mm per
@@ -35,7 +35,7 @@ pub fn one_station(seed: u64, poses: usize, pose_sigma: f64) -> Session {
         m.joints.clear();
     }
     session.robot_given = false;
-    session.robot = spherecal::engine::robot::Robot::new(String::new(), Vec::new());
+    session.robot = spherecal::engine::base::robot::Robot::new(String::new(), Vec::new());
     session.base_given = false;
     session.flange_given = false;
     session.hand_eye = Some(solve::prepare(&session).unwrap().hand_eye_initial);

@@ -98,11 +98,11 @@ pub fn status(h: &Harness<'_, WorkbenchApp>) -> String {
 pub fn simulated(
     dir: &std::path::Path,
     name: &str,
-    config: &spherecal::engine::simulate::SimConfig,
+    config: &spherecal::engine::tools::simulate::SimConfig,
 ) -> std::path::PathBuf {
-    let (session, _) = spherecal::engine::simulate::simulate(config).expect("simulate");
+    let (session, _) = spherecal::engine::tools::simulate::simulate(config).expect("simulate");
     let path = dir.join(name);
-    spherecal::engine::format::save_session(&session, &path).expect("save");
+    spherecal::engine::files::format::save_session(&session, &path).expect("save");
     path
 }
 

@@ -11,11 +11,11 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::SystemTime;
 
-use crate::engine::format::{result_text_checked, write_atomic};
-use crate::engine::report::html::{self, ReportInput, ReportMeta};
-use crate::engine::report::model::{self, ModelFormat};
-use crate::engine::report::sheet::{self, SheetInput};
-use crate::engine::result_view::{self, Tolerance};
+use crate::engine::files::format::{result_text_checked, write_atomic};
+use crate::engine::tools::report::html::{self, ReportInput, ReportMeta};
+use crate::engine::tools::report::model::{self, ModelFormat};
+use crate::engine::tools::report::sheet::{self, SheetInput};
+use crate::engine::tools::result_view::{self, Tolerance};
 
 use super::Core;
 use crate::app::error::JobError;

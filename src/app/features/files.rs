@@ -7,12 +7,12 @@
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-use crate::engine::format::{
+use crate::engine::base::session::{ExcludeError, Session, exclude_measurements};
+use crate::engine::calibrate::solve::{self, estimate::Estimate};
+use crate::engine::files::format::{
     FileError, RESULT_FORMAT, ResultFile, parse_result, parse_session, session_to_json,
     write_atomic,
 };
-use crate::engine::session::{ExcludeError, Session, exclude_measurements};
-use crate::engine::solve::{self, estimate::Estimate};
 
 use super::Core;
 use crate::app::commands::FilesCommand;
@@ -463,7 +463,7 @@ impl Core {
         self.forms.solver = SolverForm::from_session(&loaded.session);
         // The Plan view follows the open session's robot (a preset of the
         // same name), so a plan and its program are for that robot.
-        if let Some(p) = crate::engine::robot::presets::presets()
+        if let Some(p) = crate::engine::base::robot::presets::presets()
             .into_iter()
             .find(|p| p.robot.name == loaded.session.robot.name)
             && self.forms.plan.robot != p.key

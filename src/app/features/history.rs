@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use crate::engine::history::{self, DriftOptions, HistoryError, Library};
+use crate::engine::tools::history::{self, DriftOptions, HistoryError, Library};
 
 use super::Core;
 use crate::app::commands::HistoryCommand;

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use crate::engine::import;
+use crate::engine::files::import;
 
 use super::Core;
 use super::files::analyse;

@@ -1,6 +1,6 @@
 //! The Plan view's work: the engine's pose planner
-//! ([`crate::engine::plan::plan`]) and its predicted accuracy
-//! ([`crate::engine::plan::predict`]), as `spherecal plan` runs them, with
+//! ([`crate::engine::tools::plan::plan`]) and its predicted accuracy
+//! ([`crate::engine::tools::plan::predict`]), as `spherecal plan` runs them, with
 //! progress and cancel; the plan's files; and a simulated session of a
 //! plan, to try the whole workflow without a robot.
 
@@ -8,14 +8,14 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use crate::engine::format::write_atomic;
-use crate::engine::plan::{
+use crate::engine::base::robot::RobotChoice;
+use crate::engine::base::session::{Session, Use};
+use crate::engine::calibrate::solve::Control;
+use crate::engine::files::format::write_atomic;
+use crate::engine::tools::plan::{
     self, Plan, PlanConfig, PlanError, PlanStage, PredictConfig, RequestError,
 };
-use crate::engine::robot::RobotChoice;
-use crate::engine::session::{Session, Use};
-use crate::engine::simulate::{self, PlanExecution, SimConfig};
-use crate::engine::solve::Control;
+use crate::engine::tools::simulate::{self, PlanExecution, SimConfig};
 
 use super::Core;
 use super::files::analyse;

@@ -7,8 +7,8 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use crate::engine::format::ResultFile;
-use crate::engine::solve::{self, Control, Options, Phase, StopReason};
+use crate::engine::calibrate::solve::{self, Control, Options, Phase, StopReason};
+use crate::engine::files::format::ResultFile;
 
 use super::Core;
 use super::files::without;

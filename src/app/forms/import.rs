@@ -2,16 +2,16 @@
 //! flange-pose log, profiles and their axes, robot, units, column mapping,
 //! flange-pose check) and the engine's [`ImportSpec`] or
 //! [`PoseImportSpec`] it stands for. The import itself is
-//! [`crate::engine::import`], the same functions `spherecal import` calls.
+//! [`crate::engine::files::import`], the same functions `spherecal import` calls.
 
 use std::path::PathBuf;
 
-use crate::engine::import::{
+use crate::engine::base::robot::DhConvention;
+use crate::engine::files::import::{
     AngleUnit, AxisMap, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
     DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit, Observations,
     PoseImportSpec, ProfileFormat, ProfileSource, RobotSource, SideChoice,
 };
-use crate::engine::robot::DhConvention;
 
 /// Rows the preview shows.
 pub const PREVIEW_ROWS: usize = 8;

@@ -9,10 +9,10 @@ pub mod plan;
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 
-use crate::engine::history::DEFAULT_K;
-use crate::engine::session::{Session, Use};
-use crate::engine::solve::paper::{DEFAULT_SVD_TOLERANCE, Pairing, PaperOptions};
-use crate::engine::solve::{Method, Options};
+use crate::engine::base::session::{Session, Use};
+use crate::engine::calibrate::solve::paper::{DEFAULT_SVD_TOLERANCE, Pairing, PaperOptions};
+use crate::engine::calibrate::solve::{Method, Options};
+use crate::engine::tools::history::DEFAULT_K;
 pub use import::{ImportForm, ProfilesKind};
 pub use plan::PlanForm;
 
@@ -36,8 +36,8 @@ impl Default for SolverForm {
         Self {
             method: Method::ALL[0],
             pairing: Pairing::Disjoint,
-            threshold: crate::engine::session::DEFAULT_THRESHOLD,
-            max_iterations: crate::engine::session::DEFAULT_MAX_ITERATIONS,
+            threshold: crate::engine::base::session::DEFAULT_THRESHOLD,
+            max_iterations: crate::engine::base::session::DEFAULT_MAX_ITERATIONS,
             svd_tolerance: DEFAULT_SVD_TOLERANCE,
         }
     }
@@ -232,7 +232,7 @@ pub struct Forms {
     pub plan: PlanForm,
     /// The acceptance tolerance the headline's PASS/FAIL and the report
     /// use (remembered per robot in the preferences).
-    pub tolerance: crate::engine::result_view::Tolerance,
+    pub tolerance: crate::engine::tools::result_view::Tolerance,
     /// Scroll the Results view to its "after a FAIL" box once (set by
     /// Next's "Look at the outliers").
     pub focus_after_fail: bool,
@@ -256,7 +256,7 @@ impl Default for Forms {
             import: ImportForm::default(),
             history: HistoryForm::default(),
             plan: PlanForm::default(),
-            tolerance: crate::engine::result_view::Tolerance::default(),
+            tolerance: crate::engine::tools::result_view::Tolerance::default(),
             focus_after_fail: false,
         }
     }

@@ -4,10 +4,10 @@
 
 use nalgebra::Isometry3;
 
-use crate::engine::cell::workspace::Workspace;
-use crate::engine::import::RobotSource;
-use crate::engine::plan::{PlanConfig, PlanRequest};
-use crate::engine::robot::RobotChoice;
+use crate::engine::base::cell::workspace::Workspace;
+use crate::engine::base::robot::RobotChoice;
+use crate::engine::files::import::RobotSource;
+use crate::engine::tools::plan::{PlanConfig, PlanRequest};
 
 /// The Plan view's fields: the robot preset and where the hand-eye guess
 /// comes from, and the rest of the request as the command line has it.

@@ -1,8 +1,8 @@
 //! The History view: the library of a folder of sessions and results
-//! ([`crate::engine::history::scan`]) as a table, and for one robot the
+//! ([`crate::engine::tools::history::scan`]) as a table, and for one robot the
 //! drift of the hand-eye and of its main kinematic deviations over the
 //! ticked results, with every change beyond `k` combined σ flagged
-//! ([`crate::engine::history::drift`]). Nothing is computed here.
+//! ([`crate::engine::tools::history::drift`]). Nothing is computed here.
 
 use egui::RichText;
 use egui_plot::{Line, LineStyle, MarkerShape, Plot, PlotPoints, Points};
@@ -12,7 +12,7 @@ use super::{AFTER, BAD, MUTED, WARN, labelled_field};
 use crate::app::commands::{Command, FilesCommand, HistoryCommand};
 use crate::app::forms::Forms;
 use crate::app::state::{AppState, DialogPurpose};
-use crate::engine::history::{Drift, Entry, Library, Series, Verdict};
+use crate::engine::tools::history::{Drift, Entry, Library, Series, Verdict};
 
 /// Height of one drift plot, points.
 const DRIFT_PLOT_HEIGHT: f32 = 170.0;

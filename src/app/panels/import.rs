@@ -1,5 +1,5 @@
 //! The Import view: a wizard that turns a pose log and stripe profile
-//! files into a session (the engine's [`crate::engine::import`], as
+//! files into a session (the engine's [`crate::engine::files::import`], as
 //! `spherecal import`). A joint log CSV, or the controller's flange poses
 //! (JSON, RobCalibrator `.rob`, CSV) for a pose-only session; profiles as
 //! CSV/TXT or OpenCV YAML/JSON in the sensor's axes. Steps on one page:
@@ -14,8 +14,8 @@ use crate::app::commands::{Command, FilesCommand, ImportCommand};
 use crate::app::forms::Forms;
 use crate::app::forms::import::{CONVENTIONS, ImportForm, LogKind, ProfilesKind};
 use crate::app::state::{AppState, DialogPurpose};
-use crate::engine::import::{AngleUnit, FlangeConvention, LengthUnit, SideChoice};
-use crate::engine::robot::{self, DhConvention};
+use crate::engine::base::robot::{self, DhConvention};
+use crate::engine::files::import::{AngleUnit, FlangeConvention, LengthUnit, SideChoice};
 
 /// Width of the path fields, points.
 const PATH_WIDTH: f32 = 420.0;

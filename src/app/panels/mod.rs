@@ -271,9 +271,9 @@ pub fn range_fields(ui: &mut egui::Ui, id: &str, v: &mut [f64; 4], rows: bool) -
 }
 
 /// The range of `[y0, y1, z0, z1]`, or why it is not one.
-pub fn range_of(v: &[f64; 4]) -> Result<crate::engine::session::SensorRange, &'static str> {
+pub fn range_of(v: &[f64; 4]) -> Result<crate::engine::base::session::SensorRange, &'static str> {
     if v[0] < v[1] && v[2] < v[3] {
-        Ok(crate::engine::session::SensorRange {
+        Ok(crate::engine::base::session::SensorRange {
             y: [v[0], v[1]],
             z: [v[2], v[3]],
         })
@@ -284,7 +284,7 @@ pub fn range_of(v: &[f64; 4]) -> Result<crate::engine::session::SensorRange, &'s
 
 /// `[y0, y1, z0, z1]` of a range.
 #[must_use]
-pub fn range_values(r: &crate::engine::session::SensorRange) -> [f64; 4] {
+pub fn range_values(r: &crate::engine::base::session::SensorRange) -> [f64; 4] {
     [r.y[0], r.y[1], r.z[0], r.z[1]]
 }
 

@@ -14,9 +14,9 @@ use crate::app::commands::{Command, FilesCommand, PlanCommand};
 use crate::app::forms::{Forms, plan::default_sphere};
 use crate::app::provenance::Output;
 use crate::app::state::{AppState, DialogPurpose, PlanExport, PlanOutcome};
-use crate::engine::plan::{Plan, StationRole};
-use crate::engine::robot;
-use crate::engine::session::Use;
+use crate::engine::base::robot;
+use crate::engine::base::session::Use;
+use crate::engine::tools::plan::{Plan, StationRole};
 
 /// Width of the settings column, points.
 const FORM_WIDTH: f32 = 330.0;
@@ -353,10 +353,10 @@ fn outcome_ui(
         if ui.button("Browse…").clicked() {
             commands.push(Command::Files(FilesCommand::Browse(DialogPurpose::ExportFolder)));
         }
-        let robot_name = crate::engine::robot::presets::preset(&forms.plan.robot)
+        let robot_name = crate::engine::base::robot::presets::preset(&forms.plan.robot)
             .map(|p| p.robot.name)
             .unwrap_or_default();
-        let controller = crate::engine::plan::Controller::for_robot(&robot_name);
+        let controller = crate::engine::tools::plan::Controller::for_robot(&robot_name);
         if controller.is_none() {
             ui.label(
                 RichText::new(format!(
@@ -368,8 +368,8 @@ fn outcome_ui(
         for kind in std::iter::once(PlanExport::Csv).chain(controller.map(PlanExport::Program)) {
             let hint = match kind {
                 PlanExport::Csv => "the joint-log CSV that `spherecal import` reads (id, station, use, side, joints, nominal ABB flange pose)",
-                PlanExport::Program(crate::engine::plan::Controller::AbbRapid) => "an ABB RAPID module: one jointtarget per pose, MoveAbsJ in plan order, a stop per measurement",
-                PlanExport::Program(crate::engine::plan::Controller::UrScript) => "a URScript program for a Universal Robots controller: one movej per pose (rad), a popup per station, a measure hook",
+                PlanExport::Program(crate::engine::tools::plan::Controller::AbbRapid) => "an ABB RAPID module: one jointtarget per pose, MoveAbsJ in plan order, a stop per measurement",
+                PlanExport::Program(crate::engine::tools::plan::Controller::UrScript) => "a URScript program for a Universal Robots controller: one movej per pose (rad), a popup per station, a measure hook",
             };
             if ui
                 .add_enabled(

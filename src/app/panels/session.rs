@@ -11,7 +11,7 @@ use super::{
 use crate::app::commands::{Command, FilesCommand, ViewCommand};
 use crate::app::forms::{Forms, Grouping};
 use crate::app::state::{AppState, DialogPurpose, Fit, LoadedSession};
-use crate::engine::session::Use;
+use crate::engine::base::session::Use;
 
 /// A row of the table: a group header or a measurement.
 enum Row {
@@ -229,7 +229,7 @@ fn rows(state: &AppState, loaded: &LoadedSession, forms: &Forms) -> Vec<Row> {
         };
         if key.is_some() && key != current {
             let k = key.clone().unwrap_or_default();
-            let members: Vec<&crate::engine::session::Measurement> = ms
+            let members: Vec<&crate::engine::base::session::Measurement> = ms
                 .iter()
                 .filter(|m| match forms.group {
                     Grouping::Station => m.station == k,

@@ -5,8 +5,8 @@
 use egui::{RichText, Vec2};
 use egui_plot::{HLine, Line, Plot, PlotPoints, Points};
 
-use crate::engine::solve::Method;
-use crate::engine::solve::paper::Pairing;
+use crate::engine::calibrate::solve::Method;
+use crate::engine::calibrate::solve::paper::Pairing;
 
 use super::{AFTER, BAD, BEFORE, labelled_field};
 use crate::app::commands::{Command, FilesCommand, RunCommand, ViewCommand};

@@ -14,7 +14,7 @@ use crate::app::commands::{Command, PlanCommand, RunCommand, ViewCommand};
 use crate::app::forms::{Forms, Tab};
 use crate::app::provenance::Output;
 use crate::app::state::{AppState, ExportKind};
-use crate::engine::result_view::Verdict;
+use crate::engine::tools::result_view::Verdict;
 
 /// Where one step stands.
 #[derive(Debug, Clone, PartialEq, Eq)]

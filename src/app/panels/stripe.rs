@@ -11,9 +11,9 @@ use super::{AFTER, BAD, BEFORE, MUTED, WARN};
 use crate::app::commands::{Command, ViewCommand};
 use crate::app::forms::Forms;
 use crate::app::state::{AppState, Fit};
-use crate::engine::geometry::roll_pitch_yaw_deg;
-use crate::engine::session::Observation;
-use crate::engine::stripe::StripeResult;
+use crate::engine::base::geometry::roll_pitch_yaw_deg;
+use crate::engine::base::session::Observation;
+use crate::engine::calibrate::stripe::StripeResult;
 
 /// Points on the drawn circle.
 const CIRCLE_SEGMENTS: usize = 256;

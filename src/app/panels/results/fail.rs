@@ -11,8 +11,8 @@ use crate::app::features::plan::more_stations;
 use crate::app::forms::Forms;
 use crate::app::panels::{BAD, MUTED};
 use crate::app::state::AppState;
-use crate::engine::result_view::Verdict;
-use crate::engine::session::Use;
+use crate::engine::base::session::Use;
+use crate::engine::tools::result_view::Verdict;
 
 /// Outliers listed here; the rest are in the Outliers table below.
 const OUTLIERS_SHOWN: usize = 8;

@@ -12,7 +12,7 @@ use crate::app::panels::plots::{readable, spaced_labels};
 use crate::app::panels::side::epsilon_plot_ui;
 use crate::app::panels::{AFTER, BAD, BEFORE, MUTED};
 use crate::app::view::ResultView;
-use crate::engine::result_view::PairDistance;
+use crate::engine::tools::result_view::PairDistance;
 
 /// Singular values with their index.
 type Indexed = Vec<(usize, f64)>;

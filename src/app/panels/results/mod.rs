@@ -26,7 +26,7 @@ use crate::app::forms::Forms;
 use crate::app::provenance::{Output, Stale};
 use crate::app::state::{AppState, DialogPurpose, ExportKind};
 use crate::app::view::{ResultOrigin, ResultView};
-use crate::engine::result_view::Verdict;
+use crate::engine::tools::result_view::Verdict;
 
 /// Height of each of the four plots, points.
 const PLOT_HEIGHT: f32 = 230.0;

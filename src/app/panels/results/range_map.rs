@@ -10,7 +10,7 @@ use egui_plot::{Line, MarkerShape, Plot, PlotPoints, Points, Polygon};
 use super::PLOT_HEIGHT;
 use crate::app::panels::MUTED;
 use crate::app::panels::plots::{nice_step, readable, tick_label};
-use crate::engine::solve::ml::range::RangeError;
+use crate::engine::calibrate::solve::ml::range::RangeError;
 
 /// The ends of the colour scale's top: 1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6,
 /// 8 times a power of ten (a round number just above the largest cell).
@@ -43,11 +43,11 @@ pub fn scale_top(largest: f64) -> f64 {
 }
 
 /// The engine's map colour at `sigma` on the scale 0 … `top` mm
-/// ([`heat_rgb`](crate::engine::report::svg::heat_rgb): green at 0, red
+/// ([`heat_rgb`](crate::engine::tools::report::svg::heat_rgb): green at 0, red
 /// at the top).
 #[must_use]
 pub fn cell_colour(sigma: f64, top: f64) -> egui::Color32 {
-    let [r, g, b] = crate::engine::report::svg::heat_rgb(sigma / top.max(f64::MIN_POSITIVE));
+    let [r, g, b] = crate::engine::tools::report::svg::heat_rgb(sigma / top.max(f64::MIN_POSITIVE));
     egui::Color32::from_rgb(r, g, b)
 }
 

@@ -8,9 +8,9 @@ use egui::RichText;
 
 use crate::app::panels::{MUTED, WARN};
 use crate::app::view::{HandEyeView, ResultView};
-use crate::engine::geometry::{rows_from_isometry, wrap_deg};
-use crate::engine::robot::{PARAM_NAMES, PARAMS_PER_JOINT};
-use crate::engine::solve::estimate::HAND_EYE_LABELS;
+use crate::engine::base::geometry::{rows_from_isometry, wrap_deg};
+use crate::engine::base::robot::{PARAM_NAMES, PARAMS_PER_JOINT};
+use crate::engine::calibrate::solve::estimate::HAND_EYE_LABELS;
 
 /// Longest solver-block value shown in full (longer ones are cut, the
 /// whole value is in the tooltip and the exported JSON).

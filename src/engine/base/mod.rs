@@ -1,0 +1,21 @@
+//! Layer 1, the ground every later layer stands on: numbers and frames,
+//! the CSV reader, plausibility limits, the robot's modified-DH model and
+//! the in-memory session. Nothing here knows how a calibration is made.
+//!
+//! | unit | holds |
+//! |---|---|
+//! | [`numeric`] | rounding, medians, shared numeric helpers |
+//! | [`geometry`] | rigid transforms, twists, roll/pitch/yaw |
+//! | [`table`] | CSV tables as the engine reads them (line numbers for messages) |
+//! | [`limits`] | physical plausibility limits of a session's numbers |
+//! | [`robot`] | the MDH model, forward kinematics and Jacobians (eq. 1-2, 16), presets, inverse kinematics, URDF and DH tables |
+//! | [`session`] | the in-memory session every function takes, its rules, leaving measurements out |
+//! | [`cell`] | what the simulator, the planner and compensation share about a cell: sensor, workspace, approach cones, joint logs, configuration branches, seeded streams |
+
+pub mod numeric;
+pub mod geometry;
+pub mod table;
+pub mod limits;
+pub mod robot;
+pub mod session;
+pub mod cell;

@@ -1,0 +1,250 @@
+//! How robot controllers write a flange pose (`bT_e`, base frame): ABB's
+//! quaternion, KUKA's A B C, FANUC's W P R, UR's rotation vector in metres,
+//! or a plain 4×4 matrix. One implementation for every reader of
+//! controller poses: the import's flange-pose check and pose-only logs.
+
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
+
+use crate::engine::base::geometry::{isometry_from_rows, rows_from_isometry};
+
+/// Largest accepted deviation of an ABB quaternion's norm from 1.
+const QUATERNION_NORM_TOLERANCE: f64 = 1e-3;
+
+/// How a controller writes the flange pose.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FlangeConvention {
+    /// ABB: x, y, z (mm), q1..q4 = w, x, y, z of a unit quaternion.
+    AbbQuaternion,
+    /// KUKA: x, y, z (mm), A, B, C (deg), `R = Rz(A)·Ry(B)·Rx(C)`.
+    KukaAbc,
+    /// Fanuc: x, y, z (mm), W, P, R (deg), `R = Rz(R)·Ry(P)·Rx(W)`.
+    FanucWpr,
+    /// Universal Robots: x, y, z (m), rx, ry, rz (rad) rotation vector.
+    UrRotationVector,
+    /// A 4×4 homogeneous matrix, 16 numbers row-major (mm), last row
+    /// `0 0 0 1`, its 3×3 block a rotation (checked to 1e-6).
+    Matrix,
+}
+
+impl FlangeConvention {
+    /// Every convention, in the order the workbench lists them.
+    pub const ALL: [Self; 5] = [
+        Self::AbbQuaternion,
+        Self::KukaAbc,
+        Self::FanucWpr,
+        Self::UrRotationVector,
+        Self::Matrix,
+    ];
+
+    /// The name [`Self::parse`] reads (`abb`, `kuka`, `fanuc`, `ur`, `matrix`).
+    #[must_use]
+    pub fn key(self) -> &'static str {
+        match self {
+            Self::AbbQuaternion => "abb",
+            Self::KukaAbc => "kuka",
+            Self::FanucWpr => "fanuc",
+            Self::UrRotationVector => "ur",
+            Self::Matrix => "matrix",
+        }
+    }
+
+    /// What the values are, for people: "FANUC x, y, z (mm), W, P, R (deg)".
+    #[must_use]
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::AbbQuaternion => "ABB x, y, z (mm), q1..q4 (unit quaternion w, x, y, z)",
+            Self::KukaAbc => "KUKA x, y, z (mm), A, B, C (deg), R = Rz(A)·Ry(B)·Rx(C)",
+            Self::FanucWpr => "FANUC x, y, z (mm), W, P, R (deg), R = Rz(R)·Ry(P)·Rx(W)",
+            Self::UrRotationVector => "UR x, y, z (m), rx, ry, rz (rotation vector, rad)",
+            Self::Matrix => "a 4×4 matrix, 16 numbers row-major (mm)",
+        }
+    }
+}
+
+impl FlangeConvention {
+    /// Number of columns a pose takes (7 for ABB, 16 for a matrix, 6
+    /// otherwise).
+    #[must_use]
+    pub fn n_columns(self) -> usize {
+        match self {
+            Self::AbbQuaternion => 7,
+            Self::Matrix => 16,
+            _ => 6,
+        }
+    }
+
+    /// Default column names.
+    #[must_use]
+    pub fn default_columns(self) -> Vec<String> {
+        let names: &[&str] = match self {
+            Self::AbbQuaternion => &["x", "y", "z", "q1", "q2", "q3", "q4"],
+            Self::KukaAbc => &["x", "y", "z", "a", "b", "c"],
+            Self::FanucWpr => &["x", "y", "z", "w", "p", "r"],
+            Self::UrRotationVector => &["x", "y", "z", "rx", "ry", "rz"],
+            Self::Matrix => &[
+                "m11", "m12", "m13", "m14", "m21", "m22", "m23", "m24", "m31", "m32", "m33", "m34",
+                "m41", "m42", "m43", "m44",
+            ],
+        };
+        names.iter().map(|s| (*s).to_string()).collect()
+    }
+
+    /// Parses `ABB`, `KUKA`, `FANUC`, `UR` or `matrix` (also `4x4`), any case.
+    #[must_use]
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "abb" => Some(Self::AbbQuaternion),
+            "kuka" => Some(Self::KukaAbc),
+            "fanuc" => Some(Self::FanucWpr),
+            "ur" => Some(Self::UrRotationVector),
+            "matrix" | "4x4" => Some(Self::Matrix),
+            _ => None,
+        }
+    }
+
+    /// The flange pose `bT_e` (mm) from the controller's values, or what
+    /// is wrong with them.
+    ///
+    /// # Errors
+    /// A message when the count is wrong or an ABB quaternion is not unit.
+    pub fn pose_from_values(self, v: &[f64]) -> Result<Isometry3<f64>, String> {
+        if v.len() != self.n_columns() {
+            return Err(format!(
+                "{} values given, the convention needs {}",
+                v.len(),
+                self.n_columns()
+            ));
+        }
+        let (t, r) = match self {
+            Self::AbbQuaternion => {
+                let q = Quaternion::new(v[3], v[4], v[5], v[6]);
+                if (q.norm() - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+                    return Err(format!("quaternion norm {:.6} is not 1", q.norm()));
+                }
+                (
+                    Vector3::new(v[0], v[1], v[2]),
+                    UnitQuaternion::from_quaternion(q),
+                )
+            }
+            Self::KukaAbc => (
+                Vector3::new(v[0], v[1], v[2]),
+                UnitQuaternion::from_euler_angles(
+                    v[5].to_radians(),
+                    v[4].to_radians(),
+                    v[3].to_radians(),
+                ),
+            ),
+            Self::FanucWpr => (
+                Vector3::new(v[0], v[1], v[2]),
+                UnitQuaternion::from_euler_angles(
+                    v[3].to_radians(),
+                    v[4].to_radians(),
+                    v[5].to_radians(),
+                ),
+            ),
+            Self::UrRotationVector => (
+                Vector3::new(v[0], v[1], v[2]) * 1000.0,
+                UnitQuaternion::from_scaled_axis(Vector3::new(v[3], v[4], v[5])),
+            ),
+            Self::Matrix => {
+                let mut rows = [[0.0; 4]; 4];
+                for (k, x) in v.iter().enumerate() {
+                    rows[k / 4][k % 4] = *x;
+                }
+                return isometry_from_rows(&rows).map_err(|e| e.to_string());
+            }
+        };
+        if v.iter().any(|x| !x.is_finite()) {
+            return Err("a value is not a finite number".to_string());
+        }
+        Ok(Isometry3::from_parts(Translation3::from(t), r))
+    }
+
+    /// The controller's values for a flange pose `bT_e` (mm): the inverse
+    /// of [`Self::pose_from_values`] (for tests and simulated logs).
+    #[must_use]
+    pub fn values_from_pose(self, pose: &Isometry3<f64>) -> Vec<f64> {
+        let t = pose.translation.vector;
+        let r = pose.rotation;
+        match self {
+            Self::AbbQuaternion => vec![t.x, t.y, t.z, r.w, r.i, r.j, r.k],
+            Self::KukaAbc => {
+                let (roll, pitch, yaw) = r.euler_angles();
+                vec![
+                    t.x,
+                    t.y,
+                    t.z,
+                    yaw.to_degrees(),
+                    pitch.to_degrees(),
+                    roll.to_degrees(),
+                ]
+            }
+            Self::FanucWpr => {
+                let (roll, pitch, yaw) = r.euler_angles();
+                vec![
+                    t.x,
+                    t.y,
+                    t.z,
+                    roll.to_degrees(),
+                    pitch.to_degrees(),
+                    yaw.to_degrees(),
+                ]
+            }
+            Self::UrRotationVector => {
+                let s = r.scaled_axis();
+                vec![t.x / 1000.0, t.y / 1000.0, t.z / 1000.0, s.x, s.y, s.z]
+            }
+            Self::Matrix => rows_from_isometry(pose).iter().flatten().copied().collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::engine::base::geometry::{rot_x, rot_y, rot_z, trans};
+
+    #[test]
+    fn every_convention_round_trips() {
+        let pose = trans(-195.8, 1363.3, 524.8) * rot_z(0.4) * rot_y(-0.3) * rot_x(2.9);
+        for c in FlangeConvention::ALL {
+            let v = c.values_from_pose(&pose);
+            assert_eq!(v.len(), c.n_columns(), "{c:?}");
+            let back = c.pose_from_values(&v).unwrap();
+            assert!(
+                (back.translation.vector - pose.translation.vector).norm() < 1e-9,
+                "{c:?}"
+            );
+            assert!(back.rotation.angle_to(&pose.rotation) < 1e-12, "{c:?}");
+            assert_eq!(FlangeConvention::parse(c.key()), Some(c));
+        }
+    }
+
+    #[test]
+    fn fanuc_wpr_is_rz_ry_rx() {
+        // RobCalibrator's first pose: R = Rz(r)·Ry(p)·Rx(w).
+        let (w, p, r) = (-179.924_f64, 0.889_f64, 179.635_f64);
+        let pose = FlangeConvention::FanucWpr
+            .pose_from_values(&[-195.8, 1363.305, 524.812, w, p, r])
+            .unwrap();
+        let expected = rot_z(r.to_radians()) * rot_y(p.to_radians()) * rot_x(w.to_radians());
+        assert!(pose.rotation.angle_to(&expected.rotation) < 1e-12);
+        assert!((pose.translation.vector.x + 195.8).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_values_are_named() {
+        let e = FlangeConvention::FanucWpr
+            .pose_from_values(&[1.0, 2.0, 3.0, 4.0, 5.0])
+            .unwrap_err();
+        assert!(e.contains("5 values"), "{e}");
+        let mut m = vec![0.0; 16];
+        m[0] = 2.0;
+        assert!(FlangeConvention::Matrix.pose_from_values(&m).is_err());
+        let nan = FlangeConvention::KukaAbc
+            .pose_from_values(&[1.0, 2.0, f64::NAN, 0.0, 0.0, 0.0])
+            .unwrap_err();
+        assert!(nan.contains("finite"), "{nan}");
+    }
+}

@@ -1,0 +1,487 @@
+//! FORMAT.md's session rules on typed values, stated once. The file
+//! loader (`format::session`) applies each where it reads the value and
+//! adds the position in the file; an import, which builds its session
+//! from other files, applies them all through [`Session::validate`] and
+//! blames the file a broken rule came from by its measurement and key
+//! ([`RuleError::measurement`], [`RuleError::key`]). Messages carry no
+//! position; the caller adds it.
+
+use nalgebra::{Isometry3, Vector3};
+
+use super::{
+    MIN_STRIPE_POINTS, Measurement, Observation, ReferenceDistance, RuleError, SensorRange,
+    Session, SolverSettings, Use, limits,
+};
+use crate::engine::base::numeric::show;
+use crate::engine::base::robot::Joint;
+
+/// Largest `max_iterations` accepted: 2^53, the largest integer an `f64`
+/// (JSON number) holds exactly. Any real value is far below.
+pub const MAX_ITERATIONS_LIMIT: f64 = 9_007_199_254_740_992.0;
+
+/// `|value| ≤ limit` (a [`limits`] constant), else "`key` = v unit is
+/// not plausible for a sphere calibration (at most limit unit)".
+///
+/// # Errors
+/// The message, without position.
+pub fn plausible(value: f64, limit: f64, key: &str, unit: &str) -> Result<(), String> {
+    if value.abs() <= limit {
+        return Ok(());
+    }
+    let unit = if unit.is_empty() {
+        String::new()
+    } else {
+        format!(" {unit}")
+    };
+    Err(format!(
+        "{key} = {}{unit} is not plausible for a sphere calibration (at most {}{unit})",
+        show(value),
+        show(limit)
+    ))
+}
+
+/// One MDH joint `robot.joints[i]`: each parameter plausible.
+///
+/// # Errors
+/// The first implausible parameter.
+pub fn joint(i: usize, joint: &Joint) -> Result<(), String> {
+    for (name, v, limit, unit) in [
+        ("alpha", joint.alpha, limits::ANGLE_DEG, "deg"),
+        ("a", joint.a, limits::LENGTH_MM, "mm"),
+        ("beta", joint.beta, limits::ANGLE_DEG, "deg"),
+        ("theta", joint.theta, limits::ANGLE_DEG, "deg"),
+        ("d", joint.d, limits::LENGTH_MM, "mm"),
+    ] {
+        plausible(v, limit, &format!("robot.joints[{i}].{name}"), unit)?;
+        if !v.is_finite() {
+            return Err(format!("robot.joints[{i}].{name} is not a finite number"));
+        }
+    }
+    Ok(())
+}
+
+/// A 4×4 transform `key`: finite, its translation plausible.
+///
+/// # Errors
+/// The message.
+pub fn transform(key: &str, iso: &Isometry3<f64>) -> Result<(), String> {
+    let t = iso.translation.vector;
+    if !(t.iter().all(|v| v.is_finite()) && iso.rotation.coords.iter().all(|v| v.is_finite())) {
+        return Err(format!("{key}: not a finite transform"));
+    }
+    if let Some(v) = t.iter().copied().find(|v| v.abs() > limits::LENGTH_MM) {
+        return Err(format!(
+            "{key}: a translation of {} mm is not plausible for a sphere calibration (at most {} mm)",
+            show(v),
+            show(limits::LENGTH_MM)
+        ));
+    }
+    Ok(())
+}
+
+/// `sphere.diameter`: positive and plausible.
+///
+/// # Errors
+/// The message.
+pub fn sphere_diameter(diameter: f64) -> Result<(), String> {
+    if !(diameter > 0.0 && diameter.is_finite()) {
+        return Err(format!(
+            "sphere.diameter must be positive (mm), found {}",
+            show(diameter)
+        ));
+    }
+    plausible(
+        diameter,
+        limits::SPHERE_DIAMETER_MM,
+        "sphere.diameter",
+        "mm",
+    )
+}
+
+/// `sensor.range`: each interval plausible with `min < max`.
+///
+/// # Errors
+/// The message.
+pub fn range(range: &SensorRange) -> Result<(), String> {
+    for (name, v) in [("y", range.y), ("z", range.z)] {
+        let key = format!("sensor.range.{name}");
+        for x in v {
+            plausible(x, limits::SENSOR_COORDINATE_MM, &key, "mm")?;
+        }
+        if v[0] >= v[1] || !v.iter().all(|x| x.is_finite()) {
+            return Err(format!(
+                "{key} must be [min, max] with min < max (mm), found [{}, {}]",
+                show(v[0]),
+                show(v[1])
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// `solver.threshold`: zero or positive, plausible.
+///
+/// # Errors
+/// The message.
+pub fn threshold(threshold: f64) -> Result<(), String> {
+    if !(threshold >= 0.0 && threshold.is_finite()) {
+        return Err(format!(
+            "solver.threshold must be zero or positive (mm), found {}",
+            show(threshold)
+        ));
+    }
+    plausible(threshold, limits::THRESHOLD_MM, "solver.threshold", "mm")
+}
+
+/// `solver.max_iterations` as written (a JSON number): a non-negative
+/// integer, plausible.
+///
+/// # Errors
+/// The message.
+pub fn max_iterations(n: f64) -> Result<(), String> {
+    if !(n >= 0.0 && n.fract() == 0.0 && n <= MAX_ITERATIONS_LIMIT) {
+        return Err(format!(
+            "solver.max_iterations must be a non-negative integer, found {}",
+            show(n)
+        ));
+    }
+    plausible(n, limits::MAX_ITERATIONS, "solver.max_iterations", "")
+}
+
+/// A measurement's `key` (`id`, `station`) is not empty.
+///
+/// # Errors
+/// The message.
+pub fn non_empty(key: &str, value: &str) -> Result<(), String> {
+    if value.is_empty() {
+        Err(format!("{key} must not be empty"))
+    } else {
+        Ok(())
+    }
+}
+
+/// A side: +1 or −1.
+///
+/// # Errors
+/// The message.
+pub fn side(key: &str, side: i8) -> Result<(), String> {
+    if side == 1 || side == -1 {
+        Ok(())
+    } else {
+        Err(format!("{key} must be 1 or -1, found {side}"))
+    }
+}
+
+/// Joint readings `key`: each plausible, one per robot joint.
+///
+/// # Errors
+/// The message.
+pub fn joints(key: &str, joints: &[f64], robot_joints: usize) -> Result<(), String> {
+    for (k, q) in joints.iter().enumerate() {
+        plausible(*q, limits::ANGLE_DEG, &format!("{key}[{k}]"), "deg")?;
+        if !q.is_finite() {
+            return Err(format!("{key}[{k}] is not a finite number"));
+        }
+    }
+    if joints.len() != robot_joints {
+        return Err(format!(
+            "{key} has {} readings, the robot has {robot_joints} joints",
+            joints.len()
+        ));
+    }
+    Ok(())
+}
+
+/// Stripe points `key`: each plausible and finite, at least
+/// [`MIN_STRIPE_POINTS`]. `prefix` starts the count message
+/// (`measurements[3].` when the measurement has no id).
+///
+/// # Errors
+/// The message.
+pub fn stripe_points(key: &str, prefix: &str, points: &[[f64; 2]]) -> Result<(), String> {
+    if let Some((i, p)) = points.iter().enumerate().find(|(_, p)| {
+        p.iter()
+            .any(|v| v.abs() > limits::SENSOR_COORDINATE_MM || !v.is_finite())
+    }) {
+        let v = if p[0].abs() > limits::SENSOR_COORDINATE_MM || !p[0].is_finite() {
+            p[0]
+        } else {
+            p[1]
+        };
+        plausible(
+            v,
+            limits::SENSOR_COORDINATE_MM,
+            &format!("{key}[{i}]"),
+            "mm",
+        )?;
+        return Err(format!("{key}[{i}] is not a finite number"));
+    }
+    if points.len() < MIN_STRIPE_POINTS {
+        // The words of the stripe fit's own refusal
+        // (`stripe::StripeError::TooFewPoints`), which comes later in the
+        // pipeline than the session's rules.
+        return Err(format!(
+            "{prefix}stripe has {} points, at least {MIN_STRIPE_POINTS} are needed",
+            points.len()
+        ));
+    }
+    Ok(())
+}
+
+/// A given centre `key`: plausible and finite.
+///
+/// # Errors
+/// The message.
+pub fn centre(key: &str, c: &Vector3<f64>) -> Result<(), String> {
+    for v in c.iter() {
+        plausible(*v, limits::SENSOR_COORDINATE_MM, key, "mm")?;
+        if !v.is_finite() {
+            return Err(format!("{key} is not a finite number"));
+        }
+    }
+    Ok(())
+}
+
+/// Reference distance `key` (`reference_distances[i]`) between validate
+/// stations of `session`: the key at fault (`from`, `to`, `distance` or
+/// the whole item, empty) and the message.
+///
+/// # Errors
+/// The key and the message.
+pub fn reference(
+    key: &str,
+    r: &ReferenceDistance,
+    session: &Session,
+) -> Result<(), (&'static str, String)> {
+    let validate = session.stations(Use::Validate);
+    for (field, id) in [("from", &r.from), ("to", &r.to)] {
+        if validate.iter().any(|(s, _)| s == id) {
+            continue;
+        }
+        let other = session
+            .measurements
+            .iter()
+            .find(|m| m.station == *id)
+            .map(|m| m.usage.as_str());
+        let detail = match other {
+            Some(u) => format!(" (it has {u} measurements)"),
+            None => " (no measurement has this station)".to_owned(),
+        };
+        return Err((
+            field,
+            format!(
+                "{key}.{field}: station `{id}` has no validate measurements{detail}; reference distances may only name validate stations"
+            ),
+        ));
+    }
+    if r.from == r.to {
+        return Err((
+            "",
+            format!("{key}: from and to are the same station `{}`", r.from),
+        ));
+    }
+    if !(r.distance > 0.0 && r.distance.is_finite()) {
+        return Err((
+            "distance",
+            format!(
+                "{key}.distance must be positive (mm), found {}",
+                show(r.distance)
+            ),
+        ));
+    }
+    plausible(
+        r.distance,
+        limits::DISTANCE_MM,
+        &format!("{key}.distance"),
+        "mm",
+    )
+    .map_err(|m| ("distance", m))
+}
+
+/// The reference distances seen so far, by pair of stations (in name
+/// order): two different distances for one pair contradict each other.
+#[derive(Debug, Default)]
+pub struct ReferencePairs {
+    first: std::collections::HashMap<(String, String), (usize, f64)>,
+}
+
+impl ReferencePairs {
+    /// Records `reference_distances[index]` (`key`).
+    ///
+    /// # Errors
+    /// The pair was given before with another distance.
+    pub fn check(&mut self, key: &str, index: usize, r: &ReferenceDistance) -> Result<(), String> {
+        let pair = if r.from < r.to {
+            (r.from.clone(), r.to.clone())
+        } else {
+            (r.to.clone(), r.from.clone())
+        };
+        match self.first.get(&pair) {
+            Some(&(first, other)) if other != r.distance => Err(format!(
+                "{key}: the pair {} – {} is {} mm here and {} mm in reference_distances[{first}]: two distances for one pair contradict each other; keep the right one",
+                r.from,
+                r.to,
+                show(r.distance),
+                show(other)
+            )),
+            Some(_) => Ok(()),
+            None => {
+                self.first.insert(pair, (index, r.distance));
+                Ok(())
+            }
+        }
+    }
+}
+
+/// "gives `joints` but the session has no `robot`…".
+pub const JOINTS_WITHOUT_ROBOT: &str = "gives `joints` but the session has no `robot`: joint readings need the robot model (only a pose-only session, `flange` in every measurement, may leave `robot` out)";
+
+/// Two measurements share an id.
+#[must_use]
+pub fn duplicate_id(id: &str, first: usize, index: usize) -> String {
+    format!(
+        "id `{id}` is used by measurements[{first}] and measurements[{index}]; ids must be unique"
+    )
+}
+
+/// `m` gives the other pose kind than `first` (joints or flange).
+#[must_use]
+pub fn mixed_pose_kind(first: &Measurement, m: &Measurement) -> Option<String> {
+    let kind = |m: &Measurement| {
+        if m.flange.is_some() {
+            "flange"
+        } else {
+            "joints"
+        }
+    };
+    (kind(first) != kind(m)).then(|| {
+        format!(
+            "gives `{}` but measurement {} gives `{}`: a session uses `joints` in every measurement or `flange` in every measurement, not both",
+            kind(m),
+            first.id,
+            kind(first)
+        )
+    })
+}
+
+/// The rules of one measurement that concern only itself: id and station
+/// not empty, side, joints or flange (one, joints only with a robot),
+/// stripe or centre. The key of the fault, relative to the measurement
+/// (`joints`, `stripe.points`, …), and the message.
+///
+/// # Errors
+/// The key and the message.
+pub fn measurement(
+    m: &Measurement,
+    robot_joints: usize,
+    robot_given: bool,
+) -> Result<(), (&'static str, String)> {
+    non_empty("id", &m.id).map_err(|e| ("id", e))?;
+    non_empty("station", &m.station).map_err(|e| ("station", e))?;
+    side("side", m.side).map_err(|e| ("side", e))?;
+    match &m.flange {
+        Some(pose) => transform("flange", pose).map_err(|e| ("flange", e))?,
+        None => {
+            if !robot_given {
+                return Err(("joints", JOINTS_WITHOUT_ROBOT.to_string()));
+            }
+            joints("joints", &m.joints, robot_joints).map_err(|e| ("joints", e))?;
+        }
+    }
+    match &m.observation {
+        Observation::Stripe(points) => {
+            stripe_points("stripe.points", "", points).map_err(|e| ("stripe.points", e))
+        }
+        Observation::Centre(c) => centre("centre", c).map_err(|e| ("centre", e)),
+    }
+}
+
+impl Session {
+    /// Every FORMAT.md rule of a session, on its typed values: what the
+    /// file loader checks as it reads, for a session built in code (an
+    /// import). A broken rule names its measurement (when one is to
+    /// blame) and its key.
+    ///
+    /// # Errors
+    /// The first broken rule.
+    pub fn validate(&self) -> Result<(), RuleError> {
+        let general = |key: &str, message: String| RuleError {
+            measurement: None,
+            key: Some(key.to_string()),
+            message,
+        };
+        if self.robot_given || !self.robot.joints.is_empty() {
+            if self.robot.joints.is_empty() {
+                return Err(general(
+                    "robot.joints",
+                    "robot.joints is empty: at least one joint is needed".to_string(),
+                ));
+            }
+            for (i, j) in self.robot.joints.iter().enumerate() {
+                joint(i, j).map_err(|m| general(&format!("robot.joints[{i}]"), m))?;
+            }
+            transform("robot.base", &self.robot.base).map_err(|m| general("robot.base", m))?;
+            transform("robot.flange", &self.robot.flange)
+                .map_err(|m| general("robot.flange", m))?;
+        }
+        sphere_diameter(self.sphere_diameter).map_err(|m| general("sphere.diameter", m))?;
+        side("sensor.side", self.default_side).map_err(|m| general("sensor.side", m))?;
+        if let Some(r) = &self.sensor_range {
+            range(r).map_err(|m| general("sensor.range", m))?;
+        }
+        if let Some(h) = &self.hand_eye {
+            transform("hand_eye", h).map_err(|m| general("hand_eye", m))?;
+        }
+        let SolverSettings {
+            threshold: t,
+            max_iterations: n,
+        } = self.solver;
+        threshold(t).map_err(|m| general("solver.threshold", m))?;
+        #[allow(
+            clippy::cast_precision_loss,
+            reason = "compared with limits far below 2^52"
+        )]
+        max_iterations(n as f64).map_err(|m| general("solver.max_iterations", m))?;
+        let robot_given = self.robot_given || !self.robot.joints.is_empty();
+        let mut first: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
+        for (index, m) in self.measurements.iter().enumerate() {
+            measurement(m, self.robot.dof(), robot_given).map_err(|(key, message)| RuleError {
+                measurement: (!m.id.is_empty()).then(|| m.id.clone()),
+                key: Some(key.to_string()),
+                message,
+            })?;
+            if let Some(f) = first.insert(m.id.as_str(), index) {
+                return Err(RuleError {
+                    measurement: Some(m.id.clone()),
+                    key: Some("id".to_string()),
+                    message: duplicate_id(&m.id, f, index),
+                });
+            }
+            if let Some(message) = self
+                .measurements
+                .first()
+                .and_then(|f| mixed_pose_kind(f, m))
+            {
+                return Err(RuleError {
+                    measurement: Some(m.id.clone()),
+                    key: Some(
+                        if m.flange.is_some() {
+                            "flange"
+                        } else {
+                            "joints"
+                        }
+                        .to_string(),
+                    ),
+                    message,
+                });
+            }
+        }
+        let mut pairs = ReferencePairs::default();
+        for (i, r) in self.reference_distances.iter().enumerate() {
+            let key = format!("reference_distances[{i}]");
+            reference(&key, r, self).map_err(|(_, m)| general(&key, m))?;
+            pairs.check(&key, i, r).map_err(|m| general(&key, m))?;
+        }
+        self.check_rules()
+    }
+}

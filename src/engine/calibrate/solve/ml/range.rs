@@ -1,0 +1,323 @@
+//! The predicted error over the sensor's measuring range (beyond the
+//! paper): a sphere calibration learns the hand-eye where the sphere was
+//! seen, and its rotation error grows with the lever to any other point
+//! of the laser plane. From `ml`'s covariance of the estimated parameters
+//! this gives, for a grid of points `(0, y, z)` of the laser plane at the
+//! session's working poses (its validate poses, else its identify poses),
+//! the 1σ of each point's base-frame position (3-D) after the common
+//! rigid motion of all of them is taken out (the base frame is not
+//! observable from a sphere, and a workpiece frame is aligned anyway):
+//! its rms, mean, maximum and where, and the same at the mean sphere
+//! position. To first order the error of point `i` is `G_i·δθ`; the best
+//! rigid motion `R_i·(t, ω)`, `R_i = [I | −[p_i − c]×]`, is fitted to all
+//! of them by least squares and removed: `H_i = G_i − R_i·(RᵀR)⁻¹RᵀG`,
+//! `σ_i² = tr(H_i·C·H_iᵀ)`. The grid covers `sensor.range` when the
+//! session has one, else the region the sphere positions covered (and
+//! says so).
+
+use nalgebra::{DMatrix, Vector3};
+use serde::{Deserialize, Serialize};
+
+use super::problem::Problem;
+use crate::engine::base::session::{SensorRange, Session, Use};
+use crate::engine::calibrate::solve::Prepared;
+use crate::engine::calibrate::solve::estimate::{Estimate, PoseSensitivity};
+
+/// Grid points along each side of the range.
+pub const RANGE_GRID: usize = 7;
+
+/// Most working poses the prediction is averaged over (an even sample
+/// beyond).
+pub const RANGE_POSES: usize = 20;
+
+/// Below this fraction of `sensor.range` covered by the sphere positions
+/// the report warns.
+pub const RANGE_COVERAGE_WARNING: f64 = 0.25;
+
+/// The predicted error over the range (result file: `solver.range_error`).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RangeError {
+    /// What the grid covers: `sensor.range`, or `sphere positions` when
+    /// the session gives no range.
+    pub region: String,
+    /// The grid's `[min, max]` along the line, mm (sensor frame).
+    pub y: [f64; 2],
+    /// The grid's `[min, max]` in depth, mm.
+    pub z: [f64; 2],
+    /// Grid points per side.
+    pub grid: usize,
+    /// Working poses the figures are over.
+    pub poses: usize,
+    /// RMS over grid points and poses of the 3-D 1σ, mm.
+    pub rms_mm: f64,
+    /// Mean of the 3-D 1σ, mm.
+    pub mean_mm: f64,
+    /// Largest 3-D 1σ (at any pose), mm.
+    pub max_mm: f64,
+    /// Where the largest is, `[y, z]` mm.
+    pub max_at: [f64; 2],
+    /// RMS 3-D 1σ at the mean sphere position, mm.
+    pub at_sphere_mm: f64,
+    /// `[min, max]` of the measured sphere positions along the line, mm.
+    pub sphere_y: [f64; 2],
+    /// `[min, max]` of the measured sphere positions in depth, mm.
+    pub sphere_z: [f64; 2],
+    /// Fraction of the range's area inside the sphere positions' extent
+    /// (1 when the region is the sphere positions).
+    pub coverage: f64,
+    /// The map: `[y, z, σ]` (mm) of every grid point, σ the rms over the
+    /// working poses.
+    pub map: Vec<[f64; 3]>,
+    /// Set when the sphere covered less than [`RANGE_COVERAGE_WARNING`]
+    /// of the range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warning: Option<String>,
+}
+
+impl RangeError {
+    /// One line for people.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let what = if self.region == "sensor.range" {
+            format!(
+                "over sensor.range (y {:.0}…{:.0}, z {:.0}…{:.0} mm)",
+                self.y[0], self.y[1], self.z[0], self.z[1]
+            )
+        } else {
+            format!(
+                "over the region the sphere covered (y {:.1}…{:.1}, z {:.1}…{:.1} mm; no sensor.range in the session)",
+                self.y[0], self.y[1], self.z[0], self.z[1]
+            )
+        };
+        format!(
+            "predicted point error {what}: rms {:.3} mm, max {:.3} mm at (y {:.0}, z {:.0}); {:.3} mm at the sphere",
+            self.rms_mm, self.max_mm, self.max_at[0], self.max_at[1], self.at_sphere_mm
+        )
+    }
+}
+
+/// The restricted sensitivity `G` (3 × k, scaled units: column `c` is
+/// parameter `estimated[c]` divided by `scale[c]`) of sensor point `g` at
+/// a pose, and the point's base-frame position.
+fn point_rows(
+    est: &Estimate,
+    pose: &PoseSensitivity,
+    estimated: &[usize],
+    scale: &[f64],
+    g: Vector3<f64>,
+) -> (DMatrix<f64>, Vector3<f64>) {
+    let (p, a) = pose.at(est, &g);
+    let rows = DMatrix::from_fn(3, estimated.len(), |r, c| a[(r, estimated[c])] / scale[c]);
+    (rows, p)
+}
+
+/// `R_i = [I | −[p − c]×]`: a point's motion under a small rigid motion
+/// `(t, ω)` about `c`.
+fn rigid_rows(p: &Vector3<f64>, c: &Vector3<f64>) -> DMatrix<f64> {
+    let d = p - c;
+    let mut r = DMatrix::zeros(3, 6);
+    r.view_mut((0, 0), (3, 3))
+        .copy_from(&nalgebra::Matrix3::identity());
+    let skew = nalgebra::Matrix3::new(0.0, -d.z, d.y, d.z, 0.0, -d.x, -d.y, d.x, 0.0);
+    r.view_mut((0, 3), (3, 3)).copy_from(&(-skew));
+    r
+}
+
+/// The grid over a range at a set of poses, with the common rigid motion
+/// fitted: `H_i = G_i − R_i·M`, `M = (RᵀR)⁻¹RᵀG` (module doc). One home
+/// for the prediction of the result and the planner's criterion.
+pub(crate) struct AlignedGrid {
+    /// `([y, z], G_i, p_i)`, point-major: each grid point's poses follow
+    /// one another.
+    points: Vec<([f64; 2], DMatrix<f64>, Vector3<f64>)>,
+    /// Poses per grid point.
+    poses: usize,
+    centroid: Vector3<f64>,
+    /// The rigid-motion fit `M`, 6 × k.
+    m: DMatrix<f64>,
+}
+
+impl AlignedGrid {
+    /// The `RANGE_GRID × RANGE_GRID` grid over `range` at `poses`.
+    pub(crate) fn new(
+        est: &Estimate,
+        poses: &[PoseSensitivity],
+        estimated: &[usize],
+        scale: &[f64],
+        range: &SensorRange,
+    ) -> Self {
+        let mut points = Vec::with_capacity(RANGE_GRID * RANGE_GRID * poses.len());
+        for [y, z] in range.grid(RANGE_GRID) {
+            for s in poses {
+                let (g, p) = point_rows(est, s, estimated, scale, Vector3::new(0.0, y, z));
+                points.push(([y, z], g, p));
+            }
+        }
+        let k = estimated.len();
+        let centroid =
+            points.iter().map(|(_, _, p)| p).sum::<Vector3<f64>>() / points.len().max(1) as f64;
+        let mut rtr = DMatrix::zeros(6, 6);
+        let mut rtg = DMatrix::zeros(6, k);
+        for (_, g, p) in &points {
+            let r = rigid_rows(p, &centroid);
+            rtr += r.transpose() * &r;
+            rtg += r.transpose() * g;
+        }
+        // A degenerate set (every point on one line) leaves a rotation
+        // free: the pseudo-inverse takes out what can be taken out.
+        let pinv = rtr
+            .clone()
+            .pseudo_inverse(1e-12 * rtr.norm().max(1e-300))
+            .unwrap_or_else(|_| DMatrix::zeros(6, 6));
+        Self {
+            points,
+            poses: poses.len(),
+            centroid,
+            m: pinv * rtg,
+        }
+    }
+
+    /// `H` of a point with sensitivity `g` at base position `p`.
+    fn aligned(&self, g: &DMatrix<f64>, p: &Vector3<f64>) -> DMatrix<f64> {
+        g - rigid_rows(p, &self.centroid) * &self.m
+    }
+
+    /// `Q = Σ H_iᵀH_i / n` (k × k): `tr(Q·C)` is the mean square predicted
+    /// error over the grid for a covariance `C` of the (scaled) estimated
+    /// parameters: the planner's criterion.
+    pub(crate) fn weight(&self) -> DMatrix<f64> {
+        let k = self.m.ncols();
+        let mut q = DMatrix::zeros(k, k);
+        for (_, g, p) in &self.points {
+            let h = self.aligned(g, p);
+            q += h.transpose() * &h;
+        }
+        q / self.points.len().max(1) as f64
+    }
+}
+
+/// `σ` (mm) of a point's aligned error `h` under covariance `cov`.
+fn sigma(h: &DMatrix<f64>, cov: &DMatrix<f64>) -> f64 {
+    (h * cov * h.transpose()).trace().max(0.0).sqrt()
+}
+
+/// The prediction (see the module doc); `None` without working poses.
+pub(super) fn range_error(
+    session: &Session,
+    prepared: &Prepared,
+    problem: &Problem,
+    est: &Estimate,
+    cov: &DMatrix<f64>,
+) -> Option<RangeError> {
+    let pick = |usage: Use| -> Vec<usize> {
+        (0..session.measurements.len())
+            .filter(|&i| session.measurements[i].usage == usage)
+            .collect()
+    };
+    let identify = pick(Use::Identify);
+    let validate = pick(Use::Validate);
+    let working = if validate.is_empty() {
+        &identify
+    } else {
+        &validate
+    };
+    if working.is_empty() || identify.is_empty() {
+        return None;
+    }
+    let stride = working.len().div_ceil(RANGE_POSES).max(1);
+    let poses: Vec<PoseSensitivity> = working
+        .iter()
+        .step_by(stride)
+        .map(|&i| PoseSensitivity::new(est, &prepared.sighting(session, i)))
+        .collect();
+    // Where the sphere was seen (identify centres, sensor frame).
+    let centres: Vec<Vector3<f64>> = identify
+        .iter()
+        .map(|&i| prepared.measurements[i].centre_in_sensor)
+        .collect();
+    let extent = |k: usize| {
+        centres
+            .iter()
+            .fold([f64::INFINITY, f64::NEG_INFINITY], |e, c| {
+                [e[0].min(c[k]), e[1].max(c[k])]
+            })
+    };
+    let (sphere_y, sphere_z) = (extent(1), extent(2));
+    let mean = centres.iter().sum::<Vector3<f64>>() / centres.len() as f64;
+    let (region, range, coverage) = match session.sensor_range {
+        Some(r) => {
+            let overlap = |a: [f64; 2], b: [f64; 2]| (a[1].min(b[1]) - a[0].max(b[0])).max(0.0);
+            let covered = overlap(sphere_y, r.y) * overlap(sphere_z, r.z);
+            ("sensor.range".to_string(), r, covered / r.area())
+        }
+        None => (
+            "sphere positions".to_string(),
+            SensorRange {
+                y: sphere_y,
+                z: sphere_z,
+            },
+            1.0,
+        ),
+    };
+    let grid = AlignedGrid::new(est, &poses, &problem.estimated, &problem.scale, &range);
+    let (mut sum_sq, mut sum, mut max, mut max_at) = (0.0, 0.0, 0.0_f64, [0.0; 2]);
+    let mut map: Vec<[f64; 3]> = Vec::with_capacity(RANGE_GRID * RANGE_GRID);
+    for chunk in grid.points.chunks(grid.poses.max(1)) {
+        let mut point_sq = 0.0;
+        for (yz, g, p) in chunk {
+            let sigma = sigma(&grid.aligned(g, p), cov);
+            sum_sq += sigma * sigma;
+            point_sq += sigma * sigma;
+            sum += sigma;
+            if sigma > max {
+                max = sigma;
+                max_at = *yz;
+            }
+        }
+        if let Some((yz, _, _)) = chunk.first() {
+            map.push([yz[0], yz[1], (point_sq / chunk.len() as f64).sqrt()]);
+        }
+    }
+    let sphere_sq: f64 = poses
+        .iter()
+        .map(|s| {
+            let centre = Vector3::new(0.0, mean.y, mean.z);
+            let (g, p) = point_rows(est, s, &problem.estimated, &problem.scale, centre);
+            sigma(&grid.aligned(&g, &p), cov).powi(2)
+        })
+        .sum();
+    let nf = grid.points.len().max(1) as f64;
+    let at_sphere_mm = (sphere_sq / poses.len() as f64).sqrt();
+    let warning = (coverage < RANGE_COVERAGE_WARNING).then(|| {
+        format!(
+            "the sphere positions (y {:.1}…{:.1}, z {:.1}…{:.1} mm) cover {:.0} % of sensor.range: the predicted error grows from {:.3} mm at the sphere to {:.3} mm at (y {:.0}, z {:.0}); spread the sphere over the range",
+            sphere_y[0],
+            sphere_y[1],
+            sphere_z[0],
+            sphere_z[1],
+            coverage * 100.0,
+            at_sphere_mm,
+            max,
+            max_at[0],
+            max_at[1]
+        )
+    });
+    Some(RangeError {
+        region,
+        y: range.y,
+        z: range.z,
+        grid: RANGE_GRID,
+        poses: poses.len(),
+        rms_mm: (sum_sq / nf).sqrt(),
+        mean_mm: sum / nf,
+        max_mm: max,
+        max_at,
+        at_sphere_mm,
+        sphere_y,
+        sphere_z,
+        coverage,
+        map,
+        warning,
+    })
+}

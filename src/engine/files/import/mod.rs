@@ -1,0 +1,636 @@
+//! Import of real data: a pose log plus stripe profiles become a
+//! [`Session`], validated by the same typed rules as the session loader
+//! ([`Session::validate`]), a broken rule blamed on the file it came from.
+//!
+//! Two kinds of pose log:
+//!
+//! - a **joint log** ([`import`], [`log`]): one CSV row a pose with its id,
+//!   station, use, side and joint readings, optionally with the flange pose
+//!   the controller reports, checked against the nominal model ([`check`]);
+//! - a **pose file** ([`import_poses`], [`poses`]): a pose table, a JSON
+//!   list or a robot program (FANUC `.ls`, RAPID, KUKA, URScript; read by
+//!   [`crate::engine::files::program`]): flange poses give a pose-only session
+//!   (FORMAT.md "Additions to version 1"), which calibrates the hand-eye
+//!   and the station centres only; joint targets a session with joints.
+//!
+//! Profiles ([`profiles`]) come as CSV/TXT or OpenCV YAML/JSON in the
+//! sensor's own axes and units; an axis map puts them in FORMAT.md's laser
+//! plane, and no-return points are dropped and counted.
+//!
+//! CSV files are read with the `csv` crate
+//! ([`Table`](crate::engine::base::table::Table)): a UTF-8 byte-order
+//! mark, quotes, `,` `;` or tab separators, `#` comment lines; column names
+//! match case-insensitively; line numbers in messages are 1-based lines of
+//! the file.
+
+pub mod check;
+mod csv_file;
+pub mod initial;
+pub mod log;
+pub mod pairing;
+pub mod poses;
+pub mod profiles;
+pub mod references;
+pub mod robot_source;
+pub mod side;
+pub mod units;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use nalgebra::Isometry3;
+
+pub use self::check::{
+    DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG, FlangeCheck, PoseCheck,
+};
+pub use self::log::{ColumnMap, DEFAULT_SIDE_COLUMN, header, preview};
+pub use self::poses::{
+    Observations, PoseImportSpec, PoseInputs, SideChoice, build_pose_session, read_pose_inputs,
+};
+pub use self::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource, RawProfile};
+pub use self::references::{read_references, reference_rows};
+pub use self::robot_source::{RobotSource, load_robot};
+pub use self::side::{decide_side, import_poses};
+pub use self::units::{AngleUnit, LengthUnit};
+pub use crate::engine::base::robot::controller::FlangeConvention;
+pub use crate::engine::files::program::PoseFormat;
+
+use self::csv_file::CsvFile;
+use crate::engine::base::robot::Robot;
+use crate::engine::base::session::{
+    MIN_STRIPE_POINTS, Measurement, Observation, Session, SolverSettings, Use,
+};
+use crate::engine::files::format::FileError;
+
+/// Default sphere diameter, mm: the 1.5 inch sphere of the paper.
+pub const DEFAULT_SPHERE_DIAMETER: f64 = 38.1;
+
+/// Everything the import of a joint log needs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImportSpec {
+    /// The joint log CSV.
+    pub joint_log: PathBuf,
+    /// Its column names.
+    pub columns: ColumnMap,
+    /// Unit of its joint columns.
+    pub joint_unit: AngleUnit,
+    /// The stripe profiles.
+    pub profiles: ProfileSource,
+    /// How to read the profiles: unit, axis map, no-return value, key.
+    pub profile_format: ProfileFormat,
+    /// The nominal robot model.
+    pub robot: RobotSource,
+    /// Sphere diameter, mm.
+    pub sphere_diameter: f64,
+    /// Session name; `None` gives the joint log's file stem.
+    pub name: Option<String>,
+    /// Optional flange-pose check.
+    pub flange: Option<FlangeCheck>,
+    /// Optional laser-tracker reference distances: a CSV with columns
+    /// `from`, `to`, `distance` (station ids, mm).
+    pub references: Option<PathBuf>,
+}
+
+/// An import failed; every message names the file and, where it applies,
+/// the line, column or pose id.
+#[derive(Debug, thiserror::Error)]
+pub enum ImportError {
+    /// A file could not be read.
+    #[error("reading failed: {source} ({path})")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A CSV problem at a line.
+    #[error("line {line}: {message} ({path})")]
+    Csv {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line of the file.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A problem with the file as a whole (no header, missing column).
+    #[error("{message} ({path})")]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A pose of the log has no profile.
+    #[error("pose {id}: no stripe profile ({path})")]
+    MissingProfile {
+        /// The pose id.
+        id: String,
+        /// The file that was expected, or the single profile file.
+        path: PathBuf,
+    },
+    /// The specification itself is inconsistent.
+    #[error("{0}")]
+    Spec(String),
+    /// The built session breaks a FORMAT.md rule (the loader's message).
+    #[error("{0}")]
+    Session(#[from] FileError),
+}
+
+/// What an import built and found out.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Imported {
+    /// The session, validated by the session loader.
+    pub session: Session,
+    /// The flange-pose checks of a joint log (empty without a check).
+    pub checks: Vec<PoseCheck>,
+    /// How the profiles were read.
+    pub profiles: ProfileReport,
+    /// Decisions the import made, in words (axis map, uses, side, initial
+    /// hand-eye), for the summary.
+    pub notes: Vec<String>,
+}
+
+/// How the profiles were read: the axis map and, per pose, what was kept
+/// and dropped.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProfileReport {
+    /// The axis map applied.
+    pub axes: AxisMap,
+    /// True when it was guessed from the data.
+    pub axes_guessed: bool,
+    /// One per pose, session order.
+    pub poses: Vec<ProfileCount>,
+}
+
+/// One pose's profile as read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProfileCount {
+    /// Measurement id.
+    pub id: String,
+    /// The profile file.
+    pub file: PathBuf,
+    /// Points kept (finite, not the no-return value).
+    pub points: usize,
+    /// Points dropped for a NaN or infinite coordinate.
+    pub non_finite: usize,
+    /// Points dropped for the no-return value.
+    pub no_return: usize,
+}
+
+impl ProfileReport {
+    /// One line: the axis map and the dropped points.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let non_finite: usize = self.poses.iter().map(|p| p.non_finite).sum();
+        let no_return: usize = self.poses.iter().map(|p| p.no_return).sum();
+        let points: usize = self.poses.iter().map(|p| p.points).sum();
+        format!(
+            "profiles: {} poses, {points} points; axis map {} ({}{}); dropped {non_finite} non-finite and {no_return} no-return points",
+            self.poses.len(),
+            self.axes,
+            self.axes.describe(),
+            if self.axes_guessed {
+                ", guessed: the constant coordinate is the plane's normal"
+            } else {
+                ""
+            }
+        )
+    }
+}
+
+/// Reads the profiles of `ids` (in that order) and puts them in the laser
+/// plane: the axis map given, or guessed from all of them together.
+///
+/// # Errors
+/// A missing or unreadable profile, a profile with too few points, an axis
+/// map that cannot be guessed or puts points off the plane.
+pub fn read_profiles(
+    source: &ProfileSource,
+    format: &ProfileFormat,
+    ids: &[String],
+) -> Result<(Vec<PlaneProfile>, ProfileReport), ImportError> {
+    let raws: Vec<RawProfile> = match source {
+        ProfileSource::Folder(dir) => {
+            let file = |id: &String| {
+                profiles::file_of(dir, id).ok_or_else(|| ImportError::MissingProfile {
+                    id: id.clone(),
+                    path: dir.join(format!("{id}.csv")),
+                })
+            };
+            if let Some(axes) = format.axes {
+                // The map is known: each file is read and put in the plane
+                // on its own, one raw profile in memory at a time.
+                let mut planes = Vec::with_capacity(ids.len());
+                let mut poses = Vec::with_capacity(ids.len());
+                for id in ids {
+                    let raw = profiles::read_profile(&file(id)?, format)?;
+                    let (plane, count) = plane_of(&raw, &axes, id)?;
+                    planes.push(plane);
+                    poses.push(count);
+                }
+                return Ok((
+                    planes,
+                    ProfileReport {
+                        axes,
+                        axes_guessed: false,
+                        poses,
+                    },
+                ));
+            }
+            ids.iter()
+                .map(|id| profiles::read_profile(&file(id)?, format))
+                .collect::<Result<_, _>>()?
+        }
+        ProfileSource::File { path, pose_column } => {
+            let (order, mut by_id) = profiles::read_profile_table(path, pose_column, format)?;
+            if let Some(stray) = order.iter().find(|id| !ids.contains(id)) {
+                return Err(ImportError::File {
+                    path: path.clone(),
+                    message: format!("pose `{stray}` is not in the pose log"),
+                });
+            }
+            ids.iter()
+                .map(|id| {
+                    by_id.remove(id).ok_or_else(|| ImportError::MissingProfile {
+                        id: id.clone(),
+                        path: path.clone(),
+                    })
+                })
+                .collect::<Result<_, _>>()?
+        }
+    };
+    planar(raws, format, ids)
+}
+
+/// Raw profiles in the laser plane, with their report. Each raw profile
+/// is dropped as soon as it is converted, so the peak is the raw data
+/// plus one converted profile, not both sets.
+pub(crate) fn planar(
+    raws: Vec<RawProfile>,
+    format: &ProfileFormat,
+    ids: &[String],
+) -> Result<(Vec<PlaneProfile>, ProfileReport), ImportError> {
+    let (axes, axes_guessed) = match format.axes {
+        Some(m) => (m, false),
+        None => {
+            let m = AxisMap::guess(&raws).map_err(|message| {
+                // Name the profile that breaks the plane the others share.
+                match AxisMap::odd_profile(&raws) {
+                    Some(k) => ImportError::File {
+                        path: raws[k].source.clone(),
+                        message: format!(
+                            "this profile is not in the plane the other profiles lie in: {message}"
+                        ),
+                    },
+                    None => ImportError::File {
+                        path: raws.first().map_or_else(PathBuf::new, |r| r.source.clone()),
+                        message,
+                    },
+                }
+            })?;
+            (m, true)
+        }
+    };
+    let mut planes = Vec::with_capacity(raws.len());
+    let mut poses = Vec::with_capacity(raws.len());
+    for (raw, id) in raws.into_iter().zip(ids) {
+        let (plane, count) = plane_of(&raw, &axes, id)?;
+        drop(raw);
+        planes.push(plane);
+        poses.push(count);
+    }
+    Ok((
+        planes,
+        ProfileReport {
+            axes,
+            axes_guessed,
+            poses,
+        },
+    ))
+}
+
+/// One raw profile in the laser plane, with its count; too few points is
+/// an error naming the profile file.
+fn plane_of(
+    raw: &RawProfile,
+    axes: &AxisMap,
+    id: &str,
+) -> Result<(PlaneProfile, ProfileCount), ImportError> {
+    let plane = raw.to_plane(axes)?;
+    if plane.points.len() < MIN_STRIPE_POINTS {
+        return Err(ImportError::File {
+            path: raw.source.clone(),
+            message: format!(
+                "pose {id}: the profile has {} usable points ({} non-finite and {} no-return dropped); a stripe needs at least {MIN_STRIPE_POINTS}",
+                plane.points.len(),
+                plane.non_finite,
+                plane.no_return
+            ),
+        });
+    }
+    let count = ProfileCount {
+        id: id.to_string(),
+        file: raw.source.clone(),
+        points: plane.points.len(),
+        non_finite: plane.non_finite,
+        no_return: plane.no_return,
+    };
+    Ok((plane, count))
+}
+
+/// Refuses a sphere diameter that is not positive or not plausible
+/// (the session loader's limit), before any file is read.
+///
+/// # Errors
+/// [`ImportError::Spec`] naming the value and the limit.
+pub(crate) fn check_sphere_diameter(d: f64) -> Result<(), ImportError> {
+    let limit = crate::engine::base::limits::SPHERE_DIAMETER_MM;
+    if d > 0.0 && d <= limit {
+        return Ok(());
+    }
+    Err(ImportError::Spec(format!(
+        "--sphere-diameter {} mm is not plausible: a reference sphere is more than 0 and at most {limit} mm",
+        crate::engine::base::numeric::show(d)
+    )))
+}
+
+/// Refuses profiles whose size does not fit the sphere (a unit read
+/// wrong), naming the profile unit that would fit
+/// ([`units::check_profile_unit`]).
+///
+/// # Errors
+/// [`ImportError::File`] naming the first profile's file.
+pub(crate) fn check_profile_size(
+    planes: &[PlaneProfile],
+    format: &ProfileFormat,
+    sphere_diameter: f64,
+) -> Result<(), ImportError> {
+    let extents: Vec<f64> = planes.iter().map(PlaneProfile::extent).collect();
+    units::check_profile_unit(format.unit, sphere_diameter, &extents).map_err(|message| {
+        ImportError::File {
+            path: planes
+                .first()
+                .map_or_else(PathBuf::new, |p| p.source.clone()),
+            message,
+        }
+    })
+}
+
+/// Builds the session of a joint log and checks the flange poses, if
+/// given. The session is validated by writing it as FORMAT.md JSON and
+/// loading it back, so every FORMAT.md rule is enforced with the loader's
+/// messages.
+///
+/// # Errors
+/// [`ImportError`] naming the file, the line, the column or the pose id.
+pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
+    check_sphere_diameter(spec.sphere_diameter)?;
+    let robot = load_robot(&spec.robot)?;
+    let log = CsvFile::read(&spec.joint_log)?;
+    let cols = log::log_columns(spec, &log, robot.dof())?;
+    if log.rows.is_empty() {
+        return Err(ImportError::File {
+            path: log.path.clone(),
+            message: "the joint log has a header but no pose rows".into(),
+        });
+    }
+    let ids: Vec<String> = log.rows.iter().map(|(_, r)| r[cols.id].clone()).collect();
+    let mut seen: HashMap<&str, usize> = HashMap::new();
+    for ((line, _), id) in log.rows.iter().zip(&ids) {
+        if let Some(first) = seen.insert(id.as_str(), *line) {
+            return Err(ImportError::Csv {
+                path: log.path.clone(),
+                line: *line,
+                message: format!("pose id `{id}` is used twice (first at line {first})"),
+            });
+        }
+    }
+    let (planes, report) = read_profiles(&spec.profiles, &spec.profile_format, &ids)?;
+    check_profile_size(&planes, &spec.profile_format, spec.sphere_diameter)?;
+    let mut measurements = Vec::with_capacity(log.rows.len());
+    let mut checks = Vec::new();
+    for (((line, row), id), plane) in log.rows.iter().zip(ids).zip(planes) {
+        let csv_error = |message: String| ImportError::Csv {
+            path: log.path.clone(),
+            line: *line,
+            message: format!("pose {id}: {message}"),
+        };
+        let usage = Use::parse(&row[cols.usage]).ok_or_else(|| {
+            csv_error(format!(
+                "column `{}`: `{}` is not translation, rotation, identify or validate",
+                log.header[cols.usage], row[cols.usage]
+            ))
+        })?;
+        let side_given = match cols.side {
+            None => None,
+            Some(c) => log::side_cell(&row[c])
+                .map_err(|m| csv_error(format!("column `{}`: {m}", log.header[c])))?,
+        };
+        let raw: Vec<f64> = cols
+            .joints
+            .iter()
+            .map(|&c| log.number(*line, row, c))
+            .collect::<Result<_, _>>()?;
+        units::check_joint_unit(spec.joint_unit, [(*line, id.as_str(), raw.as_slice())]).map_err(
+            |(line, message)| ImportError::Csv {
+                path: log.path.clone(),
+                line,
+                message,
+            },
+        )?;
+        let joints: Vec<f64> = raw.iter().map(|&v| spec.joint_unit.to_deg(v)).collect();
+        if let Some(f) = &spec.flange {
+            let values: Vec<f64> = cols
+                .flange
+                .iter()
+                .map(|&c| log.number(*line, row, c))
+                .collect::<Result<_, _>>()?;
+            let pose = f
+                .convention
+                .pose_from_values(&values)
+                .map_err(|m| csv_error(format!("flange pose: {m}")))?;
+            checks.push(check::check_pose(
+                &robot,
+                f,
+                spec.joint_unit,
+                &id,
+                &raw,
+                &pose,
+            ));
+        }
+        measurements.push(Measurement {
+            id,
+            station: row[cols.station].clone(),
+            usage,
+            side_given,
+            side: side_given.unwrap_or(1),
+            joints,
+            flange: None,
+            observation: Observation::Stripe(plane.points),
+        });
+    }
+    let name = spec.name.clone().unwrap_or_else(|| {
+        spec.joint_log
+            .file_stem()
+            .map_or_else(|| "imported".into(), |s| s.to_string_lossy().into_owned())
+    });
+    let session = new_session(
+        name,
+        Some(robot),
+        spec.sphere_diameter,
+        None,
+        spec.references.as_deref(),
+        measurements,
+    )?;
+    let lines: HashMap<&str, usize> = log
+        .rows
+        .iter()
+        .map(|(line, row)| (row[cols.id].as_str(), *line))
+        .collect();
+    let session = recheck(
+        session,
+        &Sources {
+            log: &spec.joint_log,
+            lines: &lines,
+            profiles: &report,
+            references: spec.references.as_deref(),
+        },
+    )?;
+    let mut notes = vec![report.summary()];
+    notes.extend(units::joint_unit_warning(
+        spec.joint_unit,
+        session
+            .measurements
+            .iter()
+            .flat_map(|m| m.joints.iter().copied()),
+    ));
+    Ok(Imported {
+        session,
+        checks,
+        profiles: report,
+        notes,
+    })
+}
+
+/// Where an imported session's data came from, so that a rule the
+/// session breaks is blamed on the file the user can fix.
+pub(crate) struct Sources<'a> {
+    /// The pose log.
+    pub log: &'a Path,
+    /// Line of each pose id in the log.
+    pub lines: &'a HashMap<&'a str, usize>,
+    /// Each pose's profile file.
+    pub profiles: &'a ProfileReport,
+    /// The reference distances file, if any.
+    pub references: Option<&'a Path>,
+}
+
+/// The session checked by every FORMAT.md rule ([`Session::validate`],
+/// the rules the file loader applies too); a broken rule is blamed on its
+/// source by its measurement and key: a stripe's on the pose's profile
+/// file, a pose's other data on its log line, a reference distance on its
+/// row of the references file, the rest on the log.
+///
+/// # Errors
+/// The rule's message, placed in the file it came from.
+pub(crate) fn recheck(session: Session, sources: &Sources) -> Result<Session, ImportError> {
+    let e = match session.validate() {
+        Ok(()) => return Ok(session),
+        Err(e) => e,
+    };
+    let key = e.key.as_deref().unwrap_or("");
+    if let Some(id) = &e.measurement {
+        let profile = sources.profiles.poses.iter().find(|p| p.id == *id);
+        if let Some(p) = profile.filter(|_| key.starts_with("stripe")) {
+            return Err(ImportError::File {
+                path: p.file.clone(),
+                message: format!("pose {id}: {}", e.message),
+            });
+        }
+        if let Some(&line) = sources.lines.get(id.as_str()) {
+            return Err(ImportError::Csv {
+                path: sources.log.to_path_buf(),
+                line,
+                message: format!("pose {id}: {}", e.message),
+            });
+        }
+    }
+    if let Some(path) = sources.references
+        && let Some(index) = reference_index(key)
+    {
+        let line = reference_rows(path)
+            .ok()
+            .and_then(|rows| rows.get(index).map(|(line, _)| *line));
+        return Err(match line {
+            Some(line) => ImportError::Csv {
+                path: path.to_path_buf(),
+                line,
+                message: e.message,
+            },
+            None => ImportError::File {
+                path: path.to_path_buf(),
+                message: e.message,
+            },
+        });
+    }
+    Err(ImportError::File {
+        path: sources.log.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
+/// `i` of a key `reference_distances[i]`.
+fn reference_index(key: &str) -> Option<usize> {
+    key.strip_prefix("reference_distances[")?
+        .split(']')
+        .next()?
+        .parse()
+        .ok()
+}
+
+/// A session built by an import: `name` given, the robot (none for a
+/// pose-only log without one), the sphere, `side` as `sensor.side` when
+/// the import decided it, the reference distances of `references`, and
+/// default solver settings.
+pub(crate) fn new_session(
+    name: String,
+    robot: Option<Robot>,
+    sphere_diameter: f64,
+    side: Option<i8>,
+    references: Option<&Path>,
+    measurements: Vec<Measurement>,
+) -> Result<Session, ImportError> {
+    let robot_given = robot.is_some();
+    let robot = robot.unwrap_or_else(|| Robot::new(String::new(), Vec::new()));
+    Ok(Session {
+        name,
+        name_given: true,
+        base_given: robot.base != Isometry3::identity(),
+        flange_given: robot.flange != Isometry3::identity(),
+        robot,
+        robot_given,
+        sphere_diameter,
+        default_side: side.unwrap_or(1),
+        sensor_given: side.is_some(),
+        sensor_range: None,
+        hand_eye: None,
+        solver: SolverSettings::default(),
+        solver_given: false,
+        reference_distances: match references {
+            Some(path) => read_references(path)?,
+            None => Vec::new(),
+        },
+        measurements,
+    })
+}
+
+/// The JSON value of a file's text (a UTF-8 byte-order mark allowed), or
+/// the syntax error at its line.
+pub(crate) fn json_value(text: &str, path: &Path) -> Result<serde_json::Value, ImportError> {
+    serde_json::from_str(text.trim_start_matches('\u{feff}')).map_err(|e| ImportError::Csv {
+        path: path.to_path_buf(),
+        line: e.line(),
+        message: format!("not valid JSON: {e}"),
+    })
+}

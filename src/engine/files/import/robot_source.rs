@@ -1,0 +1,117 @@
+//! Where the nominal robot model of an import comes from: a preset, the
+//! `robot` block of a session or result file, a URDF, or a DH table.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use super::ImportError;
+use crate::engine::base::robot::{self, DhConvention, Robot, UrdfOptions};
+use crate::engine::files::format::{parse_result, parse_session};
+
+/// Where the nominal robot model comes from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum RobotSource {
+    /// A preset key of [`robot::preset`] (`irb2400`, `irb120`, `ur5e`).
+    Preset(String),
+    /// The `robot` block of a session or result file.
+    File(PathBuf),
+    /// A URDF: the serial chain of revolute joints from its root link to
+    /// `tip` (default: the chain's only end link), converted to FORMAT.md's
+    /// modified DH ([`robot::urdf`]).
+    Urdf {
+        /// The file.
+        path: PathBuf,
+        /// The tip link, e.g. `tool0`.
+        tip: Option<String>,
+    },
+    /// A DH table (CSV, columns a, alpha, d, theta), standard or modified
+    /// ([`robot::dh_table`]).
+    DhTable {
+        /// The file.
+        path: PathBuf,
+        /// The table's convention.
+        convention: DhConvention,
+    },
+}
+
+impl RobotSource {
+    /// The source a command-line or form value names: a `.json` session
+    /// or result file, a `.urdf`, a `.csv` DH table (with `convention`,
+    /// which a DH table needs), else a preset key.
+    ///
+    /// # Errors
+    /// A `.csv` without a DH convention.
+    pub fn from_text(
+        text: &str,
+        tip: Option<String>,
+        convention: Option<DhConvention>,
+    ) -> Result<Self, String> {
+        let path = Path::new(text);
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        Ok(match ext.as_str() {
+            "json" => Self::File(path.to_path_buf()),
+            "urdf" | "xml" => Self::Urdf {
+                path: path.to_path_buf(),
+                tip,
+            },
+            "csv" | "txt" => Self::DhTable {
+                path: path.to_path_buf(),
+                convention: convention.ok_or_else(|| {
+                    format!(
+                        "{text} is a DH table: say whether it is the standard or the modified convention (--dh standard|modified)"
+                    )
+                })?,
+            },
+            _ => Self::Preset(text.to_string()),
+        })
+    }
+}
+
+/// The nominal robot model of the spec.
+///
+/// # Errors
+/// [`ImportError::Spec`] for an unknown preset, the loader's error for a
+/// file that is neither a valid session nor a valid result file.
+pub fn load_robot(source: &RobotSource) -> Result<Robot, ImportError> {
+    match source {
+        RobotSource::Preset(key) => robot::preset(key).map(|p| p.robot).ok_or_else(|| {
+            let keys: Vec<&str> = robot::presets().iter().map(|p| p.key).collect();
+            ImportError::Spec(format!(
+                "unknown robot `{key}`, expected one of: {} or a session/result file, a URDF or a DH table",
+                keys.join(", ")
+            ))
+        }),
+        RobotSource::File(path) => {
+            let text = fs::read_to_string(path).map_err(|source| ImportError::Io {
+                path: path.clone(),
+                source,
+            })?;
+            let no_robot = || ImportError::File {
+                path: path.clone(),
+                message: "the file has no robot model (a pose-only session or result)".into(),
+            };
+            match parse_session(&text, path) {
+                Ok(s) if s.robot_given => Ok(s.robot),
+                Ok(_) => Err(no_robot()),
+                Err(session_error) => match parse_result(&text, path) {
+                    Ok(r) => r.robot.ok_or_else(no_robot),
+                    Err(_) => Err(ImportError::Session(session_error)),
+                },
+            }
+        }
+        RobotSource::Urdf { path, tip } => {
+            let options = UrdfOptions {
+                tip: tip.clone(),
+                ..UrdfOptions::default()
+            };
+            robot::load_urdf(path, &options)
+                .map(|u| u.robot)
+                .map_err(|e| ImportError::Spec(e.to_string()))
+        }
+        RobotSource::DhTable { path, convention } => robot::load_dh_csv(path, *convention)
+            .map_err(|e| ImportError::Spec(e.to_string())),
+    }
+}

@@ -1,0 +1,312 @@
+//! ABB RAPID modules: `robtarget` and `jointtarget` values, declared
+//! (`CONST robtarget p10 := [[x,y,z],[q1,q2,q3,q4],[cf1,cf4,cf6,cfx],[eax_a,…]];`,
+//! also `PERS`/`VAR`, arrays `{n}`) or written inline in a move
+//! instruction, and the order the `Move…` instructions go to them.
+//!
+//! A robtarget is `x, y, z` (mm) and the quaternion `q1..q4` (w, x, y, z)
+//! of the TCP in the work object; a jointtarget `[[j1..j6],[eax…]]` (deg).
+//! Comments run from `!` to the end of the line; RAPID names are not case
+//! sensitive.
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use super::scan::{Lines, inside, line_comments, number_at, shown, skip_space};
+use super::{ParseError, Parsed, Target, TargetValue};
+use crate::engine::base::robot::controller::FlangeConvention;
+
+/// Deepest nesting of `[` read: a robtarget array is 4 deep; deeper is
+/// not a target and is refused rather than recursed into.
+const MAX_DEPTH: usize = 8;
+
+/// A value of a RAPID aggregate literal.
+enum Node {
+    /// A number and its byte range.
+    Number(f64, Range<usize>),
+    /// A bracketed list and its byte range.
+    List(Vec<Node>, Range<usize>),
+    /// Anything else (a name, a string, `TRUE`).
+    Other,
+}
+
+impl Node {
+    fn numbers(&self, n: usize) -> Option<Vec<(f64, Range<usize>)>> {
+        let Self::List(items, _) = self else {
+            return None;
+        };
+        if items.len() != n {
+            return None;
+        }
+        items
+            .iter()
+            .map(|i| match i {
+                Self::Number(v, r) => Some((*v, r.clone())),
+                _ => None,
+            })
+            .collect()
+    }
+
+    fn range(&self) -> Option<Range<usize>> {
+        match self {
+            Self::List(_, r) | Self::Number(_, r) => Some(r.clone()),
+            Self::Other => None,
+        }
+    }
+}
+
+/// Parses the list that opens at byte `at` (`[`); returns it and the
+/// byte after its `]`.
+fn list(text: &str, at: usize, depth: usize, lines: &Lines) -> Result<(Node, usize), ParseError> {
+    if depth > MAX_DEPTH {
+        return Err((
+            lines.line(at),
+            format!("brackets nested deeper than {MAX_DEPTH}: not a RAPID target"),
+        ));
+    }
+    let bytes = text.as_bytes();
+    let mut items = Vec::new();
+    let mut i = at + 1;
+    loop {
+        i = skip_space(text, i);
+        match bytes.get(i) {
+            None => return Err((lines.line(at), "`[` without its `]`".to_string())),
+            Some(b']') => return Ok((Node::List(items, at..i + 1), i + 1)),
+            Some(b',') => i += 1,
+            Some(b'[') => {
+                let (node, next) = list(text, i, depth + 1, lines)?;
+                items.push(node);
+                i = next;
+            }
+            Some(_) => {
+                if let Some((v, r)) = number_at(text, i) {
+                    let end = skip_space(text, r.end);
+                    if matches!(bytes.get(end), Some(b',' | b']')) {
+                        i = r.end;
+                        items.push(Node::Number(v, r));
+                        continue;
+                    }
+                }
+                let end = bytes[i..]
+                    .iter()
+                    .position(|&b| matches!(b, b',' | b']' | b'[' | b';'))
+                    .map_or(bytes.len(), |p| i + p);
+                if bytes.get(end) == Some(&b';') || end == i {
+                    return Err((
+                        lines.line(i),
+                        format!("`{}` ends a list without `]`", shown(&text[i..end])),
+                    ));
+                }
+                items.push(Node::Other);
+                i = end;
+            }
+        }
+    }
+}
+
+/// A robtarget or jointtarget of a literal, if it is one.
+fn target_of(node: &Node, name: String, line: usize) -> Option<Target> {
+    let Node::List(items, _) = node else {
+        return None;
+    };
+    if items.len() == 4
+        && let (Some(xyz), Some(q), Some(_), Some(_)) = (
+            items[0].numbers(3),
+            items[1].numbers(4),
+            items[2].numbers(4),
+            items[3].numbers(6),
+        )
+    {
+        let (values, spans): (Vec<f64>, Vec<Range<usize>>) = xyz.into_iter().chain(q).unzip();
+        let mut t = Target::new(
+            name,
+            line,
+            TargetValue::Pose {
+                values,
+                convention: FlangeConvention::AbbQuaternion,
+            },
+            spans,
+        );
+        t.config = items[2].range().map(|r| (String::new(), r));
+        return Some(t);
+    }
+    if items.len() == 2
+        && let (Some(j), Some(_)) = (items[0].numbers(6), items[1].numbers(6))
+    {
+        let (deg, spans): (Vec<f64>, Vec<Range<usize>>) = j.into_iter().unzip();
+        return Some(Target::new(
+            name,
+            line,
+            TargetValue::Joints {
+                deg,
+                radians: false,
+            },
+            spans,
+        ));
+    }
+    None
+}
+
+/// The declared name before a literal at `at` (`… robtarget NAME :=` or
+/// `… jointtarget NAME{n} :=`), if there is one.
+fn declared_name(text: &str, at: usize) -> Option<String> {
+    let before = text[..at].trim_end();
+    let before = before.strip_suffix(":=")?.trim_end();
+    let name_start = before
+        .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '{' || c == '}'))
+        .map_or(0, |i| i + 1);
+    let name = &before[name_start..];
+    let kind = before[..name_start].split_whitespace().last()?;
+    (kind.eq_ignore_ascii_case("robtarget") || kind.eq_ignore_ascii_case("jointtarget"))
+        .then(|| name.split('{').next().unwrap_or(name).to_string())
+        .filter(|n| !n.is_empty())
+}
+
+/// Reads the targets of `text`.
+pub(super) fn read(text: &str) -> Result<Parsed, ParseError> {
+    let lines = Lines::new(text);
+    let comments = line_comments(text, b'!');
+    let bytes = text.as_bytes();
+    let mut targets: Vec<Target> = Vec::new();
+    // Start byte of each inline literal that is a target, for the visits.
+    let mut inline_at: HashMap<usize, usize> = HashMap::new();
+    let mut in_string = false;
+    let mut i = 0;
+    while i < bytes.len() {
+        let b = bytes[i];
+        if b == b'\n' {
+            in_string = false;
+        }
+        if b == b'"' && !inside(&comments, i) {
+            in_string = !in_string;
+        }
+        if b != b'[' || in_string || inside(&comments, i) {
+            i += 1;
+            continue;
+        }
+        let line = lines.line(i);
+        let (node, next) = list(text, i, 0, &lines)?;
+        let declared = declared_name(text, i);
+        let name = declared.clone().unwrap_or_else(|| format!("line {line}"));
+        if let Some(t) = target_of(&node, name.clone(), line) {
+            if declared.is_none() {
+                inline_at.insert(i, targets.len());
+            }
+            targets.push(t);
+        } else if let (Some(base), Node::List(items, _)) = (&declared, &node) {
+            // An array of targets: `robtarget pts{3} := [[…], […], […]]`.
+            for (k, item) in items.iter().enumerate() {
+                if let Some(t) = target_of(item, format!("{base}{{{}}}", k + 1), line) {
+                    targets.push(t);
+                }
+            }
+        }
+        i = next;
+    }
+    let visits = motion_visits(text, &comments, &targets, &inline_at);
+    Ok(Parsed {
+        targets,
+        visits,
+        warnings: Vec::new(),
+    })
+}
+
+/// The targets the `Move…` instructions go to, in program order: a named
+/// target, or an inline literal (`MoveC` names two).
+fn motion_visits(
+    text: &str,
+    comments: &[Range<usize>],
+    targets: &[Target],
+    inline_at: &HashMap<usize, usize>,
+) -> Vec<usize> {
+    let by_name: HashMap<String, usize> = targets
+        .iter()
+        .enumerate()
+        .map(|(i, t)| (t.name.to_ascii_lowercase(), i))
+        .collect();
+    let mut visits = Vec::new();
+    let lower = text.to_ascii_lowercase();
+    for (at, _) in lower.match_indices("move") {
+        if inside(comments, at)
+            || (at > 0 && {
+                let b = lower.as_bytes()[at - 1];
+                b.is_ascii_alphanumeric() || b == b'_'
+            })
+        {
+            continue;
+        }
+        let word_end = at
+            + lower[at..]
+                .bytes()
+                .take_while(|b| b.is_ascii_alphanumeric() || *b == b'_')
+                .count();
+        let instruction = &lower[at..word_end];
+        let count = if instruction.starts_with("movec") {
+            2
+        } else {
+            1
+        };
+        let mut i = skip_space(text, word_end);
+        for _ in 0..count {
+            if text.as_bytes().get(i) == Some(&b'[') {
+                if let Some(&t) = inline_at.get(&i) {
+                    visits.push(t);
+                }
+                break;
+            }
+            let end = i + lower[i..]
+                .bytes()
+                .take_while(|b| b.is_ascii_alphanumeric() || *b == b'_' || *b == b'{' || *b == b'}')
+                .count();
+            let name = lower[i..end].split('{').next().unwrap_or("");
+            let indexed = &lower[i..end];
+            if let Some(&t) = by_name.get(indexed).or_else(|| by_name.get(name)) {
+                visits.push(t);
+            }
+            i = skip_space(text, end);
+            if text.as_bytes().get(i) == Some(&b',') {
+                i = skip_space(text, i + 1);
+            } else {
+                break;
+            }
+        }
+    }
+    visits
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MODULE: &str = "MODULE Cell\n  ! a robtarget in a comment: [[1,2,3],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]]\n  CONST robtarget p20 := [[600.5,-10,450],[0.6,0,0.8,0],[0,-1,0,1],[9E+09,9E+09,9E9,9E9,9E9,9E9]];\n  PERS robtarget p10:=[[500,0,400],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n  CONST jointtarget jhome := [[0,-10.5,20,0,45,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n  PERS tooldata tSensor := [TRUE,[[0,0,100],[1,0,0,0]],[1,[0,0,1],[1,0,0,0],0,0,0]];\n  PROC main()\n    MoveAbsJ jhome, v100, fine, tool0;\n    MoveL p10, v100, fine, tSensor;\n    MoveJ P20, v100, z10, tSensor;\n    MoveL [[700,0,400],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, fine, tool0;\n  ENDPROC\nENDMODULE\n";
+
+    #[test]
+    fn targets_names_and_moves() {
+        let p = read(MODULE).unwrap();
+        let names: Vec<&str> = p.targets.iter().map(|t| t.name.as_str()).collect();
+        assert_eq!(names, ["p20", "p10", "jhome", "line 11"]);
+        let TargetValue::Pose { values, .. } = &p.targets[0].value else {
+            panic!()
+        };
+        assert_eq!(values[..4], [600.5, -10.0, 450.0, 0.6]);
+        assert_eq!(&MODULE[p.targets[0].spans[1].clone()], "-10");
+        assert_eq!(
+            &MODULE[p.targets[0].config.clone().unwrap().1],
+            "[0,-1,0,1]"
+        );
+        assert!(matches!(p.targets[2].value, TargetValue::Joints { .. }));
+        // jhome, p10, p20 (case-insensitive), then the inline literal.
+        assert_eq!(p.visits, vec![2, 1, 0, 3]);
+    }
+
+    #[test]
+    fn arrays_and_errors() {
+        let p = read("VAR robtarget pts{2} := [[[1,2,3],[1,0,0,0],[0,0,0,0],[0,0,0,0,0,0]],[[4,5,6],[1,0,0,0],[0,0,0,0],[0,0,0,0,0,0]]];").unwrap();
+        assert_eq!(p.targets.len(), 2);
+        assert_eq!(p.targets[1].name, "pts{2}");
+        let (line, m) = read("MODULE m\nCONST robtarget p := [[1,2,3],[1,0,0,0];\n").unwrap_err();
+        assert_eq!(line, 2);
+        assert!(m.contains("without"), "{m}");
+        let deep = format!("x := {}{};", "[".repeat(50), "]".repeat(50));
+        assert!(read(&deep).unwrap_err().1.contains("nested"));
+    }
+}

@@ -1,0 +1,459 @@
+//! Pose tables as controllers and scripts write them: one pose a row, the
+//! convention's numbers, separated by `,`, `;`, tabs or spaces, with or
+//! without a header.
+//!
+//! - **With a header** (any field of the first row not a number): the
+//!   pose columns by name (the convention's default names, any case, or
+//!   the names given), and optionally `id`, `station`, `use`, `side`.
+//! - **Without a header**: the convention's numbers in its order, e.g.
+//!   `x y z w p r` for FANUC; a row with one more field takes the first as
+//!   the pose id.
+//!
+//! Blank lines and lines starting with `#` or `//` are skipped; a UTF-8
+//! byte-order mark is allowed; fields may be quoted. Pose `k` of a table
+//! without ids has number `k` (1-based), for pairing with numbered
+//! profiles.
+
+use std::ops::Range;
+
+use super::scan::shown;
+use super::{ParseError, Parsed, Target, TargetValue};
+use crate::engine::base::robot::controller::FlangeConvention;
+use crate::engine::base::session::Use;
+
+/// How the fields of a row are separated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Separator {
+    Char(u8),
+    Whitespace,
+}
+
+impl Separator {
+    /// From the first row: `;` when it has one, else a tab without a
+    /// comma, else `,` when it has one, else runs of spaces.
+    fn of(line: &str) -> Self {
+        if line.contains(';') {
+            Self::Char(b';')
+        } else if line.contains('\t') && !line.contains(',') {
+            Self::Char(b'\t')
+        } else if line.contains(',') {
+            Self::Char(b',')
+        } else {
+            Self::Whitespace
+        }
+    }
+
+    fn describe(self) -> &'static str {
+        match self {
+            Self::Char(b';') => "semicolons",
+            Self::Char(b'\t') => "tabs",
+            Self::Char(_) => "commas",
+            Self::Whitespace => "spaces",
+        }
+    }
+}
+
+/// A row's fields as byte ranges into the text (trimmed, unquoted).
+fn fields(text: &str, line: Range<usize>, sep: Separator) -> Vec<Range<usize>> {
+    let bytes = text.as_bytes();
+    let mut out = Vec::new();
+    let trim = |mut r: Range<usize>| {
+        while r.start < r.end && bytes[r.start].is_ascii_whitespace() {
+            r.start += 1;
+        }
+        while r.end > r.start && bytes[r.end - 1].is_ascii_whitespace() {
+            r.end -= 1;
+        }
+        if r.end >= r.start + 2 && bytes[r.start] == b'"' && bytes[r.end - 1] == b'"' {
+            r.start += 1;
+            r.end -= 1;
+        }
+        r
+    };
+    match sep {
+        Separator::Char(c) => {
+            let mut start = line.start;
+            for i in line.clone() {
+                if bytes[i] == c {
+                    out.push(trim(start..i));
+                    start = i + 1;
+                }
+            }
+            out.push(trim(start..line.end));
+        }
+        Separator::Whitespace => {
+            let mut start = None;
+            for i in line.clone() {
+                let blank = bytes[i].is_ascii_whitespace();
+                match (start, blank) {
+                    (None, false) => start = Some(i),
+                    (Some(s), true) => {
+                        out.push(trim(s..i));
+                        start = None;
+                    }
+                    _ => {}
+                }
+            }
+            if let Some(s) = start {
+                out.push(trim(s..line.end));
+            }
+        }
+    }
+    out
+}
+
+/// The rows of `text` that are not blank or comments: `(line, range)`.
+fn rows(text: &str) -> Vec<(usize, Range<usize>)> {
+    let mut out = Vec::new();
+    let mut at = 0;
+    for (k, raw) in text.split_inclusive('\n').enumerate() {
+        let start = if k == 0 && raw.starts_with('\u{feff}') {
+            at + '\u{feff}'.len_utf8()
+        } else {
+            at
+        };
+        let end = at + raw.trim_end_matches(['\n', '\r']).len();
+        at += raw.len();
+        let body = text[start..end].trim();
+        if body.is_empty() || body.starts_with('#') || body.starts_with("//") {
+            continue;
+        }
+        out.push((k + 1, start..end));
+    }
+    out
+}
+
+/// One row of a numeric table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// 1-based line.
+    pub line: usize,
+    /// The row's 1-based ordinal among the data rows.
+    pub ordinal: usize,
+    /// The numbers of the wanted columns, in their order.
+    pub values: Vec<f64>,
+    /// Their byte ranges.
+    pub spans: Vec<Range<usize>>,
+    /// The `id` column, or the leading id of a headerless row.
+    pub id: Option<String>,
+    /// The `station` column.
+    pub station: Option<String>,
+    /// The `use` column.
+    pub usage: Option<Use>,
+    /// The `side` column, when it has a value.
+    pub side: Option<i8>,
+}
+
+/// Reads a table of numbers: the columns `names` (by name when the table
+/// has a header; in order without one, `names_given` then being an error),
+/// and optionally `id`, `station`, `use`, `side`. `what` names the
+/// numbers in messages ("FANUC x, y, z (mm), W, P, R (deg)").
+///
+/// # Errors
+/// No rows, a missing column, a row of another width, a cell that is not
+/// a number: each naming the line.
+pub fn read_rows(
+    text: &str,
+    names: &[String],
+    names_given: bool,
+    what: &str,
+) -> Result<Vec<Row>, ParseError> {
+    let rows = rows(text);
+    let Some((first_line, first)) = rows.first().cloned() else {
+        return Err((0, "the table has no rows".to_string()));
+    };
+    let sep = Separator::of(&text[first.clone()]);
+    let first_fields = fields(text, first, sep);
+    let is_number = |r: &Range<usize>| text[r.clone()].parse::<f64>().is_ok();
+    let n = names.len();
+    // A header has names; a first row whose only text is its first field
+    // with one field more than the numbers need is data with an id first.
+    let text_fields: Vec<usize> = (0..first_fields.len())
+        .filter(|&i| !is_number(&first_fields[i]))
+        .collect();
+    let has_header =
+        !(text_fields.is_empty() || (text_fields == [0] && first_fields.len() == n + 1));
+    let layout = if has_header {
+        let header: Vec<String> = first_fields
+            .iter()
+            .map(|r| text[r.clone()].to_string())
+            .collect();
+        Layout::named(&header, names, what).map_err(|m| (first_line, m))?
+    } else {
+        if names_given {
+            return Err((
+                first_line,
+                format!(
+                    "columns were named, but the table has no header (its first row is numbers separated by {})",
+                    sep.describe()
+                ),
+            ));
+        }
+        match first_fields.len() {
+            w if w == n => Layout::ordered(0, None, w),
+            w if w == n + 1 => Layout::ordered(1, Some(0), w),
+            w => {
+                return Err((
+                    first_line,
+                    format!(
+                        "{w} numbers separated by {}: a table without a header has {n} a row ({what}), or {} with an id first",
+                        sep.describe(),
+                        n + 1
+                    ),
+                ));
+            }
+        }
+    };
+    let data = if has_header { &rows[1..] } else { &rows[..] };
+    let mut out = Vec::with_capacity(data.len());
+    for (k, (line, range)) in data.iter().enumerate() {
+        let f = fields(text, range.clone(), sep);
+        if f.len() != layout.width {
+            return Err((
+                *line,
+                format!(
+                    "{} fields separated by {}, the {} has {}",
+                    f.len(),
+                    sep.describe(),
+                    if has_header { "header" } else { "first row" },
+                    layout.width
+                ),
+            ));
+        }
+        let mut values = Vec::with_capacity(n);
+        let mut spans = Vec::with_capacity(n);
+        for (c, &col) in layout.numbers.iter().enumerate() {
+            let r = f[col].clone();
+            let v: f64 = text[r.clone()].parse().map_err(|_| {
+                (
+                    *line,
+                    format!(
+                        "column {}: `{}` is not a number",
+                        layout
+                            .names
+                            .get(c)
+                            .map_or_else(|| (col + 1).to_string(), |n| format!("`{n}`")),
+                        shown(&text[r.clone()])
+                    ),
+                )
+            })?;
+            values.push(v);
+            spans.push(r);
+        }
+        let cell = |c: Option<usize>| c.map(|c| text[f[c].clone()].to_string());
+        let usage = match cell(layout.usage) {
+            Some(u) => Some(Use::parse(&u).ok_or_else(|| {
+                (
+                    *line,
+                    format!(
+                        "column `use`: `{}` is not translation, rotation, identify or validate",
+                        shown(&u)
+                    ),
+                )
+            })?),
+            None => None,
+        };
+        let side = match cell(layout.side) {
+            Some(s) => side_cell(&s).map_err(|m| (*line, format!("column `side`: {m}")))?,
+            None => None,
+        };
+        out.push(Row {
+            line: *line,
+            ordinal: k + 1,
+            values,
+            spans,
+            id: cell(layout.id).filter(|s| !s.is_empty()),
+            station: cell(layout.station).filter(|s| !s.is_empty()),
+            usage,
+            side,
+        });
+    }
+    Ok(out)
+}
+
+/// Reads a pose table in `convention`, with the pose columns named
+/// `columns` when given.
+pub(super) fn read(
+    text: &str,
+    convention: FlangeConvention,
+    columns: Option<&[String]>,
+) -> Result<Parsed, ParseError> {
+    let names = columns.map_or_else(|| convention.default_columns(), <[String]>::to_vec);
+    if names.len() != convention.n_columns() {
+        return Err((
+            0,
+            format!(
+                "{} pose columns named, {} needs {}",
+                names.len(),
+                convention.describe(),
+                convention.n_columns()
+            ),
+        ));
+    }
+    let rows = read_rows(text, &names, columns.is_some(), convention.describe())?;
+    let targets = rows
+        .into_iter()
+        .map(|row| {
+            let name = row
+                .id
+                .clone()
+                .unwrap_or_else(|| format!("line {}", row.line));
+            let mut t = Target::new(
+                name,
+                row.line,
+                TargetValue::Pose {
+                    values: row.values,
+                    convention,
+                },
+                row.spans,
+            );
+            if row.id.is_none() {
+                t.number = Some(row.ordinal as u64);
+            }
+            t.id = row.id;
+            t.station = row.station;
+            t.usage = row.usage;
+            t.side = row.side;
+            t
+        })
+        .collect();
+    Ok(Parsed {
+        targets,
+        visits: Vec::new(),
+        warnings: Vec::new(),
+    })
+}
+
+/// A `side` cell: `+1`/`1`, `-1`, or blank for the session default.
+fn side_cell(s: &str) -> Result<Option<i8>, String> {
+    match s.trim() {
+        "" => Ok(None),
+        "1" | "+1" | "1.0" | "+1.0" => Ok(Some(1)),
+        "-1" | "-1.0" => Ok(Some(-1)),
+        other => Err(format!("`{}` is not +1 or -1", shown(other))),
+    }
+}
+
+/// Where a table's values are.
+struct Layout {
+    width: usize,
+    numbers: Vec<usize>,
+    names: Vec<String>,
+    id: Option<usize>,
+    station: Option<usize>,
+    usage: Option<usize>,
+    side: Option<usize>,
+}
+
+impl Layout {
+    fn ordered(first: usize, id: Option<usize>, width: usize) -> Self {
+        Self {
+            width,
+            numbers: (first..width).collect(),
+            names: Vec::new(),
+            id,
+            station: None,
+            usage: None,
+            side: None,
+        }
+    }
+
+    fn named(header: &[String], names: &[String], what: &str) -> Result<Self, String> {
+        let find = |n: &str| header.iter().position(|h| h.trim().eq_ignore_ascii_case(n));
+        let numbers = names
+            .iter()
+            .map(|n| {
+                find(n).ok_or_else(|| {
+                    format!(
+                        "no column `{n}` (the header has: {}); the columns of {what} are {} (--pose-columns names others)",
+                        shown(&header.join(", ")),
+                        names.join(", ")
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            width: header.len(),
+            numbers,
+            names: names.to_vec(),
+            id: find("id"),
+            station: find("station"),
+            usage: find("use"),
+            side: find("side"),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn values(p: &Parsed, k: usize) -> Vec<f64> {
+        match &p.targets[k].value {
+            TargetValue::Pose { values, .. } => values.clone(),
+            TargetValue::Joints { .. } => panic!(),
+        }
+    }
+
+    #[test]
+    fn headerless_whitespace_rows() {
+        let text = "-683.432 1182.213 591.413 178.562 -0.060 177.524\n  -669.571\t1182.217 591.370 178.563 -0.059 177.524  \n\n";
+        let p = read(text, FlangeConvention::FanucWpr, None).unwrap();
+        assert_eq!(p.targets.len(), 2);
+        assert_eq!(values(&p, 1)[0], -669.571);
+        assert_eq!(p.targets[1].number, Some(2));
+        assert_eq!(&text[p.targets[0].spans[4].clone()], "-0.060");
+    }
+
+    #[test]
+    fn headers_in_any_separator_and_ids() {
+        for sep in [",", ";", "\t", " "] {
+            let text = format!(
+                "\u{feff}id{sep}X{sep}Y{sep}Z{sep}W{sep}P{sep}R\np7{sep}1{sep}2{sep}3{sep}4{sep}5{sep}6\n"
+            );
+            let p = read(&text, FlangeConvention::FanucWpr, None).unwrap();
+            assert_eq!(p.targets[0].id.as_deref(), Some("p7"), "{sep:?}");
+            assert_eq!(p.targets[0].number, Some(7));
+            assert_eq!(values(&p, 0), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        }
+        let p = read(
+            "1, 10,20,30,0,0,0\n2, 11,21,31,0,0,1\n",
+            FlangeConvention::KukaAbc,
+            None,
+        )
+        .unwrap();
+        assert_eq!(p.targets[1].id.as_deref(), Some("2"));
+        let p = read(
+            "p1 10 20 30 0 0 0\np2 11 21 31 0 0 1\n",
+            FlangeConvention::KukaAbc,
+            None,
+        )
+        .unwrap();
+        assert_eq!(p.targets[1].id.as_deref(), Some("p2"));
+    }
+
+    #[test]
+    fn bad_rows_name_their_line() {
+        let (line, m) = read("1 2 3 4 5\n", FlangeConvention::FanucWpr, None).unwrap_err();
+        assert_eq!(line, 1);
+        assert!(m.contains("5 numbers") && m.contains("6 a row"), "{m}");
+        let (line, m) = read(
+            "x,y,z,w,p,r\n1,2,3,4,5,6\n1,2,x3,4,5,6\n",
+            FlangeConvention::FanucWpr,
+            None,
+        )
+        .unwrap_err();
+        assert_eq!(line, 3);
+        assert!(m.contains("`z`") && m.contains("x3"), "{m}");
+        let (_, m) = read("a,b\n1,2\n", FlangeConvention::FanucWpr, None).unwrap_err();
+        assert!(m.contains("no column `x`"), "{m}");
+        let (line, m) = read(
+            "1 2 3 4 5 6\n1 2 3 4 5 6 7 8\n",
+            FlangeConvention::FanucWpr,
+            None,
+        )
+        .unwrap_err();
+        assert_eq!(line, 2);
+        assert!(m.contains("8 fields"), "{m}");
+    }
+}

@@ -1,0 +1,305 @@
+//! A plan as a person asks for it — the command line's flags and the
+//! workbench's Plan view are two ways of filling in one [`PlanRequest`] —
+//! and the files such a request may name: a hand-eye guess and a list of
+//! stations.
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::Isometry3;
+
+use super::config::{
+    DEFAULT_CANDIDATES, DEFAULT_CONE_DEG, DEFAULT_CUT_ANGLE_DEG, PlanConfig, Selection,
+    StationLayout,
+};
+use super::predict::PredictConfig;
+use crate::engine::base::cell::workspace;
+use crate::engine::base::robot::{self, JointLimit};
+use crate::engine::base::session::SensorRange;
+use crate::engine::base::table::Table;
+use crate::engine::files::import::{RobotSource, load_robot};
+
+/// Why a request cannot be made into a plan configuration, or a file it
+/// names cannot be read: what and where.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum RequestError {
+    /// The robot is unknown or its file cannot be read.
+    #[error("{0}")]
+    Robot(String),
+    /// A robot from a file that is not a preset needs its joint limits.
+    #[error(
+        "robot {robot} from {source_file} is not a preset: give its joint limits (min:max per joint, deg)"
+    )]
+    LimitsNeeded {
+        /// The robot's name.
+        robot: String,
+        /// The file it came from.
+        source_file: String,
+    },
+    /// A file the request names is wrong.
+    #[error("{what}: {message} ({})", path.display())]
+    File {
+        /// What the file is for (`hand-eye`, `stations`).
+        what: &'static str,
+        /// What is wrong, with the line where there is one.
+        message: String,
+        /// The file.
+        path: PathBuf,
+    },
+}
+
+/// The defaults of a request, the command line's and the Plan view's.
+pub mod defaults {
+    /// Sphere diameter, mm: the paper's 38.1 mm sphere.
+    pub const DIAMETER_MM: f64 = 38.1;
+    /// Translation poses at P0: one more than eq. 6-7's minimum of 3.
+    pub const TRANSLATIONS: usize = 4;
+    /// Rotation poses at P0, as the paper's experiment.
+    pub const ROTATIONS: usize = 6;
+    /// Identify stations: the paper's 3 × 3 layers.
+    pub const IDENTIFY_STATIONS: usize = 9;
+    /// Poses per identify station, as the paper's.
+    pub const IDENTIFY_POSES: usize = 6;
+    /// Validate stations: the paper's 54 distances are 9 pairs × 6 poses.
+    pub const VALIDATE_STATIONS: usize = 10;
+    /// Poses per validate station.
+    pub const VALIDATE_POSES: usize = 6;
+    /// Seed of every random choice.
+    pub const SEED: u64 = 1;
+}
+
+/// A plan as asked for.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanRequest {
+    /// The robot: a preset key, or a session or result file whose `robot`
+    /// block is the nominal model.
+    pub robot: RobotSource,
+    /// Joint limits, deg; `None`: the preset's, as a cell plans within.
+    pub limits: Option<Vec<JointLimit>>,
+    /// Rough sphere position, base frame, mm.
+    pub sphere: [f64; 3],
+    /// Hand-eye guess `flange_from_sensor`; `None`: the paper's initial one.
+    pub hand_eye: Option<Isometry3<f64>>,
+    /// Sphere diameter, mm.
+    pub diameter: f64,
+    /// Translation poses at P0.
+    pub n_translation: usize,
+    /// Rotation poses at P0.
+    pub n_rotation: usize,
+    /// Identify stations.
+    pub n_identify: usize,
+    /// Poses per identify station.
+    pub identify_poses: usize,
+    /// Validate stations.
+    pub n_validate: usize,
+    /// Poses per validate station.
+    pub validate_poses: usize,
+    /// Station box `dx, dy, dz` (mm) about the sphere; `None`: the preset's.
+    pub box_size: Option<[f64; 3]>,
+    /// Explicit stations instead of the box.
+    pub stations: Option<StationLayout>,
+    /// Cut angle of the laser plane, deg.
+    pub cut_angle: f64,
+    /// Half-angle of the cone of approach directions, deg.
+    pub cone_angle: f64,
+    /// Flange orientations drawn per station.
+    pub candidates: usize,
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// D-optimal or random identify poses.
+    pub selection: Selection,
+    /// Simulated calibrations for the predicted accuracy (0: none).
+    pub predict_runs: usize,
+    /// The sensor's measuring range (`sensor.range`): the plan predicts
+    /// the error over it.
+    pub range: Option<SensorRange>,
+    /// Spread the sphere over `range` (the default with a range).
+    pub spread: bool,
+}
+
+impl PlanRequest {
+    /// A request with every default, for the robot `robot` and a sphere
+    /// at `sphere`.
+    #[must_use]
+    pub fn new(robot: RobotSource, sphere: [f64; 3]) -> Self {
+        Self {
+            robot,
+            limits: None,
+            sphere,
+            hand_eye: None,
+            diameter: defaults::DIAMETER_MM,
+            n_translation: defaults::TRANSLATIONS,
+            n_rotation: defaults::ROTATIONS,
+            n_identify: defaults::IDENTIFY_STATIONS,
+            identify_poses: defaults::IDENTIFY_POSES,
+            n_validate: defaults::VALIDATE_STATIONS,
+            validate_poses: defaults::VALIDATE_POSES,
+            box_size: None,
+            stations: None,
+            cut_angle: DEFAULT_CUT_ANGLE_DEG,
+            cone_angle: DEFAULT_CONE_DEG,
+            candidates: DEFAULT_CANDIDATES,
+            seed: defaults::SEED,
+            selection: Selection::DOptimal,
+            predict_runs: PredictConfig::default().runs,
+            range: None,
+            spread: false,
+        }
+    }
+
+    /// The planner's configuration of this request.
+    ///
+    /// # Errors
+    /// An unknown robot or unreadable robot file, or a robot from a file
+    /// that is not a preset without joint limits. (The configuration's own
+    /// checks, the count of limits among them, run when it is planned.)
+    pub fn config(&self) -> Result<PlanConfig, RequestError> {
+        let mut config = match &self.robot {
+            RobotSource::Preset(key) => {
+                let preset = robot::preset(key)
+                    .ok_or_else(|| RequestError::Robot(format!("unknown robot preset `{key}`")))?;
+                PlanConfig::for_preset(&preset, self.sphere)
+            }
+            RobotSource::Urdf { path, tip } => {
+                let options = robot::UrdfOptions {
+                    tip: tip.clone(),
+                    ..robot::UrdfOptions::default()
+                };
+                let urdf = robot::load_urdf(path, &options)
+                    .map_err(|e| RequestError::Robot(e.to_string()))?;
+                // A continuous joint has no limits: one turn each way.
+                let limits = urdf
+                    .limits
+                    .iter()
+                    .map(|l| robot::JointLimit {
+                        min: l.min.max(-360.0),
+                        max: l.max.min(360.0),
+                    })
+                    .collect();
+                PlanConfig::new(urdf.robot, limits, self.sphere)
+            }
+            RobotSource::File(path) | RobotSource::DhTable { path, .. } => {
+                let robot =
+                    load_robot(&self.robot).map_err(|e| RequestError::Robot(e.to_string()))?;
+                match robot::presets()
+                    .into_iter()
+                    .find(|p| p.robot.name == robot.name)
+                {
+                    Some(p) => {
+                        let limits = workspace::cell_limits(p.key, &p.limits);
+                        PlanConfig::new(robot, limits, self.sphere)
+                    }
+                    None if self.limits.is_some() => {
+                        let limits = self.limits.clone().unwrap_or_default();
+                        PlanConfig::new(robot, limits, self.sphere)
+                    }
+                    None => {
+                        return Err(RequestError::LimitsNeeded {
+                            robot: robot.name,
+                            source_file: path.display().to_string(),
+                        });
+                    }
+                }
+            }
+        };
+        if let Some(limits) = &self.limits {
+            config.limits.clone_from(limits);
+        }
+        if let Some(he) = self.hand_eye {
+            config.flange_from_sensor = he;
+        }
+        config.diameter = self.diameter;
+        config.n_translation = self.n_translation;
+        config.n_rotation = self.n_rotation;
+        config.n_identify = self.n_identify;
+        config.identify_poses = self.identify_poses;
+        config.n_validate = self.n_validate;
+        config.validate_poses = self.validate_poses;
+        if let Some(size) = self.box_size {
+            config.stations = StationLayout::Box { size };
+        }
+        if let Some(stations) = &self.stations {
+            config.stations = stations.clone();
+        }
+        config.cut_angle = self.cut_angle;
+        config.cone_angle = self.cone_angle;
+        config.candidates = self.candidates;
+        config.seed = self.seed;
+        config.selection = self.selection;
+        config.range = self.range;
+        config.spread = self.spread && self.range.is_some();
+        Ok(config)
+    }
+}
+
+/// A hand-eye `flange_from_sensor` from a JSON file: a bare 4×4 array of
+/// rows, or an object with a `hand_eye` 4×4 (a session or result file).
+///
+/// # Errors
+/// [`RequestError::File`] naming the file and what is wrong.
+pub fn read_hand_eye(path: &Path) -> Result<Isometry3<f64>, RequestError> {
+    crate::engine::files::format::read_transform(path, "hand_eye").map_err(|message| {
+        RequestError::File {
+            what: "hand-eye",
+            message,
+            path: path.to_path_buf(),
+        }
+    })
+}
+
+/// Explicit stations from a CSV with columns `use` (identify or validate),
+/// `x`, `y`, `z` (mm, base frame).
+///
+/// # Errors
+/// [`RequestError::File`] naming the file, the line and what is wrong.
+pub fn read_stations(path: &Path) -> Result<StationLayout, RequestError> {
+    let fail = |line: usize, m: String| RequestError::File {
+        what: "stations",
+        message: format!("line {line}: {m}"),
+        path: path.to_path_buf(),
+    };
+    let text =
+        crate::engine::base::table::read_text_file(path).map_err(|e| RequestError::File {
+            what: "stations",
+            message: format!("reading failed: {e}"),
+            path: path.to_path_buf(),
+        })?;
+    let table = Table::parse(&text).map_err(|e| fail(e.line, e.message))?;
+    let col = |name: &str| {
+        table
+            .column(name)
+            .ok_or_else(|| fail(table.header_line, format!("no column `{name}`")))
+    };
+    let (u, x, y, z) = (col("use")?, col("x")?, col("y")?, col("z")?);
+    let (mut identify, mut validate) = (Vec::new(), Vec::new());
+    for (line, f) in &table.rows {
+        let num = |c: usize| {
+            f[c].parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    fail(
+                        *line,
+                        format!(
+                            "`{}` is not a finite number",
+                            crate::engine::base::table::excerpt(&f[c])
+                        ),
+                    )
+                })
+        };
+        let p = [num(x)?, num(y)?, num(z)?];
+        match f[u].as_str() {
+            "identify" => identify.push(p),
+            "validate" => validate.push(p),
+            other => {
+                return Err(fail(
+                    *line,
+                    format!(
+                        "use `{}` is not identify or validate",
+                        crate::engine::base::table::excerpt(other)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(StationLayout::Explicit { identify, validate })
+}

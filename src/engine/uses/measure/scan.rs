@@ -1,0 +1,535 @@
+//! What is measured: a [`Scan`], one [`ScanPose`] a robot pose (joint
+//! readings or the controller's flange pose) with the profile points the
+//! sensor saw there, `[y, z]` in the laser plane (mm, sensor frame).
+//!
+//! Two doors lead in:
+//!
+//! - [`Scan::from_session`]: a session's stripes as they are (every point
+//!   of every stripe; the measurements chosen by their `use`). A
+//!   measurement that gives a sphere centre has no profile and is skipped
+//!   (listed in [`Scan::skipped`]).
+//! - [`scan_from_files`]: a raw scan, the import's pose log and profile
+//!   files. A part has no sphere: no segmentation, no sphere-size check,
+//!   every valid point kept; NaN and no-return points are dropped and
+//!   counted per pose ([`Dropped`]). This is the one function that reads
+//!   raw scan files, so that a change of the pose-log readers touches it
+//!   alone.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use nalgebra::Isometry3;
+
+use crate::engine::base::robot::Robot;
+use crate::engine::base::session::{Observation, ReferenceDistance, Session, Use};
+use crate::engine::base::table::Table;
+use crate::engine::files::import::pairing::list_profiles;
+use crate::engine::files::import::poses::PoseValue;
+use crate::engine::files::import::profiles::{self, RawProfile};
+use crate::engine::files::import::units::{self, AngleUnit};
+use crate::engine::files::import::{
+    AxisMap, FlangeConvention, ImportError, PoseFormat, ProfileFormat, ProfileSource,
+    read_references,
+};
+
+/// Where the robot was: what the model needs to place the sensor.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Placement {
+    /// Joint readings, deg, one per robot joint: the flange pose is the
+    /// model's forward kinematics.
+    Joints(Vec<f64>),
+    /// The flange pose `base_from_flange` the controller reported (mm): the
+    /// kinematic model is not used.
+    Flange(Isometry3<f64>),
+}
+
+/// Profile points dropped from one pose.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Dropped {
+    /// Points with a NaN or infinite coordinate.
+    pub non_finite: usize,
+    /// Points with the sensor's no-return value.
+    pub no_return: usize,
+}
+
+/// One pose of a scan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScanPose {
+    /// The measurement or pose id.
+    pub id: String,
+    /// The sphere station it saw (sessions; a raw scan's log `station`
+    /// column), if any.
+    pub station: Option<String>,
+    /// Its `use` (sessions; a raw scan's log `use` column), if any.
+    pub usage: Option<Use>,
+    /// Where the robot was.
+    pub placement: Placement,
+    /// Profile points `[y, z]`, mm, laser plane `x = 0` of the sensor frame.
+    pub points: Vec<[f64; 2]>,
+    /// Points dropped while reading.
+    pub dropped: Dropped,
+}
+
+/// A scan: poses with their profiles, and what the input says about the
+/// cell.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scan {
+    /// Session name, or the pose log's file name.
+    pub name: String,
+    /// The nominal robot the input names (a session's `robot`, a raw
+    /// scan's `--robot`), to check against the result's.
+    pub robot: Option<Robot>,
+    /// Diameter of the sphere the scan saw, mm (a session's sphere; for a
+    /// raw scan of a sphere artefact, as given).
+    pub sphere_diameter: Option<f64>,
+    /// Reference distances between stations (mm).
+    pub reference_distances: Vec<ReferenceDistance>,
+    /// The poses, in input order.
+    pub poses: Vec<ScanPose>,
+    /// Ids of measurements left out because they have no profile (a
+    /// session's given centres).
+    pub skipped: Vec<String>,
+    /// How the input was read, in words (axis map, units).
+    pub notes: Vec<String>,
+}
+
+impl Scan {
+    /// A session's measurements whose `use` is in `uses` (all of them when
+    /// `uses` is empty), every stripe point as it is. Consumes the session
+    /// (the points move, they are not copied).
+    #[must_use]
+    pub fn from_session(session: Session, uses: &[Use]) -> Self {
+        let robot = session.robot_given.then(|| session.robot.clone());
+        let mut poses = Vec::with_capacity(session.measurements.len());
+        let mut skipped = Vec::new();
+        for m in session.measurements {
+            if !uses.is_empty() && !uses.contains(&m.usage) {
+                continue;
+            }
+            let points = match m.observation {
+                Observation::Stripe(points) => points,
+                Observation::Centre(_) => {
+                    skipped.push(m.id);
+                    continue;
+                }
+            };
+            let placement = match m.flange {
+                Some(pose) => Placement::Flange(pose),
+                None => Placement::Joints(m.joints),
+            };
+            poses.push(ScanPose {
+                id: m.id,
+                station: Some(m.station),
+                usage: Some(m.usage),
+                placement,
+                points,
+                dropped: Dropped::default(),
+            });
+        }
+        Self {
+            name: session.name,
+            robot,
+            sphere_diameter: Some(session.sphere_diameter),
+            reference_distances: session.reference_distances,
+            poses,
+            skipped,
+            notes: Vec::new(),
+        }
+    }
+
+    /// Points in all poses.
+    #[must_use]
+    pub fn point_count(&self) -> usize {
+        self.poses.iter().map(|p| p.points.len()).sum()
+    }
+
+    /// Points dropped in all poses.
+    #[must_use]
+    pub fn dropped(&self) -> Dropped {
+        self.poses.iter().fold(Dropped::default(), |a, p| Dropped {
+            non_finite: a.non_finite + p.dropped.non_finite,
+            no_return: a.no_return + p.dropped.no_return,
+        })
+    }
+}
+
+/// The columns of a raw scan's joint log.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ScanColumns {
+    /// The pose id (required).
+    pub id: String,
+    /// The joint columns, joint 1 first.
+    pub joints: Vec<String>,
+    /// A station column, read when present (a sphere artefact's place).
+    pub station: String,
+    /// A `use` column, read when present.
+    pub usage: String,
+}
+
+impl ScanColumns {
+    /// `id`, `j1..jn`, `station`, `use`.
+    #[must_use]
+    pub fn new(dof: usize) -> Self {
+        Self {
+            id: "id".into(),
+            joints: (1..=dof).map(|k| format!("j{k}")).collect(),
+            station: "station".into(),
+            usage: "use".into(),
+        }
+    }
+}
+
+/// The pose log of a raw scan.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ScanLog {
+    /// A joint log CSV: one row a pose.
+    Joints {
+        /// The file.
+        path: PathBuf,
+        /// Its columns.
+        columns: ScanColumns,
+        /// Unit of the joint columns.
+        unit: AngleUnit,
+    },
+    /// A pose file (a table, a JSON list or a robot program), the
+    /// import's reader ([`crate::engine::files::program`]).
+    Poses {
+        /// The file.
+        path: PathBuf,
+        /// Its layout; `None`: detected from the content.
+        format: Option<PoseFormat>,
+        /// How a table or JSON list writes a pose (a program fixes its own).
+        convention: Option<FlangeConvention>,
+        /// The pose columns of a table; `None`: the convention's.
+        columns: Option<Vec<String>>,
+    },
+}
+
+impl ScanLog {
+    /// The log file.
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        match self {
+            Self::Joints { path, .. } | Self::Poses { path, .. } => path,
+        }
+    }
+}
+
+/// Everything a raw scan is read from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScanFiles {
+    /// The pose log.
+    pub log: ScanLog,
+    /// The profiles: a folder (`<id>.<ext>`, or for a log without ids every
+    /// profile file in natural order) or one CSV with a pose column.
+    pub profiles: ProfileSource,
+    /// How to read them: unit, axis map (guessed when `None`), no-return
+    /// value, key of OpenCV files.
+    pub profile_format: ProfileFormat,
+    /// The nominal robot the scan was taken with, to check against the
+    /// result's (optional).
+    pub robot: Option<Robot>,
+    /// Diameter of the spheres of a sphere artefact, mm, for the
+    /// self-validation (optional).
+    pub sphere_diameter: Option<f64>,
+    /// Reference distances between the artefact's stations (`from,to,distance`
+    /// CSV, mm), optional.
+    pub references: Option<PathBuf>,
+}
+
+/// One pose of a log before its profile: id, station, use, placement.
+struct LogPose {
+    id: Option<String>,
+    station: Option<String>,
+    usage: Option<Use>,
+    placement: Placement,
+}
+
+/// A raw scan from its files (module doc): the pose log read by the
+/// import's readers, each pose paired with its profile, the profiles put
+/// in the laser plane by the axis map (given, or guessed from all of
+/// them). No point is dropped but NaN, infinite and no-return ones.
+///
+/// # Errors
+/// [`ImportError`] naming the file and the line or pose: an unreadable
+/// log or profile, a missing column, a reading that is not a number, a
+/// pose without a profile, an axis map that puts points off the plane.
+pub fn scan_from_files(spec: &ScanFiles) -> Result<Scan, ImportError> {
+    let mut notes = Vec::new();
+    let log = match &spec.log {
+        ScanLog::Joints {
+            path,
+            columns,
+            unit,
+        } => joint_log(path, columns, *unit)?,
+        ScanLog::Poses {
+            path,
+            format,
+            convention,
+            columns,
+        } => {
+            let (records, read_notes) = crate::engine::files::import::poses::read_pose_log(
+                path,
+                *format,
+                *convention,
+                columns.as_deref(),
+            )?;
+            notes.extend(read_notes);
+            records
+                .into_iter()
+                .map(|r| LogPose {
+                    id: r.id,
+                    station: r.station,
+                    usage: r.usage,
+                    placement: match r.value {
+                        PoseValue::Flange(pose) => Placement::Flange(pose),
+                        PoseValue::Joints(q) => Placement::Joints(q),
+                    },
+                })
+                .collect()
+        }
+    };
+    let (ids, raws) = pair_profiles(spec, &log, &mut notes)?;
+    let (axes, guessed) = match spec.profile_format.axes {
+        Some(m) => (m, false),
+        None => (
+            AxisMap::guess(&raws).map_err(|message| ImportError::File {
+                path: raws.first().map_or_else(PathBuf::new, |r| r.source.clone()),
+                message,
+            })?,
+            true,
+        ),
+    };
+    let mut poses = Vec::with_capacity(log.len());
+    for ((pose, id), raw) in log.into_iter().zip(ids).zip(raws) {
+        let plane = raw.to_plane(&axes)?;
+        drop(raw);
+        poses.push(ScanPose {
+            id,
+            station: pose.station,
+            usage: pose.usage,
+            placement: pose.placement,
+            points: plane.points,
+            dropped: Dropped {
+                non_finite: plane.non_finite,
+                no_return: plane.no_return,
+            },
+        });
+    }
+    let name = spec
+        .log
+        .path()
+        .file_name()
+        .map_or_else(|| "scan".to_string(), |n| n.to_string_lossy().into_owned());
+    Ok(Scan {
+        name,
+        robot: spec.robot.clone(),
+        sphere_diameter: spec.sphere_diameter,
+        reference_distances: match &spec.references {
+            Some(path) => read_references(path)?,
+            None => Vec::new(),
+        },
+        poses,
+        skipped: Vec::new(),
+        notes: {
+            notes.push(format!(
+                "profiles: axis map {axes} ({}{})",
+                axes.describe(),
+                if guessed {
+                    ", guessed: the constant coordinate is the plane's normal"
+                } else {
+                    ""
+                }
+            ));
+            notes
+        },
+    })
+}
+
+/// The poses of a raw scan's joint log: `id` and the joint columns
+/// required, `station` and `use` read when the log has them.
+fn joint_log(
+    path: &Path,
+    columns: &ScanColumns,
+    unit: AngleUnit,
+) -> Result<Vec<LogPose>, ImportError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ImportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let table = Table::parse(&text).map_err(|e| ImportError::Csv {
+        path: path.to_path_buf(),
+        line: e.line,
+        message: e.message,
+    })?;
+    let file_error = |message: String| ImportError::File {
+        path: path.to_path_buf(),
+        message,
+    };
+    let column = |name: &str| {
+        table
+            .column(name)
+            .ok_or_else(|| file_error(table.no_column(name)))
+    };
+    let id = column(&columns.id)?;
+    let joints: Vec<usize> = columns
+        .joints
+        .iter()
+        .map(|c| column(c))
+        .collect::<Result<_, _>>()?;
+    let station = table.column(&columns.station);
+    let usage = table.column(&columns.usage);
+    if table.rows.is_empty() {
+        return Err(file_error(
+            "the joint log has a header but no pose rows".into(),
+        ));
+    }
+    let mut raw_rows: Vec<(usize, String, Vec<f64>)> = Vec::with_capacity(table.rows.len());
+    let mut out = Vec::with_capacity(table.rows.len());
+    let mut seen: HashMap<String, usize> = HashMap::new();
+    for (line, row) in &table.rows {
+        let csv_error = |message: String| ImportError::Csv {
+            path: path.to_path_buf(),
+            line: *line,
+            message,
+        };
+        let pose_id = row[id].clone();
+        if let Some(first) = seen.insert(pose_id.clone(), *line) {
+            return Err(csv_error(format!(
+                "pose id `{pose_id}` is used twice (first at line {first})"
+            )));
+        }
+        let raw: Vec<f64> = joints
+            .iter()
+            .map(|&c| match row[c].parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(csv_error(format!(
+                    "pose {pose_id}: column `{}`: `{}` is not a finite number",
+                    table.header[c], row[c]
+                ))),
+            })
+            .collect::<Result<_, _>>()?;
+        let usage = match usage.map(|c| row[c].as_str()) {
+            None | Some("") => None,
+            Some(text) => Some(Use::parse(text).ok_or_else(|| {
+                csv_error(format!(
+                    "pose {pose_id}: `{text}` is not translation, rotation, identify or validate"
+                ))
+            })?),
+        };
+        out.push(LogPose {
+            id: Some(pose_id.clone()),
+            station: station.map(|c| row[c].clone()).filter(|s| !s.is_empty()),
+            usage,
+            placement: Placement::Joints(raw.iter().map(|&v| unit.to_deg(v)).collect()),
+        });
+        raw_rows.push((*line, pose_id, raw));
+    }
+    units::check_joint_unit(
+        unit,
+        raw_rows
+            .iter()
+            .map(|(line, id, raw)| (*line, id.as_str(), raw.as_slice())),
+    )
+    .map_err(|(line, message)| ImportError::Csv {
+        path: path.to_path_buf(),
+        line,
+        message,
+    })?;
+    Ok(out)
+}
+
+/// Each pose's raw profile and id: by id (`<id>.<ext>` in the folder, or
+/// the id's rows of one CSV) when the log has ids, else the folder's
+/// profile files in natural order, one a pose, ids from the file names.
+fn pair_profiles(
+    spec: &ScanFiles,
+    log: &[LogPose],
+    notes: &mut Vec<String>,
+) -> Result<(Vec<String>, Vec<RawProfile>), ImportError> {
+    let named = match &spec.profiles {
+        ProfileSource::Folder(dir) => log.iter().all(|p| {
+            p.id.as_ref()
+                .is_some_and(|id| profiles::file_of(dir, id).is_some())
+        }),
+        ProfileSource::File { .. } => log.iter().all(|p| p.id.is_some()),
+    };
+    if named {
+        let ids: Vec<String> = log.iter().filter_map(|p| p.id.clone()).collect();
+        let raws = match &spec.profiles {
+            ProfileSource::Folder(dir) => ids
+                .iter()
+                .map(|id| {
+                    let file =
+                        profiles::file_of(dir, id).ok_or_else(|| ImportError::MissingProfile {
+                            id: id.clone(),
+                            path: dir.join(format!("{id}.csv")),
+                        })?;
+                    profiles::read_profile(&file, &spec.profile_format)
+                })
+                .collect::<Result<Vec<_>, _>>()?,
+            ProfileSource::File { path, pose_column } => {
+                let (_, mut by_id) =
+                    profiles::read_profile_table(path, pose_column, &spec.profile_format)?;
+                ids.iter()
+                    .map(|id| {
+                        by_id.remove(id).ok_or_else(|| ImportError::MissingProfile {
+                            id: id.clone(),
+                            path: path.clone(),
+                        })
+                    })
+                    .collect::<Result<Vec<_>, _>>()?
+            }
+        };
+        return Ok((ids, raws));
+    }
+    let raws: Vec<RawProfile> = match &spec.profiles {
+        ProfileSource::Folder(dir) => {
+            // The folder as published: the pose file and other files
+            // skipped, the profiles in the order of their number.
+            let listing = list_profiles(dir, &[spec.log.path()], Some(log.len()))?;
+            notes.push(listing.summary());
+            if listing.profiles.len() != log.len() {
+                return Err(ImportError::File {
+                    path: dir.clone(),
+                    message: format!(
+                        "{} profiles for {} poses of {}: a log without ids pairs pose k with the k-th profile in the order of the number in their names, so the counts must match",
+                        listing.profiles.len(),
+                        log.len(),
+                        spec.log.path().display()
+                    ),
+                });
+            }
+            listing
+                .profiles
+                .iter()
+                .map(|p| profiles::read_profile(p, &spec.profile_format))
+                .collect::<Result<_, _>>()?
+        }
+        ProfileSource::File { path, pose_column } => {
+            let (order, mut by_id) =
+                profiles::read_profile_table(path, pose_column, &spec.profile_format)?;
+            if order.len() != log.len() {
+                return Err(ImportError::File {
+                    path: path.clone(),
+                    message: format!(
+                        "{} profiles for {} poses of {}: a log without ids pairs pose k with the k-th profile, so the counts must match",
+                        order.len(),
+                        log.len(),
+                        spec.log.path().display()
+                    ),
+                });
+            }
+            order.iter().filter_map(|id| by_id.remove(id)).collect()
+        }
+    };
+    let ids = raws
+        .iter()
+        .map(|r| {
+            r.source
+                .file_stem()
+                .map_or_else(|| "pose".into(), |s| s.to_string_lossy().into_owned())
+        })
+        .collect();
+    Ok((ids, raws))
+}
