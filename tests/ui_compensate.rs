@@ -5,7 +5,8 @@
 //! file written is byte-identical to what `spherecal compensate` and the
 //! engine give for the same inputs; a new calibration marks it stale and
 //! writing is refused; an unreachable target is an error naming it and
-//! nothing is written. egui_kittest, no display.
+//! nothing is written; a cancelled job shows nothing. egui_kittest, no
+//! display.
 
 #![cfg(feature = "gui")]
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
@@ -51,7 +52,14 @@ fn calibrated() -> (Harness<'static, WorkbenchApp>, ResultFile) {
     let mut h = demo_app();
     h.get_by_label("▶ Run").click();
     settle(&mut h);
-    let result = h.state().state().result.as_ref().expect("a result").file.clone();
+    let result = h
+        .state()
+        .state()
+        .result
+        .as_ref()
+        .expect("a result")
+        .file
+        .clone();
     assert!(
         !result.pose_joints.is_empty(),
         "a run records the joints of its poses"
@@ -170,13 +178,18 @@ fn targets_are_compensated_largest_first_flagged_written_and_refused_when_stale(
     let far = view.rows.iter().find(|r| r.name == "FAR").unwrap();
     assert_eq!(far.line, 4);
     assert!(
-        far.flags.iter().any(|f| f.contains("from every identify pose")),
+        far.flags
+            .iter()
+            .any(|f| f.contains("from every identify pose")),
         "{far:?}"
     );
     assert_eq!(view.flagged, 1);
     assert!(
-        view.summary.starts_with("5 targets compensated: largest correction")
-            && view.summary.contains("; 1 flagged outside what the calibration saw"),
+        view.summary
+            .starts_with("5 targets compensated: largest correction")
+            && view
+                .summary
+                .contains("; 1 flagged outside what the calibration saw"),
         "{}",
         view.summary
     );
@@ -257,7 +270,7 @@ fn targets_are_compensated_largest_first_flagged_written_and_refused_when_stale(
     settle(&mut h);
     assert_ne!(std::fs::read_to_string(&out).unwrap(), "old\n");
 
-    // Editing the targets file's path marks it stale too.
+    // Another pose convention marks it stale too, saying which.
     h.state_mut().forms_mut().compensate.convention = Some(FlangeConvention::KukaAbc);
     h.run();
     assert!(!labels_with(&h, "pose convention abb → kuka").is_empty());
@@ -271,6 +284,22 @@ fn an_unreachable_target_is_an_error_naming_it_and_nothing_is_written() {
     let mut text = table(&targets(&result));
     text.push_str("GONE,5000,0,500,1,0,0,0\n");
     std::fs::write(&t_csv, text).unwrap();
+
+    // Cancel wins: the job's outcome, arriving after the Cancel, is not
+    // shown.
+    let form = &mut h.state_mut().forms_mut().compensate;
+    form.targets = t_csv.display().to_string();
+    form.convention = Some(FlangeConvention::AbbQuaternion);
+    command(&mut h, Command::Compensate(CompensateCommand::Run));
+    command(&mut h, Command::Compensate(CompensateCommand::Cancel));
+    for _ in 0..40 {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        h.step();
+    }
+    settle(&mut h);
+    assert!(h.state().state().compensate.outcome.is_none());
+    assert!(ui_support::status(&h).contains("compensation cancelled"));
+
     compensate_in_view(&mut h, &t_csv);
     let error = match &h.state().state().compensate.outcome {
         Some(Err(e)) => e.clone(),

@@ -192,7 +192,10 @@ impl Core {
                 Input::Calibration,
                 self.state.provenance.reading(Input::Calibration),
             )
-            .with(Input::Targets, self.state.provenance.reading(Input::Targets));
+            .with(
+                Input::Targets,
+                self.state.provenance.reading(Input::Targets),
+            );
         let job = self.state.compensate.job + 1;
         let cancel = Arc::new(AtomicBool::new(false));
         let flag = Arc::clone(&cancel);
@@ -221,7 +224,9 @@ impl Core {
 
     /// The compensated text and its stamp when it may be written; `None`
     /// (with the reason in a notice) when it is stale, failed or not made.
-    fn compensation_to_write(&mut self) -> Option<(String, PathBuf, crate::app::provenance::Stamp)> {
+    fn compensation_to_write(
+        &mut self,
+    ) -> Option<(String, PathBuf, crate::app::provenance::Stamp)> {
         let refuse = |state: &mut crate::app::state::AppState, why: String| {
             state.say(Level::Warning, format!("{WRITTEN_WHAT} not written: {why}"));
             state.notice = Some(Notice {
@@ -245,7 +250,10 @@ impl Core {
             }
         };
         if let Err(why) = self.state.provenance.check(Output::Compensation) {
-            refuse(&mut self.state, format!("{why}: press Compensate targets again"));
+            refuse(
+                &mut self.state,
+                format!("{why}: press Compensate targets again"),
+            );
             return None;
         }
         let stamp = self.state.provenance.made(Output::Compensation).cloned()?;
@@ -350,6 +358,14 @@ impl Core {
                             Level::Info
                         };
                         self.state.say(level, view.summary.clone());
+                        // Where the compensated file goes by default:
+                        // beside the targets.
+                        if self.forms.compensate.out.trim().is_empty()
+                            && let Some(dir) = view.targets.parent()
+                        {
+                            self.forms.compensate.out =
+                                dir.join(view.default_file_name()).display().to_string();
+                        }
                         self.state.compensate.outcome = Some(Ok(*view));
                     }
                     Err(e) => {

@@ -275,10 +275,15 @@ impl Core {
                     dialog.add_filter("CSV", &["csv", "txt"]).pick_file()
                 }
                 DialogPurpose::CompensateTargets => dialog
-                    .add_filter("pose table or robot program", super::compensate::TARGET_EXTENSIONS)
+                    .add_filter(
+                        "pose table or robot program",
+                        super::compensate::TARGET_EXTENSIONS,
+                    )
                     .add_filter("all files", &["*"])
                     .pick_file(),
-                DialogPurpose::CompensateTool => dialog.add_filter("tool (JSON)", &["json"]).pick_file(),
+                DialogPurpose::CompensateTool => {
+                    dialog.add_filter("tool (JSON)", &["json"]).pick_file()
+                }
                 DialogPurpose::CompensateOut => match compensated_name {
                     Some(n) => dialog.set_file_name(n),
                     None => dialog,

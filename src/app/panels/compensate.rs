@@ -10,7 +10,7 @@
 use egui::RichText;
 
 use super::{BAD, MUTED, WARN, dialog_note_ui, labelled_field, stale_banner_ui};
-use crate::app::commands::{CompensateCommand, Command, FilesCommand};
+use crate::app::commands::{Command, CompensateCommand, FilesCommand};
 use crate::app::forms::Forms;
 use crate::app::forms::compensate::{CompensateForm, TcpChoice};
 use crate::app::provenance::Output;
@@ -38,7 +38,7 @@ pub fn compensate_ui(
         .id_salt("compensate_scroll")
         .auto_shrink([false, false])
         .show(ui, |ui| {
-            ui.label(RichText::new("Compensate targets through the calibration").strong());
+            ui.heading("Compensate targets through the calibration");
             ui.label(
                 RichText::new(
                     "The controller runs its nominal kinematics: each target (the TCP pose wanted, base frame) \
@@ -92,10 +92,8 @@ fn inputs_ui(
                         DialogPurpose::CompensateTargets,
                     )));
                 }
+                dialog_note_ui(ui, state, &[DialogPurpose::CompensateTargets]);
             });
-            ui.end_row();
-            ui.label("");
-            dialog_note_ui(ui, state, &[DialogPurpose::CompensateTargets]);
             ui.end_row();
 
             let l = ui.label("Pose convention");
@@ -201,12 +199,18 @@ fn outcome_ui(
     match &state.compensate.outcome {
         None => {
             ui.label(
-                RichText::new("No compensation yet: choose a targets file and press Compensate targets.")
-                    .color(MUTED),
+                RichText::new(
+                    "No compensation yet: choose a targets file and press Compensate targets.",
+                )
+                .color(MUTED),
             );
         }
         Some(Err(e)) => {
-            ui.label(RichText::new("Not compensated (nothing can be written)").strong().color(BAD));
+            ui.label(
+                RichText::new("Not compensated (nothing can be written)")
+                    .strong()
+                    .color(BAD),
+            );
             ui.add(egui::Label::new(RichText::new(e).color(BAD)).wrap());
         }
         Some(Ok(view)) => {
@@ -224,7 +228,10 @@ fn outcome_ui(
                 ui.label(RichText::new(format!("warning: {w}")).small().color(WARN));
             }
             for n in &view.notes {
-                ui.add(egui::Label::new(RichText::new(format!("note: {n}")).small().color(MUTED)).wrap());
+                ui.add(
+                    egui::Label::new(RichText::new(format!("note: {n}")).small().color(MUTED))
+                        .wrap(),
+                );
             }
             tool_data_ui(ui, view);
             ui.add_space(4.0);
@@ -344,17 +351,17 @@ fn table_ui(ui: &mut egui::Ui, rows: &[TargetRow]) {
         .num_columns(8)
         .spacing([14.0, 3.0])
         .show(ui, |ui| {
-            for h in [
-                "target",
-                "line",
-                "correction mm",
-                "correction °",
-                "Δq max °",
-                "σ mm (1σ)",
-                "nearest pose °",
-                "flag",
+            for (h, hover) in [
+                ("target", "its name in the file"),
+                ("line", "its line in the file"),
+                ("correction mm", "how far the pose to command is from the target (TCP position)"),
+                ("correction °", "the rotation between the pose to command and the target"),
+                ("Δq max °", "the largest joint change between the nominal and the calibrated solution"),
+                ("σ mm (1σ)", "the predicted 1σ residual of the TCP position after compensation (ml's covariance)"),
+                ("nearest pose °", "joint-space distance to the nearest identify pose"),
+                ("flag", "why a target lies outside what the calibration saw (compensated and written all the same)"),
             ] {
-                ui.label(RichText::new(h).strong());
+                ui.label(RichText::new(h).strong()).on_hover_text(hover);
             }
             ui.end_row();
             for r in &rows[..shown] {
