@@ -6,7 +6,7 @@
 
 use std::path::PathBuf;
 
-use crate::engine::compensate::{Compensation, Model, Tcp, tool};
+use crate::engine::compensate::{Compensation, Model, Tcp, report};
 use crate::engine::program::PoseFile;
 use crate::engine::robot::controller::FlangeConvention;
 
@@ -81,28 +81,9 @@ impl CompensationView {
         model: &Model,
         convention: Option<FlangeConvention>,
     ) -> Self {
-        let file_line = format!(
-            "{} {}: {} ({})",
-            file.format.describe(),
-            file.path.display(),
-            file.order_note,
-            if file.detected {
-                "layout detected"
-            } else {
-                "layout given"
-            }
-        );
+        let file_line = report::file_line(file);
         let tool_data = if model.tcp == Tcp::Sensor {
-            let controllers: Vec<tool::Controller> = match file
-                .format
-                .convention()
-                .or(convention)
-                .map(tool::Controller::of)
-            {
-                Some(Some(c)) => vec![c],
-                _ => tool::Controller::ALL.to_vec(),
-            };
-            controllers
+            report::tool_controllers(file, convention)
                 .into_iter()
                 .map(|c| {
                     (
