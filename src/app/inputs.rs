@@ -211,6 +211,7 @@ fn file_stamp(path: &str) -> Option<(u64, std::time::SystemTime)> {
 #[must_use]
 pub fn targets(f: &CompensateForm) -> Reading {
     let tcp = match f.tcp {
+        TcpChoice::ToolFile if f.tool.trim().is_empty() => "tool file (none chosen)".to_string(),
         TcpChoice::ToolFile => format!("tool {}", f.tool.trim()),
         other => other.key().to_string(),
     };

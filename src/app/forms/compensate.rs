@@ -33,7 +33,8 @@ impl TcpChoice {
         }
     }
 
-    /// The command line's `--tcp` spelling (a tool file: its path).
+    /// The command line's `--tcp` spelling; a tool file is given there
+    /// by its path, here in words ("tool file").
     #[must_use]
     pub fn key(self) -> &'static str {
         match self {

@@ -97,8 +97,8 @@ pub enum Tab {
 
 impl Tab {
     /// All tabs, in the order of the job: plan the poses, bring the data
-    /// in, check the stripes and centres, calibrate and validate, follow
-    /// the cell over time.
+    /// in, check the stripes and centres, calibrate and validate,
+    /// compensate the robot's targets, follow the cell over time.
     pub const ALL: [Self; 8] = [
         Self::Plan,
         Self::Import,
@@ -106,8 +106,8 @@ impl Tab {
         Self::Stripe,
         Self::Centres,
         Self::Results,
-        Self::History,
         Self::Compensate,
+        Self::History,
     ];
 
     /// The tab's title.
