@@ -65,12 +65,13 @@ fn every_path_readme_names_exists() {
 
 #[test]
 fn the_scan_finds_a_missing_path() {
-    let text = "| eq. 21 | `src/engine/stripe/segment.rs` (`find_arc`) |\n![x](assets/none.png)";
+    let text =
+        "| eq. 21 | `src/engine/calibrate/stripe/segment.rs` (`find_arc`) |\n![x](assets/none.png)";
     let found = readme_paths(text);
     assert_eq!(
         found,
         [
-            (1, "src/engine/stripe/segment.rs".to_string()),
+            (1, "src/engine/calibrate/stripe/segment.rs".to_string()),
             (2, "assets/none.png".to_string())
         ]
     );

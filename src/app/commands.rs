@@ -25,6 +25,8 @@ pub enum Command {
     History(HistoryCommand),
     /// The pose planner.
     Plan(PlanCommand),
+    /// The Compensate view.
+    Compensate(CompensateCommand),
 }
 
 /// Opening and saving files.
@@ -133,4 +135,16 @@ pub enum PlanCommand {
     /// After a FAIL: open the Plan view set for the open session's robot
     /// with more identify stations than the session has.
     MoreStations,
+}
+
+/// The Compensate view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CompensateCommand {
+    /// Compensate the form's targets file through the result on show.
+    Run,
+    /// Stop the compensation job (what it sends later is dropped).
+    Cancel,
+    /// Write the compensated file to the form's output path (refused when
+    /// the compensation is stale or the targets had errors).
+    Write,
 }

@@ -9,6 +9,7 @@ use std::collections::BTreeSet;
 
 use nalgebra::Isometry3;
 
+use super::forms::compensate::{CompensateForm, TcpChoice};
 use super::forms::{Forms, PlanForm, SolverForm};
 use super::provenance::{Input, Reading};
 use super::state::AppState;
@@ -31,6 +32,8 @@ pub fn readings(state: &AppState, forms: &Forms) -> Vec<(Input, Reading)> {
             plan_form(&forms.plan, plan_hand_eye(state)),
         ),
         (Input::Tolerance, tolerance(&forms.tolerance)),
+        (Input::Calibration, calibration(state)),
+        (Input::Targets, targets(&forms.compensate)),
     ]
 }
 
@@ -162,4 +165,71 @@ pub fn tolerance(t: &Tolerance) -> Reading {
         ],
         (t.std_mm.to_bits(), t.max_mm.to_bits()),
     )
+}
+
+/// The calibration result on show: which one (the how-many-th shown in
+/// this window, where it came from, its method); a new run or a result
+/// opened reads otherwise even with the same numbers.
+#[must_use]
+pub fn calibration(state: &AppState) -> Reading {
+    let text = match &state.result {
+        None => "none".to_string(),
+        Some(r) => match &r.origin {
+            super::view::ResultOrigin::Run { .. } => {
+                format!("run #{} ({})", state.results_shown, r.method)
+            }
+            super::view::ResultOrigin::Review(p) => format!(
+                "{} (#{}, {})",
+                p.file_name().map_or_else(
+                    || p.display().to_string(),
+                    |n| n.to_string_lossy().into_owned()
+                ),
+                state.results_shown,
+                r.method
+            ),
+        },
+    };
+    Reading::new(
+        vec![("result".into(), text)],
+        (state.result.is_some(), state.results_shown),
+    )
+}
+
+/// Size and modification time of a file, when it can be read: a file
+/// rewritten in place reads otherwise.
+fn file_stamp(path: &str) -> Option<(u64, std::time::SystemTime)> {
+    let path = path.trim();
+    if path.is_empty() {
+        return None;
+    }
+    let m = std::fs::metadata(path).ok()?;
+    Some((m.len(), m.modified().ok()?))
+}
+
+/// The Compensate view's targets file and options: the fields it shows,
+/// and (unseen) the size and time of the targets and tool files.
+#[must_use]
+pub fn targets(f: &CompensateForm) -> Reading {
+    let tcp = match f.tcp {
+        TcpChoice::ToolFile if f.tool.trim().is_empty() => "tool file (none chosen)".to_string(),
+        TcpChoice::ToolFile => format!("tool {}", f.tool.trim()),
+        other => other.key().to_string(),
+    };
+    let fields = vec![
+        (
+            "file".into(),
+            if f.targets.trim().is_empty() {
+                "none".to_string()
+            } else {
+                f.targets.trim().to_string()
+            },
+        ),
+        (
+            "pose convention".into(),
+            CompensateForm::convention_label(f.convention),
+        ),
+        ("TCP".into(), tcp),
+    ];
+    let tool = (f.tcp == TcpChoice::ToolFile).then(|| file_stamp(&f.tool));
+    Reading::new(fields, (file_stamp(&f.targets), tool))
 }

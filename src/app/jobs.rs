@@ -16,6 +16,7 @@ use super::forms::ImportForm;
 use super::provenance::Stamp;
 use super::state::{DialogPurpose, ExportKind, LoadedSession, PlanExport, PlanOutcome};
 use super::view::ResultView;
+use super::view::compensate::CompensationView;
 
 /// Messages a job may have in flight before it waits for the UI to drain
 /// them: far more than a run's ε reports (one per update), so the solver
@@ -46,6 +47,8 @@ pub enum JobMessage {
     History(HistoryMessage),
     /// The pose planner.
     Plan(PlanMessage),
+    /// The Compensate view.
+    Compensate(CompensateMessage),
 }
 
 /// What the file jobs report.
@@ -226,6 +229,36 @@ pub enum PlanMessage {
     },
     /// A session simulated from the plan, or why not.
     Simulated(Result<Box<LoadedSession>, JobError>),
+}
+
+/// What the Compensate view's jobs report, each with the number of its
+/// job (a cancelled job's messages are dropped).
+#[derive(Debug)]
+pub enum CompensateMessage {
+    /// Another target is done, in words.
+    Progress {
+        /// Which job.
+        job: u64,
+        /// "target P[7]: 12 of 40".
+        text: String,
+    },
+    /// The compensation, or why there is none (naming the target or the
+    /// file).
+    Finished {
+        /// Which job.
+        job: u64,
+        /// The view of it, or the message.
+        outcome: Result<Box<CompensationView>, String>,
+    },
+    /// The compensated file was written, or why not.
+    Written {
+        /// Target file.
+        path: PathBuf,
+        /// Success or why not.
+        outcome: Result<(), JobError>,
+        /// The inputs of the compensation it was written from.
+        stamp: Stamp,
+    },
 }
 
 /// The sending end handed to a job.

@@ -52,16 +52,24 @@ pub enum Input {
     PlanForm,
     /// The acceptance tolerance of the verdict.
     Tolerance,
+    /// The calibration result on show (a new run, a result opened, or
+    /// none).
+    Calibration,
+    /// The Compensate view's targets file (its path, size and time) and
+    /// options (pose convention, TCP).
+    Targets,
 }
 
 impl Input {
     /// Every input, in the order of the job.
-    pub const ALL: [Self; 5] = [
+    pub const ALL: [Self; 7] = [
         Self::PlanForm,
         Self::Session,
         Self::LeftOut,
         Self::Solver,
         Self::Tolerance,
+        Self::Calibration,
+        Self::Targets,
     ];
 
     /// Its name in a sentence: "the Plan form changed".
@@ -73,6 +81,8 @@ impl Input {
             Self::Solver => "the solver settings",
             Self::PlanForm => "the Plan form",
             Self::Tolerance => "the tolerance",
+            Self::Calibration => "the calibration result",
+            Self::Targets => "the targets",
         }
     }
 }
@@ -134,6 +144,9 @@ pub enum Output {
     Result,
     /// The HTML report written of the result on show.
     Report,
+    /// The Compensate view's compensated targets (and the program
+    /// written of them).
+    Compensation,
 }
 
 impl Output {
@@ -149,6 +162,13 @@ impl Output {
                 Input::Solver,
                 Input::Tolerance,
             ],
+            Self::Compensation => &[
+                Input::Session,
+                Input::LeftOut,
+                Input::Solver,
+                Input::Calibration,
+                Input::Targets,
+            ],
         }
     }
 
@@ -159,6 +179,7 @@ impl Output {
             Self::Plan => "the plan",
             Self::Result => "the result",
             Self::Report => "the report",
+            Self::Compensation => "the compensation",
         }
     }
 }

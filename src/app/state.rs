@@ -23,6 +23,7 @@ use crate::engine::tools::result_view::Tolerance;
 
 use super::forms::{Forms, Grouping};
 use super::provenance::{Provenance, Stamp};
+use super::view::compensate::CompensationView;
 use super::view::{CentreSet, ResultView};
 
 /// How many recent files the start list keeps.
@@ -243,6 +244,12 @@ pub enum DialogPurpose {
     ImportReferences,
     /// History: the library folder.
     HistoryFolder,
+    /// Compensate: the targets file (a pose table or a robot program).
+    CompensateTargets,
+    /// Compensate: the tool file (`flange_from_tcp`).
+    CompensateTool,
+    /// Compensate: where the compensated file goes.
+    CompensateOut,
 }
 
 /// What the Plan view writes.
@@ -507,6 +514,11 @@ pub struct AppState {
     /// The operator has been shown the outliers of the result on show
     /// (after a FAIL the next step is then the planner).
     pub outliers_seen: bool,
+    /// Results shown so far (a run's or a file's): each new one is
+    /// another calibration for what was derived from the last.
+    pub results_shown: u64,
+    /// The Compensate view's job and its outcome.
+    pub compensate: CompensateState,
 }
 
 impl AppState {
@@ -532,6 +544,7 @@ impl AppState {
             || self.history.drifting
             || self.plan.cancel.is_some()
             || self.plan.writing > 0
+            || self.compensate.is_busy()
     }
 
     /// Indices of the measurements the session table shows, in its order
@@ -594,5 +607,33 @@ impl AppState {
                 .filter(|m| self.excluded.contains(&m.id))
                 .count()
         })
+    }
+}
+
+/// The Compensate view's job and what it shows.
+#[derive(Debug, Default)]
+pub struct CompensateState {
+    /// The job's last progress, in words, while it runs.
+    pub progress: Option<String>,
+    /// Set to stop the job; `Some` while it runs.
+    pub cancel: Option<Arc<AtomicBool>>,
+    /// The number of the latest job (a message of another is dropped).
+    pub job: u64,
+    /// The inputs the job in flight started from.
+    pub pending: Option<Stamp>,
+    /// The last compensation, or why there is none (an unreachable
+    /// target named, a file that cannot be read).
+    pub outcome: Option<Result<CompensationView, String>>,
+    /// Compensated files being written.
+    pub writing: usize,
+    /// The last file written.
+    pub written: Option<PathBuf>,
+}
+
+impl CompensateState {
+    /// A job or a write is in flight.
+    #[must_use]
+    pub fn is_busy(&self) -> bool {
+        self.cancel.is_some() || self.writing > 0
     }
 }

@@ -4,6 +4,8 @@
 //! [`result_view`](crate::engine::tools::result_view), and the [`CentreSet`] of
 //! the centres view. The `*_ui` functions only draw them.
 
+pub mod compensate;
+
 use std::collections::HashMap;
 use std::path::PathBuf;
 

@@ -174,6 +174,9 @@ impl WorkbenchApp {
                 Tab::Import => panels::import::import_ui(ui, state, forms, &mut commands),
                 Tab::Plan => panels::plan::plan_ui(ui, state, forms, &mut commands),
                 Tab::History => panels::history::history_ui(ui, state, forms, &mut commands),
+                Tab::Compensate => {
+                    panels::compensate::compensate_ui(ui, state, forms, &mut commands);
+                }
             }
         });
         panels::drop_overlay_ui(&ctx);

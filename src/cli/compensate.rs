@@ -158,32 +158,13 @@ pub fn run(args: &CompensateArgs) -> Result<(), CliError> {
     if args.quiet {
         return Ok(());
     }
-    sayln!(
-        "{} {}: {} ({})",
-        file.format.describe(),
-        args.targets.display(),
-        file.order_note,
-        if file.detected {
-            "layout detected"
-        } else {
-            "layout given"
-        }
-    );
+    sayln!("{}", report::file_line(&file));
     for w in &file.warnings {
         sayln!("  warning: {w}");
     }
     sayln!("TCP: {}", model.tcp.describe());
     if model.tcp == Tcp::Sensor {
-        let controllers: Vec<tool::Controller> = match file
-            .format
-            .convention()
-            .or(args.pose_convention)
-            .map(tool::Controller::of)
-        {
-            Some(Some(c)) => vec![c],
-            _ => tool::Controller::ALL.to_vec(),
-        };
-        for c in controllers {
+        for c in report::tool_controllers(&file, args.pose_convention) {
             sayln!("tool data to set on the controller ({}):", c.describe());
             for line in c.tool_data(&model.tool, "tSpherecal").lines() {
                 sayln!("  {line}");

@@ -245,6 +245,7 @@ impl Core {
         let file_name = Path::new(self.forms.save_path.trim())
             .file_name()
             .map(|n| n.to_string_lossy().into_owned());
+        let compensated_name = self.compensated_file_name();
         let started = self.spawn(ctx, "file-dialog", move |rep| {
             let mut dialog = rfd::FileDialog::new();
             if let Some(dir) = folder.filter(|d| d.is_dir()) {
@@ -273,6 +274,21 @@ impl Core {
                 DialogPurpose::ImportProfiles => {
                     dialog.add_filter("CSV", &["csv", "txt"]).pick_file()
                 }
+                DialogPurpose::CompensateTargets => dialog
+                    .add_filter(
+                        "pose table or robot program",
+                        super::compensate::TARGET_EXTENSIONS,
+                    )
+                    .add_filter("all files", &["*"])
+                    .pick_file(),
+                DialogPurpose::CompensateTool => {
+                    dialog.add_filter("tool (JSON)", &["json"]).pick_file()
+                }
+                DialogPurpose::CompensateOut => match compensated_name {
+                    Some(n) => dialog.set_file_name(n),
+                    None => dialog,
+                }
+                .save_file(),
             };
             rep.send(JobMessage::Files(FilesMessage::Dialog { purpose, path }));
         });
@@ -335,6 +351,7 @@ impl Core {
                 let notes = view.notes.join("; ");
                 self.forms.centres.magnify = view.centres.suggested_magnify;
                 self.state.result = Some(*view);
+                self.state.results_shown += 1;
                 self.state.reported = None;
                 self.state.result_unseen = false;
                 self.state.outliers_seen = false;
@@ -436,6 +453,9 @@ impl Core {
                 self.forms.history.folder = path.display().to_string();
                 self.history_scan(ctx);
             }
+            DialogPurpose::CompensateTargets
+            | DialogPurpose::CompensateTool
+            | DialogPurpose::CompensateOut => self.compensate_dialog(ctx, purpose, path),
         }
     }
 

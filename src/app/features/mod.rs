@@ -13,9 +13,11 @@
 //! | [`import`] | preview, import | the import wizard's engine calls |
 //! | [`history`] | scan, drift | scan a library folder |
 //! | [`plan`] | plan, cancel, export, simulate | the pose planner and its prediction |
+//! | [`compensate`] | compensate, cancel, write | targets and programs through the result on show |
 //!
 //! [`Core`] holds what they share: the state, the forms and the job runner.
 
+pub mod compensate;
 pub mod export;
 pub mod files;
 pub mod history;
@@ -78,6 +80,7 @@ impl Core {
             Command::Import(c) => self.import(ctx, c),
             Command::History(c) => self.history(ctx, c),
             Command::Plan(c) => self.plan(ctx, c),
+            Command::Compensate(c) => self.compensate(ctx, c),
         }
     }
 
@@ -90,6 +93,7 @@ impl Core {
             JobMessage::Import(m) => self.on_import(ctx, m),
             JobMessage::History(m) => self.on_history(ctx, m),
             JobMessage::Plan(m) => self.on_plan(ctx, m),
+            JobMessage::Compensate(m) => self.on_compensate(m),
         }
     }
 

@@ -181,6 +181,7 @@ impl Core {
                 }
                 self.forms.centres.magnify = view.centres.suggested_magnify;
                 self.state.result = Some(*view);
+                self.state.results_shown += 1;
                 self.state.reported = None;
                 self.state.outliers_seen = false;
                 self.state.provenance.record(Output::Result, run.stamp);

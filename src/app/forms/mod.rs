@@ -3,6 +3,7 @@
 //! import wizard, the History view and the Plan view. Nothing here runs a
 //! job; the features read these when a command comes.
 
+pub mod compensate;
 pub mod import;
 pub mod plan;
 
@@ -13,6 +14,7 @@ use crate::engine::base::session::{Session, Use};
 use crate::engine::calibrate::solve::paper::{DEFAULT_SVD_TOLERANCE, Pairing, PaperOptions};
 use crate::engine::calibrate::solve::{Method, Options};
 use crate::engine::tools::history::DEFAULT_K;
+pub use compensate::CompensateForm;
 pub use import::{ImportForm, ProfilesKind};
 pub use plan::PlanForm;
 
@@ -89,19 +91,22 @@ pub enum Tab {
     History,
     /// The pose planner.
     Plan,
+    /// Targets and programs compensated through the result on show.
+    Compensate,
 }
 
 impl Tab {
     /// All tabs, in the order of the job: plan the poses, bring the data
-    /// in, check the stripes and centres, calibrate and validate, follow
-    /// the cell over time.
-    pub const ALL: [Self; 7] = [
+    /// in, check the stripes and centres, calibrate and validate,
+    /// compensate the robot's targets, follow the cell over time.
+    pub const ALL: [Self; 8] = [
         Self::Plan,
         Self::Import,
         Self::Session,
         Self::Stripe,
         Self::Centres,
         Self::Results,
+        Self::Compensate,
         Self::History,
     ];
 
@@ -116,6 +121,7 @@ impl Tab {
             Self::Import => "Import",
             Self::History => "History",
             Self::Plan => "Plan",
+            Self::Compensate => "Compensate",
         }
     }
 }
@@ -236,6 +242,8 @@ pub struct Forms {
     /// Scroll the Results view to its "after a FAIL" box once (set by
     /// Next's "Look at the outliers").
     pub focus_after_fail: bool,
+    /// The Compensate view's fields.
+    pub compensate: CompensateForm,
 }
 
 impl Default for Forms {
@@ -258,6 +266,7 @@ impl Default for Forms {
             plan: PlanForm::default(),
             tolerance: crate::engine::tools::result_view::Tolerance::default(),
             focus_after_fail: false,
+            compensate: CompensateForm::default(),
         }
     }
 }

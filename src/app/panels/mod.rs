@@ -3,6 +3,7 @@
 //! Shared widgets and colours live here.
 
 pub mod centres;
+pub mod compensate;
 pub mod history;
 pub mod import;
 pub mod plan;

@@ -5,6 +5,9 @@
 use std::fmt::Write as _;
 
 use super::TargetReport;
+use super::tool::Controller;
+use crate::engine::base::robot::controller::FlangeConvention;
+use crate::engine::files::program::PoseFile;
 
 /// Targets, largest correction, flagged.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -161,6 +164,34 @@ pub fn flagged(targets: &[TargetReport]) -> String {
         );
     }
     s
+}
+
+/// What the targets file is and how it was read, one line: "pose table
+/// T.csv: 8 poses in the order written (layout detected)".
+#[must_use]
+pub fn file_line(file: &PoseFile) -> String {
+    format!(
+        "{} {}: {} ({})",
+        file.format.describe(),
+        file.path.display(),
+        file.order_note,
+        if file.detected {
+            "layout detected"
+        } else {
+            "layout given"
+        }
+    )
+}
+
+/// The controllers whose tool data to show for `file`: its language's,
+/// else the one of the `convention` given for a table, else all four
+/// (a matrix table).
+#[must_use]
+pub fn tool_controllers(file: &PoseFile, convention: Option<FlangeConvention>) -> Vec<Controller> {
+    match file.format.convention().or(convention).map(Controller::of) {
+        Some(Some(c)) => vec![c],
+        _ => Controller::ALL.to_vec(),
+    }
 }
 
 /// `name` cut to `n` characters with `…`.

@@ -1,0 +1,399 @@
+//! The Compensate view's work: the targets of a pose table or a robot
+//! program compensated through the result on show, by the engine's
+//! [`compensate`](crate::engine::uses::compensate::compensate) as
+//! `spherecal compensate` runs it (same reading, same model, same
+//! default options), on a job thread with progress and Cancel; and the
+//! compensated file written atomically, refused when the compensation is
+//! stale or the targets had errors.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::engine::base::robot::controller::FlangeConvention;
+use crate::engine::base::session::Session;
+use crate::engine::calibrate::solve::Control;
+use crate::engine::files::format::{ResultFile, refuse_inputs, write_atomic};
+use crate::engine::files::program::{self, ReadSpec};
+use crate::engine::uses::compensate::{self, CompensateError, Model, Options, Tcp, tool};
+
+use super::Core;
+use crate::app::commands::CompensateCommand;
+use crate::app::forms::compensate::TcpChoice;
+use crate::app::jobs::{CompensateMessage, JobMessage};
+use crate::app::provenance::{Input, Output};
+use crate::app::state::{DialogPurpose, Level, Notice};
+use crate::app::view::compensate::CompensationView;
+
+/// The extensions the targets dialog offers: tables, JSON pose lists,
+/// RAPID modules, KUKA files, FANUC TP programs, URScript.
+pub const TARGET_EXTENSIONS: &[&str] = &[
+    "csv", "txt", "json", "rob", "mod", "modx", "prg", "src", "dat", "ls", "script", "urscript",
+];
+
+/// What "Write compensated program" calls the file it writes (status
+/// line, list of files written).
+pub const WRITTEN_WHAT: &str = "compensated program";
+
+/// Everything a compensation job needs, taken when it starts.
+#[derive(Debug, Clone)]
+pub struct CompensateRequest {
+    /// The result on show.
+    pub result: ResultFile,
+    /// The open session, for a result that does not record the joints of
+    /// its poses (`pose_joints`, older results): as `--session`.
+    pub session: Option<Session>,
+    /// The targets file.
+    pub targets: PathBuf,
+    /// A table's pose convention (`--pose-convention`).
+    pub convention: Option<FlangeConvention>,
+    /// The TCP (`--tcp`).
+    pub tcp: TcpChoice,
+    /// The tool file, for [`TcpChoice::ToolFile`].
+    pub tool: PathBuf,
+}
+
+/// Reads the targets, builds the model of the result and compensates
+/// every target, as `spherecal compensate` with the request's options
+/// and the defaults of the others; `progress` hears of each target,
+/// `cancel` stops at the next one.
+///
+/// # Errors
+/// The message, naming the file (and the target and line): a file that
+/// cannot be read, a result without a 6-axis robot, an unreachable
+/// target, "cancelled".
+pub fn compensate_targets(
+    request: &CompensateRequest,
+    cancel: &AtomicBool,
+    progress: &mut dyn FnMut(String),
+) -> Result<CompensationView, String> {
+    let tcp = match request.tcp {
+        TcpChoice::Sensor => Tcp::Sensor,
+        TcpChoice::Flange => Tcp::Flange,
+        TcpChoice::ToolFile => Tcp::Tool(tool::read_tool(&request.tool)?),
+    };
+    let spec = ReadSpec {
+        format: None,
+        convention: request.convention,
+        columns: None,
+    };
+    let file = program::read_pose_file(&request.targets, &spec).map_err(|e| e.to_string())?;
+    let mut notes = Vec::new();
+    let model = match Model::new(&request.result, request.session.as_ref(), tcp.clone()) {
+        // The open session is not the result's: go on without it, as the
+        // command line without `--session`.
+        Err(CompensateError::Session(why)) => {
+            notes.push(format!("the open session is not used: {why}"));
+            Model::new(&request.result, None, tcp)
+        }
+        other => other,
+    }
+    .map_err(|e| format!("{e} (the result on show)"))?;
+    let done = compensate::compensate(&model, &file, &Options::default(), &mut |p| {
+        progress(format!("target {}: {} of {}", p.target, p.done, p.total));
+        if cancel.load(Ordering::Relaxed) {
+            Control::Cancel
+        } else {
+            Control::Continue
+        }
+    })
+    .map_err(|e| format!("{e} ({})", request.targets.display()))?;
+    let mut view = CompensationView::new(done, &file, &model, request.convention);
+    view.notes.extend(notes);
+    Ok(view)
+}
+
+/// Writes the compensated text to `path` atomically (all or nothing),
+/// refusing to write over the targets or tool file it was made from.
+///
+/// # Errors
+/// The output is an input, or the write failed (the old file, if any,
+/// is left as it was).
+pub fn write_compensated(
+    text: &str,
+    path: &Path,
+    inputs: &[&Path],
+) -> Result<(), crate::app::error::JobError> {
+    refuse_inputs(path, inputs)?;
+    Ok(write_atomic(path, text.as_bytes())?)
+}
+
+impl Core {
+    /// Handles a [`CompensateCommand`].
+    pub(super) fn compensate(&mut self, ctx: &egui::Context, command: CompensateCommand) {
+        match command {
+            CompensateCommand::Run => self.compensate_run(ctx),
+            CompensateCommand::Cancel => {
+                if let Some(c) = self.state.compensate.cancel.take() {
+                    c.store(true, Ordering::Relaxed);
+                    self.state.compensate.pending = None;
+                    self.state.compensate.progress = None;
+                    self.state.say(
+                        Level::Warning,
+                        "compensation cancelled: what is on show did not change",
+                    );
+                }
+            }
+            CompensateCommand::Write => self.compensate_write(ctx),
+        }
+    }
+
+    fn compensate_run(&mut self, ctx: &egui::Context) {
+        if self.state.compensate.cancel.is_some() {
+            return;
+        }
+        let Some(view) = &self.state.result else {
+            self.state.say(
+                Level::Warning,
+                "nothing to compensate with: run the calibration or open a result first",
+            );
+            return;
+        };
+        // Targets are never compensated through a result that is out of
+        // date.
+        if let Err(why) = self.state.provenance.check(Output::Result) {
+            self.state
+                .say(Level::Warning, format!("not compensated: {why}"));
+            self.state.notice = Some(Notice {
+                title: "Not compensated".to_string(),
+                body: format!("{why}: run the calibration again, then compensate"),
+            });
+            return;
+        }
+        let form = &self.forms.compensate;
+        if form.targets.trim().is_empty() {
+            self.state.say(
+                Level::Warning,
+                "choose a targets file first (a pose table or a robot program)",
+            );
+            return;
+        }
+        let result = view.file.clone();
+        let session = if result.pose_joints.is_empty() {
+            self.state.loaded.as_ref().map(|l| l.session.clone())
+        } else {
+            None
+        };
+        let request = CompensateRequest {
+            result,
+            session,
+            targets: PathBuf::from(form.targets.trim()),
+            convention: form.convention,
+            tcp: form.tcp,
+            tool: PathBuf::from(form.tool.trim()),
+        };
+        let stamp = self
+            .state
+            .provenance
+            .made(Output::Result)
+            .cloned()
+            .unwrap_or_default()
+            .with(
+                Input::Calibration,
+                self.state.provenance.reading(Input::Calibration),
+            )
+            .with(
+                Input::Targets,
+                self.state.provenance.reading(Input::Targets),
+            );
+        let job = self.state.compensate.job + 1;
+        let cancel = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&cancel);
+        let started = self.spawn(ctx, "compensate", move |rep| {
+            let outcome = compensate_targets(&request, &flag, &mut |text| {
+                rep.send(JobMessage::Compensate(CompensateMessage::Progress {
+                    job,
+                    text,
+                }));
+            })
+            .map(Box::new);
+            rep.send(JobMessage::Compensate(CompensateMessage::Finished {
+                job,
+                outcome,
+            }));
+        });
+        if started {
+            let c = &mut self.state.compensate;
+            c.job = job;
+            c.cancel = Some(cancel);
+            c.pending = Some(stamp);
+            c.progress = Some("reading the targets…".to_string());
+            self.state.say(Level::Info, "compensating the targets…");
+        }
+    }
+
+    /// The compensated text and its stamp when it may be written; `None`
+    /// (with the reason in a notice) when it is stale, failed or not made.
+    fn compensation_to_write(
+        &mut self,
+    ) -> Option<(String, PathBuf, crate::app::provenance::Stamp)> {
+        let refuse = |state: &mut crate::app::state::AppState, why: String| {
+            state.say(Level::Warning, format!("{WRITTEN_WHAT} not written: {why}"));
+            state.notice = Some(Notice {
+                title: format!("{WRITTEN_WHAT} not written"),
+                body: why,
+            });
+        };
+        let (text, targets) = match &self.state.compensate.outcome {
+            Some(Ok(v)) => (v.text.clone(), v.targets.clone()),
+            Some(Err(e)) => {
+                let why = format!("the targets had errors, nothing is written: {e}");
+                refuse(&mut self.state, why);
+                return None;
+            }
+            None => {
+                refuse(
+                    &mut self.state,
+                    "compensate the targets first (press Compensate targets)".to_string(),
+                );
+                return None;
+            }
+        };
+        if let Err(why) = self.state.provenance.check(Output::Compensation) {
+            refuse(
+                &mut self.state,
+                format!("{why}: press Compensate targets again"),
+            );
+            return None;
+        }
+        let stamp = self.state.provenance.made(Output::Compensation).cloned()?;
+        Some((text, targets, stamp))
+    }
+
+    fn compensate_write(&mut self, ctx: &egui::Context) {
+        let Some((text, targets, stamp)) = self.compensation_to_write() else {
+            return;
+        };
+        let out = self.forms.compensate.out.trim().to_string();
+        if out.is_empty() {
+            self.state.say(
+                Level::Warning,
+                "type where to write the compensated file, or press Write compensated program…",
+            );
+            return;
+        }
+        let path = PathBuf::from(out);
+        let tool = (self.forms.compensate.tcp == TcpChoice::ToolFile)
+            .then(|| PathBuf::from(self.forms.compensate.tool.trim()));
+        let started = self.spawn(ctx, "compensate-write", move |rep| {
+            let mut inputs: Vec<&Path> = vec![targets.as_path()];
+            if let Some(t) = &tool {
+                inputs.push(t.as_path());
+            }
+            let outcome = write_compensated(&text, &path, &inputs);
+            rep.send(JobMessage::Compensate(CompensateMessage::Written {
+                path,
+                outcome,
+                stamp,
+            }));
+        });
+        if started {
+            self.state.compensate.writing += 1;
+        }
+    }
+
+    /// The file name the save dialog offers: the output field's, else
+    /// `<targets stem>-compensated.<ext>`.
+    pub(super) fn compensated_file_name(&self) -> Option<String> {
+        Path::new(self.forms.compensate.out.trim())
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .or_else(|| match &self.state.compensate.outcome {
+                Some(Ok(v)) => Some(v.default_file_name()),
+                _ => None,
+            })
+    }
+
+    /// A file dialog of the Compensate view chose `path`: a targets file
+    /// is compensated at once (when a result is on show), an output is
+    /// written.
+    pub(super) fn compensate_dialog(
+        &mut self,
+        ctx: &egui::Context,
+        purpose: DialogPurpose,
+        path: PathBuf,
+    ) {
+        let text = path.display().to_string();
+        match purpose {
+            DialogPurpose::CompensateTargets => {
+                self.forms.compensate.targets = text;
+                if self.state.result.is_some() {
+                    self.observe();
+                    self.compensate_run(ctx);
+                }
+            }
+            DialogPurpose::CompensateTool => self.forms.compensate.tool = text,
+            DialogPurpose::CompensateOut => {
+                self.forms.compensate.out = text;
+                self.compensate_write(ctx);
+            }
+            _ => {}
+        }
+    }
+
+    /// Handles a [`CompensateMessage`].
+    pub(super) fn on_compensate(&mut self, message: CompensateMessage) {
+        match message {
+            CompensateMessage::Progress { job, text } => {
+                let c = &mut self.state.compensate;
+                if c.job == job && c.cancel.is_some() {
+                    c.progress = Some(text);
+                }
+            }
+            CompensateMessage::Finished { job, outcome } => {
+                let c = &mut self.state.compensate;
+                // A cancelled job's outcome is not shown.
+                if c.job != job || c.cancel.is_none() {
+                    return;
+                }
+                c.cancel = None;
+                c.progress = None;
+                let stamp = c.pending.take().unwrap_or_default();
+                match outcome {
+                    Ok(view) => {
+                        self.state.provenance.record(Output::Compensation, stamp);
+                        let level = if view.flagged > 0 {
+                            Level::Warning
+                        } else {
+                            Level::Info
+                        };
+                        self.state.say(level, view.summary.clone());
+                        // Where the compensated file goes by default:
+                        // beside the targets.
+                        if self.forms.compensate.out.trim().is_empty()
+                            && let Some(dir) = view.targets.parent()
+                        {
+                            self.forms.compensate.out =
+                                dir.join(view.default_file_name()).display().to_string();
+                        }
+                        self.state.compensate.outcome = Some(Ok(*view));
+                    }
+                    Err(e) => {
+                        self.state.provenance.forget(Output::Compensation);
+                        self.state
+                            .say(Level::Error, format!("not compensated: {e}"));
+                        self.state.compensate.outcome = Some(Err(e));
+                    }
+                }
+            }
+            CompensateMessage::Written {
+                path,
+                outcome,
+                stamp,
+            } => {
+                let c = &mut self.state.compensate;
+                c.writing = c.writing.saturating_sub(1);
+                if outcome.is_ok() {
+                    c.written = Some(path.clone());
+                    self.state.provenance.wrote(
+                        WRITTEN_WHAT,
+                        path.clone(),
+                        Output::Compensation,
+                        stamp,
+                    );
+                }
+                self.say_written(WRITTEN_WHAT, &path, outcome);
+            }
+        }
+    }
+}

