@@ -30,7 +30,7 @@ fn the_step_bar_walks_the_job_in_order() {
     assert_eq!(
         order,
         [
-            "Plan", "Import", "Session", "Stripe", "Centres", "Results", "History"
+            "Plan", "Import", "Session", "Stripe", "Centres", "Results", "History", "Measure"
         ]
     );
 

@@ -25,6 +25,8 @@ pub enum Command {
     History(HistoryCommand),
     /// The pose planner.
     Plan(PlanCommand),
+    /// The Measure view.
+    Measure(MeasureCommand),
 }
 
 /// Opening and saving files.
@@ -133,4 +135,19 @@ pub enum PlanCommand {
     /// After a FAIL: open the Plan view set for the open session's robot
     /// with more identify stations than the session has.
     MoreStations,
+}
+
+/// The Measure view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeasureCommand {
+    /// Measure the form's scan with the result on show (a job).
+    Start,
+    /// Stop the measuring job; the cloud on show stays.
+    Cancel,
+    /// Write the cloud on show to the form's export path (format by its
+    /// extension).
+    Export,
+    /// Show a file dialog for one of the view's paths (an export: a save
+    /// dialog that writes once a file is chosen).
+    Browse(super::state::measure::MeasureDialog),
 }

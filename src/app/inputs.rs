@@ -31,6 +31,8 @@ pub fn readings(state: &AppState, forms: &Forms) -> Vec<(Input, Reading)> {
             plan_form(&forms.plan, plan_hand_eye(state)),
         ),
         (Input::Tolerance, tolerance(&forms.tolerance)),
+        (Input::ResultShown, result_shown(state)),
+        (Input::MeasureForm, measure_form(&forms.measure)),
     ]
 }
 
@@ -162,4 +164,76 @@ pub fn tolerance(t: &Tolerance) -> Reading {
         ],
         (t.std_mm.to_bits(), t.max_mm.to_bits()),
     )
+}
+
+/// The result on show: its method and ε in words, and (unseen) which
+/// result it is (its origin, ε and hand-eye: a new run is another result
+/// even with the same figures, its wall time differs).
+#[must_use]
+pub fn result_shown(state: &AppState) -> Reading {
+    match &state.result {
+        Some(v) => {
+            let origin = match &v.origin {
+                super::view::ResultOrigin::Run { seconds, .. } => {
+                    format!("a run ({seconds:.2} s)")
+                }
+                super::view::ResultOrigin::Review(p) => p.display().to_string(),
+            };
+            let h = &v.file.hand_eye;
+            let hidden = (
+                format!("{:?}", v.origin),
+                v.file.epsilon_after.to_bits(),
+                h.translation
+                    .vector
+                    .iter()
+                    .map(|x| x.to_bits())
+                    .collect::<Vec<_>>(),
+                h.rotation
+                    .coords
+                    .iter()
+                    .map(|x| x.to_bits())
+                    .collect::<Vec<_>>(),
+            );
+            Reading::new(
+                vec![
+                    ("result".into(), format!("{} {origin}", v.method)),
+                    ("ε after".into(), format!("{:.4} mm", v.file.epsilon_after)),
+                ],
+                hidden,
+            )
+        }
+        None => Reading::new(vec![("result".into(), "none".into())], 0_u64),
+    }
+}
+
+/// The Measure form: what is measured and how (not where it is
+/// exported).
+#[must_use]
+pub fn measure_form(f: &super::forms::measure::MeasureForm) -> Reading {
+    use super::forms::measure::ScanChoice;
+    let scan = match f.choice {
+        ScanChoice::OpenSession => "the open session".to_string(),
+        ScanChoice::SessionFile => f.session_file.trim().to_string(),
+        ScanChoice::RawScan => format!("{} + {}", f.log.trim(), f.profiles.trim()),
+    };
+    let fields = vec![
+        ("scan".into(), scan),
+        (
+            "use".into(),
+            f.usage.map_or("all", |u| u.as_str()).to_string(),
+        ),
+        (
+            "frame".into(),
+            f.frame_path()
+                .map_or_else(|| "base".to_string(), |p| p.display().to_string()),
+        ),
+        ("sensor noise".into(), format!("{} mm", f.sensor_noise_mm)),
+        (
+            "σ".into(),
+            if f.no_sigma { "no" } else { "yes" }.to_string(),
+        ),
+    ];
+    let mut unseen = f.clone();
+    unseen.out.clear();
+    Reading::new(fields, format!("{unseen:?}"))
 }

@@ -4,6 +4,8 @@
 //! with `ctx.request_repaint()`. The frame loop only drains [`JobMessage`]s
 //! (egui's http_app, rerun's `background_tasks.rs`).
 
+pub mod measure;
+
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
 
@@ -46,6 +48,8 @@ pub enum JobMessage {
     History(HistoryMessage),
     /// The pose planner.
     Plan(PlanMessage),
+    /// The Measure view.
+    Measure(measure::MeasureMessage),
 }
 
 /// What the file jobs report.

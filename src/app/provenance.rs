@@ -52,16 +52,22 @@ pub enum Input {
     PlanForm,
     /// The acceptance tolerance of the verdict.
     Tolerance,
+    /// The calibration result on show (a new one, or none, is another).
+    ResultShown,
+    /// The Measure form: the scan, `use`, frame, sensor noise, σ or not.
+    MeasureForm,
 }
 
 impl Input {
     /// Every input, in the order of the job.
-    pub const ALL: [Self; 5] = [
+    pub const ALL: [Self; 7] = [
         Self::PlanForm,
         Self::Session,
         Self::LeftOut,
         Self::Solver,
         Self::Tolerance,
+        Self::ResultShown,
+        Self::MeasureForm,
     ];
 
     /// Its name in a sentence: "the Plan form changed".
@@ -73,6 +79,8 @@ impl Input {
             Self::Solver => "the solver settings",
             Self::PlanForm => "the Plan form",
             Self::Tolerance => "the tolerance",
+            Self::ResultShown => "the result on show",
+            Self::MeasureForm => "the Measure form",
         }
     }
 }
@@ -134,6 +142,8 @@ pub enum Output {
     Result,
     /// The HTML report written of the result on show.
     Report,
+    /// The Measure view's point cloud (and its PLY, E57, CSV files).
+    Cloud,
 }
 
 impl Output {
@@ -149,6 +159,7 @@ impl Output {
                 Input::Solver,
                 Input::Tolerance,
             ],
+            Self::Cloud => &[Input::Session, Input::ResultShown, Input::MeasureForm],
         }
     }
 
@@ -159,6 +170,7 @@ impl Output {
             Self::Plan => "the plan",
             Self::Result => "the result",
             Self::Report => "the report",
+            Self::Cloud => "the cloud",
         }
     }
 }

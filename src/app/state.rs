@@ -4,6 +4,8 @@
 //! and job messages). The fields widgets edit are in
 //! [`forms`](super::forms).
 
+pub mod measure;
+
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -507,6 +509,8 @@ pub struct AppState {
     /// The operator has been shown the outliers of the result on show
     /// (after a FAIL the next step is then the planner).
     pub outliers_seen: bool,
+    /// The Measure view: its job, the cloud on show, its exports.
+    pub measure: measure::MeasureView,
 }
 
 impl AppState {
@@ -532,6 +536,7 @@ impl AppState {
             || self.history.drifting
             || self.plan.cancel.is_some()
             || self.plan.writing > 0
+            || self.measure.is_busy()
     }
 
     /// Indices of the measurements the session table shows, in its order

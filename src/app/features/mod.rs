@@ -13,6 +13,7 @@
 //! | [`import`] | preview, import | the import wizard's engine calls |
 //! | [`history`] | scan, drift | scan a library folder |
 //! | [`plan`] | plan, cancel, export, simulate | the pose planner and its prediction |
+//! | [`measure`] | measure, cancel, export, browse | a scan into a point cloud, its self-validation, PLY/E57/CSV |
 //!
 //! [`Core`] holds what they share: the state, the forms and the job runner.
 
@@ -20,6 +21,7 @@ pub mod export;
 pub mod files;
 pub mod history;
 pub mod import;
+pub mod measure;
 pub mod plan;
 pub mod run;
 pub mod view;
@@ -78,6 +80,7 @@ impl Core {
             Command::Import(c) => self.import(ctx, c),
             Command::History(c) => self.history(ctx, c),
             Command::Plan(c) => self.plan(ctx, c),
+            Command::Measure(c) => self.measure(ctx, c),
         }
     }
 
@@ -90,6 +93,7 @@ impl Core {
             JobMessage::Import(m) => self.on_import(ctx, m),
             JobMessage::History(m) => self.on_history(ctx, m),
             JobMessage::Plan(m) => self.on_plan(ctx, m),
+            JobMessage::Measure(m) => self.on_measure(ctx, m),
         }
     }
 

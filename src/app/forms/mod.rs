@@ -4,6 +4,7 @@
 //! job; the features read these when a command comes.
 
 pub mod import;
+pub mod measure;
 pub mod plan;
 
 use std::collections::BTreeSet;
@@ -89,13 +90,15 @@ pub enum Tab {
     History,
     /// The pose planner.
     Plan,
+    /// Scans measured with the calibrated cell: the point cloud.
+    Measure,
 }
 
 impl Tab {
     /// All tabs, in the order of the job: plan the poses, bring the data
     /// in, check the stripes and centres, calibrate and validate, follow
     /// the cell over time.
-    pub const ALL: [Self; 7] = [
+    pub const ALL: [Self; 8] = [
         Self::Plan,
         Self::Import,
         Self::Session,
@@ -103,6 +106,7 @@ impl Tab {
         Self::Centres,
         Self::Results,
         Self::History,
+        Self::Measure,
     ];
 
     /// The tab's title.
@@ -116,6 +120,7 @@ impl Tab {
             Self::Import => "Import",
             Self::History => "History",
             Self::Plan => "Plan",
+            Self::Measure => "Measure",
         }
     }
 }
@@ -236,6 +241,8 @@ pub struct Forms {
     /// Scroll the Results view to its "after a FAIL" box once (set by
     /// Next's "Look at the outliers").
     pub focus_after_fail: bool,
+    /// The Measure view's fields.
+    pub measure: measure::MeasureForm,
 }
 
 impl Default for Forms {
@@ -258,6 +265,7 @@ impl Default for Forms {
             plan: PlanForm::default(),
             tolerance: crate::engine::result_view::Tolerance::default(),
             focus_after_fail: false,
+            measure: measure::MeasureForm::default(),
         }
     }
 }

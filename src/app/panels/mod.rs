@@ -5,6 +5,7 @@
 pub mod centres;
 pub mod history;
 pub mod import;
+pub mod measure;
 pub mod plan;
 pub mod plots;
 pub mod results;

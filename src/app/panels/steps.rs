@@ -1,5 +1,6 @@
 //! The step bar: the operator's job in order (plan → data in → stripes
-//! checked → calibrated → validated → reported), where the open session
+//! checked → calibrated → validated → reported, then measured: scans
+//! through the calibrated cell), where the open session
 //! stands, and the next action as one button, with an action in every
 //! state: a stale step is done again, a FAIL leads to the outliers and
 //! then to the planner, a session without validate measurements skips
@@ -84,7 +85,8 @@ fn outliers(state: &AppState) -> usize {
         .map_or(0, |m| m.outliers.len())
 }
 
-/// The six steps of the job for the current state.
+/// The steps of the job for the current state (the Measure step, the
+/// cell's use once calibrated, last).
 #[must_use]
 pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
     let prov = &state.provenance;
@@ -231,6 +233,7 @@ pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
                 Command::Export(ExportKind::ReportHtml),
             ),
         },
+        super::measure::measure_step(state),
     ]
 }
 
