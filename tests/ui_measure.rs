@@ -29,7 +29,7 @@ use spherecal::engine::simulate::SimConfig;
 use spherecal::engine::solve::Method;
 
 mod ui_support;
-use ui_support::{harness, open_path, settle, simulated, status, step_label};
+use ui_support::{harness, settle, simulated, status, step_label};
 
 /// A small simulated session (seeded, the paper's cell), opened and
 /// calibrated with `method`.

@@ -248,8 +248,10 @@ pub fn measure_scan(
             measured.out_of_range.len() - LISTED_POSES
         ));
     }
+    let out_of_range_count = measured.out_of_range.len();
     stopped(cancel)?;
     Ok(MeasuredCloud {
+        out_of_range_count,
         points: cloud.len(),
         poses: cloud.poses.len(),
         dropped: cloud.dropped(),
@@ -479,6 +481,7 @@ impl Core {
             form.log.trim(),
             form.profiles.trim(),
             form.frame.trim(),
+            form.references.trim(),
         ]
         .iter()
         .filter(|s| !s.is_empty())
@@ -594,6 +597,7 @@ impl Core {
                 MeasureDialog::SessionFile | MeasureDialog::Frame => {
                     dialog.add_filter("JSON", &["json"]).pick_file()
                 }
+                MeasureDialog::References => dialog.add_filter("CSV", &["csv", "txt"]).pick_file(),
                 MeasureDialog::Log => dialog
                     .add_filter(
                         "pose log",
@@ -675,6 +679,7 @@ impl Core {
                     MeasureDialog::Log => form.log = text,
                     MeasureDialog::Profiles => form.profiles = text,
                     MeasureDialog::Frame => form.frame = text,
+                    MeasureDialog::References => form.references = text,
                     MeasureDialog::Export => {
                         form.out = text;
                         // The dialog has asked about replacing a file.

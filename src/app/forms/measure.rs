@@ -75,6 +75,12 @@ pub struct MeasureForm {
     pub axes: String,
     /// The sensor's no-return value (file units); empty for none.
     pub no_return: String,
+    /// A raw scan of a sphere artefact: the spheres' diameter, mm, for
+    /// the self-validation of its stations; empty for none.
+    pub sphere_diameter: String,
+    /// A raw scan of a sphere artefact: reference distances between its
+    /// stations (CSV `from,to,distance`, mm); empty for none.
+    pub references: String,
     /// A workpiece frame file (a JSON 4×4 `base_from_workpiece`, mm);
     /// empty for the robot base frame.
     pub frame: String,
@@ -101,6 +107,8 @@ impl Default for MeasureForm {
             pose_convention: None,
             axes: "auto".into(),
             no_return: String::new(),
+            sphere_diameter: String::new(),
+            references: String::new(),
             frame: String::new(),
             sensor_noise_mm: 0.0,
             no_sigma: false,
@@ -166,6 +174,18 @@ impl MeasureForm {
                     .ok_or_else(|| format!("the no-return value `{text}` is not a number"))?,
             ),
         };
+        let sphere_diameter = match self.sphere_diameter.trim() {
+            "" => None,
+            text => Some(
+                text.parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite() && *v > 0.0)
+                    .ok_or_else(|| {
+                        format!("the sphere diameter `{text}` is not a positive number of mm")
+                    })?,
+            ),
+        };
+        let references = self.references.trim();
         let log = match self.raw_log {
             RawLog::Joints => ScanLog::Joints {
                 path: log,
@@ -189,8 +209,8 @@ impl MeasureForm {
                 key: None,
             },
             robot: None,
-            sphere_diameter: None,
-            references: None,
+            sphere_diameter,
+            references: (!references.is_empty()).then(|| PathBuf::from(references)),
         })
     }
 }
@@ -222,6 +242,11 @@ mod tests {
         }
         assert!(matches!(spec.profiles, ProfileSource::File { .. }));
         assert!(spec.profile_format.axes.is_some());
+        f.sphere_diameter = "25.4".into();
+        assert_eq!(f.scan_files(6).unwrap().sphere_diameter, Some(25.4));
+        f.sphere_diameter = "-1".into();
+        assert!(f.scan_files(6).unwrap_err().contains("diameter"));
+        f.sphere_diameter.clear();
         f.no_return = "x".into();
         assert!(f.scan_files(6).unwrap_err().contains("no-return"));
     }

@@ -35,7 +35,7 @@ const BAR_WIDTH: f32 = 86.0;
 
 /// Tallest projection, points: three of them and the inputs above fit a
 /// 1366×768 screen with the self-validation one scroll below.
-const MAX_PLOT_HEIGHT: f32 = 300.0;
+const MAX_PLOT_HEIGHT: f32 = 270.0;
 
 /// Below this largest σ (mm) the colour bar and figures are in µm: a
 /// well calibrated cell's points are tens of micrometres.
@@ -128,7 +128,7 @@ pub fn measure_ui(
             let Some(cloud) = &state.measure.shown else {
                 ui.label(
                     RichText::new(
-                        "No cloud yet: choose the scan above and press ▶ Measure. The cloud is drawn in three projections coloured by each point's σ; the self-validation and the export come below it.",
+                        "No cloud yet: choose the scan above and press ▶ Measure. The cloud is drawn in three projections coloured by each point's σ; the counts, the export and the self-validation come with it.",
                     )
                     .color(MUTED),
                 );
@@ -182,8 +182,12 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
         ui.label(RichText::new("Result:").strong());
         match &state.result {
             Some(v) => {
+                let origin = match &v.origin {
+                    crate::app::view::ResultOrigin::Review(p) => p.display().to_string(),
+                    crate::app::view::ResultOrigin::Run { .. } => "this window's run".to_string(),
+                };
                 ui.label(format!(
-                    "the result on show (method {}, \"{}\")",
+                    "the result on show: {origin} (method {}, session \"{}\")",
                     v.method, v.file.session
                 ));
                 if !has_covariance(&v.file) {
@@ -207,6 +211,70 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
             }
         }
     });
+    let summary = match form.choice {
+        ScanChoice::OpenSession => "the open session".to_string(),
+        ScanChoice::SessionFile => form.session_file.trim().to_string(),
+        ScanChoice::RawScan => form.log.trim().to_string(),
+    };
+    egui::CollapsingHeader::new(RichText::new(format!("Scan and options: {summary}")).strong())
+        .id_salt("measure_inputs")
+        .default_open(true)
+        .show(ui, |ui| scan_ui(ui, state, form, commands));
+    ui.horizontal_wrapped(|ui| {
+        if let Some(v) = number_field(
+            ui,
+            "measure_noise",
+            "Sensor noise (1σ in-plane)",
+            form.sensor_noise_mm,
+            0.0..=MAX_SENSOR_NOISE_MM,
+            "mm",
+        ) {
+            form.sensor_noise_mm = v;
+        }
+        ui.checkbox(&mut form.no_sigma, "no σ (as --no-sigma)")
+            .on_hover_text("measure without σ: for a result without covariance (method paper)");
+        ui.add_space(12.0);
+        let running = state.measure.job.is_some();
+        if ui
+            .add_enabled(
+                !running && state.result.is_some(),
+                egui::Button::new(RichText::new("▶ Measure").size(16.0)),
+            )
+            .on_hover_text("measure the scan with the result on show, on a background thread")
+            .on_disabled_hover_text("a result is needed (and no measuring under way)")
+            .clicked()
+        {
+            commands.push(Command::Measure(MeasureCommand::Start));
+        }
+        if ui
+            .add_enabled(running, egui::Button::new("Cancel measuring"))
+            .on_hover_text("stop the measuring job; the cloud on show stays")
+            .clicked()
+        {
+            commands.push(Command::Measure(MeasureCommand::Cancel));
+        }
+        if let Some(job) = &state.measure.job {
+            ui.add(
+                egui::ProgressBar::new(job.fraction as f32)
+                    .desired_width(160.0)
+                    .show_percentage(),
+            );
+            ui.label(RichText::new(&job.phase).small());
+        }
+    });
+    if let Some(why) = &state.measure.failure {
+        ui.label(RichText::new(why).color(BAD));
+    }
+}
+
+/// What is measured and how: the scan (the open session, a session
+/// file, a raw scan's files and their options), the workpiece frame.
+fn scan_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    form: &mut crate::app::forms::measure::MeasureForm,
+    commands: &mut Vec<Command>,
+) {
     ui.horizontal_wrapped(|ui| {
         ui.label(RichText::new("Scan:").strong());
         for choice in ScanChoice::ALL {
@@ -322,7 +390,24 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
                     .labelled_by(l.id);
                 labelled_field(ui, "axes", &mut form.axes, "auto or -y,x,z", 70.0);
                 labelled_field(ui, "no-return value", &mut form.no_return, "none", 60.0);
+                labelled_field(
+                    ui,
+                    "sphere artefact Ø (mm)",
+                    &mut form.sphere_diameter,
+                    "none",
+                    60.0,
+                )
+                .on_hover_text("a scan of a sphere artefact: its spheres' diameter, for the self-validation of the log's stations");
             });
+            path_row(
+                ui,
+                state,
+                "References",
+                &mut form.references,
+                "optional: the artefact's distances CSV (from,to,distance mm)",
+                MeasureDialog::References,
+                commands,
+            );
         }
     }
     path_row(
@@ -334,51 +419,6 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
         MeasureDialog::Frame,
         commands,
     );
-    ui.horizontal_wrapped(|ui| {
-        if let Some(v) = number_field(
-            ui,
-            "measure_noise",
-            "Sensor noise (1σ in-plane)",
-            form.sensor_noise_mm,
-            0.0..=MAX_SENSOR_NOISE_MM,
-            "mm",
-        ) {
-            form.sensor_noise_mm = v;
-        }
-        ui.checkbox(&mut form.no_sigma, "no σ (as --no-sigma)")
-            .on_hover_text("measure without σ: for a result without covariance (method paper)");
-        ui.add_space(12.0);
-        let running = state.measure.job.is_some();
-        if ui
-            .add_enabled(
-                !running && state.result.is_some(),
-                egui::Button::new(RichText::new("▶ Measure").size(16.0)),
-            )
-            .on_hover_text("measure the scan with the result on show, on a background thread")
-            .on_disabled_hover_text("a result is needed (and no measuring under way)")
-            .clicked()
-        {
-            commands.push(Command::Measure(MeasureCommand::Start));
-        }
-        if ui
-            .add_enabled(running, egui::Button::new("Cancel measuring"))
-            .on_hover_text("stop the measuring job; the cloud on show stays")
-            .clicked()
-        {
-            commands.push(Command::Measure(MeasureCommand::Cancel));
-        }
-        if let Some(job) = &state.measure.job {
-            ui.add(
-                egui::ProgressBar::new(job.fraction as f32)
-                    .desired_width(160.0)
-                    .show_percentage(),
-            );
-            ui.label(RichText::new(&job.phase).small());
-        }
-    });
-    if let Some(why) = &state.measure.failure {
-        ui.label(RichText::new(why).color(BAD));
-    }
 }
 
 /// The counts, the σ figures, the warnings.
@@ -451,8 +491,8 @@ fn summary_ui(ui: &mut egui::Ui, c: &MeasuredCloud) {
     if !c.out_of_range.is_empty() {
         ui.collapsing(
             RichText::new(format!(
-                "warning: pose(s) outside the joint range the calibration saw ({})",
-                c.out_of_range.len()
+                "warning: {} pose(s) outside the joint range the calibration saw (the model was not checked there)",
+                c.out_of_range_count
             ))
             .color(WARN),
             |ui| {
@@ -576,6 +616,9 @@ fn colour_bar_ui(ui: &mut egui::Ui, c: &MeasuredCloud, height: f32) {
     });
 }
 
+/// A figure's rms and largest value, mm.
+type RmsMax = (f64, f64);
+
 /// `rms / max` of a figure in `unit`.
 fn pair(v: (f64, f64), k: f64, unit: &str) -> String {
     format!("{:.4} / {:.4} {unit}", v.0 * k, v.1 * k)
@@ -603,7 +646,7 @@ fn self_check_ui(ui: &mut egui::Ui, c: &MeasuredCloud) {
         ))
         .small(),
     );
-    let rows: Vec<(String, (f64, f64), (f64, f64))> = {
+    let rows: Vec<(String, RmsMax, RmsMax)> = {
         let mut rows = vec![
             (
                 "size error (fitted − calibrated diameter)".to_string(),

@@ -42,8 +42,11 @@ pub struct MeasuredCloud {
     pub check: Option<SelfValidation>,
     /// Warnings of the measurement (flange poses, robots).
     pub warnings: Vec<String>,
-    /// Poses outside the joint range the calibration saw, in words.
+    /// Poses outside the joint range the calibration saw, in words (the
+    /// first few).
     pub out_of_range: Vec<String>,
+    /// How many poses are outside that range.
+    pub out_of_range_count: usize,
     /// Measurements without a profile (given centres), not in the cloud.
     pub skipped: usize,
     /// How the scan was read (axis map, units).
@@ -97,6 +100,8 @@ pub enum MeasureDialog {
     Profiles,
     /// The workpiece frame file.
     Frame,
+    /// A sphere artefact's reference distances CSV.
+    References,
     /// Where to export the cloud (a save dialog; writes once chosen).
     Export,
 }
