@@ -31,18 +31,19 @@ use spherecal::engine::solve::Method;
 mod ui_support;
 use ui_support::{harness, settle, simulated, status, step_label};
 
+/// The small simulated cell of these tests (seeded, the paper's).
+fn small() -> SimConfig {
+    SimConfig {
+        seed: 20,
+        n_validate: 4,
+        ..SimConfig::default()
+    }
+}
+
 /// A small simulated session (seeded, the paper's cell), opened and
 /// calibrated with `method`.
 fn calibrated(dir: &Path, method: Method) -> Harness<'static, WorkbenchApp> {
-    let path = simulated(
-        dir,
-        "small.json",
-        &SimConfig {
-            seed: 20,
-            n_validate: 4,
-            ..SimConfig::default()
-        },
-    );
+    let path = simulated(dir, "small.json", &small());
     let mut h = harness(WorkbenchApp::new(
         spherecal::app::state::Prefs::default(),
         Some(path),
@@ -323,4 +324,90 @@ fn a_paper_result_is_measured_only_without_sigma() {
             .count()
             >= 1
     );
+}
+
+/// The raw-scan door: a simulated scan of a three-sphere artefact (the
+/// same seed's cell) read from its joint log and profiles folder as
+/// `spherecal measure --joints --profiles` reads them: every finite point
+/// kept, the no-hit (NaN) points dropped and counted, the artefact's
+/// self-validation; a workpiece frame moves the cloud by its inverse
+/// and, changed, makes the cloud stale.
+#[test]
+fn a_raw_scan_of_an_artefact_is_measured_through_the_form() {
+    use spherecal::engine::simulate::{PartKind, ScanConfig, simulate_scan};
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = calibrated(dir.path(), Method::Ml);
+    let sim = simulate_scan(
+        &small(),
+        &ScanConfig {
+            part: PartKind::Spheres,
+            poses: 8,
+            ..ScanConfig::default()
+        },
+    )
+    .unwrap();
+    let scan = dir.path().join("scan");
+    std::fs::create_dir_all(scan.join("profiles")).unwrap();
+    std::fs::write(scan.join("joints.csv"), &sim.joints_csv).unwrap();
+    std::fs::write(
+        scan.join("references.csv"),
+        sim.references_csv.as_ref().unwrap(),
+    )
+    .unwrap();
+    let (mut finite, mut nan) = (0, 0);
+    for (id, text) in &sim.profiles {
+        std::fs::write(scan.join("profiles").join(format!("{id}.csv")), text).unwrap();
+        for line in text
+            .lines()
+            .filter(|l| l.starts_with(|c: char| c == '-' || c == 'n' || c.is_ascii_digit()))
+        {
+            if line.contains("nan") {
+                nan += 1;
+            } else {
+                finite += 1;
+            }
+        }
+    }
+    let form = &mut h.state_mut().forms_mut().measure;
+    form.choice = ScanChoice::RawScan;
+    form.log = scan.join("joints.csv").display().to_string();
+    form.profiles = scan.join("profiles").display().to_string();
+    form.sphere_diameter = "38.1".into();
+    form.references = scan.join("references.csv").display().to_string();
+    measure(&mut h);
+    let first = h.state().state().measure.shown.clone().expect("a cloud");
+    assert_eq!(first.points, finite);
+    assert_eq!(first.dropped.non_finite, nan);
+    assert!(nan > 0, "the artefact scan has rays that meet nothing");
+    assert!(
+        h.query_by_label_contains(&format!("dropped {} NaN", group(nan)))
+            .is_some()
+    );
+    let check = first.check.as_ref().expect("the artefact's stations");
+    assert_eq!(check.after.stations.len(), 3);
+    let (b, a) = (
+        check.before.spacing_error().unwrap(),
+        check.after.spacing_error().unwrap(),
+    );
+    assert!(a.0 * 10.0 < b.0, "spacing error {a:?} vs {b:?}");
+
+    // A workpiece frame 100 mm along x of the base: the cloud moves by
+    // −100 mm in x; typing it makes the cloud on show stale at once.
+    let frame = dir.path().join("wobj.json");
+    std::fs::write(&frame, "[[1,0,0,100],[0,1,0,0],[0,0,1,0],[0,0,0,1]]").unwrap();
+    h.state_mut().forms_mut().measure.frame = frame.display().to_string();
+    h.run();
+    assert!(
+        step_label(&h, "7. Measured").starts_with('!'),
+        "the frame changed"
+    );
+    h.get_by_label("▶ Measure").click();
+    settle(&mut h);
+    let moved = h.state().state().measure.shown.clone().unwrap();
+    assert!(moved.frame.contains("workpiece frame"), "{}", moved.frame);
+    for (p, q) in first.cloud.points().zip(moved.cloud.points()) {
+        assert!((p.position[0] - 100.0 - q.position[0]).abs() < 1e-9);
+        assert!((p.position[1] - q.position[1]).abs() < 1e-9);
+        assert!((p.position[2] - q.position[2]).abs() < 1e-9);
+    }
 }
