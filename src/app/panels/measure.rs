@@ -12,13 +12,12 @@
 use egui::{Color32, RichText};
 use egui_plot::{Plot, PlotPoint};
 
-use super::steps::{Step, StepState};
 use super::{AFTER, BAD, GOOD, MUTED, WARN, labelled_field, number_field, stale_banner_ui};
-use crate::app::commands::{Command, MeasureCommand, ViewCommand};
+use crate::app::commands::{Command, MeasureCommand};
 use crate::app::features::measure::{DRAWN_MAX, group, has_covariance};
+use crate::app::forms::Forms;
 use crate::app::forms::import::CONVENTIONS;
 use crate::app::forms::measure::{MAX_SENSOR_NOISE_MM, RawLog, ScanChoice};
-use crate::app::forms::{Forms, Tab};
 use crate::app::provenance::Output;
 use crate::app::state::AppState;
 use crate::app::state::measure::{MeasureDialog, MeasuredCloud};
@@ -77,39 +76,6 @@ pub fn sigma_unit(max_mm: f64) -> (&'static str, f64) {
         ("µm", 1000.0)
     } else {
         ("mm", 1.0)
-    }
-}
-
-/// The Measure step of the step bar: to do, under way, done or stale
-/// (the cloud's provenance).
-#[must_use]
-pub fn measure_step(state: &AppState) -> Step {
-    let m = &state.measure;
-    let stale = state.provenance.stale(Output::Cloud);
-    let show = Command::View(ViewCommand::ShowTab(Tab::Measure));
-    let (step_state, detail) = match (&m.job, &m.shown, &stale) {
-        (Some(job), _, _) => (
-            StepState::Running,
-            format!("measuring: {} ({:.0} %)", job.phase, job.fraction * 100.0),
-        ),
-        (None, Some(_), Some(s)) => (
-            StepState::Stale(s.what_changed()),
-            format!("{s}: measure again before exporting"),
-        ),
-        (None, Some(c), None) => (
-            StepState::Done,
-            format!("{} points measured of {}", group(c.points), c.scan),
-        ),
-        (None, None, _) => (
-            StepState::Todo,
-            "measure a scan with the calibrated cell (optional)".to_string(),
-        ),
-    };
-    Step {
-        name: "Measured",
-        state: step_state,
-        detail,
-        action: ("Measure a scan".to_string(), show),
     }
 }
 

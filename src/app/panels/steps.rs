@@ -233,7 +233,7 @@ pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
                 Command::Export(ExportKind::ReportHtml),
             ),
         },
-        super::measure::measure_step(state),
+        measure_step(state),
     ]
 }
 
@@ -448,5 +448,42 @@ pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &m
                 .small()
                 .color(WARN),
         );
+    }
+}
+
+/// The Measure step of the step bar: to do, under way, done or stale
+/// (the cloud's provenance).
+#[must_use]
+pub fn measure_step(state: &AppState) -> Step {
+    let m = &state.measure;
+    let stale = state.provenance.stale(Output::Cloud);
+    let show = Command::View(ViewCommand::ShowTab(Tab::Measure));
+    let (step_state, detail) = match (&m.job, &m.shown, &stale) {
+        (Some(job), _, _) => (
+            StepState::Running,
+            format!("measuring: {} ({:.0} %)", job.phase, job.fraction * 100.0),
+        ),
+        (None, Some(_), Some(s)) => (
+            StepState::Stale(s.what_changed()),
+            format!("{s}: measure again before exporting"),
+        ),
+        (None, Some(c), None) => (
+            StepState::Done,
+            format!(
+                "{} points measured of {}",
+                crate::app::features::measure::group(c.points),
+                c.scan
+            ),
+        ),
+        (None, None, _) => (
+            StepState::Todo,
+            "measure a scan with the calibrated cell (optional)".to_string(),
+        ),
+    };
+    Step {
+        name: "Measured",
+        state: step_state,
+        detail,
+        action: ("Measure a scan".to_string(), show),
     }
 }
