@@ -36,6 +36,7 @@ fn the_step_bar_walks_the_job_in_order() {
             "Stripe",
             "Centres",
             "Results",
+            "Measure",
             "Compensate",
             "History"
         ]

@@ -27,6 +27,8 @@ pub enum Command {
     Plan(PlanCommand),
     /// The Compensate view.
     Compensate(CompensateCommand),
+    /// The Measure view.
+    Measure(MeasureCommand),
 }
 
 /// Opening and saving files.
@@ -147,4 +149,19 @@ pub enum CompensateCommand {
     /// Write the compensated file to the form's output path (refused when
     /// the compensation is stale or the targets had errors).
     Write,
+}
+
+/// The Measure view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeasureCommand {
+    /// Measure the form's scan with the result on show (a job).
+    Start,
+    /// Stop the measuring job; the cloud on show stays.
+    Cancel,
+    /// Write the cloud on show to the form's export path (format by its
+    /// extension).
+    Export,
+    /// Show a file dialog for one of the view's paths (an export: a save
+    /// dialog that writes once a file is chosen).
+    Browse(super::state::measure::MeasureDialog),
 }

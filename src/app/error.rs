@@ -66,4 +66,7 @@ pub enum JobError {
         /// The path.
         path: PathBuf,
     },
+    /// A scan could not be measured.
+    #[error(transparent)]
+    Measure(#[from] crate::engine::uses::measure::MeasureError),
 }

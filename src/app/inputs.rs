@@ -34,6 +34,7 @@ pub fn readings(state: &AppState, forms: &Forms) -> Vec<(Input, Reading)> {
         (Input::Tolerance, tolerance(&forms.tolerance)),
         (Input::Calibration, calibration(state)),
         (Input::Targets, targets(&forms.compensate)),
+        (Input::MeasureForm, measure_form(&forms.measure)),
     ]
 }
 
@@ -232,4 +233,36 @@ pub fn targets(f: &CompensateForm) -> Reading {
     ];
     let tool = (f.tcp == TcpChoice::ToolFile).then(|| file_stamp(&f.tool));
     Reading::new(fields, (file_stamp(&f.targets), tool))
+}
+
+/// The Measure form: what is measured and how (not where it is
+/// exported).
+#[must_use]
+pub fn measure_form(f: &super::forms::measure::MeasureForm) -> Reading {
+    use super::forms::measure::ScanChoice;
+    let scan = match f.choice {
+        ScanChoice::OpenSession => "the open session".to_string(),
+        ScanChoice::SessionFile => f.session_file.trim().to_string(),
+        ScanChoice::RawScan => format!("{} + {}", f.log.trim(), f.profiles.trim()),
+    };
+    let fields = vec![
+        ("scan".into(), scan),
+        (
+            "use".into(),
+            f.usage.map_or("all", |u| u.as_str()).to_string(),
+        ),
+        (
+            "frame".into(),
+            f.frame_path()
+                .map_or_else(|| "base".to_string(), |p| p.display().to_string()),
+        ),
+        ("sensor noise".into(), format!("{} mm", f.sensor_noise_mm)),
+        (
+            "σ".into(),
+            if f.no_sigma { "no" } else { "yes" }.to_string(),
+        ),
+    ];
+    let mut unseen = f.clone();
+    unseen.out.clear();
+    Reading::new(fields, format!("{unseen:?}"))
 }

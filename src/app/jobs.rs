@@ -4,6 +4,8 @@
 //! with `ctx.request_repaint()`. The frame loop only drains [`JobMessage`]s
 //! (egui's http_app, rerun's `background_tasks.rs`).
 
+pub mod measure;
+
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
 
@@ -49,6 +51,8 @@ pub enum JobMessage {
     Plan(PlanMessage),
     /// The Compensate view.
     Compensate(CompensateMessage),
+    /// The Measure view.
+    Measure(measure::MeasureMessage),
 }
 
 /// What the file jobs report.

@@ -58,11 +58,13 @@ pub enum Input {
     /// The Compensate view's targets file (its path, size and time) and
     /// options (pose convention, TCP).
     Targets,
+    /// The Measure form: the scan, `use`, frame, sensor noise, σ or not.
+    MeasureForm,
 }
 
 impl Input {
     /// Every input, in the order of the job.
-    pub const ALL: [Self; 7] = [
+    pub const ALL: [Self; 8] = [
         Self::PlanForm,
         Self::Session,
         Self::LeftOut,
@@ -70,6 +72,7 @@ impl Input {
         Self::Tolerance,
         Self::Calibration,
         Self::Targets,
+        Self::MeasureForm,
     ];
 
     /// Its name in a sentence: "the Plan form changed".
@@ -83,6 +86,7 @@ impl Input {
             Self::Tolerance => "the tolerance",
             Self::Calibration => "the calibration result",
             Self::Targets => "the targets",
+            Self::MeasureForm => "the Measure form",
         }
     }
 }
@@ -147,6 +151,8 @@ pub enum Output {
     /// The Compensate view's compensated targets (and the program
     /// written of them).
     Compensation,
+    /// The Measure view's point cloud (and its PLY, E57, CSV files).
+    Cloud,
 }
 
 impl Output {
@@ -169,6 +175,7 @@ impl Output {
                 Input::Calibration,
                 Input::Targets,
             ],
+            Self::Cloud => &[Input::Session, Input::Calibration, Input::MeasureForm],
         }
     }
 
@@ -180,6 +187,7 @@ impl Output {
             Self::Result => "the result",
             Self::Report => "the report",
             Self::Compensation => "the compensation",
+            Self::Cloud => "the cloud",
         }
     }
 }

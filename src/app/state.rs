@@ -4,6 +4,8 @@
 //! and job messages). The fields widgets edit are in
 //! [`forms`](super::forms).
 
+pub mod measure;
+
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -519,6 +521,8 @@ pub struct AppState {
     pub results_shown: u64,
     /// The Compensate view's job and its outcome.
     pub compensate: CompensateState,
+    /// The Measure view: its job, the cloud on show, its exports.
+    pub measure: measure::MeasureView,
 }
 
 impl AppState {
@@ -545,6 +549,7 @@ impl AppState {
             || self.plan.cancel.is_some()
             || self.plan.writing > 0
             || self.compensate.is_busy()
+            || self.measure.is_busy()
     }
 
     /// Indices of the measurements the session table shows, in its order

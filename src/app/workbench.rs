@@ -177,6 +177,7 @@ impl WorkbenchApp {
                 Tab::Compensate => {
                     panels::compensate::compensate_ui(ui, state, forms, &mut commands);
                 }
+                Tab::Measure => panels::measure::measure_ui(ui, state, forms, &mut commands),
             }
         });
         panels::drop_overlay_ui(&ctx);
@@ -186,6 +187,7 @@ impl WorkbenchApp {
         // A run's outcome is shown after the frame's commands: a Cancel
         // clicked in the frame it arrived in wins.
         self.core.finish_run();
+        self.core.finish_measure();
         // Fields edited this frame mark what they feed stale at once.
         self.core.observe();
     }

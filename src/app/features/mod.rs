@@ -14,6 +14,7 @@
 //! | [`history`] | scan, drift | scan a library folder |
 //! | [`plan`] | plan, cancel, export, simulate | the pose planner and its prediction |
 //! | [`compensate`] | compensate, cancel, write | targets and programs through the result on show |
+//! | [`measure`] | measure, cancel, export, browse | a scan into a point cloud, its self-validation, PLY/E57/CSV |
 //!
 //! [`Core`] holds what they share: the state, the forms and the job runner.
 
@@ -22,6 +23,7 @@ pub mod export;
 pub mod files;
 pub mod history;
 pub mod import;
+pub mod measure;
 pub mod plan;
 pub mod run;
 pub mod view;
@@ -81,6 +83,7 @@ impl Core {
             Command::History(c) => self.history(ctx, c),
             Command::Plan(c) => self.plan(ctx, c),
             Command::Compensate(c) => self.compensate(ctx, c),
+            Command::Measure(c) => self.measure(ctx, c),
         }
     }
 
@@ -94,6 +97,7 @@ impl Core {
             JobMessage::History(m) => self.on_history(ctx, m),
             JobMessage::Plan(m) => self.on_plan(ctx, m),
             JobMessage::Compensate(m) => self.on_compensate(m),
+            JobMessage::Measure(m) => self.on_measure(ctx, m),
         }
     }
 

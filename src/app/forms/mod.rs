@@ -5,6 +5,7 @@
 
 pub mod compensate;
 pub mod import;
+pub mod measure;
 pub mod plan;
 
 use std::collections::BTreeSet;
@@ -93,19 +94,23 @@ pub enum Tab {
     Plan,
     /// Targets and programs compensated through the result on show.
     Compensate,
+    /// Scans measured with the calibrated cell: the point cloud.
+    Measure,
 }
 
 impl Tab {
     /// All tabs, in the order of the job: plan the poses, bring the data
-    /// in, check the stripes and centres, calibrate and validate,
-    /// compensate the robot's targets, follow the cell over time.
-    pub const ALL: [Self; 8] = [
+    /// in, check the stripes and centres, calibrate and validate, measure
+    /// with the calibrated cell, compensate the robot's targets, follow the
+    /// cell over time.
+    pub const ALL: [Self; 9] = [
         Self::Plan,
         Self::Import,
         Self::Session,
         Self::Stripe,
         Self::Centres,
         Self::Results,
+        Self::Measure,
         Self::Compensate,
         Self::History,
     ];
@@ -122,6 +127,7 @@ impl Tab {
             Self::History => "History",
             Self::Plan => "Plan",
             Self::Compensate => "Compensate",
+            Self::Measure => "Measure",
         }
     }
 }
@@ -244,6 +250,8 @@ pub struct Forms {
     pub focus_after_fail: bool,
     /// The Compensate view's fields.
     pub compensate: CompensateForm,
+    /// The Measure view's fields.
+    pub measure: measure::MeasureForm,
 }
 
 impl Default for Forms {
@@ -267,6 +275,7 @@ impl Default for Forms {
             tolerance: crate::engine::tools::result_view::Tolerance::default(),
             focus_after_fail: false,
             compensate: CompensateForm::default(),
+            measure: measure::MeasureForm::default(),
         }
     }
 }

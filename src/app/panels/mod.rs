@@ -6,6 +6,7 @@ pub mod centres;
 pub mod compensate;
 pub mod history;
 pub mod import;
+pub mod measure;
 pub mod plan;
 pub mod plots;
 pub mod results;

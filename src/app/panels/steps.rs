@@ -1,5 +1,6 @@
 //! The step bar: the operator's job in order (plan → data in → stripes
-//! checked → calibrated → validated → reported), where the open session
+//! checked → calibrated → validated → reported, then measured: scans
+//! through the calibrated cell), where the open session
 //! stands, and the next action as one button, with an action in every
 //! state: a stale step is done again, a FAIL leads to the outliers and
 //! then to the planner, a session without validate measurements skips
@@ -84,7 +85,8 @@ fn outliers(state: &AppState) -> usize {
         .map_or(0, |m| m.outliers.len())
 }
 
-/// The six steps of the job for the current state.
+/// The steps of the job for the current state (the Measure step, the
+/// cell's use once calibrated, last).
 #[must_use]
 pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
     let prov = &state.provenance;
@@ -231,6 +233,7 @@ pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
                 Command::Export(ExportKind::ReportHtml),
             ),
         },
+        measure_step(state),
     ]
 }
 
@@ -445,5 +448,42 @@ pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &m
                 .small()
                 .color(WARN),
         );
+    }
+}
+
+/// The Measure step of the step bar: to do, under way, done or stale
+/// (the cloud's provenance).
+#[must_use]
+pub fn measure_step(state: &AppState) -> Step {
+    let m = &state.measure;
+    let stale = state.provenance.stale(Output::Cloud);
+    let show = Command::View(ViewCommand::ShowTab(Tab::Measure));
+    let (step_state, detail) = match (&m.job, &m.shown, &stale) {
+        (Some(job), _, _) => (
+            StepState::Running,
+            format!("measuring: {} ({:.0} %)", job.phase, job.fraction * 100.0),
+        ),
+        (None, Some(_), Some(s)) => (
+            StepState::Stale(s.what_changed()),
+            format!("{s}: measure again before exporting"),
+        ),
+        (None, Some(c), None) => (
+            StepState::Done,
+            format!(
+                "{} points measured of {}",
+                crate::app::features::measure::group(c.points),
+                c.scan
+            ),
+        ),
+        (None, None, _) => (
+            StepState::Todo,
+            "measure a scan with the calibrated cell (optional)".to_string(),
+        ),
+    };
+    Step {
+        name: "Measured",
+        state: step_state,
+        detail,
+        action: ("Measure a scan".to_string(), show),
     }
 }

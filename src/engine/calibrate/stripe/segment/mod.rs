@@ -371,7 +371,8 @@ fn no_circle_message(sphere: f64, min: f64, max: f64, best: &Option<BestCircle>)
 }
 
 /// A count with thousands separators: 2514 → "2,514".
-fn grouped(n: usize) -> String {
+#[must_use]
+pub fn grouped(n: usize) -> String {
     let digits = n.to_string();
     let mut out = String::with_capacity(digits.len() + digits.len() / 3);
     for (i, c) in digits.chars().enumerate() {
