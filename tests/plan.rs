@@ -228,14 +228,14 @@ fn degenerate_requests_are_explained() {
     config.sphere = [5000.0, 0.0, 0.0];
     config.candidates = 2;
     match make(&config) {
-        Err(PlanError::Unreachable { station, .. }) => assert_eq!(station, "P0"),
+        Err(PlanError::Unreachable(u)) => assert_eq!(u.station, "P0"),
         other => panic!("{other:?}"),
     }
     // No hand-eye groups: the first identify station is out of reach.
     config.n_translation = 0;
     config.n_rotation = 0;
     match make(&config) {
-        Err(e @ PlanError::Unreachable { .. }) => {
+        Err(e @ PlanError::Unreachable(_)) => {
             assert!(e.to_string().contains("station P1"), "{e}");
         }
         other => panic!("{other:?}"),

@@ -185,7 +185,8 @@ fn a_new_calibration_makes_the_cloud_stale_and_its_export_refused() {
     let notice = h.state().state().notice.clone().expect("refused");
     assert_eq!(notice.title, "Cloud not written");
     assert!(
-        notice.body.contains("the cloud is stale") && notice.body.contains("the calibration result"),
+        notice.body.contains("the cloud is stale")
+            && notice.body.contains("the calibration result"),
         "{}",
         notice.body
     );

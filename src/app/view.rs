@@ -79,17 +79,7 @@ fn step_125(x: f64) -> f32 {
     if !(x.is_finite() && x > 1.0) {
         return 1.0;
     }
-    let x = x.min(1000.0);
-    let decade = 10f64.powf(x.log10().floor());
-    let m = x / decade;
-    let step = if m >= 5.0 {
-        5.0
-    } else if m >= 2.0 {
-        2.0
-    } else {
-        1.0
-    };
-    (step * decade) as f32
+    crate::engine::base::numeric::step_125_at_most(x.min(1000.0)) as f32
 }
 
 impl CentreSet {

@@ -36,15 +36,7 @@ pub const DATE_LABEL_GAP: f64 = 96.0;
 /// `least` (data units); at least 1 when `whole`.
 #[must_use]
 pub fn nice_step(least: f64, whole: bool) -> f64 {
-    if !(least.is_finite() && least > 0.0) {
-        return 1.0;
-    }
-    let decade = 10f64.powf(least.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0]
-        .into_iter()
-        .map(|m| m * decade)
-        .find(|s| *s >= least * (1.0 - 1e-9))
-        .unwrap_or(10.0 * decade);
+    let step = crate::engine::base::numeric::step_125_at_least(least);
     if whole { step.max(1.0).round() } else { step }
 }
 
@@ -129,7 +121,7 @@ pub fn readable_y(plot: Plot<'_>) -> Plot<'_> {
 /// Mantissas tried, finest last, when whole decades leave fewer than two
 /// labels on a log axis.
 const LOG_MANTISSAS: [&[f64]; 2] = [
-    &[1.0, 2.0, 5.0],
+    &crate::engine::base::numeric::STEPS_125,
     &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
 ];
 

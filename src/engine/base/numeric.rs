@@ -1,5 +1,5 @@
 //! Small numerical helpers shared by the engine: rounding for files,
-//! medians and quantiles of samples.
+//! medians and quantiles of samples, 1-2-5 steps for axes and scale bars.
 
 /// Sweeps a singular value or symmetric eigen decomposition may take
 /// before it is abandoned: converging ones take a few per dimension; the
@@ -88,6 +88,46 @@ pub fn upper_median(values: &mut [f64]) -> f64 {
     *m
 }
 
+/// The steps of a decade that axes, scale bars and arrow scales use: 1, 2
+/// or 5 times a power of ten (the one home of this idea for the report's
+/// SVG figures and the workbench's plots).
+pub const STEPS_125: [f64; 3] = [1.0, 2.0, 5.0];
+
+/// Relative slack when comparing a step with its bound, so that a bound
+/// computed as 0.2 · (1 + 1e-16) still gets the step 0.2.
+const STEP_SLACK: f64 = 1e-9;
+
+/// The smallest step of 1, 2 or 5 times a power of ten that is at least
+/// `least` (same unit); 1 when `least` is not a positive finite number.
+#[must_use]
+pub fn step_125_at_least(least: f64) -> f64 {
+    if !(least.is_finite() && least > 0.0) {
+        return 1.0;
+    }
+    let decade = 10f64.powf(least.log10().floor());
+    STEPS_125
+        .iter()
+        .map(|m| m * decade)
+        .find(|s| *s >= least * (1.0 - STEP_SLACK))
+        .unwrap_or(10.0 * decade)
+}
+
+/// The largest step of 1, 2 or 5 times a power of ten at or below `most`
+/// (same unit); 1 when `most` is not a positive finite number.
+#[must_use]
+pub fn step_125_at_most(most: f64) -> f64 {
+    if !(most.is_finite() && most > 0.0) {
+        return 1.0;
+    }
+    let decade = 10f64.powf(most.log10().floor());
+    STEPS_125
+        .iter()
+        .rev()
+        .map(|m| m * decade)
+        .find(|s| *s <= most * (1.0 + STEP_SLACK))
+        .unwrap_or(decade)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -111,5 +151,18 @@ mod tests {
         assert_eq!(upper_median(&mut v), 3.0);
         let mut w = [4.0, 1.0, 3.0, 2.0];
         assert_eq!(upper_median(&mut w), 3.0);
+    }
+
+    #[test]
+    fn steps_125_both_ways() {
+        assert_eq!(step_125_at_least(0.7), 1.0);
+        assert_eq!(step_125_at_least(1.3), 2.0);
+        assert_eq!(step_125_at_least(0.2 * (1.0 + 1e-15)), 0.2);
+        assert_eq!(step_125_at_least(6.0), 10.0);
+        assert_eq!(step_125_at_least(-1.0), 1.0);
+        assert_eq!(step_125_at_most(7.9), 5.0);
+        assert_eq!(step_125_at_most(23.0), 20.0);
+        assert_eq!(step_125_at_most(0.3), 0.2);
+        assert_eq!(step_125_at_most(f64::NAN), 1.0);
     }
 }

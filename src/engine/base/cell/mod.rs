@@ -10,3 +10,21 @@ pub mod joint_log;
 pub mod random;
 pub mod sensor;
 pub mod workspace;
+
+/// A station that no candidate pose reaches: the simulator's and the
+/// planner's one refusal of a sphere out of reach.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "station {station} at [{:.1}, {:.1}, {:.1}] mm (base) is out of reach: {why}",
+    position[0], position[1], position[2]
+)]
+pub struct Unreachable {
+    /// Station id (and the pose, when one pose of a path failed).
+    pub station: String,
+    /// Its position, base frame, mm.
+    pub position: [f64; 3],
+    /// Flange orientations tried.
+    pub orientations: usize,
+    /// What was tried and what to change, in words.
+    pub why: String,
+}

@@ -250,6 +250,37 @@ pub struct Session {
 }
 
 impl Session {
+    /// A session made in code (imported, simulated, planned) rather than
+    /// read: named, its robot given (`base`/`flange` given when not the
+    /// identity), a `sphere_diameter` mm sphere, side +1 and no sensor,
+    /// solver or hand-eye block, no reference distances. Callers change
+    /// what they know with struct update syntax.
+    #[must_use]
+    pub fn made(
+        name: String,
+        robot: Robot,
+        sphere_diameter: f64,
+        measurements: Vec<Measurement>,
+    ) -> Self {
+        Self {
+            name,
+            name_given: true,
+            base_given: robot.base != Isometry3::identity(),
+            flange_given: robot.flange != Isometry3::identity(),
+            robot,
+            robot_given: true,
+            sphere_diameter,
+            default_side: 1,
+            sensor_given: false,
+            sensor_range: None,
+            hand_eye: None,
+            solver: SolverSettings::default(),
+            solver_given: false,
+            reference_distances: Vec::new(),
+            measurements,
+        }
+    }
+
     /// True for a pose-only session (FORMAT.md "Additions to version 1"):
     /// every measurement gives its flange pose instead of joint readings,
     /// so only the hand-eye and the station centres are calibrated.

@@ -38,8 +38,6 @@ pub mod units;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use nalgebra::Isometry3;
-
 pub use self::check::{
     DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG, FlangeCheck, PoseCheck,
 };
@@ -57,9 +55,7 @@ pub use crate::engine::files::program::PoseFormat;
 
 use self::csv_file::CsvFile;
 use crate::engine::base::robot::Robot;
-use crate::engine::base::session::{
-    MIN_STRIPE_POINTS, Measurement, Observation, Session, SolverSettings, Use,
-};
+use crate::engine::base::session::{MIN_STRIPE_POINTS, Measurement, Observation, Session, Use};
 use crate::engine::files::format::FileError;
 
 /// Default sphere diameter, mm: the 1.5 inch sphere of the paper.
@@ -604,24 +600,14 @@ pub(crate) fn new_session(
     let robot_given = robot.is_some();
     let robot = robot.unwrap_or_else(|| Robot::new(String::new(), Vec::new()));
     Ok(Session {
-        name,
-        name_given: true,
-        base_given: robot.base != Isometry3::identity(),
-        flange_given: robot.flange != Isometry3::identity(),
-        robot,
         robot_given,
-        sphere_diameter,
         default_side: side.unwrap_or(1),
         sensor_given: side.is_some(),
-        sensor_range: None,
-        hand_eye: None,
-        solver: SolverSettings::default(),
-        solver_given: false,
         reference_distances: match references {
             Some(path) => read_references(path)?,
             None => Vec::new(),
         },
-        measurements,
+        ..Session::made(name, robot, sphere_diameter, measurements)
     })
 }
 

@@ -9,12 +9,12 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::engine::base::cell::workspace::{self, Workspace};
-use crate::engine::base::cell::{approach, random};
+use crate::engine::base::cell::{Unreachable, approach, random};
 use crate::engine::base::geometry::wrap_deg;
 use crate::engine::base::robot::Robot;
 use crate::engine::base::robot::ik::{Chain, DOF};
 use crate::engine::base::session::{
-    Measurement, Observation, ReferenceDistance, SensorRange, Session, SolverSettings, Use,
+    Measurement, Observation, ReferenceDistance, SensorRange, Session, Use,
 };
 use crate::engine::calibrate::handeye::{MIN_TRANSLATION_SPREAD, Sighting};
 use crate::engine::calibrate::solve::estimate::{
@@ -284,14 +284,19 @@ impl Planner<'_> {
         station: &Vector3<f64>,
         orientations: usize,
     ) -> PlanError {
-        PlanError::Unreachable {
+        let (cone, cut, min_wrist) = (
+            self.config.cone_angle,
+            self.config.cut_angle,
+            self.config.min_wrist_angle,
+        );
+        PlanError::Unreachable(Unreachable {
             station: id.to_owned(),
             position: [station.x, station.y, station.z],
             orientations,
-            cone: self.config.cone_angle,
-            cut: self.config.cut_angle,
-            min_wrist: self.config.min_wrist_angle,
-        }
+            why: format!(
+                "none of {orientations} flange orientations (approach within {cone:.0}° of the look from the eye point) sees it with the laser plane at ±{cut:.0}° within the joint limits and {min_wrist:.0}° from the wrist singularity; move the sphere (or the station box) toward the robot, or widen the cone"
+            ),
+        })
     }
 
     /// The translation group at `P0` (side +1, one orientation, one IK
@@ -549,21 +554,12 @@ impl Planner<'_> {
             })
             .collect();
         let session = Session {
-            name: "plan".to_owned(),
-            name_given: true,
-            robot: c.robot.clone(),
-            robot_given: true,
             base_given: false,
             flange_given: false,
-            sphere_diameter: c.diameter,
-            default_side: 1,
-            sensor_given: false,
             sensor_range: c.range,
             hand_eye: Some(c.flange_from_sensor),
-            solver: SolverSettings::default(),
-            solver_given: false,
             reference_distances,
-            measurements,
+            ..Session::made("plan".to_owned(), c.robot.clone(), c.diameter, measurements)
         };
         let prepared = Prepared {
             measurements: prepared,

@@ -129,24 +129,8 @@ pub enum PlanError {
     #[error("invalid plan setting: {0}")]
     InvalidConfig(String),
     /// No candidate pose sees the station.
-    #[error(
-        "station {station} at [{:.1}, {:.1}, {:.1}] mm (base) is out of reach: none of {orientations} flange orientations (approach within {cone:.0}° of the look from the eye point) sees it with the laser plane at ±{cut:.0}° within the joint limits and {min_wrist:.0}° from the wrist singularity; move the sphere (or the station box) toward the robot, or widen the cone",
-        position[0], position[1], position[2]
-    )]
-    Unreachable {
-        /// Station id.
-        station: String,
-        /// Its position, base frame, mm.
-        position: [f64; 3],
-        /// Orientations tried.
-        orientations: usize,
-        /// Cone half-angle, deg.
-        cone: f64,
-        /// Cut angle, deg.
-        cut: f64,
-        /// Smallest wrist angle, deg.
-        min_wrist: f64,
-    },
+    #[error(transparent)]
+    Unreachable(#[from] crate::engine::base::cell::Unreachable),
     /// A station has too few reachable candidate poses on one side.
     #[error(
         "station {station} at [{:.1}, {:.1}, {:.1}] mm (base): only {found} reachable pose(s) see the sphere on side {side:+} of the laser plane, {needed} needed; draw more candidates, ask for fewer poses, or move the station toward the middle of the robot's reach",

@@ -10,6 +10,8 @@
 
 use std::fmt::Write as _;
 
+use crate::engine::base::numeric::step_125_at_least;
+
 /// Room left of the plot area for the y tick labels and the y label, px.
 const MARGIN_LEFT: f64 = 64.0;
 /// Room right of the plot area, px.
@@ -153,18 +155,7 @@ pub fn nice_ticks(lo: f64, hi: f64, target: usize, integer: bool) -> Vec<f64> {
     }
     let span = (hi - lo).max(f64::EPSILON * hi.abs().max(1.0));
     let raw = span / target.max(1) as f64;
-    let decade = 10f64.powf(raw.log10().floor());
-    let m = raw / decade;
-    let mut step = decade
-        * if m <= 1.0 {
-            1.0
-        } else if m <= 2.0 {
-            2.0
-        } else if m <= 5.0 {
-            5.0
-        } else {
-            10.0
-        };
+    let mut step = step_125_at_least(raw);
     if integer {
         step = step.max(1.0).round();
     }
@@ -183,7 +174,7 @@ fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     let mut out = Vec::new();
     for e in (a..=b).filter(|e| e.rem_euclid(every) == 0) {
         for m in if few {
-            &[1.0, 2.0, 5.0][..]
+            &crate::engine::base::numeric::STEPS_125[..]
         } else {
             &[1.0][..]
         } {

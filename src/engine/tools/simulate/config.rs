@@ -232,18 +232,8 @@ pub enum SimError {
     InvalidConfig(String),
     /// No orientation in the cone reached a station within the joint
     /// limits and away from the wrist singularity.
-    #[error(
-        "station {station} at [{:.1}, {:.1}, {:.1}] mm (base) is out of reach: no pose found in {attempts} orientations; use a smaller workspace or cone",
-        position[0], position[1], position[2]
-    )]
-    Unreachable {
-        /// Station id.
-        station: String,
-        /// Station centre, base frame, mm.
-        position: [f64; 3],
-        /// Orientations tried.
-        attempts: usize,
-    },
+    #[error(transparent)]
+    Unreachable(#[from] crate::engine::base::cell::Unreachable),
     /// A pose of a plan does not see the sphere on the true robot: the
     /// sphere centre falls outside the usable cut of the laser plane.
     #[error(

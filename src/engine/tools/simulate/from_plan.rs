@@ -15,7 +15,7 @@ use crate::engine::base::cell::sensor::paper_initial_hand_eye;
 use crate::engine::base::geometry::rows_from_isometry;
 use crate::engine::base::robot::Robot;
 use crate::engine::base::robot::ik::{Chain, DOF};
-use crate::engine::base::session::{Session, SolverSettings, Use};
+use crate::engine::base::session::{Session, Use};
 
 /// Smallest cut angle (deg) at which a pose of a plan still counts as
 /// seeing the sphere on the true robot: below it the centre is within
@@ -224,24 +224,8 @@ pub fn simulate_plan(
         InitialHandEye::Truth => Some(*flange_from_sensor),
     };
     let session = Session {
-        name: name.clone(),
-        name_given: true,
-        robot: nominal.clone(),
-        robot_given: true,
-        base_given: nominal.base != Isometry3::identity(),
-        flange_given: nominal.flange != Isometry3::identity(),
-        sphere_diameter: config.diameter,
-        default_side,
-        sensor_given: true,
-        sensor_range: config.range,
-        hand_eye,
-        solver: SolverSettings {
-            threshold: config.threshold,
-            max_iterations: config.max_iterations,
-        },
-        solver_given: true,
         reference_distances,
-        measurements,
+        ..super::simulated_session(&name, nominal, config, default_side, hand_eye, measurements)
     };
     echoed.name = Some(name.clone());
     let truth = Truth {

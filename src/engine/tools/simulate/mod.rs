@@ -304,24 +304,18 @@ pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
         InitialHandEye::Truth => Some(flange_from_sensor),
     };
     let session = Session {
-        name: name.clone(),
-        name_given: true,
-        robot: nominal.clone(),
-        robot_given: true,
+        // The simulator's own robots keep their base and flange unwritten.
         base_given: false,
         flange_given: false,
-        sphere_diameter: config.diameter,
-        default_side,
-        sensor_given: true,
-        sensor_range: config.range,
-        hand_eye,
-        solver: SolverSettings {
-            threshold: config.threshold,
-            max_iterations: config.max_iterations,
-        },
-        solver_given: true,
         reference_distances,
-        measurements,
+        ..simulated_session(
+            &name,
+            &nominal,
+            config,
+            default_side,
+            hand_eye,
+            measurements,
+        )
     };
     let mut echoed = config.clone();
     echoed.name = Some(name.clone());
@@ -345,6 +339,36 @@ pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
         measurements: OrderedMap(truths),
     };
     Ok((session, truth))
+}
+
+/// The session of a simulation: the nominal robot, the simulated sensor
+/// (its side and range) and solver settings, the hand-eye when the
+/// configuration gives one; reference distances added by the caller.
+pub(crate) fn simulated_session(
+    name: &str,
+    nominal: &crate::engine::base::robot::Robot,
+    config: &SimConfig,
+    default_side: i8,
+    hand_eye: Option<nalgebra::Isometry3<f64>>,
+    measurements: Vec<Measurement>,
+) -> Session {
+    Session {
+        default_side,
+        sensor_given: true,
+        sensor_range: config.range,
+        hand_eye,
+        solver: SolverSettings {
+            threshold: config.threshold,
+            max_iterations: config.max_iterations,
+        },
+        solver_given: true,
+        ..Session::made(
+            name.to_owned(),
+            nominal.clone(),
+            config.diameter,
+            measurements,
+        )
+    }
 }
 
 #[cfg(test)]
@@ -454,7 +478,7 @@ mod tests {
             ..SimConfig::default()
         };
         match simulate(&c) {
-            Err(SimError::Unreachable { station, .. }) => assert_eq!(station, "P1"),
+            Err(SimError::Unreachable(u)) => assert_eq!(u.station, "P1"),
             other => panic!("{other:?}"),
         }
     }

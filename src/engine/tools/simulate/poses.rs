@@ -331,10 +331,27 @@ impl Planner<'_> {
 }
 
 pub(super) fn unreachable(id: &str, station: &Vector3<f64>) -> SimError {
-    SimError::Unreachable {
-        station: id.to_owned(),
-        position: [station.x, station.y, station.z],
-        attempts: MAX_POSE_ATTEMPTS,
+    SimError::Unreachable(unreachable_after(
+        id.to_owned(),
+        [station.x, station.y, station.z],
+        MAX_POSE_ATTEMPTS,
+    ))
+}
+
+/// The simulator's refusal of a station (or a scan pose) after
+/// `orientations` tried.
+pub(super) fn unreachable_after(
+    station: String,
+    position: [f64; 3],
+    orientations: usize,
+) -> crate::engine::base::cell::Unreachable {
+    crate::engine::base::cell::Unreachable {
+        station,
+        position,
+        orientations,
+        why: format!(
+            "no pose found in {orientations} orientations; use a smaller workspace or cone"
+        ),
     }
 }
 

@@ -517,10 +517,12 @@ pub fn simulate_scan(config: &SimConfig, scan: &ScanConfig) -> Result<SimulatedS
         let actual = solutions
             .into_iter()
             .min_by(|a, b| nearest(a).total_cmp(&nearest(b)))
-            .ok_or_else(|| SimError::Unreachable {
-                station: format!("{station} (scan pose {id})"),
-                position: base_from_sensor.translation.vector.into(),
-                attempts: 1,
+            .ok_or_else(|| {
+                SimError::Unreachable(super::poses::unreachable_after(
+                    format!("{station} (scan pose {id})"),
+                    base_from_sensor.translation.vector.into(),
+                    1,
+                ))
             })?;
         previous = Some(actual);
         let recorded: Vec<f64> = actual
