@@ -13,7 +13,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::engine::history::{Drift, Library};
-use crate::engine::import::PoseCheck;
+use crate::engine::import::{PoseCheck, PoseImportSpec, PosePreview};
 use crate::engine::plan::Controller;
 use crate::engine::plan::{Plan, PlanError, Prediction};
 use crate::engine::result_view::Tolerance;
@@ -243,6 +243,10 @@ pub enum DialogPurpose {
     ImportReferences,
     /// History: the library folder.
     HistoryFolder,
+    /// Import wizard: the sphere centres the sensor reported.
+    ImportCentres,
+    /// Import wizard: a hand-eye guess file (4×4 JSON, session or result).
+    ImportHandEye,
 }
 
 /// What the Plan view writes.
@@ -359,6 +363,17 @@ pub struct ImportView {
     pub checks: Vec<PoseCheck>,
     /// The last import's outcome in one line, or its error.
     pub outcome: Option<Result<String, String>>,
+    /// The pose file's preview (layout, pairing, eq. 6-9 group) of the
+    /// latest scan, or why the pose file cannot be read.
+    pub pose_preview: Option<Result<PosePreview, String>>,
+    /// What the latest scan was started from (the form's
+    /// [`crate::app::forms::ImportForm::pose_scan_key`]): a form that
+    /// reads otherwise is scanned again.
+    pub scanned: Option<PoseImportSpec>,
+    /// The latest scan's number; an older scan's answer is dropped.
+    pub scan_generation: u64,
+    /// The last import found no initial hand-eye: why (a guess is needed).
+    pub guess_needed: Option<String>,
 }
 
 /// What the Plan view shows.

@@ -11,6 +11,7 @@
 //! | [`run`] | run, cancel | the calibration |
 //! | [`export`] | the Results view's exports | result JSON, CSV, PNG, HTML report, model |
 //! | [`import`] | preview, import | the import wizard's engine calls |
+//! | [`import_poses`] | scan | a pose file read and paired before import |
 //! | [`history`] | scan, drift | scan a library folder |
 //! | [`plan`] | plan, cancel, export, simulate | the pose planner and its prediction |
 //!
@@ -20,6 +21,7 @@ pub mod export;
 pub mod files;
 pub mod history;
 pub mod import;
+pub mod import_poses;
 pub mod plan;
 pub mod run;
 pub mod view;

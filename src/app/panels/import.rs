@@ -1,8 +1,10 @@
 //! The Import view: a wizard that turns a pose log and stripe profile
 //! files into a session (the engine's [`crate::engine::import`], as
-//! `spherecal import`). A joint log CSV, or the controller's flange poses
-//! (JSON, RobCalibrator `.rob`, CSV) for a pose-only session; profiles as
-//! CSV/TXT or OpenCV YAML/JSON in the sensor's axes. Steps on one page:
+//! `spherecal import`). A joint log CSV, or a pose file in any layout the
+//! engine reads (tables with or without a header, `.rob`, FANUC `.ls`,
+//! RAPID, KUKA, URScript; [`super::import_poses`]: layout detected,
+//! pairing shown before the import, a hand-eye guess, centres); profiles
+//! as CSV/TXT or OpenCV YAML/JSON in the sensor's axes. Steps on one page:
 //! files, robot, units and axes, column mapping with a preview of the
 //! first rows (joint logs); then Import opens the session and says what it
 //! decided (axis map, side, initial hand-eye) and the flange-pose checks.
@@ -12,13 +14,13 @@ use egui::RichText;
 use super::{BAD, DEFAULT_RANGE, WARN, labelled_field, range_fields, range_of};
 use crate::app::commands::{Command, FilesCommand, ImportCommand};
 use crate::app::forms::Forms;
-use crate::app::forms::import::{CONVENTIONS, ImportForm, LogKind, ProfilesKind};
+use crate::app::forms::import::{CONVENTIONS, ImportForm, LogKind, ObservationKind, ProfilesKind};
 use crate::app::state::{AppState, DialogPurpose};
-use crate::engine::import::{AngleUnit, FlangeConvention, LengthUnit, SideChoice};
+use crate::engine::import::{AngleUnit, LengthUnit, SideChoice};
 use crate::engine::robot::{self, DhConvention};
 
 /// Width of the path fields, points.
-const PATH_WIDTH: f32 = 420.0;
+pub(super) const PATH_WIDTH: f32 = 420.0;
 /// Width of a column-name field, points.
 const COLUMN_WIDTH: f32 = 90.0;
 
@@ -34,6 +36,11 @@ pub fn import_ui(
     import_form_ui(ui, state, forms, commands);
     if forms.import != before {
         commands.push(Command::Import(ImportCommand::Edited));
+    }
+    // A pose file (or its layout, convention, profiles) that reads
+    // otherwise than at the last scan is read and paired again.
+    if forms.import.pose_scan_key() != state.import.scanned {
+        commands.push(Command::Import(ImportCommand::Scan));
     }
 }
 
@@ -55,21 +62,29 @@ fn import_form_ui(
                     DialogPurpose::ImportPoses,
                     DialogPurpose::ImportProfiles,
                     DialogPurpose::ImportReferences,
+                    DialogPurpose::ImportCentres,
+                    DialogPurpose::ImportHandEye,
                 ],
             );
             ui.label(
                 RichText::new(
-                    "A joint log (one row per pose: id, station, use, joints) or the controller's flange poses \
-                     (no joints: a pose-only session that calibrates the hand-eye); one profile file per pose \
-                     (CSV/TXT, OpenCV YAML/JSON) or one file with a pose column. The session is checked by the \
-                     same rules as a session file.",
+                    "A joint log (one row per pose: id, station, use, joints) or a pose file as the cell wrote it \
+                     (a robot program or a pose table: flange poses give a pose-only session that calibrates the hand-eye); \
+                     one profile file per pose (CSV/TXT, OpenCV YAML/JSON; a published folder as it is) or one file with a \
+                     pose column, or the sphere centres the sensor reported. The session is checked by the same rules as a session file.",
                 )
                 .weak(),
             );
             ui.add_space(6.0);
             let busy = state.busy.importing > 0 || state.busy.dialog;
-            files_ui(ui, busy, &mut forms.import, commands);
+            files_ui(ui, state, busy, &mut forms.import, commands);
             ui.separator();
+            if forms.import.log_kind == LogKind::FlangePoses {
+                super::import_poses::detected_ui(ui, state, commands);
+                ui.separator();
+                super::import_poses::hand_eye_ui(ui, state, busy, &mut forms.import, commands);
+                ui.separator();
+            }
             robot_ui(ui, &mut forms.import);
             ui.separator();
             let joints = forms.import.log_kind == LogKind::Joints;
@@ -112,7 +127,13 @@ fn import_form_ui(
         });
 }
 
-fn files_ui(ui: &mut egui::Ui, busy: bool, f: &mut ImportForm, commands: &mut Vec<Command>) {
+fn files_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    busy: bool,
+    f: &mut ImportForm,
+    commands: &mut Vec<Command>,
+) {
     ui.label(RichText::new("1 · Files").strong());
     ui.horizontal(|ui| {
         ui.label("Pose log");
@@ -120,7 +141,7 @@ fn files_ui(ui: &mut egui::Ui, busy: bool, f: &mut ImportForm, commands: &mut Ve
         ui.radio_value(
             &mut f.log_kind,
             LogKind::FlangePoses,
-            "flange poses, no joints (pose-only)",
+            "a pose file (robot program or pose table)",
         );
     });
     egui::Grid::new("import_files")
@@ -138,64 +159,57 @@ fn files_ui(ui: &mut egui::Ui, busy: bool, f: &mut ImportForm, commands: &mut Ve
                     commands,
                 );
             } else {
+                let preview = state
+                    .import
+                    .pose_preview
+                    .as_ref()
+                    .and_then(|p| p.as_ref().ok());
+                super::import_poses::pose_file_rows(ui, busy, f, preview, commands);
+                if f.observations == ObservationKind::Profiles {
+                    ui.label("Sphere side");
+                    ui.horizontal(|ui| {
+                        ui.radio_value(&mut f.side, SideChoice::Auto, "decide from the data");
+                        ui.radio_value(&mut f.side, SideChoice::Plus, "+1 (sensor x > 0)");
+                        ui.radio_value(&mut f.side, SideChoice::Minus, "−1");
+                    });
+                    ui.end_row();
+                }
+            }
+            let centres =
+                f.log_kind == LogKind::FlangePoses && f.observations == ObservationKind::Centres;
+            if !centres {
+                let hint = match f.profiles_kind {
+                    ProfilesKind::Folder => {
+                        "/path/to/profiles/ (one file per pose: <id>.csv, .yml …)"
+                    }
+                    ProfilesKind::File => "/path/to/profiles.csv (with a pose column)",
+                };
                 path_row(
                     ui,
-                    "Flange-pose log",
-                    &mut f.poses,
-                    "/path/to/RobPoses.rob (JSON) or poses.csv",
+                    "Stripe profiles",
+                    &mut f.profiles,
+                    hint,
                     busy,
-                    DialogPurpose::ImportPoses,
+                    DialogPurpose::ImportProfiles,
                     commands,
                 );
-                let l = ui.label("Pose convention");
-                egui::ComboBox::from_id_salt("import_pose_convention")
-                    .selected_text(f.pose_convention.describe())
-                    .width(PATH_WIDTH)
-                    .show_ui(ui, |ui| {
-                        for c in FlangeConvention::ALL {
-                            ui.selectable_value(&mut f.pose_convention, c, c.describe());
-                        }
-                    })
-                    .response
-                    .labelled_by(l.id);
-                ui.end_row();
-                ui.label("Sphere side");
+                ui.label("");
                 ui.horizontal(|ui| {
-                    ui.radio_value(&mut f.side, SideChoice::Auto, "decide from the data");
-                    ui.radio_value(&mut f.side, SideChoice::Plus, "+1 (sensor x > 0)");
-                    ui.radio_value(&mut f.side, SideChoice::Minus, "−1");
+                    ui.radio_value(
+                        &mut f.profiles_kind,
+                        ProfilesKind::Folder,
+                        "a folder, one file per pose",
+                    );
+                    ui.radio_value(&mut f.profiles_kind, ProfilesKind::File, "one file");
+                    let l = ui.label("pose column");
+                    ui.add_enabled(
+                        f.profiles_kind == ProfilesKind::File,
+                        egui::TextEdit::singleline(&mut f.pose_column).desired_width(COLUMN_WIDTH),
+                    )
+                    .labelled_by(l.id);
                 });
                 ui.end_row();
             }
-            let hint = match f.profiles_kind {
-                ProfilesKind::Folder => "/path/to/profiles/ (one file per pose: <id>.csv, .yml …)",
-                ProfilesKind::File => "/path/to/profiles.csv (with a pose column)",
-            };
-            path_row(
-                ui,
-                "Stripe profiles",
-                &mut f.profiles,
-                hint,
-                busy,
-                DialogPurpose::ImportProfiles,
-                commands,
-            );
-            ui.label("");
-            ui.horizontal(|ui| {
-                ui.radio_value(
-                    &mut f.profiles_kind,
-                    ProfilesKind::Folder,
-                    "a folder, one file per pose",
-                );
-                ui.radio_value(&mut f.profiles_kind, ProfilesKind::File, "one file");
-                let l = ui.label("pose column");
-                ui.add_enabled(
-                    f.profiles_kind == ProfilesKind::File,
-                    egui::TextEdit::singleline(&mut f.pose_column).desired_width(COLUMN_WIDTH),
-                )
-                .labelled_by(l.id);
-            });
-            ui.end_row();
             path_row(
                 ui,
                 "Reference distances CSV",
@@ -208,7 +222,7 @@ fn files_ui(ui: &mut egui::Ui, busy: bool, f: &mut ImportForm, commands: &mut Ve
         });
 }
 
-fn path_row(
+pub(super) fn path_row(
     ui: &mut egui::Ui,
     label: &str,
     text: &mut String,

@@ -5,6 +5,7 @@
 pub mod centres;
 pub mod history;
 pub mod import;
+pub mod import_poses;
 pub mod plan;
 pub mod plots;
 pub mod results;

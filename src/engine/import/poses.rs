@@ -488,7 +488,10 @@ type Paired = (Vec<String>, Vec<PlaneProfile>, ProfileReport, Vec<String>);
 /// with the `k`-th profile.
 #[must_use]
 pub fn paired_by_id(source: &ProfileSource, records: &[PoseRecord]) -> Option<Vec<String>> {
-    let ids: Vec<String> = records.iter().map(|r| r.id.clone()).collect::<Option<_>>()?;
+    let ids: Vec<String> = records
+        .iter()
+        .map(|r| r.id.clone())
+        .collect::<Option<_>>()?;
     let named = match source {
         ProfileSource::Folder(dir) => ids.iter().all(|id| profiles::file_of(dir, id).is_some()),
         ProfileSource::File { .. } => true,

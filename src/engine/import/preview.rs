@@ -294,8 +294,7 @@ fn pairing(spec: &PoseImportSpec, records: &[PoseRecord]) -> Result<PairingPrevi
             }
             match source {
                 ProfileSource::Folder(dir) => {
-                    let listing =
-                        list_profiles(dir, &[spec.poses.as_path()], Some(records.len()))?;
+                    let listing = list_profiles(dir, &[spec.poses.as_path()], Some(records.len()))?;
                     let mut p = in_order(
                         "pose k with the k-th profile in the order of the number in their names"
                             .into(),
