@@ -829,7 +829,7 @@ fn the_wizard_imports_flange_poses_and_the_run_calibrates_the_hand_eye_only() {
         form.pose_convention = Some(spherecal::engine::import::FlangeConvention::FanucWpr);
         form.sphere_diameter = 80.0;
     }
-    h.run();
+    settle(&mut h);
     assert!(
         h.query_all_by_label_contains("Pose file").count() > 0,
         "the pose-log fields are shown"

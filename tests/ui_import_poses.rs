@@ -17,8 +17,8 @@ use egui_kittest::kittest::Queryable as _;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use spherecal::app::WorkbenchApp;
 use spherecal::app::forms::Tab;
-use spherecal::app::forms::import::HandEyeChoice;
-use spherecal::engine::geometry::roll_pitch_yaw_deg;
+use spherecal::app::forms::import::{HandEyeChoice, ObservationKind};
+use spherecal::engine::geometry::{rigid_from_rows, roll_pitch_yaw_deg};
 use spherecal::engine::import::{FlangeConvention, PoseFormat, PosePreview, SideChoice};
 use spherecal::engine::session::Observation;
 use spherecal::engine::simulate::{self, SimConfig};
@@ -29,6 +29,12 @@ use ui_support::{demo_app, scroll_to, settle};
 /// True flange poses and stripes of one station of a noise-free
 /// simulated cell: 4 pure translations and 8 orientation changes.
 fn cell() -> (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>) {
+    let (poses, stripes, _) = cell_with_centres();
+    (poses, stripes)
+}
+
+/// As [`cell`], with each pose's true sphere centre in the sensor frame.
+fn cell_with_centres() -> (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>, Vec<Point3<f64>>) {
     let config = SimConfig {
         seed: 3,
         n_translation: 4,
@@ -50,7 +56,18 @@ fn cell() -> (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>) {
         };
         stripes.push(p.clone());
     }
-    (poses, stripes)
+    let flange_from_sensor = rigid_from_rows(&truth.hand_eye);
+    let station = truth
+        .stations
+        .iter()
+        .find(|(k, _)| *k == "P0")
+        .map(|(_, c)| Point3::from(Vector3::from(*c)))
+        .unwrap();
+    let centres = poses
+        .iter()
+        .map(|p| (p * flange_from_sensor).inverse() * station)
+        .collect();
+    (poses, stripes, centres)
 }
 
 /// Profiles named as a published folder names them (`7_3C_line.txt`,
@@ -145,20 +162,9 @@ fn preview(h: &Harness<'_, WorkbenchApp>) -> PosePreview {
 /// Where the view's content is (the wheel scrolls it there).
 const VIEW: egui::Pos2 = egui::pos2(900.0, 400.0);
 
-/// Scrolls the view to its end (where the Import button is) and clicks
-/// Import and open; waits for the import.
+/// Clicks Import and open (above the form, always in view) and waits
+/// for the import.
 fn import_and_open(h: &mut Harness<'_, WorkbenchApp>) {
-    for _ in 0..20 {
-        h.hover_at(egui::pos2(1340.0, 700.0));
-        h.event(egui::Event::MouseWheel {
-            unit: egui::MouseWheelUnit::Point,
-            delta: egui::vec2(0.0, -400.0),
-            phase: egui::TouchPhase::Move,
-            source: egui::MouseWheelSource::Unknown,
-            modifiers: egui::Modifiers::NONE,
-        });
-        h.run();
-    }
     h.get_by_label("Import and open").click();
     settle(h);
 }
@@ -411,4 +417,52 @@ fn a_headerless_whitespace_table_needs_its_convention_then_imports() {
     assert_eq!(loaded.session.measurements.len(), 12);
     let first = loaded.session.measurements[0].flange.unwrap();
     assert!((first.translation.vector - poses[0].translation.vector).norm() < 1e-6);
+}
+
+#[test]
+fn centres_the_sensor_reported_are_chosen_instead_of_profiles() {
+    let (poses, _, centres) = cell_with_centres();
+    let dir = tempfile::tempdir().unwrap();
+    let ls = dir.path().join("calib.ls");
+    std::fs::write(&ls, fanuc_ls(&poses)).unwrap();
+    let table = dir.path().join("centres.txt");
+    let mut t = String::new();
+    for c in &centres {
+        writeln!(t, "{:.9} {:.9} {:.9}", c.x, c.y, c.z).unwrap();
+    }
+    std::fs::write(&table, t).unwrap();
+    let mut h = import_view(&ls, Path::new(""));
+    h.get_by_label("sphere centres (its own sphere fit)")
+        .click();
+    settle(&mut h);
+    assert_eq!(
+        h.state().forms().import.observations,
+        ObservationKind::Centres
+    );
+    assert!(
+        h.query_by_label("Stripe profiles").is_none(),
+        "centres instead of profiles"
+    );
+    h.get_by_label("Centres file").click();
+    settle(&mut h);
+    h.get_by_label("Centres file")
+        .type_text(&table.display().to_string());
+    settle(&mut h);
+    let pairing = preview(&h).pairing.expect("paired");
+    assert_eq!(pairing.pairs.len(), 12);
+    assert_eq!(pairing.pairs[0], (0, "centre at line 1".to_string()));
+    assert!(
+        pairing
+            .how
+            .contains("sphere centres of centres.txt in order")
+    );
+    import_and_open(&mut h);
+    let loaded = h.state().state().loaded.as_ref().expect("a session");
+    assert_eq!(loaded.session.measurements.len(), 12);
+    for (m, c) in loaded.session.measurements.iter().zip(&centres) {
+        let Observation::Centre(x) = &m.observation else {
+            panic!("{}: a centre measurement", m.id)
+        };
+        assert!((x - c.coords).norm() < 1e-6);
+    }
 }

@@ -11,7 +11,7 @@
 
 use egui::RichText;
 
-use super::{BAD, DEFAULT_RANGE, WARN, labelled_field, range_fields, range_of};
+use super::{BAD, DEFAULT_RANGE, GOOD, WARN, labelled_field, range_fields, range_of};
 use crate::app::commands::{Command, FilesCommand, ImportCommand};
 use crate::app::forms::Forms;
 use crate::app::forms::import::{CONVENTIONS, ImportForm, LogKind, ObservationKind, ProfilesKind};
@@ -21,6 +21,9 @@ use crate::engine::robot::{self, DhConvention};
 
 /// Width of the path fields, points.
 pub(super) const PATH_WIDTH: f32 = 420.0;
+/// Largest height of the import's error above the form, points: a long
+/// message scrolls rather than push the form off a 768-pixel screen.
+const ERROR_HEIGHT: f32 = 90.0;
 /// Width of a column-name field, points.
 const COLUMN_WIDTH: f32 = 90.0;
 
@@ -50,36 +53,39 @@ fn import_form_ui(
     forms: &mut Forms,
     commands: &mut Vec<Command>,
 ) {
+    ui.heading("Import a pose log and stripe profiles");
+    super::dialog_note_ui(
+        ui,
+        state,
+        &[
+            DialogPurpose::ImportJoints,
+            DialogPurpose::ImportPoses,
+            DialogPurpose::ImportProfiles,
+            DialogPurpose::ImportReferences,
+            DialogPurpose::ImportCentres,
+            DialogPurpose::ImportHandEye,
+        ],
+    );
+    ui.label(
+        RichText::new(
+            "A joint log (id, station, use, joints a row) or a pose file as the cell wrote it (program or table; \
+             flange poses give a pose-only session); one profile file a pose (CSV/TXT, OpenCV YAML/JSON), one file \
+             with a pose column, or the sensor's sphere centres. Checked by the session file's rules.",
+        )
+        .weak(),
+    );
+    let busy = state.busy.importing > 0 || state.busy.dialog;
+    let joints = forms.import.log_kind == LogKind::Joints;
+    // The actions stay in view above the form (it is taller than the
+    // window at 1366×768); the full outcome is at the form's end.
+    actions_ui(ui, state, busy, joints, commands);
+    ui.separator();
     egui::ScrollArea::vertical()
         .auto_shrink([false, false])
         .show(ui, |ui| {
-            ui.heading("Import a pose log and stripe profiles");
-            super::dialog_note_ui(
-                ui,
-                state,
-                &[
-                    DialogPurpose::ImportJoints,
-                    DialogPurpose::ImportPoses,
-                    DialogPurpose::ImportProfiles,
-                    DialogPurpose::ImportReferences,
-                    DialogPurpose::ImportCentres,
-                    DialogPurpose::ImportHandEye,
-                ],
-            );
-            ui.label(
-                RichText::new(
-                    "A joint log (one row per pose: id, station, use, joints) or a pose file as the cell wrote it \
-                     (a robot program or a pose table: flange poses give a pose-only session that calibrates the hand-eye); \
-                     one profile file per pose (CSV/TXT, OpenCV YAML/JSON; a published folder as it is) or one file with a \
-                     pose column, or the sphere centres the sensor reported. The session is checked by the same rules as a session file.",
-                )
-                .weak(),
-            );
-            ui.add_space(6.0);
-            let busy = state.busy.importing > 0 || state.busy.dialog;
             files_ui(ui, state, busy, &mut forms.import, commands);
             ui.separator();
-            if forms.import.log_kind == LogKind::FlangePoses {
+            if !joints {
                 super::import_poses::detected_ui(ui, state, commands);
                 ui.separator();
                 super::import_poses::hand_eye_ui(ui, state, busy, &mut forms.import, commands);
@@ -87,44 +93,76 @@ fn import_form_ui(
             }
             robot_ui(ui, &mut forms.import);
             ui.separator();
-            let joints = forms.import.log_kind == LogKind::Joints;
             if joints {
                 mapping_ui(ui, state, &mut forms.import);
                 ui.separator();
                 flange_ui(ui, &mut forms.import);
                 ui.separator();
             }
-            ui.horizontal(|ui| {
-                if ui
-                    .add_enabled(!busy && joints, egui::Button::new("Preview"))
-                    .on_hover_text("read the header and show the first rows with this mapping")
-                    .clicked()
-                {
-                    commands.push(Command::Import(ImportCommand::Preview { guess: false }));
-                }
-                if ui
-                    .add_enabled(!busy && joints, egui::Button::new("Guess mapping"))
-                    .on_hover_text("fill the column names from the header where they are obvious")
-                    .clicked()
-                {
-                    commands.push(Command::Import(ImportCommand::Preview { guess: true }));
-                }
-                let import = ui
-                    .add_enabled(
-                        !busy,
-                        egui::Button::new(RichText::new("Import and open").strong().size(16.0)),
-                    )
-                    .on_hover_text("build the session and open it (save it with Save as… afterwards)");
-                if import.clicked() {
-                    commands.push(Command::Import(ImportCommand::Run));
-                }
-                if state.busy.importing > 0 {
-                    ui.spinner();
-                }
-            });
             outcome_ui(ui, state);
             preview_ui(ui, state);
         });
+}
+
+/// Preview and Guess mapping (joint logs), Import and open, and the last
+/// outcome in one line.
+fn actions_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    busy: bool,
+    joints: bool,
+    commands: &mut Vec<Command>,
+) {
+    ui.horizontal_wrapped(|ui| {
+        let import = ui
+            .add_enabled(
+                !busy,
+                egui::Button::new(RichText::new("Import and open").strong().size(16.0)),
+            )
+            .on_hover_text("build the session and open it (save it with Save as… afterwards)");
+        if import.clicked() {
+            commands.push(Command::Import(ImportCommand::Run));
+        }
+        if joints {
+            if ui
+                .add_enabled(!busy, egui::Button::new("Preview"))
+                .on_hover_text("read the header and show the first rows with this mapping")
+                .clicked()
+            {
+                commands.push(Command::Import(ImportCommand::Preview { guess: false }));
+            }
+            if ui
+                .add_enabled(!busy, egui::Button::new("Guess mapping"))
+                .on_hover_text("fill the column names from the header where they are obvious")
+                .clicked()
+            {
+                commands.push(Command::Import(ImportCommand::Preview { guess: true }));
+            }
+        }
+        if state.busy.importing > 0 {
+            ui.spinner();
+        }
+        match &state.import.outcome {
+            Some(Ok(text)) => {
+                ui.label(RichText::new(text.lines().next().unwrap_or_default()).color(GOOD));
+            }
+            Some(Err(_)) | None => {}
+        }
+    });
+    if let Some(Err(e)) = &state.import.outcome {
+        egui::Frame::group(ui.style())
+            .stroke(egui::Stroke::new(1.5, BAD))
+            .show(ui, |ui| {
+                ui.set_width(ui.available_width());
+                ui.label(RichText::new("The import failed").strong().color(BAD));
+                egui::ScrollArea::vertical()
+                    .id_salt("import_error")
+                    .max_height(ERROR_HEIGHT)
+                    .show(ui, |ui| {
+                        ui.label(e);
+                    });
+            });
+    }
 }
 
 fn files_ui(
@@ -365,7 +403,7 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
             let l = ui.label("Session name");
             ui.add(
                 egui::TextEdit::singleline(&mut f.name)
-                    .hint_text("default: the joint log's file name")
+                    .hint_text("default: the pose log's file name")
                     .desired_width(PATH_WIDTH),
             )
             .labelled_by(l.id);
@@ -496,18 +534,26 @@ fn preview_ui(ui: &mut egui::Ui, state: &AppState) {
 fn outcome_ui(ui: &mut egui::Ui, state: &AppState) {
     let view = &state.import;
     match &view.outcome {
-        Some(Ok(line)) => {
-            ui.label(RichText::new(line).strong());
-        }
-        Some(Err(e)) => {
-            egui::Frame::group(ui.style())
-                .stroke(egui::Stroke::new(1.5, BAD))
-                .show(ui, |ui| {
-                    ui.label(RichText::new("The import failed").strong().color(BAD));
-                    ui.label(e);
+        Some(Ok(text)) => {
+            // The first line says what was imported; then what the import
+            // decided, the side and the initial hand-eye marked, warnings
+            // in orange.
+            for (k, line) in text.lines().enumerate() {
+                let decided = line.starts_with("initial hand-eye")
+                    || line.starts_with("side ")
+                    || line.starts_with("pose file:");
+                let text = RichText::new(line);
+                ui.label(if k == 0 || decided {
+                    text.strong()
+                } else if line.contains("warning") {
+                    text.color(WARN)
+                } else {
+                    text
                 });
+            }
         }
-        None => {}
+        // A failure is shown above the form, beside Import.
+        Some(Err(_)) | None => {}
     }
     let flagged: Vec<_> = view.checks.iter().filter(|c| c.flagged).collect();
     if view.checks.is_empty() {

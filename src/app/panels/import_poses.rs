@@ -40,7 +40,7 @@ pub fn pose_file_rows(
         ui,
         "Pose file",
         &mut f.poses,
-        "robot program (.ls, RAPID .mod, KUKA .dat, URScript) or pose table / .rob",
+        "program (.ls .mod .dat .script) or pose table, .rob",
         busy,
         DialogPurpose::ImportPoses,
         commands,
