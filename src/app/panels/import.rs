@@ -155,6 +155,14 @@ fn actions_ui(
             .show(ui, |ui| {
                 ui.set_width(ui.available_width());
                 ui.label(RichText::new("The import failed").strong().color(BAD));
+                if state.import.guess_needed.is_some() {
+                    ui.label(
+                        RichText::new(
+                            "A hand-eye guess is needed: give one under \"Initial hand-eye\" below (numbers or a file).",
+                        )
+                        .strong(),
+                    );
+                }
                 egui::ScrollArea::vertical()
                     .id_salt("import_error")
                     .max_height(ERROR_HEIGHT)
