@@ -175,6 +175,9 @@ pub fn detected_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Comma
         Ok(p) => p,
         Err(e) => {
             ui.label(RichText::new(format!("The pose file cannot be read: {e}")).color(BAD));
+            ui.label(
+                RichText::new("The layout and the convention above change how it is read.").weak(),
+            );
             return;
         }
     };
@@ -231,16 +234,17 @@ fn pairing_ui(ui: &mut egui::Ui, p: &PosePreview, pairing: &PairingPreview) {
                 .auto_shrink([false, true])
                 .show_rows(ui, row_height, pairing.pairs.len(), |ui, rows| {
                     for (pose, observation) in &pairing.pairs[rows] {
-                        let (name, line) = p
-                            .poses
-                            .get(*pose)
-                            .map_or(("?", 0), |(n, l)| (n.as_str(), *l));
+                        // A table row's name is its line already.
+                        let name = p.poses.get(*pose).map_or_else(String::new, |(n, l)| {
+                            if n.starts_with("line ") {
+                                n.clone()
+                            } else {
+                                format!("{n}, line {l}")
+                            }
+                        });
                         ui.label(
-                            RichText::new(format!(
-                                "{:>5}  {name:<14} line {line:<6} ↔ {observation}",
-                                pose + 1
-                            ))
-                            .monospace(),
+                            RichText::new(format!("{:>5}  {name:<22} ↔ {observation}", pose + 1))
+                                .monospace(),
                         );
                     }
                 });

@@ -500,11 +500,15 @@ pub fn paired_by_id(source: &ProfileSource, records: &[PoseRecord]) -> Option<Ve
 }
 
 /// Whether a pose's own number (`P[3]` → 3) differs from its profile's
-/// (`p4.yml` → 4) anywhere in the pairing: the order may be wrong.
+/// (`p4.yml` → 4) anywhere in the pairing: the order may be wrong. A
+/// table row or list entry (`line 4`, `pose 2`) has no number of its own.
 #[must_use]
 pub fn numbers_differ(records: &[PoseRecord], listing: &FolderListing) -> bool {
     records.iter().zip(&listing.numbers).any(|(r, n)| {
-        let pose_number = crate::engine::program::number_in(&r.name);
+        let unnamed = r.name.starts_with("line ") || r.name.starts_with("pose ");
+        let pose_number = (!unnamed)
+            .then(|| crate::engine::program::number_in(&r.name))
+            .flatten();
         pose_number.is_some() && n.is_some() && pose_number != *n
     })
 }
