@@ -248,11 +248,14 @@ fn files_ui(
                     );
                     ui.radio_value(&mut f.profiles_kind, ProfilesKind::File, "one file");
                     let l = ui.label("pose column");
-                    ui.add_enabled(
-                        f.profiles_kind == ProfilesKind::File,
-                        egui::TextEdit::singleline(&mut f.pose_column).desired_width(COLUMN_WIDTH),
-                    )
-                    .labelled_by(l.id);
+                    // Sized, not squeezed by the grid's column.
+                    ui.add_enabled_ui(f.profiles_kind == ProfilesKind::File, |ui| {
+                        ui.add_sized(
+                            [COLUMN_WIDTH, ui.spacing().interact_size.y],
+                            egui::TextEdit::singleline(&mut f.pose_column),
+                        )
+                        .labelled_by(l.id);
+                    });
                 });
                 ui.end_row();
             }
