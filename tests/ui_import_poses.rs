@@ -26,6 +26,9 @@ use spherecal::engine::simulate::{self, SimConfig};
 mod ui_support;
 use ui_support::{demo_app, scroll_to, settle};
 
+/// One stripe a pose: `[y, z]` points in the laser plane, mm.
+type Stripes = Vec<Vec<[f64; 2]>>;
+
 /// True flange poses and stripes of one station of a noise-free
 /// simulated cell: 4 pure translations and 8 orientation changes.
 fn cell() -> (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>) {
@@ -34,7 +37,7 @@ fn cell() -> (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>) {
 }
 
 /// As [`cell`], with each pose's true sphere centre in the sensor frame.
-fn cell_with_centres() -> (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>, Vec<Point3<f64>>) {
+fn cell_with_centres() -> (Vec<Isometry3<f64>>, Stripes, Vec<Point3<f64>>) {
     let config = SimConfig {
         seed: 3,
         n_translation: 4,
@@ -248,7 +251,7 @@ fn a_fanuc_program_in_its_profile_folder_is_detected_paired_and_imported() {
 /// (no two poses share an orientation): neither eq. 6-9 nor the general
 /// solution gives a hand-eye. The true flange poses, the stripes and the
 /// true hand-eye.
-fn turned_about_one_axis() -> (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>, Isometry3<f64>) {
+fn turned_about_one_axis() -> (Vec<Isometry3<f64>>, Stripes, Isometry3<f64>) {
     const RADIUS: f64 = 38.1 / 2.0;
     let flange_from_sensor = Isometry3::from_parts(
         Translation3::new(12.0, -30.0, 140.0),

@@ -142,11 +142,8 @@ fn actions_ui(
         if state.busy.importing > 0 {
             ui.spinner();
         }
-        match &state.import.outcome {
-            Some(Ok(text)) => {
-                ui.label(RichText::new(text.lines().next().unwrap_or_default()).color(GOOD));
-            }
-            Some(Err(_)) | None => {}
+        if let Some(Ok(text)) = &state.import.outcome {
+            ui.label(RichText::new(text.lines().next().unwrap_or_default()).color(GOOD));
         }
     });
     if let Some(Err(e)) = &state.import.outcome {
@@ -544,27 +541,23 @@ fn preview_ui(ui: &mut egui::Ui, state: &AppState) {
 
 fn outcome_ui(ui: &mut egui::Ui, state: &AppState) {
     let view = &state.import;
-    match &view.outcome {
-        Some(Ok(text)) => {
-            // The first line says what was imported; then what the import
-            // decided, the side and the initial hand-eye marked, warnings
-            // in orange.
-            for (k, line) in text.lines().enumerate() {
-                let decided = line.starts_with("initial hand-eye")
-                    || line.starts_with("side ")
-                    || line.starts_with("pose file:");
-                let text = RichText::new(line);
-                ui.label(if k == 0 || decided {
-                    text.strong()
-                } else if line.contains("warning") {
-                    text.color(WARN)
-                } else {
-                    text
-                });
-            }
+    // The first line says what was imported; then what the import
+    // decided, the side and the initial hand-eye marked, warnings in
+    // orange. A failure is shown above the form, beside Import.
+    if let Some(Ok(text)) = &view.outcome {
+        for (k, line) in text.lines().enumerate() {
+            let decided = line.starts_with("initial hand-eye")
+                || line.starts_with("side ")
+                || line.starts_with("pose file:");
+            let text = RichText::new(line);
+            ui.label(if k == 0 || decided {
+                text.strong()
+            } else if line.contains("warning") {
+                text.color(WARN)
+            } else {
+                text
+            });
         }
-        // A failure is shown above the form, beside Import.
-        Some(Err(_)) | None => {}
     }
     let flagged: Vec<_> = view.checks.iter().filter(|c| c.flagged).collect();
     if view.checks.is_empty() {
