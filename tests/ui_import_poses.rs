@@ -374,6 +374,31 @@ fn a_set_without_pure_translations_asks_for_a_guess_with_the_reason() {
         (start.translation.vector - truth.translation.vector - Vector3::new(2.0, -1.0, 3.0)).norm()
             < 1e-9
     );
+
+    // Or from a file, as `--hand-eye FILE` takes it (a 4×4, rows, mm).
+    let file = dir.path().join("hand_eye.json");
+    let rows: Vec<Vec<f64>> = (0..4)
+        .map(|r| (0..4).map(|c| truth.to_homogeneous()[(r, c)]).collect())
+        .collect();
+    std::fs::write(&file, format!("{{\"hand_eye\": {rows:?}}}")).unwrap();
+    {
+        let form = &mut h.state_mut().forms_mut().import;
+        form.hand_eye = HandEyeChoice::File;
+        form.hand_eye_file = file.display().to_string();
+    }
+    h.state_mut().forms_mut().tab = Tab::Import;
+    settle(&mut h);
+    import_and_open(&mut h);
+    let session = &h
+        .state()
+        .state()
+        .loaded
+        .as_ref()
+        .expect("a session")
+        .session;
+    let start = session.hand_eye.expect("the file's guess is the start");
+    assert!((start.translation.vector - truth.translation.vector).norm() < 1e-9);
+    assert!(start.rotation.angle_to(&truth.rotation) < 1e-9);
 }
 
 #[test]
