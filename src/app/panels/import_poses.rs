@@ -24,6 +24,10 @@ const PAIRING_HEIGHT: f32 = 190.0;
 /// Names listed in one line before "… (n in all)".
 const NAMES_SHOWN: usize = 12;
 
+/// Largest height of the reason a guess is needed, points (it names
+/// both reasons for both sides: long; the rest scrolls).
+const WHY_HEIGHT: f32 = 70.0;
+
 /// Width of a hand-eye number field, points.
 const NUMBER_WIDTH: f32 = 70.0;
 
@@ -350,13 +354,18 @@ pub fn hand_eye_ui(
                         .strong()
                         .color(colour),
                 );
-                ui.label(why);
                 ui.label(
                     RichText::new(
                         "Give x y z (mm) and roll pitch yaw (deg) of the sensor on the flange, or a file, below; the calibration refines it.",
                     )
-                    .weak(),
+                    .strong(),
                 );
+                egui::ScrollArea::vertical()
+                    .id_salt("import_guess_why")
+                    .max_height(WHY_HEIGHT)
+                    .show(ui, |ui| {
+                        ui.label(RichText::new(why).weak());
+                    });
             });
     }
     ui.horizontal_wrapped(|ui| {
@@ -371,27 +380,26 @@ pub fn hand_eye_ui(
     match f.hand_eye {
         HandEyeChoice::Computed => {}
         HandEyeChoice::Numbers => {
-            ui.horizontal_wrapped(|ui| {
-                let labels = [
-                    ("x", " mm"),
-                    ("y", " mm"),
-                    ("z", " mm"),
-                    ("roll", "°"),
-                    ("pitch", "°"),
-                    ("yaw", "°"),
-                ];
-                for ((label, unit), v) in labels.iter().zip(f.hand_eye_numbers.iter_mut()) {
-                    let l = ui.label(format!("hand-eye {label}"));
-                    ui.add_sized(
-                        [NUMBER_WIDTH + 20.0, ui.spacing().interact_size.y],
-                        egui::DragValue::new(v)
-                            .speed(0.1)
-                            .max_decimals(4)
-                            .suffix(*unit),
-                    )
-                    .labelled_by(l.id);
-                }
-            });
+            // Translation on one row, rotation on the next.
+            let (translation, rotation) = f.hand_eye_numbers.split_at_mut(3);
+            for (values, names, unit) in [
+                (translation, ["x", "y", "z"], " mm"),
+                (rotation, ["roll", "pitch", "yaw"], "°"),
+            ] {
+                ui.horizontal(|ui| {
+                    for (name, v) in names.iter().zip(values.iter_mut()) {
+                        let l = ui.label(format!("hand-eye {name}"));
+                        ui.add_sized(
+                            [NUMBER_WIDTH + 20.0, ui.spacing().interact_size.y],
+                            egui::DragValue::new(v)
+                                .speed(0.1)
+                                .max_decimals(4)
+                                .suffix(unit),
+                        )
+                        .labelled_by(l.id);
+                    }
+                });
+            }
             ui.label(
                 RichText::new(
                     "eT_s, the sensor frame in the flange frame: R = Rz(yaw)·Ry(pitch)·Rx(roll)",
