@@ -830,12 +830,12 @@ fn the_wizard_imports_flange_poses_and_the_run_calibrates_the_hand_eye_only() {
         form.log_kind = spherecal::app::forms::import::LogKind::FlangePoses;
         form.poses = dir.join("RobPoses.rob").display().to_string();
         form.profiles = dir.display().to_string();
-        form.pose_convention = spherecal::engine::files::import::FlangeConvention::FanucWpr;
+        form.pose_convention = Some(spherecal::engine::files::import::FlangeConvention::FanucWpr);
         form.sphere_diameter = 80.0;
     }
-    h.run();
+    settle(&mut h);
     assert!(
-        h.query_all_by_label_contains("Flange-pose log").count() > 0,
+        h.query_all_by_label_contains("Pose file").count() > 0,
         "the pose-log fields are shown"
     );
     h.get_by_label("Import and open").click();

@@ -112,6 +112,9 @@ pub enum ImportCommand {
     /// A field of the form changed: the preview, the last outcome and the
     /// flange checks no longer describe it and are cleared.
     Edited,
+    /// Read the pose file and pair it with the profiles or centres (the
+    /// preview shown before Import).
+    Scan,
 }
 
 /// The library of past results.

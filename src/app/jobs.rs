@@ -174,6 +174,13 @@ pub enum ImportMessage {
     },
     /// The import built a session, or why not.
     Imported(Result<Imported, JobError>),
+    /// The pose file was read and paired (no profile read), or why not.
+    Scanned {
+        /// Which scan (an older one's answer is dropped).
+        generation: u64,
+        /// The preview, or why the pose file cannot be read.
+        outcome: Result<Box<crate::engine::files::import::PosePreview>, JobError>,
+    },
 }
 
 /// The outcome of an import job.

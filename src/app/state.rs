@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 use crate::engine::base::session::Session;
 use crate::engine::calibrate::solve::{Analysis, SolveError};
 use crate::engine::calibrate::stripe::{StripeError, StripeResult};
-use crate::engine::files::import::PoseCheck;
+use crate::engine::files::import::{PoseCheck, PoseImportSpec, PosePreview};
 use crate::engine::tools::history::{Drift, Library};
 use crate::engine::tools::plan::Controller;
 use crate::engine::tools::plan::{Plan, PlanError, Prediction};
@@ -252,6 +252,10 @@ pub enum DialogPurpose {
     CompensateTool,
     /// Compensate: where the compensated file goes.
     CompensateOut,
+    /// Import wizard: the sphere centres the sensor reported.
+    ImportCentres,
+    /// Import wizard: a hand-eye guess file (4×4 JSON, session or result).
+    ImportHandEye,
 }
 
 /// What the Plan view writes.
@@ -368,6 +372,17 @@ pub struct ImportView {
     pub checks: Vec<PoseCheck>,
     /// The last import's outcome in one line, or its error.
     pub outcome: Option<Result<String, String>>,
+    /// The pose file's preview (layout, pairing, eq. 6-9 group) of the
+    /// latest scan, or why the pose file cannot be read.
+    pub pose_preview: Option<Result<PosePreview, String>>,
+    /// What the latest scan was started from (the form's
+    /// [`crate::app::forms::ImportForm::pose_scan_key`]): a form that
+    /// reads otherwise is scanned again.
+    pub scanned: Option<PoseImportSpec>,
+    /// The latest scan's number; an older scan's answer is dropped.
+    pub scan_generation: u64,
+    /// The last import found no initial hand-eye: why (a guess is needed).
+    pub guess_needed: Option<String>,
 }
 
 /// What the Plan view shows.

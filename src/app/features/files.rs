@@ -17,6 +17,7 @@ use crate::engine::files::format::{
 use super::Core;
 use crate::app::commands::FilesCommand;
 use crate::app::error::JobError;
+use crate::app::forms::import::LogKind;
 use crate::app::forms::{ProfilesKind, SolverForm, Tab};
 use crate::app::jobs::{FilesMessage, JobMessage};
 use crate::app::provenance::{Input, Output};
@@ -232,8 +233,15 @@ impl Core {
                 .history_folder
                 .clone()
                 .or_else(|| self.state.prefs.last_folder.clone()),
-            DialogPurpose::ImportProfiles | DialogPurpose::ImportReferences => {
-                Path::new(self.forms.import.joints.trim())
+            DialogPurpose::ImportProfiles
+            | DialogPurpose::ImportReferences
+            | DialogPurpose::ImportCentres
+            | DialogPurpose::ImportHandEye => {
+                let log = match self.forms.import.log_kind {
+                    LogKind::Joints => &self.forms.import.joints,
+                    LogKind::FlangePoses => &self.forms.import.poses,
+                };
+                Path::new(log.trim())
                     .parent()
                     .map(Path::to_path_buf)
                     .filter(|d| !d.as_os_str().is_empty())
@@ -268,7 +276,21 @@ impl Core {
                     dialog.add_filter("CSV", &["csv", "txt"]).pick_file()
                 }
                 DialogPurpose::ImportPoses => dialog
-                    .add_filter("pose log", &["json", "rob", "csv", "txt"])
+                    .add_filter(
+                        "pose file",
+                        &[
+                            "ls", "mod", "modx", "prg", "dat", "src", "script", "urscript", "rob",
+                            "json", "csv", "txt",
+                        ],
+                    )
+                    .add_filter("any file", &["*"])
+                    .pick_file(),
+                DialogPurpose::ImportCentres => dialog
+                    .add_filter("centres table", &["csv", "txt"])
+                    .add_filter("any file", &["*"])
+                    .pick_file(),
+                DialogPurpose::ImportHandEye => dialog
+                    .add_filter("4×4 JSON, session or result", &["json"])
                     .pick_file(),
                 DialogPurpose::ImportProfiles if profiles_folder => dialog.pick_folder(),
                 DialogPurpose::ImportProfiles => {
@@ -456,6 +478,12 @@ impl Core {
             DialogPurpose::CompensateTargets
             | DialogPurpose::CompensateTool
             | DialogPurpose::CompensateOut => self.compensate_dialog(ctx, purpose, path),
+            DialogPurpose::ImportCentres => {
+                self.forms.import.centres = path.display().to_string();
+            }
+            DialogPurpose::ImportHandEye => {
+                self.forms.import.hand_eye_file = path.display().to_string();
+            }
         }
     }
 

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use crate::engine::files::import;
+use crate::engine::files::import::{self, ImportError};
 
 use super::Core;
 use super::files::analyse;
@@ -63,11 +63,25 @@ pub fn import_session(form: &ImportForm) -> Result<Imported, JobError> {
             (import::import(&spec)?, spec.joint_log)
         }
         LogKind::FlangePoses => {
-            let spec = form.pose_spec().map_err(JobError::ImportForm)?;
+            let mut spec = form.pose_spec().map_err(JobError::ImportForm)?;
+            if spec.hand_eye.is_none() {
+                spec.hand_eye = form.hand_eye_guess().map_err(JobError::ImportForm)?;
+            }
             (import::import_poses(&spec)?, spec.poses)
         }
     };
     let mut session = imported.session;
+    let mut notes = imported.notes;
+    if form.log_kind == LogKind::FlangePoses
+        && let Some(he) = &session.hand_eye
+    {
+        let t = he.translation.vector;
+        let [roll, pitch, yaw] = crate::engine::base::geometry::roll_pitch_yaw_deg(&he.rotation);
+        notes.push(format!(
+            "initial hand-eye in the session: x {:.3}, y {:.3}, z {:.3} mm; roll {roll:.3}, pitch {pitch:.3}, yaw {yaw:.3} deg",
+            t.x, t.y, t.z
+        ));
+    }
     if let Some(v) = form.range {
         session.sensor_range = Some(
             crate::app::panels::range_of(&v)
@@ -77,7 +91,7 @@ pub fn import_session(form: &ImportForm) -> Result<Imported, JobError> {
     Ok(Imported {
         loaded: Box::new(analyse(session, Source::Imported(log))),
         checks: imported.checks,
-        notes: imported.notes,
+        notes,
     })
 }
 
@@ -87,6 +101,7 @@ impl Core {
         match command {
             ImportCommand::Preview { guess } => self.import_preview(ctx, guess),
             ImportCommand::Run => self.import_run(ctx),
+            ImportCommand::Scan => self.import_scan(ctx),
             ImportCommand::Edited => {
                 let view = &mut self.state.import;
                 view.preview = None;
@@ -139,6 +154,10 @@ impl Core {
     pub(super) fn on_import(&mut self, ctx: &egui::Context, message: ImportMessage) {
         self.state.busy.importing = self.state.busy.importing.saturating_sub(1);
         match message {
+            ImportMessage::Scanned {
+                generation,
+                outcome,
+            } => self.on_import_scanned(generation, outcome),
             ImportMessage::Previewed {
                 header,
                 guessed,
@@ -178,6 +197,7 @@ impl Core {
                 }
                 self.state.import.checks = imported.checks;
                 self.state.import.outcome = Some(Ok(outcome));
+                self.state.import.guess_needed = None;
                 self.on_session(ctx, *imported.loaded);
                 self.forms.tab = if flagged > 0 {
                     Tab::Import
@@ -196,6 +216,12 @@ impl Core {
             }
             ImportMessage::Imported(Err(e)) => {
                 self.state.say(Level::Error, "the import failed");
+                self.state.import.guess_needed = match &e {
+                    JobError::Import(ImportError::NoInitialHandEye { message, .. }) => {
+                        Some(message.clone())
+                    }
+                    _ => None,
+                };
                 self.state.import.checks.clear();
                 self.state.import.outcome = Some(Err(e.to_string()));
             }

@@ -11,6 +11,7 @@
 //! | [`run`] | run, cancel | the calibration |
 //! | [`export`] | the Results view's exports | result JSON, CSV, PNG, HTML report, model |
 //! | [`import`] | preview, import | the import wizard's engine calls |
+//! | [`import_poses`] | scan | a pose file read and paired before import |
 //! | [`history`] | scan, drift | scan a library folder |
 //! | [`plan`] | plan, cancel, export, simulate | the pose planner and its prediction |
 //! | [`compensate`] | compensate, cancel, write | targets and programs through the result on show |
@@ -24,6 +25,7 @@ pub mod files;
 pub mod history;
 pub mod import;
 pub mod measure;
+pub mod import_poses;
 pub mod plan;
 pub mod run;
 pub mod view;

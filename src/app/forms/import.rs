@@ -6,11 +6,13 @@
 
 use std::path::PathBuf;
 
+use nalgebra::{Isometry3, Translation3};
+
 use crate::engine::base::robot::DhConvention;
 use crate::engine::files::import::{
     AngleUnit, AxisMap, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
     DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit, Observations,
-    PoseImportSpec, ProfileFormat, ProfileSource, RobotSource, SideChoice,
+    PoseFormat, PoseImportSpec, ProfileFormat, ProfileSource, RobotSource, SideChoice,
 };
 
 /// Rows the preview shows.
@@ -43,13 +45,36 @@ pub const CONVENTIONS: [(FlangeConvention, &str); 4] = [
     ),
 ];
 
+/// What the sensor gave for each pose of a pose file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ObservationKind {
+    /// Stripe profiles (a folder or one file).
+    Profiles,
+    /// Sphere centres the sensor reported itself (one table, `x y z` a
+    /// pose, sensor frame, mm): `spherecal import --centres`.
+    Centres,
+}
+
+/// Where the initial hand-eye of a pose file's session comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HandEyeChoice {
+    /// Computed by the import: eq. 6-9, else the general solution.
+    Computed,
+    /// A guess typed in: x y z mm, roll pitch yaw deg.
+    Numbers,
+    /// A guess from a file, as `spherecal import --hand-eye FILE`: a 4×4
+    /// JSON matrix (rows, mm) or a session/result file's `hand_eye`.
+    File,
+}
+
 /// What kind of pose log the wizard imports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LogKind {
     /// A joint log CSV (id, station, use, joints).
     Joints,
-    /// The controller's flange poses (JSON, `.rob` or CSV), no joints: a
-    /// pose-only session.
+    /// A pose file in any layout the engine reads (a table with or
+    /// without a header, JSON/`.rob`, FANUC `.ls`, RAPID, KUKA, URScript):
+    /// flange poses give a pose-only session.
     FlangePoses,
 }
 
@@ -60,10 +85,12 @@ pub struct ImportForm {
     pub log_kind: LogKind,
     /// The joint log CSV.
     pub joints: String,
-    /// The flange-pose log (JSON, `.rob` or CSV).
+    /// The pose file (any layout `spherecal import --poses` reads).
     pub poses: String,
-    /// How the flange-pose log writes a pose.
-    pub pose_convention: FlangeConvention,
+    /// How a pose table or JSON list writes a pose (`--pose-convention`);
+    /// `None`: as the program's language fixes it (a table or JSON list
+    /// needs one).
+    pub pose_convention: Option<FlangeConvention>,
     /// Side of the sphere centres for a flange-pose log without a side
     /// column.
     pub side: SideChoice,
@@ -115,6 +142,20 @@ pub struct ImportForm {
     /// The sensor's measuring range to write as `sensor.range`, `[y0, y1,
     /// z0, z1]` mm; `None`: not known.
     pub range: Option<[f64; 4]>,
+    /// The pose file's layout forced (`--pose-format`); `None`: detected
+    /// from the content.
+    pub pose_format: Option<PoseFormat>,
+    /// Profiles or centres, for a pose file.
+    pub observations: ObservationKind,
+    /// The centres table (`--centres`), with [`ObservationKind::Centres`].
+    pub centres: String,
+    /// Where the initial hand-eye comes from.
+    pub hand_eye: HandEyeChoice,
+    /// The typed hand-eye guess `eT_s`: x, y, z (mm), roll, pitch, yaw
+    /// (deg, `R = Rz(yaw)·Ry(pitch)·Rx(roll)`).
+    pub hand_eye_numbers: [f64; 6],
+    /// The hand-eye guess file, with [`HandEyeChoice::File`].
+    pub hand_eye_file: String,
 }
 
 impl Default for ImportForm {
@@ -123,7 +164,7 @@ impl Default for ImportForm {
             log_kind: LogKind::Joints,
             joints: String::new(),
             poses: String::new(),
-            pose_convention: FlangeConvention::FanucWpr,
+            pose_convention: None,
             side: SideChoice::Auto,
             axes: "auto".into(),
             no_return: String::new(),
@@ -148,6 +189,12 @@ impl Default for ImportForm {
             tolerance_mm: DEFAULT_POSITION_TOLERANCE_MM,
             tolerance_deg: DEFAULT_ROTATION_TOLERANCE_DEG,
             range: None,
+            pose_format: None,
+            observations: ObservationKind::Profiles,
+            centres: String::new(),
+            hand_eye: HandEyeChoice::Computed,
+            hand_eye_numbers: [0.0; 6],
+            hand_eye_file: String::new(),
         }
     }
 }
@@ -156,8 +203,7 @@ impl ImportForm {
     /// The profiles' source, format and the sphere check shared by both
     /// kinds of log.
     fn profile_choices(&self) -> Result<(ProfileSource, ProfileFormat), String> {
-        let profiles = self.profiles.trim();
-        if profiles.is_empty() {
+        if self.profiles.trim().is_empty() {
             return Err("choose the stripe profiles (a folder or one file) first".into());
         }
         if !(self.sphere_diameter.is_finite() && self.sphere_diameter > 0.0) {
@@ -166,6 +212,12 @@ impl ImportForm {
                 self.sphere_diameter
             ));
         }
+        self.profile_choices_unchecked()
+    }
+
+    /// The profiles' source (an empty path when none is chosen) and format.
+    fn profile_choices_unchecked(&self) -> Result<(ProfileSource, ProfileFormat), String> {
+        let profiles = self.profiles.trim();
         let source = match self.profiles_kind {
             ProfilesKind::Folder => ProfileSource::Folder(PathBuf::from(profiles)),
             ProfilesKind::File => ProfileSource::File {
@@ -208,25 +260,67 @@ impl ImportForm {
         }
     }
 
-    /// The engine's spec of a flange-pose log, or what is missing.
+    /// The engine's spec of a pose file, or what is missing. A guess from
+    /// a file is not read here (the job reads it: [`Self::hand_eye_guess`]).
     ///
     /// # Errors
-    /// No pose log or profiles chosen, a bad axis map or sphere diameter:
-    /// a sentence for the operator.
+    /// No pose file, profiles or centres chosen, a bad axis map, sphere
+    /// diameter or typed guess: a sentence for the operator.
     pub fn pose_spec(&self) -> Result<PoseImportSpec, String> {
+        let mut spec = self.pose_preview_spec()?;
+        spec.observations = match self.observations {
+            ObservationKind::Profiles => Observations::Profiles(self.profile_choices()?.0),
+            ObservationKind::Centres => {
+                let centres = self.centres.trim();
+                if centres.is_empty() {
+                    return Err("choose the centres file first".into());
+                }
+                Observations::Centres(PathBuf::from(centres))
+            }
+        };
+        if !(self.sphere_diameter.is_finite() && self.sphere_diameter > 0.0) {
+            return Err(format!(
+                "the sphere diameter {} mm is not positive",
+                self.sphere_diameter
+            ));
+        }
+        match self.hand_eye {
+            HandEyeChoice::Computed => {}
+            HandEyeChoice::Numbers => spec.hand_eye = Some(self.typed_hand_eye()?),
+            HandEyeChoice::File => {
+                if self.hand_eye_file.trim().is_empty() {
+                    return Err("choose the hand-eye guess file first".into());
+                }
+            }
+        }
+        Ok(spec)
+    }
+
+    /// The engine's spec of a pose file for its preview (the layout and
+    /// the pairing): observations not chosen yet are left empty (the
+    /// preview says so), no guess.
+    ///
+    /// # Errors
+    /// No pose file chosen, a bad axis map or robot: a sentence.
+    pub fn pose_preview_spec(&self) -> Result<PoseImportSpec, String> {
         let poses = self.poses.trim();
         if poses.is_empty() {
-            return Err("choose the flange-pose log first".into());
+            return Err("choose the pose file first".into());
         }
-        let (profiles, profile_format) = self.profile_choices()?;
+        let (source, profile_format) = self.profile_choices_unchecked()?;
         let name = self.name.trim();
         let references = self.references.trim();
         Ok(PoseImportSpec {
             poses: PathBuf::from(poses),
-            format: None,
-            convention: Some(self.pose_convention),
+            format: self.pose_format,
+            convention: self.pose_convention,
             pose_columns: None,
-            observations: Observations::Profiles(profiles),
+            observations: match self.observations {
+                ObservationKind::Profiles => Observations::Profiles(source),
+                ObservationKind::Centres => {
+                    Observations::Centres(PathBuf::from(self.centres.trim()))
+                }
+            },
             profile_format,
             robot: (!self.robot_file.trim().is_empty())
                 .then(|| self.robot_source())
@@ -237,6 +331,56 @@ impl ImportForm {
             name: (!name.is_empty()).then(|| name.to_string()),
             references: (!references.is_empty()).then(|| PathBuf::from(references)),
         })
+    }
+
+    /// What the pose file's preview depends on (the preview spec without
+    /// the fields it does not read); `None` when there is nothing to
+    /// preview (a joint log, no pose file, a bad field).
+    #[must_use]
+    pub fn pose_scan_key(&self) -> Option<PoseImportSpec> {
+        if self.log_kind != LogKind::FlangePoses {
+            return None;
+        }
+        let mut spec = self.pose_preview_spec().ok()?;
+        spec.sphere_diameter = 0.0;
+        spec.side = SideChoice::Auto;
+        spec.name = None;
+        spec.references = None;
+        Some(spec)
+    }
+
+    /// The typed guess as `eT_s`.
+    ///
+    /// # Errors
+    /// A number that is not finite.
+    pub fn typed_hand_eye(&self) -> Result<Isometry3<f64>, String> {
+        let [x, y, z, roll, pitch, yaw] = self.hand_eye_numbers;
+        if self.hand_eye_numbers.iter().any(|v| !v.is_finite()) {
+            return Err("the hand-eye guess has a number that is not finite".into());
+        }
+        Ok(Isometry3::from_parts(
+            Translation3::new(x, y, z),
+            crate::engine::base::geometry::rotation_from_rpy_deg([roll, pitch, yaw]),
+        ))
+    }
+
+    /// The hand-eye guess the import starts from: typed, or read from the
+    /// file (as `spherecal import --hand-eye FILE`); `None`: computed.
+    /// Reads a file: call it on a job.
+    ///
+    /// # Errors
+    /// The file cannot be read or holds no 4×4 `hand_eye`.
+    pub fn hand_eye_guess(&self) -> Result<Option<Isometry3<f64>>, String> {
+        match self.hand_eye {
+            HandEyeChoice::Computed => Ok(None),
+            HandEyeChoice::Numbers => self.typed_hand_eye().map(Some),
+            HandEyeChoice::File => {
+                let path = PathBuf::from(self.hand_eye_file.trim());
+                crate::engine::files::format::read_transform(&path, "hand_eye")
+                    .map(Some)
+                    .map_err(|m| format!("hand-eye guess: {m} ({})", path.display()))
+            }
+        }
     }
 
     /// The engine's spec, or what is missing.
@@ -362,6 +506,39 @@ mod tests {
         assert_eq!(f.station_column, "Sphere");
         assert_eq!(f.joint_columns[5], "A6");
         assert!(f.side_column.is_empty(), "no side column in the header");
+    }
+
+    #[test]
+    fn a_pose_file_spec_carries_the_layout_centres_and_the_typed_guess() {
+        let mut f = ImportForm {
+            log_kind: LogKind::FlangePoses,
+            ..ImportForm::default()
+        };
+        assert!(f.pose_spec().unwrap_err().contains("pose file"));
+        f.poses = "calib.ls".into();
+        assert!(f.pose_spec().unwrap_err().contains("profiles"));
+        // The preview needs only the pose file.
+        let p = f.pose_preview_spec().unwrap();
+        assert_eq!(p.convention, None, "a program's language fixes it");
+        f.observations = ObservationKind::Centres;
+        assert!(f.pose_spec().unwrap_err().contains("centres"));
+        f.centres = "centres.txt".into();
+        f.pose_format = Some(PoseFormat::FanucLs);
+        f.hand_eye = HandEyeChoice::Numbers;
+        f.hand_eye_numbers = [10.0, -20.0, 150.0, 0.0, 0.0, 90.0];
+        let s = f.pose_spec().unwrap();
+        assert_eq!(s.format, Some(PoseFormat::FanucLs));
+        assert_eq!(s.observations, Observations::Centres("centres.txt".into()));
+        let he = s.hand_eye.unwrap();
+        assert_eq!(
+            he.translation.vector,
+            nalgebra::Vector3::new(10.0, -20.0, 150.0)
+        );
+        // yaw 90°: the sensor's x is the flange's y.
+        let x = he.rotation * nalgebra::Vector3::x();
+        assert!((x - nalgebra::Vector3::y()).norm() < 1e-12, "{x}");
+        f.hand_eye = HandEyeChoice::File;
+        assert!(f.pose_spec().unwrap_err().contains("hand-eye guess file"));
     }
 
     #[test]

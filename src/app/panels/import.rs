@@ -1,24 +1,29 @@
 //! The Import view: a wizard that turns a pose log and stripe profile
 //! files into a session (the engine's [`crate::engine::files::import`], as
-//! `spherecal import`). A joint log CSV, or the controller's flange poses
-//! (JSON, RobCalibrator `.rob`, CSV) for a pose-only session; profiles as
-//! CSV/TXT or OpenCV YAML/JSON in the sensor's axes. Steps on one page:
+//! `spherecal import`). A joint log CSV, or a pose file in any layout the
+//! engine reads (tables with or without a header, `.rob`, FANUC `.ls`,
+//! RAPID, KUKA, URScript; [`super::import_poses`]: layout detected,
+//! pairing shown before the import, a hand-eye guess, centres); profiles
+//! as CSV/TXT or OpenCV YAML/JSON in the sensor's axes. Steps on one page:
 //! files, robot, units and axes, column mapping with a preview of the
 //! first rows (joint logs); then Import opens the session and says what it
 //! decided (axis map, side, initial hand-eye) and the flange-pose checks.
 
 use egui::RichText;
 
-use super::{BAD, DEFAULT_RANGE, WARN, labelled_field, range_fields, range_of};
+use super::{BAD, DEFAULT_RANGE, GOOD, WARN, labelled_field, range_fields, range_of};
 use crate::app::commands::{Command, FilesCommand, ImportCommand};
 use crate::app::forms::Forms;
-use crate::app::forms::import::{CONVENTIONS, ImportForm, LogKind, ProfilesKind};
+use crate::app::forms::import::{CONVENTIONS, ImportForm, LogKind, ObservationKind, ProfilesKind};
 use crate::app::state::{AppState, DialogPurpose};
 use crate::engine::base::robot::{self, DhConvention};
-use crate::engine::files::import::{AngleUnit, FlangeConvention, LengthUnit, SideChoice};
+use crate::engine::files::import::{AngleUnit, LengthUnit, SideChoice};
 
 /// Width of the path fields, points.
-const PATH_WIDTH: f32 = 420.0;
+pub(super) const PATH_WIDTH: f32 = 420.0;
+/// Largest height of the import's error above the form, points: a long
+/// message scrolls rather than push the form off a 768-pixel screen.
+const ERROR_HEIGHT: f32 = 90.0;
 /// Width of a column-name field, points.
 const COLUMN_WIDTH: f32 = 90.0;
 
@@ -35,6 +40,11 @@ pub fn import_ui(
     if forms.import != before {
         commands.push(Command::Import(ImportCommand::Edited));
     }
+    // A pose file (or its layout, convention, profiles) that reads
+    // otherwise than at the last scan is read and paired again.
+    if forms.import.pose_scan_key() != state.import.scanned {
+        commands.push(Command::Import(ImportCommand::Scan));
+    }
 }
 
 fn import_form_ui(
@@ -43,76 +53,130 @@ fn import_form_ui(
     forms: &mut Forms,
     commands: &mut Vec<Command>,
 ) {
+    ui.heading("Import a pose log and stripe profiles");
+    super::dialog_note_ui(
+        ui,
+        state,
+        &[
+            DialogPurpose::ImportJoints,
+            DialogPurpose::ImportPoses,
+            DialogPurpose::ImportProfiles,
+            DialogPurpose::ImportReferences,
+            DialogPurpose::ImportCentres,
+            DialogPurpose::ImportHandEye,
+        ],
+    );
+    ui.label(
+        RichText::new(
+            "A joint log (id, station, use, joints a row) or a pose file as the cell wrote it (program or table; \
+             flange poses give a pose-only session); one profile file a pose (CSV/TXT, OpenCV YAML/JSON), one file \
+             with a pose column, or the sensor's sphere centres. Checked by the session file's rules.",
+        )
+        .weak(),
+    );
+    let busy = state.busy.importing > 0 || state.busy.dialog;
+    let joints = forms.import.log_kind == LogKind::Joints;
+    // The actions stay in view above the form (it is taller than the
+    // window at 1366×768); the full outcome is at the form's end.
+    actions_ui(ui, state, busy, joints, commands);
+    ui.separator();
     egui::ScrollArea::vertical()
         .auto_shrink([false, false])
         .show(ui, |ui| {
-            ui.heading("Import a pose log and stripe profiles");
-            super::dialog_note_ui(
-                ui,
-                state,
-                &[
-                    DialogPurpose::ImportJoints,
-                    DialogPurpose::ImportPoses,
-                    DialogPurpose::ImportProfiles,
-                    DialogPurpose::ImportReferences,
-                ],
-            );
-            ui.label(
-                RichText::new(
-                    "A joint log (one row per pose: id, station, use, joints) or the controller's flange poses \
-                     (no joints: a pose-only session that calibrates the hand-eye); one profile file per pose \
-                     (CSV/TXT, OpenCV YAML/JSON) or one file with a pose column. The session is checked by the \
-                     same rules as a session file.",
-                )
-                .weak(),
-            );
-            ui.add_space(6.0);
-            let busy = state.busy.importing > 0 || state.busy.dialog;
-            files_ui(ui, busy, &mut forms.import, commands);
+            files_ui(ui, state, busy, &mut forms.import, commands);
             ui.separator();
+            if !joints {
+                super::import_poses::detected_ui(ui, state, commands);
+                ui.separator();
+                super::import_poses::hand_eye_ui(ui, state, busy, &mut forms.import, commands);
+                ui.separator();
+            }
             robot_ui(ui, &mut forms.import);
             ui.separator();
-            let joints = forms.import.log_kind == LogKind::Joints;
             if joints {
                 mapping_ui(ui, state, &mut forms.import);
                 ui.separator();
                 flange_ui(ui, &mut forms.import);
                 ui.separator();
             }
-            ui.horizontal(|ui| {
-                if ui
-                    .add_enabled(!busy && joints, egui::Button::new("Preview"))
-                    .on_hover_text("read the header and show the first rows with this mapping")
-                    .clicked()
-                {
-                    commands.push(Command::Import(ImportCommand::Preview { guess: false }));
-                }
-                if ui
-                    .add_enabled(!busy && joints, egui::Button::new("Guess mapping"))
-                    .on_hover_text("fill the column names from the header where they are obvious")
-                    .clicked()
-                {
-                    commands.push(Command::Import(ImportCommand::Preview { guess: true }));
-                }
-                let import = ui
-                    .add_enabled(
-                        !busy,
-                        egui::Button::new(RichText::new("Import and open").strong().size(16.0)),
-                    )
-                    .on_hover_text("build the session and open it (save it with Save as… afterwards)");
-                if import.clicked() {
-                    commands.push(Command::Import(ImportCommand::Run));
-                }
-                if state.busy.importing > 0 {
-                    ui.spinner();
-                }
-            });
             outcome_ui(ui, state);
             preview_ui(ui, state);
         });
 }
 
-fn files_ui(ui: &mut egui::Ui, busy: bool, f: &mut ImportForm, commands: &mut Vec<Command>) {
+/// Preview and Guess mapping (joint logs), Import and open, and the last
+/// outcome in one line.
+fn actions_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    busy: bool,
+    joints: bool,
+    commands: &mut Vec<Command>,
+) {
+    ui.horizontal_wrapped(|ui| {
+        let import = ui
+            .add_enabled(
+                !busy,
+                egui::Button::new(RichText::new("Import and open").strong().size(16.0)),
+            )
+            .on_hover_text("build the session and open it (save it with Save as… afterwards)");
+        if import.clicked() {
+            commands.push(Command::Import(ImportCommand::Run));
+        }
+        if joints {
+            if ui
+                .add_enabled(!busy, egui::Button::new("Preview"))
+                .on_hover_text("read the header and show the first rows with this mapping")
+                .clicked()
+            {
+                commands.push(Command::Import(ImportCommand::Preview { guess: false }));
+            }
+            if ui
+                .add_enabled(!busy, egui::Button::new("Guess mapping"))
+                .on_hover_text("fill the column names from the header where they are obvious")
+                .clicked()
+            {
+                commands.push(Command::Import(ImportCommand::Preview { guess: true }));
+            }
+        }
+        if state.busy.importing > 0 {
+            ui.spinner();
+        }
+        if let Some(Ok(text)) = &state.import.outcome {
+            ui.label(RichText::new(text.lines().next().unwrap_or_default()).color(GOOD));
+        }
+    });
+    if let Some(Err(e)) = &state.import.outcome {
+        egui::Frame::group(ui.style())
+            .stroke(egui::Stroke::new(1.5, BAD))
+            .show(ui, |ui| {
+                ui.set_width(ui.available_width());
+                ui.label(RichText::new("The import failed").strong().color(BAD));
+                if state.import.guess_needed.is_some() {
+                    ui.label(
+                        RichText::new(
+                            "A hand-eye guess is needed: give one under \"Initial hand-eye\" below (numbers or a file).",
+                        )
+                        .strong(),
+                    );
+                }
+                egui::ScrollArea::vertical()
+                    .id_salt("import_error")
+                    .max_height(ERROR_HEIGHT)
+                    .show(ui, |ui| {
+                        ui.label(e);
+                    });
+            });
+    }
+}
+
+fn files_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    busy: bool,
+    f: &mut ImportForm,
+    commands: &mut Vec<Command>,
+) {
     ui.label(RichText::new("1 · Files").strong());
     ui.horizontal(|ui| {
         ui.label("Pose log");
@@ -120,7 +184,7 @@ fn files_ui(ui: &mut egui::Ui, busy: bool, f: &mut ImportForm, commands: &mut Ve
         ui.radio_value(
             &mut f.log_kind,
             LogKind::FlangePoses,
-            "flange poses, no joints (pose-only)",
+            "a pose file (robot program or pose table)",
         );
     });
     egui::Grid::new("import_files")
@@ -138,64 +202,60 @@ fn files_ui(ui: &mut egui::Ui, busy: bool, f: &mut ImportForm, commands: &mut Ve
                     commands,
                 );
             } else {
+                let preview = state
+                    .import
+                    .pose_preview
+                    .as_ref()
+                    .and_then(|p| p.as_ref().ok());
+                super::import_poses::pose_file_rows(ui, busy, f, preview, commands);
+                if f.observations == ObservationKind::Profiles {
+                    ui.label("Sphere side");
+                    ui.horizontal(|ui| {
+                        ui.radio_value(&mut f.side, SideChoice::Auto, "decide from the data");
+                        ui.radio_value(&mut f.side, SideChoice::Plus, "+1 (sensor x > 0)");
+                        ui.radio_value(&mut f.side, SideChoice::Minus, "−1");
+                    });
+                    ui.end_row();
+                }
+            }
+            let centres =
+                f.log_kind == LogKind::FlangePoses && f.observations == ObservationKind::Centres;
+            if !centres {
+                let hint = match f.profiles_kind {
+                    ProfilesKind::Folder => {
+                        "/path/to/profiles/ (one file per pose: <id>.csv, .yml …)"
+                    }
+                    ProfilesKind::File => "/path/to/profiles.csv (with a pose column)",
+                };
                 path_row(
                     ui,
-                    "Flange-pose log",
-                    &mut f.poses,
-                    "/path/to/RobPoses.rob (JSON) or poses.csv",
+                    "Stripe profiles",
+                    &mut f.profiles,
+                    hint,
                     busy,
-                    DialogPurpose::ImportPoses,
+                    DialogPurpose::ImportProfiles,
                     commands,
                 );
-                let l = ui.label("Pose convention");
-                egui::ComboBox::from_id_salt("import_pose_convention")
-                    .selected_text(f.pose_convention.describe())
-                    .width(PATH_WIDTH)
-                    .show_ui(ui, |ui| {
-                        for c in FlangeConvention::ALL {
-                            ui.selectable_value(&mut f.pose_convention, c, c.describe());
-                        }
-                    })
-                    .response
-                    .labelled_by(l.id);
-                ui.end_row();
-                ui.label("Sphere side");
+                ui.label("");
                 ui.horizontal(|ui| {
-                    ui.radio_value(&mut f.side, SideChoice::Auto, "decide from the data");
-                    ui.radio_value(&mut f.side, SideChoice::Plus, "+1 (sensor x > 0)");
-                    ui.radio_value(&mut f.side, SideChoice::Minus, "−1");
+                    ui.radio_value(
+                        &mut f.profiles_kind,
+                        ProfilesKind::Folder,
+                        "a folder, one file per pose",
+                    );
+                    ui.radio_value(&mut f.profiles_kind, ProfilesKind::File, "one file");
+                    let l = ui.label("pose column");
+                    // Sized, not squeezed by the grid's column.
+                    ui.add_enabled_ui(f.profiles_kind == ProfilesKind::File, |ui| {
+                        ui.add_sized(
+                            [COLUMN_WIDTH, ui.spacing().interact_size.y],
+                            egui::TextEdit::singleline(&mut f.pose_column),
+                        )
+                        .labelled_by(l.id);
+                    });
                 });
                 ui.end_row();
             }
-            let hint = match f.profiles_kind {
-                ProfilesKind::Folder => "/path/to/profiles/ (one file per pose: <id>.csv, .yml …)",
-                ProfilesKind::File => "/path/to/profiles.csv (with a pose column)",
-            };
-            path_row(
-                ui,
-                "Stripe profiles",
-                &mut f.profiles,
-                hint,
-                busy,
-                DialogPurpose::ImportProfiles,
-                commands,
-            );
-            ui.label("");
-            ui.horizontal(|ui| {
-                ui.radio_value(
-                    &mut f.profiles_kind,
-                    ProfilesKind::Folder,
-                    "a folder, one file per pose",
-                );
-                ui.radio_value(&mut f.profiles_kind, ProfilesKind::File, "one file");
-                let l = ui.label("pose column");
-                ui.add_enabled(
-                    f.profiles_kind == ProfilesKind::File,
-                    egui::TextEdit::singleline(&mut f.pose_column).desired_width(COLUMN_WIDTH),
-                )
-                .labelled_by(l.id);
-            });
-            ui.end_row();
             path_row(
                 ui,
                 "Reference distances CSV",
@@ -208,7 +268,7 @@ fn files_ui(ui: &mut egui::Ui, busy: bool, f: &mut ImportForm, commands: &mut Ve
         });
 }
 
-fn path_row(
+pub(super) fn path_row(
     ui: &mut egui::Ui,
     label: &str,
     text: &mut String,
@@ -351,7 +411,7 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
             let l = ui.label("Session name");
             ui.add(
                 egui::TextEdit::singleline(&mut f.name)
-                    .hint_text("default: the joint log's file name")
+                    .hint_text("default: the pose log's file name")
                     .desired_width(PATH_WIDTH),
             )
             .labelled_by(l.id);
@@ -481,19 +541,23 @@ fn preview_ui(ui: &mut egui::Ui, state: &AppState) {
 
 fn outcome_ui(ui: &mut egui::Ui, state: &AppState) {
     let view = &state.import;
-    match &view.outcome {
-        Some(Ok(line)) => {
-            ui.label(RichText::new(line).strong());
+    // The first line says what was imported; then what the import
+    // decided, the side and the initial hand-eye marked, warnings in
+    // orange. A failure is shown above the form, beside Import.
+    if let Some(Ok(text)) = &view.outcome {
+        for (k, line) in text.lines().enumerate() {
+            let decided = line.starts_with("initial hand-eye")
+                || line.starts_with("side ")
+                || line.starts_with("pose file:");
+            let text = RichText::new(line);
+            ui.label(if k == 0 || decided {
+                text.strong()
+            } else if line.contains("warning") {
+                text.color(WARN)
+            } else {
+                text
+            });
         }
-        Some(Err(e)) => {
-            egui::Frame::group(ui.style())
-                .stroke(egui::Stroke::new(1.5, BAD))
-                .show(ui, |ui| {
-                    ui.label(RichText::new("The import failed").strong().color(BAD));
-                    ui.label(e);
-                });
-        }
-        None => {}
     }
     let flagged: Vec<_> = view.checks.iter().filter(|c| c.flagged).collect();
     if view.checks.is_empty() {

@@ -7,6 +7,7 @@ pub mod compensate;
 pub mod history;
 pub mod import;
 pub mod measure;
+pub mod import_poses;
 pub mod plan;
 pub mod plots;
 pub mod results;

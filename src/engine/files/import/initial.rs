@@ -28,6 +28,16 @@ use crate::engine::calibrate::solve::analyse;
 /// report a kept orientation to a few thousandths of a degree.
 pub const SAME_ORIENTATION_DEG: f64 = 0.1;
 
+/// Poses of one orientation eq. 6-7 need: they solve the sensor's
+/// rotation from the moves between these poses, and two independent
+/// moves take three poses.
+pub const MIN_TRANSLATIONS: usize = 3;
+
+/// Poses of other orientations eq. 8-9 need: they solve the sensor's
+/// translation, and one turn leaves its component along the turn's axis
+/// open.
+pub const MIN_ROTATIONS: usize = 2;
+
 /// The translation group: the poses sharing the most common orientation
 /// (within [`SAME_ORIENTATION_DEG`]), in session order.
 fn translation_group(poses: &[Isometry3<f64>]) -> Vec<usize> {
@@ -44,6 +54,27 @@ fn translation_group(poses: &[Isometry3<f64>]) -> Vec<usize> {
         }
     }
     best
+}
+
+/// The poses (flange poses `bT_e`, mm) of the group of one orientation
+/// the paper's eq. 6-9 start from, when there is one: at least
+/// [`MIN_TRANSLATIONS`] poses of one orientation (within
+/// [`SAME_ORIENTATION_DEG`]) and [`MIN_ROTATIONS`] others.
+///
+/// # Errors
+/// No such group: the sentence that says why (the sizes found and what
+/// eq. 6-9 need).
+pub fn eq69_group(poses: &[Isometry3<f64>]) -> Result<Vec<usize>, String> {
+    let group = translation_group(poses);
+    let others = poses.len() - group.len();
+    if group.len() >= MIN_TRANSLATIONS && others >= MIN_ROTATIONS {
+        Ok(group)
+    } else {
+        Err(format!(
+            "no group of one orientation for eq. 6-9: the largest set of poses with one orientation (within {SAME_ORIENTATION_DEG}°) has {} poses and {others} others change orientation; eq. 6-9 need at least {MIN_TRANSLATIONS} of the one and {MIN_ROTATIONS} of the other",
+            group.len()
+        ))
+    }
 }
 
 /// RMS 3-D distance of each measurement's base-frame centre under
@@ -180,9 +211,7 @@ pub(crate) fn settle(
     let general: Result<GeneralHandEye, String> =
         general_hand_eye(&sightings, station_index.len()).map_err(|e| e.to_string());
     // Eq. 6-9 when one station holds a group of one orientation.
-    let group = translation_group(&poses);
-    let others = poses.len() - group.len();
-    let paper: Result<(Isometry3<f64>, String), String> = if group.len() >= 3 && others >= 2 {
+    let paper: Result<(Isometry3<f64>, String), String> = eq69_group(&poses).and_then(|group| {
         let sight = |i: usize| -> Option<Sighting> {
             let m = &session.measurements[i];
             centres[i].map(|c| Sighting {
@@ -215,12 +244,7 @@ pub(crate) fn settle(
                 )
             })
             .map_err(|e| e.to_string())
-    } else {
-        Err(format!(
-            "no group of one orientation for eq. 6-9: the largest set of poses with one orientation (within {SAME_ORIENTATION_DEG}°) has {} poses and {others} others change orientation; eq. 6-9 need at least 3 of the one and 2 of the other",
-            group.len()
-        ))
-    };
+    });
     let mut notes = Vec::new();
     let describe = |g: &GeneralHandEye| {
         format!(
@@ -263,7 +287,7 @@ pub(crate) fn settle(
             g.flange_from_sensor
         }
         (Err(no_group), Err(general)) => {
-            return Err(ImportError::File {
+            return Err(ImportError::NoInitialHandEye {
                 path: poses_file.to_path_buf(),
                 message: format!(
                     "no initial hand-eye can be had from these poses: {no_group}; and {general}. Give a guess with --hand-eye FILE (a 4×4, or a session or result file), or add poses that turn the flange about two different axes"

@@ -29,6 +29,7 @@ pub mod initial;
 pub mod log;
 pub mod pairing;
 pub mod poses;
+pub mod preview;
 pub mod profiles;
 pub mod references;
 pub mod robot_source;
@@ -45,6 +46,7 @@ pub use self::log::{ColumnMap, DEFAULT_SIDE_COLUMN, header, preview};
 pub use self::poses::{
     Observations, PoseImportSpec, PoseInputs, SideChoice, build_pose_session, read_pose_inputs,
 };
+pub use self::preview::{PairingPreview, PosePreview, preview_pose_import};
 pub use self::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource, RawProfile};
 pub use self::references::{read_references, reference_rows};
 pub use self::robot_source::{RobotSource, load_robot};
@@ -131,6 +133,16 @@ pub enum ImportError {
     /// The built session breaks a FORMAT.md rule (the loader's message).
     #[error("{0}")]
     Session(#[from] FileError),
+    /// No initial hand-eye can be had from the poses (no group of one
+    /// orientation for eq. 6-9, and the general solution degenerate): a
+    /// guess must be given. The message names both reasons.
+    #[error("{message} ({path})")]
+    NoInitialHandEye {
+        /// The pose file.
+        path: PathBuf,
+        /// Why, both reasons named.
+        message: String,
+    },
 }
 
 /// What an import built and found out.

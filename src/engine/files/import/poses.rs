@@ -192,7 +192,7 @@ impl PoseInputs {
 }
 
 /// A pose file error as an import error, naming the file and the line.
-fn program_error(e: ProgramError) -> ImportError {
+pub(crate) fn program_error(e: ProgramError) -> ImportError {
     if e.line == 0 {
         ImportError::File {
             path: e.path,
@@ -228,6 +228,7 @@ pub fn read_pose_log(
         },
     )
     .map_err(program_error)?;
+    let records = records_of(&file)?;
     let mut notes = vec![format!(
         "pose file: {} ({}); {}",
         file.format.describe(),
@@ -239,6 +240,17 @@ pub fn read_pose_log(
         file.order_note
     )];
     notes.extend(file.warnings.iter().map(|w| format!("warning: {w}")));
+    Ok((records, notes))
+}
+
+/// The targets of a pose file as records, in the order the robot went to
+/// them.
+///
+/// # Errors
+/// A target that is not a pose (naming the line), targets that mix joints
+/// and Cartesian poses.
+pub fn records_of(file: &PoseFile) -> Result<Vec<PoseRecord>, ImportError> {
+    let path = file.path.as_path();
     let mut records = Vec::with_capacity(file.order.len());
     let (mut poses, mut joints) = (0, 0);
     for t in file.ordered() {
@@ -281,7 +293,7 @@ pub fn read_pose_log(
             ),
         });
     }
-    Ok((records, notes))
+    Ok(records)
 }
 
 /// A measurement id for a record without one: `pose<k>` for a table row
@@ -395,6 +407,16 @@ pub fn read_pose_inputs(spec: &PoseImportSpec) -> Result<PoseInputs, ImportError
     })
 }
 
+/// The rows of a centres table: `x y z` (sensor frame, mm), a header
+/// and an `id` column optional.
+///
+/// # Errors
+/// The table cannot be read (naming the line).
+pub fn centre_rows(path: &Path) -> Result<Vec<program::Row>, ImportError> {
+    let names: Vec<String> = ["x", "y", "z"].iter().map(|s| (*s).to_string()).collect();
+    read_number_table(path, &names, false, "x, y, z (sensor frame, mm)").map_err(program_error)
+}
+
 /// The centres of a centres table, paired with the records: by id when
 /// both have ids, else in order (the counts must match).
 fn read_centres(
@@ -402,9 +424,7 @@ fn read_centres(
     records: &[PoseRecord],
     poses: &Path,
 ) -> Result<(Vec<String>, Vec<Vector3<f64>>), ImportError> {
-    let names: Vec<String> = ["x", "y", "z"].iter().map(|s| (*s).to_string()).collect();
-    let rows = read_number_table(path, &names, false, "x, y, z (sensor frame, mm)")
-        .map_err(program_error)?;
+    let rows = centre_rows(path)?;
     let record_ids: Vec<Option<&String>> = records.iter().map(|r| r.id.as_ref()).collect();
     let by_id = rows.iter().all(|r| r.id.is_some()) && record_ids.iter().all(Option::is_some);
     let mut out = Vec::with_capacity(records.len());
@@ -462,6 +482,37 @@ fn read_centres(
 /// the pairing in words.
 type Paired = (Vec<String>, Vec<PlaneProfile>, ProfileReport, Vec<String>);
 
+/// The pose ids, when the profiles are paired by them: the pose file
+/// has an id for every pose, and they name the folder's profile files
+/// (or the single profile file has a pose column); `None`: pose `k` goes
+/// with the `k`-th profile.
+#[must_use]
+pub fn paired_by_id(source: &ProfileSource, records: &[PoseRecord]) -> Option<Vec<String>> {
+    let ids: Vec<String> = records
+        .iter()
+        .map(|r| r.id.clone())
+        .collect::<Option<_>>()?;
+    let named = match source {
+        ProfileSource::Folder(dir) => ids.iter().all(|id| profiles::file_of(dir, id).is_some()),
+        ProfileSource::File { .. } => true,
+    };
+    named.then_some(ids)
+}
+
+/// Whether a pose's own number (`P[3]` → 3) differs from its profile's
+/// (`p4.yml` → 4) anywhere in the pairing: the order may be wrong. A
+/// table row or list entry (`line 4`, `pose 2`) has no number of its own.
+#[must_use]
+pub fn numbers_differ(records: &[PoseRecord], listing: &FolderListing) -> bool {
+    records.iter().zip(&listing.numbers).any(|(r, n)| {
+        let unnamed = r.name.starts_with("line ") || r.name.starts_with("pose ");
+        let pose_number = (!unnamed)
+            .then(|| crate::engine::files::program::number_in(&r.name))
+            .flatten();
+        pose_number.is_some() && n.is_some() && pose_number != *n
+    })
+}
+
 /// Pose ids and their profiles, and the pairing in words: by id when the
 /// log has ids that name profile files, else pose `k` with the `k`-th
 /// profile in the order of their numbers.
@@ -470,15 +521,7 @@ fn pair_profiles(
     source: &ProfileSource,
     records: &[PoseRecord],
 ) -> Result<Paired, ImportError> {
-    let ids: Option<Vec<String>> = records.iter().map(|r| r.id.clone()).collect();
-    let named = match (&ids, source) {
-        (Some(ids), ProfileSource::Folder(dir)) => {
-            ids.iter().all(|id| profiles::file_of(dir, id).is_some())
-        }
-        (Some(_), ProfileSource::File { .. }) => true,
-        (None, _) => false,
-    };
-    if let (true, Some(ids)) = (named, ids) {
+    if let Some(ids) = paired_by_id(source, records) {
         let mut first: HashMap<&str, usize> = HashMap::new();
         for (r, id) in records.iter().zip(&ids) {
             if let Some(line) = first.insert(id, r.line) {
@@ -567,6 +610,10 @@ fn check_count(
     })
 }
 
+/// The warning of a pairing whose pose and profile numbers differ.
+pub const NUMBERS_DIFFER_WARNING: &str =
+    "; warning: some pose numbers differ from their profile's number: check the order";
+
 /// "pairing: P[1] ↔ p1.yml, …", with a warning when numbers differ.
 fn pairing_note(records: &[PoseRecord], listing: &FolderListing) -> String {
     let pairs: Vec<String> = records
@@ -583,14 +630,10 @@ fn pairing_note(records: &[PoseRecord], listing: &FolderListing) -> String {
     } else {
         pairs.join(", ")
     };
-    let numbers_differ = records.iter().zip(&listing.numbers).any(|(r, n)| {
-        let pose_number = crate::engine::files::program::number_in(&r.name);
-        pose_number.is_some() && n.is_some() && pose_number != *n
-    });
     format!(
         "pairing (pose order ↔ profile number): {shown}{}",
-        if numbers_differ {
-            "; warning: some pose numbers differ from their profile's number: check the order"
+        if numbers_differ(records, listing) {
+            NUMBERS_DIFFER_WARNING
         } else {
             ""
         }

@@ -73,8 +73,24 @@ pub fn decide_side(spec: &PoseImportSpec, inputs: &PoseInputs) -> Result<Importe
     if tried.iter().all(|t| t.imported.is_err()) {
         let plus = tried.swap_remove(0);
         let same = tried[0].epsilon.as_ref().err() == plus.epsilon.as_ref().err();
+        let no_hand_eye = |i: &Result<Imported, ImportError>| {
+            matches!(i, Err(ImportError::NoInitialHandEye { .. }))
+        };
+        let both_without_hand_eye = no_hand_eye(&plus.imported) && no_hand_eye(&tried[0].imported);
         return match plus.imported {
             Err(e) if same => Err(e),
+            // Neither side has an initial hand-eye: still that error (a
+            // guess is what is missing), with both sides' reasons.
+            Err(ImportError::NoInitialHandEye { path, .. }) if both_without_hand_eye => {
+                Err(ImportError::NoInitialHandEye {
+                    path,
+                    message: format!(
+                        "on neither side of the laser plane: side +1: {}; side −1: {}",
+                        plus.epsilon.err().unwrap_or_default(),
+                        tried[0].epsilon.clone().err().unwrap_or_default()
+                    ),
+                })
+            }
             _ => Err(ImportError::File {
                 path: spec.poses.clone(),
                 message: format!(
