@@ -107,15 +107,15 @@ fn bench_find_arc(c: &mut Criterion) {
     let mut group = c.benchmark_group("segment");
     group.throughput(Throughput::Elements(points.len() as u64));
     group.bench_function("find_arc_synthetic_2500", |b| {
-        b.iter(|| find_arc(black_box(&points), black_box(R)))
+        b.iter(|| find_arc(black_box(&points), black_box(R)));
     });
     if let Some(real) = &real {
         group.throughput(Throughput::Elements(real.len() as u64));
         group.bench_function("find_arc_real_p1", |b| {
-            b.iter(|| find_arc(black_box(real), black_box(R)))
+            b.iter(|| find_arc(black_box(real), black_box(R)));
         });
         group.bench_function("fit_circle_real_p1", |b| {
-            b.iter(|| fit_circle(black_box(real)))
+            b.iter(|| fit_circle(black_box(real)));
         });
     }
     group.finish();

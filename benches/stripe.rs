@@ -34,10 +34,10 @@ fn bench_fit(c: &mut Criterion) {
     let mut group = c.benchmark_group("stripe");
     group.throughput(Throughput::Elements(POINTS as u64));
     group.bench_function("fit_circle_60", |b| {
-        b.iter(|| fit_circle(black_box(&points)))
+        b.iter(|| fit_circle(black_box(&points)));
     });
     group.bench_function("centre_from_stripe_60", |b| {
-        b.iter(|| centre_from_stripe(black_box(&points), black_box(19.05), 1))
+        b.iter(|| centre_from_stripe(black_box(&points), black_box(19.05), 1));
     });
     group.finish();
 }

@@ -665,7 +665,7 @@ fn joint_targets_are_compensated_or_kept() {
     let file = spherecal::engine::files::program::parse_pose_text(
         written,
         Path::new("j.mod"),
-        &Default::default(),
+        &spherecal::engine::files::program::ReadSpec::default(),
     )
     .unwrap();
     let spherecal::engine::files::program::TargetValue::Joints { deg, .. } = &file.targets[0].value

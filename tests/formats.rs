@@ -163,7 +163,7 @@ fn independent_example_session_loads() {
         assert_eq!(m.joints.len(), 6);
         match &m.observation {
             Observation::Stripe(points) => {
-                assert!(points.len() >= 40, "{}: {}", m.id, points.len())
+                assert!(points.len() >= 40, "{}: {}", m.id, points.len());
             }
             Observation::Centre(_) => {
                 panic!("{} gives a centre; the example has stripes only", m.id)

@@ -622,8 +622,8 @@ fn dates_come_from_names_then_file_names_then_file_times() {
     let dir = tempfile::tempdir().unwrap();
     let base = &calibrations()[0];
     // 2026-08-01 12:00:00 UTC and 2026-09-02 08:30:00 UTC.
-    let aug = UNIX_EPOCH + Duration::from_secs(1_785_585_600);
-    let sep = UNIX_EPOCH + Duration::from_secs(1_788_337_800);
+    let aug = UNIX_EPOCH + Duration::from_hours(495996);
+    let sep = UNIX_EPOCH + Duration::from_mins(29805630);
     let undated = |stem: &str, session_name: &str| Cal {
         stem: stem.to_string(),
         session: Session {

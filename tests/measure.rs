@@ -368,7 +368,9 @@ fn scaled(result: &ResultFile, factor: f64) -> ResultFile {
     let mut out = result.clone();
     if let SolverReport::Ml(ml) = &mut out.solver {
         for row in &mut ml.covariance.matrix {
-            row.iter_mut().for_each(|v| *v *= factor);
+            for v in row.iter_mut() {
+                *v *= factor;
+            }
         }
     }
     out

@@ -396,8 +396,7 @@ fn simulated_data_from_a_plan_imports_through_the_csv_path_and_calibrates() {
     let score = evaluate::score(&imported, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
     assert!(
         score.after.std < score.before.std / 3.0 && score.after.std < 0.3,
-        "{:?}",
-        score
+        "{score:?}"
     );
 
     // The plan CSV itself is a joint log the import reads, with the

@@ -6,6 +6,10 @@
 //! plan's programs read back; bad files named with their line; mutated
 //! files never panic or hang.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(
+    clippy::case_sensitive_file_extension_comparisons,
+    reason = "the tests name their own files, in lower case"
+)]
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -446,7 +450,7 @@ fn plan_programs_import_back_to_the_planned_poses() {
         ("ur5e", robot::ur5e(), Controller::UrScript),
     ] {
         let w = Workspace::for_robot(RobotChoice::from_key(key).unwrap());
-        let sphere = [0, 1, 2].map(|i| (w.min[i] + w.max[i]) / 2.0);
+        let sphere = [0, 1, 2].map(|i| f64::midpoint(w.min[i], w.max[i]));
         let mut config = PlanConfig::for_preset(&preset, sphere);
         config.n_identify = 2;
         config.identify_poses = 4;

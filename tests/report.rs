@@ -324,7 +324,10 @@ fn the_papers_method_marks_the_dropped_directions() {
     let marks = result_view::identifiability_marks(&result.solver);
     assert!(!marks.is_empty() && marks.contains_key("theta1"));
     // Every mark of a joint or hand-eye parameter is a marked cell.
-    let mut labels: Vec<String> = HAND_EYE_LABELS.iter().map(|l| l.to_string()).collect();
+    let mut labels: Vec<String> = HAND_EYE_LABELS
+        .iter()
+        .map(std::string::ToString::to_string)
+        .collect();
     for j in 1..=6 {
         labels.extend(PARAM_NAMES.iter().map(|p| format!("{p}{j}")));
     }

@@ -22,7 +22,7 @@ use spherecal::engine::tools::report::html::{AFTER_COLOUR, BEFORE_COLOUR};
 
 /// Longest a Chromium run may take before the test fails (it takes 1-3 s;
 /// a loaded CI machine may be much slower).
-const CHROMIUM_TIMEOUT: Duration = Duration::from_secs(120);
+const CHROMIUM_TIMEOUT: Duration = Duration::from_mins(2);
 /// Width of the screenshot window, px.
 const SHOT_WIDTH: u32 = 1200;
 /// Height of the screenshot window, px: header, summary, settings, stripe

@@ -130,7 +130,7 @@ fn scene(seed: u64, r: f64, sigma: f64) -> Scene {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), c| {
             (a.min(c.1), b.max(c.1))
         });
-    for c in cols.iter_mut() {
+    for c in &mut cols {
         if rng.random::<f64>() < 0.02 {
             c.1 = rng.random_range(zmin - 5.0..zmax + 5.0);
             c.2 = Label::Other;
@@ -395,7 +395,7 @@ fn a_straight_line_has_no_arc() {
     let noise = Normal::new(0.0, 0.02).unwrap();
     let line: Vec<[f64; 2]> = (0..2500)
         .map(|i| {
-            let y = i as f64 * PITCH;
+            let y = f64::from(i) * PITCH;
             [y, -20.0 + 0.1 * y + noise.sample(&mut rng)]
         })
         .collect();
@@ -415,7 +415,7 @@ fn a_circle_twice_the_sphere_is_rejected() {
     let big = 2.0 * R;
     let circle: Vec<[f64; 2]> = (0..2500)
         .map(|i| {
-            let y = -60.0 + i as f64 * 120.0 / 2499.0;
+            let y = -60.0 + f64::from(i) * 120.0 / 2499.0;
             [y, cap([0.0, -70.0], big, y) + noise.sample(&mut rng)]
         })
         .collect();

@@ -491,7 +491,7 @@ fn every_error_variant() {
     }
     // Collinear, coincident, two distinct points, a line with rounding noise.
     let line: Vec<_> = (0..20)
-        .map(|i| [0.1 * i as f64, 3.0 + 0.2 * i as f64])
+        .map(|i| [0.1 * f64::from(i), 3.0 + 0.2 * f64::from(i)])
         .collect();
     assert_eq!(fit_circle(&line), Err(StripeError::Degenerate));
     assert_eq!(fit_circle(&[[7.0, 7.0]; 6]), Err(StripeError::Degenerate));
@@ -502,7 +502,7 @@ fn every_error_variant() {
     // Far too flat to be a circle: sagitta 1e-9 of the length.
     let flat: Vec<_> = (0..10)
         .map(|i| {
-            let x = i as f64 - 4.5;
+            let x = f64::from(i) - 4.5;
             [x, 1e-9 * x * x]
         })
         .collect();

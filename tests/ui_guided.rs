@@ -472,7 +472,7 @@ fn the_plots_png_is_whole_and_light() {
             .filter(|&(x, y)| dark(png.get_pixel(x, y)))
             .count()
     };
-    let height = png.height() as f64;
+    let height = f64::from(png.height());
     for (name, y0, y1) in [("Fig. 5", 0.1, 0.4), ("Fig. 6", 0.4, 0.7), ("ε", 0.7, 0.98)] {
         assert!(
             band(y0 * height, y1 * height) > 50,

@@ -282,6 +282,10 @@ pub struct Reporter {
 impl Reporter {
     /// Sends a message and wakes the UI. Returns false when the workbench
     /// is gone (the job should stop).
+    #[allow(
+        clippy::must_use_candidate,
+        reason = "a job that has nothing more to do after its last message ignores the answer"
+    )]
     pub fn send(&self, message: JobMessage) -> bool {
         let ok = self.tx.send(message).is_ok();
         self.ctx.request_repaint();

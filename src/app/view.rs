@@ -239,8 +239,16 @@ impl ErrorSet {
                 set: VALIDATION_SET,
                 what: "reference distances, measured − reference".to_string(),
                 within: false,
-                before: shown.distances.iter().map(|d| d.error_before()).collect(),
-                after: shown.distances.iter().map(|d| d.error_after()).collect(),
+                before: shown
+                    .distances
+                    .iter()
+                    .map(super::super::engine::calibrate::validate::DistanceRecord::error_before)
+                    .collect(),
+                after: shown
+                    .distances
+                    .iter()
+                    .map(super::super::engine::calibrate::validate::DistanceRecord::error_after)
+                    .collect(),
             });
         }
         out

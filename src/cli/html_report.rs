@@ -74,26 +74,23 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         format::parse_session(text, &args.session).map_err(|e| CliError::from_file(&e, true))?;
     let prepared =
         solve::prepare(&session).map_err(|e| CliError::from_calibration(&e, &args.session))?;
-    let result = match &args.result {
-        Some(path) => {
-            let result = format::load_result(path).map_err(|e| CliError::from_file(&e, true))?;
-            result_view::check_result(&session, &result, Some(&prepared)).map_err(|e| {
-                CliError::input(format!(
-                    "{} does not belong to {}: {e}",
-                    path.display(),
-                    args.session.display()
-                ))
-            })?;
-            result
-        }
-        None => {
-            let mut options = Options::from_session(&session);
-            options.method = args.method;
-            let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
-                .map_err(|e| CliError::from_calibration(&e, &args.session))?;
-            super::check_plausible(&session, &cal, args.accept_implausible, &args.session)?;
-            format::ResultFile::from_calibration(&session, &cal)
-        }
+    let result = if let Some(path) = &args.result {
+        let result = format::load_result(path).map_err(|e| CliError::from_file(&e, true))?;
+        result_view::check_result(&session, &result, Some(&prepared)).map_err(|e| {
+            CliError::input(format!(
+                "{} does not belong to {}: {e}",
+                path.display(),
+                args.session.display()
+            ))
+        })?;
+        result
+    } else {
+        let mut options = Options::from_session(&session);
+        options.method = args.method;
+        let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
+            .map_err(|e| CliError::from_calibration(&e, &args.session))?;
+        super::check_plausible(&session, &cal, args.accept_implausible, &args.session)?;
+        format::ResultFile::from_calibration(&session, &cal)
     };
     let meta = ReportMeta::new(args.session.display().to_string(), SystemTime::now());
     let rendering = Instant::now();

@@ -338,7 +338,10 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
         }
         Scan::from_session(session, &uses(args)?)
     } else {
-        let dof = result.robot.as_ref().map_or(0, |r| r.dof());
+        let dof = result
+            .robot
+            .as_ref()
+            .map_or(0, super::super::engine::base::robot::kinematics::Robot::dof);
         measure::scan_from_files(&scan_files(args, dof)?)
             .map_err(|e| CliError::input(e.to_string()))?
     };

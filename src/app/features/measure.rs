@@ -362,7 +362,11 @@ impl Core {
                 ScanInput::SessionFile(PathBuf::from(path), form.uses())
             }
             ScanChoice::RawScan => {
-                let dof = view.file.robot.as_ref().map_or(0, |r| r.dof());
+                let dof = view
+                    .file
+                    .robot
+                    .as_ref()
+                    .map_or(0, crate::engine::base::robot::kinematics::Robot::dof);
                 ScanInput::Files(Box::new(form.scan_files(dof)?))
             }
         };
@@ -577,17 +581,17 @@ impl Core {
         }
         let folder = self.state.prefs.last_folder.clone();
         let form = &self.forms.measure;
-        let file_name = Path::new(form.out.trim())
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| {
+        let file_name = Path::new(form.out.trim()).file_name().map_or_else(
+            || {
                 let stem = self
                     .state
                     .loaded
                     .as_ref()
                     .map_or_else(|| "scan".to_string(), |l| l.source.stem());
                 format!("{stem}-cloud.ply")
-            });
+            },
+            |n| n.to_string_lossy().into_owned(),
+        );
         let started = self.spawn(ctx, "file-dialog", move |rep| {
             let mut dialog = rfd::FileDialog::new();
             if let Some(dir) = folder.filter(|d| d.is_dir()) {

@@ -210,12 +210,11 @@ impl Core {
     /// `None`, and the operator is told why nothing is written (a stale
     /// plan is never written as another robot's program).
     fn current_plan(&mut self, what: &str) -> Option<(Plan, Stamp)> {
-        let plan = match &self.state.plan.outcome {
-            Some(Ok(o)) => (*o.plan).clone(),
-            _ => {
-                self.state.say(Level::Warning, "make a plan first");
-                return None;
-            }
+        let plan = if let Some(Ok(o)) = &self.state.plan.outcome {
+            (*o.plan).clone()
+        } else {
+            self.state.say(Level::Warning, "make a plan first");
+            return None;
         };
         if let Err(why) = self.state.provenance.check(Output::Plan) {
             self.state

@@ -40,7 +40,7 @@ impl Default for PlanForm {
 pub fn default_sphere(key: &str) -> [f64; 3] {
     RobotChoice::from_key(key).map_or([1000.0, 0.0, 500.0], |c| {
         let w = Workspace::for_robot(c);
-        [0, 1, 2].map(|i| (w.min[i] + w.max[i]) / 2.0)
+        [0, 1, 2].map(|i| f64::midpoint(w.min[i], w.max[i]))
     })
 }
 

@@ -575,7 +575,7 @@ fn colour_bar_ui(ui: &mut egui::Ui, c: &MeasuredCloud, height: f32) {
         ui.painter().add(egui::Shape::mesh(mesh));
         ui.label(format!("{:.3}", lo * k));
         ui.label(
-            RichText::new(format!("mid {:.3}", (lo + hi) / 2.0 * k))
+            RichText::new(format!("mid {:.3}", f64::midpoint(lo, hi) * k))
                 .small()
                 .color(MUTED),
         );

@@ -274,6 +274,10 @@ pub fn range_fields(ui: &mut egui::Ui, id: &str, v: &mut [f64; 4], rows: bool) -
 }
 
 /// The range of `[y0, y1, z0, z1]`, or why it is not one.
+///
+/// # Errors
+/// Why the four numbers are not a range (a lower bound not below its
+/// upper one).
 pub fn range_of(v: &[f64; 4]) -> Result<crate::engine::base::session::SensorRange, &'static str> {
     if v[0] < v[1] && v[2] < v[3] {
         Ok(crate::engine::base::session::SensorRange {
@@ -369,7 +373,8 @@ pub fn log_tick(exponent: f64) -> String {
     let most = (3.0 - v.log10().floor()).max(0.0) as usize;
     let decimals = (0..=most)
         .find(|&d| {
-            let scale = 10f64.powi(d as i32);
+            // At most four decimals: the cast cannot wrap.
+            let scale = 10f64.powi(i32::try_from(d).unwrap_or(i32::MAX));
             ((v * scale).round() / scale - v).abs() <= v * 1e-6
         })
         .unwrap_or(most);

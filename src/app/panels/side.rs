@@ -50,32 +50,29 @@ pub fn load_ui(
     let line = |ui: &mut egui::Ui, text: RichText| ui.add(egui::Label::new(text).truncate());
     // Whole, wrapped: a cut path or count hides what is open.
     let whole = |ui: &mut egui::Ui, text: RichText| ui.add(egui::Label::new(text).wrap());
-    match &state.loaded {
-        Some(l) => {
-            name_ui(ui, &l.session.name);
-            whole(ui, RichText::new(l.source.label()).small().weak());
-            let n = l.session.measurements.len();
-            let stations = l.station_ids().len();
-            let text = format!(
-                "{n} measurements, {stations} station{}, sphere Ø {} mm{}",
-                if stations == 1 { "" } else { "s" },
-                l.session.sphere_diameter,
-                if l.session.pose_only() {
-                    " · pose-only (flange poses)"
-                } else {
-                    ""
-                }
-            );
-            whole(ui, RichText::new(text).small());
-        }
-        None => {
-            match &state.busy.opening {
-                Some(what) => name_ui(ui, &format!("opening {what}…")),
-                None => name_ui(ui, "no session open"),
+    if let Some(l) = &state.loaded {
+        name_ui(ui, &l.session.name);
+        whole(ui, RichText::new(l.source.label()).small().weak());
+        let n = l.session.measurements.len();
+        let stations = l.station_ids().len();
+        let text = format!(
+            "{n} measurements, {stations} station{}, sphere Ø {} mm{}",
+            if stations == 1 { "" } else { "s" },
+            l.session.sphere_diameter,
+            if l.session.pose_only() {
+                " · pose-only (flange poses)"
+            } else {
+                ""
             }
-            line(ui, RichText::new(" ").small());
-            line(ui, RichText::new(" ").small());
+        );
+        whole(ui, RichText::new(text).small());
+    } else {
+        match &state.busy.opening {
+            Some(what) => name_ui(ui, &format!("opening {what}…")),
+            None => name_ui(ui, "no session open"),
         }
+        line(ui, RichText::new(" ").small());
+        line(ui, RichText::new(" ").small());
     }
     ui.add_space(4.0);
     let width = ui.available_width();

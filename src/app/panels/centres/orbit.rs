@@ -68,9 +68,9 @@ impl Orbit {
             }
         }
         let centre = [
-            (lo[0] + hi[0]) / 2.0,
-            (lo[1] + hi[1]) / 2.0,
-            (lo[2] + hi[2]) / 2.0,
+            f64::midpoint(lo[0], hi[0]),
+            f64::midpoint(lo[1], hi[1]),
+            f64::midpoint(lo[2], hi[2]),
         ];
         let half = (0..3)
             .map(|k| (hi[k] - lo[k]) / 2.0)

@@ -168,7 +168,7 @@ fn colour_bar_ui(ui: &mut egui::Ui, top: f64) {
             top * (k + 1) as f64 / BAR_BANDS as f64,
         );
         let band = egui::Rect::from_x_y_ranges(bar.x_range(), y_of(b)..=y_of(a));
-        painter.rect_filled(band, 0.0, cell_colour((a + b) / 2.0, top));
+        painter.rect_filled(band, 0.0, cell_colour(f64::midpoint(a, b), top));
     }
     let text = ui.visuals().text_color();
     painter.rect_stroke(

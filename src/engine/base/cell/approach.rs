@@ -33,6 +33,7 @@ fn perpendiculars(axis: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
 
 /// The rotation whose z axis is `approach` (unit), turned by `roll` rad
 /// about it.
+#[must_use]
 pub fn rotation_from_approach(approach: &Vector3<f64>, roll: f64) -> UnitQuaternion<f64> {
     let (e1, e2) = perpendiculars(approach);
     let x = e1 * roll.cos() + e2 * roll.sin();

@@ -142,7 +142,7 @@ impl SensorRange {
     pub fn grid(&self, n: usize) -> Vec<[f64; 2]> {
         let at = |lo: f64, hi: f64, k: usize| {
             if n < 2 {
-                (lo + hi) / 2.0
+                f64::midpoint(lo, hi)
             } else {
                 lo + (hi - lo) * k as f64 / (n - 1) as f64
             }
@@ -335,12 +335,11 @@ impl Session {
             if m.usage != usage {
                 continue;
             }
-            match index.get(m.station.as_str()) {
-                Some(&k) => out[k].1.push(i),
-                None => {
-                    index.insert(&m.station, out.len());
-                    out.push((m.station.clone(), vec![i]));
-                }
+            if let Some(&k) = index.get(m.station.as_str()) {
+                out[k].1.push(i);
+            } else {
+                index.insert(&m.station, out.len());
+                out.push((m.station.clone(), vec![i]));
             }
         }
         out

@@ -379,14 +379,13 @@ pub fn measurement(
     non_empty("id", &m.id).map_err(|e| ("id", e))?;
     non_empty("station", &m.station).map_err(|e| ("station", e))?;
     side("side", m.side).map_err(|e| ("side", e))?;
-    match &m.flange {
-        Some(pose) => transform("flange", pose).map_err(|e| ("flange", e))?,
-        None => {
-            if !robot_given {
-                return Err(("joints", JOINTS_WITHOUT_ROBOT.to_string()));
-            }
-            joints("joints", &m.joints, robot_joints).map_err(|e| ("joints", e))?;
+    if let Some(pose) = &m.flange {
+        transform("flange", pose).map_err(|e| ("flange", e))?;
+    } else {
+        if !robot_given {
+            return Err(("joints", JOINTS_WITHOUT_ROBOT.to_string()));
         }
+        joints("joints", &m.joints, robot_joints).map_err(|e| ("joints", e))?;
     }
     match &m.observation {
         Observation::Stripe(points) => {
@@ -437,10 +436,6 @@ impl Session {
             max_iterations: n,
         } = self.solver;
         threshold(t).map_err(|m| general("solver.threshold", m))?;
-        #[allow(
-            clippy::cast_precision_loss,
-            reason = "compared with limits far below 2^52"
-        )]
         max_iterations(n as f64).map_err(|m| general("solver.max_iterations", m))?;
         let robot_given = self.robot_given || !self.robot.joints.is_empty();
         let mut first: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();

@@ -398,10 +398,6 @@ pub fn general_hand_eye(
         .zip(&counts)
         .map(|(s, c)| if *c > 0.0 { s / *c } else { *s })
         .collect();
-    #[allow(
-        clippy::cast_precision_loss,
-        reason = "a count of sightings is far below 2^52"
-    )]
     let rms_mm = (cost / sightings.len() as f64).sqrt();
     Ok(GeneralHandEye {
         flange_from_sensor,
@@ -496,6 +492,6 @@ mod tests {
         let e = general_hand_eye(&sightings(3, 30.0, 0.0, 2), 1)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("3"), "{e}");
+        assert!(e.contains('3'), "{e}");
     }
 }

@@ -315,14 +315,11 @@ pub(super) fn paper_refits(
                 return None;
             }
             let mut inner = |_: Phase| Control::Continue;
-            match update.update(u, &mut inner) {
-                Ok(Step::Moved) => {}
-                // A fold whose rest cannot be calibrated (no pair left)
-                // predicts nothing: its measurements stay undetermined.
-                Ok(_) | Err(_) => {
-                    failed = true;
-                    break;
-                }
+            // A fold whose rest cannot be calibrated (no pair left)
+            // predicts nothing: its measurements stay undetermined.
+            if !matches!(update.update(u, &mut inner), Ok(Step::Moved)) {
+                failed = true;
+                break;
             }
         }
         if failed {

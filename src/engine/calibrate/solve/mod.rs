@@ -493,10 +493,6 @@ pub fn run(
             limits::THRESHOLD_MM
         )));
     }
-    #[allow(
-        clippy::cast_precision_loss,
-        reason = "compared against a limit far below 2^52"
-    )]
     if options.max_iterations as f64 > limits::MAX_ITERATIONS {
         return Err(SolveError::InvalidOption(format!(
             "max_iterations {} is not plausible: give at most {}",

@@ -384,7 +384,6 @@ fn check_points(points: &[[f64; 2]]) -> Result<Frame, StripeError> {
     {
         return Err(StripeError::NonFinite { index });
     }
-    #[allow(clippy::cast_precision_loss)] // point counts are far below 2^52
     let count = points.len() as f64;
     let (sy, sz) = points
         .iter()
@@ -476,7 +475,6 @@ pub fn fit_circle(points: &[[f64; 2]]) -> Result<CircleFit, StripeError> {
         // From the second round on, the outliers are out of the fit and its
         // own σ̂ is a steadier scale than the MAD; it only ever raises the
         // threshold, so that a low MAD does not trim good points.
-        #[allow(clippy::cast_precision_loss)] // point counts are far below 2^52
         let sigma = if rounds > 1 {
             (normal.cost / (used - 3) as f64).sqrt()
         } else {
@@ -498,12 +496,10 @@ pub fn fit_circle(points: &[[f64; 2]]) -> Result<CircleFit, StripeError> {
             return Err(StripeError::TooManyOutliers { kept: used, total });
         }
     };
-    #[allow(clippy::cast_precision_loss)] // point counts are far below 2^52
     if (used as f64) < MIN_INLIER_FRACTION * total as f64 {
         return Err(StripeError::TooManyOutliers { kept: used, total });
     }
 
-    #[allow(clippy::cast_precision_loss)] // point counts are far below 2^52
     let (used_f, dof) = (used as f64, (used - 3) as f64);
     let scale = frame.scale;
     let inverse = normal
@@ -595,7 +591,7 @@ mod tests {
         // 12 points evenly around the whole circle: 330° between first and last.
         let full: Vec<_> = (0..12)
             .map(|i| {
-                let t = (30.0 * i as f64).to_radians();
+                let t = (30.0 * f64::from(i)).to_radians();
                 [1.0 + 5.0 * t.cos(), 2.0 + 5.0 * t.sin()]
             })
             .collect();
@@ -612,7 +608,7 @@ mod tests {
     #[test]
     fn collinear_and_coincident_are_degenerate() {
         let line: Vec<_> = (0..10)
-            .map(|i| [1.0 + i as f64, 2.0 - 0.5 * i as f64])
+            .map(|i| [1.0 + f64::from(i), 2.0 - 0.5 * f64::from(i)])
             .collect();
         assert_eq!(fit_circle(&line), Err(StripeError::Degenerate));
         let same = vec![[4.2, -1.3]; 8];

@@ -423,6 +423,10 @@ impl<'a> Ctx<'a> {
 
     /// Whether `format` and `version` name a version 1 file of kind
     /// `expected` (the fast check; [`Self::header`] says what is wrong).
+    #[allow(
+        clippy::unused_self,
+        reason = "the fast twin of `Self::header`, which needs the context for its message"
+    )]
     pub(super) fn is_header(
         &self,
         format: Option<&'a RawValue>,
@@ -627,15 +631,12 @@ mod tests {
         let mut i = 0;
         while i < lines.len() {
             let line = lines[i];
-            match flat_container(&lines[i..], open, close, max) {
-                Some((collapsed, used)) => {
-                    out.push(collapsed);
-                    i += used;
-                }
-                None => {
-                    out.push(line.to_owned());
-                    i += 1;
-                }
+            if let Some((collapsed, used)) = flat_container(&lines[i..], open, close, max) {
+                out.push(collapsed);
+                i += used;
+            } else {
+                out.push(line.to_owned());
+                i += 1;
             }
         }
         out.join("\n")

@@ -756,7 +756,7 @@ impl ResultKeys {
     }
 }
 
-impl<'a> Ctx<'a> {
+impl Ctx<'_> {
     /// Checks that the result's records are JSON objects (serde's derive
     /// would also take an array of the values in field order).
     fn result_objects(&self, top: &Value) -> Result<(), FileError> {

@@ -355,32 +355,29 @@ impl<'a> Ctx<'a> {
         // Parsed strictly first; only when that fails is the id picked out
         // leniently, so that the error can name the measurement.
         let (keys, m, scope): (MeasurementKeys, Option<String>, String) =
-            match self.object::<MeasurementKeys>(raw, "", None) {
-                Ok(keys) => {
-                    let lenient = keys
-                        .id
-                        .and_then(|r| serde_json::from_str::<String>(r.get()).ok())
-                        .filter(|id| !id.is_empty());
-                    let scope = if lenient.is_some() {
-                        String::new()
-                    } else {
-                        format!("measurements[{index}]")
-                    };
-                    (keys, lenient, scope)
-                }
-                Err(_) => {
-                    let lenient = serde_json::from_str::<IdProbe>(raw.get())
-                        .ok()
-                        .and_then(|p| p.id)
-                        .filter(|id| !id.is_empty());
-                    let scope = if lenient.is_some() {
-                        String::new()
-                    } else {
-                        format!("measurements[{index}]")
-                    };
-                    let keys = self.object(raw, &scope, lenient.as_deref())?;
-                    (keys, lenient, scope)
-                }
+            if let Ok(keys) = self.object::<MeasurementKeys>(raw, "", None) {
+                let lenient = keys
+                    .id
+                    .and_then(|r| serde_json::from_str::<String>(r.get()).ok())
+                    .filter(|id| !id.is_empty());
+                let scope = if lenient.is_some() {
+                    String::new()
+                } else {
+                    format!("measurements[{index}]")
+                };
+                (keys, lenient, scope)
+            } else {
+                let lenient = serde_json::from_str::<IdProbe>(raw.get())
+                    .ok()
+                    .and_then(|p| p.id)
+                    .filter(|id| !id.is_empty());
+                let scope = if lenient.is_some() {
+                    String::new()
+                } else {
+                    format!("measurements[{index}]")
+                };
+                let keys = self.object(raw, &scope, lenient.as_deref())?;
+                (keys, lenient, scope)
             };
         let m = m.as_deref();
 
@@ -478,9 +475,10 @@ impl<'a> Ctx<'a> {
                 let points_key = join(&stripe_key, "points");
                 // One pass for a well-formed list; on any problem, item by
                 // item for a message that names the point.
-                let points = match serde_json::from_str::<Vec<[f64; 2]>>(points_raw.get()) {
-                    Ok(points) => points,
-                    Err(_) => {
+                let points =
+                    if let Ok(points) = serde_json::from_str::<Vec<[f64; 2]>>(points_raw.get()) {
+                        points
+                    } else {
                         let items: Vec<&'a RawValue> = self.parse(points_raw, &points_key, m)?;
                         items
                             .into_iter()
@@ -489,8 +487,7 @@ impl<'a> Ctx<'a> {
                                 self.numbers::<2>(item, &format!("{points_key}[{i}]"), " [y, z]", m)
                             })
                             .collect::<Result<Vec<_>, _>>()?
-                    }
-                };
+                    };
                 rules::stripe_points(&points_key, &prefix(&scope), &points)
                     .map_err(|e| self.rule(m, e, points_raw))?;
                 Observation::Stripe(points)

@@ -279,26 +279,25 @@ pub(crate) fn planar(
     format: &ProfileFormat,
     ids: &[String],
 ) -> Result<(Vec<PlaneProfile>, ProfileReport), ImportError> {
-    let (axes, axes_guessed) = match format.axes {
-        Some(m) => (m, false),
-        None => {
-            let m = AxisMap::guess(&raws).map_err(|message| {
-                // Name the profile that breaks the plane the others share.
-                match AxisMap::odd_profile(&raws) {
-                    Some(k) => ImportError::File {
-                        path: raws[k].source.clone(),
-                        message: format!(
-                            "this profile is not in the plane the other profiles lie in: {message}"
-                        ),
-                    },
-                    None => ImportError::File {
-                        path: raws.first().map_or_else(PathBuf::new, |r| r.source.clone()),
-                        message,
-                    },
-                }
-            })?;
-            (m, true)
-        }
+    let (axes, axes_guessed) = if let Some(m) = format.axes {
+        (m, false)
+    } else {
+        let m = AxisMap::guess(&raws).map_err(|message| {
+            // Name the profile that breaks the plane the others share.
+            match AxisMap::odd_profile(&raws) {
+                Some(k) => ImportError::File {
+                    path: raws[k].source.clone(),
+                    message: format!(
+                        "this profile is not in the plane the other profiles lie in: {message}"
+                    ),
+                },
+                None => ImportError::File {
+                    path: raws.first().map_or_else(PathBuf::new, |r| r.source.clone()),
+                    message,
+                },
+            }
+        })?;
+        (m, true)
     };
     let mut planes = Vec::with_capacity(raws.len());
     let mut poses = Vec::with_capacity(raws.len());

@@ -172,7 +172,6 @@ pub fn joint_unit_warning(
         }
         largest = largest.max(v.abs());
     }
-    #[allow(clippy::cast_precision_loss, reason = "counts far below 2^52")]
     let share = within as f64 / count.max(1) as f64;
     let radian_like =
         count >= 6 && share >= RADIAN_LIKE_SHARE && largest <= MAX_PLAUSIBLE_JOINT_DEG.to_radians();

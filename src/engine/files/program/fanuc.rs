@@ -320,10 +320,6 @@ fn position(
 
 /// An integral value as an integer.
 fn integer(v: f64) -> Option<i64> {
-    #[allow(
-        clippy::cast_possible_truncation,
-        reason = "a frame number is a small integer; checked to be integral"
-    )]
     let n = v as i64;
     ((n as f64 - v).abs() < 1e-9).then_some(n)
 }

@@ -198,14 +198,9 @@ pub(super) fn read(text: &str) -> Result<Parsed, ParseError> {
             ))
         } else {
             let number = |k: &str| {
-                get(k).and_then(|f| f.number.as_ref()).map(|(v, _)| {
-                    #[allow(
-                        clippy::cast_possible_truncation,
-                        reason = "tool and base numbers are small integers"
-                    )]
-                    let n = *v as i64;
-                    n
-                })
+                get(k)
+                    .and_then(|f| f.number.as_ref())
+                    .map(|(v, _)| *v as i64)
             };
             if let (Some(tool), Some(base)) = (number("TOOL_NO"), number("BASE_NO"))
                 && !frames.contains(&(base, tool))

@@ -391,6 +391,10 @@ pub fn read_pose_file(path: &Path, spec: &ReadSpec) -> Result<PoseFile, ProgramE
     }
     let bytes = std::fs::read(path).map_err(|e| fail(0, format!("cannot be read: {e}")))?;
     let text = String::from_utf8(bytes).map_err(|e| {
+        #[allow(
+            clippy::naive_bytecount,
+            reason = "once, on an error path: not worth a crate"
+        )]
         let line = 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
             .iter()
             .filter(|&&b| b == b'\n')

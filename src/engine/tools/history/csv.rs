@@ -2,8 +2,8 @@
 
 use std::fmt::Write as _;
 
-use super::drift::*;
-use super::*;
+use super::Library;
+use super::drift::{Drift, value_from};
 use crate::engine::base::robot::PARAMS_PER_JOINT;
 
 pub(super) fn csv_field(s: &str) -> String {

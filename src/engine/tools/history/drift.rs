@@ -3,8 +3,11 @@
 
 use std::collections::HashSet;
 
-use super::entry::*;
-use super::*;
+use super::entry::coupled_twist;
+use super::{
+    Combination, DEFAULT_K, DEFAULT_TOP, Entry, HAND_EYE_NAMES, HistoryError, Library,
+    PRIOR_HELD_FRACTION, ParamValue, Status, Timestamp, Unit,
+};
 use crate::engine::base::geometry::wrap_deg;
 use crate::engine::base::numeric::median;
 use crate::engine::base::robot::{Joint, PARAM_IS_ANGLE, PARAMS_PER_JOINT, Robot};

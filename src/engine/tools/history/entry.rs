@@ -8,7 +8,10 @@ use std::path::PathBuf;
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
-use super::*;
+use super::{
+    COUPLING_REL, Combination, DateSource, Entry, HAND_EYE_NAMES, HandEye, PRIOR_HELD_FRACTION,
+    PairedBy, ParamValue, RPY_STEP_DEG, Status, Timestamp, Unit,
+};
 use crate::engine::base::geometry::wrap_deg;
 use crate::engine::base::robot::{Joint, PARAM_IS_ANGLE, PARAMS_PER_JOINT, Robot};
 use crate::engine::calibrate::solve::SolverReport;
@@ -116,6 +119,10 @@ pub(super) fn coupled_twist(rotation: &UnitQuaternion<f64>, index: usize) -> Vec
         .collect()
 }
 
+#[allow(
+    clippy::unnecessary_wraps,
+    reason = "the same shape as the scan's other readers, which can fail"
+)]
 pub(super) fn build_entry(
     path: PathBuf,
     result: &ResultFile,

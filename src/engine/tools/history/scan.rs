@@ -11,8 +11,11 @@ use serde::Deserialize;
 use serde::de::IgnoredAny;
 use serde_json::Value;
 
-use super::entry::*;
-use super::*;
+use super::entry::build_entry;
+use super::{
+    DateSource, HistoryError, Library, MAX_DEPTH, MAX_FILE_BYTES, PairedBy, Problem,
+    RESULT_SUFFIXES, SessionInfo, Timestamp, date_in_name,
+};
 use crate::engine::files::format::FileError;
 use crate::engine::files::format::{self, RESULT_FORMAT, ResultFile, SESSION_FORMAT};
 

@@ -26,7 +26,7 @@ use crate::engine::calibrate::solve::{self, HandEyeSource, Method, Options, Prep
 use crate::engine::tools::simulate::SimConfig;
 
 use super::select::{Info, StationInfo, rotation_criterion};
-use super::*;
+use super::{Plan, PlanConfig, PlanError, PlannedPose, StationLayout, StationRole};
 use crate::engine::calibrate::solve::estimate::unknown_scale;
 
 /// Reference FK must put the planned centre on the station to this, mm
@@ -328,7 +328,6 @@ impl Planner<'_> {
                 continue;
             }
             // Directions 120° apart for 4 translations (the simulator's).
-            #[allow(clippy::cast_precision_loss)]
             let step = std::f64::consts::TAU / (n - 1) as f64;
             let first = c.centre(1);
             let centres: Vec<Vector3<f64>> = (0..n)
@@ -336,7 +335,6 @@ impl Planner<'_> {
                     if k == 0 {
                         first
                     } else {
-                        #[allow(clippy::cast_precision_loss)]
                         let angle = phase + step * (k - 1) as f64;
                         first
                             + Vector3::new(
@@ -438,21 +436,20 @@ impl Planner<'_> {
                     best = Some((value, i));
                 }
             }
-            match best {
-                Some((_, i)) => chosen.push(i),
-                None => {
-                    // The side still short of its quota.
-                    let plus = chosen.iter().filter(|&&j| pool[j].side == 1).count();
-                    let side: i8 = if plus < side_quota(n, 1) { 1 } else { -1 };
-                    let found = chosen.iter().filter(|&&j| pool[j].side == side).count();
-                    return Err(PlanError::TooFewPoses {
-                        station: "P0".to_owned(),
-                        position: [p0.x, p0.y, p0.z],
-                        side,
-                        found,
-                        needed: side_quota(n, side),
-                    });
-                }
+            if let Some((_, i)) = best {
+                chosen.push(i);
+            } else {
+                // The side still short of its quota.
+                let plus = chosen.iter().filter(|&&j| pool[j].side == 1).count();
+                let side: i8 = if plus < side_quota(n, 1) { 1 } else { -1 };
+                let found = chosen.iter().filter(|&&j| pool[j].side == side).count();
+                return Err(PlanError::TooFewPoses {
+                    station: "P0".to_owned(),
+                    position: [p0.x, p0.y, p0.z],
+                    side,
+                    found,
+                    needed: side_quota(n, side),
+                });
             }
         }
         Ok(chosen.into_iter().map(|i| pool[i].clone()).collect())
@@ -581,7 +578,7 @@ impl Planner<'_> {
             method: Method::Ml,
             threshold: 0.0,
             max_iterations: 0,
-            paper: Default::default(),
+            paper: crate::engine::calibrate::solve::paper::PaperOptions::default(),
             ml: MlOptions {
                 joint_sigma_deg: self.config.joint_sigma_deg,
                 cross_validation: false,
@@ -741,11 +738,9 @@ pub fn stripe_centre_covariance(radius: f64, cut_deg: f64, side: i8, sigma: f64)
     let t = radius * cut_deg.to_radians().sin();
     let half = sim.arc_half_angle.to_radians();
     let arc = 2.0 * half * r;
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     let n = ((arc / sim.point_spacing).floor().max(0.0) as usize + 1).max(3);
     let mut jtj = Matrix3::zeros();
     for k in 0..n {
-        #[allow(clippy::cast_precision_loss)]
         let phi = -half + 2.0 * half * k as f64 / (n - 1) as f64;
         // Residual of a point along the circle normal: ∂/∂(y_c, z_c, r).
         let row = Vector3::new(-phi.sin(), -phi.cos(), -1.0);

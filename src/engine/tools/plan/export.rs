@@ -129,8 +129,8 @@ pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPose>, PlanError> {
             other => return Err(fail(format!("side `{other}` is not +1 or -1"))),
         };
         out.push(PlanPose {
-            id: fields[id].to_owned(),
-            station: fields[station].to_owned(),
+            id: fields[id].clone(),
+            station: fields[station].clone(),
             usage,
             side,
             joints: joints

@@ -104,7 +104,10 @@ mod request;
 mod select;
 
 pub use candidates::stripe_centre_covariance;
-use candidates::*;
+use candidates::{
+    Candidate, Group, Planner, STREAM_BASELINE, STREAM_GEOMETRY, Site, joint_gap, provisional_id,
+    side_quota, unknown_indices,
+};
 pub use config::{
     DEFAULT_BOX_MM, DEFAULT_CANDIDATES, DEFAULT_CENTRE_SPREAD_MM, DEFAULT_CONE_DEG,
     DEFAULT_CUT_ANGLE_DEG, DEFAULT_MIN_WRIST_DEG, DEFAULT_ROTATION_MAX_DEG,

@@ -201,7 +201,6 @@ pub fn predict(
             return Err(PlanError::Cancelled);
         }
     }
-    #[allow(clippy::cast_precision_loss)]
     let n = runs.len() as f64;
     let mean = |f: &dyn Fn(&RunScore) -> f64| runs.iter().map(f).sum::<f64>() / n;
     let after_mean = mean(&|r| r.after_std);

@@ -170,7 +170,7 @@ mod tests {
             .map(|k| PairDistance {
                 station: format!("V{}", k / 2),
                 ids: (format!("m{k}a"), format!("m{k}b")),
-                before: 1.0 + k as f64,
+                before: 1.0 + f64::from(k),
                 after: 0.05,
             })
             .collect();

@@ -319,10 +319,10 @@ pub fn render(plot: &Plot) -> String {
     let _ = write!(
         s,
         r#"<text x="{:.1}" y="{:.1}" text-anchor="middle">{}</text><text transform="translate(14 {:.1}) rotate(-90)" text-anchor="middle">{}</text>"#,
-        (left + right) / 2.0,
+        f64::midpoint(left, right),
         h - 6.0,
         escape(&plot.x_label),
-        (top + bottom) / 2.0,
+        f64::midpoint(top, bottom),
         escape(&plot.y_label)
     );
     // Bands: separators and labels.

@@ -170,12 +170,11 @@ where
     let mut groups: Vec<(String, Vec<&'a T>)> = Vec::new();
     for item in items {
         let k = key(item);
-        match at.get(k) {
-            Some(&g) => groups[g].1.push(item),
-            None => {
-                at.insert(k.to_string(), groups.len());
-                groups.push((k.to_string(), vec![item]));
-            }
+        if let Some(&g) = at.get(k) {
+            groups[g].1.push(item);
+        } else {
+            at.insert(k.to_string(), groups.len());
+            groups.push((k.to_string(), vec![item]));
         }
     }
     groups

@@ -512,7 +512,6 @@ pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
 pub(super) fn stripe_point_count(r: f64, half_angle_deg: f64, spacing: f64) -> usize {
     let arc = 2.0 * half_angle_deg.to_radians() * r;
     // Truncation intended: whole points that fit on the arc.
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     let n = (arc / spacing).floor().max(0.0) as usize;
     n + 1
 }

@@ -598,7 +598,6 @@ fn profile(
     let [y0, y1] = scan.range.y;
     let [z0, z1] = scan.range.z;
     // Truncation intended: whole rays over the line.
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     let rays = ((y1 - y0) / RAY_SPACING_MM).floor() as usize + 1;
     let d = base_from_sensor.rotation * -Vector3::z();
     let mut text = String::from("y,z\n");

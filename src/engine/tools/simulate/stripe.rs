@@ -30,7 +30,6 @@ pub(super) fn stripe(c: &SimConfig, rng: &mut ChaCha8Rng, centre: &Vector3<f64>)
         })
         .collect();
     // Rounding to nearest intended: a count of points.
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
     let n_outliers = (c.outlier_fraction * n as f64).round() as usize;
     if n_outliers > 0 {
         for index in rand::seq::index::sample(rng, n, n_outliers.min(n)).into_vec() {

@@ -120,6 +120,10 @@ mod use_serde {
     use crate::engine::base::session::Use;
     use serde::{Deserialize, Deserializer, Serializer};
 
+    #[allow(
+        clippy::trivially_copy_pass_by_ref,
+        reason = "serde's `serialize_with` passes a reference"
+    )]
     pub fn serialize<S: Serializer>(usage: &Use, serializer: S) -> Result<S::Ok, S::Error> {
         serializer.serialize_str(usage.as_str())
     }

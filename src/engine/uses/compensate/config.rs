@@ -150,22 +150,12 @@ pub fn posture(robot: &Robot, q: &[f64; DOF]) -> Posture {
 
 /// `⌊q / 90⌋`: ABB's quadrant of a joint reading (deg).
 fn quadrant(q: f64) -> i64 {
-    #[allow(
-        clippy::cast_possible_truncation,
-        reason = "a joint reading of at most 36,000° has a small quadrant"
-    )]
-    let k = (q / 90.0).floor() as i64;
-    k
+    (q / 90.0).floor() as i64
 }
 
 /// FANUC's turn number: `t` with `q` in `(−180 + 360·t, 180 + 360·t]`.
 fn turn(q: f64) -> i64 {
-    #[allow(
-        clippy::cast_possible_truncation,
-        reason = "a joint reading of at most 36,000° has a small turn number"
-    )]
-    let k = ((q - 180.0) / 360.0).ceil() as i64;
-    k
+    ((q - 180.0) / 360.0).ceil() as i64
 }
 
 impl Vendor {

@@ -223,7 +223,7 @@ mod tests {
         let rho = (r * r - x * x).sqrt();
         let pts: Vec<Vector3<f64>> = (0..40)
             .map(|i| {
-                let phi = -1.0 + 2.0 * i as f64 / 39.0;
+                let phi = -1.0 + 2.0 * f64::from(i) / 39.0;
                 c + Vector3::new(-x, rho * phi.sin(), rho * phi.cos())
             })
             .collect();

@@ -8,7 +8,10 @@ use super::MlUpdate;
 use super::identifiability::raw_per_file_unit;
 use super::noise::{OUTLIER_QUANTILE, base_covariance, chi3_quantile, sensor_covariance};
 use super::problem::Problem;
-use super::report::*;
+use super::report::{
+    DistanceStd, IdentifiabilityRecord, LabelledMatrix, LossRecord, MlReport, NoiseModel,
+    OutlierRecord, ParameterRecord, PivotRecord, PriorRecord,
+};
 use crate::engine::base::session::Use;
 use crate::engine::calibrate::handeye::Sighting;
 use crate::engine::calibrate::solve::estimate::{

@@ -185,6 +185,7 @@ pub fn base_covariance(
 }
 
 /// Whitening `C⁻¹` of a covariance `Σ = C·Cᵀ`; `None` when not positive definite.
+#[must_use]
 pub fn whitening(cov: &Matrix3<f64>) -> Option<Matrix3<f64>> {
     let c = cov.cholesky()?;
     c.l().try_inverse()

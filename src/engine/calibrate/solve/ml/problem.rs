@@ -281,6 +281,10 @@ impl Problem {
     }
 
     /// Whitened residual of observation `o` at `state`.
+    #[allow(
+        clippy::unused_self,
+        reason = "a residual of this problem, beside its Jacobian, which needs the problem"
+    )]
     pub(super) fn residual(&self, o: &Obs, state: &State) -> Vector3<f64> {
         o.whiten * (state.est.centre_in_base(&o.sighting) - state.centres[o.station])
     }

@@ -3,7 +3,10 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::*;
+use super::{
+    CANDIDATE_SLACK, GAUSS_NEWTON_STEPS, HALVINGS, MAD_TO_SIGMA, MIN_TRIPLE_SPAN, SPAN_LEVELS,
+    upper_median,
+};
 
 /// A circle `(y_c, z_c, r)`, mm.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -169,7 +172,6 @@ pub(super) fn normal_equations(
         gr -= res;
         cost += res * res;
     }
-    #[allow(clippy::cast_precision_loss)] // point counts are far below 2^52
     let rr = indices.len() as f64;
     (
         Matrix3::new(xx, xy, xr, xy, yy, yr, xr, yr, rr),

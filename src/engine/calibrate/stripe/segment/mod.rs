@@ -101,9 +101,9 @@ mod geometry;
 mod pieces;
 mod refine;
 
-use self::geometry::*;
-use self::pieces::*;
-use self::refine::*;
+use self::geometry::{Bounds, Circle, geometric_fit, pitch, robust_sigma, span_deg, triples};
+use self::pieces::{Piece, Profile};
+use self::refine::{Attempt, Failure, Refined, refine};
 
 use nalgebra::Matrix3;
 
@@ -309,7 +309,7 @@ pub enum SegmentError {
     },
     /// No circle of the profile has a radius a sphere of radius `R` can
     /// produce.
-    #[error("{}", no_circle_message(*.sphere_radius, *.min_radius, *.max_radius, .best))]
+    #[error("{}", no_circle_message(*.sphere_radius, *.min_radius, *.max_radius, .best.as_ref()))]
     NoCircle {
         /// Sphere radius `R`, mm.
         sphere_radius: f64,
@@ -357,7 +357,7 @@ pub struct BestCircle {
     pub points: usize,
 }
 
-fn no_circle_message(sphere: f64, min: f64, max: f64, best: &Option<BestCircle>) -> String {
+fn no_circle_message(sphere: f64, min: f64, max: f64, best: Option<&BestCircle>) -> String {
     match best {
         Some(b) => format!(
             "no arc of a sphere of radius {sphere} mm: the best circle has r = {:.3} mm ({} points on it), outside {min:.3}..{max:.3} mm",
@@ -439,7 +439,6 @@ pub fn find_arc(points: &[[f64; 2]], sphere_radius: f64) -> Result<Arc, SegmentE
 
     // Scores on the subsample (step 4).
     let step = n.div_ceil(SCORE_POINTS).max(1);
-    #[allow(clippy::cast_precision_loss)] // point counts are far below 2^52
     let score_gap = max_gap.max(2.0 * step as f64 * pitch);
     let score_gap2 = score_gap * score_gap;
     let mut scored: Vec<(Piece, Circle)> = inside

@@ -1,7 +1,7 @@
 //! The profile as the arc search sees it: points in order, the pitch
 //! between neighbours, and contiguous pieces along the profile.
 
-use super::*;
+use super::{Circle, OPEN_PIECES};
 
 /// A piece of consensus: consecutive band points along the profile, each
 /// within the gap limit of the one before it in the piece.
@@ -24,6 +24,10 @@ pub(super) struct Piece {
 /// (clutter on its far side) thus starts a piece of its own without cutting
 /// the arc in two.
 pub(super) struct Pieces {
+    #[allow(
+        clippy::struct_field_names,
+        reason = "the pieces themselves, beside the open ones"
+    )]
     pub(super) pieces: Vec<Piece>,
     /// Ids of the open pieces, most recently extended first.
     pub(super) open: Vec<usize>,

@@ -2,7 +2,11 @@
 //! points of the largest piece within the band, refit, and repeat until
 //! the set stops changing.
 
-use super::*;
+use super::{
+    BAND_CAP_MM, BAND_FLOOR_MM, BAND_SIGMAS, Bounds, Circle, CircleFit, MAX_REFINE_ROUNDS,
+    MIN_ARC_POINTS, MIN_ARC_SPAN_DEG, Piece, Profile, SEARCH_BAND_MM, StripeError, fit_circle,
+    geometric_fit, robust_sigma, span_deg,
+};
 
 /// Why one refinement did not give an arc.
 pub(super) enum Failure {

@@ -393,15 +393,14 @@ pub fn read_profile_table(
         };
         let id = row.get(pose).unwrap_or("");
         let p = text::xyz_of(csv, line, row, &columns)?;
-        let pushed = match collectors.get_mut(id) {
-            Some(c) => c.push(p),
-            None => {
-                order.push(id.to_string());
-                let mut c = Collector::new(format);
-                let pushed = c.push(p);
-                collectors.insert(id.to_string(), c);
-                pushed
-            }
+        let pushed = if let Some(c) = collectors.get_mut(id) {
+            c.push(p)
+        } else {
+            order.push(id.to_string());
+            let mut c = Collector::new(format);
+            let pushed = c.push(p);
+            collectors.insert(id.to_string(), c);
+            pushed
         };
         pushed.map_err(|message| ImportError::Csv {
             path: path.to_path_buf(),

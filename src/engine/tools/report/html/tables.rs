@@ -190,19 +190,18 @@ pub(super) fn marked_cell(ctx: &Ctx<'_>, label: &str, text: String) -> String {
 /// the † mark.
 pub(super) fn hand_eye_cell(ctx: &Ctx<'_>, k: usize, text: String) -> String {
     let label = HAND_EYE_LABELS[k];
-    match ctx.marks.get(label) {
-        Some(why) => format!(
+    if let Some(why) = ctx.marks.get(label) {
+        format!(
             "<td class=\"n marked\" title=\"{}\">{} †</td>",
             escape(&format!("{label}: {why}")),
             escape(&text)
-        ),
-        None => {
-            let sigma = ctx
-                .hand_eye_sigma
-                .map(|s| format!(" <span class=\"muted\">± {}</span>", num(s[k], 4)))
-                .unwrap_or_default();
-            format!("<td class=\"n\">{}{sigma}</td>", escape(&text))
-        }
+        )
+    } else {
+        let sigma = ctx
+            .hand_eye_sigma
+            .map(|s| format!(" <span class=\"muted\">± {}</span>", num(s[k], 4)))
+            .unwrap_or_default();
+        format!("<td class=\"n\">{}{sigma}</td>", escape(&text))
     }
 }
 

@@ -205,32 +205,29 @@ pub(super) fn summary(h: &mut String, ctx: &Ctx<'_>) {
         )),
         None => None,
     };
-    match &headline {
-        Some((what, b, a)) => {
-            let _ = writeln!(h, "<p><strong>{}</strong></p>\n<p>", escape(what));
-            for (name, vb, va) in [("std", b.std, a.std), ("max", b.max, a.max)] {
-                let _ = write!(
-                    h,
-                    "<span class=\"big\">{name} {} → {} mm<span class=\"ratio\">{}</span></span>",
-                    num(vb, 3),
-                    num(va, 3),
-                    escape(&ratio(vb, va))
-                );
-            }
-            h.push_str("</p>\n");
-        }
-        None => {
-            h.push_str(
-                "<p class=\"warn\" id=\"no-validation\">No validate measurements in this session: accuracy is not checked (no Fig. 6, no validation table).</p>\n",
-            );
-            let (b, a) = ctx.identify_scatter;
-            let _ = writeln!(
+    if let Some((what, b, a)) = &headline {
+        let _ = writeln!(h, "<p><strong>{}</strong></p>\n<p>", escape(what));
+        for (name, vb, va) in [("std", b.std, a.std), ("max", b.max, a.max)] {
+            let _ = write!(
                 h,
-                "<p>Identify centres about their station's mean (3-D rms): <span class=\"big\">{} → {} mm</span></p>",
-                num(b, 3),
-                num(a, 3)
+                "<span class=\"big\">{name} {} → {} mm<span class=\"ratio\">{}</span></span>",
+                num(vb, 3),
+                num(va, 3),
+                escape(&ratio(vb, va))
             );
         }
+        h.push_str("</p>\n");
+    } else {
+        h.push_str(
+            "<p class=\"warn\" id=\"no-validation\">No validate measurements in this session: accuracy is not checked (no Fig. 6, no validation table).</p>\n",
+        );
+        let (b, a) = ctx.identify_scatter;
+        let _ = writeln!(
+            h,
+            "<p>Identify centres about their station's mean (3-D rms): <span class=\"big\">{} → {} mm</span></p>",
+            num(b, 3),
+            num(a, 3)
+        );
     }
     if let Some((verdict, tolerance)) = &ctx.verdict {
         let class = match verdict {
@@ -407,7 +404,7 @@ pub(super) fn settings(h: &mut String, ctx: &Ctx<'_>) {
             }
         },
         Err(_) => {
-            h.push_str("<p>Initial hand-eye: unknown (the session could not be prepared).</p>\n")
+            h.push_str("<p>Initial hand-eye: unknown (the session could not be prepared).</p>\n");
         }
     }
     h.push_str("<table class=\"keep\" id=\"settings-table\">\n");
@@ -496,8 +493,7 @@ pub(super) fn stripes(h: &mut String, ctx: &Ctx<'_>) {
     let worst = fits
         .iter()
         .max_by(|a, b| a.1.fit.rms.total_cmp(&b.1.fit.rms))
-        .map(|(id, _)| *id)
-        .unwrap_or("");
+        .map_or("", |(id, _)| *id);
     let rejected: usize = fits.iter().map(|(_, f)| f.fit.rejected()).sum();
     let trimmed = fits.iter().filter(|(_, f)| f.fit.rejected() > 0).count();
     let total: usize = fits.iter().map(|(_, f)| f.fit.inlier.len()).sum();

@@ -121,7 +121,6 @@ pub fn write(file: &mut File, cloud: &Cloud, provenance: &Provenance) -> io::Res
             ];
             if sigma {
                 // Narrowing intended: the attribute is a float.
-                #[allow(clippy::cast_possible_truncation)]
                 values.push(RecordValue::Single(pose.sigma_mm(p) as f32));
             }
             pc.add_point(values).map_err(|e| io_error(&e))?;

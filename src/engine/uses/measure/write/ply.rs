@@ -62,7 +62,6 @@ pub fn write(out: &mut impl Write, cloud: &Cloud, provenance: &Provenance) -> io
             buf.extend_from_slice(&y.to_le_bytes());
             buf.extend_from_slice(&z.to_le_bytes());
             // Narrowing intended: the format's sigma is a float.
-            #[allow(clippy::cast_possible_truncation)]
             let sigma = pose.sigma_mm(p) as f32;
             buf.extend_from_slice(&sigma.to_le_bytes());
             buf.extend_from_slice(&index.to_le_bytes());
