@@ -586,7 +586,7 @@ impl Planner<'_> {
             },
             held_out: false,
         };
-        ml::analyse(session, prepared, &options).map_err(|e| PlanError::Analysis(e.to_string()))
+        ml::analyse(session, prepared, &options).map_err(PlanError::Analysis)
     }
 
     /// `ml`'s analysis of every identify candidate.

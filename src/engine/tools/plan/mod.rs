@@ -174,7 +174,7 @@ pub enum PlanError {
     },
     /// The `ml` analysis of the candidates or the plan failed.
     #[error("identifiability analysis failed: {0}")]
-    Analysis(String),
+    Analysis(#[source] crate::engine::calibrate::solve::SolveError),
     /// A plan CSV could not be read.
     #[error("line {line}: {message}")]
     Csv {
