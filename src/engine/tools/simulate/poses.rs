@@ -158,7 +158,12 @@ impl Planner<'_> {
         hint: Option<&[f64; DOF]>,
     ) -> Option<[f64; DOF]> {
         let centre_in_flange = self.flange_from_sensor * Point3::from(*centre_in_sensor);
-        let target = flange_target(station, rotation, &self.flange_from_sensor, centre_in_sensor);
+        let target = flange_target(
+            station,
+            rotation,
+            &self.flange_from_sensor,
+            centre_in_sensor,
+        );
         let min_wrist = self.config.min_wrist_angle.to_radians().sin();
         // Readings are moved by whole turns into (−180, 180] (the same
         // pose, tidier numbers) before the limits are checked.
