@@ -571,6 +571,22 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// A command's flags parsed from `argv` (its first word the command's
+/// name), as the commands' tests read them; panics on bad flags (tests only).
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+pub(crate) fn parse_flags<A: clap::Args>(argv: &[&str]) -> A {
+    use clap::Parser;
+
+    #[derive(Debug, Parser)]
+    struct Wrapper<A: clap::Args> {
+        #[command(flatten)]
+        args: A,
+    }
+
+    Wrapper::<A>::try_parse_from(argv).unwrap().args
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

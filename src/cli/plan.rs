@@ -412,18 +412,11 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
 mod tests {
     use super::*;
     use crate::engine::tools::plan::StationLayout;
-    use clap::Parser;
-
-    #[derive(Debug, Parser)]
-    struct Wrapper {
-        #[command(flatten)]
-        args: PlanArgs,
-    }
 
     fn parse(extra: &[&str]) -> PlanArgs {
         let mut argv = vec!["plan"];
         argv.extend_from_slice(extra);
-        Wrapper::try_parse_from(argv).unwrap().args
+        super::super::parse_flags(&argv)
     }
 
     #[test]

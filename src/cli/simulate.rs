@@ -413,18 +413,11 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
     use super::*;
-    use clap::Parser;
-
-    #[derive(Debug, Parser)]
-    struct Wrapper {
-        #[command(flatten)]
-        args: SimulateArgs,
-    }
 
     fn parse(extra: &[&str]) -> SimulateArgs {
         let mut argv = vec!["simulate", "--out", "dir/s.json"];
         argv.extend_from_slice(extra);
-        Wrapper::try_parse_from(argv).unwrap().args
+        super::super::parse_flags(&argv)
     }
 
     #[test]

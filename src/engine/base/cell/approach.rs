@@ -1,10 +1,13 @@
 //! Approach directions and flange orientations: a direction uniform in a
 //! cone about a mean, and the flange rotation whose z axis (the approach)
-//! is that direction with a given roll.
+//! is that direction with a given roll; the mean approach from an eye
+//! point, a random turn of a reference orientation, and the flange pose
+//! that puts the sphere where the sensor should see it (shared by the
+//! simulator and the planner).
 
 use std::f64::consts::PI;
 
-use nalgebra::{Rotation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Rotation3, Translation3, Unit, UnitQuaternion, Vector3};
 use rand_chacha::ChaCha8Rng;
 
 use rand::Rng;
@@ -50,6 +53,49 @@ pub fn random_orientation(
     let approach = direction_in_cone(rng, mean, cone);
     let roll = 2.0 * PI * rng.random::<f64>();
     rotation_from_approach(&approach, roll)
+}
+
+/// The mean approach direction (base frame, unit) at `station` looked at
+/// from `eye` (both base frame, mm): from the eye to the station; straight
+/// down (`−z`) when the two coincide.
+#[must_use]
+pub fn mean_approach(station: &Vector3<f64>, eye: &Vector3<f64>) -> Vector3<f64> {
+    let d = station - eye;
+    if d.norm() > 0.0 {
+        d.normalize()
+    } else {
+        -Vector3::z()
+    }
+}
+
+/// `reference` turned by an angle uniform in `min_deg..max_deg` (deg) about
+/// a uniformly random axis; draws the axis first, then the angle (the
+/// seeded streams of the simulator and the planner depend on that order).
+pub fn turned_orientation(
+    rng: &mut ChaCha8Rng,
+    reference: &UnitQuaternion<f64>,
+    min_deg: f64,
+    max_deg: f64,
+) -> UnitQuaternion<f64> {
+    let axis = Unit::new_normalize(direction_in_cone(rng, &Vector3::z(), PI));
+    let angle = super::random::uniform(rng, min_deg, max_deg).to_radians();
+    reference * UnitQuaternion::from_axis_angle(&axis, angle)
+}
+
+/// The flange pose `base_from_flange` (mm) with flange rotation `rotation`
+/// that puts the sphere centre at `station` (base frame, mm) and at
+/// `centre_in_sensor` (sensor frame, mm) through the hand-eye
+/// `flange_from_sensor`.
+#[must_use]
+pub fn flange_target(
+    station: &Vector3<f64>,
+    rotation: &UnitQuaternion<f64>,
+    flange_from_sensor: &Isometry3<f64>,
+    centre_in_sensor: &Vector3<f64>,
+) -> Isometry3<f64> {
+    let centre_in_flange = flange_from_sensor * Point3::from(*centre_in_sensor);
+    let position = station - rotation * centre_in_flange.coords;
+    Isometry3::from_parts(Translation3::from(position), *rotation)
 }
 
 #[cfg(test)]

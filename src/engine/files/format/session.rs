@@ -354,31 +354,7 @@ impl<'a> Ctx<'a> {
         let robot_joints = robot.joints.len();
         // Parsed strictly first; only when that fails is the id picked out
         // leniently, so that the error can name the measurement.
-        let (keys, m, scope): (MeasurementKeys, Option<String>, String) =
-            if let Ok(keys) = self.object::<MeasurementKeys>(raw, "", None) {
-                let lenient = keys
-                    .id
-                    .and_then(|r| serde_json::from_str::<String>(r.get()).ok())
-                    .filter(|id| !id.is_empty());
-                let scope = if lenient.is_some() {
-                    String::new()
-                } else {
-                    format!("measurements[{index}]")
-                };
-                (keys, lenient, scope)
-            } else {
-                let lenient = serde_json::from_str::<IdProbe>(raw.get())
-                    .ok()
-                    .and_then(|p| p.id)
-                    .filter(|id| !id.is_empty());
-                let scope = if lenient.is_some() {
-                    String::new()
-                } else {
-                    format!("measurements[{index}]")
-                };
-                let keys = self.object(raw, &scope, lenient.as_deref())?;
-                (keys, lenient, scope)
-            };
+        let (keys, m, scope) = self.measurement_keys(index, raw)?;
         let m = m.as_deref();
 
         let id_raw = self.required(keys.id, raw, &scope, "id", m)?;
@@ -409,13 +385,74 @@ impl<'a> Ctx<'a> {
             None => None,
         };
 
-        let (joints, flange) = match (keys.joints, keys.flange) {
+        let (joints, flange) = self.pose(&keys, raw, &scope, m, robot_given, robot_joints)?;
+
+        let observation = self.observation(&keys, raw, &scope, m)?;
+
+        Ok(Measurement {
+            id,
+            station,
+            usage,
+            side_given,
+            side: side_given.unwrap_or(default_side),
+            joints,
+            flange,
+            observation,
+        })
+    }
+
+    /// The keys of measurement `index`, parsed strictly; when that fails
+    /// the id is picked out leniently so that the error can name the
+    /// measurement. Also the id so found and the scope its errors name
+    /// (`measurements[i]` without an id).
+    fn measurement_keys(
+        &self,
+        index: usize,
+        raw: &'a RawValue,
+    ) -> Result<(MeasurementKeys<'a>, Option<String>, String), FileError> {
+        // The scope errors name: the id when there is one.
+        let scope_of = |lenient: &Option<String>| {
+            if lenient.is_some() {
+                String::new()
+            } else {
+                format!("measurements[{index}]")
+            }
+        };
+        if let Ok(keys) = self.object::<MeasurementKeys>(raw, "", None) {
+            let lenient = keys
+                .id
+                .and_then(|r| serde_json::from_str::<String>(r.get()).ok())
+                .filter(|id| !id.is_empty());
+            let scope = scope_of(&lenient);
+            return Ok((keys, lenient, scope));
+        }
+        let lenient = serde_json::from_str::<IdProbe>(raw.get())
+            .ok()
+            .and_then(|p| p.id)
+            .filter(|id| !id.is_empty());
+        let scope = scope_of(&lenient);
+        let keys = self.object(raw, &scope, lenient.as_deref())?;
+        Ok((keys, lenient, scope))
+    }
+
+    /// The pose of a measurement: its joint readings (one per robot
+    /// joint, which needs a robot) or its flange pose, exactly one.
+    fn pose(
+        &self,
+        keys: &MeasurementKeys<'a>,
+        raw: &'a RawValue,
+        scope: &str,
+        m: Option<&str>,
+        robot_given: bool,
+        robot_joints: usize,
+    ) -> Result<(Vec<f64>, Option<Isometry3<f64>>), FileError> {
+        let pose = match (keys.joints, keys.flange) {
             (Some(_), Some(_)) => {
                 return Err(self.invalid(
                     m,
                     format!(
                         "{}both `joints` and `flange` are given; give exactly one{}",
-                        prefix(&scope),
+                        prefix(scope),
                         self.at(raw)
                     ),
                 ));
@@ -425,34 +462,45 @@ impl<'a> Ctx<'a> {
                     m,
                     format!(
                         "{}missing key `joints` (or `flange`, the flange pose, in a pose-only session){}",
-                        prefix(&scope),
+                        prefix(scope),
                         self.at(raw)
                     ),
                 ));
             }
             (None, Some(flange_raw)) => {
-                let pose = self.matrix_in(flange_raw, &join(&scope, "flange"), m)?;
+                let pose = self.matrix_in(flange_raw, &join(scope, "flange"), m)?;
                 (Vec::new(), Some(pose))
             }
             (Some(joints_raw), None) => {
                 if !robot_given {
                     return Err(self.rule(
                         m,
-                        format!("{}{}", prefix(&scope), rules::JOINTS_WITHOUT_ROBOT),
+                        format!("{}{}", prefix(scope), rules::JOINTS_WITHOUT_ROBOT),
                         joints_raw,
                     ));
                 }
-                (self.joints(joints_raw, &scope, m, robot_joints)?, None)
+                (self.joints(joints_raw, scope, m, robot_joints)?, None)
             }
         };
+        Ok(pose)
+    }
 
+    /// The observation of a measurement: its stripe points (sensor `y`,
+    /// `z`, mm) or its sphere centre (sensor frame, mm), exactly one.
+    fn observation(
+        &self,
+        keys: &MeasurementKeys<'a>,
+        raw: &'a RawValue,
+        scope: &str,
+        m: Option<&str>,
+    ) -> Result<Observation, FileError> {
         let observation = match (keys.stripe, keys.centre) {
             (Some(_), Some(_)) => {
                 return Err(self.invalid(
                     m,
                     format!(
                         "{}both `stripe` and `centre` are given; give exactly one{}",
-                        prefix(&scope),
+                        prefix(scope),
                         self.at(raw)
                     ),
                 ));
@@ -462,13 +510,13 @@ impl<'a> Ctx<'a> {
                     m,
                     format!(
                         "{}neither `stripe` nor `centre` is given; give exactly one{}",
-                        prefix(&scope),
+                        prefix(scope),
                         self.at(raw)
                     ),
                 ));
             }
             (Some(stripe_raw), None) => {
-                let stripe_key = join(&scope, "stripe");
+                let stripe_key = join(scope, "stripe");
                 let stripe: StripeKeys = self.object(stripe_raw, &stripe_key, m)?;
                 let points_raw =
                     self.required(stripe.points, stripe_raw, &stripe_key, "points", m)?;
@@ -488,33 +536,23 @@ impl<'a> Ctx<'a> {
                             })
                             .collect::<Result<Vec<_>, _>>()?
                     };
-                rules::stripe_points(&points_key, &prefix(&scope), &points)
+                rules::stripe_points(&points_key, &prefix(scope), &points)
                     .map_err(|e| self.rule(m, e, points_raw))?;
                 Observation::Stripe(points)
             }
             (None, Some(centre_raw)) => {
                 let c = Vector3::from(self.numbers::<3>(
                     centre_raw,
-                    &join(&scope, "centre"),
+                    &join(scope, "centre"),
                     " [x, y, z]",
                     m,
                 )?);
-                rules::centre(&join(&scope, "centre"), &c)
+                rules::centre(&join(scope, "centre"), &c)
                     .map_err(|e| self.rule(m, e, centre_raw))?;
                 Observation::Centre(c)
             }
         };
-
-        Ok(Measurement {
-            id,
-            station,
-            usage,
-            side_given,
-            side: side_given.unwrap_or(default_side),
-            joints,
-            flange,
-            observation,
-        })
+        Ok(observation)
     }
 
     /// The joint readings of a measurement: one per robot joint.

@@ -21,7 +21,7 @@ use crate::engine::calibrate::handeye::general::{
     GeneralHandEye, GeneralSighting, general_hand_eye,
 };
 use crate::engine::calibrate::handeye::{Sighting, initial_hand_eye};
-use crate::engine::calibrate::solve::analyse;
+use crate::engine::calibrate::solve::{Analysis, analyse};
 
 /// Largest orientation difference (deg) between poses counted as "the
 /// same orientation" when the translation group is found: controllers
@@ -136,22 +136,7 @@ pub(crate) fn settle(
     profiles: &ProfileReport,
 ) -> Result<(Session, Vec<String>), ImportError> {
     if let Some(he) = given {
-        session.hand_eye = Some(he);
-        let t = he.translation.vector;
-        return Ok((
-            session,
-            vec![format!(
-                "initial hand-eye: the guess given (translation [{:.2}, {:.2}, {:.2}] mm){}",
-                t.x,
-                t.y,
-                t.z,
-                if auto_uses {
-                    "; every pose is `identify`"
-                } else {
-                    ""
-                }
-            )],
-        ));
+        return Ok(given_guess(session, he, auto_uses));
     }
     if !auto_uses {
         return Ok((session, Vec::new()));
@@ -181,18 +166,7 @@ pub(crate) fn settle(
     let ids: Vec<&str> = session.measurements.iter().map(|m| m.id.as_str()).collect();
     // A stripe that gives no sphere centre is bad input: named with its
     // profile file, before any hand-eye is tried.
-    if let Some((i, e)) = analysis.failures().next() {
-        let id = &session.measurements[i].id;
-        let file = profiles
-            .poses
-            .iter()
-            .find(|p| p.id == *id)
-            .map_or_else(|| poses_file.to_path_buf(), |p| p.file.clone());
-        return Err(ImportError::File {
-            path: file,
-            message: format!("pose {id}: {e}"),
-        });
-    }
+    reject_bad_stripe(&session, &analysis, poses_file, profiles)?;
     // The general solution, on every pose whose stripe gave a centre.
     let sightings: Vec<GeneralSighting> = poses
         .iter()
@@ -211,54 +185,9 @@ pub(crate) fn settle(
     let general: Result<GeneralHandEye, String> =
         general_hand_eye(&sightings, station_index.len()).map_err(|e| e.to_string());
     // Eq. 6-9 when one station holds a group of one orientation.
-    let paper: Result<(Isometry3<f64>, String), String> = eq69_group(&poses).and_then(|group| {
-        let sight = |i: usize| -> Option<Sighting> {
-            let m = &session.measurements[i];
-            centres[i].map(|c| Sighting {
-                id: m.id.clone(),
-                joints: m.joints.clone(),
-                flange: m.flange,
-                centre_in_sensor: c,
-            })
-        };
-        let in_group: Vec<bool> = (0..poses.len()).map(|i| group.contains(&i)).collect();
-        let translations: Vec<Sighting> = group.iter().filter_map(|&i| sight(i)).collect();
-        let rotations: Vec<Sighting> = (0..poses.len())
-            .filter(|&i| !in_group[i] && stations[i] == stations[group[0]])
-            .filter_map(sight)
-            .collect();
-        let t_ids: Vec<&str> = group.iter().map(|&i| ids[i]).collect();
-        let r_ids: Vec<&str> = (0..poses.len())
-            .filter(|&i| !in_group[i])
-            .map(|i| ids[i])
-            .collect();
-        initial_hand_eye(&robot, &translations, &rotations)
-            .map(|h| {
-                (
-                    h.flange_from_sensor,
-                    format!(
-                        "translation group {} (one orientation), rotation {}",
-                        names(&t_ids),
-                        names(&r_ids)
-                    ),
-                )
-            })
-            .map_err(|e| e.to_string())
-    });
+    let paper = paper_hand_eye(&session, &poses, &centres, &stations, &ids);
     let mut notes = Vec::new();
-    let describe = |g: &GeneralHandEye| {
-        format!(
-            "the general solution (all {} poses at once, orientations spanning {:.1}°): centres scatter {:.3} mm rms; weakest translation ±{:.2} mm along ({:.2}, {:.2}, {:.2}) per {} mm of centre noise",
-            sightings.len(),
-            g.orientation_span_deg,
-            g.rms_mm,
-            g.weakest_translation.0,
-            g.weakest_translation.1.x,
-            g.weakest_translation.1.y,
-            g.weakest_translation.1.z,
-            crate::engine::calibrate::handeye::general::ASSUMED_CENTRE_NOISE_MM
-        )
-    };
+    let describe = |g: &GeneralHandEye| describe_general(g, sightings.len());
     let chosen = match (&paper, &general) {
         (Ok((he, groups)), general) => {
             let own = scatter(&poses, &centres, &stations, he);
@@ -298,6 +227,117 @@ pub(crate) fn settle(
     session.hand_eye = Some(chosen);
     notes.push("every pose is `identify`".to_string());
     Ok((session, notes))
+}
+
+/// The session with the guess `he` as its initial hand-eye, and the note
+/// saying so (every pose `identify` with `auto_uses`).
+fn given_guess(
+    mut session: Session,
+    he: Isometry3<f64>,
+    auto_uses: bool,
+) -> (Session, Vec<String>) {
+    session.hand_eye = Some(he);
+    let t = he.translation.vector;
+    (
+        session,
+        vec![format!(
+            "initial hand-eye: the guess given (translation [{:.2}, {:.2}, {:.2}] mm){}",
+            t.x,
+            t.y,
+            t.z,
+            if auto_uses {
+                "; every pose is `identify`"
+            } else {
+                ""
+            }
+        )],
+    )
+}
+
+/// A stripe that gives no sphere centre is bad input: the error names
+/// the pose and its profile file (the poses file when it has none).
+fn reject_bad_stripe(
+    session: &Session,
+    analysis: &Analysis,
+    poses_file: &Path,
+    profiles: &ProfileReport,
+) -> Result<(), ImportError> {
+    if let Some((i, e)) = analysis.failures().next() {
+        let id = &session.measurements[i].id;
+        let file = profiles
+            .poses
+            .iter()
+            .find(|p| p.id == *id)
+            .map_or_else(|| poses_file.to_path_buf(), |p| p.file.clone());
+        return Err(ImportError::File {
+            path: file,
+            message: format!("pose {id}: {e}"),
+        });
+    }
+    Ok(())
+}
+
+/// The paper's eq. 6-9 hand-eye when one station holds a group of one
+/// orientation (its translations; the other poses at that station its
+/// rotations), with the groups in words; else why not.
+fn paper_hand_eye(
+    session: &Session,
+    poses: &[Isometry3<f64>],
+    centres: &[Option<Vector3<f64>>],
+    stations: &[usize],
+    ids: &[&str],
+) -> Result<(Isometry3<f64>, String), String> {
+    let robot = &session.robot;
+    eq69_group(poses).and_then(|group| {
+        let sight = |i: usize| -> Option<Sighting> {
+            let m = &session.measurements[i];
+            centres[i].map(|c| Sighting {
+                id: m.id.clone(),
+                joints: m.joints.clone(),
+                flange: m.flange,
+                centre_in_sensor: c,
+            })
+        };
+        let in_group: Vec<bool> = (0..poses.len()).map(|i| group.contains(&i)).collect();
+        let translations: Vec<Sighting> = group.iter().filter_map(|&i| sight(i)).collect();
+        let rotations: Vec<Sighting> = (0..poses.len())
+            .filter(|&i| !in_group[i] && stations[i] == stations[group[0]])
+            .filter_map(sight)
+            .collect();
+        let t_ids: Vec<&str> = group.iter().map(|&i| ids[i]).collect();
+        let r_ids: Vec<&str> = (0..poses.len())
+            .filter(|&i| !in_group[i])
+            .map(|i| ids[i])
+            .collect();
+        initial_hand_eye(robot, &translations, &rotations)
+            .map(|h| {
+                (
+                    h.flange_from_sensor,
+                    format!(
+                        "translation group {} (one orientation), rotation {}",
+                        names(&t_ids),
+                        names(&r_ids)
+                    ),
+                )
+            })
+            .map_err(|e| e.to_string())
+    })
+}
+
+/// The general solution from `n` poses in words: its orientation span,
+/// scatter and weakest translation.
+fn describe_general(g: &GeneralHandEye, n: usize) -> String {
+    format!(
+        "the general solution (all {} poses at once, orientations spanning {:.1}°): centres scatter {:.3} mm rms; weakest translation ±{:.2} mm along ({:.2}, {:.2}, {:.2}) per {} mm of centre noise",
+        n,
+        g.orientation_span_deg,
+        g.rms_mm,
+        g.weakest_translation.0,
+        g.weakest_translation.1.x,
+        g.weakest_translation.1.y,
+        g.weakest_translation.1.z,
+        crate::engine::calibrate::handeye::general::ASSUMED_CENTRE_NOISE_MM
+    )
 }
 
 #[cfg(test)]

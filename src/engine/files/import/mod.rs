@@ -133,7 +133,7 @@ pub enum ImportError {
     /// The robot's URDF or DH table could not be read (the loader's error,
     /// naming the file and the line).
     #[error(transparent)]
-    Robot(#[from] crate::engine::base::robot::RobotImportError),
+    Robot(Box<crate::engine::base::robot::RobotImportError>),
     /// The built session breaks a FORMAT.md rule (the loader's message).
     #[error("{0}")]
     Session(#[from] FileError),

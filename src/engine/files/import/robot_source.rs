@@ -109,9 +109,9 @@ pub fn load_robot(source: &RobotSource) -> Result<Robot, ImportError> {
             };
             robot::load_urdf(path, &options)
                 .map(|u| u.robot)
-                .map_err(ImportError::from)
+                .map_err(|e| ImportError::Robot(Box::new(e)))
         }
         RobotSource::DhTable { path, convention } => robot::load_dh_csv(path, *convention)
-            .map_err(ImportError::from),
+            .map_err(|e| ImportError::Robot(Box::new(e))),
     }
 }

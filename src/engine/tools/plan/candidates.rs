@@ -4,7 +4,7 @@
 //! kinematics puts the planned centre on the station; the hand-eye groups
 //! at P0; `ml`'s analysis of a set of poses.
 
-use nalgebra::{DMatrix, Isometry3, Matrix3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
+use nalgebra::{DMatrix, Isometry3, Matrix3, Point3, UnitQuaternion, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
@@ -153,13 +153,10 @@ impl Planner<'_> {
             .collect()
     }
 
+    /// The mean approach at `station` from the configuration's eye point
+    /// ([`approach::mean_approach`]).
     pub(super) fn mean_approach(&self, station: &Vector3<f64>) -> Vector3<f64> {
-        let d = station - self.config.eye_point();
-        if d.norm() > 0.0 {
-            d.normalize()
-        } else {
-            -Vector3::z()
-        }
+        approach::mean_approach(station, &self.config.eye_point())
     }
 
     /// The flange pose that puts the sphere at `station` and at `centre`
@@ -170,9 +167,7 @@ impl Planner<'_> {
         rotation: &UnitQuaternion<f64>,
         centre: &Vector3<f64>,
     ) -> Isometry3<f64> {
-        let centre_in_flange = self.config.flange_from_sensor * Point3::from(*centre);
-        let position = station - rotation * centre_in_flange.coords;
-        Isometry3::from_parts(Translation3::from(position), *rotation)
+        approach::flange_target(station, rotation, &self.config.flange_from_sensor, centre)
     }
 
     /// Whether the reference FK at `q` sees the station at `centre`.
@@ -395,13 +390,8 @@ impl Planner<'_> {
         let draws = c.candidates.max(n) * 2;
         let mut pool: Vec<Candidate> = Vec::new();
         for k in 0..draws {
-            let axis = Unit::new_normalize(approach::direction_in_cone(
-                rng,
-                &Vector3::z(),
-                std::f64::consts::PI,
-            ));
-            let angle = random::uniform(rng, c.rotation_min, c.rotation_max).to_radians();
-            let rotation = reference * UnitQuaternion::from_axis_angle(&axis, angle);
+            let rotation =
+                approach::turned_orientation(rng, reference, c.rotation_min, c.rotation_max);
             let side = if k % 2 == 0 { 1 } else { -1 };
             // One branch per orientation: the eq. 8 rows depend on the
             // orientation only.

@@ -243,6 +243,15 @@ impl PlanConfig {
     /// # Errors
     /// [`PlanError::InvalidConfig`] naming the setting and its value.
     pub fn validate(&self) -> Result<(), PlanError> {
+        self.check_robot()?;
+        self.check_lengths()?;
+        self.check_angles()?;
+        self.check_counts()?;
+        self.check_stations()
+    }
+
+    /// The robot: a 6-axis arm with a limit and a positive weight per joint.
+    fn check_robot(&self) -> Result<(), PlanError> {
         let dof = self.robot.dof();
         check(dof == DOF, || {
             format!(
@@ -272,6 +281,13 @@ impl PlanConfig {
             self.joint_weights.iter().all(|w| w.is_finite() && *w > 0.0),
             || "joint weights must be positive numbers".to_owned(),
         )?;
+        Ok(())
+    }
+
+    /// Every real setting finite; the centre spread, the sensor range and its
+    /// spread; the sphere and the stations within the session file's
+    /// plausibility limits.
+    fn check_lengths(&self) -> Result<(), PlanError> {
         let reals = [
             ("diameter", self.diameter),
             ("cut angle", self.cut_angle),
@@ -346,6 +362,12 @@ impl PlanConfig {
                 limits::LENGTH_MM
             )
         })?;
+        Ok(())
+    }
+
+    /// The cut, cone, wrist and rotation angles, the noise model, at least
+    /// one candidate orientation.
+    fn check_angles(&self) -> Result<(), PlanError> {
         check(self.cut_angle > 5.0 && self.cut_angle < 80.0, || {
             format!(
                 "the cut angle must be within (5, 80) deg, found {}",
@@ -382,6 +404,12 @@ impl PlanConfig {
         check(self.candidates >= 1, || {
             "at least one candidate orientation per station is needed".to_owned()
         })?;
+        Ok(())
+    }
+
+    /// The counts of stations, candidates and poses: within the plan's limits
+    /// and enough for each group.
+    fn check_counts(&self) -> Result<(), PlanError> {
         let stations = self.n_identify_stations() + self.n_validate_stations();
         check(stations <= MAX_STATIONS, || {
             format!(
@@ -432,6 +460,11 @@ impl PlanConfig {
             self.n_validate_stations() == 0 || self.validate_poses >= 1,
             || "validate stations need at least 1 pose".to_owned(),
         )?;
+        Ok(())
+    }
+
+    /// The station box or the explicit station positions: finite (mm).
+    fn check_stations(&self) -> Result<(), PlanError> {
         match &self.stations {
             StationLayout::Box { size } => {
                 check(size.iter().all(|v| v.is_finite() && *v >= 0.0), || {

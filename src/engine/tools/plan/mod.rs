@@ -84,6 +84,7 @@
 use std::fmt::Write as _;
 
 use nalgebra::{Isometry3, Vector3};
+use rand_chacha::ChaCha8Rng;
 
 use crate::engine::base::cell::random;
 use crate::engine::base::robot::ik::{Chain, DOF};
@@ -354,6 +355,44 @@ pub fn plan(
     config: &PlanConfig,
     progress: &mut dyn FnMut(PlanStage) -> Control,
 ) -> Result<Plan, PlanError> {
+    let chain = checked_chain(config)?;
+    let planner = Planner { config, chain };
+    let mut rng = random::stream(config.seed, STREAM_GEOMETRY);
+    let mut sites = planner.sites(&mut rng);
+    let mut cancel = |stage| {
+        if progress(stage) == Control::Cancel {
+            Err(PlanError::Cancelled)
+        } else {
+            Ok(())
+        }
+    };
+    let groups = gather_candidates(&planner, &mut rng, &mut sites, &mut cancel)?;
+    let (log_det, log_det_random) = choose_poses(&planner, &mut sites, &mut cancel)?;
+    cancel(PlanStage::Ordering)?;
+    let mut plan = ordered_plan(config, &sites, groups);
+    plan.stats.log_det = log_det;
+    plan.stats.log_det_random = log_det_random;
+    analyse_plan(&planner, &mut plan)?;
+    if config.spread {
+        // The comparison: the same cell planned without the spread.
+        let unspread = PlanConfig {
+            spread: false,
+            ..config.clone()
+        };
+        // Best effort: a comparison that cannot be planned (the spot's
+        // candidates fewer than needed) leaves the figure out, not the plan.
+        match self::plan(&unspread, &mut |_| progress(PlanStage::Comparison)) {
+            Ok(other) => plan.stats.range_error_unspread = other.stats.range_error,
+            Err(PlanError::Cancelled) => return Err(PlanError::Cancelled),
+            Err(_) => {}
+        }
+    }
+    Ok(plan)
+}
+
+/// Checks the configuration (its settings, then a translation group that
+/// would be collinear) and builds the fast IK chain of its robot.
+fn checked_chain(config: &PlanConfig) -> Result<Chain, PlanError> {
     config.validate()?;
     if (1..3).contains(&config.n_translation) {
         return Err(PlanError::CollinearTranslations {
@@ -369,33 +408,33 @@ pub fn plan(
             detail: format!("the translation step is {} mm", config.translation_step),
         });
     }
-    let chain = Chain::new(&config.robot).ok_or_else(|| {
+    Chain::new(&config.robot).ok_or_else(|| {
         PlanError::InvalidConfig(format!(
             "the planner solves 6-axis arms, {} has {} joints",
             config.robot.name,
             config.robot.dof()
         ))
-    })?;
-    let planner = Planner { config, chain };
-    let mut rng = random::stream(config.seed, STREAM_GEOMETRY);
-    let mut sites = planner.sites(&mut rng);
-    let mut cancel = |stage| {
-        if progress(stage) == Control::Cancel {
-            Err(PlanError::Cancelled)
-        } else {
-            Ok(())
-        }
-    };
+    })
+}
 
-    // Hand-eye groups at P0.
+/// Draws the candidates: the hand-eye groups at `P0` (inserted as the
+/// first site, returned as the first groups) and every station's pool,
+/// each checked for enough poses on both sides; reports each station.
+fn gather_candidates(
+    planner: &Planner<'_>,
+    rng: &mut ChaCha8Rng,
+    sites: &mut Vec<Site>,
+    cancel: &mut dyn FnMut(PlanStage) -> Result<(), PlanError>,
+) -> Result<Vec<Group>, PlanError> {
+    let config = planner.config;
     let mut groups: Vec<Group> = Vec::new();
     let hand_eye = config.n_translation + config.n_rotation > 0;
     let total = sites.len() + usize::from(hand_eye);
     let mut done = 0;
     if hand_eye {
         let p0 = Vector3::from(config.sphere);
-        let (translations, reference) = planner.translation_group(&mut rng, &p0)?;
-        let rotations = planner.rotation_group(&mut rng, &p0, &reference)?;
+        let (translations, reference) = planner.translation_group(rng, &p0)?;
+        let rotations = planner.rotation_group(rng, &p0, &reference)?;
         sites.insert(
             0,
             Site {
@@ -420,8 +459,8 @@ pub fn plan(
     }
     let first_station = usize::from(hand_eye);
     for k in first_station..sites.len() {
-        let id = provisional_id(&sites, k);
-        sites[k].candidates = planner.station_candidates(&mut rng, &sites[k].position, &id)?;
+        let id = provisional_id(sites, k);
+        sites[k].candidates = planner.station_candidates(rng, &sites[k].position, &id)?;
         let needed = match sites[k].role {
             StationRole::Identify => config.identify_poses,
             _ => config.validate_poses,
@@ -447,10 +486,21 @@ pub fn plan(
         done += 1;
         cancel(PlanStage::Candidates { done, of: total })?;
     }
+    Ok(groups)
+}
 
-    // The identifiable parameters of the candidate pool, by ml.
+/// The analysis of the candidate pool (the identifiable parameters, by
+/// ml) and the selection: the validate poses spread, the identify poses
+/// D-optimal (or random). Returns `ln det` of the chosen identify poses
+/// and of the random baseline of the same size.
+fn choose_poses(
+    planner: &Planner<'_>,
+    sites: &mut [Site],
+    cancel: &mut dyn FnMut(PlanStage) -> Result<(), PlanError>,
+) -> Result<(f64, f64), PlanError> {
+    let config = planner.config;
     cancel(PlanStage::Analysis)?;
-    let pool = planner.pool_report(&sites)?;
+    let pool = planner.pool_report(sites)?;
     let estimated = unknown_indices(&config.robot, &pool.estimated);
     let infos: Vec<Vec<Info>> = sites
         .iter()
@@ -467,14 +517,13 @@ pub fn plan(
         .collect();
     let prior = prior_information(&estimated);
 
-    // Selection.
     cancel(PlanStage::Selection)?;
     let identify_sites: Vec<usize> = (0..sites.len())
         .filter(|&k| sites[k].role == StationRole::Identify)
         .collect();
     let mut baseline_rng = random::stream(config.seed, STREAM_BASELINE);
     let random = random_selection(
-        &sites,
+        sites,
         &identify_sites,
         config.identify_poses,
         &mut baseline_rng,
@@ -482,24 +531,19 @@ pub fn plan(
     let log_det_random = criterion(&prior, &infos, &random).unwrap_or(f64::NEG_INFINITY);
     // The validate poses first: they are the working poses the range
     // criterion is judged at.
-    for site in &mut sites {
+    for site in sites.iter_mut() {
         if site.role == StationRole::Validate {
-            site.chosen = spread_selection(&planner, site, config.validate_poses);
+            site.chosen = spread_selection(planner, site, config.validate_poses);
         }
     }
     let objective = match (config.spread, config.range) {
-        (true, Some(range)) => Objective::Range(planner.range_weight(&sites, &estimated, &range)),
+        (true, Some(range)) => Objective::Range(planner.range_weight(sites, &estimated, &range)),
         _ => Objective::LogDet,
     };
     let chosen = match config.selection {
-        Selection::DOptimal => greedy_selection(
-            &planner,
-            &sites,
-            &identify_sites,
-            &infos,
-            &prior,
-            &objective,
-        ),
+        Selection::DOptimal => {
+            greedy_selection(planner, sites, &identify_sites, &infos, &prior, &objective)
+        }
         Selection::Random => random,
     };
     for (k, c) in chosen {
@@ -516,9 +560,14 @@ pub fn plan(
             .collect::<Vec<_>>(),
     )
     .unwrap_or(f64::NEG_INFINITY);
+    Ok((log_det, log_det_random))
+}
 
-    // Ordering.
-    cancel(PlanStage::Ordering)?;
+/// The chosen poses in visit order: the groups (the hand-eye ones, then
+/// one a station) ordered for a short joint path, the stations and poses
+/// numbered in that order. The statistics hold the path lengths; the rest
+/// of them is filled by the caller.
+fn ordered_plan(config: &PlanConfig, sites: &[Site], mut groups: Vec<Group>) -> Plan {
     for (k, s) in sites.iter().enumerate() {
         if s.role == StationRole::HandEye {
             continue;
@@ -542,19 +591,51 @@ pub fn plan(
         .flat_map(|g| g.poses.iter().map(|c| c.joints))
         .collect();
     let path_unordered_deg = metric.path(&metric.unwrap_path(&unordered));
-    let ordered_groups = order_groups(&sites, groups, &metric);
+    let ordered_groups = order_groups(sites, groups, &metric);
     let sequence: Vec<[f64; DOF]> = ordered_groups
         .iter()
         .flat_map(|g| g.poses.iter().map(|c| c.joints))
         .collect();
     let realized = metric.unwrap_path(&sequence);
     let path_deg = metric.path(&realized);
+    let (station_ids, stations) = numbered_stations(sites, &ordered_groups);
+    let poses = numbered_poses(config, &ordered_groups, &station_ids, &realized);
+    Plan {
+        robot: config.robot.clone(),
+        limits: config.limits.clone(),
+        flange_from_sensor: config.flange_from_sensor,
+        diameter: config.diameter,
+        cut_angle: config.cut_angle,
+        range: config.range,
+        stations,
+        poses,
+        stats: PlanStats {
+            candidates: sites.iter().map(|s| s.candidates.len()).sum(),
+            estimated: Vec::new(),
+            fixed: Vec::new(),
+            inseparable: Vec::new(),
+            log_det: f64::NAN,
+            log_det_random: f64::NAN,
+            condition: f64::NAN,
+            predicted_validation_std: None,
+            path_unordered_deg,
+            path_deg,
+            range_error: None,
+            range_error_unspread: None,
+        },
+    }
+}
 
-    // Ids in visit order.
+/// Station ids in visit order (`P0`, `P1`.., `V1`..): the id of each site
+/// (by site index) and the planned stations in that order.
+fn numbered_stations(
+    sites: &[Site],
+    ordered_groups: &[Group],
+) -> (Vec<Option<String>>, Vec<PlannedStation>) {
     let mut station_ids: Vec<Option<String>> = vec![None; sites.len()];
     let (mut n_identify, mut n_validate) = (0, 0);
     let mut stations = Vec::new();
-    for g in &ordered_groups {
+    for g in ordered_groups {
         if station_ids[g.site].is_some() {
             continue;
         }
@@ -578,10 +659,22 @@ pub fn plan(
             candidates: site.candidates.len(),
         });
     }
+    (station_ids, stations)
+}
+
+/// The planned poses in visit order, numbered per use (`t1`.., `r1`..,
+/// `c1`.., `v1`..), with the joints of the realized (unwrapped) path and
+/// their flange poses on the nominal model.
+fn numbered_poses(
+    config: &PlanConfig,
+    ordered_groups: &[Group],
+    station_ids: &[Option<String>],
+    realized: &[[f64; DOF]],
+) -> Vec<PlannedPose> {
     let mut counters = [0usize; 4];
     let mut poses = Vec::with_capacity(realized.len());
     let mut joints_iter = realized.iter();
-    for g in &ordered_groups {
+    for g in ordered_groups {
         let station = station_ids[g.site].clone().unwrap_or_default();
         for c in &g.poses {
             let joints = joints_iter.next().map_or(c.joints.to_vec(), |q| q.to_vec());
@@ -603,53 +696,22 @@ pub fn plan(
             });
         }
     }
-    let mut plan = Plan {
-        robot: config.robot.clone(),
-        limits: config.limits.clone(),
-        flange_from_sensor: config.flange_from_sensor,
-        diameter: config.diameter,
-        cut_angle: config.cut_angle,
-        range: config.range,
-        stations,
-        poses,
-        stats: PlanStats {
-            candidates: sites.iter().map(|s| s.candidates.len()).sum(),
-            estimated: Vec::new(),
-            fixed: Vec::new(),
-            inseparable: Vec::new(),
-            log_det,
-            log_det_random,
-            condition: f64::NAN,
-            predicted_validation_std: None,
-            path_unordered_deg,
-            path_deg,
-            range_error: None,
-            range_error_unspread: None,
-        },
-    };
-    let report = planner.plan_report(&plan)?;
-    let plan_estimated = unknown_indices(&config.robot, &report.estimated);
-    plan.stats.condition = planner.condition(&plan, &plan_estimated);
+    poses
+}
+
+/// The `ml` analysis of the chosen plan into its statistics: what it
+/// identifies, the condition number, the predicted validation std and
+/// the error over the range.
+fn analyse_plan(planner: &Planner<'_>, plan: &mut Plan) -> Result<(), PlanError> {
+    let report = planner.plan_report(plan)?;
+    let plan_estimated = unknown_indices(&planner.config.robot, &report.estimated);
+    plan.stats.condition = planner.condition(plan, &plan_estimated);
     plan.stats.estimated = report.estimated;
     plan.stats.fixed = report.fixed;
     plan.stats.inseparable = report.inseparable;
     plan.stats.predicted_validation_std = report.predicted_distance_std_validate.map(|d| d.centred);
     plan.stats.range_error = report.range_error;
-    if config.spread {
-        // The comparison: the same cell planned without the spread.
-        let unspread = PlanConfig {
-            spread: false,
-            ..config.clone()
-        };
-        // Best effort: a comparison that cannot be planned (the spot's
-        // candidates fewer than needed) leaves the figure out, not the plan.
-        match self::plan(&unspread, &mut |_| progress(PlanStage::Comparison)) {
-            Ok(other) => plan.stats.range_error_unspread = other.stats.range_error,
-            Err(PlanError::Cancelled) => return Err(PlanError::Cancelled),
-            Err(_) => {}
-        }
-    }
-    Ok(plan)
+    Ok(())
 }
 
 /// A few lines for people (the command line's summary).

@@ -229,63 +229,126 @@ fn padded(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     Some((lo - pad, hi + pad))
 }
 
+/// The plot area (SVG px) and the data ranges it shows (x, and y in the
+/// plotted scale: `log10` on a log axis).
+struct Frame {
+    left: f64,
+    right: f64,
+    top: f64,
+    bottom: f64,
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+    y_log: bool,
+}
+
+impl Frame {
+    /// The plot area of `plot` and the padded ranges of its data (with
+    /// zero when asked, room above for band labels).
+    fn of(plot: &Plot) -> Self {
+        let (w, h) = (plot.width, plot.height);
+        let to_y = |v: f64| plotted_y(plot.y_log, v);
+        let xs = plot
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter().map(|p| p[0]))
+            .chain(plot.bands.iter().flat_map(|b| [b.from, b.to]));
+        let ys = plot
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter().filter_map(|p| to_y(p[1])))
+            .chain(plot.rules.iter().filter_map(|r| to_y(r.y)))
+            .chain((plot.include_zero && !plot.y_log).then_some(0.0));
+        let (x0, x1) = padded(xs).unwrap_or((0.0, 1.0));
+        let (mut y0, mut y1) = padded(ys).unwrap_or((0.0, 1.0));
+        if plot.include_zero && !plot.y_log && y0 > -1e-12 {
+            y0 = 0.0;
+        }
+        if !plot.bands.is_empty() {
+            // Room for the band labels above the data.
+            y1 += 0.08 * (y1 - y0);
+        }
+        Self {
+            left: MARGIN_LEFT,
+            right: w - MARGIN_RIGHT,
+            top: MARGIN_TOP,
+            bottom: h - MARGIN_BOTTOM,
+            x0,
+            x1,
+            y0,
+            y1,
+            y_log: plot.y_log,
+        }
+    }
+
+    /// A data value on the plotted y scale; `None` for a non-positive
+    /// value on a log axis.
+    fn to_y(&self, v: f64) -> Option<f64> {
+        plotted_y(self.y_log, v)
+    }
+
+    /// SVG x (px) of the data x.
+    fn px(&self, x: f64) -> f64 {
+        self.left + (x - self.x0) / (self.x1 - self.x0) * (self.right - self.left)
+    }
+
+    /// SVG y (px) of the plotted y.
+    fn py(&self, y: f64) -> f64 {
+        self.bottom - (y - self.y0) / (self.y1 - self.y0) * (self.bottom - self.top)
+    }
+}
+
+/// A data value on the plotted y scale (`log10` on a log axis, where a
+/// non-positive value has none).
+fn plotted_y(y_log: bool, v: f64) -> Option<f64> {
+    if y_log {
+        (v > 0.0).then(|| v.log10())
+    } else {
+        Some(v)
+    }
+}
+
 /// The plot as an `<svg>` element (no XML prolog, no namespace needed
 /// inside HTML).
 #[must_use]
 pub fn render(plot: &Plot) -> String {
     let (w, h) = (plot.width, plot.height);
-    let (left, right) = (MARGIN_LEFT, w - MARGIN_RIGHT);
-    let (top, bottom) = (MARGIN_TOP, h - MARGIN_BOTTOM);
-    let to_y = |v: f64| -> Option<f64> {
-        if plot.y_log {
-            (v > 0.0).then(|| v.log10())
-        } else {
-            Some(v)
-        }
-    };
-    let xs = plot
-        .series
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p[0]))
-        .chain(plot.bands.iter().flat_map(|b| [b.from, b.to]));
-    let ys = plot
-        .series
-        .iter()
-        .flat_map(|s| s.points.iter().filter_map(|p| to_y(p[1])))
-        .chain(plot.rules.iter().filter_map(|r| to_y(r.y)))
-        .chain((plot.include_zero && !plot.y_log).then_some(0.0));
-    let (x0, x1) = padded(xs).unwrap_or((0.0, 1.0));
-    let (mut y0, mut y1) = padded(ys).unwrap_or((0.0, 1.0));
-    if plot.include_zero && !plot.y_log && y0 > -1e-12 {
-        y0 = 0.0;
-    }
-    if !plot.bands.is_empty() {
-        // Room for the band labels above the data.
-        y1 += 0.08 * (y1 - y0);
-    }
-    let px = |x: f64| left + (x - x0) / (x1 - x0) * (right - left);
-    let py = |y: f64| bottom - (y - y0) / (y1 - y0) * (bottom - top);
-
+    let f = Frame::of(plot);
     let mut s = String::new();
     let _ = write!(
         s,
         r#"<svg class="plot" viewBox="0 0 {w:.0} {h:.0}" width="{w:.0}" height="{h:.0}" role="img" font-family="sans-serif" font-size="11"><title>{}</title>"#,
         escape(&plot.title)
     );
-    // Frame and grid.
+    write_axes(&mut s, plot, &f);
+    write_bands(&mut s, plot, &f);
+    // Rules, then the data.
+    write_rules(&mut s, plot, &f);
+    for series in &plot.series {
+        write_series(&mut s, series, &f);
+    }
+    write_legend(&mut s, plot, &f);
+    s.push_str("</svg>");
+    s
+}
+
+/// The frame, the grid with its tick labels, and the axis labels.
+fn write_axes(s: &mut String, plot: &Plot, f: &Frame) {
+    let (left, right, top, bottom) = (f.left, f.right, f.top, f.bottom);
     let _ = write!(
         s,
         r#"<rect x="{left:.1}" y="{top:.1}" width="{:.1}" height="{:.1}" fill="none" stroke="{MUTED}"/>"#,
         right - left,
         bottom - top
     );
-    let x_ticks = nice_ticks(x0, x1, TICKS + 2, plot.x_integer);
+    let x_ticks = nice_ticks(f.x0, f.x1, TICKS + 2, plot.x_integer);
     let x_step = x_ticks
         .get(1)
         .zip(x_ticks.first())
         .map_or(1.0, |(b, a)| b - a);
     for t in &x_ticks {
-        let x = px(*t);
+        let x = f.px(*t);
         let _ = write!(
             s,
             r#"<line x1="{x:.1}" y1="{bottom:.1}" x2="{x:.1}" y2="{:.1}" stroke="{MUTED}"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
@@ -295,14 +358,14 @@ pub fn render(plot: &Plot) -> String {
         );
     }
     let (y_ticks, y_step) = if plot.y_log {
-        (log_ticks(y0, y1), 0.0)
+        (log_ticks(f.y0, f.y1), 0.0)
     } else {
-        let t = nice_ticks(y0, y1, TICKS, false);
+        let t = nice_ticks(f.y0, f.y1, TICKS, false);
         let step = t.get(1).zip(t.first()).map_or(1.0, |(b, a)| b - a);
         (t, step)
     };
     for t in &y_ticks {
-        let y = py(*t);
+        let y = f.py(*t);
         let label = if plot.y_log {
             log_tick_label(*t)
         } else {
@@ -315,40 +378,47 @@ pub fn render(plot: &Plot) -> String {
             y + 4.0
         );
     }
-    // Axis labels.
     let _ = write!(
         s,
         r#"<text x="{:.1}" y="{:.1}" text-anchor="middle">{}</text><text transform="translate(14 {:.1}) rotate(-90)" text-anchor="middle">{}</text>"#,
         f64::midpoint(left, right),
-        h - 6.0,
+        plot.height - 6.0,
         escape(&plot.x_label),
         f64::midpoint(top, bottom),
         escape(&plot.y_label)
     );
-    // Bands: separators and labels.
+}
+
+/// The bands' separators and, where they fit, their labels.
+fn write_bands(s: &mut String, plot: &Plot, f: &Frame) {
+    let (top, bottom) = (f.top, f.bottom);
     for (k, b) in plot.bands.iter().enumerate() {
         if k > 0 {
-            let x = px(b.from);
+            let x = f.px(b.from);
             let _ = write!(
                 s,
                 r#"<line x1="{x:.1}" y1="{top:.1}" x2="{x:.1}" y2="{bottom:.1}" stroke="{MUTED}" stroke-dasharray="2 2"/>"#
             );
         }
-        let width = px(b.to) - px(b.from);
+        let width = f.px(b.to) - f.px(b.from);
         if width >= CHAR_WIDTH * b.label.chars().count() as f64 {
             let _ = write!(
                 s,
                 r#"<text x="{:.1}" y="{:.1}" text-anchor="middle" fill="{MUTED}">{}</text>"#,
-                px(f64::midpoint(b.from, b.to)),
+                f.px(f64::midpoint(b.from, b.to)),
                 top + 13.0,
                 escape(&b.label)
             );
         }
     }
-    // Rules, then the data.
+}
+
+/// The horizontal rules across the plot area.
+fn write_rules(s: &mut String, plot: &Plot, f: &Frame) {
+    let (left, right) = (f.left, f.right);
     for r in &plot.rules {
-        if let Some(v) = to_y(r.y) {
-            let y = py(v);
+        if let Some(v) = f.to_y(r.y) {
+            let y = f.py(v);
             let dash = if r.dashed {
                 r#" stroke-dasharray="6 4""#
             } else {
@@ -361,70 +431,82 @@ pub fn render(plot: &Plot) -> String {
             );
         }
     }
-    for series in &plot.series {
-        let pts: Vec<(f64, f64)> = series
-            .points
-            .iter()
-            .filter_map(|p| to_y(p[1]).map(|y| (px(p[0]), py(y))))
-            .filter(|(x, y)| x.is_finite() && y.is_finite())
-            .collect();
-        let colour = escape(&series.colour);
-        if series.line && pts.len() > 1 {
-            let mut line = String::new();
-            for (x, y) in &pts {
-                let _ = write!(line, "{x:.1},{y:.1} ");
-            }
-            let _ = write!(
-                s,
-                r#"<polyline points="{}" fill="none" stroke="{colour}" stroke-width="1.2"/>"#,
-                line.trim_end()
-            );
-        }
-        let mut d = String::new();
-        let m = MARKER;
+}
+
+/// One series: its line (when drawn) and its markers.
+fn write_series(s: &mut String, series: &Series, f: &Frame) {
+    let pts: Vec<(f64, f64)> = series
+        .points
+        .iter()
+        .filter_map(|p| f.to_y(p[1]).map(|y| (f.px(p[0]), f.py(y))))
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .collect();
+    let colour = escape(&series.colour);
+    if series.line && pts.len() > 1 {
+        let mut line = String::new();
         for (x, y) in &pts {
-            let _ = match series.marker {
-                Marker::None => Ok(()),
-                Marker::Square => write!(
-                    d,
-                    "M{:.1} {:.1}h{:.0}v{:.0}h-{:.0}z",
-                    x - m,
-                    y - m,
-                    2.0 * m,
-                    2.0 * m,
-                    2.0 * m
-                ),
-                Marker::Circle => write!(
-                    d,
-                    "M{:.1} {y:.1}a{m} {m} 0 1 0 {:.0} 0a{m} {m} 0 1 0 -{:.0} 0z",
-                    x - m,
-                    2.0 * m,
-                    2.0 * m
-                ),
-                Marker::Cross => write!(
-                    d,
-                    "M{:.1} {:.1}l{:.0} {:.0}m0 -{:.0}l-{:.0} {:.0}",
-                    x - m,
-                    y - m,
-                    2.0 * m,
-                    2.0 * m,
-                    2.0 * m,
-                    2.0 * m,
-                    2.0 * m
-                ),
-            };
+            let _ = write!(line, "{x:.1},{y:.1} ");
         }
-        if !d.is_empty() {
-            let paint = if series.marker == Marker::Cross {
-                format!(r#"fill="none" stroke="{colour}" stroke-width="1.5""#)
-            } else {
-                format!(r#"fill="{colour}""#)
-            };
-            let _ = write!(s, r#"<path d="{d}" {paint}/>"#);
-        }
+        let _ = write!(
+            s,
+            r#"<polyline points="{}" fill="none" stroke="{colour}" stroke-width="1.2"/>"#,
+            line.trim_end()
+        );
     }
-    // Legend, in a row above the plot area.
-    let mut x = left;
+    let d = marker_path(series.marker, &pts);
+    if !d.is_empty() {
+        let paint = if series.marker == Marker::Cross {
+            format!(r#"fill="none" stroke="{colour}" stroke-width="1.5""#)
+        } else {
+            format!(r#"fill="{colour}""#)
+        };
+        let _ = write!(s, r#"<path d="{d}" {paint}/>"#);
+    }
+}
+
+/// The SVG path data of `marker` at each of `pts` (px); empty for none.
+fn marker_path(marker: Marker, pts: &[(f64, f64)]) -> String {
+    let mut d = String::new();
+    let m = MARKER;
+    for (x, y) in pts {
+        let _ = match marker {
+            Marker::None => Ok(()),
+            Marker::Square => write!(
+                d,
+                "M{:.1} {:.1}h{:.0}v{:.0}h-{:.0}z",
+                x - m,
+                y - m,
+                2.0 * m,
+                2.0 * m,
+                2.0 * m
+            ),
+            Marker::Circle => write!(
+                d,
+                "M{:.1} {y:.1}a{m} {m} 0 1 0 {:.0} 0a{m} {m} 0 1 0 -{:.0} 0z",
+                x - m,
+                2.0 * m,
+                2.0 * m
+            ),
+            Marker::Cross => write!(
+                d,
+                "M{:.1} {:.1}l{:.0} {:.0}m0 -{:.0}l-{:.0} {:.0}",
+                x - m,
+                y - m,
+                2.0 * m,
+                2.0 * m,
+                2.0 * m,
+                2.0 * m,
+                2.0 * m
+            ),
+        };
+    }
+    d
+}
+
+/// The legend, in a row above the plot area: the named series, then the
+/// labelled rules.
+fn write_legend(s: &mut String, plot: &Plot, f: &Frame) {
+    let mut x = f.left;
     let entries = plot
         .series
         .iter()
@@ -438,7 +520,7 @@ pub fn render(plot: &Plot) -> String {
         );
     for (name, colour, marker, dashed) in entries {
         let colour = escape(colour);
-        let y = top - 10.0;
+        let y = f.top - 10.0;
         match marker {
             Some(Marker::Circle) => {
                 let _ = write!(
@@ -485,8 +567,6 @@ pub fn render(plot: &Plot) -> String {
         );
         x += 20.0 + CHAR_WIDTH * name.chars().count() as f64 + 18.0;
     }
-    s.push_str("</svg>");
-    s
 }
 
 #[cfg(test)]

@@ -224,7 +224,8 @@ impl Default for SimConfig {
     }
 }
 
-/// Why [`simulate`](crate::engine::tools::simulate::simulate) could not build a session.
+/// Why [`simulate`](crate::engine::tools::simulate::simulate) could not
+/// build a session.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
     /// A setting is out of range; the message names it.
@@ -274,6 +275,15 @@ impl SimConfig {
 }
 
 pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
+    check_numbers(c)?;
+    check_sensor_model(c)?;
+    check_motion(c)?;
+    check_stripes_and_range(c)
+}
+
+/// Every number finite, the noises not negative and plausible, the counts
+/// within the session limits, at least one identify station.
+fn check_numbers(c: &SimConfig) -> Result<(), SimError> {
     let reals = [
         ("error_scale", c.error_scale),
         ("joint_noise", c.joint_noise),
@@ -352,6 +362,12 @@ pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
         "at least one identify station is needed: a session without one cannot be calibrated"
             .to_owned()
     })?;
+    Ok(())
+}
+
+/// The sensor model: outliers, the sphere's diameter, the stripe sampling,
+/// the cut angle and the camera's distance.
+fn check_sensor_model(c: &SimConfig) -> Result<(), SimError> {
     check((0.0..=1.0).contains(&c.outlier_fraction), || {
         format!(
             "outlier_fraction must be within 0..1, found {}",
@@ -410,6 +426,13 @@ pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
             c.stripe_decimals
         )
     })?;
+    Ok(())
+}
+
+/// The robot's motion: the approach cone, the wrist, the translation and
+/// rotation groups, the poses per station, and the hand-eye groups a
+/// session without an initial hand-eye needs.
+fn check_motion(c: &SimConfig) -> Result<(), SimError> {
     check((0.0..=90.0).contains(&c.cone_angle), || {
         format!(
             "cone_angle must be within 0..90 deg, found {}",
@@ -466,6 +489,12 @@ pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
             )
         })?;
     }
+    Ok(())
+}
+
+/// Enough points on the shortest stripe, the sensor range and its spread,
+/// the workspace box.
+fn check_stripes_and_range(c: &SimConfig) -> Result<(), SimError> {
     // The shortest stripe: the largest cut angle gives the smallest circle.
     let radius = c.diameter / 2.0;
     let smallest_r = radius * (c.cut_angle + c.cut_jitter).to_radians().cos();

@@ -77,61 +77,10 @@ pub fn simulate_plan(
     poses: &[PlanPose],
     execution: PlanExecution,
 ) -> Result<(Session, Truth), SimError> {
-    let count = |usage: Use| poses.iter().filter(|p| p.usage == usage).count();
-    let mut per_station: Vec<(String, usize)> = Vec::new();
-    for p in poses {
-        match per_station.iter_mut().find(|(s, _)| *s == p.station) {
-            Some((_, n)) => *n += 1,
-            None => per_station.push((p.station.clone(), 1)),
-        }
-    }
-    let smallest_station = poses
-        .iter()
-        .filter(|p| matches!(p.usage, Use::Identify | Use::Validate))
-        .filter_map(|p| per_station.iter().find(|(s, _)| *s == p.station))
-        .map(|(_, n)| *n)
-        .min()
-        .unwrap_or(2);
-    let mut echoed = SimConfig {
-        n_translation: count(Use::Translation),
-        n_rotation: count(Use::Rotation),
-        n_identify: count_stations(poses, Use::Identify),
-        n_validate: count_stations(poses, Use::Validate),
-        poses_per_station: smallest_station,
-        workspace: None,
-        ..config.clone()
-    };
+    let per_station = station_counts(poses);
+    let mut echoed = echoed_config(config, poses, &per_station);
     validate_config(&echoed)?;
-    let dof = nominal.dof();
-    check(dof == DOF, || {
-        format!(
-            "the simulator drives 6-axis arms, {} has {dof} joints",
-            nominal.name
-        )
-    })?;
-    check(!poses.is_empty(), || "the plan has no poses".to_owned())?;
-    let mut ids = HashSet::new();
-    for p in poses {
-        check(ids.insert(p.id.as_str()), || {
-            format!("pose id {} is given twice", p.id)
-        })?;
-        check(p.joints.len() == dof, || {
-            format!(
-                "pose {}: {} joint values, the robot has {dof}",
-                p.id,
-                p.joints.len()
-            )
-        })?;
-        check(p.joints.iter().all(|v| v.is_finite()), || {
-            format!("pose {}: a joint value is not finite", p.id)
-        })?;
-        check(p.side == 1 || p.side == -1, || {
-            format!("pose {}: side must be +1 or -1, found {}", p.id, p.side)
-        })?;
-        check(p.centre_in_sensor.iter().all(|v| v.is_finite()), || {
-            format!("pose {}: the planned centre is not finite", p.id)
-        })?;
-    }
+    check_poses(nominal, poses)?;
     let mut rng_noise = stream(config.seed, STREAM_NOISE);
     let (true_robot, errors) = super::with_errors(config, nominal);
     let base_from_sensor = |q: &[f64]| true_robot.base_from_flange(q) * flange_from_sensor;
@@ -147,56 +96,15 @@ pub fn simulate_plan(
             (id.clone(), sum / *n as f64)
         })
         .collect();
-    let radius = config.diameter / 2.0;
-    let (lo, hi) = (
-        radius * PLAN_MIN_CUT_DEG.to_radians().sin(),
-        radius * PLAN_MAX_CUT_DEG.to_radians().sin(),
-    );
-    let chain = Chain::new(&true_robot)
-        .ok_or_else(|| SimError::InvalidConfig(format!("{} is not a 6-axis arm", nominal.name)))?;
-    let mut simulated = Vec::with_capacity(poses.len());
-    for p in poses {
-        let station = stations
-            .iter()
-            .find(|(id, _)| *id == p.station)
-            .map_or_else(Vector3::zeros, |(_, c)| *c);
-        let mut joints = [0.0; DOF];
-        joints.copy_from_slice(&p.joints);
-        if execution == PlanExecution::TouchUp {
-            let planned = Vector3::from(p.centre_in_sensor);
-            joints = touch_up(&chain, flange_from_sensor, &joints, &planned, &station)
-                .filter(|q| {
-                    let seen = base_from_sensor(q) * Point3::from(planned);
-                    (seen.coords - station).norm() < IK_CHECK_TOLERANCE
-                })
-                .ok_or_else(|| {
-                    SimError::InvalidConfig(format!(
-                        "pose {}: the touch-up found no joints that see the sphere at the planned centre",
-                        p.id
-                    ))
-                })?;
-        }
-        let centre = base_from_sensor(&joints)
-            .inverse_transform_point(&Point3::from(station))
-            .coords;
-        let x = centre.x * f64::from(p.side);
-        if !(lo..=hi).contains(&x) {
-            return Err(SimError::PlanMiss {
-                id: p.id.clone(),
-                x: centre.x,
-                side: p.side,
-                lo,
-                hi,
-            });
-        }
-        simulated.push(Pose {
-            station: p.station.clone(),
-            usage: p.usage,
-            side: p.side,
-            joints,
-            centre_in_sensor: centre,
-        });
-    }
+    let simulated = executed_poses(
+        config,
+        nominal,
+        &true_robot,
+        flange_from_sensor,
+        poses,
+        &stations,
+        execution,
+    )?;
     let default_side = 1;
     let (mut measurements, mut truths) = record(config, &simulated, default_side, &mut rng_noise);
     for ((m, t), p) in measurements.iter_mut().zip(truths.iter_mut()).zip(poses) {
@@ -247,6 +155,148 @@ pub fn simulate_plan(
         measurements: OrderedMap(truths),
     };
     Ok((session, truth))
+}
+
+/// The plan's stations in order of first appearance, with their pose
+/// counts.
+fn station_counts(poses: &[PlanPose]) -> Vec<(String, usize)> {
+    let mut per_station: Vec<(String, usize)> = Vec::new();
+    for p in poses {
+        match per_station.iter_mut().find(|(s, _)| *s == p.station) {
+            Some((_, n)) => *n += 1,
+            None => per_station.push((p.station.clone(), 1)),
+        }
+    }
+    per_station
+}
+
+/// The configuration the truth file echoes: the plan's counts of poses
+/// and stations, no workspace.
+fn echoed_config(
+    config: &SimConfig,
+    poses: &[PlanPose],
+    per_station: &[(String, usize)],
+) -> SimConfig {
+    let count = |usage: Use| poses.iter().filter(|p| p.usage == usage).count();
+    let smallest_station = poses
+        .iter()
+        .filter(|p| matches!(p.usage, Use::Identify | Use::Validate))
+        .filter_map(|p| per_station.iter().find(|(s, _)| *s == p.station))
+        .map(|(_, n)| *n)
+        .min()
+        .unwrap_or(2);
+    SimConfig {
+        n_translation: count(Use::Translation),
+        n_rotation: count(Use::Rotation),
+        n_identify: count_stations(poses, Use::Identify),
+        n_validate: count_stations(poses, Use::Validate),
+        poses_per_station: smallest_station,
+        workspace: None,
+        ..config.clone()
+    }
+}
+
+/// Checks the robot (6-axis) and every pose: a unique id, one finite
+/// value per joint, a side of ±1, a finite planned centre.
+fn check_poses(nominal: &Robot, poses: &[PlanPose]) -> Result<(), SimError> {
+    let dof = nominal.dof();
+    check(dof == DOF, || {
+        format!(
+            "the simulator drives 6-axis arms, {} has {dof} joints",
+            nominal.name
+        )
+    })?;
+    check(!poses.is_empty(), || "the plan has no poses".to_owned())?;
+    let mut ids = HashSet::new();
+    for p in poses {
+        check(ids.insert(p.id.as_str()), || {
+            format!("pose id {} is given twice", p.id)
+        })?;
+        check(p.joints.len() == dof, || {
+            format!(
+                "pose {}: {} joint values, the robot has {dof}",
+                p.id,
+                p.joints.len()
+            )
+        })?;
+        check(p.joints.iter().all(|v| v.is_finite()), || {
+            format!("pose {}: a joint value is not finite", p.id)
+        })?;
+        check(p.side == 1 || p.side == -1, || {
+            format!("pose {}: side must be +1 or -1, found {}", p.id, p.side)
+        })?;
+        check(p.centre_in_sensor.iter().all(|v| v.is_finite()), || {
+            format!("pose {}: the planned centre is not finite", p.id)
+        })?;
+    }
+    Ok(())
+}
+
+/// The poses as executed by the true robot (the `nominal` one with its
+/// errors; `stations`: where it sees
+/// the sphere, base frame, mm): the planned joints, or touched up to the
+/// planned centre; each seeing the sphere within the usable cut.
+fn executed_poses(
+    config: &SimConfig,
+    nominal: &Robot,
+    true_robot: &Robot,
+    flange_from_sensor: &Isometry3<f64>,
+    poses: &[PlanPose],
+    stations: &[(String, Vector3<f64>)],
+    execution: PlanExecution,
+) -> Result<Vec<Pose>, SimError> {
+    let base_from_sensor = |q: &[f64]| true_robot.base_from_flange(q) * flange_from_sensor;
+    let radius = config.diameter / 2.0;
+    let (lo, hi) = (
+        radius * PLAN_MIN_CUT_DEG.to_radians().sin(),
+        radius * PLAN_MAX_CUT_DEG.to_radians().sin(),
+    );
+    let chain = Chain::new(true_robot)
+        .ok_or_else(|| SimError::InvalidConfig(format!("{} is not a 6-axis arm", nominal.name)))?;
+    let mut simulated = Vec::with_capacity(poses.len());
+    for p in poses {
+        let station = stations
+            .iter()
+            .find(|(id, _)| *id == p.station)
+            .map_or_else(Vector3::zeros, |(_, c)| *c);
+        let mut joints = [0.0; DOF];
+        joints.copy_from_slice(&p.joints);
+        if execution == PlanExecution::TouchUp {
+            let planned = Vector3::from(p.centre_in_sensor);
+            joints = touch_up(&chain, flange_from_sensor, &joints, &planned, &station)
+                .filter(|q| {
+                    let seen = base_from_sensor(q) * Point3::from(planned);
+                    (seen.coords - station).norm() < IK_CHECK_TOLERANCE
+                })
+                .ok_or_else(|| {
+                    SimError::InvalidConfig(format!(
+                        "pose {}: the touch-up found no joints that see the sphere at the planned centre",
+                        p.id
+                    ))
+                })?;
+        }
+        let centre = base_from_sensor(&joints)
+            .inverse_transform_point(&Point3::from(station))
+            .coords;
+        let x = centre.x * f64::from(p.side);
+        if !(lo..=hi).contains(&x) {
+            return Err(SimError::PlanMiss {
+                id: p.id.clone(),
+                x: centre.x,
+                side: p.side,
+                lo,
+                hi,
+            });
+        }
+        simulated.push(Pose {
+            station: p.station.clone(),
+            usage: p.usage,
+            side: p.side,
+            joints,
+            centre_in_sensor: centre,
+        });
+    }
+    Ok(simulated)
 }
 
 /// How the cell executes a plan in [`simulate_plan`].

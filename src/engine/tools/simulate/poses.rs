@@ -6,12 +6,14 @@
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
-use nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::config::{SideChoice, SimConfig, SimError};
-use crate::engine::base::cell::approach::{direction_in_cone, random_orientation};
+use crate::engine::base::cell::approach::{
+    flange_target, mean_approach, random_orientation, turned_orientation,
+};
 use crate::engine::base::cell::branch;
 use crate::engine::base::cell::random::uniform;
 use crate::engine::base::cell::workspace::{Workspace, identify_stations, validate_stations};
@@ -122,13 +124,10 @@ impl Planner<'_> {
         f64::from(side) * self.radius() * cut.to_radians().sin()
     }
 
+    /// The mean approach at `station` from the workspace's eye point
+    /// ([`mean_approach`]).
     fn mean_approach(&self, station: &Vector3<f64>) -> Vector3<f64> {
-        let d = station - Vector3::from(self.workspace.eye);
-        if d.norm() > 0.0 {
-            d.normalize()
-        } else {
-            -Vector3::z()
-        }
+        mean_approach(station, &Vector3::from(self.workspace.eye))
     }
 
     /// Arm guesses `(q1, q2, q3)` (deg) for a flange target: the cell's
@@ -159,8 +158,12 @@ impl Planner<'_> {
         hint: Option<&[f64; DOF]>,
     ) -> Option<[f64; DOF]> {
         let centre_in_flange = self.flange_from_sensor * Point3::from(*centre_in_sensor);
-        let position = station - rotation * centre_in_flange.coords;
-        let target = Isometry3::from_parts(Translation3::from(position), *rotation);
+        let target = flange_target(
+            station,
+            rotation,
+            &self.flange_from_sensor,
+            centre_in_sensor,
+        );
         let min_wrist = self.config.min_wrist_angle.to_radians().sin();
         // Readings are moved by whole turns into (−180, 180] (the same
         // pose, tidier numbers) before the limits are checked.
@@ -300,9 +303,7 @@ impl Planner<'_> {
         for side in sides {
             let mut found = None;
             for _ in 0..MAX_POSE_ATTEMPTS {
-                let axis = Unit::new_normalize(direction_in_cone(rng, &Vector3::z(), PI));
-                let angle = uniform(rng, c.rotation_min, c.rotation_max).to_radians();
-                let rotation = reference * UnitQuaternion::from_axis_angle(&axis, angle);
+                let rotation = turned_orientation(rng, reference, c.rotation_min, c.rotation_max);
                 let centre = self.sample_centre(rng, side);
                 let distinct = rotations
                     .iter()

@@ -71,6 +71,7 @@ use nalgebra::{Isometry3, Vector3};
 use self::arms::{Arms, BranchRule};
 use self::region::Region;
 use self::uncertainty::{Covariance, Predictor};
+use crate::engine::base::robot::Robot;
 use crate::engine::base::robot::ik::DOF;
 use crate::engine::base::session::{Session, Use};
 use crate::engine::calibrate::solve::Control;
@@ -345,53 +346,7 @@ impl Model {
             .filter_map(|(id, q)| Some((id.clone(), <[f64; DOF]>::try_from(q.as_slice()).ok()?)))
             .collect();
         if let Some(s) = session {
-            let from_session: Vec<(String, [f64; DOF])> = result
-                .centres
-                .iter()
-                .filter_map(|c| {
-                    let m = s.measurements.iter().find(|m| m.id == c.measurement)?;
-                    Some((
-                        c.measurement.clone(),
-                        <[f64; DOF]>::try_from(m.joints.as_slice()).ok()?,
-                    ))
-                })
-                .collect();
-            // The session's joints, the calibrated model and hand-eye must
-            // give back the result's own base-frame centres.
-            let worst = from_session
-                .iter()
-                .filter_map(|(id, q)| {
-                    let c = result.centres.iter().find(|c| c.measurement == *id)?;
-                    let seen = calibrated.base_from_flange(q)
-                        * result.hand_eye
-                        * nalgebra::Point3::from(Vector3::from(c.sensor));
-                    Some((seen.coords - Vector3::from(c.after)).norm())
-                })
-                .fold(0.0, f64::max);
-            if from_session.is_empty() || worst > SAME_SESSION_MM {
-                return Err(CompensateError::Session(format!(
-                    "the session {:?} {}: it is not the session the result was calibrated from",
-                    s.name,
-                    if from_session.is_empty() {
-                        "has none of the result's measurements with joints".to_string()
-                    } else {
-                        format!(
-                            "does not give back the result's centres (its joints put one {worst:.3} mm away)"
-                        )
-                    }
-                )));
-            }
-            let same = s.robot.joints.len() == nominal.joints.len()
-                && s.robot
-                    .joints
-                    .iter()
-                    .zip(&nominal.joints)
-                    .all(|(a, b)| (0..5).all(|k| (a.get(k) - b.get(k)).abs() < 1e-6));
-            if !same {
-                notes.push(
-                    "the session's robot differs from the result's nominal model (calibrated minus joint errors): the result's is used".to_string(),
-                );
-            }
+            let from_session = session_joints(result, s, &calibrated, &nominal, &mut notes)?;
             if joints.is_empty() {
                 joints = from_session;
             }
@@ -439,44 +394,19 @@ impl Model {
             ),
             Some(_) => {}
         }
-        let working_point = match tcp {
-            Tcp::Sensor => {
-                let sensor: Vec<Vector3<f64>> = result
-                    .centres
-                    .iter()
-                    .filter(|c| c.usage == Use::Identify)
-                    .map(|c| Vector3::from(c.sensor))
-                    .collect();
-                sensor.iter().sum::<Vector3<f64>>() / sensor.len().max(1) as f64
-            }
-            _ => Vector3::zeros(),
-        };
+        let working_point = working_point(result, &tcp);
         // The box of the working points the calibration saw: at the
         // identify poses when their joints are known, else (for the
         // sensor) the identify sphere positions themselves.
-        let seen: Vec<Vector3<f64>> = if identify.is_empty() {
-            if tcp == Tcp::Sensor {
-                result
-                    .centres
-                    .iter()
-                    .filter(|c| c.usage == Use::Identify)
-                    .map(|c| Vector3::from(c.after))
-                    .collect()
-            } else {
-                notes.push(
-                    "the region is not checked in the base frame: without the joints of the calibration's poses, where a TCP other than the sensor was is not known".to_string(),
-                );
-                Vec::new()
-            }
-        } else {
-            identify
-                .iter()
-                .map(|(_, q)| {
-                    (calibrated.base_from_flange(q) * tool * nalgebra::Point3::from(working_point))
-                        .coords
-                })
-                .collect()
-        };
+        let seen = seen_points(
+            result,
+            &tcp,
+            &identify,
+            &calibrated,
+            &tool,
+            &working_point,
+            &mut notes,
+        );
         let region = Region::new(identify, &seen, working_point);
         Ok(Self {
             arms,
@@ -493,6 +423,121 @@ impl Model {
     #[must_use]
     pub fn has_identify_joints(&self) -> bool {
         self.region.has_joints()
+    }
+}
+
+/// The joints of the result's measurements in `s` (the session given
+/// with the result), checked to be the result's session: they must give
+/// back the result's base-frame centres. Notes a session robot that
+/// differs from the result's nominal model.
+fn session_joints(
+    result: &ResultFile,
+    s: &Session,
+    calibrated: &Robot,
+    nominal: &Robot,
+    notes: &mut Vec<String>,
+) -> Result<Vec<(String, [f64; DOF])>, CompensateError> {
+    let from_session: Vec<(String, [f64; DOF])> = result
+        .centres
+        .iter()
+        .filter_map(|c| {
+            let m = s.measurements.iter().find(|m| m.id == c.measurement)?;
+            Some((
+                c.measurement.clone(),
+                <[f64; DOF]>::try_from(m.joints.as_slice()).ok()?,
+            ))
+        })
+        .collect();
+    // The session's joints, the calibrated model and hand-eye must
+    // give back the result's own base-frame centres.
+    let worst = from_session
+        .iter()
+        .filter_map(|(id, q)| {
+            let c = result.centres.iter().find(|c| c.measurement == *id)?;
+            let seen = calibrated.base_from_flange(q)
+                * result.hand_eye
+                * nalgebra::Point3::from(Vector3::from(c.sensor));
+            Some((seen.coords - Vector3::from(c.after)).norm())
+        })
+        .fold(0.0, f64::max);
+    if from_session.is_empty() || worst > SAME_SESSION_MM {
+        return Err(CompensateError::Session(format!(
+            "the session {:?} {}: it is not the session the result was calibrated from",
+            s.name,
+            if from_session.is_empty() {
+                "has none of the result's measurements with joints".to_string()
+            } else {
+                format!(
+                    "does not give back the result's centres (its joints put one {worst:.3} mm away)"
+                )
+            }
+        )));
+    }
+    let same = s.robot.joints.len() == nominal.joints.len()
+        && s.robot
+            .joints
+            .iter()
+            .zip(&nominal.joints)
+            .all(|(a, b)| (0..5).all(|k| (a.get(k) - b.get(k)).abs() < 1e-6));
+    if !same {
+        notes.push(
+            "the session's robot differs from the result's nominal model (calibrated minus joint errors): the result's is used".to_string(),
+        );
+    }
+    Ok(from_session)
+}
+
+/// The working point in the TCP frame (mm): the mean identify centre
+/// (sensor frame) for the sensor, else the TCP's origin.
+fn working_point(result: &ResultFile, tcp: &Tcp) -> Vector3<f64> {
+    match tcp {
+        Tcp::Sensor => {
+            let sensor: Vec<Vector3<f64>> = result
+                .centres
+                .iter()
+                .filter(|c| c.usage == Use::Identify)
+                .map(|c| Vector3::from(c.sensor))
+                .collect();
+            sensor.iter().sum::<Vector3<f64>>() / sensor.len().max(1) as f64
+        }
+        _ => Vector3::zeros(),
+    }
+}
+
+/// The working points the calibration saw (base frame, mm): at the
+/// identify poses when their joints are known, else (for the sensor) the
+/// identify sphere positions themselves; none otherwise, with a note.
+fn seen_points(
+    result: &ResultFile,
+    tcp: &Tcp,
+    identify: &[(String, [f64; DOF])],
+    calibrated: &Robot,
+    tool: &Isometry3<f64>,
+    working_point: &Vector3<f64>,
+    notes: &mut Vec<String>,
+) -> Vec<Vector3<f64>> {
+    if identify.is_empty() {
+        if *tcp == Tcp::Sensor {
+            result
+                .centres
+                .iter()
+                .filter(|c| c.usage == Use::Identify)
+                .map(|c| Vector3::from(c.after))
+                .collect()
+        } else {
+            notes.push(
+            "the region is not checked in the base frame: without the joints of the calibration's poses, where a TCP other than the sensor was is not known".to_string(),
+        );
+            Vec::new()
+        }
+    } else {
+        identify
+            .iter()
+            .map(|(_, q)| {
+                (calibrated.base_from_flange(q) * tool * nalgebra::Point3::from(*working_point))
+                    .coords
+            })
+            .collect()
     }
 }
 

@@ -7,7 +7,7 @@ use nalgebra::{DMatrix, DVector, Matrix3};
 use super::MlUpdate;
 use super::identifiability::raw_per_file_unit;
 use super::noise::{OUTLIER_QUANTILE, base_covariance, chi3_quantile, sensor_covariance};
-use super::problem::Problem;
+use super::problem::{InverseBlocks, Problem, State};
 use super::report::{
     DistanceStd, IdentifiabilityRecord, LabelledMatrix, LossRecord, MlReport, NoiseModel,
     OutlierRecord, ParameterRecord, PivotRecord, PriorRecord,
@@ -178,10 +178,89 @@ pub(super) fn report(
     let problem = &solver.problem;
     let state = &solver.state;
     let mo = &solver.options.ml;
-    let k = problem.estimated.len();
     let lin = problem.linearize(state);
     let inverse = lin.inverse_blocks();
     let cov_scaled = inverse.p.clone();
+    let FileCovariance {
+        labels,
+        units,
+        matrix: cov_file,
+        std,
+        corr,
+        strong,
+    } = file_covariance(problem, &cov_scaled);
+    let parameters = parameter_changes(solver, &labels, &units, &std);
+    // Residual statistics, leverage and outliers.
+    if phase(Phase::Outliers) == Control::Cancel {
+        return cancelled(solver);
+    }
+    let limit = chi3_quantile(OUTLIER_QUANTILE);
+    let (outliers, variance_factor) = outliers_and_variance(problem, state, &inverse);
+    // Predicted distance σ.
+    if phase(Phase::Prediction) == Control::Cancel {
+        return cancelled(solver);
+    }
+    let (predicted_validate, predicted_identify) = predicted_distances(solver, &cov_scaled);
+    if phase(Phase::RangeError) == Control::Cancel {
+        return cancelled(solver);
+    }
+    let range_error =
+        super::range::range_error(session, prepared, problem, &state.est, &cov_scaled);
+    // Leave-one-station-out.
+    let cross_validation = if mo.cross_validation && problem.stations.len() >= 2 {
+        match problem.cross_validate(state, phase) {
+            Some(cv) => Some(cv),
+            None => return cancelled(solver),
+        }
+    } else {
+        None
+    };
+    let report = MlReport {
+        parameters,
+        covariance: LabelledMatrix {
+            labels: labels.clone(),
+            units,
+            matrix: cov_file,
+        },
+        correlation: LabelledMatrix {
+            labels,
+            units: Vec::new(),
+            matrix: corr,
+        },
+        strong_correlations: strong,
+        variance_factor,
+        predicted_distance_std_validate: predicted_validate,
+        predicted_distance_std_identify: predicted_identify,
+        cross_validation,
+        range_error,
+        outlier_limit_sigma: limit,
+        outliers,
+        ..base
+    };
+    (report, false)
+}
+
+/// The covariance of the estimated parameters in file units (mm, deg)
+/// with what a reader needs of it.
+struct FileCovariance {
+    /// The parameters' labels.
+    labels: Vec<String>,
+    /// Their units (`mm` or `deg`).
+    units: Vec<String>,
+    /// The covariance, file units.
+    matrix: Vec<Vec<f64>>,
+    /// The standard deviations, file units.
+    std: Vec<f64>,
+    /// The correlations.
+    corr: Vec<Vec<f64>>,
+    /// The pairs correlated at least [`STRONG_CORRELATION`], as text.
+    strong: Vec<String>,
+}
+
+/// The covariance `cov_scaled` (scaled unknowns) of `problem` in file
+/// units, with its standard deviations and correlations.
+fn file_covariance(problem: &Problem, cov_scaled: &DMatrix<f64>) -> FileCovariance {
+    let k = problem.estimated.len();
     // File units: scaled → raw (÷ scale) → deg for angles.
     let to_file: Vec<f64> = problem
         .estimated
@@ -237,13 +316,34 @@ pub(super) fn report(
             }
         }
     }
+    FileCovariance {
+        labels,
+        units,
+        matrix: cov_file,
+        std,
+        corr,
+        strong,
+    }
+}
+
+/// The change of each estimated parameter from the start (file units),
+/// with its standard deviation.
+fn parameter_changes(
+    solver: &MlUpdate<'_>,
+    labels: &[String],
+    units: &[String],
+    std: &[f64],
+) -> Vec<ParameterRecord> {
+    let (session, prepared) = (solver.session, solver.prepared);
+    let problem = &solver.problem;
+    let state = &solver.state;
     // Changes from the start, file units.
     let start_params = session.robot.params();
     let params = state.est.robot.params();
     let he_change = prepared.hand_eye_initial.inverse() * state.est.flange_from_sensor;
     let he_t = he_change.translation.vector;
     let he_r = he_change.rotation.scaled_axis();
-    let parameters = problem
+    problem
         .estimated
         .iter()
         .enumerate()
@@ -262,11 +362,17 @@ pub(super) fn report(
                 unit: units[slot].clone(),
             }
         })
-        .collect();
-    // Residual statistics, leverage and outliers.
-    if phase(Phase::Outliers) == Control::Cancel {
-        return cancelled(solver);
-    }
+        .collect()
+}
+
+/// The outliers at the final state (residual beyond the χ(3) limit once
+/// its leverage is accounted for), worst first, and the variance factor
+/// `χ² / dof`.
+fn outliers_and_variance(
+    problem: &Problem,
+    state: &State,
+    inverse: &InverseBlocks,
+) -> (Vec<OutlierRecord>, f64) {
     let limit = chi3_quantile(OUTLIER_QUANTILE);
     let mut chi2 = 0.0;
     let mut outliers = Vec::new();
@@ -298,10 +404,19 @@ pub(super) fn report(
     outliers.sort_by(|a, b| b.sigma.total_cmp(&a.sigma));
     let dof = (3 * problem.obs.len()).saturating_sub(problem.dim()).max(1);
     let variance_factor = chi2 / dof as f64;
-    // Predicted distance σ.
-    if phase(Phase::Prediction) == Control::Cancel {
-        return cancelled(solver);
-    }
+    (outliers, variance_factor)
+}
+
+/// The predicted σ of the validate distances (`None` without reference
+/// distances) and of the identify station pairs.
+fn predicted_distances(
+    solver: &MlUpdate<'_>,
+    cov_scaled: &DMatrix<f64>,
+) -> (Option<DistanceStd>, DistanceStd) {
+    let (session, prepared) = (solver.session, solver.prepared);
+    let problem = &solver.problem;
+    let state = &solver.state;
+    let mo = &solver.options.ml;
     let noisy = |i: usize| -> NoisySighting {
         let s = prepared.sighting(session, i);
         let cov = base_covariance(
@@ -342,43 +457,7 @@ pub(super) fn report(
         }
     }
     let predicted_validate =
-        (!vpairs.is_empty()).then(|| distance_std(problem, &state.est, &cov_scaled, &vpairs));
-    let predicted_identify = distance_std(problem, &state.est, &cov_scaled, &ipairs);
-    if phase(Phase::RangeError) == Control::Cancel {
-        return cancelled(solver);
-    }
-    let range_error =
-        super::range::range_error(session, prepared, problem, &state.est, &cov_scaled);
-    // Leave-one-station-out.
-    let cross_validation = if mo.cross_validation && problem.stations.len() >= 2 {
-        match problem.cross_validate(state, phase) {
-            Some(cv) => Some(cv),
-            None => return cancelled(solver),
-        }
-    } else {
-        None
-    };
-    let report = MlReport {
-        parameters,
-        covariance: LabelledMatrix {
-            labels: labels.clone(),
-            units,
-            matrix: cov_file,
-        },
-        correlation: LabelledMatrix {
-            labels,
-            units: Vec::new(),
-            matrix: corr,
-        },
-        strong_correlations: strong,
-        variance_factor,
-        predicted_distance_std_validate: predicted_validate,
-        predicted_distance_std_identify: predicted_identify,
-        cross_validation,
-        range_error,
-        outlier_limit_sigma: limit,
-        outliers,
-        ..base
-    };
-    (report, false)
+        (!vpairs.is_empty()).then(|| distance_std(problem, &state.est, cov_scaled, &vpairs));
+    let predicted_identify = distance_std(problem, &state.est, cov_scaled, &ipairs);
+    (predicted_validate, predicted_identify)
 }
