@@ -10,13 +10,11 @@ use std::time::Instant;
 use clap::Args;
 
 use super::CliError;
+use super::scan_flags::ScanFlags;
 use crate::engine::base::session::Use;
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
-use crate::engine::files::import::{
-    self, AngleUnit, AxisMap, FlangeConvention, LengthUnit, ProfileFormat, ProfileSource,
-    RobotSource,
-};
+use crate::engine::files::import::{self, ProfileSource};
 use crate::engine::uses::measure::{
     self, CellModel, CloudFormat, JointRange, MeasureError, MeasureOptions, ModelChoice,
     Provenance, Scan, ScanColumns, ScanFiles, ScanLog, ScanPose, selfcheck,
@@ -26,9 +24,17 @@ use crate::engine::uses::measure::{
 /// scan of thousands of poses would bury the summary).
 const LISTED_POSES: usize = 20;
 
-/// `spherecal measure`.
+/// `spherecal measure`. The scan flags it shares with the import keep
+/// their measure wording here.
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("input").required(true).args(["session", "joints", "poses"])))]
+#[command(mut_arg("pose_format", |a| a.help("Force the pose file's layout: table, json, fanuc-ls, rapid, krl or urscript")))]
+#[command(mut_arg("pose_convention", |a| a.help("How a pose table or JSON list writes a pose: ABB, KUKA, FANUC, UR or matrix (a robot program fixes its own)")))]
+#[command(mut_arg("pose_columns", |a| a.help("The pose columns of a CSV pose log, in the convention's order")))]
+#[command(mut_arg("urdf_tip", |a| a.help("The tip link of a URDF robot")))]
+#[command(mut_arg("axes", |a| a.help("Axis map from the sensor's axes to spherecal's (laser plane x = 0): `auto` or e.g. `-y,x,z`")))]
+#[command(mut_arg("no_return", |a| a.help("The sensor's no-return value in the profiles (file units), dropped and counted like NaN")))]
+#[command(mut_arg("profile_key", |a| a.help("Key of the point list in OpenCV YAML/JSON profiles")))]
 pub struct MeasureArgs {
     /// A session file: its stripes are measured as they are (every point of every stripe of the measurements chosen by --use).
     pub session: Option<PathBuf>,
@@ -65,45 +71,16 @@ pub struct MeasureArgs {
     /// Raw scan: a pose file instead of a joint log, as the import reads it (a table with or without header, a JSON list, or a robot program: FANUC .ls, RAPID, KUKA .dat/.src, URScript; layout detected). Flange poses: only the hand-eye applies.
     #[arg(long)]
     pub poses: Option<PathBuf>,
-    /// Force the pose file's layout: table, json, fanuc-ls, rapid, krl or urscript.
-    #[arg(long, value_parser = super::import::parse_pose_format)]
-    pub pose_format: Option<crate::engine::files::import::PoseFormat>,
-    /// How a pose table or JSON list writes a pose: ABB, KUKA, FANUC, UR or matrix (a robot program fixes its own).
-    #[arg(long, value_parser = parse_convention)]
-    pub pose_convention: Option<FlangeConvention>,
-    /// The pose columns of a CSV pose log, in the convention's order.
-    #[arg(long, value_delimiter = ',')]
-    pub pose_columns: Vec<String>,
+    /// How to read the pose file and the profiles (flags shared with
+    /// the other command).
+    #[command(flatten)]
+    pub scan: ScanFlags,
     /// Raw scan: a folder of profiles (`<id>.csv|txt|yml|yaml|json`, or in natural order for a log without ids) or one CSV with a pose column.
     #[arg(long)]
     pub profiles: Option<PathBuf>,
-    /// Column of the pose id in a single profile file.
-    #[arg(long, default_value = "pose")]
-    pub pose_column: String,
     /// Raw scan: the nominal robot it was taken with (a preset key, a session/result file, a URDF or a DH table), checked against the result's.
     #[arg(long)]
     pub robot: Option<String>,
-    /// The tip link of a URDF robot.
-    #[arg(long)]
-    pub urdf_tip: Option<String>,
-    /// The convention of a DH table robot: standard or modified.
-    #[arg(long, value_parser = super::parse_dh)]
-    pub dh: Option<crate::engine::base::robot::DhConvention>,
-    /// Axis map from the sensor's axes to spherecal's (laser plane x = 0): `auto` or e.g. `-y,x,z`.
-    #[arg(long, default_value = "auto")]
-    pub axes: String,
-    /// The sensor's no-return value in the profiles (file units), dropped and counted like NaN.
-    #[arg(long, allow_hyphen_values = true)]
-    pub no_return: Option<f64>,
-    /// Key of the point list in OpenCV YAML/JSON profiles.
-    #[arg(long)]
-    pub profile_key: Option<String>,
-    /// Unit of the joint columns: deg or rad.
-    #[arg(long, default_value = "deg", value_parser = parse_angle_unit)]
-    pub joint_unit: AngleUnit,
-    /// Unit of the profile coordinates: mm, um or m.
-    #[arg(long, default_value = "mm", value_parser = parse_length_unit)]
-    pub profile_unit: LengthUnit,
     /// Joint-log columns, e.g. `id=Pose,j1=A1,...,station=Sphere,use=Use` (defaults: id, j1..jn, station, use).
     #[arg(long, value_delimiter = ',')]
     pub map: Vec<String>,
@@ -126,21 +103,6 @@ fn parse_model(s: &str) -> Result<ModelChoice, String> {
             "unknown model `{s}`, expected calibrated or nominal"
         )),
     }
-}
-
-fn parse_angle_unit(s: &str) -> Result<AngleUnit, String> {
-    AngleUnit::parse(s).ok_or_else(|| format!("unknown joint unit `{s}`, expected `deg` or `rad`"))
-}
-
-fn parse_length_unit(s: &str) -> Result<LengthUnit, String> {
-    LengthUnit::parse(s)
-        .ok_or_else(|| format!("unknown profile unit `{s}`, expected `mm`, `um` or `m`"))
-}
-
-fn parse_convention(s: &str) -> Result<FlangeConvention, String> {
-    FlangeConvention::parse(s).ok_or_else(|| {
-        format!("unknown pose convention `{s}`, expected ABB, KUKA, FANUC, UR or matrix")
-    })
 }
 
 /// The uses `--use` names; empty for all.
@@ -178,13 +140,8 @@ fn scan_files(args: &MeasureArgs, dof: usize) -> Result<ScanFiles, CliError> {
     } else {
         ProfileSource::File {
             path: profiles,
-            pose_column: args.pose_column.clone(),
+            pose_column: args.scan.pose_column.clone(),
         }
-    };
-    let axes = if args.axes.trim().eq_ignore_ascii_case("auto") {
-        None
-    } else {
-        Some(AxisMap::parse(&args.axes).map_err(|e| CliError::input(format!("--axes: {e}")))?)
     };
     let log = match (&args.joints, &args.poses) {
         (Some(path), _) => {
@@ -217,14 +174,14 @@ fn scan_files(args: &MeasureArgs, dof: usize) -> Result<ScanFiles, CliError> {
             ScanLog::Joints {
                 path: path.clone(),
                 columns,
-                unit: args.joint_unit,
+                unit: args.scan.joint_unit,
             }
         }
         (None, Some(path)) => ScanLog::Poses {
             path: path.clone(),
-            format: args.pose_format,
-            convention: args.pose_convention,
-            columns: (!args.pose_columns.is_empty()).then(|| args.pose_columns.clone()),
+            format: args.scan.pose_format,
+            convention: args.scan.pose_convention,
+            columns: args.scan.pose_columns(),
         },
         (None, None) => {
             return Err(CliError::input(
@@ -236,20 +193,14 @@ fn scan_files(args: &MeasureArgs, dof: usize) -> Result<ScanFiles, CliError> {
         .robot
         .as_deref()
         .map(|text| {
-            let source = RobotSource::from_text(text, args.urdf_tip.clone(), args.dh)
-                .map_err(CliError::input)?;
+            let source = args.scan.robot_source(text)?;
             import::load_robot(&source).map_err(|e| CliError::input(e.to_string()))
         })
         .transpose()?;
     Ok(ScanFiles {
         log,
         profiles,
-        profile_format: ProfileFormat {
-            unit: args.profile_unit,
-            axes,
-            no_return: args.no_return,
-            key: args.profile_key.clone(),
-        },
+        profile_format: args.scan.profile_format()?,
         robot,
         sphere_diameter: args.sphere_diameter,
         references: args.references.clone(),
