@@ -23,7 +23,7 @@ use spherecal::engine::files::program::{self, PoseFormat, ReadSpec};
 use spherecal::engine::tools::simulate::{self, SimConfig, Truth};
 
 mod pose_support;
-use pose_support::{fanuc_ls, headerless_table};
+use pose_support::{fanuc_ls, headerless_table, station_poses};
 
 /// True flange poses, stripes and the truth of a simulated cell.
 type Cell = (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>, Truth);
@@ -51,15 +51,7 @@ fn cell(n_translation: usize, n_rotation: usize, noisy: bool, seed: u64) -> Cell
         ..SimConfig::default()
     };
     let (session, truth) = simulate::simulate(&config).unwrap();
-    let robot = truth.true_robot();
-    let (mut poses, mut stripes) = (Vec::new(), Vec::new());
-    for m in session.measurements.iter().filter(|m| m.station == "P0") {
-        poses.push(robot.base_from_flange(&m.joints));
-        let Observation::Stripe(p) = &m.observation else {
-            panic!("stripes expected")
-        };
-        stripes.push(p.clone());
-    }
+    let (poses, stripes) = station_poses(&session, &truth, "P0");
     (poses, stripes, truth)
 }
 

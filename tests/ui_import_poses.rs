@@ -25,7 +25,7 @@ use spherecal::engine::tools::simulate::{self, SimConfig};
 
 mod pose_support;
 mod ui_support;
-use pose_support::{fanuc_ls, headerless_table};
+use pose_support::{fanuc_ls, headerless_table, station_poses};
 use ui_support::{demo_app, scroll_to, settle};
 
 /// One stripe a pose: `[y, z]` points in the laser plane, mm.
@@ -52,15 +52,7 @@ fn cell_with_centres() -> (Vec<Isometry3<f64>>, Stripes, Vec<Point3<f64>>) {
         ..SimConfig::default()
     };
     let (session, truth) = simulate::simulate(&config).unwrap();
-    let robot = truth.true_robot();
-    let (mut poses, mut stripes) = (Vec::new(), Vec::new());
-    for m in session.measurements.iter().filter(|m| m.station == "P0") {
-        poses.push(robot.base_from_flange(&m.joints));
-        let Observation::Stripe(p) = &m.observation else {
-            panic!("stripes expected")
-        };
-        stripes.push(p.clone());
-    }
+    let (poses, stripes) = station_poses(&session, &truth, "P0");
     let flange_from_sensor = rigid_from_rows(&truth.hand_eye);
     let station = truth
         .stations

@@ -8,7 +8,29 @@
 use std::fmt::Write as _;
 
 use nalgebra::Isometry3;
+use spherecal::engine::base::session::{Observation, Session};
 use spherecal::engine::files::import::FlangeConvention;
+use spherecal::engine::tools::simulate::Truth;
+
+/// The true flange poses (`base_from_flange`, mm) and the stripes (`[y, z]`
+/// in the laser plane, mm) of a simulated session's measurements of
+/// `station`, in the session's order.
+pub fn station_poses(
+    session: &Session,
+    truth: &Truth,
+    station: &str,
+) -> (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>) {
+    let robot = truth.true_robot();
+    let (mut poses, mut stripes) = (Vec::new(), Vec::new());
+    for m in session.measurements.iter().filter(|m| m.station == station) {
+        poses.push(robot.base_from_flange(&m.joints));
+        let Observation::Stripe(p) = &m.observation else {
+            panic!("stripes expected")
+        };
+        stripes.push(p.clone());
+    }
+    (poses, stripes)
+}
 
 /// A FANUC TP program: positions in `/POS` (GP1, and a GP2 block), moved
 /// through by `/MN`, recorded in user frame 0 with tool `tool` (any tool
