@@ -244,13 +244,9 @@ fn rate(points: usize, seconds: f64) -> String {
     )
 }
 
-/// Runs `spherecal measure`.
-///
-/// # Errors
-/// [`CliError`] with status 2 for bad input (nothing written), 1 when the
-/// cloud cannot be written.
-pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
-    let started = Instant::now();
+/// The output's format from its extension, after refusing an output that
+/// is one of the inputs and a bad `--sensor-noise`.
+fn output_format(args: &MeasureArgs) -> Result<CloudFormat, CliError> {
     let input_files = inputs(args);
     let input_refs: Vec<&Path> = input_files.iter().map(PathBuf::as_path).collect();
     CliError::guard_output(&args.out, &input_refs)?;
@@ -265,16 +261,17 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
             "--sensor-noise must be a finite number ≥ 0 (mm)",
         ));
     }
-    let result = format::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;
-    let frame = args
-        .frame
-        .as_ref()
-        .map(|path| {
-            measure::load_frame(path)
-                .map(|w| (w, path.display().to_string()))
-                .map_err(|e| from_measure(&e))
-        })
-        .transpose()?;
+    Ok(format)
+}
+
+/// The scan to measure (a session's stripes or a raw scan's files) and
+/// the joint range the calibration saw (from `--calibration`, else the
+/// measured session's own; none for a raw scan without it). Refuses a
+/// scan with no pose to measure.
+fn load_scan(
+    args: &MeasureArgs,
+    result: &format::ResultFile,
+) -> Result<(Scan, Option<JointRange>), CliError> {
     let mut joint_range = match &args.calibration {
         Some(path) => {
             let s = format::load_session(path).map_err(|e| CliError::from_file(&e, true))?;
@@ -309,20 +306,33 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
                 .map_or_else(|| scan.name.clone(), |p| p.display().to_string())
         )));
     }
-    let loaded = started.elapsed().as_secs_f64();
-    let sigma = !args.no_sigma && args.model == ModelChoice::Calibrated;
-    let options = MeasureOptions {
-        model: args.model,
-        frame,
-        sigma,
-        sensor_noise_mm: args.sensor_noise,
-        covariance_as_written: args.covariance_as_written,
-    };
+    Ok((scan, joint_range))
+}
+
+/// The cloud measured and written, the self-validation beside it, and
+/// how long each took (s).
+struct Done {
+    measured: measure::Measured,
+    check: Option<selfcheck::SelfValidation>,
+    checked_secs: f64,
+    placed_secs: f64,
+    written_secs: f64,
+}
+
+/// Measures the scan and writes the cloud while the sphere
+/// self-validation (when the scan gives a sphere diameter) runs on its
+/// own thread beside them, on a copy of the poses it looks at.
+fn measure_and_write(
+    args: &MeasureArgs,
+    scan: Scan,
+    result: &format::ResultFile,
+    options: &MeasureOptions,
+    joint_range: Option<&JointRange>,
+    format: CloudFormat,
+    provenance: &Provenance,
+) -> Result<Done, CliError> {
     let sphere = scan.sphere_diameter;
     let references = scan.reference_distances.clone();
-    let (scan_name, notes, skipped) = (scan.name.clone(), scan.notes.clone(), scan.skipped.clone());
-    // The self-validation runs on its own thread beside the measurement
-    // and the write, on a copy of the poses it looks at.
     let checked: Vec<ScanPose> = match sphere {
         Some(_) => scan
             .poses
@@ -333,8 +343,8 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
         None => Vec::new(),
     };
     let (nominal, calibrated) = (
-        CellModel::of_result(&result, ModelChoice::Nominal),
-        CellModel::of_result(&result, ModelChoice::Calibrated),
+        CellModel::of_result(result, ModelChoice::Nominal),
+        CellModel::of_result(result, ModelChoice::Calibrated),
     );
     let self_validation = || {
         let t = Instant::now();
@@ -342,36 +352,39 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
             .and_then(|d| measure::self_validate(&checked, &nominal, &calibrated, d, &references));
         (check, t.elapsed().as_secs_f64())
     };
-    let provenance = Provenance {
-        result: args.result.display().to_string(),
-        scan: args
-            .session
-            .as_ref()
-            .map_or_else(|| scan_name.clone(), |p| p.display().to_string()),
-    };
-    let (measured, (check, checked_secs), placed, written) = std::thread::scope(|s| {
+    std::thread::scope(|s| {
         let worker = std::thread::Builder::new()
             .name("self-validation".into())
             .spawn_scoped(s, self_validation);
         let t0 = Instant::now();
-        let measured = measure::measure(scan, &result, &options, joint_range.as_ref(), &mut |_| {
+        let measured = measure::measure(scan, result, options, joint_range, &mut |_| {
             Control::Continue
         })
         .map_err(|e| from_measure(&e))?;
-        let placed = t0.elapsed().as_secs_f64();
+        let placed_secs = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
-        measure::write_cloud(&measured.cloud, &args.out, format, &provenance)
+        measure::write_cloud(&measured.cloud, &args.out, format, provenance)
             .map_err(|e| CliError::from_file(&e, false))?;
-        let written = t1.elapsed().as_secs_f64();
-        let check = match worker {
+        let written_secs = t1.elapsed().as_secs_f64();
+        let (check, checked_secs) = match worker {
             Ok(handle) => handle
                 .join()
                 .map_err(|_| CliError::internal("the self-validation thread failed"))?,
             Err(_) => self_validation(),
         };
-        Ok::<_, CliError>((measured, check, placed, written))
-    })?;
-    let cloud = &measured.cloud;
+        Ok(Done {
+            measured,
+            check,
+            checked_secs,
+            placed_secs,
+            written_secs,
+        })
+    })
+}
+
+/// The measurement's warnings on stderr, the poses outside the calibrated
+/// joint range listed up to [`LISTED_POSES`].
+fn print_warnings(measured: &measure::Measured) {
     for w in &measured.warnings {
         eprintln!("warning: {w}");
     }
@@ -390,12 +403,23 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
             );
         }
     }
-    if args.quiet {
-        return Ok(());
-    }
+}
+
+/// The summary on stdout: the scan's notes, the points measured and
+/// dropped, the measurements left out, σ, the joint-range check, the
+/// self-validation and the timing line (`loaded`: seconds to load).
+fn print_summary(
+    args: &MeasureArgs,
+    result: &format::ResultFile,
+    format: CloudFormat,
+    (notes, skipped): (&[String], &[String]),
+    done: &Done,
+    (started, loaded): (Instant, f64),
+) {
+    let cloud = &done.measured.cloud;
     let n = cloud.len();
     let dropped = cloud.dropped();
-    for note in &notes {
+    for note in notes {
         sayln!("{note}");
     }
     sayln!(
@@ -427,7 +451,7 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
             if args.covariance_as_written {
                 "as written".to_string()
             } else {
-                format!("× variance factor {:.3}", measure::variance_factor(&result))
+                format!("× variance factor {:.3}", measure::variance_factor(result))
             },
             if args.sensor_noise > 0.0 {
                 format!(", sensor noise {} mm", args.sensor_noise)
@@ -452,7 +476,7 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
             "joint range: not checked (give --calibration SESSION, the session the result was calibrated from)"
         );
     }
-    if let Some(c) = &check {
+    if let Some(c) = &done.check {
         say!("{}", c.summary());
     }
     sayln!(
@@ -460,9 +484,67 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
         args.out.display(),
         started.elapsed().as_secs_f64() * 1e3,
         loaded,
-        rate(n, placed),
-        rate(n, written),
-        checked_secs
+        rate(n, done.placed_secs),
+        rate(n, done.written_secs),
+        done.checked_secs
+    );
+}
+
+/// Runs `spherecal measure`.
+///
+/// # Errors
+/// [`CliError`] with status 2 for bad input (nothing written), 1 when the
+/// cloud cannot be written.
+pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
+    let started = Instant::now();
+    let format = output_format(args)?;
+    let result = format::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;
+    let frame = args
+        .frame
+        .as_ref()
+        .map(|path| {
+            measure::load_frame(path)
+                .map(|w| (w, path.display().to_string()))
+                .map_err(|e| from_measure(&e))
+        })
+        .transpose()?;
+    let (scan, joint_range) = load_scan(args, &result)?;
+    let loaded = started.elapsed().as_secs_f64();
+    let options = MeasureOptions {
+        model: args.model,
+        frame,
+        sigma: !args.no_sigma && args.model == ModelChoice::Calibrated,
+        sensor_noise_mm: args.sensor_noise,
+        covariance_as_written: args.covariance_as_written,
+    };
+    let (notes, skipped) = (scan.notes.clone(), scan.skipped.clone());
+    let provenance = Provenance {
+        result: args.result.display().to_string(),
+        scan: args
+            .session
+            .as_ref()
+            .map_or_else(|| scan.name.clone(), |p| p.display().to_string()),
+    };
+    let done = measure_and_write(
+        args,
+        scan,
+        &result,
+        &options,
+        joint_range.as_ref(),
+        format,
+        &provenance,
+    )?;
+    print_warnings(&done.measured);
+    if args.quiet {
+        return Ok(());
+    }
+    print_summary(
+        args,
+        &result,
+        format,
+        (&notes, &skipped),
+        &done,
+        (started, loaded),
     );
     Ok(())
 }
