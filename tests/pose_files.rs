@@ -26,6 +26,9 @@ use spherecal::engine::files::import::{
 use spherecal::engine::files::program::{self, PoseFormat, ReadSpec};
 use spherecal::engine::tools::simulate::{self, SimConfig, Truth};
 
+mod pose_support;
+use pose_support::{fanuc_ls, headerless_table, station_poses};
+
 /// True flange poses, stripes and the truth of a simulated cell.
 type Cell = (Vec<Isometry3<f64>>, Vec<Vec<[f64; 2]>>, Truth);
 
@@ -52,15 +55,7 @@ fn cell(n_translation: usize, n_rotation: usize, noisy: bool, seed: u64) -> Cell
         ..SimConfig::default()
     };
     let (session, truth) = simulate::simulate(&config).unwrap();
-    let robot = truth.true_robot();
-    let (mut poses, mut stripes) = (Vec::new(), Vec::new());
-    for m in session.measurements.iter().filter(|m| m.station == "P0") {
-        poses.push(robot.base_from_flange(&m.joints));
-        let Observation::Stripe(p) = &m.observation else {
-            panic!("stripes expected")
-        };
-        stripes.push(p.clone());
-    }
+    let (poses, stripes) = station_poses(&session, &truth, "P0");
     (poses, stripes, truth)
 }
 
@@ -112,37 +107,6 @@ fn folder(stripes: &[Vec<[f64; 2]>], name: &str, text: &str) -> (tempfile::TempD
 
 fn values(c: FlangeConvention, pose: &Isometry3<f64>) -> Vec<f64> {
     c.values_from_pose(pose)
-}
-
-fn headerless_table(poses: &[Isometry3<f64>]) -> String {
-    let mut t = String::new();
-    for p in poses {
-        let v = values(FlangeConvention::FanucWpr, p);
-        let cells: Vec<String> = v.iter().map(|x| format!("{x:.9}")).collect();
-        writeln!(t, "{}", cells.join("   ")).unwrap();
-    }
-    t
-}
-
-fn fanuc_ls(poses: &[Isometry3<f64>]) -> String {
-    let mut t = String::from(
-        "/PROG  CALIB_SPH\n/ATTR\nOWNER\t\t= MNEDITOR;\nCOMMENT\t\t= \"\";\nDEFAULT_GROUP\t= 1,1,*,*,*;\n/MN\n   1:  UFRAME_NUM=0 ;\n   2:  UTOOL_NUM=0 ;\n",
-    );
-    for k in 0..poses.len() {
-        writeln!(t, "{:>4}:J P[{}] 100% FINE    ;", k + 3, k + 1).unwrap();
-    }
-    t.push_str("/POS\n");
-    for (k, p) in poses.iter().enumerate() {
-        let v = values(FlangeConvention::FanucWpr, p);
-        writeln!(
-            t,
-            "P[{}]{{\n   GP1:\n\tUF : 0, UT : 0,\t\tCONFIG : 'N U T, 0, 0, -1',\n\tX = {:>12.6}  mm,\tY = {:>12.6}  mm,\tZ = {:>12.6}  mm,\n\tW = {:>12.9} deg,\tP = {:>12.9} deg,\tR = {:>12.9} deg\n   GP2:\n\tUF : 0, UT : 0,\t\n\tJ1=     6.207 deg\n}};",
-            k + 1, v[0], v[1], v[2], v[3], v[4], v[5]
-        )
-        .unwrap();
-    }
-    t.push_str("/END\n");
-    t
 }
 
 fn rapid(poses: &[Isometry3<f64>]) -> String {
@@ -245,7 +209,7 @@ fn every_layout_imports_from_the_profile_folder_it_sits_in() {
         ),
         (
             "calib.ls",
-            fanuc_ls(&poses),
+            fanuc_ls(&poses, 0),
             Some(FlangeConvention::FanucWpr),
             PoseFormat::FanucLs,
         ),
@@ -496,7 +460,7 @@ fn bad_pose_files_name_their_line_and_write_nothing() {
         ),
         (
             "calib.ls",
-            fanuc_ls(&poses).replacen("Y = ", "Y = ****", 1),
+            fanuc_ls(&poses, 0).replacen("Y = ", "Y = ****", 1),
             "line 25",
         ),
         (
@@ -593,7 +557,7 @@ proptest! {
         let p = &poses[..4];
         for (name, text) in [
             ("t.txt", headerless_table(p)),
-            ("c.ls", fanuc_ls(p)),
+            ("c.ls", fanuc_ls(p, 0)),
             ("c.mod", rapid(p)),
             ("c.dat", kuka_dat(p)),
             ("c.script", urscript(p)),

@@ -23,7 +23,9 @@ use spherecal::engine::base::session::Observation;
 use spherecal::engine::files::import::{FlangeConvention, PoseFormat, PosePreview, SideChoice};
 use spherecal::engine::tools::simulate::{self, SimConfig};
 
+mod pose_support;
 mod ui_support;
+use pose_support::{fanuc_ls, headerless_table, station_poses};
 use ui_support::{demo_app, scroll_to, settle};
 
 /// One stripe a pose: `[y, z]` points in the laser plane, mm.
@@ -50,15 +52,7 @@ fn cell_with_centres() -> (Vec<Isometry3<f64>>, Stripes, Vec<Point3<f64>>) {
         ..SimConfig::default()
     };
     let (session, truth) = simulate::simulate(&config).unwrap();
-    let robot = truth.true_robot();
-    let (mut poses, mut stripes) = (Vec::new(), Vec::new());
-    for m in session.measurements.iter().filter(|m| m.station == "P0") {
-        poses.push(robot.base_from_flange(&m.joints));
-        let Observation::Stripe(p) = &m.observation else {
-            panic!("stripes expected")
-        };
-        stripes.push(p.clone());
-    }
+    let (poses, stripes) = station_poses(&session, &truth, "P0");
     let flange_from_sensor = rigid_from_rows(&truth.hand_eye);
     let station = truth
         .stations
@@ -84,40 +78,6 @@ fn profile_folder(dir: &Path, stripes: &[Vec<[f64; 2]>]) {
         std::fs::write(dir.join(format!("{}_3C_line.txt", k + 1)), t).unwrap();
     }
     std::fs::write(dir.join("calibration.sec"), "{}").unwrap();
-}
-
-/// A FANUC TP program: positions in `/POS` (GP1, and a GP2 block),
-/// moved through by `/MN`, recorded with tool 1 (a warning).
-fn fanuc_ls(poses: &[Isometry3<f64>]) -> String {
-    let mut t = String::from(
-        "/PROG  CALIB_SPH\n/ATTR\nOWNER\t\t= MNEDITOR;\nDEFAULT_GROUP\t= 1,1,*,*,*;\n/MN\n   1:  UFRAME_NUM=0 ;\n",
-    );
-    for k in 0..poses.len() {
-        writeln!(t, "{:>4}:J P[{}] 100% FINE    ;", k + 2, k + 1).unwrap();
-    }
-    t.push_str("/POS\n");
-    for (k, p) in poses.iter().enumerate() {
-        let v = FlangeConvention::FanucWpr.values_from_pose(p);
-        writeln!(
-            t,
-            "P[{}]{{\n   GP1:\n\tUF : 0, UT : 1,\t\tCONFIG : 'N U T, 0, 0, -1',\n\tX = {:>12.6}  mm,\tY = {:>12.6}  mm,\tZ = {:>12.6}  mm,\n\tW = {:>12.9} deg,\tP = {:>12.9} deg,\tR = {:>12.9} deg\n   GP2:\n\tUF : 0, UT : 1,\t\n\tJ1=     6.207 deg\n}};",
-            k + 1, v[0], v[1], v[2], v[3], v[4], v[5]
-        )
-        .unwrap();
-    }
-    t.push_str("/END\n");
-    t
-}
-
-/// Six numbers a line, separated by spaces, no header (FANUC x y z W P R).
-fn headerless_table(poses: &[Isometry3<f64>]) -> String {
-    let mut t = String::new();
-    for p in poses {
-        let v = FlangeConvention::FanucWpr.values_from_pose(p);
-        let cells: Vec<String> = v.iter().map(|x| format!("{x:.9}")).collect();
-        writeln!(t, "{}", cells.join("   ")).unwrap();
-    }
-    t
 }
 
 /// Every label (or value) that contains `part`.
@@ -179,7 +139,7 @@ fn a_fanuc_program_in_its_profile_folder_is_detected_paired_and_imported() {
     let dir = tempfile::tempdir().unwrap();
     profile_folder(dir.path(), &stripes);
     let ls = dir.path().join("calib.ls");
-    std::fs::write(&ls, fanuc_ls(&poses)).unwrap();
+    std::fs::write(&ls, fanuc_ls(&poses, 1)).unwrap();
     let mut h = import_view(&ls, dir.path());
 
     // The layout as the engine detects it, the tool warning in orange.
@@ -454,7 +414,7 @@ fn centres_the_sensor_reported_are_chosen_instead_of_profiles() {
     let (poses, _, centres) = cell_with_centres();
     let dir = tempfile::tempdir().unwrap();
     let ls = dir.path().join("calib.ls");
-    std::fs::write(&ls, fanuc_ls(&poses)).unwrap();
+    std::fs::write(&ls, fanuc_ls(&poses, 1)).unwrap();
     let table = dir.path().join("centres.txt");
     let mut t = String::new();
     for c in &centres {

@@ -11,13 +11,13 @@ use clap::Args;
 
 use crate::engine::files::format;
 use crate::engine::files::import::{
-    self, AngleUnit, AxisMap, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM,
-    DEFAULT_ROTATION_TOLERANCE_DEG, DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention,
-    ImportError, ImportSpec, Imported, LengthUnit, Observations, PoseFormat, PoseImportSpec,
-    ProfileFormat, ProfileSource, RobotSource, SideChoice,
+    self, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
+    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportError, ImportSpec, Imported,
+    Observations, PoseImportSpec, ProfileSource, SideChoice,
 };
 
 use super::CliError;
+use super::scan_flags::ScanFlags;
 
 /// `spherecal import`.
 #[derive(Debug, Args)]
@@ -29,15 +29,10 @@ pub struct ImportArgs {
     /// A pose file instead of a joint log: a table (header optional; commas, semicolons, tabs or spaces), a JSON list (RobCalibrator `.rob`), or a robot program (FANUC .ls, ABB RAPID, KUKA .dat/.src, URScript); the layout is detected from the content and printed. Flange poses give a pose-only session; joint targets need --robot.
     #[arg(long)]
     pub poses: Option<PathBuf>,
-    /// Force the pose file's layout: table, json, fanuc-ls, rapid, krl or urscript (default: detected from the content).
-    #[arg(long, value_parser = parse_pose_format)]
-    pub pose_format: Option<PoseFormat>,
-    /// How a pose table or JSON list writes a pose: ABB (x y z q1..q4), KUKA (x y z A B C), FANUC (x y z W P R), UR (x y z m, rotation vector) or matrix (16 numbers row-major). A robot program's language fixes its own.
-    #[arg(long, value_parser = parse_convention)]
-    pub pose_convention: Option<FlangeConvention>,
-    /// The pose columns of a CSV pose log, in the convention's order (default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44).
-    #[arg(long, value_delimiter = ',')]
-    pub pose_columns: Vec<String>,
+    /// How to read the pose file and the profiles (flags shared with
+    /// the other command).
+    #[command(flatten)]
+    pub scan: ScanFlags,
     /// A folder of stripe profiles (`<id>.csv|txt|yml|yaml|json`; for a pose log without ids the files named alike, in the order of the number in their names: p7.yml, 7_3C_line.yml, scan_007.csv; other files, the pose file among them, are skipped and listed) or one CSV with a pose column.
     #[arg(long, required_unless_present = "centres", conflicts_with = "centres")]
     pub profiles: Option<PathBuf>,
@@ -47,39 +42,15 @@ pub struct ImportArgs {
     /// A hand-eye guess to start from instead of computing one: a JSON 4x4 matrix (rows, mm), or a session or result file (its `hand_eye`).
     #[arg(long)]
     pub hand_eye: Option<PathBuf>,
-    /// Column of the pose id in a single profile file.
-    #[arg(long, default_value = "pose")]
-    pub pose_column: String,
     /// Robot: a preset key (irb2400, irb120, ur5e), a session/result file whose `robot` block is the nominal model, a URDF or a DH table CSV (with --dh). Needed with --joints; optional with --poses.
     #[arg(long)]
     pub robot: Option<String>,
-    /// The tip link of a URDF robot (default: the chain's only end link), e.g. tool0.
-    #[arg(long)]
-    pub urdf_tip: Option<String>,
-    /// The convention of a DH table robot: standard or modified.
-    #[arg(long, value_parser = super::parse_dh)]
-    pub dh: Option<crate::engine::base::robot::DhConvention>,
-    /// Axis map from the sensor's axes to spherecal's (laser plane x = 0): `auto` (the constant coordinate is the plane's normal) or e.g. `-y,x,z` (spherecal x = -y, y = x, z = z). A mirroring map is refused.
-    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
-    pub axes: String,
-    /// The sensor's no-return value in the profiles (file units), dropped like NaN.
-    #[arg(long, allow_hyphen_values = true)]
-    pub no_return: Option<f64>,
-    /// Key of the point list in OpenCV YAML/JSON profiles (default: scan_line, profile, points, data, or the only list).
-    #[arg(long)]
-    pub profile_key: Option<String>,
     /// Side of the sphere centres for a pose log without a side column: +1, -1 or auto (both calibrated, the clearly better chosen, else refused).
     #[arg(long, default_value = "auto", allow_hyphen_values = true, value_parser = parse_side)]
     pub side: SideChoice,
     /// Where to write the session file (required unless --preview).
     #[arg(long, short)]
     pub out: Option<PathBuf>,
-    /// Unit of the joint columns: deg or rad.
-    #[arg(long, default_value = "deg", value_parser = parse_angle_unit)]
-    pub joint_unit: AngleUnit,
-    /// Unit of the profile coordinates: mm, um or m.
-    #[arg(long, default_value = "mm", value_parser = parse_length_unit)]
-    pub profile_unit: LengthUnit,
     /// Column mapping, e.g. `id=Pose,station=Sphere,use=Use,side=Side,j1=A1,...`
     /// (defaults: id, station, use, side when the log has a `side` column, j1..jn).
     #[arg(long, value_delimiter = ',')]
@@ -94,7 +65,7 @@ pub struct ImportArgs {
     #[arg(long)]
     pub name: Option<String>,
     /// Check the controller's flange poses: ABB (quaternion), KUKA (ABC), FANUC (WPR) or UR (rotation vector).
-    #[arg(long, value_parser = parse_convention)]
+    #[arg(long, value_parser = super::scan_flags::parse_convention)]
     pub flange_poses: Option<FlangeConvention>,
     /// The flange-pose columns in the convention's order (default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz).
     #[arg(long, value_delimiter = ',')]
@@ -116,50 +87,8 @@ pub struct ImportArgs {
     pub quiet: bool,
 }
 
-pub(super) fn parse_pose_format(s: &str) -> Result<PoseFormat, String> {
-    PoseFormat::parse(s).ok_or_else(|| {
-        format!("unknown pose format `{s}`, expected table, json, fanuc-ls, rapid, krl or urscript")
-    })
-}
-
-fn parse_angle_unit(s: &str) -> Result<AngleUnit, String> {
-    AngleUnit::parse(s).ok_or_else(|| format!("unknown joint unit `{s}`, expected `deg` or `rad`"))
-}
-
-fn parse_length_unit(s: &str) -> Result<LengthUnit, String> {
-    LengthUnit::parse(s)
-        .ok_or_else(|| format!("unknown profile unit `{s}`, expected `mm`, `um` or `m`"))
-}
-
-fn parse_convention(s: &str) -> Result<FlangeConvention, String> {
-    FlangeConvention::parse(s).ok_or_else(|| {
-        format!("unknown pose convention `{s}`, expected ABB, KUKA, FANUC, UR or matrix")
-    })
-}
-
 fn parse_side(s: &str) -> Result<SideChoice, String> {
     SideChoice::parse(s).ok_or_else(|| format!("unknown side `{s}`, expected +1, -1 or auto"))
-}
-
-/// A robot argument: a JSON file (session or result), a URDF, a DH table
-/// or a preset key.
-fn robot_source(args: &ImportArgs, text: &str) -> Result<RobotSource, CliError> {
-    RobotSource::from_text(text, args.urdf_tip.clone(), args.dh).map_err(CliError::input)
-}
-
-/// The profile flags as the engine's format.
-fn profile_format(args: &ImportArgs) -> Result<ProfileFormat, CliError> {
-    let axes = if args.axes.trim().eq_ignore_ascii_case("auto") {
-        None
-    } else {
-        Some(AxisMap::parse(&args.axes).map_err(|e| CliError::input(format!("--axes: {e}")))?)
-    };
-    Ok(ProfileFormat {
-        unit: args.profile_unit,
-        axes,
-        no_return: args.no_return,
-        key: args.profile_key.clone(),
-    })
 }
 
 /// Where the profiles are, from the flag.
@@ -172,7 +101,7 @@ fn profile_source(args: &ImportArgs) -> Result<ProfileSource, CliError> {
     } else {
         ProfileSource::File {
             path: profiles.clone(),
-            pose_column: args.pose_column.clone(),
+            pose_column: args.scan.pose_column.clone(),
         }
     })
 }
@@ -196,15 +125,15 @@ pub fn pose_spec(args: &ImportArgs, poses: &std::path::Path) -> Result<PoseImpor
         .transpose()?;
     Ok(PoseImportSpec {
         poses: poses.to_path_buf(),
-        format: args.pose_format,
-        convention: args.pose_convention,
-        pose_columns: (!args.pose_columns.is_empty()).then(|| args.pose_columns.clone()),
+        format: args.scan.pose_format,
+        convention: args.scan.pose_convention,
+        pose_columns: args.scan.pose_columns(),
         observations,
-        profile_format: profile_format(args)?,
+        profile_format: args.scan.profile_format()?,
         robot: args
             .robot
             .as_deref()
-            .map(|r| robot_source(args, r))
+            .map(|r| args.scan.robot_source(r))
             .transpose()?,
         sphere_diameter: args.sphere_diameter,
         side: args.side,
@@ -226,14 +155,13 @@ pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
     let Some(joint_log) = &args.joints else {
         return Err(CliError::input("a joint log (--joints) is needed here"));
     };
-    let robot = robot_source(
-        args,
-        args.robot.as_deref().ok_or_else(|| {
-            CliError::input(
-                "--joints needs --robot (a preset key, a session/result file, a URDF or a DH table)",
-            )
-        })?,
-    )?;
+    let robot = args
+        .scan
+        .robot_source(args.robot.as_deref().ok_or_else(|| {
+        CliError::input(
+            "--joints needs --robot (a preset key, a session/result file, a URDF or a DH table)",
+        )
+    })?)?;
     let dof = import::load_robot(&robot).map_err(|e| input(&e))?.dof();
     let mut columns = ColumnMap {
         id: "id".into(),
@@ -281,9 +209,9 @@ pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
     Ok(ImportSpec {
         joint_log: joint_log.clone(),
         columns,
-        joint_unit: args.joint_unit,
+        joint_unit: args.scan.joint_unit,
         profiles,
-        profile_format: profile_format(args)?,
+        profile_format: args.scan.profile_format()?,
         robot,
         sphere_diameter: args.sphere_diameter,
         name: args.name.clone(),

@@ -10,13 +10,11 @@ use std::time::Instant;
 use clap::Args;
 
 use super::CliError;
+use super::scan_flags::ScanFlags;
 use crate::engine::base::session::Use;
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
-use crate::engine::files::import::{
-    self, AngleUnit, AxisMap, FlangeConvention, LengthUnit, ProfileFormat, ProfileSource,
-    RobotSource,
-};
+use crate::engine::files::import::{self, ProfileSource};
 use crate::engine::uses::measure::{
     self, CellModel, CloudFormat, JointRange, MeasureError, MeasureOptions, ModelChoice,
     Provenance, Scan, ScanColumns, ScanFiles, ScanLog, ScanPose, selfcheck,
@@ -26,9 +24,17 @@ use crate::engine::uses::measure::{
 /// scan of thousands of poses would bury the summary).
 const LISTED_POSES: usize = 20;
 
-/// `spherecal measure`.
+/// `spherecal measure`. The scan flags it shares with the import keep
+/// their measure wording here.
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("input").required(true).args(["session", "joints", "poses"])))]
+#[command(mut_arg("pose_format", |a| a.help("Force the pose file's layout: table, json, fanuc-ls, rapid, krl or urscript")))]
+#[command(mut_arg("pose_convention", |a| a.help("How a pose table or JSON list writes a pose: ABB, KUKA, FANUC, UR or matrix (a robot program fixes its own)")))]
+#[command(mut_arg("pose_columns", |a| a.help("The pose columns of a CSV pose log, in the convention's order")))]
+#[command(mut_arg("urdf_tip", |a| a.help("The tip link of a URDF robot")))]
+#[command(mut_arg("axes", |a| a.help("Axis map from the sensor's axes to spherecal's (laser plane x = 0): `auto` or e.g. `-y,x,z`")))]
+#[command(mut_arg("no_return", |a| a.help("The sensor's no-return value in the profiles (file units), dropped and counted like NaN")))]
+#[command(mut_arg("profile_key", |a| a.help("Key of the point list in OpenCV YAML/JSON profiles")))]
 pub struct MeasureArgs {
     /// A session file: its stripes are measured as they are (every point of every stripe of the measurements chosen by --use).
     pub session: Option<PathBuf>,
@@ -65,45 +71,16 @@ pub struct MeasureArgs {
     /// Raw scan: a pose file instead of a joint log, as the import reads it (a table with or without header, a JSON list, or a robot program: FANUC .ls, RAPID, KUKA .dat/.src, URScript; layout detected). Flange poses: only the hand-eye applies.
     #[arg(long)]
     pub poses: Option<PathBuf>,
-    /// Force the pose file's layout: table, json, fanuc-ls, rapid, krl or urscript.
-    #[arg(long, value_parser = super::import::parse_pose_format)]
-    pub pose_format: Option<crate::engine::files::import::PoseFormat>,
-    /// How a pose table or JSON list writes a pose: ABB, KUKA, FANUC, UR or matrix (a robot program fixes its own).
-    #[arg(long, value_parser = parse_convention)]
-    pub pose_convention: Option<FlangeConvention>,
-    /// The pose columns of a CSV pose log, in the convention's order.
-    #[arg(long, value_delimiter = ',')]
-    pub pose_columns: Vec<String>,
+    /// How to read the pose file and the profiles (flags shared with
+    /// the other command).
+    #[command(flatten)]
+    pub scan: ScanFlags,
     /// Raw scan: a folder of profiles (`<id>.csv|txt|yml|yaml|json`, or in natural order for a log without ids) or one CSV with a pose column.
     #[arg(long)]
     pub profiles: Option<PathBuf>,
-    /// Column of the pose id in a single profile file.
-    #[arg(long, default_value = "pose")]
-    pub pose_column: String,
     /// Raw scan: the nominal robot it was taken with (a preset key, a session/result file, a URDF or a DH table), checked against the result's.
     #[arg(long)]
     pub robot: Option<String>,
-    /// The tip link of a URDF robot.
-    #[arg(long)]
-    pub urdf_tip: Option<String>,
-    /// The convention of a DH table robot: standard or modified.
-    #[arg(long, value_parser = super::parse_dh)]
-    pub dh: Option<crate::engine::base::robot::DhConvention>,
-    /// Axis map from the sensor's axes to spherecal's (laser plane x = 0): `auto` or e.g. `-y,x,z`.
-    #[arg(long, default_value = "auto")]
-    pub axes: String,
-    /// The sensor's no-return value in the profiles (file units), dropped and counted like NaN.
-    #[arg(long, allow_hyphen_values = true)]
-    pub no_return: Option<f64>,
-    /// Key of the point list in OpenCV YAML/JSON profiles.
-    #[arg(long)]
-    pub profile_key: Option<String>,
-    /// Unit of the joint columns: deg or rad.
-    #[arg(long, default_value = "deg", value_parser = parse_angle_unit)]
-    pub joint_unit: AngleUnit,
-    /// Unit of the profile coordinates: mm, um or m.
-    #[arg(long, default_value = "mm", value_parser = parse_length_unit)]
-    pub profile_unit: LengthUnit,
     /// Joint-log columns, e.g. `id=Pose,j1=A1,...,station=Sphere,use=Use` (defaults: id, j1..jn, station, use).
     #[arg(long, value_delimiter = ',')]
     pub map: Vec<String>,
@@ -126,21 +103,6 @@ fn parse_model(s: &str) -> Result<ModelChoice, String> {
             "unknown model `{s}`, expected calibrated or nominal"
         )),
     }
-}
-
-fn parse_angle_unit(s: &str) -> Result<AngleUnit, String> {
-    AngleUnit::parse(s).ok_or_else(|| format!("unknown joint unit `{s}`, expected `deg` or `rad`"))
-}
-
-fn parse_length_unit(s: &str) -> Result<LengthUnit, String> {
-    LengthUnit::parse(s)
-        .ok_or_else(|| format!("unknown profile unit `{s}`, expected `mm`, `um` or `m`"))
-}
-
-fn parse_convention(s: &str) -> Result<FlangeConvention, String> {
-    FlangeConvention::parse(s).ok_or_else(|| {
-        format!("unknown pose convention `{s}`, expected ABB, KUKA, FANUC, UR or matrix")
-    })
 }
 
 /// The uses `--use` names; empty for all.
@@ -178,13 +140,8 @@ fn scan_files(args: &MeasureArgs, dof: usize) -> Result<ScanFiles, CliError> {
     } else {
         ProfileSource::File {
             path: profiles,
-            pose_column: args.pose_column.clone(),
+            pose_column: args.scan.pose_column.clone(),
         }
-    };
-    let axes = if args.axes.trim().eq_ignore_ascii_case("auto") {
-        None
-    } else {
-        Some(AxisMap::parse(&args.axes).map_err(|e| CliError::input(format!("--axes: {e}")))?)
     };
     let log = match (&args.joints, &args.poses) {
         (Some(path), _) => {
@@ -217,14 +174,14 @@ fn scan_files(args: &MeasureArgs, dof: usize) -> Result<ScanFiles, CliError> {
             ScanLog::Joints {
                 path: path.clone(),
                 columns,
-                unit: args.joint_unit,
+                unit: args.scan.joint_unit,
             }
         }
         (None, Some(path)) => ScanLog::Poses {
             path: path.clone(),
-            format: args.pose_format,
-            convention: args.pose_convention,
-            columns: (!args.pose_columns.is_empty()).then(|| args.pose_columns.clone()),
+            format: args.scan.pose_format,
+            convention: args.scan.pose_convention,
+            columns: args.scan.pose_columns(),
         },
         (None, None) => {
             return Err(CliError::input(
@@ -236,20 +193,14 @@ fn scan_files(args: &MeasureArgs, dof: usize) -> Result<ScanFiles, CliError> {
         .robot
         .as_deref()
         .map(|text| {
-            let source = RobotSource::from_text(text, args.urdf_tip.clone(), args.dh)
-                .map_err(CliError::input)?;
+            let source = args.scan.robot_source(text)?;
             import::load_robot(&source).map_err(|e| CliError::input(e.to_string()))
         })
         .transpose()?;
     Ok(ScanFiles {
         log,
         profiles,
-        profile_format: ProfileFormat {
-            unit: args.profile_unit,
-            axes,
-            no_return: args.no_return,
-            key: args.profile_key.clone(),
-        },
+        profile_format: args.scan.profile_format()?,
         robot,
         sphere_diameter: args.sphere_diameter,
         references: args.references.clone(),
@@ -293,13 +244,9 @@ fn rate(points: usize, seconds: f64) -> String {
     )
 }
 
-/// Runs `spherecal measure`.
-///
-/// # Errors
-/// [`CliError`] with status 2 for bad input (nothing written), 1 when the
-/// cloud cannot be written.
-pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
-    let started = Instant::now();
+/// The output's format from its extension, after refusing an output that
+/// is one of the inputs and a bad `--sensor-noise`.
+fn output_format(args: &MeasureArgs) -> Result<CloudFormat, CliError> {
     let input_files = inputs(args);
     let input_refs: Vec<&Path> = input_files.iter().map(PathBuf::as_path).collect();
     CliError::guard_output(&args.out, &input_refs)?;
@@ -314,16 +261,17 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
             "--sensor-noise must be a finite number ≥ 0 (mm)",
         ));
     }
-    let result = format::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;
-    let frame = args
-        .frame
-        .as_ref()
-        .map(|path| {
-            measure::load_frame(path)
-                .map(|w| (w, path.display().to_string()))
-                .map_err(|e| from_measure(&e))
-        })
-        .transpose()?;
+    Ok(format)
+}
+
+/// The scan to measure (a session's stripes or a raw scan's files) and
+/// the joint range the calibration saw (from `--calibration`, else the
+/// measured session's own; none for a raw scan without it). Refuses a
+/// scan with no pose to measure.
+fn load_scan(
+    args: &MeasureArgs,
+    result: &format::ResultFile,
+) -> Result<(Scan, Option<JointRange>), CliError> {
     let mut joint_range = match &args.calibration {
         Some(path) => {
             let s = format::load_session(path).map_err(|e| CliError::from_file(&e, true))?;
@@ -361,20 +309,33 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
                 .map_or_else(|| scan.name.clone(), |p| p.display().to_string())
         )));
     }
-    let loaded = started.elapsed().as_secs_f64();
-    let sigma = !args.no_sigma && args.model == ModelChoice::Calibrated;
-    let options = MeasureOptions {
-        model: args.model,
-        frame,
-        sigma,
-        sensor_noise_mm: args.sensor_noise,
-        covariance_as_written: args.covariance_as_written,
-    };
+    Ok((scan, joint_range))
+}
+
+/// The cloud measured and written, the self-validation beside it, and
+/// how long each took (s).
+struct Done {
+    measured: measure::Measured,
+    check: Option<selfcheck::SelfValidation>,
+    checked_secs: f64,
+    placed_secs: f64,
+    written_secs: f64,
+}
+
+/// Measures the scan and writes the cloud while the sphere
+/// self-validation (when the scan gives a sphere diameter) runs on its
+/// own thread beside them, on a copy of the poses it looks at.
+fn measure_and_write(
+    args: &MeasureArgs,
+    scan: Scan,
+    result: &format::ResultFile,
+    options: &MeasureOptions,
+    joint_range: Option<&JointRange>,
+    format: CloudFormat,
+    provenance: &Provenance,
+) -> Result<Done, CliError> {
     let sphere = scan.sphere_diameter;
     let references = scan.reference_distances.clone();
-    let (scan_name, notes, skipped) = (scan.name.clone(), scan.notes.clone(), scan.skipped.clone());
-    // The self-validation runs on its own thread beside the measurement
-    // and the write, on a copy of the poses it looks at.
     let checked: Vec<ScanPose> = match sphere {
         Some(_) => scan
             .poses
@@ -385,8 +346,8 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
         None => Vec::new(),
     };
     let (nominal, calibrated) = (
-        CellModel::of_result(&result, ModelChoice::Nominal),
-        CellModel::of_result(&result, ModelChoice::Calibrated),
+        CellModel::of_result(result, ModelChoice::Nominal),
+        CellModel::of_result(result, ModelChoice::Calibrated),
     );
     let self_validation = || {
         let t = Instant::now();
@@ -394,36 +355,39 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
             .and_then(|d| measure::self_validate(&checked, &nominal, &calibrated, d, &references));
         (check, t.elapsed().as_secs_f64())
     };
-    let provenance = Provenance {
-        result: args.result.display().to_string(),
-        scan: args
-            .session
-            .as_ref()
-            .map_or_else(|| scan_name.clone(), |p| p.display().to_string()),
-    };
-    let (measured, (check, checked_secs), placed, written) = std::thread::scope(|s| {
+    std::thread::scope(|s| {
         let worker = std::thread::Builder::new()
             .name("self-validation".into())
             .spawn_scoped(s, self_validation);
         let t0 = Instant::now();
-        let measured = measure::measure(scan, &result, &options, joint_range.as_ref(), &mut |_| {
+        let measured = measure::measure(scan, result, options, joint_range, &mut |_| {
             Control::Continue
         })
         .map_err(|e| from_measure(&e))?;
-        let placed = t0.elapsed().as_secs_f64();
+        let placed_secs = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
-        measure::write_cloud(&measured.cloud, &args.out, format, &provenance)
+        measure::write_cloud(&measured.cloud, &args.out, format, provenance)
             .map_err(|e| CliError::from_file(&e, false))?;
-        let written = t1.elapsed().as_secs_f64();
-        let check = match worker {
+        let written_secs = t1.elapsed().as_secs_f64();
+        let (check, checked_secs) = match worker {
             Ok(handle) => handle
                 .join()
                 .map_err(|_| CliError::internal("the self-validation thread failed"))?,
             Err(_) => self_validation(),
         };
-        Ok::<_, CliError>((measured, check, placed, written))
-    })?;
-    let cloud = &measured.cloud;
+        Ok(Done {
+            measured,
+            check,
+            checked_secs,
+            placed_secs,
+            written_secs,
+        })
+    })
+}
+
+/// The measurement's warnings on stderr, the poses outside the calibrated
+/// joint range listed up to [`LISTED_POSES`].
+fn print_warnings(measured: &measure::Measured) {
     for w in &measured.warnings {
         eprintln!("warning: {w}");
     }
@@ -442,12 +406,23 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
             );
         }
     }
-    if args.quiet {
-        return Ok(());
-    }
+}
+
+/// The summary on stdout: the scan's notes, the points measured and
+/// dropped, the measurements left out, σ, the joint-range check, the
+/// self-validation and the timing line (`loaded`: seconds to load).
+fn print_summary(
+    args: &MeasureArgs,
+    result: &format::ResultFile,
+    format: CloudFormat,
+    (notes, skipped): (&[String], &[String]),
+    done: &Done,
+    (started, loaded): (Instant, f64),
+) {
+    let cloud = &done.measured.cloud;
     let n = cloud.len();
     let dropped = cloud.dropped();
-    for note in &notes {
+    for note in notes {
         sayln!("{note}");
     }
     sayln!(
@@ -479,7 +454,7 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
             if args.covariance_as_written {
                 "as written".to_string()
             } else {
-                format!("× variance factor {:.3}", measure::variance_factor(&result))
+                format!("× variance factor {:.3}", measure::variance_factor(result))
             },
             if args.sensor_noise > 0.0 {
                 format!(", sensor noise {} mm", args.sensor_noise)
@@ -504,7 +479,7 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
             "joint range: not checked (give --calibration SESSION, the session the result was calibrated from)"
         );
     }
-    if let Some(c) = &check {
+    if let Some(c) = &done.check {
         say!("{}", c.summary());
     }
     sayln!(
@@ -512,9 +487,67 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
         args.out.display(),
         started.elapsed().as_secs_f64() * 1e3,
         loaded,
-        rate(n, placed),
-        rate(n, written),
-        checked_secs
+        rate(n, done.placed_secs),
+        rate(n, done.written_secs),
+        done.checked_secs
+    );
+}
+
+/// Runs `spherecal measure`.
+///
+/// # Errors
+/// [`CliError`] with status 2 for bad input (nothing written), 1 when the
+/// cloud cannot be written.
+pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
+    let started = Instant::now();
+    let format = output_format(args)?;
+    let result = format::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;
+    let frame = args
+        .frame
+        .as_ref()
+        .map(|path| {
+            measure::load_frame(path)
+                .map(|w| (w, path.display().to_string()))
+                .map_err(|e| from_measure(&e))
+        })
+        .transpose()?;
+    let (scan, joint_range) = load_scan(args, &result)?;
+    let loaded = started.elapsed().as_secs_f64();
+    let options = MeasureOptions {
+        model: args.model,
+        frame,
+        sigma: !args.no_sigma && args.model == ModelChoice::Calibrated,
+        sensor_noise_mm: args.sensor_noise,
+        covariance_as_written: args.covariance_as_written,
+    };
+    let (notes, skipped) = (scan.notes.clone(), scan.skipped.clone());
+    let provenance = Provenance {
+        result: args.result.display().to_string(),
+        scan: args
+            .session
+            .as_ref()
+            .map_or_else(|| scan.name.clone(), |p| p.display().to_string()),
+    };
+    let done = measure_and_write(
+        args,
+        scan,
+        &result,
+        &options,
+        joint_range.as_ref(),
+        format,
+        &provenance,
+    )?;
+    print_warnings(&done.measured);
+    if args.quiet {
+        return Ok(());
+    }
+    print_summary(
+        args,
+        &result,
+        format,
+        (&notes, &skipped),
+        &done,
+        (started, loaded),
     );
     Ok(())
 }

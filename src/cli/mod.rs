@@ -35,6 +35,7 @@ pub mod html_report;
 pub mod import;
 pub mod measure;
 pub mod plan;
+pub mod scan_flags;
 pub mod simulate;
 
 use std::path::{Path, PathBuf};

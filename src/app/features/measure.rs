@@ -18,8 +18,8 @@ use crate::engine::calibrate::solve::{Control, SolverReport};
 pub use crate::engine::calibrate::stripe::segment::grouped as group;
 use crate::engine::files::format::{self, ResultFile, refuse_inputs};
 use crate::engine::uses::measure::{
-    self, CellModel, CloudFormat, JointRange, MeasureError, MeasureOptions, ModelChoice, Scan,
-    ScanFiles, Stage,
+    self, CellModel, Cloud, CloudFormat, CloudPoint, JointRange, MeasureError, MeasureOptions,
+    ModelChoice, Scan, ScanFiles, Stage,
 };
 
 use super::Core;
@@ -97,6 +97,109 @@ fn fraction(stage: Stage, done: usize, of: usize) -> f64 {
     }
 }
 
+/// The scan a request names, read (a session as it is, a session file,
+/// or a raw scan's files), with the label it is shown under.
+fn read_scan(scan: ScanInput) -> Result<(Scan, String), MeasureFailure> {
+    Ok(match scan {
+        ScanInput::Session(session, uses, name) => (Scan::from_session(*session, &uses), name),
+        ScanInput::SessionFile(path, uses) => {
+            let session = format::load_session(&path)
+                .map_err(|e| MeasureFailure::Failed(JobError::from(e)))?;
+            (
+                Scan::from_session(session, &uses),
+                path.display().to_string(),
+            )
+        }
+        ScanInput::Files(files) => {
+            let scan = measure::scan_from_files(&files)
+                .map_err(|e| MeasureFailure::Failed(JobError::from(e)))?;
+            let label = files.log.path().display().to_string();
+            (scan, label)
+        }
+    })
+}
+
+/// Refuses a scan with no pose to measure (saying when its measurements
+/// give sphere centres instead of profiles).
+fn refuse_empty(scan: &Scan, scan_label: &str) -> Result<(), MeasureFailure> {
+    if scan.poses.is_empty() {
+        return Err(MeasureFailure::Failed(JobError::Missing(format!(
+            "nothing to measure: no pose with a profile in {scan_label}{}",
+            if scan.skipped.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " (its {} measurements give sphere centres)",
+                    scan.skipped.len()
+                )
+            }
+        ))));
+    }
+    Ok(())
+}
+
+/// The points drawn (at most [`DRAWN_MAX`], the largest σ last so that
+/// it is drawn on top) and the range of their finite σ (mm).
+fn drawn_points(cloud: &Cloud) -> (Vec<CloudPoint>, Option<(f64, f64)>) {
+    let mut drawn = cloud.decimated(DRAWN_MAX);
+    drawn.sort_by(|a, b| a.sigma_mm.total_cmp(&b.sigma_mm));
+    let sigma_range = drawn
+        .iter()
+        .map(|p| p.sigma_mm)
+        .filter(|s| s.is_finite())
+        .fold(None, |r: Option<(f64, f64)>, s| {
+            Some(r.map_or((s, s), |(lo, hi)| (lo.min(s), hi.max(s))))
+        });
+    (drawn, sigma_range)
+}
+
+/// Why the cloud has no σ (`None` when it has), and what its σ rests on
+/// (the covariance as written or scaled, the sensor noise).
+fn sigma_words(
+    cloud: &Cloud,
+    result: &ResultFile,
+    options: &MeasureOptions,
+) -> (Option<String>, String) {
+    let no_sigma = (!cloud.has_sigma()).then(|| {
+        if options.sigma {
+            "σ is unavailable".to_string()
+        } else if has_covariance(result) {
+            "no σ (as asked)".to_string()
+        } else {
+            format!(
+                "σ is unavailable: the result (method {}) has no parameter covariance",
+                result.solver.method()
+            )
+        }
+    });
+    let mut sigma_basis = if options.covariance_as_written {
+        "covariance as written".to_string()
+    } else {
+        format!(
+            "covariance × variance factor {:.3}",
+            measure::variance_factor(result)
+        )
+    };
+    if options.sensor_noise_mm > 0.0 {
+        sigma_basis.push_str(&format!(", sensor noise {} mm", options.sensor_noise_mm));
+    }
+    (no_sigma, sigma_basis)
+}
+
+/// The poses outside the calibrated joint range, in words, at most
+/// [`LISTED_POSES`] and a line for the rest.
+fn listed_out_of_range(out_of_range: &[measure::OutOfRange]) -> Vec<String> {
+    let mut listed: Vec<String> = out_of_range
+        .iter()
+        .take(LISTED_POSES)
+        .map(ToString::to_string)
+        .collect();
+    if out_of_range.len() > LISTED_POSES {
+        listed.push(format!("… and {} more", out_of_range.len() - LISTED_POSES));
+    }
+    listed
+}
+
 /// Measures `request` (module doc): reads the scan, measures it, runs
 /// the self-validation on its sphere stations, and makes the view of the
 /// cloud. `progress` gets each phase in words and the fraction done
@@ -132,37 +235,9 @@ pub fn measure_scan(
         frame,
         mut options,
     } = request;
-    let (scan, scan_label): (Scan, String) = match scan {
-        ScanInput::Session(session, uses, name) => (Scan::from_session(*session, &uses), name),
-        ScanInput::SessionFile(path, uses) => {
-            let session = format::load_session(&path)
-                .map_err(|e| MeasureFailure::Failed(JobError::from(e)))?;
-            (
-                Scan::from_session(session, &uses),
-                path.display().to_string(),
-            )
-        }
-        ScanInput::Files(files) => {
-            let scan = measure::scan_from_files(&files)
-                .map_err(|e| MeasureFailure::Failed(JobError::from(e)))?;
-            let label = files.log.path().display().to_string();
-            (scan, label)
-        }
-    };
+    let (scan, scan_label) = read_scan(scan)?;
     stopped(cancel)?;
-    if scan.poses.is_empty() {
-        return Err(MeasureFailure::Failed(JobError::Missing(format!(
-            "nothing to measure: no pose with a profile in {scan_label}{}",
-            if scan.skipped.is_empty() {
-                String::new()
-            } else {
-                format!(
-                    " (its {} measurements give sphere centres)",
-                    scan.skipped.len()
-                )
-            }
-        ))));
-    }
+    refuse_empty(&scan, &scan_label)?;
     if let Some(path) = &frame {
         let w = measure::load_frame(path).map_err(failed)?;
         options.frame = Some((w, path.display().to_string()));
@@ -203,51 +278,10 @@ pub fn measure_scan(
     stopped(cancel)?;
     progress("the view of the cloud (decimated, σ colours)", 0.95);
     let cloud = measured.cloud;
-    let mut drawn = cloud.decimated(DRAWN_MAX);
-    drawn.sort_by(|a, b| a.sigma_mm.total_cmp(&b.sigma_mm));
-    let sigma_range = drawn
-        .iter()
-        .map(|p| p.sigma_mm)
-        .filter(|s| s.is_finite())
-        .fold(None, |r: Option<(f64, f64)>, s| {
-            Some(r.map_or((s, s), |(lo, hi)| (lo.min(s), hi.max(s))))
-        });
+    let (drawn, sigma_range) = drawn_points(&cloud);
     let sigma = cloud.sigma_stats();
-    let no_sigma = (!cloud.has_sigma()).then(|| {
-        if options.sigma {
-            "σ is unavailable".to_string()
-        } else if has_covariance(&result) {
-            "no σ (as asked)".to_string()
-        } else {
-            format!(
-                "σ is unavailable: the result (method {}) has no parameter covariance",
-                result.solver.method()
-            )
-        }
-    });
-    let mut sigma_basis = if options.covariance_as_written {
-        "covariance as written".to_string()
-    } else {
-        format!(
-            "covariance × variance factor {:.3}",
-            measure::variance_factor(&result)
-        )
-    };
-    if options.sensor_noise_mm > 0.0 {
-        sigma_basis.push_str(&format!(", sensor noise {} mm", options.sensor_noise_mm));
-    }
-    let mut out_of_range: Vec<String> = measured
-        .out_of_range
-        .iter()
-        .take(LISTED_POSES)
-        .map(ToString::to_string)
-        .collect();
-    if measured.out_of_range.len() > LISTED_POSES {
-        out_of_range.push(format!(
-            "… and {} more",
-            measured.out_of_range.len() - LISTED_POSES
-        ));
-    }
+    let (no_sigma, sigma_basis) = sigma_words(&cloud, &result, &options);
+    let out_of_range = listed_out_of_range(&measured.out_of_range);
     let out_of_range_count = measured.out_of_range.len();
     stopped(cancel)?;
     Ok(MeasuredCloud {

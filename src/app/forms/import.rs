@@ -229,15 +229,7 @@ impl ImportForm {
             "" | "auto" => None,
             text => Some(AxisMap::parse(text)?),
         };
-        let no_return = match self.no_return.trim() {
-            "" => None,
-            text => Some(
-                text.parse::<f64>()
-                    .ok()
-                    .filter(|v| v.is_finite())
-                    .ok_or_else(|| format!("the no-return value `{text}` is not a number"))?,
-            ),
-        };
+        let no_return = super::no_return(&self.no_return)?;
         Ok((
             source,
             ProfileFormat {

@@ -165,15 +165,7 @@ impl MeasureForm {
             "" | "auto" => None,
             text => Some(AxisMap::parse(text).map_err(|e| format!("axes: {e}"))?),
         };
-        let no_return = match self.no_return.trim() {
-            "" => None,
-            text => Some(
-                text.parse::<f64>()
-                    .ok()
-                    .filter(|v| v.is_finite())
-                    .ok_or_else(|| format!("the no-return value `{text}` is not a number"))?,
-            ),
-        };
+        let no_return = super::no_return(&self.no_return)?;
         let sphere_diameter = match self.sphere_diameter.trim() {
             "" => None,
             text => Some(

@@ -303,3 +303,20 @@ impl Default for HistoryForm {
         }
     }
 }
+
+/// The sensor's no-return value as a form field holds it (profile file
+/// units): `None` when the field is empty.
+///
+/// # Errors
+/// The message to show when the text is not a finite number.
+pub(crate) fn no_return(text: &str) -> Result<Option<f64>, String> {
+    match text.trim() {
+        "" => Ok(None),
+        text => text
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .map(Some)
+            .ok_or_else(|| format!("the no-return value `{text}` is not a number")),
+    }
+}

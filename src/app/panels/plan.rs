@@ -12,11 +12,11 @@ use super::{
 };
 use crate::app::commands::{Command, FilesCommand, PlanCommand};
 use crate::app::forms::{Forms, plan::default_sphere};
-use crate::app::provenance::Output;
+use crate::app::provenance::{Output, Stale};
 use crate::app::state::{AppState, DialogPurpose, PlanExport, PlanOutcome};
 use crate::engine::base::robot;
 use crate::engine::base::session::Use;
-use crate::engine::tools::plan::{Plan, StationRole};
+use crate::engine::tools::plan::{Plan, PlanStats, StationRole};
 
 /// Width of the settings column, points.
 const FORM_WIDTH: f32 = 330.0;
@@ -196,38 +196,9 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
     }
 }
 
-fn outcome_ui(
-    ui: &mut egui::Ui,
-    state: &AppState,
-    forms: &mut Forms,
-    o: &PlanOutcome,
-    commands: &mut Vec<Command>,
-) {
-    let plan = &o.plan;
-    let st = &plan.stats;
-    let stale = state.provenance.stale(Output::Plan);
-    if let Some(s) = &stale {
-        super::stale_banner_ui(
-            ui,
-            s,
-            "Its program, CSV and simulation are refused until you press Make plan.",
-        );
-    }
-    let stations = |role| plan.stations.iter().filter(|s| s.role == role).count();
-    ui.label(
-        RichText::new(format!(
-            "{} poses: {} translation + {} rotation at P0, {} identify at {} stations, {} validate at {} stations",
-            plan.poses.len(),
-            plan.count(Use::Translation),
-            plan.count(Use::Rotation),
-            plan.count(Use::Identify),
-            stations(StationRole::Identify),
-            plan.count(Use::Validate),
-            stations(StationRole::Validate),
-        ))
-        .strong()
-        .size(16.0),
-    );
+/// The predicted validation std after calibration (simulated
+/// calibrations of the plan), or why there is none.
+fn prediction_ui(ui: &mut egui::Ui, o: &PlanOutcome) {
     match &o.prediction {
         Some(Ok(p)) => {
             ui.label(
@@ -260,6 +231,12 @@ fn outcome_ui(
             ui.label(RichText::new("No prediction asked for (runs = 0).").weak());
         }
     }
+}
+
+/// The plan's statistics: candidates, D-optimality, condition, predicted
+/// errors over the range, path length, parameters identified, and what
+/// the data cannot identify or separate.
+fn stats_ui(ui: &mut egui::Ui, st: &PlanStats) {
     egui::Grid::new("plan_stats")
         .num_columns(2)
         .spacing([12.0, 4.0])
@@ -337,8 +314,19 @@ fn outcome_ui(
                 }
             });
     }
-    ui.separator();
-    let refused = stale.as_ref().map_or_else(
+}
+
+/// The export row: the folder, the Plan CSV and the controller's program,
+/// and "Simulate and open"; refused while a file is written or the plan
+/// is stale.
+fn export_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    stale: Option<&Stale>,
+    commands: &mut Vec<Command>,
+) {
+    let refused = stale.map_or_else(
         || "a file is being written".to_string(),
         |s| format!("refused: {s}; press Make plan"),
     );
@@ -395,6 +383,44 @@ fn outcome_ui(
             commands.push(Command::Plan(PlanCommand::Simulate));
         }
     });
+}
+
+fn outcome_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    o: &PlanOutcome,
+    commands: &mut Vec<Command>,
+) {
+    let plan = &o.plan;
+    let st = &plan.stats;
+    let stale = state.provenance.stale(Output::Plan);
+    if let Some(s) = &stale {
+        super::stale_banner_ui(
+            ui,
+            s,
+            "Its program, CSV and simulation are refused until you press Make plan.",
+        );
+    }
+    let stations = |role| plan.stations.iter().filter(|s| s.role == role).count();
+    ui.label(
+        RichText::new(format!(
+            "{} poses: {} translation + {} rotation at P0, {} identify at {} stations, {} validate at {} stations",
+            plan.poses.len(),
+            plan.count(Use::Translation),
+            plan.count(Use::Rotation),
+            plan.count(Use::Identify),
+            stations(StationRole::Identify),
+            plan.count(Use::Validate),
+            stations(StationRole::Validate),
+        ))
+        .strong()
+        .size(16.0),
+    );
+    prediction_ui(ui, o);
+    stats_ui(ui, st);
+    ui.separator();
+    export_ui(ui, state, forms, stale.as_ref(), commands);
     super::dialog_note_ui(ui, state, &[DialogPurpose::ExportFolder]);
     ui.separator();
     ui.label(RichText::new("Stations seen from above (base frame x, y in mm)").strong());

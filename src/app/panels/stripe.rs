@@ -197,6 +197,8 @@ pub fn residual_limit(used: &[[f64; 2]], rms_um: f64) -> f64 {
 /// Height of a plot's title and key lines above it, points.
 const KEY_HEIGHT: f32 = 44.0;
 
+/// The stripe plot beside the residual plot, the points sorted into
+/// kept, rejected by the fit and off the arc.
 fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) {
     let inlier = |k: usize| fit.is_none_or(|s| s.fit.inlier.get(k).copied().unwrap_or(true));
     // Points a raw profile's arc search left out (background, the stand).
@@ -220,145 +222,172 @@ fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) 
     ui.horizontal(|ui| {
         ui.vertical(|ui| {
             ui.set_width(width * 0.58);
-            ui.label(RichText::new("Stripe in the laser plane (sensor x = 0)").strong());
-            // The key above the plot, off the data.
-            let mut key = vec![("● stripe points", AFTER)];
-            if fit.is_some() {
-                key.push(("- - fitted circle", BEFORE));
-                key.push(("+ circle centre", BEFORE));
-            }
-            if !rejected.is_empty() {
-                key.push(("× rejected", BAD));
-            }
-            if !dropped.is_empty() {
-                key.push(("• off the arc (dropped)", MUTED));
-            }
-            super::plot_key(ui, &key);
-            super::plots::readable(Plot::new("stripe_plot"), false)
-                .data_aspect(1.0)
-                .height(height - KEY_HEIGHT)
-                .x_axis_label("y (mm)")
-                .y_axis_label("z (mm)")
-                .show(ui, |p| {
-                    if let Some(s) = fit {
-                        let [yc, zc] = s.fit.centre;
-                        let r = s.fit.radius;
-                        let circle: Vec<[f64; 2]> = (0..=CIRCLE_SEGMENTS)
-                            .map(|k| {
-                                let a = TAU * k as f64 / CIRCLE_SEGMENTS as f64;
-                                [yc + r * a.cos(), zc + r * a.sin()]
-                            })
-                            .collect();
-                        p.line(
-                            Line::new("fitted circle", PlotPoints::from(circle))
-                                .color(BEFORE)
-                                .style(LineStyle::dashed_loose())
-                                .width(1.5),
-                        );
-                        p.points(
-                            Points::new("circle centre", PlotPoints::from(vec![[yc, zc]]))
-                                .shape(MarkerShape::Plus)
-                                .radius(6.0)
-                                .color(BEFORE),
-                        );
-                    }
-                    if !dropped.is_empty() {
-                        p.points(
-                            Points::new("off the arc (dropped)", PlotPoints::from(dropped))
-                                .color(MUTED)
-                                .radius(1.5),
-                        );
-                    }
-                    p.points(
-                        Points::new("stripe points", PlotPoints::from(kept))
-                            .color(AFTER)
-                            .radius(2.5),
-                    );
-                    if !rejected.is_empty() {
-                        p.points(
-                            Points::new("rejected", PlotPoints::from(rejected))
-                                .shape(MarkerShape::Cross)
-                                .color(BAD)
-                                .radius(6.0),
-                        );
-                    }
-                });
+            stripe_plot_ui(ui, height, fit, [kept, rejected, dropped]);
         });
         ui.vertical(|ui| {
-            ui.label(RichText::new("Residuals |p − c| − r").strong());
             let Some(s) = fit else {
+                ui.label(RichText::new("Residuals |p − c| − r").strong());
                 ui.label(RichText::new("no fit").color(MUTED));
                 return;
             };
-            let um = |k: usize| s.fit.residuals.get(k).copied().unwrap_or(0.0) * 1000.0;
-            let used: Vec<[f64; 2]> = (0..points.len())
-                .filter(|&k| inlier(k))
-                .map(|k| [k as f64, um(k)])
-                .collect();
-            let rms = s.fit.rms * 1000.0;
-            // The scale is the used points' (and ±RMS): a rejected point
-            // of 783 µm must not flatten residuals of ±10 µm. Rejected
-            // points beyond it are drawn at its edge.
-            let limit = residual_limit(&used, rms);
-            // Points off the arc are far from the circle: not plotted here.
-            let rejected_um: Vec<[f64; 2]> = (0..points.len())
-                .filter(|&k| !inlier(k) && !off_arc(k))
-                .map(|k| [k as f64, um(k)])
-                .collect();
-            let beyond = rejected_um.iter().filter(|p| p[1].abs() > limit).count();
-            let largest = rejected_um.iter().fold(0.0_f64, |m, p| m.max(p[1].abs()));
-            let out: Vec<[f64; 2]> = rejected_um
-                .iter()
-                .map(|p| [p[0], p[1].clamp(-limit, limit)])
-                .collect();
-            let rms_key = format!("- - ± RMS ({rms:.1} µm)");
-            let rejected_key = if beyond > 0 {
-                format!(
-                    "× rejected ({beyond} beyond ±{limit:.0} µm drawn at the edge; largest {largest:.0} µm)"
-                )
-            } else {
-                "× rejected".to_string()
-            };
-            let mut key = vec![("● used", AFTER), (rms_key.as_str(), MUTED)];
-            if !out.is_empty() {
-                key.push((rejected_key.as_str(), BAD));
-            }
-            super::plot_key(ui, &key);
-            super::plots::readable(Plot::new("residual_plot"), true)
-                .height(height - KEY_HEIGHT)
-                .x_axis_label("point")
-                .y_axis_label("residual (µm)")
-                .include_y(-limit)
-                .include_y(limit)
-                .show(ui, |p| {
-                    p.points(
-                        Points::new("used", PlotPoints::from(used))
-                            .color(AFTER)
-                            .radius(2.5)
-                            .stems(0.0),
-                    );
-                    if !out.is_empty() {
-                        p.points(
-                            Points::new("rejected", PlotPoints::from(out))
-                                .shape(MarkerShape::Cross)
-                                .color(BAD)
-                                .radius(5.0)
-                                .stems(0.0),
-                        );
-                    }
-                    p.hline(
-                        HLine::new("± RMS", rms)
-                            .color(MUTED)
-                            .style(LineStyle::dashed_dense()),
-                    );
-                    p.hline(
-                        HLine::new("± RMS", -rms)
-                            .color(MUTED)
-                            .style(LineStyle::dashed_dense()),
-                    );
-                });
+            residual_plot_ui(ui, height, points.len(), s, &inlier, &off_arc);
         });
     });
+}
+
+/// The stripe in the laser plane with its key: the points kept by the
+/// fit, the fitted circle and its centre, the points the fit rejected
+/// and those off the arc (`[kept, rejected, dropped]`, `[y, z]` mm).
+fn stripe_plot_ui(
+    ui: &mut egui::Ui,
+    height: f32,
+    fit: Option<&StripeResult>,
+    [kept, rejected, dropped]: [Vec<[f64; 2]>; 3],
+) {
+    ui.label(RichText::new("Stripe in the laser plane (sensor x = 0)").strong());
+    // The key above the plot, off the data.
+    let mut key = vec![("● stripe points", AFTER)];
+    if fit.is_some() {
+        key.push(("- - fitted circle", BEFORE));
+        key.push(("+ circle centre", BEFORE));
+    }
+    if !rejected.is_empty() {
+        key.push(("× rejected", BAD));
+    }
+    if !dropped.is_empty() {
+        key.push(("• off the arc (dropped)", MUTED));
+    }
+    super::plot_key(ui, &key);
+    super::plots::readable(Plot::new("stripe_plot"), false)
+        .data_aspect(1.0)
+        .height(height - KEY_HEIGHT)
+        .x_axis_label("y (mm)")
+        .y_axis_label("z (mm)")
+        .show(ui, |p| {
+            if let Some(s) = fit {
+                let [yc, zc] = s.fit.centre;
+                let r = s.fit.radius;
+                let circle: Vec<[f64; 2]> = (0..=CIRCLE_SEGMENTS)
+                    .map(|k| {
+                        let a = TAU * k as f64 / CIRCLE_SEGMENTS as f64;
+                        [yc + r * a.cos(), zc + r * a.sin()]
+                    })
+                    .collect();
+                p.line(
+                    Line::new("fitted circle", PlotPoints::from(circle))
+                        .color(BEFORE)
+                        .style(LineStyle::dashed_loose())
+                        .width(1.5),
+                );
+                p.points(
+                    Points::new("circle centre", PlotPoints::from(vec![[yc, zc]]))
+                        .shape(MarkerShape::Plus)
+                        .radius(6.0)
+                        .color(BEFORE),
+                );
+            }
+            if !dropped.is_empty() {
+                p.points(
+                    Points::new("off the arc (dropped)", PlotPoints::from(dropped))
+                        .color(MUTED)
+                        .radius(1.5),
+                );
+            }
+            p.points(
+                Points::new("stripe points", PlotPoints::from(kept))
+                    .color(AFTER)
+                    .radius(2.5),
+            );
+            if !rejected.is_empty() {
+                p.points(
+                    Points::new("rejected", PlotPoints::from(rejected))
+                        .shape(MarkerShape::Cross)
+                        .color(BAD)
+                        .radius(6.0),
+                );
+            }
+        });
+}
+
+/// The fit's residuals of each point (µm) with ± RMS and its key; the
+/// scale is the used points' and the rejected beyond it are drawn at its
+/// edge (points off the arc are not drawn).
+fn residual_plot_ui(
+    ui: &mut egui::Ui,
+    height: f32,
+    n_points: usize,
+    s: &StripeResult,
+    inlier: &dyn Fn(usize) -> bool,
+    off_arc: &dyn Fn(usize) -> bool,
+) {
+    ui.label(RichText::new("Residuals |p − c| − r").strong());
+    let um = |k: usize| s.fit.residuals.get(k).copied().unwrap_or(0.0) * 1000.0;
+    let used: Vec<[f64; 2]> = (0..n_points)
+        .filter(|&k| inlier(k))
+        .map(|k| [k as f64, um(k)])
+        .collect();
+    let rms = s.fit.rms * 1000.0;
+    // The scale is the used points' (and ±RMS): a rejected point
+    // of 783 µm must not flatten residuals of ±10 µm. Rejected
+    // points beyond it are drawn at its edge.
+    let limit = residual_limit(&used, rms);
+    // Points off the arc are far from the circle: not plotted here.
+    let rejected_um: Vec<[f64; 2]> = (0..n_points)
+        .filter(|&k| !inlier(k) && !off_arc(k))
+        .map(|k| [k as f64, um(k)])
+        .collect();
+    let beyond = rejected_um.iter().filter(|p| p[1].abs() > limit).count();
+    let largest = rejected_um.iter().fold(0.0_f64, |m, p| m.max(p[1].abs()));
+    let out: Vec<[f64; 2]> = rejected_um
+        .iter()
+        .map(|p| [p[0], p[1].clamp(-limit, limit)])
+        .collect();
+    let rms_key = format!("- - ± RMS ({rms:.1} µm)");
+    let rejected_key = if beyond > 0 {
+        format!(
+            "× rejected ({beyond} beyond ±{limit:.0} µm drawn at the edge; largest {largest:.0} µm)"
+        )
+    } else {
+        "× rejected".to_string()
+    };
+    let mut key = vec![("● used", AFTER), (rms_key.as_str(), MUTED)];
+    if !out.is_empty() {
+        key.push((rejected_key.as_str(), BAD));
+    }
+    super::plot_key(ui, &key);
+    super::plots::readable(Plot::new("residual_plot"), true)
+        .height(height - KEY_HEIGHT)
+        .x_axis_label("point")
+        .y_axis_label("residual (µm)")
+        .include_y(-limit)
+        .include_y(limit)
+        .show(ui, |p| {
+            p.points(
+                Points::new("used", PlotPoints::from(used))
+                    .color(AFTER)
+                    .radius(2.5)
+                    .stems(0.0),
+            );
+            if !out.is_empty() {
+                p.points(
+                    Points::new("rejected", PlotPoints::from(out))
+                        .shape(MarkerShape::Cross)
+                        .color(BAD)
+                        .radius(5.0)
+                        .stems(0.0),
+                );
+            }
+            p.hline(
+                HLine::new("± RMS", rms)
+                    .color(MUTED)
+                    .style(LineStyle::dashed_dense()),
+            );
+            p.hline(
+                HLine::new("± RMS", -rms)
+                    .color(MUTED)
+                    .style(LineStyle::dashed_dense()),
+            );
+        });
 }
 
 #[cfg(test)]
