@@ -308,63 +308,7 @@ fn scan_ui(
                 MeasureDialog::Profiles,
                 commands,
             );
-            ui.horizontal_wrapped(|ui| {
-                match form.raw_log {
-                    RawLog::Joints => {
-                        let l = ui.label("joints in");
-                        egui::ComboBox::from_id_salt("measure_joint_unit")
-                            .selected_text(form.joint_unit.as_str())
-                            .show_ui(ui, |ui| {
-                                for u in [AngleUnit::Deg, AngleUnit::Rad] {
-                                    ui.selectable_value(&mut form.joint_unit, u, u.as_str());
-                                }
-                            })
-                            .response
-                            .labelled_by(l.id);
-                    }
-                    RawLog::Poses => {
-                        let l = ui.label("pose convention");
-                        let shown = CONVENTIONS
-                            .iter()
-                            .find(|(c, _)| Some(*c) == form.pose_convention)
-                            .map_or("as the file says", |(_, t)| t);
-                        egui::ComboBox::from_id_salt("measure_convention")
-                            .selected_text(shown)
-                            .show_ui(ui, |ui| {
-                                ui.selectable_value(
-                                    &mut form.pose_convention,
-                                    None,
-                                    "as the file says",
-                                );
-                                for (c, t) in CONVENTIONS {
-                                    ui.selectable_value(&mut form.pose_convention, Some(c), t);
-                                }
-                            })
-                            .response
-                            .labelled_by(l.id);
-                    }
-                }
-                let l = ui.label("profiles in");
-                egui::ComboBox::from_id_salt("measure_profile_unit")
-                    .selected_text(form.profile_unit.as_str())
-                    .show_ui(ui, |ui| {
-                        for u in [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M] {
-                            ui.selectable_value(&mut form.profile_unit, u, u.as_str());
-                        }
-                    })
-                    .response
-                    .labelled_by(l.id);
-                labelled_field(ui, "axes", &mut form.axes, "auto or -y,x,z", 70.0);
-                labelled_field(ui, "no-return value", &mut form.no_return, "none", 60.0);
-                labelled_field(
-                    ui,
-                    "sphere artefact Ø (mm)",
-                    &mut form.sphere_diameter,
-                    "none",
-                    60.0,
-                )
-                .on_hover_text("a scan of a sphere artefact: its spheres' diameter, for the self-validation of the log's stations");
-            });
+            raw_units_ui(ui, form);
             path_row(
                 ui,
                 state,
@@ -385,6 +329,68 @@ fn scan_ui(
         MeasureDialog::Frame,
         commands,
     );
+}
+
+/// The raw scan's units and readings: joint unit or pose convention,
+/// profile unit, axes, no-return value, the artefact's diameter.
+fn raw_units_ui(ui: &mut egui::Ui, form: &mut crate::app::forms::measure::MeasureForm) {
+    ui.horizontal_wrapped(|ui| {
+        match form.raw_log {
+            RawLog::Joints => {
+                let l = ui.label("joints in");
+                egui::ComboBox::from_id_salt("measure_joint_unit")
+                    .selected_text(form.joint_unit.as_str())
+                    .show_ui(ui, |ui| {
+                        for u in [AngleUnit::Deg, AngleUnit::Rad] {
+                            ui.selectable_value(&mut form.joint_unit, u, u.as_str());
+                        }
+                    })
+                    .response
+                    .labelled_by(l.id);
+            }
+            RawLog::Poses => {
+                let l = ui.label("pose convention");
+                let shown = CONVENTIONS
+                    .iter()
+                    .find(|(c, _)| Some(*c) == form.pose_convention)
+                    .map_or("as the file says", |(_, t)| t);
+                egui::ComboBox::from_id_salt("measure_convention")
+                    .selected_text(shown)
+                    .show_ui(ui, |ui| {
+                        ui.selectable_value(
+                            &mut form.pose_convention,
+                            None,
+                            "as the file says",
+                        );
+                        for (c, t) in CONVENTIONS {
+                            ui.selectable_value(&mut form.pose_convention, Some(c), t);
+                        }
+                    })
+                    .response
+                    .labelled_by(l.id);
+            }
+        }
+        let l = ui.label("profiles in");
+        egui::ComboBox::from_id_salt("measure_profile_unit")
+            .selected_text(form.profile_unit.as_str())
+            .show_ui(ui, |ui| {
+                for u in [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M] {
+                    ui.selectable_value(&mut form.profile_unit, u, u.as_str());
+                }
+            })
+            .response
+            .labelled_by(l.id);
+        labelled_field(ui, "axes", &mut form.axes, "auto or -y,x,z", 70.0);
+        labelled_field(ui, "no-return value", &mut form.no_return, "none", 60.0);
+        labelled_field(
+            ui,
+            "sphere artefact Ø (mm)",
+            &mut form.sphere_diameter,
+            "none",
+            60.0,
+        )
+        .on_hover_text("a scan of a sphere artefact: its spheres' diameter, for the self-validation of the log's stations");
+    });
 }
 
 /// The counts, the σ figures, the warnings.

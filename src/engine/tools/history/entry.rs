@@ -119,6 +119,21 @@ pub(super) fn coupled_twist(rotation: &UnitQuaternion<f64>, index: usize) -> Vec
         .collect()
 }
 
+/// The nominal and calibrated joints of a result (none for a hand-eye
+/// only result): the calibrated model minus its errors is the nominal.
+fn model_joints(result: &ResultFile) -> (Vec<Joint>, Vec<Joint>) {
+    let calibrated: Vec<Joint> = match &result.robot {
+        Some(r) if !result.hand_eye_only() => r.joints.clone(),
+        _ => Vec::new(),
+    };
+    let nominal: Vec<Joint> = calibrated
+        .iter()
+        .zip(&result.joint_errors)
+        .map(|(c, e)| c.minus(e))
+        .collect();
+    (nominal, calibrated)
+}
+
 #[allow(
     clippy::unnecessary_wraps,
     reason = "the same shape as the scan's other readers, which can fail"
@@ -234,15 +249,7 @@ pub(super) fn build_entry(
             prior_held,
         });
     }
-    let calibrated: Vec<Joint> = match &result.robot {
-        Some(r) if !result.hand_eye_only() => r.joints.clone(),
-        _ => Vec::new(),
-    };
-    let nominal: Vec<Joint> = calibrated
-        .iter()
-        .zip(&result.joint_errors)
-        .map(|(c, e)| c.minus(e))
-        .collect();
+    let (nominal, calibrated) = model_joints(result);
     let validation = result.validation.as_ref();
     Ok(Entry {
         path,

@@ -34,6 +34,32 @@ fn vendor(format: PoseFormat) -> Option<Vendor> {
     }
 }
 
+/// The flags of a target: far in joint space from every identify pose
+/// (deg), outside the region the calibration saw (mm), or a predicted σ
+/// above the tolerance (mm).
+fn flags_of(
+    options: &Options,
+    nearest_identify_deg: Option<f64>,
+    outside_mm: f64,
+    sigma_mm: Option<f64>,
+) -> Vec<Flag> {
+    let mut flags = Vec::new();
+    if let Some(d) = nearest_identify_deg
+        && d > options.far_joints_deg
+    {
+        flags.push(Flag::FarInJoints(d, options.far_joints_deg));
+    }
+    if outside_mm > options.region_margin_mm {
+        flags.push(Flag::OutsideRegion(outside_mm, options.region_margin_mm));
+    }
+    if let Some(s) = sigma_mm
+        && s > options.sigma_tolerance_mm
+    {
+        flags.push(Flag::Uncertain(s, options.sigma_tolerance_mm));
+    }
+    flags
+}
+
 /// Compensates target `index` of `file`.
 pub(super) fn compensate_target(
     model: &Model,
@@ -148,20 +174,7 @@ pub(super) fn compensate_target(
     let sigma_mm = model.predictor.as_ref().map(|p| p.sigma(&qc));
     let nearest_identify_deg = model.region.nearest_identify(&qc);
     let outside_mm = model.region.outside(&wanted);
-    let mut flags = Vec::new();
-    if let Some(d) = nearest_identify_deg
-        && d > options.far_joints_deg
-    {
-        flags.push(Flag::FarInJoints(d, options.far_joints_deg));
-    }
-    if outside_mm > options.region_margin_mm {
-        flags.push(Flag::OutsideRegion(outside_mm, options.region_margin_mm));
-    }
-    if let Some(s) = sigma_mm
-        && s > options.sigma_tolerance_mm
-    {
-        flags.push(Flag::Uncertain(s, options.sigma_tolerance_mm));
-    }
+    let flags = flags_of(options, nearest_identify_deg, outside_mm, sigma_mm);
     if joints_target && !written {
         notes.push("a joint target, kept as written (--joint-targets keep)".to_string());
     }
