@@ -15,7 +15,6 @@ use crate::app::forms::{Forms, plan::default_sphere};
 use crate::app::provenance::{Output, Stale};
 use crate::app::state::{AppState, DialogPurpose, PlanExport, PlanOutcome};
 use crate::engine::base::robot;
-use crate::engine::base::session::Use;
 use crate::engine::tools::plan::{Plan, PlanStats, StationRole};
 
 /// Width of the settings column, points.
@@ -402,21 +401,7 @@ fn outcome_ui(
             "Its program, CSV and simulation are refused until you press Make plan.",
         );
     }
-    let stations = |role| plan.stations.iter().filter(|s| s.role == role).count();
-    ui.label(
-        RichText::new(format!(
-            "{} poses: {} translation + {} rotation at P0, {} identify at {} stations, {} validate at {} stations",
-            plan.poses.len(),
-            plan.count(Use::Translation),
-            plan.count(Use::Rotation),
-            plan.count(Use::Identify),
-            stations(StationRole::Identify),
-            plan.count(Use::Validate),
-            stations(StationRole::Validate),
-        ))
-        .strong()
-        .size(16.0),
-    );
+    ui.label(RichText::new(plan.pose_counts()).strong().size(16.0));
     prediction_ui(ui, o);
     stats_ui(ui, st);
     ui.separator();

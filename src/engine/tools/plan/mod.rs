@@ -714,24 +714,31 @@ fn analyse_plan(planner: &Planner<'_>, plan: &mut Plan) -> Result<(), PlanError>
     Ok(())
 }
 
+impl Plan {
+    /// The plan's poses in one line, as the command line and the
+    /// workbench show it: poses of each use, stations of each role.
+    #[must_use]
+    pub fn pose_counts(&self) -> String {
+        let stations = |role| self.stations.iter().filter(|s| s.role == role).count();
+        format!(
+            "{} poses: {} translation, {} rotation at P0; {} identify at {} stations; {} validate at {} stations",
+            self.poses.len(),
+            self.count(Use::Translation),
+            self.count(Use::Rotation),
+            self.count(Use::Identify),
+            stations(StationRole::Identify),
+            self.count(Use::Validate),
+            stations(StationRole::Validate)
+        )
+    }
+}
+
 /// A few lines for people (the command line's summary).
 #[must_use]
 pub fn summary(plan: &Plan) -> String {
     let mut s = String::new();
     let st = &plan.stats;
-    let stations = |role| plan.stations.iter().filter(|s| s.role == role).count();
-    let _ = writeln!(
-        s,
-        "plan for {}: {} poses: {} translation, {} rotation at P0; {} identify at {} stations; {} validate at {} stations",
-        plan.robot.name,
-        plan.poses.len(),
-        plan.count(Use::Translation),
-        plan.count(Use::Rotation),
-        plan.count(Use::Identify),
-        stations(StationRole::Identify),
-        plan.count(Use::Validate),
-        stations(StationRole::Validate)
-    );
+    let _ = writeln!(s, "plan for {}: {}", plan.robot.name, plan.pose_counts());
     let _ = writeln!(
         s,
         "  reachable candidates: {} (IK branches within limits, laser plane at ±{}°)",
