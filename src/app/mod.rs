@@ -22,7 +22,8 @@
 //! - [`jobs`]: named background threads and the messages they send, by
 //!   feature;
 //! - [`features`]: one module per feature (files, view, run, export,
-//!   import, history, plan), each with its command handler, its message
+//!   import and import_poses, history, plan, measure, compensate), each
+//!   with its command handler, its message
 //!   handler and the engine calls its jobs make;
 //! - [`panels`]: one module per panel or view, each a `*_ui` function
 //!   that reads the state, edits the forms and pushes commands;
@@ -55,8 +56,9 @@
 //!    views show it with `panels::stale_banner_ui`).
 //!
 //! Layout of the window, for an operator at 1366×768: the load and solver
-//! panel on the left, the Session, Stripe, Centres and Results views in the
-//! middle, a status bar at the bottom.
+//! panel on the left, the Plan, Import, Session, Stripe, Centres, Results,
+//! Measure, Compensate and History views in the middle, a status bar at
+//! the bottom.
 
 pub mod commands;
 pub mod error;
