@@ -236,3 +236,81 @@ fn the_paper_loop_stops_when_epsilon_has_levelled_off() {
         cal.iterations.len()
     );
 }
+
+/// A session broken in code and the same session written and read:
+/// the typed rules and the loader say the same (one home for each
+/// rule), the loader adding only the position.
+#[test]
+fn typed_rules_and_the_loader_agree() {
+    let (base, _) = spherecal::engine::tools::simulate::simulate(
+        &spherecal::engine::tools::simulate::SimConfig {
+            n_identify: 2,
+            n_validate: 2,
+            ..spherecal::engine::tools::simulate::SimConfig::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(base.validate(), Ok(()));
+    type Break = Box<dyn Fn(&mut spherecal::engine::base::session::Session)>;
+    let breaks: Vec<(&str, Break)> = vec![
+        (
+            "few points",
+            Box::new(|s: &mut spherecal::engine::base::session::Session| {
+                s.measurements[3].observation =
+                    spherecal::engine::base::session::Observation::Stripe(vec![[0.0, 1.0]; 3]);
+            }),
+        ),
+        (
+            "duplicate id",
+            Box::new(|s: &mut spherecal::engine::base::session::Session| {
+                s.measurements[4].id = s.measurements[2].id.clone();
+            }),
+        ),
+        (
+            "joint count",
+            Box::new(|s: &mut spherecal::engine::base::session::Session| {
+                s.measurements[5].joints.pop();
+            }),
+        ),
+        (
+            "implausible joint",
+            Box::new(|s: &mut spherecal::engine::base::session::Session| {
+                s.measurements[5].joints[2] = 1e9;
+            }),
+        ),
+        (
+            "diameter",
+            Box::new(|s: &mut spherecal::engine::base::session::Session| {
+                s.sphere_diameter = 5000.0;
+            }),
+        ),
+        (
+            "reference",
+            Box::new(|s: &mut spherecal::engine::base::session::Session| {
+                s.reference_distances[0].from = "P1".to_string();
+            }),
+        ),
+        (
+            "robot",
+            Box::new(|s: &mut spherecal::engine::base::session::Session| {
+                s.robot.joints[1].a = 1e12;
+            }),
+        ),
+    ];
+    for (what, broken) in breaks {
+        let mut s = base.clone();
+        broken(&mut s);
+        let typed = s.validate().expect_err(what);
+        let loaded = spherecal::engine::files::format::parse_session(
+            &spherecal::engine::files::format::session_to_json(&s),
+            std::path::Path::new("t.json"),
+        )
+        .expect_err(what)
+        .to_string();
+        assert!(
+            loaded.contains(&typed.message),
+            "{what}: typed `{}` vs loader `{loaded}`",
+            typed.message
+        );
+    }
+}

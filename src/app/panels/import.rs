@@ -11,16 +11,16 @@
 
 use egui::RichText;
 
-use super::{BAD, DEFAULT_RANGE, GOOD, WARN, labelled_field, range_fields, range_of};
-use crate::app::commands::{Command, FilesCommand, ImportCommand};
+use super::{
+    BAD, DEFAULT_RANGE, GOOD, PATH_WIDTH, WARN, labelled_field, path_row, range_fields, range_of,
+};
+use crate::app::commands::{Command, ImportCommand};
 use crate::app::forms::Forms;
 use crate::app::forms::import::{CONVENTIONS, ImportForm, LogKind, ObservationKind, ProfilesKind};
 use crate::app::state::{AppState, DialogPurpose};
 use crate::engine::base::robot::{self, DhConvention};
 use crate::engine::files::import::{AngleUnit, LengthUnit, SideChoice};
 
-/// Width of the path fields, points.
-pub(super) const PATH_WIDTH: f32 = 420.0;
 /// Largest height of the import's error above the form, points: a long
 /// message scrolls rather than push the form off a 768-pixel screen.
 const ERROR_HEIGHT: f32 = 90.0;
@@ -266,35 +266,6 @@ fn files_ui(
                 commands,
             );
         });
-}
-
-pub(super) fn path_row(
-    ui: &mut egui::Ui,
-    label: &str,
-    text: &mut String,
-    hint: &str,
-    busy: bool,
-    purpose: DialogPurpose,
-    commands: &mut Vec<Command>,
-) {
-    let l = ui.label(label);
-    ui.add(
-        egui::TextEdit::singleline(text)
-            .hint_text(hint)
-            .desired_width(PATH_WIDTH),
-    )
-    .labelled_by(l.id);
-    if ui
-        .add_enabled(!busy, egui::Button::new("Browse…"))
-        .on_hover_text(format!(
-            "choose the {} with the desktop's dialog",
-            label.to_lowercase()
-        ))
-        .clicked()
-    {
-        commands.push(Command::Files(FilesCommand::Browse(purpose)));
-    }
-    ui.end_row();
 }
 
 fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {

@@ -10,7 +10,7 @@
 
 use egui::RichText;
 
-use super::import::path_row;
+use super::path_row;
 use super::{BAD, GOOD, MUTED, WARN};
 use crate::app::commands::{Command, ImportCommand};
 use crate::app::forms::import::{HandEyeChoice, ImportForm, ObservationKind};

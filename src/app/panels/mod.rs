@@ -381,6 +381,42 @@ pub fn log_tick(exponent: f64) -> String {
     format!("{v:.decimals$}")
 }
 
+/// Width of the path fields, points.
+pub const PATH_WIDTH: f32 = 420.0;
+
+/// A path row of a form grid: its label, the path field and a Browse…
+/// button that asks for the desktop's dialog for `purpose`.
+pub fn path_row(
+    ui: &mut egui::Ui,
+    label: &str,
+    text: &mut String,
+    hint: &str,
+    busy: bool,
+    purpose: DialogPurpose,
+    commands: &mut Vec<Command>,
+) {
+    let l = ui.label(label);
+    ui.add(
+        egui::TextEdit::singleline(text)
+            .hint_text(hint)
+            .desired_width(PATH_WIDTH),
+    )
+    .labelled_by(l.id);
+    if ui
+        .add_enabled(!busy, egui::Button::new("Browse…"))
+        .on_hover_text(format!(
+            "choose the {} with the desktop's dialog",
+            label.to_lowercase()
+        ))
+        .clicked()
+    {
+        commands.push(Command::Files(crate::app::commands::FilesCommand::Browse(
+            purpose,
+        )));
+    }
+    ui.end_row();
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
