@@ -23,7 +23,8 @@ use spherecal::engine::files::import::{
 };
 use spherecal::engine::tools::evaluate;
 use spherecal::engine::tools::plan::{
-    self, Controller, Plan, PlanConfig, PlanError, PredictConfig, Selection, StationRole,
+    self, Controller, Plan, PlanConfig, PlanDesign, PlanError, PredictConfig, Selection,
+    StationRole,
 };
 use spherecal::engine::tools::simulate::{self, ErrorModel, PlanExecution, SimConfig, Truth};
 
@@ -32,12 +33,12 @@ use spherecal::engine::tools::simulate::{self, ErrorModel, PlanExecution, SimCon
 /// 8 orientations per station.
 fn small_config(seed: u64) -> PlanConfig {
     let mut c = PlanConfig::for_preset(&robot::irb2400(), [1050.0, 0.0, 475.0]);
-    c.n_identify = 4;
-    c.identify_poses = 6;
-    c.n_validate = 4;
-    c.validate_poses = 4;
-    c.candidates = 8;
-    c.seed = seed;
+    c.design.n_identify = 4;
+    c.design.identify_poses = 6;
+    c.design.n_validate = 4;
+    c.design.validate_poses = 4;
+    c.design.candidates = 8;
+    c.design.seed = seed;
     c
 }
 
@@ -67,8 +68,8 @@ fn simulate_plan(plan: &Plan, config: &SimConfig) -> (Session, Truth) {
 fn every_pose_is_reachable_and_sees_the_sphere_at_the_planned_offset() {
     let plan = small_plan();
     let config = small_config(1);
-    let radius = config.diameter / 2.0;
-    let offset = radius * config.cut_angle.to_radians().sin();
+    let radius = config.design.diameter / 2.0;
+    let offset = radius * config.design.cut_angle.to_radians().sin();
     assert_eq!(plan.poses.len(), 4 + 6 + 4 * 6 + 4 * 4);
     for p in &plan.poses {
         for (q, l) in p.joints.iter().zip(&config.limits) {
@@ -151,7 +152,7 @@ fn d_optimal_selection_beats_random_selections() {
     // Random selections of other seeds from their own candidates.
     for seed in [2, 3] {
         let mut config = small_config(seed);
-        config.selection = Selection::Random;
+        config.design.selection = Selection::Random;
         let random = make(&config).unwrap();
         assert_eq!(random.stats.log_det, random.stats.log_det_random);
         assert!(st.log_det > random.stats.log_det, "seed {seed}");
@@ -221,19 +222,51 @@ fn same_seed_same_plan_other_seed_other_plan() {
     assert_ne!(a, c);
 }
 
+/// The least translation group eq. 6-7 take (3 poses, as `--translations`
+/// allows) plans: two displacements of the step, at right angles, one
+/// flange orientation.
+#[test]
+fn three_translations_give_two_directions() {
+    let mut config = small_config(1);
+    config.design.n_translation = 3;
+    let plan = make(&config).unwrap();
+    let t: Vec<_> = plan
+        .poses
+        .iter()
+        .filter(|p| p.usage == Use::Translation)
+        .collect();
+    assert_eq!(t.len(), 3);
+    let d: Vec<Vector3<f64>> = t[1..]
+        .iter()
+        .map(|p| p.base_from_flange.translation.vector - t[0].base_from_flange.translation.vector)
+        .collect();
+    for v in &d {
+        assert!((v.norm() - config.translation_step).abs() < 1e-6, "{v}");
+    }
+    assert!(d[0].dot(&d[1]).abs() < 1e-6, "{d:?}");
+    for p in &t[1..] {
+        assert!(
+            p.base_from_flange
+                .rotation
+                .angle_to(&t[0].base_from_flange.rotation)
+                < 1e-9
+        );
+    }
+}
+
 #[test]
 fn degenerate_requests_are_explained() {
     // A sphere 5 m away.
     let mut config = small_config(1);
-    config.sphere = [5000.0, 0.0, 0.0];
-    config.candidates = 2;
+    config.design.sphere = [5000.0, 0.0, 0.0];
+    config.design.candidates = 2;
     match make(&config) {
         Err(PlanError::Unreachable(u)) => assert_eq!(u.station, "P0"),
         other => panic!("{other:?}"),
     }
     // No hand-eye groups: the first identify station is out of reach.
-    config.n_translation = 0;
-    config.n_rotation = 0;
+    config.design.n_translation = 0;
+    config.design.n_rotation = 0;
     match make(&config) {
         Err(e @ PlanError::Unreachable(_)) => {
             assert!(e.to_string().contains("station P1"), "{e}");
@@ -242,10 +275,10 @@ fn degenerate_requests_are_explained() {
     }
     // More poses than reachable candidates.
     let mut config = small_config(1);
-    config.n_translation = 0;
-    config.n_rotation = 0;
-    config.candidates = 1;
-    config.identify_poses = 40;
+    config.design.n_translation = 0;
+    config.design.n_rotation = 0;
+    config.design.candidates = 1;
+    config.design.identify_poses = 40;
     match make(&config) {
         Err(PlanError::TooFewPoses { needed, found, .. }) => {
             assert_eq!(needed, 20);
@@ -255,31 +288,36 @@ fn degenerate_requests_are_explained() {
     }
     // Two translations only span one direction; a zero step none.
     let mut config = small_config(1);
-    config.n_translation = 2;
+    config.design.n_translation = 2;
     assert!(matches!(
         make(&config),
         Err(PlanError::CollinearTranslations { .. })
     ));
-    config.n_translation = 4;
+    config.design.n_translation = 4;
     config.translation_step = 0.0;
     assert!(matches!(
         make(&config),
         Err(PlanError::CollinearTranslations { .. })
     ));
     // Settings out of range.
+    let small = small_config(1).design;
+    let with = |design: PlanDesign| PlanConfig {
+        design,
+        ..small_config(1)
+    };
     for broken in [
-        PlanConfig {
+        with(PlanDesign {
             cut_angle: 85.0,
-            ..small_config(1)
-        },
-        PlanConfig {
+            ..small
+        }),
+        with(PlanDesign {
             identify_poses: 1,
-            ..small_config(1)
-        },
-        PlanConfig {
+            ..small
+        }),
+        with(PlanDesign {
             n_rotation: 1,
-            ..small_config(1)
-        },
+            ..small
+        }),
         PlanConfig {
             limits: Vec::new(),
             ..small_config(1)

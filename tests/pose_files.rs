@@ -416,11 +416,11 @@ fn plan_programs_import_back_to_the_planned_poses() {
         let w = Workspace::for_robot(RobotChoice::from_key(key).unwrap());
         let sphere = [0, 1, 2].map(|i| f64::midpoint(w.min[i], w.max[i]));
         let mut config = PlanConfig::for_preset(&preset, sphere);
-        config.n_identify = 2;
-        config.identify_poses = 4;
-        config.n_validate = 1;
-        config.validate_poses = 3;
-        config.candidates = 8;
+        config.design.n_identify = 2;
+        config.design.identify_poses = 4;
+        config.design.n_validate = 1;
+        config.design.validate_poses = 3;
+        config.design.candidates = 8;
         let plan = plan::plan(&config, &mut |_| Control::Continue).unwrap();
         let robot = key;
         let dir = tempfile::tempdir().unwrap();

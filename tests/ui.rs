@@ -745,11 +745,11 @@ fn a_plan_is_made_exported_simulated_and_calibrated() {
     assert_eq!(h.state().forms().tab, Tab::Plan);
     {
         let f = &mut h.state_mut().forms_mut().plan;
-        f.request.n_identify = 3;
-        f.request.identify_poses = 4;
-        f.request.n_validate = 2;
-        f.request.validate_poses = 3;
-        f.request.candidates = 8;
+        f.request.design.n_identify = 3;
+        f.request.design.identify_poses = 4;
+        f.request.design.n_validate = 2;
+        f.request.design.validate_poses = 3;
+        f.request.design.candidates = 8;
         f.request.predict_runs = 1;
     }
     h.get_by_label("Make plan").click();

@@ -479,7 +479,7 @@ fn next_has_an_action_after_a_fail_and_without_validation() {
     h.get_by_label("Next: Plan more stations").click();
     h.run();
     assert_eq!(h.state().forms().tab, Tab::Plan);
-    assert!(h.state().forms().plan.request.n_identify > 9);
+    assert!(h.state().forms().plan.request.design.n_identify > 9);
     assert!(
         h.query_all_by_label_contains("or: write the report (FAIL)")
             .next()

@@ -15,8 +15,8 @@ use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
 use crate::engine::files::import::RobotSource;
 use crate::engine::tools::plan::{
-    self, Controller, PlanConfig, PlanError, PlanRequest, PlanStage, PredictConfig, RequestError,
-    Selection, defaults, read_hand_eye, read_stations,
+    self, Controller, PlanConfig, PlanDesign, PlanError, PlanRequest, PlanStage, PredictConfig,
+    RequestError, Selection, defaults, read_hand_eye, read_stations,
 };
 use crate::engine::tools::simulate;
 
@@ -149,6 +149,24 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
             .map_err(CliError::input)?
     };
     Ok(PlanRequest {
+        design: PlanDesign {
+            sphere: args.sphere,
+            diameter: args.diameter,
+            n_translation: args.translations,
+            n_rotation: args.rotations,
+            n_identify: args.identify_stations,
+            identify_poses: args.identify_poses,
+            n_validate: args.validate_stations,
+            validate_poses: args.validate_poses,
+            cut_angle: args.angle,
+            candidates: args.candidates,
+            selection: if args.random {
+                Selection::Random
+            } else {
+                Selection::DOptimal
+            },
+            seed: args.seed,
+        },
         limits: if args.limits.is_empty() {
             None
         } else {
@@ -160,13 +178,6 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
             .map(read_hand_eye)
             .transpose()
             .map_err(input)?,
-        diameter: args.diameter,
-        n_translation: args.translations,
-        n_rotation: args.rotations,
-        n_identify: args.identify_stations,
-        identify_poses: args.identify_poses,
-        n_validate: args.validate_stations,
-        validate_poses: args.validate_poses,
         box_size: args.box_size,
         stations: args
             .stations
@@ -174,15 +185,7 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
             .map(read_stations)
             .transpose()
             .map_err(input)?,
-        cut_angle: args.angle,
         cone_angle: args.cone,
-        candidates: args.candidates,
-        seed: args.seed,
-        selection: if args.random {
-            Selection::Random
-        } else {
-            Selection::DOptimal
-        },
         predict_runs: args.predict,
         range: args.range,
         spread: args.range.is_some() && !args.no_spread,
@@ -445,13 +448,13 @@ mod tests {
             "-360:360,-150:-10,10:160,-360:360,-360:360,-360:360",
         ]);
         let c = config(&args).unwrap();
-        assert_eq!(c.sphere, [-525.0, 0.0, 125.5]);
+        assert_eq!(c.design.sphere, [-525.0, 0.0, 125.5]);
         assert_eq!(c.robot.name, "Universal Robots UR5e");
-        assert_eq!((c.n_identify, c.identify_poses), (4, 5));
-        assert_eq!((c.n_validate, c.validate_poses), (3, 2));
-        assert_eq!(c.cut_angle, 35.0);
-        assert_eq!(c.seed, 9);
-        assert_eq!(c.selection, Selection::Random);
+        assert_eq!((c.design.n_identify, c.design.identify_poses), (4, 5));
+        assert_eq!((c.design.n_validate, c.design.validate_poses), (3, 2));
+        assert_eq!(c.design.cut_angle, 35.0);
+        assert_eq!(c.design.seed, 9);
+        assert_eq!(c.design.selection, Selection::Random);
         assert_eq!(
             c.stations,
             StationLayout::Box {

@@ -59,11 +59,11 @@ pub fn open_path(h: &mut Harness<'_, WorkbenchApp>, path: std::path::PathBuf) {
 /// prediction): planned in well under a second.
 pub fn small_plan(h: &mut Harness<'_, WorkbenchApp>, n_identify: usize, n_validate: usize) {
     let r = &mut h.state_mut().forms_mut().plan.request;
-    r.n_identify = n_identify;
-    r.identify_poses = 4;
-    r.n_validate = n_validate;
-    r.validate_poses = 3;
-    r.candidates = 8;
+    r.design.n_identify = n_identify;
+    r.design.identify_poses = 4;
+    r.design.n_validate = n_validate;
+    r.design.validate_poses = 3;
+    r.design.candidates = 8;
     r.predict_runs = 0;
 }
 

@@ -517,7 +517,7 @@ impl Core {
             && self.forms.plan.robot != p.key
         {
             self.forms.plan.robot = p.key.to_string();
-            self.forms.plan.request.sphere = crate::app::forms::plan::default_sphere(p.key);
+            self.forms.plan.request.design.sphere = crate::app::forms::plan::default_sphere(p.key);
         }
         // A session that knows its measuring range plans for it.
         self.forms.range_edit = None;

@@ -164,7 +164,7 @@ impl Core {
         };
         let have = loaded.session.stations(Use::Identify).len();
         let want = more_stations(have);
-        self.forms.plan.request.n_identify = want;
+        self.forms.plan.request.design.n_identify = want;
         self.state.say(
             Level::Info,
             format!(
@@ -260,7 +260,7 @@ impl Core {
             return;
         };
         let robot = self.forms.plan.robot.clone();
-        let seed = self.forms.plan.request.seed;
+        let seed = self.forms.plan.request.design.seed;
         let started = self.spawn(ctx, "simulate", move |rep| {
             let outcome = simulate_plan(&plan, &robot, seed)
                 .map(|session| Box::new(analyse(session, Source::Simulated)));

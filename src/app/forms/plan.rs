@@ -71,10 +71,10 @@ mod tests {
     #[test]
     fn defaults_match_the_cli_and_the_preset_workspace() {
         let f = PlanForm::default();
-        assert_eq!(f.request.sphere, [1050.0, 0.0, 475.0]);
+        assert_eq!(f.request.design.sphere, [1050.0, 0.0, 475.0]);
         let c = f.config(None).unwrap();
-        assert_eq!(c.n_identify, 9);
-        assert_eq!(c.seed, 1);
+        assert_eq!(c.design.n_identify, 9);
+        assert_eq!(c.design.seed, 1);
         assert!(f.config(Some(Isometry3::identity())).is_ok());
         let g = PlanForm {
             hand_eye_from_session: true,

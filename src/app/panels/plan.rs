@@ -90,13 +90,13 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
                 .response
                 .labelled_by(l.id);
             if f.robot != before {
-                f.request.sphere = default_sphere(&f.robot);
+                f.request.design.sphere = default_sphere(&f.robot);
             }
             ui.end_row();
             for (k, axis) in ["x", "y", "z"].iter().enumerate() {
                 let l = ui.label(format!("Sphere {axis}"));
                 ui.add(
-                    egui::DragValue::new(&mut f.request.sphere[k])
+                    egui::DragValue::new(&mut f.request.design.sphere[k])
                         .speed(1.0)
                         .max_decimals(1)
                         .suffix(" mm"),
@@ -106,13 +106,13 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
                 ui.end_row();
             }
             let counts: [(&str, &mut usize, usize, &str); 8] = [
-                ("Translations", &mut f.request.n_translation, 12, "pure translations at P0 (initial rotation, eq. 6-7)"),
-                ("Rotations", &mut f.request.n_rotation, 12, "orientation changes at P0 (initial translation, eq. 8-9)"),
-                ("Identify stations", &mut f.request.n_identify, 30, "sphere positions for the identification"),
-                ("Poses per identify station", &mut f.request.identify_poses, 20, "measurements at each identify station"),
-                ("Validate stations", &mut f.request.n_validate, 30, "sphere positions held out, with tracker distances"),
-                ("Poses per validate station", &mut f.request.validate_poses, 20, "measurements at each validate station"),
-                ("Candidates per station", &mut f.request.candidates, 200, "orientations tried per station before selection"),
+                ("Translations", &mut f.request.design.n_translation, 12, "pure translations at P0 (initial rotation, eq. 6-7)"),
+                ("Rotations", &mut f.request.design.n_rotation, 12, "orientation changes at P0 (initial translation, eq. 8-9)"),
+                ("Identify stations", &mut f.request.design.n_identify, 30, "sphere positions for the identification"),
+                ("Poses per identify station", &mut f.request.design.identify_poses, 20, "measurements at each identify station"),
+                ("Validate stations", &mut f.request.design.n_validate, 30, "sphere positions held out, with tracker distances"),
+                ("Poses per validate station", &mut f.request.design.validate_poses, 20, "measurements at each validate station"),
+                ("Candidates per station", &mut f.request.design.candidates, 200, "orientations tried per station before selection"),
                 ("Predicted by (runs)", &mut f.request.predict_runs, 50, "simulated calibrations for the predicted accuracy (0: none)"),
             ];
             for (label, value, max, hint) in counts {
@@ -124,7 +124,7 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
             }
             let l = ui.label("Cut angle");
             ui.add(
-                egui::DragValue::new(&mut f.request.cut_angle)
+                egui::DragValue::new(&mut f.request.design.cut_angle)
                     .range(5.0..=80.0)
                     .speed(0.2)
                     .suffix(" deg"),
@@ -133,7 +133,7 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
             .on_hover_text("the laser plane cuts the sphere this far from its centre (sphere centre at sensor x = ±R·sin)");
             ui.end_row();
             let l = ui.label("Seed");
-            ui.add(egui::DragValue::new(&mut f.request.seed).speed(0.2))
+            ui.add(egui::DragValue::new(&mut f.request.design.seed).speed(0.2))
                 .labelled_by(l.id)
                 .on_hover_text("the same settings and seed give the same plan");
             ui.end_row();

@@ -122,7 +122,7 @@ impl Planner<'_> {
         let c = self.config;
         let (identify, validate): (Vec<Vector3<f64>>, Vec<Vector3<f64>>) = match &c.stations {
             StationLayout::Box { size } => {
-                let centre = Vector3::from(c.sphere);
+                let centre = Vector3::from(c.design.sphere);
                 let half = Vector3::from(*size) / 2.0;
                 let eye = self.config.eye_point();
                 let w = Workspace {
@@ -131,8 +131,8 @@ impl Planner<'_> {
                     eye: eye.into(),
                 };
                 (
-                    workspace::identify_stations(rng, &w, c.n_identify),
-                    workspace::validate_stations(rng, &w, c.n_validate),
+                    workspace::identify_stations(rng, &w, c.design.n_identify),
+                    workspace::validate_stations(rng, &w, c.design.n_validate),
                 )
             }
             StationLayout::Explicit { identify, validate } => (
@@ -194,10 +194,10 @@ impl Planner<'_> {
         let mean = self.mean_approach(station);
         let cone = c.cone_angle.to_radians();
         let mut out = Vec::new();
-        for k in 0..c.candidates {
+        for k in 0..c.design.candidates {
             let rotation = approach::random_orientation(rng, &mean, cone);
             for side in [1_i8, -1] {
-                let offset = self.station_offset(rng, k, c.candidates);
+                let offset = self.station_offset(rng, k, c.design.candidates);
                 out.extend(self.candidates_at(
                     station,
                     &rotation,
@@ -207,7 +207,7 @@ impl Planner<'_> {
             }
         }
         if out.is_empty() {
-            return Err(self.unreachable(id, station, c.candidates));
+            return Err(self.unreachable(id, station, c.design.candidates));
         }
         Ok(out)
     }
@@ -281,7 +281,7 @@ impl Planner<'_> {
     ) -> PlanError {
         let (cone, cut, min_wrist) = (
             self.config.cone_angle,
-            self.config.cut_angle,
+            self.config.design.cut_angle,
             self.config.min_wrist_angle,
         );
         PlanError::Unreachable(Unreachable {
@@ -306,8 +306,8 @@ impl Planner<'_> {
         let mean = self.mean_approach(p0);
         // Near the middle of the cone, so the rotations about it stay reachable.
         let cone = c.cone_angle.to_radians() / 2.0;
-        let n = c.n_translation;
-        let tries = c.candidates * TRANSLATION_TRIES_PER_CANDIDATE;
+        let n = c.design.n_translation;
+        let tries = c.design.candidates * TRANSLATION_TRIES_PER_CANDIDATE;
         for _ in 0..tries {
             let rotation = approach::random_orientation(rng, &mean, cone);
             let phase = std::f64::consts::TAU * rng.random::<f64>();
@@ -322,8 +322,14 @@ impl Planner<'_> {
                 }
                 continue;
             }
-            // Directions 120° apart for 4 translations (the simulator's).
-            let step = std::f64::consts::TAU / (n - 1) as f64;
+            // Directions 120° apart for 4 translations (the simulator's),
+            // evenly round the turn for more; the two displacements of 3
+            // translations 90° apart (half a turn would be collinear).
+            let step = if n == 3 {
+                std::f64::consts::FRAC_PI_2
+            } else {
+                std::f64::consts::TAU / (n - 1) as f64
+            };
             let first = c.centre(1);
             let centres: Vec<Vector3<f64>> = (0..n)
                 .map(|k| {
@@ -383,11 +389,11 @@ impl Planner<'_> {
         reference: &UnitQuaternion<f64>,
     ) -> Result<Vec<Candidate>, PlanError> {
         let c = self.config;
-        let n = c.n_rotation;
+        let n = c.design.n_rotation;
         if n == 0 {
             return Ok(Vec::new());
         }
-        let draws = c.candidates.max(n) * 2;
+        let draws = c.design.candidates.max(n) * 2;
         let mut pool: Vec<Candidate> = Vec::new();
         for k in 0..draws {
             let rotation =
@@ -479,7 +485,7 @@ impl Planner<'_> {
     pub(super) fn sensor_covariance(&self, side: i8) -> Matrix3<f64> {
         stripe_centre_covariance(
             self.config.radius(),
-            self.config.cut_angle,
+            self.config.design.cut_angle,
             side,
             self.config.stripe_sigma,
         )
@@ -546,7 +552,12 @@ impl Planner<'_> {
             sensor_range: c.range,
             hand_eye: Some(c.flange_from_sensor),
             reference_distances,
-            ..Session::made("plan".to_owned(), c.robot.clone(), c.diameter, measurements)
+            ..Session::made(
+                "plan".to_owned(),
+                c.robot.clone(),
+                c.design.diameter,
+                measurements,
+            )
         };
         let prepared = Prepared {
             measurements: prepared,

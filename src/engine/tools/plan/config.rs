@@ -89,18 +89,37 @@ pub enum Selection {
     Random,
 }
 
-/// Everything the planner needs. [`PlanConfig::for_preset`] and
-/// [`PlanConfig::new`] fill the defaults.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PlanConfig {
-    /// The nominal model the controller uses (6 joints).
-    pub robot: Robot,
-    /// Joint limits, deg, one per joint.
-    pub limits: Vec<JointLimit>,
+/// The defaults of a plan, the command line's, the Plan view's and
+/// [`PlanDesign::new`]'s: the paper's experiment (section 4), as the
+/// simulator's defaults.
+pub mod defaults {
+    /// Sphere diameter, mm: the paper's 38.1 mm sphere.
+    pub const DIAMETER_MM: f64 = 38.1;
+    /// Translation poses at P0: one more than eq. 6-7's minimum of 3.
+    pub const TRANSLATIONS: usize = 4;
+    /// Rotation poses at P0, as the paper's experiment.
+    pub const ROTATIONS: usize = 6;
+    /// Identify stations: the paper's 3 × 3 layers.
+    pub const IDENTIFY_STATIONS: usize = 9;
+    /// Poses per identify station, as the paper's.
+    pub const IDENTIFY_POSES: usize = 6;
+    /// Validate stations: the paper's 54 distances are 9 pairs × 6 poses.
+    pub const VALIDATE_STATIONS: usize = 10;
+    /// Poses per validate station.
+    pub const VALIDATE_POSES: usize = 6;
+    /// Seed of every random choice.
+    pub const SEED: u64 = 1;
+}
+
+/// What a plan is made of, the same whether a person asks for it
+/// ([`super::PlanRequest`]) or the planner works from it
+/// ([`PlanConfig`]): the sphere, how many stations and poses of each
+/// group, the cut of the laser plane and how the identify poses are
+/// searched and chosen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanDesign {
     /// Rough sphere position (station `P0`), base frame, mm.
     pub sphere: [f64; 3],
-    /// The hand-eye guess `flange_from_sensor` (mm).
-    pub flange_from_sensor: Isometry3<f64>,
     /// Sphere diameter, mm.
     pub diameter: f64,
     /// Translation poses at `P0` (0, or at least 3).
@@ -123,6 +142,45 @@ pub struct PlanConfig {
     pub selection: Selection,
     /// Seed of every random choice: the same configuration gives the same plan.
     pub seed: u64,
+}
+
+impl PlanDesign {
+    /// The paper-like design ([`defaults`]) about a sphere at `sphere`:
+    /// 4 translations, 6 rotations, 9 identify and 10 validate stations of
+    /// 6 poses, a 38.1 mm sphere cut at 40°, 24 candidate orientations per
+    /// station, D-optimal selection, seed 1.
+    #[must_use]
+    pub fn new(sphere: [f64; 3]) -> Self {
+        Self {
+            sphere,
+            diameter: defaults::DIAMETER_MM,
+            n_translation: defaults::TRANSLATIONS,
+            n_rotation: defaults::ROTATIONS,
+            n_identify: defaults::IDENTIFY_STATIONS,
+            identify_poses: defaults::IDENTIFY_POSES,
+            n_validate: defaults::VALIDATE_STATIONS,
+            validate_poses: defaults::VALIDATE_POSES,
+            cut_angle: DEFAULT_CUT_ANGLE_DEG,
+            candidates: DEFAULT_CANDIDATES,
+            selection: Selection::DOptimal,
+            seed: defaults::SEED,
+        }
+    }
+}
+
+/// Everything the planner needs. [`PlanConfig::for_preset`] and
+/// [`PlanConfig::new`] fill the defaults.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanConfig {
+    /// The nominal model the controller uses (6 joints).
+    pub robot: Robot,
+    /// Joint limits, deg, one per joint.
+    pub limits: Vec<JointLimit>,
+    /// The sphere, the counts of stations and poses, the cut and the
+    /// candidate search: as the request asked.
+    pub design: PlanDesign,
+    /// The hand-eye guess `flange_from_sensor` (mm).
+    pub flange_from_sensor: Isometry3<f64>,
     /// Identify and validate stations.
     pub stations: StationLayout,
     /// Eye point (base frame, mm): approach directions centre on
@@ -174,19 +232,8 @@ impl PlanConfig {
         Self {
             robot,
             limits,
-            sphere,
+            design: PlanDesign::new(sphere),
             flange_from_sensor: sensor::paper_initial_hand_eye(),
-            diameter: sim.diameter,
-            n_translation: sim.n_translation,
-            n_rotation: sim.n_rotation,
-            n_identify: sim.n_identify,
-            identify_poses: sim.poses_per_station,
-            n_validate: sim.n_validate,
-            validate_poses: sim.poses_per_station,
-            cut_angle: DEFAULT_CUT_ANGLE_DEG,
-            candidates: DEFAULT_CANDIDATES,
-            selection: Selection::DOptimal,
-            seed: 1,
             stations: StationLayout::Box {
                 size: DEFAULT_BOX_MM,
             },
@@ -233,7 +280,7 @@ impl PlanConfig {
             return Vector3::from(e);
         }
         let b = self.robot.base.translation.vector;
-        let s = Vector3::from(self.sphere);
+        let s = Vector3::from(self.design.sphere);
         let horizontal = (s.x - b.x).hypot(s.y - b.y);
         Vector3::new(b.x, b.y, s.z + horizontal)
     }
@@ -289,8 +336,8 @@ impl PlanConfig {
     /// plausibility limits.
     fn check_lengths(&self) -> Result<(), PlanError> {
         let reals = [
-            ("diameter", self.diameter),
-            ("cut angle", self.cut_angle),
+            ("diameter", self.design.diameter),
+            ("cut angle", self.design.cut_angle),
             ("cone angle", self.cone_angle),
             ("min wrist angle", self.min_wrist_angle),
             ("translation step", self.translation_step),
@@ -322,31 +369,31 @@ impl PlanConfig {
         check(!self.spread || self.range.is_some(), || {
             "spreading the sphere needs the sensor's range (--range)".to_owned()
         })?;
-        check(self.sphere.iter().all(|v| v.is_finite()), || {
+        check(self.design.sphere.iter().all(|v| v.is_finite()), || {
             "the sphere position must be three finite numbers (mm)".to_owned()
         })?;
-        check(self.diameter > 0.0, || {
+        check(self.design.diameter > 0.0, || {
             format!(
                 "the sphere diameter must be positive, found {} mm",
-                self.diameter
+                self.design.diameter
             )
         })?;
         // The session file's plausibility limits: a plan's numbers end up
         // in sessions and messages.
-        check(self.diameter <= limits::SPHERE_DIAMETER_MM, || {
+        check(self.design.diameter <= limits::SPHERE_DIAMETER_MM, || {
             format!(
                 "the sphere diameter {} mm is not plausible (at most {} mm)",
-                show(self.diameter),
+                show(self.design.diameter),
                 limits::SPHERE_DIAMETER_MM
             )
         })?;
         let far = |v: &[f64]| v.iter().any(|x| x.abs() > limits::LENGTH_MM);
-        check(!far(&self.sphere), || {
+        check(!far(&self.design.sphere), || {
             format!(
                 "the sphere position [{}, {}, {}] mm is not plausible (at most {} mm from the base)",
-                show(self.sphere[0]),
-                show(self.sphere[1]),
-                show(self.sphere[2]),
+                show(self.design.sphere[0]),
+                show(self.design.sphere[1]),
+                show(self.design.sphere[2]),
                 limits::LENGTH_MM
             )
         })?;
@@ -368,12 +415,15 @@ impl PlanConfig {
     /// The cut, cone, wrist and rotation angles, the noise model, at least
     /// one candidate orientation.
     fn check_angles(&self) -> Result<(), PlanError> {
-        check(self.cut_angle > 5.0 && self.cut_angle < 80.0, || {
-            format!(
-                "the cut angle must be within (5, 80) deg, found {}",
-                self.cut_angle
-            )
-        })?;
+        check(
+            self.design.cut_angle > 5.0 && self.design.cut_angle < 80.0,
+            || {
+                format!(
+                    "the cut angle must be within (5, 80) deg, found {}",
+                    self.design.cut_angle
+                )
+            },
+        )?;
         check((0.0..=90.0).contains(&self.cone_angle), || {
             format!(
                 "the cone angle must be within 0..90 deg, found {}",
@@ -401,7 +451,7 @@ impl PlanConfig {
             self.joint_sigma_deg >= 0.0 && self.stripe_sigma > 0.0,
             || "the noise model needs joint sigma ≥ 0 and stripe sigma > 0".to_owned(),
         )?;
-        check(self.candidates >= 1, || {
+        check(self.design.candidates >= 1, || {
             "at least one candidate orientation per station is needed".to_owned()
         })?;
         Ok(())
@@ -418,46 +468,46 @@ impl PlanConfig {
                 self.n_validate_stations()
             )
         })?;
-        check(self.candidates <= MAX_CANDIDATES, || {
+        check(self.design.candidates <= MAX_CANDIDATES, || {
             format!(
                 "{} candidate orientations per station asked for: at most {MAX_CANDIDATES}",
-                self.candidates
+                self.design.candidates
             )
         })?;
         check(
-            stations.saturating_mul(self.candidates) <= MAX_ORIENTATIONS,
+            stations.saturating_mul(self.design.candidates) <= MAX_ORIENTATIONS,
             || {
                 format!(
                     "{stations} stations × {} candidates = {} orientations to solve: a plan has at most {MAX_ORIENTATIONS}; ask for fewer stations or candidates",
-                    self.candidates,
-                    stations.saturating_mul(self.candidates)
+                    self.design.candidates,
+                    stations.saturating_mul(self.design.candidates)
                 )
             },
         )?;
         for (name, n) in [
-            ("translation poses", self.n_translation),
-            ("rotation poses", self.n_rotation),
-            ("identify poses per station", self.identify_poses),
-            ("validate poses per station", self.validate_poses),
+            ("translation poses", self.design.n_translation),
+            ("rotation poses", self.design.n_rotation),
+            ("identify poses per station", self.design.identify_poses),
+            ("validate poses per station", self.design.validate_poses),
         ] {
             check(n <= MAX_GROUP_POSES, || {
                 format!("{n} {name} asked for: at most {MAX_GROUP_POSES}")
             })?;
         }
-        check(self.n_rotation != 1, || {
+        check(self.design.n_rotation != 1, || {
             "the rotation group needs at least 2 poses (eq. 8 uses pairs), or none".to_owned()
         })?;
         check(self.n_identify_stations() >= 1, || {
             "at least one identify station is needed".to_owned()
         })?;
-        check(self.identify_poses >= 2, || {
+        check(self.design.identify_poses >= 2, || {
             format!(
                 "an identify station needs at least 2 poses (FORMAT.md), found {}",
-                self.identify_poses
+                self.design.identify_poses
             )
         })?;
         check(
-            self.n_validate_stations() == 0 || self.validate_poses >= 1,
+            self.n_validate_stations() == 0 || self.design.validate_poses >= 1,
             || "validate stations need at least 1 pose".to_owned(),
         )?;
         Ok(())
@@ -487,26 +537,26 @@ impl PlanConfig {
 
     pub(super) fn n_identify_stations(&self) -> usize {
         match &self.stations {
-            StationLayout::Box { .. } => self.n_identify,
+            StationLayout::Box { .. } => self.design.n_identify,
             StationLayout::Explicit { identify, .. } => identify.len(),
         }
     }
 
     pub(super) fn n_validate_stations(&self) -> usize {
         match &self.stations {
-            StationLayout::Box { .. } => self.n_validate,
+            StationLayout::Box { .. } => self.design.n_validate,
             StationLayout::Explicit { validate, .. } => validate.len(),
         }
     }
 
     pub(super) fn radius(&self) -> f64 {
-        self.diameter / 2.0
+        self.design.diameter / 2.0
     }
 
     /// The planned sensor-frame centre on `side`.
     pub(super) fn centre(&self, side: i8) -> Vector3<f64> {
         Vector3::new(
-            f64::from(side) * self.radius() * self.cut_angle.to_radians().sin(),
+            f64::from(side) * self.radius() * self.design.cut_angle.to_radians().sin(),
             0.0,
             0.0,
         )

@@ -113,14 +113,14 @@ pub use config::{
     DEFAULT_BOX_MM, DEFAULT_CANDIDATES, DEFAULT_CENTRE_SPREAD_MM, DEFAULT_CONE_DEG,
     DEFAULT_CUT_ANGLE_DEG, DEFAULT_MIN_WRIST_DEG, DEFAULT_ROTATION_MAX_DEG,
     DEFAULT_ROTATION_MIN_DEG, DEFAULT_TRANSLATION_STEP_MM, MAX_CANDIDATES, MAX_GROUP_POSES,
-    MAX_ORIENTATIONS, MAX_STATIONS, PlanConfig, Selection, StationLayout,
+    MAX_ORIENTATIONS, MAX_STATIONS, PlanConfig, PlanDesign, Selection, StationLayout, defaults,
 };
 pub use export::{Controller, RAPID_MODULE, plan_csv, rapid_module, read_plan_csv, ur_script};
 use order::{Metric, order_groups};
 pub use predict::{
     PredictConfig, Prediction, RangePrediction, RunScore, predict, simulated_true_hand_eye,
 };
-pub use request::{PlanRequest, RequestError, defaults, read_hand_eye, read_stations};
+pub use request::{PlanRequest, RequestError, read_hand_eye, read_stations};
 use select::{
     Info, Objective, criterion, greedy_selection, prior_information, random_selection,
     spread_selection,
@@ -357,7 +357,7 @@ pub fn plan(
 ) -> Result<Plan, PlanError> {
     let chain = checked_chain(config)?;
     let planner = Planner { config, chain };
-    let mut rng = random::stream(config.seed, STREAM_GEOMETRY);
+    let mut rng = random::stream(config.design.seed, STREAM_GEOMETRY);
     let mut sites = planner.sites(&mut rng);
     let mut cancel = |stage| {
         if progress(stage) == Control::Cancel {
@@ -394,16 +394,16 @@ pub fn plan(
 /// would be collinear) and builds the fast IK chain of its robot.
 fn checked_chain(config: &PlanConfig) -> Result<Chain, PlanError> {
     config.validate()?;
-    if (1..3).contains(&config.n_translation) {
+    if (1..3).contains(&config.design.n_translation) {
         return Err(PlanError::CollinearTranslations {
             detail: format!(
                 "{} translation pose(s) give {} displacement(s)",
-                config.n_translation,
-                config.n_translation - 1
+                config.design.n_translation,
+                config.design.n_translation - 1
             ),
         });
     }
-    if config.n_translation >= 3 && config.translation_step <= 0.0 {
+    if config.design.n_translation >= 3 && config.translation_step <= 0.0 {
         return Err(PlanError::CollinearTranslations {
             detail: format!("the translation step is {} mm", config.translation_step),
         });
@@ -428,11 +428,11 @@ fn gather_candidates(
 ) -> Result<Vec<Group>, PlanError> {
     let config = planner.config;
     let mut groups: Vec<Group> = Vec::new();
-    let hand_eye = config.n_translation + config.n_rotation > 0;
+    let hand_eye = config.design.n_translation + config.design.n_rotation > 0;
     let total = sites.len() + usize::from(hand_eye);
     let mut done = 0;
     if hand_eye {
-        let p0 = Vector3::from(config.sphere);
+        let p0 = Vector3::from(config.design.sphere);
         let (translations, reference) = planner.translation_group(rng, &p0)?;
         let rotations = planner.rotation_group(rng, &p0, &reference)?;
         sites.insert(
@@ -462,8 +462,8 @@ fn gather_candidates(
         let id = provisional_id(sites, k);
         sites[k].candidates = planner.station_candidates(rng, &sites[k].position, &id)?;
         let needed = match sites[k].role {
-            StationRole::Identify => config.identify_poses,
-            _ => config.validate_poses,
+            StationRole::Identify => config.design.identify_poses,
+            _ => config.design.validate_poses,
         };
         for side in [1_i8, -1] {
             let found = sites[k]
@@ -521,11 +521,11 @@ fn choose_poses(
     let identify_sites: Vec<usize> = (0..sites.len())
         .filter(|&k| sites[k].role == StationRole::Identify)
         .collect();
-    let mut baseline_rng = random::stream(config.seed, STREAM_BASELINE);
+    let mut baseline_rng = random::stream(config.design.seed, STREAM_BASELINE);
     let random = random_selection(
         sites,
         &identify_sites,
-        config.identify_poses,
+        config.design.identify_poses,
         &mut baseline_rng,
     );
     let log_det_random = criterion(&prior, &infos, &random).unwrap_or(f64::NEG_INFINITY);
@@ -533,14 +533,14 @@ fn choose_poses(
     // criterion is judged at.
     for site in sites.iter_mut() {
         if site.role == StationRole::Validate {
-            site.chosen = spread_selection(planner, site, config.validate_poses);
+            site.chosen = spread_selection(planner, site, config.design.validate_poses);
         }
     }
     let objective = match (config.spread, config.range) {
         (true, Some(range)) => Objective::Range(planner.range_weight(sites, &estimated, &range)),
         _ => Objective::LogDet,
     };
-    let chosen = match config.selection {
+    let chosen = match config.design.selection {
         Selection::DOptimal => {
             greedy_selection(planner, sites, &identify_sites, &infos, &prior, &objective)
         }
@@ -604,8 +604,8 @@ fn ordered_plan(config: &PlanConfig, sites: &[Site], mut groups: Vec<Group>) -> 
         robot: config.robot.clone(),
         limits: config.limits.clone(),
         flange_from_sensor: config.flange_from_sensor,
-        diameter: config.diameter,
-        cut_angle: config.cut_angle,
+        diameter: config.design.diameter,
+        cut_angle: config.design.cut_angle,
         range: config.range,
         stations,
         poses,

@@ -7,10 +7,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::Isometry3;
 
-use super::config::{
-    DEFAULT_CANDIDATES, DEFAULT_CONE_DEG, DEFAULT_CUT_ANGLE_DEG, PlanConfig, Selection,
-    StationLayout,
-};
+use super::config::{DEFAULT_CONE_DEG, PlanConfig, PlanDesign, StationLayout};
 use super::predict::PredictConfig;
 use crate::engine::base::cell::workspace;
 use crate::engine::base::robot::{self, JointLimit};
@@ -47,26 +44,6 @@ pub enum RequestError {
     },
 }
 
-/// The defaults of a request, the command line's and the Plan view's.
-pub mod defaults {
-    /// Sphere diameter, mm: the paper's 38.1 mm sphere.
-    pub const DIAMETER_MM: f64 = 38.1;
-    /// Translation poses at P0: one more than eq. 6-7's minimum of 3.
-    pub const TRANSLATIONS: usize = 4;
-    /// Rotation poses at P0, as the paper's experiment.
-    pub const ROTATIONS: usize = 6;
-    /// Identify stations: the paper's 3 × 3 layers.
-    pub const IDENTIFY_STATIONS: usize = 9;
-    /// Poses per identify station, as the paper's.
-    pub const IDENTIFY_POSES: usize = 6;
-    /// Validate stations: the paper's 54 distances are 9 pairs × 6 poses.
-    pub const VALIDATE_STATIONS: usize = 10;
-    /// Poses per validate station.
-    pub const VALIDATE_POSES: usize = 6;
-    /// Seed of every random choice.
-    pub const SEED: u64 = 1;
-}
-
 /// A plan as asked for.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlanRequest {
@@ -75,38 +52,17 @@ pub struct PlanRequest {
     pub robot: RobotSource,
     /// Joint limits, deg; `None`: the preset's, as a cell plans within.
     pub limits: Option<Vec<JointLimit>>,
-    /// Rough sphere position, base frame, mm.
-    pub sphere: [f64; 3],
+    /// The sphere, the counts of stations and poses, the cut and the
+    /// candidate search.
+    pub design: PlanDesign,
     /// Hand-eye guess `flange_from_sensor`; `None`: the paper's initial one.
     pub hand_eye: Option<Isometry3<f64>>,
-    /// Sphere diameter, mm.
-    pub diameter: f64,
-    /// Translation poses at P0.
-    pub n_translation: usize,
-    /// Rotation poses at P0.
-    pub n_rotation: usize,
-    /// Identify stations.
-    pub n_identify: usize,
-    /// Poses per identify station.
-    pub identify_poses: usize,
-    /// Validate stations.
-    pub n_validate: usize,
-    /// Poses per validate station.
-    pub validate_poses: usize,
     /// Station box `dx, dy, dz` (mm) about the sphere; `None`: the preset's.
     pub box_size: Option<[f64; 3]>,
     /// Explicit stations instead of the box.
     pub stations: Option<StationLayout>,
-    /// Cut angle of the laser plane, deg.
-    pub cut_angle: f64,
     /// Half-angle of the cone of approach directions, deg.
     pub cone_angle: f64,
-    /// Flange orientations drawn per station.
-    pub candidates: usize,
-    /// Seed of every random choice.
-    pub seed: u64,
-    /// D-optimal or random identify poses.
-    pub selection: Selection,
     /// Simulated calibrations for the predicted accuracy (0: none).
     pub predict_runs: usize,
     /// The sensor's measuring range (`sensor.range`): the plan predicts
@@ -124,22 +80,11 @@ impl PlanRequest {
         Self {
             robot,
             limits: None,
-            sphere,
+            design: PlanDesign::new(sphere),
             hand_eye: None,
-            diameter: defaults::DIAMETER_MM,
-            n_translation: defaults::TRANSLATIONS,
-            n_rotation: defaults::ROTATIONS,
-            n_identify: defaults::IDENTIFY_STATIONS,
-            identify_poses: defaults::IDENTIFY_POSES,
-            n_validate: defaults::VALIDATE_STATIONS,
-            validate_poses: defaults::VALIDATE_POSES,
             box_size: None,
             stations: None,
-            cut_angle: DEFAULT_CUT_ANGLE_DEG,
             cone_angle: DEFAULT_CONE_DEG,
-            candidates: DEFAULT_CANDIDATES,
-            seed: defaults::SEED,
-            selection: Selection::DOptimal,
             predict_runs: PredictConfig::default().runs,
             range: None,
             spread: false,
@@ -157,7 +102,7 @@ impl PlanRequest {
             RobotSource::Preset(key) => {
                 let preset = robot::preset(key)
                     .ok_or_else(|| RequestError::Robot(format!("unknown robot preset `{key}`")))?;
-                PlanConfig::for_preset(&preset, self.sphere)
+                PlanConfig::for_preset(&preset, self.design.sphere)
             }
             RobotSource::Urdf { path, tip } => {
                 let options = robot::UrdfOptions {
@@ -175,7 +120,7 @@ impl PlanRequest {
                         max: l.max.min(360.0),
                     })
                     .collect();
-                PlanConfig::new(urdf.robot, limits, self.sphere)
+                PlanConfig::new(urdf.robot, limits, self.design.sphere)
             }
             RobotSource::File(path) | RobotSource::DhTable { path, .. } => {
                 let robot =
@@ -186,11 +131,11 @@ impl PlanRequest {
                 {
                     Some(p) => {
                         let limits = workspace::cell_limits(p.key, &p.limits);
-                        PlanConfig::new(robot, limits, self.sphere)
+                        PlanConfig::new(robot, limits, self.design.sphere)
                     }
                     None if self.limits.is_some() => {
                         let limits = self.limits.clone().unwrap_or_default();
-                        PlanConfig::new(robot, limits, self.sphere)
+                        PlanConfig::new(robot, limits, self.design.sphere)
                     }
                     None => {
                         return Err(RequestError::LimitsNeeded {
@@ -207,24 +152,14 @@ impl PlanRequest {
         if let Some(he) = self.hand_eye {
             config.flange_from_sensor = he;
         }
-        config.diameter = self.diameter;
-        config.n_translation = self.n_translation;
-        config.n_rotation = self.n_rotation;
-        config.n_identify = self.n_identify;
-        config.identify_poses = self.identify_poses;
-        config.n_validate = self.n_validate;
-        config.validate_poses = self.validate_poses;
+        config.design = self.design;
         if let Some(size) = self.box_size {
             config.stations = StationLayout::Box { size };
         }
         if let Some(stations) = &self.stations {
             config.stations = stations.clone();
         }
-        config.cut_angle = self.cut_angle;
         config.cone_angle = self.cone_angle;
-        config.candidates = self.candidates;
-        config.seed = self.seed;
-        config.selection = self.selection;
         config.range = self.range;
         config.spread = self.spread && self.range.is_some();
         Ok(config)

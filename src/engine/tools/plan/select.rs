@@ -244,7 +244,7 @@ pub(super) fn greedy_selection(
     prior: &DMatrix<f64>,
     objective: &Objective,
 ) -> Vec<(usize, Vec<usize>)> {
-    let n = planner.config.identify_poses;
+    let n = planner.config.design.identify_poses;
     let k = prior.nrows();
     let mut chosen: Vec<Vec<usize>> = identify
         .iter()
