@@ -14,7 +14,7 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
-use super::scan::{Lines, inside, line_comments, number_at, shown, skip_space};
+use super::scan::{Lines, MotionArguments, inside, line_comments, number_at, shown, skip_space};
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 
@@ -247,6 +247,11 @@ fn motion_visits(
         .collect();
     let upper = text.to_ascii_uppercase();
     let bytes = upper.as_bytes();
+    let arguments = MotionArguments {
+        folded: &upper,
+        opener: b'{',
+        inline_at,
+    };
     let mut visits = Vec::new();
     let mut at = 0;
     while at < bytes.len() {
@@ -272,28 +277,13 @@ fn motion_visits(
         if inside(comments, start) {
             continue;
         }
-        let mut i = skip_space(text, end);
-        for _ in 0..count {
-            if bytes.get(i) == Some(&b'{') {
-                if let Some(&t) = inline_at.get(&i) {
-                    visits.push(t);
-                }
-                break;
-            }
-            let name_end = i + bytes[i..]
-                .iter()
-                .take_while(|b| b.is_ascii_alphanumeric() || **b == b'_')
-                .count();
-            if let Some(&t) = by_name.get(&upper[i..name_end]) {
-                visits.push(t);
-            }
-            i = skip_space(text, name_end);
-            if bytes.get(i) == Some(&b',') {
-                i = skip_space(text, i + 1);
-            } else {
-                break;
-            }
-        }
+        arguments.read(
+            end,
+            count,
+            |b| b.is_ascii_alphanumeric() || b == b'_',
+            |name| by_name.get(name).copied(),
+            &mut visits,
+        );
     }
     visits
 }

@@ -11,7 +11,7 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
-use super::scan::{Lines, inside, line_comments, number_at, shown, skip_space};
+use super::scan::{Lines, MotionArguments, inside, line_comments, number_at, shown, skip_space};
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 
@@ -225,6 +225,11 @@ fn motion_visits(
         .collect();
     let mut visits = Vec::new();
     let lower = text.to_ascii_lowercase();
+    let arguments = MotionArguments {
+        folded: &lower,
+        opener: b'[',
+        inline_at,
+    };
     for (at, _) in lower.match_indices("move") {
         if inside(comments, at)
             || (at > 0 && {
@@ -245,30 +250,17 @@ fn motion_visits(
         } else {
             1
         };
-        let mut i = skip_space(text, word_end);
-        for _ in 0..count {
-            if text.as_bytes().get(i) == Some(&b'[') {
-                if let Some(&t) = inline_at.get(&i) {
-                    visits.push(t);
-                }
-                break;
-            }
-            let end = i + lower[i..]
-                .bytes()
-                .take_while(|b| b.is_ascii_alphanumeric() || *b == b'_' || *b == b'{' || *b == b'}')
-                .count();
-            let name = lower[i..end].split('{').next().unwrap_or("");
-            let indexed = &lower[i..end];
-            if let Some(&t) = by_name.get(indexed).or_else(|| by_name.get(name)) {
-                visits.push(t);
-            }
-            i = skip_space(text, end);
-            if text.as_bytes().get(i) == Some(&b',') {
-                i = skip_space(text, i + 1);
-            } else {
-                break;
-            }
-        }
+        arguments.read(
+            word_end,
+            count,
+            |b| b.is_ascii_alphanumeric() || b == b'_' || b == b'{' || b == b'}',
+            // An indexed name (`p{3}`) as itself, or its array.
+            |indexed| {
+                let name = indexed.split('{').next().unwrap_or("");
+                by_name.get(indexed).or_else(|| by_name.get(name)).copied()
+            },
+            &mut visits,
+        );
     }
     visits
 }

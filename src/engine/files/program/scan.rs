@@ -270,6 +270,56 @@ pub(super) fn line_comments(text: &str, marker: u8) -> Vec<Range<usize>> {
     out
 }
 
+/// Where a motion instruction's arguments read their targets: the
+/// program's text case-folded (names are matched without case), the byte
+/// an inline literal opens with, and the targets of those literals by the
+/// offset of that byte.
+pub(super) struct MotionArguments<'a> {
+    /// The whole text, upper- or lower-cased (the same byte offsets).
+    pub folded: &'a str,
+    /// `[` for RAPID's `[[x,y,z],…]`, `{` for KRL's `{X …}`.
+    pub opener: u8,
+    /// An inline literal's target by the offset of its opener.
+    pub inline_at: &'a HashMap<usize, usize>,
+}
+
+impl MotionArguments<'_> {
+    /// The targets of up to `count` comma-separated arguments from `at`
+    /// (just after the instruction's word), pushed onto `visits`: an
+    /// inline literal (which ends the list), or a name of `name_byte`
+    /// bytes that `lookup` knows. Anything but a comma after a name ends
+    /// the list.
+    pub(super) fn read(
+        &self,
+        at: usize,
+        count: usize,
+        name_byte: impl Fn(u8) -> bool,
+        lookup: impl Fn(&str) -> Option<usize>,
+        visits: &mut Vec<usize>,
+    ) {
+        let bytes = self.folded.as_bytes();
+        let mut i = skip_space(self.folded, at);
+        for _ in 0..count {
+            if bytes.get(i) == Some(&self.opener) {
+                if let Some(&t) = self.inline_at.get(&i) {
+                    visits.push(t);
+                }
+                return;
+            }
+            let end = i + bytes[i..].iter().take_while(|b| name_byte(**b)).count();
+            if let Some(t) = lookup(&self.folded[i..end]) {
+                visits.push(t);
+            }
+            i = skip_space(self.folded, end);
+            if bytes.get(i) == Some(&b',') {
+                i = skip_space(self.folded, i + 1);
+            } else {
+                return;
+            }
+        }
+    }
+}
+
 /// Whether byte `at` lies in one of the sorted, disjoint `ranges`.
 pub(super) fn inside(ranges: &[Range<usize>], at: usize) -> bool {
     let i = ranges.partition_point(|r| r.end <= at);
