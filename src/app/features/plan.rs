@@ -98,7 +98,7 @@ pub fn stage_text(stage: PlanStage) -> String {
 /// the sphere on the true robot).
 pub fn simulate_plan(plan: &Plan, robot: &str, seed: u64) -> Result<Session, JobError> {
     let robot_choice = RobotChoice::from_key(robot)
-        .ok_or_else(|| RequestError::Robot(format!("unknown robot preset `{robot}`")))?;
+        .ok_or_else(|| RequestError::UnknownPreset(robot.to_owned()))?;
     let config = SimConfig {
         robot: robot_choice,
         seed,

@@ -90,10 +90,10 @@ use crate::engine::base::cell::random;
 use crate::engine::base::robot::ik::{Chain, DOF};
 use crate::engine::base::robot::{JointLimit, Robot};
 use crate::engine::base::session::{SensorRange, Use};
-use crate::engine::calibrate::solve::Control;
 use crate::engine::calibrate::solve::ml::Inseparable;
 use crate::engine::calibrate::solve::ml::range::RangeError;
-use crate::engine::tools::simulate::PlanPose;
+use crate::engine::calibrate::solve::{Control, SolveError};
+use crate::engine::tools::simulate::{PlanPose, SimError};
 
 mod candidates;
 mod config;
@@ -125,6 +125,17 @@ use select::{
     Info, Objective, criterion, greedy_selection, prior_information, random_selection,
     spread_selection,
 };
+
+/// What failed in one simulated calibration of a prediction.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RunFailure {
+    /// The plan's poses could not be simulated on the true robot.
+    #[error(transparent)]
+    Simulate(#[from] SimError),
+    /// The calibration of the simulated session failed.
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+}
 
 /// Why a plan (or its prediction) could not be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -164,18 +175,19 @@ pub enum PlanError {
     #[error("planning cancelled")]
     Cancelled,
     /// A simulated run of [`predict`] failed.
-    #[error("prediction run {run} (seed {seed}): {message}")]
+    #[error("prediction run {run} (seed {seed}): {failure}")]
     Prediction {
         /// Run index, 1-based.
         run: usize,
         /// Its seed.
         seed: u64,
-        /// What failed.
-        message: String,
+        /// What failed: the simulation or the calibration.
+        #[source]
+        failure: RunFailure,
     },
     /// The `ml` analysis of the candidates or the plan failed.
     #[error("identifiability analysis failed: {0}")]
-    Analysis(#[source] crate::engine::calibrate::solve::SolveError),
+    Analysis(#[source] SolveError),
     /// A plan CSV could not be read.
     #[error("line {line}: {message}")]
     Csv {

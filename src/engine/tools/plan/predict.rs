@@ -148,10 +148,10 @@ pub fn predict(
     let mut runs = Vec::with_capacity(config.runs);
     for k in 0..config.runs {
         let seed = config.seed + k as u64;
-        let fail = |message: String| PlanError::Prediction {
+        let fail = |failure: RunFailure| PlanError::Prediction {
             run: k + 1,
             seed,
-            message,
+            failure,
         };
         let sim = SimConfig {
             seed,
@@ -171,16 +171,16 @@ pub fn predict(
         };
         let (mut session, truth) =
             simulate::simulate_plan(&sim, &plan.robot, &truth_hand_eye, &poses, config.execution)
-                .map_err(|e| fail(e.to_string()))?;
+                .map_err(|e| fail(e.into()))?;
         if !hand_eye_groups {
             session.hand_eye = Some(plan.flange_from_sensor);
         }
         let mut options = Options::from_session(&session);
         options.ml.cross_validation = false;
         options.held_out = false;
-        let prepared = solve::prepare(&session).map_err(|e| fail(e.to_string()))?;
+        let prepared = solve::prepare(&session).map_err(|e| fail(e.into()))?;
         let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
-            .map_err(|e| fail(e.to_string()))?;
+            .map_err(|e| fail(e.into()))?;
         let score = evaluate::score(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
         let range = range_score(
             &session,

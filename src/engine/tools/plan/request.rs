@@ -10,18 +10,24 @@ use nalgebra::Isometry3;
 use super::config::{DEFAULT_CONE_DEG, PlanConfig, PlanDesign, StationLayout};
 use super::predict::PredictConfig;
 use crate::engine::base::cell::workspace;
-use crate::engine::base::robot::{self, JointLimit};
+use crate::engine::base::robot::{self, JointLimit, RobotImportError};
 use crate::engine::base::session::SensorRange;
 use crate::engine::base::table::Table;
-use crate::engine::files::import::{RobotSource, load_robot};
+use crate::engine::files::import::{ImportError, RobotSource, load_robot};
 
 /// Why a request cannot be made into a plan configuration, or a file it
 /// names cannot be read: what and where.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum RequestError {
-    /// The robot is unknown or its file cannot be read.
-    #[error("{0}")]
-    Robot(String),
+    /// The robot key names no preset.
+    #[error("unknown robot preset `{0}`")]
+    UnknownPreset(String),
+    /// The robot's URDF cannot be read or has no 6-joint chain.
+    #[error(transparent)]
+    Urdf(#[from] RobotImportError),
+    /// The robot's session, result or DH table file cannot be read.
+    #[error(transparent)]
+    Robot(#[from] ImportError),
     /// A robot from a file that is not a preset needs its joint limits.
     #[error(
         "robot {robot} from {source_file} is not a preset: give its joint limits (min:max per joint, deg)"
@@ -100,8 +106,8 @@ impl PlanRequest {
     pub fn config(&self) -> Result<PlanConfig, RequestError> {
         let mut config = match &self.robot {
             RobotSource::Preset(key) => {
-                let preset = robot::preset(key)
-                    .ok_or_else(|| RequestError::Robot(format!("unknown robot preset `{key}`")))?;
+                let preset =
+                    robot::preset(key).ok_or_else(|| RequestError::UnknownPreset(key.clone()))?;
                 PlanConfig::for_preset(&preset, self.design.sphere)
             }
             RobotSource::Urdf { path, tip } => {
@@ -109,8 +115,7 @@ impl PlanRequest {
                     tip: tip.clone(),
                     ..robot::UrdfOptions::default()
                 };
-                let urdf = robot::load_urdf(path, &options)
-                    .map_err(|e| RequestError::Robot(e.to_string()))?;
+                let urdf = robot::load_urdf(path, &options)?;
                 // A continuous joint has no limits: one turn each way.
                 let limits = urdf
                     .limits
@@ -123,8 +128,7 @@ impl PlanRequest {
                 PlanConfig::new(urdf.robot, limits, self.design.sphere)
             }
             RobotSource::File(path) | RobotSource::DhTable { path, .. } => {
-                let robot =
-                    load_robot(&self.robot).map_err(|e| RequestError::Robot(e.to_string()))?;
+                let robot = load_robot(&self.robot)?;
                 match robot::presets()
                     .into_iter()
                     .find(|p| p.robot.name == robot.name)

@@ -26,11 +26,11 @@ pub const TRUTH_FORMAT: &str = "spherecal-truth";
 pub const TRUTH_VERSION: u32 = 1;
 
 /// Why a truth file could not be read.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum TruthError {
     /// Not valid JSON or not the truth file's shape.
     #[error("not a valid truth file: {0}")]
-    Syntax(String),
+    Syntax(#[from] serde_json::Error),
     /// `format` is not `spherecal-truth`.
     #[error("\"format\" is {0:?}, expected \"{TRUTH_FORMAT}\"")]
     Format(String),
@@ -300,7 +300,7 @@ pub fn truth_to_json(truth: &Truth) -> String {
 /// # Errors
 /// [`TruthError`] naming what is wrong.
 pub fn parse_truth(text: &str) -> Result<Truth, TruthError> {
-    let truth: Truth = serde_json::from_str(text).map_err(|e| TruthError::Syntax(e.to_string()))?;
+    let truth: Truth = serde_json::from_str(text)?;
     if truth.format != TRUTH_FORMAT {
         return Err(TruthError::Format(truth.format));
     }
