@@ -637,6 +637,28 @@ fn far_targets_are_flagged_and_unreachable_ones_are_errors_with_nothing_written(
         "{err}"
     );
     assert!(!c_csv.exists());
+    // Every target that cannot be compensated is named at once, in the
+    // robot's order (the first 8, the rest counted); nothing is written.
+    let mut text = table(&targets);
+    for k in 0..10 {
+        let _ = writeln!(text, "Tgone{k},{},0,500,1,0,0,0", 5000 + 100 * k);
+    }
+    std::fs::write(&t_csv, text).unwrap();
+    let (status, _, err) = args(&[]);
+    assert_eq!(status, 2, "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("10 targets cannot be compensated"), "{err}");
+    for k in 0..8 {
+        assert!(
+            err.contains(&format!("target Tgone{k} (line {})", 6 + k)),
+            "{err}"
+        );
+    }
+    assert!(
+        err.contains("and 2 more") && !err.contains("Tgone8"),
+        "{err}"
+    );
+    assert!(!c_csv.exists());
 }
 
 #[test]

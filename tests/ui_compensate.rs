@@ -318,4 +318,25 @@ fn an_unreachable_target_is_an_error_naming_it_and_nothing_is_written() {
     assert!(!out.exists());
     let notice = h.state().state().notice.clone().expect("a notice");
     assert!(notice.body.contains("target GONE"), "{notice:?}");
+
+    // Several: all of them listed in the view, one a line, their count in
+    // the status line.
+    let mut text = table(&targets(&result));
+    text.push_str("GONE,5000,0,500,1,0,0,0\nGONE2,5200,0,500,1,0,0,0\nGONE3,0,5000,500,1,0,0,0\n");
+    std::fs::write(&t_csv, text).unwrap();
+    compensate_in_view(&mut h, &t_csv);
+    for (name, line) in [("GONE", 7), ("GONE2", 8), ("GONE3", 9)] {
+        // (The earlier refusal's notice still quotes the first.)
+        let row: Vec<String> = labels_with(&h, &format!("target {name} (line {line}): "))
+            .into_iter()
+            .filter(|l| l.starts_with("target "))
+            .collect();
+        assert_eq!(row.len(), 1, "{name}: {row:?}");
+        assert!(row[0].contains("out of reach"), "{row:?}");
+    }
+    assert!(
+        ui_support::status(&h).contains("3 targets cannot be compensated"),
+        "{}",
+        ui_support::status(&h)
+    );
 }

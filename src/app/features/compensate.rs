@@ -15,7 +15,9 @@ use crate::engine::base::session::Session;
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format::{ResultFile, refuse_inputs, write_atomic};
 use crate::engine::files::program::{self, ReadSpec};
-use crate::engine::uses::compensate::{self, CompensateError, Model, Options, Tcp, tool};
+use crate::engine::uses::compensate::{
+    self, CompensateError, Model, Options, TargetFailure, Tcp, tool,
+};
 
 use super::Core;
 use crate::app::commands::CompensateCommand;
@@ -97,10 +99,39 @@ pub fn compensate_targets(
             Control::Continue
         }
     })
-    .map_err(|e| format!("{e} ({})", request.targets.display()))?;
+    .map_err(|e| match e {
+        CompensateError::Targets(failed) if failed.len() > 1 => {
+            failures_text(&failed, &request.targets)
+        }
+        e => format!("{e} ({})", request.targets.display()),
+    })?;
     let mut view = CompensationView::new(done, &file, &model, request.convention);
     view.notes.extend(notes);
     Ok(view)
+}
+
+/// Most failed targets the view lists, one a line; the rest are counted.
+const MAX_LISTED_FAILURES: usize = 500;
+
+/// Several failed targets for the view: a first line with their count and
+/// the file, then one line each (name, line, why).
+fn failures_text(failed: &[TargetFailure], targets: &Path) -> String {
+    let mut text = format!(
+        "{} targets cannot be compensated ({}):",
+        failed.len(),
+        targets.display()
+    );
+    for f in failed.iter().take(MAX_LISTED_FAILURES) {
+        text.push('\n');
+        text.push_str(&f.to_string());
+    }
+    if failed.len() > MAX_LISTED_FAILURES {
+        text.push_str(&format!(
+            "\nand {} more",
+            failed.len() - MAX_LISTED_FAILURES
+        ));
+    }
+    text
 }
 
 /// Writes the compensated text to `path` atomically (all or nothing),
@@ -370,8 +401,11 @@ impl Core {
                     }
                     Err(e) => {
                         self.state.provenance.forget(Output::Compensation);
+                        // Several failed targets: their count in the status
+                        // line, the list in the view.
+                        let first = e.lines().next().unwrap_or_default();
                         self.state
-                            .say(Level::Error, format!("not compensated: {e}"));
+                            .say(Level::Error, format!("not compensated: {first}"));
                         self.state.compensate.outcome = Some(Err(e));
                     }
                 }

@@ -211,7 +211,15 @@ fn outcome_ui(
                     .strong()
                     .color(BAD),
             );
-            ui.add(egui::Label::new(RichText::new(e).color(BAD)).wrap());
+            // One line a failed target (several are listed).
+            egui::ScrollArea::vertical()
+                .id_salt("compensate_failures")
+                .max_height(300.0)
+                .show(ui, |ui| {
+                    for line in e.lines() {
+                        ui.add(egui::Label::new(RichText::new(line).color(BAD)).wrap());
+                    }
+                });
         }
         Some(Ok(view)) => {
             if let Some(s) = &stale {

@@ -167,6 +167,44 @@ impl Default for Options {
     }
 }
 
+/// A target that cannot be compensated: its name, line and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("target {name} (line {line}): {message}")]
+pub struct TargetFailure {
+    /// The target's name.
+    pub name: String,
+    /// Its 1-based line.
+    pub line: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+/// Most failed targets one message names; the rest are counted (the
+/// message stays one readable line).
+pub const MAX_NAMED_FAILURES: usize = 8;
+
+/// The failed targets in one line: the one alone, or their count and the
+/// first [`MAX_NAMED_FAILURES`].
+fn failures_text(failures: &[TargetFailure]) -> String {
+    if let [one] = failures {
+        return one.to_string();
+    }
+    let mut text = format!("{} targets cannot be compensated: ", failures.len());
+    let named: Vec<String> = failures
+        .iter()
+        .take(MAX_NAMED_FAILURES)
+        .map(ToString::to_string)
+        .collect();
+    text.push_str(&named.join("; "));
+    if failures.len() > MAX_NAMED_FAILURES {
+        text.push_str(&format!(
+            "; and {} more",
+            failures.len() - MAX_NAMED_FAILURES
+        ));
+    }
+    text
+}
+
 /// Why compensation failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CompensateError {
@@ -181,16 +219,11 @@ pub enum CompensateError {
     /// The session given is not the result's.
     #[error("{0}")]
     Session(String),
-    /// A target that cannot be compensated: its name, line and why.
-    #[error("target {name} (line {line}): {message}")]
-    Target {
-        /// The target's name.
-        name: String,
-        /// Its 1-based line.
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
+    /// Targets that cannot be compensated (out of reach, a bad value):
+    /// every one, in the order the robot goes to them, so a program is
+    /// mended in one pass.
+    #[error("{}", failures_text(.0))]
+    Targets(Vec<TargetFailure>),
     /// The file could not be rewritten (an internal error).
     #[error("the targets could not be rewritten: {0}")]
     Rewrite(String),
@@ -546,8 +579,9 @@ fn seen_points(
 /// `progress` after each; it may cancel.
 ///
 /// # Errors
-/// A target that cannot be compensated (unreachable, a bad value),
-/// [`CompensateError::Cancelled`], or a rewrite that fails.
+/// The targets that cannot be compensated (unreachable, a bad value; all
+/// of them, after every target was tried), [`CompensateError::Cancelled`],
+/// or a rewrite that fails.
 pub fn compensate(
     model: &Model,
     file: &PoseFile,
@@ -556,10 +590,20 @@ pub fn compensate(
 ) -> Result<Compensation, CompensateError> {
     let total = file.order.len();
     let mut targets = Vec::with_capacity(total);
+    let mut failed = Vec::new();
     for (done, &index) in file.order.iter().enumerate() {
-        let report = target::compensate_target(model, file, index, options)?;
-        let name = report.name.clone();
-        targets.push(report);
+        let name = match target::compensate_target(model, file, index, options) {
+            Ok(report) => {
+                let name = report.name.clone();
+                targets.push(report);
+                name
+            }
+            Err(failure) => {
+                let name = failure.name.clone();
+                failed.push(failure);
+                name
+            }
+        };
         if progress(&Progress {
             done: done + 1,
             total,
@@ -568,6 +612,9 @@ pub fn compensate(
         {
             return Err(CompensateError::Cancelled);
         }
+    }
+    if !failed.is_empty() {
+        return Err(CompensateError::Targets(failed));
     }
     let edits: Vec<(usize, Vec<String>)> = targets
         .iter()

@@ -18,7 +18,7 @@ use std::f64::consts::PI;
 use nalgebra::Vector3;
 
 use super::config::{self, Vendor};
-use super::{CompensateError, Flag, JointTargets, Model, Options, TargetReport};
+use super::{Flag, JointTargets, Model, Options, TargetFailure, TargetReport};
 use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::base::robot::ik::DOF;
 use crate::engine::files::program::style::{NumberStyle, full_precision};
@@ -66,9 +66,9 @@ pub(super) fn compensate_target(
     file: &PoseFile,
     index: usize,
     options: &Options,
-) -> Result<TargetReport, CompensateError> {
+) -> Result<TargetReport, TargetFailure> {
     let t = &file.targets[index];
-    let fail = |message: String| CompensateError::Target {
+    let fail = |message: String| TargetFailure {
         name: t.name.clone(),
         line: t.line,
         message,
