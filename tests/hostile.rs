@@ -283,6 +283,7 @@ fn profile_corner_cases_are_read_right_and_blamed_right() {
         &ProfileSource::Folder(folder.clone()),
         &ProfileFormat::default(),
         &ids,
+        &mut import::progress::quiet,
     )
     .unwrap_err()
     .to_string();

@@ -782,3 +782,43 @@ fn a_large_profile_is_streamed_and_a_bad_cell_names_its_line() {
     assert!(msg.starts_with("line 6:"), "{msg}");
     assert!(msg.contains("`x7` is not a number"), "{msg}");
 }
+
+/// An import tells its progress: every profile read, in order, then the
+/// check; a cancel stops it at once with nothing built.
+#[test]
+fn an_import_tells_its_progress_and_can_be_cancelled() {
+    use spherecal::engine::calibrate::solve::Control;
+    use spherecal::engine::files::import::ImportStage;
+    let original = simulated();
+    let n = original.measurements.len();
+    let dir = tempfile::tempdir().unwrap();
+    write_files(&original, dir.path(), &PLAIN);
+    let spec = spec(dir.path(), &PLAIN);
+    let mut stages = Vec::new();
+    let imported = import::import_with(&spec, &mut |s| {
+        stages.push(s);
+        Control::Continue
+    })
+    .unwrap();
+    assert_same_measurements(&original, &imported.session);
+    let mut expected: Vec<ImportStage> = (1..=n)
+        .map(|done| ImportStage::Profiles { done, total: n })
+        .collect();
+    expected.push(ImportStage::Checking);
+    assert_eq!(stages, expected);
+    assert_eq!(stages[0].describe(), format!("reading profiles: 1 of {n}"));
+    // Cancelled at the third profile: no more is read.
+    let mut calls = 0;
+    let e = import::import_with(&spec, &mut |_| {
+        calls += 1;
+        if calls == 3 {
+            Control::Cancel
+        } else {
+            Control::Continue
+        }
+    })
+    .unwrap_err();
+    assert!(matches!(e, ImportError::Cancelled), "{e}");
+    assert_eq!(calls, 3);
+    assert_eq!(e.to_string(), "the import was cancelled");
+}

@@ -669,3 +669,40 @@ fn negative_values_and_quiet_flags_are_taken() {
         "{stdout}{err}"
     );
 }
+
+/// A pose file's import tells its progress: every profile, then the side
+/// decided by calibrating both (the file gives none); a cancel there
+/// stops it with nothing built.
+#[test]
+fn a_pose_import_tells_its_stages_and_can_be_cancelled_at_the_side() {
+    use spherecal::engine::calibrate::solve::Control;
+    use spherecal::engine::files::import::{ImportError, ImportStage};
+    let (poses, stripes, _) = cell(4, 8, false, 5);
+    let n = poses.len();
+    let (dir, path) = folder(&stripes, "poses.txt", &headerless_table(&poses));
+    let mut s = spec(
+        &path,
+        Observations::Profiles(ProfileSource::Folder(dir.path().to_path_buf())),
+    );
+    s.convention = Some(FlangeConvention::FanucWpr);
+    let mut stages = Vec::new();
+    import::import_poses_with(&s, &mut |stage| {
+        stages.push(stage);
+        Control::Continue
+    })
+    .unwrap();
+    let mut expected: Vec<ImportStage> = (1..=n)
+        .map(|done| ImportStage::Profiles { done, total: n })
+        .collect();
+    expected.push(ImportStage::Side);
+    assert_eq!(stages, expected);
+    let e = import::import_poses_with(&s, &mut |stage| {
+        if stage == ImportStage::Side {
+            Control::Cancel
+        } else {
+            Control::Continue
+        }
+    })
+    .unwrap_err();
+    assert!(matches!(e, ImportError::Cancelled), "{e}");
+}

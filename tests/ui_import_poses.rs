@@ -456,3 +456,70 @@ fn centres_the_sensor_reported_are_chosen_instead_of_profiles() {
         assert!((x - c.coords).norm() < 1e-6);
     }
 }
+
+/// A long import (1,200 profiles) shows its stage beside a Cancel
+/// button; Cancel stops it, nothing is opened, the demo stays, and the
+/// job's late answer is dropped.
+#[test]
+fn a_long_import_shows_its_progress_and_cancel_keeps_what_is_open() {
+    let (poses, stripes) = cell();
+    let n = 1200;
+    let poses: Vec<Isometry3<f64>> = (0..n).map(|k| poses[k % poses.len()]).collect();
+    let stripes: Stripes = (0..n).map(|k| stripes[k % stripes.len()].clone()).collect();
+    let dir = tempfile::tempdir().unwrap();
+    profile_folder(dir.path(), &stripes);
+    let table = dir.path().join("robpose.txt");
+    std::fs::write(&table, headerless_table(&poses)).unwrap();
+    let mut h = import_view(&table, dir.path());
+    h.state_mut().forms_mut().import.pose_convention = Some(FlangeConvention::FanucWpr);
+    settle(&mut h);
+    let demo = |h: &Harness<'_, WorkbenchApp>| {
+        let loaded = h.state().state().loaded.as_ref().expect("a session");
+        (
+            loaded.session.name.clone(),
+            loaded.session.measurements.len(),
+        )
+    };
+    let before = demo(&h);
+
+    h.get_by_label("Import and open").click();
+    h.step();
+    h.step();
+    assert!(
+        h.state().state().import_job.cancel.is_some(),
+        "{} {:?}",
+        ui_support::status(&h),
+        h.state().state().import.outcome
+    );
+    // The stage in words while it runs.
+    let mut seen = Vec::new();
+    for _ in 0..400 {
+        seen = labels_with(&h, "reading profiles: ");
+        if !seen.is_empty() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+        h.step();
+    }
+    assert!(
+        seen.len() == 1 && seen[0].ends_with(&format!(" of {n}")),
+        "{seen:?}"
+    );
+    h.get_by_label("Cancel import").click();
+    h.step();
+    assert!(h.state().state().import_job.cancel.is_none());
+    assert!(
+        ui_support::status(&h).contains("import cancelled"),
+        "{}",
+        ui_support::status(&h)
+    );
+    // Whatever the job still sends is dropped.
+    for _ in 0..60 {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        h.step();
+    }
+    settle(&mut h);
+    assert_eq!(demo(&h), before);
+    assert!(h.state().state().import.outcome.is_none());
+    assert!(labels_with(&h, "reading profiles: ").is_empty());
+}

@@ -109,6 +109,8 @@ pub enum ImportCommand {
     },
     /// Build the session from the import form and open it.
     Run,
+    /// Stop the import in flight; nothing is opened.
+    Cancel,
     /// A field of the form changed: the preview, the last outcome and the
     /// flange checks no longer describe it and are cleared.
     Edited,

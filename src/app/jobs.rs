@@ -172,8 +172,20 @@ pub enum ImportMessage {
         /// The mapped rows, or why not.
         preview: Result<String, JobError>,
     },
+    /// How far the import job is, in words.
+    Progress {
+        /// Which job.
+        job: u64,
+        /// Its stage.
+        text: String,
+    },
     /// The import built a session, or why not.
-    Imported(Result<Imported, JobError>),
+    Imported {
+        /// Which job (a cancelled one's answer is dropped).
+        job: u64,
+        /// The session, or why not.
+        outcome: Result<Imported, JobError>,
+    },
     /// The pose file was read and paired (no profile read), or why not.
     Scanned {
         /// Which scan (an older one's answer is dropped).

@@ -385,6 +385,17 @@ pub struct ImportView {
     pub guess_needed: Option<String>,
 }
 
+/// The import job (Import and open) while it runs.
+#[derive(Debug, Default)]
+pub struct ImportJob {
+    /// Its last stage, in words (`reading profiles: 120 of 9600`).
+    pub progress: Option<String>,
+    /// Set to stop it; `Some` while it runs.
+    pub cancel: Option<Arc<AtomicBool>>,
+    /// The number of the latest job (a message of another is dropped).
+    pub job: u64,
+}
+
 /// What the Plan view shows.
 #[derive(Debug, Default)]
 pub struct PlanView {
@@ -519,6 +530,8 @@ pub struct AppState {
     pub pending_result: Option<PathBuf>,
     /// What the import wizard shows (header, preview, flange checks).
     pub import: ImportView,
+    /// The import job in flight: its progress and its Cancel.
+    pub import_job: ImportJob,
     /// The scanned library and the drift on show.
     pub history: HistoryView,
     /// The plan on show and the planning job.
@@ -559,6 +572,7 @@ impl AppState {
             || self.busy.saving
             || self.busy.exporting > 0
             || self.busy.importing > 0
+            || self.import_job.cancel.is_some()
             || self.busy.scanning
             || self.history.drifting
             || self.plan.cancel.is_some()

@@ -4,8 +4,12 @@
 //! an opened file.
 
 use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
-use crate::engine::files::import::{self, ImportError};
+use crate::engine::calibrate::solve::Control;
+use crate::engine::files::import::{self, ImportError, ImportStage};
 
 use super::Core;
 use super::files::analyse;
@@ -50,26 +54,52 @@ pub fn import_preview(
     (header, guess.then(|| Box::new(form)), preview)
 }
 
+/// How often an import job tells the window its progress.
+const PROGRESS_EVERY: Duration = Duration::from_millis(100);
+
 /// Runs the import of the wizard's form (a joint log or a flange-pose
-/// log) and analyses the session like an opened file.
+/// log) and analyses the session like an opened file, telling `progress`
+/// its stage (profiles read, side, check, stripe fits) and stopping when
+/// `cancel` is set.
 ///
 /// # Errors
 /// The form is incomplete or the engine's import failed (naming the file,
-/// line, column or pose id).
-pub fn import_session(form: &ImportForm) -> Result<Imported, JobError> {
+/// line, column or pose id); [`ImportError::Cancelled`].
+pub fn import_session(
+    form: &ImportForm,
+    cancel: &AtomicBool,
+    progress: &mut dyn FnMut(String),
+) -> Result<Imported, JobError> {
+    // Told at most every 0.1 s, and at every stage that is not a profile.
+    let mut told: Option<Instant> = None;
+    let mut stage = |s: ImportStage| {
+        if cancel.load(Ordering::Relaxed) {
+            return Control::Cancel;
+        }
+        let profile = matches!(s, ImportStage::Profiles { done, total } if done < total);
+        if !profile || told.is_none_or(|t| t.elapsed() >= PROGRESS_EVERY) {
+            told = Some(Instant::now());
+            progress(s.describe());
+        }
+        Control::Continue
+    };
     let (imported, log) = match form.log_kind {
         LogKind::Joints => {
             let spec = form.spec().map_err(JobError::ImportForm)?;
-            (import::import(&spec)?, spec.joint_log)
+            (import::import_with(&spec, &mut stage)?, spec.joint_log)
         }
         LogKind::FlangePoses => {
             let mut spec = form.pose_spec().map_err(JobError::ImportForm)?;
             if spec.hand_eye.is_none() {
                 spec.hand_eye = form.hand_eye_guess().map_err(JobError::ImportForm)?;
             }
-            (import::import_poses(&spec)?, spec.poses)
+            (import::import_poses_with(&spec, &mut stage)?, spec.poses)
         }
     };
+    if cancel.load(Ordering::Relaxed) {
+        return Err(ImportError::Cancelled.into());
+    }
+    progress("fitting the stripes".to_string());
     let mut session = imported.session;
     let mut notes = imported.notes;
     if form.log_kind == LogKind::FlangePoses
@@ -101,6 +131,7 @@ impl Core {
         match command {
             ImportCommand::Preview { guess } => self.import_preview(ctx, guess),
             ImportCommand::Run => self.import_run(ctx),
+            ImportCommand::Cancel => self.import_cancel(),
             ImportCommand::Scan => self.import_scan(ctx),
             ImportCommand::Edited => {
                 let view = &mut self.state.import;
@@ -140,29 +171,69 @@ impl Core {
             return;
         }
         self.state.say(Level::Info, "importing…");
+        let job = self.state.import_job.job + 1;
+        let cancel = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&cancel);
         let started = self.spawn(ctx, "import", move |rep| {
-            rep.send(JobMessage::Import(ImportMessage::Imported(import_session(
-                &form,
-            ))));
+            let outcome = import_session(&form, &flag, &mut |text| {
+                rep.send(JobMessage::Import(ImportMessage::Progress { job, text }));
+            });
+            rep.send(JobMessage::Import(ImportMessage::Imported { job, outcome }));
         });
         if started {
-            self.state.busy.importing += 1;
+            let run = &mut self.state.import_job;
+            run.job = job;
+            run.cancel = Some(cancel);
+            run.progress = Some("starting".to_string());
+        }
+    }
+
+    /// Stops the import in flight: its answer, if it comes, is dropped and
+    /// what is open stays.
+    fn import_cancel(&mut self) {
+        let run = &mut self.state.import_job;
+        if let Some(c) = run.cancel.take() {
+            c.store(true, Ordering::Relaxed);
+            run.progress = None;
+            self.state.say(
+                Level::Warning,
+                "import cancelled: nothing was opened, what is open stays",
+            );
         }
     }
 
     /// Handles an [`ImportMessage`].
     pub(super) fn on_import(&mut self, ctx: &egui::Context, message: ImportMessage) {
-        self.state.busy.importing = self.state.busy.importing.saturating_sub(1);
         match message {
+            ImportMessage::Progress { job, text } => {
+                let run = &mut self.state.import_job;
+                if run.job == job && run.cancel.is_some() {
+                    run.progress = Some(text);
+                }
+            }
+            ImportMessage::Imported { job, outcome } => {
+                let run = &mut self.state.import_job;
+                // A cancelled job's answer is not shown.
+                if run.job != job || run.cancel.is_none() {
+                    return;
+                }
+                run.cancel = None;
+                run.progress = None;
+                self.on_imported(ctx, outcome);
+            }
             ImportMessage::Scanned {
                 generation,
                 outcome,
-            } => self.on_import_scanned(generation, outcome),
+            } => {
+                self.state.busy.importing = self.state.busy.importing.saturating_sub(1);
+                self.on_import_scanned(generation, outcome);
+            }
             ImportMessage::Previewed {
                 header,
                 guessed,
                 preview,
             } => {
+                self.state.busy.importing = self.state.busy.importing.saturating_sub(1);
                 if let Some(form) = guessed {
                     let f = &mut self.forms.import;
                     f.id_column = form.id_column;
@@ -180,7 +251,13 @@ impl Core {
                 }
                 self.state.import.preview = Some(preview.map_err(|e| e.to_string()));
             }
-            ImportMessage::Imported(Ok(imported)) => {
+        }
+    }
+
+    /// Shows an import's outcome: the session opened, or why not.
+    fn on_imported(&mut self, ctx: &egui::Context, outcome: Result<Imported, JobError>) {
+        match outcome {
+            Ok(imported) => {
                 let flagged = imported.checks.iter().filter(|c| c.flagged).count();
                 let n = imported.loaded.session.measurements.len();
                 let refs = imported.loaded.session.reference_distances.len();
@@ -214,7 +291,7 @@ impl Core {
                     format!("{line}: not saved yet, use Save as… on the Session view"),
                 );
             }
-            ImportMessage::Imported(Err(e)) => {
+            Err(e) => {
                 self.state.say(Level::Error, "the import failed");
                 self.state.import.guess_needed = match &e {
                     JobError::Import(ImportError::NoInitialHandEye { message, .. }) => {

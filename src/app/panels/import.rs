@@ -74,7 +74,7 @@ fn import_form_ui(
         )
         .weak(),
     );
-    let busy = state.busy.importing > 0 || state.busy.dialog;
+    let busy = state.busy.importing > 0 || state.busy.dialog || state.import_job.cancel.is_some();
     let joints = forms.import.log_kind == LogKind::Joints;
     // The actions stay in view above the form (it is taller than the
     // window at 1366×768); the full outcome is at the form's end.
@@ -139,7 +139,19 @@ fn actions_ui(
                 commands.push(Command::Import(ImportCommand::Preview { guess: true }));
             }
         }
-        if state.busy.importing > 0 {
+        if state.import_job.cancel.is_some() {
+            ui.spinner();
+            if let Some(p) = &state.import_job.progress {
+                ui.label(p);
+            }
+            if ui
+                .button("Cancel import")
+                .on_hover_text("stop the import: nothing is opened, what is open stays")
+                .clicked()
+            {
+                commands.push(Command::Import(ImportCommand::Cancel));
+            }
+        } else if state.busy.importing > 0 {
             ui.spinner();
         }
         if let Some(Ok(text)) = &state.import.outcome {

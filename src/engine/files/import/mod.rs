@@ -31,6 +31,7 @@ pub mod pairing;
 pub mod poses;
 pub mod preview;
 pub mod profiles;
+pub mod progress;
 pub mod references;
 pub mod robot_source;
 pub mod side;
@@ -45,12 +46,14 @@ pub use self::check::{
 pub use self::log::{ColumnMap, DEFAULT_SIDE_COLUMN, header, preview};
 pub use self::poses::{
     Observations, PoseImportSpec, PoseInputs, SideChoice, build_pose_session, read_pose_inputs,
+    read_pose_inputs_with,
 };
 pub use self::preview::{PairingPreview, PosePreview, preview_pose_import};
 pub use self::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource, RawProfile};
+pub use self::progress::{ImportProgress, ImportStage};
 pub use self::references::{read_references, reference_rows};
 pub use self::robot_source::{RobotSource, load_robot};
-pub use self::side::{decide_side, import_poses};
+pub use self::side::{decide_side, import_poses, import_poses_with};
 pub use self::units::{AngleUnit, LengthUnit};
 pub use crate::engine::base::robot::controller::FlangeConvention;
 pub use crate::engine::files::program::PoseFormat;
@@ -147,6 +150,9 @@ pub enum ImportError {
         /// Why, both reasons named.
         message: String,
     },
+    /// The caller cancelled (nothing was built).
+    #[error("the import was cancelled")]
+    Cancelled,
 }
 
 /// What an import built and found out.
@@ -221,7 +227,9 @@ pub fn read_profiles(
     source: &ProfileSource,
     format: &ProfileFormat,
     ids: &[String],
+    progress: &mut ImportProgress<'_>,
 ) -> Result<(Vec<PlaneProfile>, ProfileReport), ImportError> {
+    let total = ids.len();
     let raws: Vec<RawProfile> = match source {
         ProfileSource::Folder(dir) => {
             let file = |id: &String| {
@@ -235,11 +243,12 @@ pub fn read_profiles(
                 // on its own, one raw profile in memory at a time.
                 let mut planes = Vec::with_capacity(ids.len());
                 let mut poses = Vec::with_capacity(ids.len());
-                for id in ids {
+                for (k, id) in ids.iter().enumerate() {
                     let raw = profiles::read_profile(&file(id)?, format)?;
                     let (plane, count) = plane_of(&raw, &axes, id)?;
                     planes.push(plane);
                     poses.push(count);
+                    progress::report(progress, ImportStage::Profiles { done: k + 1, total })?;
                 }
                 return Ok((
                     planes,
@@ -250,9 +259,12 @@ pub fn read_profiles(
                     },
                 ));
             }
-            ids.iter()
-                .map(|id| profiles::read_profile(&file(id)?, format))
-                .collect::<Result<_, _>>()?
+            let mut raws = Vec::with_capacity(total);
+            for (k, id) in ids.iter().enumerate() {
+                raws.push(profiles::read_profile(&file(id)?, format)?);
+                progress::report(progress, ImportStage::Profiles { done: k + 1, total })?;
+            }
+            raws
         }
         ProfileSource::File { path, pose_column } => {
             let (order, mut by_id) = profiles::read_profile_table(path, pose_column, format)?;
@@ -262,14 +274,17 @@ pub fn read_profiles(
                     message: format!("pose `{stray}` is not in the pose log"),
                 });
             }
-            ids.iter()
+            let raws = ids
+                .iter()
                 .map(|id| {
                     by_id.remove(id).ok_or_else(|| ImportError::MissingProfile {
                         id: id.clone(),
                         path: path.clone(),
                     })
                 })
-                .collect::<Result<_, _>>()?
+                .collect::<Result<_, _>>()?;
+            progress::report(progress, ImportStage::Profiles { done: total, total })?;
+            raws
         }
     };
     planar(raws, format, ids)
@@ -396,6 +411,19 @@ pub(crate) fn check_profile_size(
 /// # Errors
 /// [`ImportError`] naming the file, the line, the column or the pose id.
 pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
+    import_with(spec, &mut progress::quiet)
+}
+
+/// [`import`], telling `progress` of each profile read and of the check;
+/// it may cancel.
+///
+/// # Errors
+/// [`ImportError`] naming the file, the line, the column or the pose id;
+/// [`ImportError::Cancelled`].
+pub fn import_with(
+    spec: &ImportSpec,
+    progress: &mut ImportProgress<'_>,
+) -> Result<Imported, ImportError> {
     check_sphere_diameter(spec.sphere_diameter)?;
     let robot = load_robot(&spec.robot)?;
     let log = CsvFile::read(&spec.joint_log)?;
@@ -417,7 +445,7 @@ pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
             });
         }
     }
-    let (planes, report) = read_profiles(&spec.profiles, &spec.profile_format, &ids)?;
+    let (planes, report) = read_profiles(&spec.profiles, &spec.profile_format, &ids, progress)?;
     check_profile_size(&planes, &spec.profile_format, spec.sphere_diameter)?;
     let mut measurements = Vec::with_capacity(log.rows.len());
     let mut checks = Vec::new();
@@ -486,6 +514,7 @@ pub fn import(spec: &ImportSpec) -> Result<Imported, ImportError> {
             .file_stem()
             .map_or_else(|| "imported".into(), |s| s.to_string_lossy().into_owned())
     });
+    progress::report(progress, ImportStage::Checking)?;
     let session = new_session(
         name,
         Some(robot),

@@ -42,6 +42,7 @@ use nalgebra::{Isometry3, Vector3};
 
 use super::pairing::{FolderListing, list_profiles};
 use super::profiles::{self, AxisMap, PlaneProfile, ProfileFormat, ProfileSource};
+use super::progress::{self, ImportProgress, ImportStage};
 use super::{FlangeConvention, ImportError, Imported, ProfileReport, RobotSource, load_robot};
 use crate::engine::base::robot::Robot;
 use crate::engine::base::session::{Measurement, Observation, Use};
@@ -330,6 +331,18 @@ fn file_name(p: &Path) -> String {
 /// files, poses that are not rigid transforms, missing or unusable
 /// profiles, counts of poses and profiles that differ (both named).
 pub fn read_pose_inputs(spec: &PoseImportSpec) -> Result<PoseInputs, ImportError> {
+    read_pose_inputs_with(spec, &mut progress::quiet)
+}
+
+/// [`read_pose_inputs`], telling `progress` of each profile read; it may
+/// cancel.
+///
+/// # Errors
+/// As [`read_pose_inputs`]; [`ImportError::Cancelled`].
+pub fn read_pose_inputs_with(
+    spec: &PoseImportSpec,
+    progress: &mut ImportProgress<'_>,
+) -> Result<PoseInputs, ImportError> {
     super::check_sphere_diameter(spec.sphere_diameter)?;
     let (records, mut notes) = read_pose_log(
         &spec.poses,
@@ -383,7 +396,7 @@ pub fn read_pose_inputs(spec: &PoseImportSpec) -> Result<PoseInputs, ImportError
             )
         }
         Observations::Profiles(source) => {
-            let (ids, planes, report, pairing) = pair_profiles(spec, source, &records)?;
+            let (ids, planes, report, pairing) = pair_profiles(spec, source, &records, progress)?;
             super::check_profile_size(&planes, &spec.profile_format, spec.sphere_diameter)?;
             notes.extend(pairing);
             notes.push(report.summary());
@@ -520,6 +533,7 @@ fn pair_profiles(
     spec: &PoseImportSpec,
     source: &ProfileSource,
     records: &[PoseRecord],
+    progress: &mut ImportProgress<'_>,
 ) -> Result<Paired, ImportError> {
     if let Some(ids) = paired_by_id(source, records) {
         let mut first: HashMap<&str, usize> = HashMap::new();
@@ -532,7 +546,7 @@ fn pair_profiles(
                 });
             }
         }
-        let (planes, report) = super::read_profiles(source, &spec.profile_format, &ids)?;
+        let (planes, report) = super::read_profiles(source, &spec.profile_format, &ids, progress)?;
         return Ok((
             ids,
             planes,
@@ -544,11 +558,12 @@ fn pair_profiles(
         ProfileSource::Folder(dir) => {
             let listing = list_profiles(dir, &[spec.poses.as_path()], Some(records.len()))?;
             check_count(spec, dir, &listing, records)?;
-            let raws = listing
-                .profiles
-                .iter()
-                .map(|p| profiles::read_profile(p, &spec.profile_format))
-                .collect::<Result<Vec<_>, _>>()?;
+            let total = listing.profiles.len();
+            let mut raws = Vec::with_capacity(total);
+            for (k, p) in listing.profiles.iter().enumerate() {
+                raws.push(profiles::read_profile(p, &spec.profile_format)?);
+                progress::report(progress, ImportStage::Profiles { done: k + 1, total })?;
+            }
             (raws, Some(listing))
         }
         ProfileSource::File { path, pose_column } => {
@@ -565,6 +580,8 @@ fn pair_profiles(
                     ),
                 });
             }
+            let total = order.len();
+            progress::report(progress, ImportStage::Profiles { done: total, total })?;
             (
                 order.iter().filter_map(|id| by_id.remove(id)).collect(),
                 None,

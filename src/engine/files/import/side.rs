@@ -8,7 +8,10 @@
 //! calibrated, or the two are too close to tell, the error says why,
 //! with both sides' outcome.
 
-use super::poses::{PoseImportSpec, PoseInputs, SideChoice, build_pose_session, read_pose_inputs};
+use super::poses::{
+    PoseImportSpec, PoseInputs, SideChoice, build_pose_session, read_pose_inputs_with,
+};
+use super::progress::{self, ImportProgress, ImportStage};
 use super::{ImportError, Imported};
 use crate::engine::calibrate::solve::{self, Options};
 
@@ -152,15 +155,31 @@ pub fn decide_side(spec: &PoseImportSpec, inputs: &PoseInputs) -> Result<Importe
 /// As [`read_pose_inputs`], [`build_pose_session`] and
 /// [`decide_side`].
 pub fn import_poses(spec: &PoseImportSpec) -> Result<Imported, ImportError> {
-    let inputs = read_pose_inputs(spec)?;
+    import_poses_with(spec, &mut progress::quiet)
+}
+
+/// [`import_poses`], telling `progress` of each profile read, of the side
+/// decision and of the check; it may cancel.
+///
+/// # Errors
+/// As [`import_poses`]; [`ImportError::Cancelled`].
+pub fn import_poses_with(
+    spec: &PoseImportSpec,
+    progress: &mut ImportProgress<'_>,
+) -> Result<Imported, ImportError> {
+    let inputs = read_pose_inputs_with(spec, progress)?;
     match spec.side {
         SideChoice::Auto if !inputs.all_sides_given() && !inputs.centres() => {
+            progress::report(progress, ImportStage::Side)?;
             decide_side(spec, &inputs)
         }
-        choice => build_pose_session(
-            spec,
-            &inputs,
-            if choice == SideChoice::Minus { -1 } else { 1 },
-        ),
+        choice => {
+            progress::report(progress, ImportStage::Checking)?;
+            build_pose_session(
+                spec,
+                &inputs,
+                if choice == SideChoice::Minus { -1 } else { 1 },
+            )
+        }
     }
 }
