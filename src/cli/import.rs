@@ -6,14 +6,16 @@
 //! caller of [`crate::engine::files::import`].
 
 use std::path::PathBuf;
+use std::time::Instant;
 
 use clap::Args;
 
+use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
 use crate::engine::files::import::{
     self, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
-    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportError, ImportSpec, Imported,
-    Observations, PoseImportSpec, ProfileSource, SideChoice,
+    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportError, ImportSpec, ImportStage,
+    Imported, Observations, PoseImportSpec, ProfileSource, SideChoice,
 };
 
 use super::CliError;
@@ -252,6 +254,42 @@ fn out_path(args: &ImportArgs) -> Result<PathBuf, CliError> {
     Ok(out)
 }
 
+/// The progress of a long import: a line at most every
+/// [`super::PROGRESS_EVERY`] (a small import prints none), and an
+/// interrupt (Ctrl-C) stops it at the next profile (exit 130, nothing
+/// written).
+fn progress_lines(quiet: bool, started: Instant) -> impl FnMut(ImportStage) -> Control {
+    let mut last = started;
+    move |stage| {
+        if format::interrupted() {
+            return Control::Cancel;
+        }
+        if !quiet && let Some(line) = progress_line(stage, started, &mut last, Instant::now()) {
+            sayln!("{line}");
+        }
+        Control::Continue
+    }
+}
+
+/// The line to print for `stage` at `now`, if one is due (the last was
+/// printed at `last`).
+fn progress_line(
+    stage: ImportStage,
+    started: Instant,
+    last: &mut Instant,
+    now: Instant,
+) -> Option<String> {
+    if now.duration_since(*last) < super::PROGRESS_EVERY {
+        return None;
+    }
+    *last = now;
+    Some(format!(
+        "  importing: {} ({:.0} s)",
+        stage.describe(),
+        now.duration_since(started).as_secs_f64()
+    ))
+}
+
 /// Runs `spherecal import`.
 ///
 /// # Errors
@@ -266,7 +304,8 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         let out = out_path(args)?;
         // Read and pair every input once; then the side, given or decided
         // from the data (a step of its own, which calibrates both sides).
-        let inputs = import::read_pose_inputs(&spec).map_err(|e| input(&e))?;
+        let mut progress = progress_lines(args.quiet, Instant::now());
+        let inputs = import::read_pose_inputs_with(&spec, &mut progress).map_err(|e| input(&e))?;
         let imported = match spec.side {
             SideChoice::Auto if !inputs.all_sides_given() && !inputs.centres() => {
                 if !args.quiet {
@@ -289,7 +328,11 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
             return Ok(());
         }
         let out = out_path(args)?;
-        (import::import(&spec).map_err(|e| input(&e))?, out)
+        let mut progress = progress_lines(args.quiet, Instant::now());
+        (
+            import::import_with(&spec, &mut progress).map_err(|e| input(&e))?,
+            out,
+        )
     };
     let (
         Imported {
@@ -355,4 +398,48 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use std::time::Duration;
+
+    use super::*;
+
+    #[test]
+    fn a_long_import_prints_a_progress_line_every_two_seconds() {
+        let t0 = Instant::now();
+        let mut last = t0;
+        let stage = ImportStage::Profiles {
+            done: 120,
+            total: 9600,
+        };
+        assert_eq!(
+            progress_line(stage, t0, &mut last, t0 + Duration::from_millis(1500)),
+            None
+        );
+        assert_eq!(
+            progress_line(stage, t0, &mut last, t0 + Duration::from_secs(3)).as_deref(),
+            Some("  importing: reading profiles: 120 of 9600 (3 s)")
+        );
+        assert_eq!(
+            progress_line(
+                ImportStage::Side,
+                t0,
+                &mut last,
+                t0 + Duration::from_secs(4)
+            ),
+            None
+        );
+        assert_eq!(
+            progress_line(
+                ImportStage::Side,
+                t0,
+                &mut last,
+                t0 + Duration::from_secs(5)
+            )
+            .as_deref(),
+            Some("  importing: deciding the stripe side (calibrating both) (5 s)")
+        );
+    }
 }

@@ -39,7 +39,7 @@ pub mod scan_flags;
 pub mod simulate;
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use clap::{Args, Parser, Subcommand};
 
@@ -181,6 +181,10 @@ pub fn stdout_result() -> Result<(), CliError> {
 /// message of spherecal's own; only one that echoes a hostile input (a
 /// line of a gigabyte) is longer.
 pub const MAX_MESSAGE_CHARS: usize = 2000;
+
+/// Time between progress lines of a long command (plan, import): work
+/// of the paper's size takes well under this and prints none.
+pub const PROGRESS_EVERY: Duration = Duration::from_secs(2);
 
 /// `message` cut in the middle to at most [`MAX_MESSAGE_CHARS`]: the
 /// start (what is wrong) and the end (the file) are kept, the middle is

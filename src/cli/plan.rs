@@ -5,11 +5,11 @@
 //! of [`crate::engine::tools::plan`]; every file is written atomically.
 
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use clap::Args;
 
-use super::CliError;
+use super::{CliError, PROGRESS_EVERY};
 use crate::engine::base::robot::{self, JointLimit};
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
@@ -211,10 +211,6 @@ fn plan_error(e: &PlanError) -> CliError {
     }
 }
 
-/// Seconds between progress lines of a long plan (stderr): a plan of the
-/// paper's size takes well under this and prints none.
-const PROGRESS_EVERY: Duration = Duration::from_secs(2);
-
 /// Progress lines of a long plan: at most one every [`PROGRESS_EVERY`].
 struct Ticker {
     started: Instant,
@@ -414,6 +410,8 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 mod tests {
     use super::*;
+    use std::time::Duration;
+
     use crate::engine::tools::plan::StationLayout;
 
     fn parse(extra: &[&str]) -> PlanArgs {
