@@ -198,6 +198,15 @@ fn simulate_is_deterministic_and_calibrates() {
     let out = dir.path().join("r.json");
     let (status, _, stderr) = calibrate(&path, &out);
     assert_eq!(status, 0, "{stderr}");
+    // -q: the same files, nothing printed.
+    let q = dir.path().join("q.json");
+    let o = spherecal()
+        .args(["simulate", "--seed", "5", "-q", "--out"])
+        .arg(&q)
+        .output()
+        .unwrap();
+    assert!(o.status.success() && o.stdout.is_empty() && o.stderr.is_empty());
+    assert_eq!(std::fs::read(&q).unwrap(), a);
 }
 
 /// Runs the binary with `args`; returns (status, stdout, stderr).

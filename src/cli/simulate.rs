@@ -91,6 +91,9 @@ pub struct SimulateArgs {
     /// Where to write the session file (FORMAT.md `spherecal-session`); with --scan, the scan's truth.
     #[arg(long, short)]
     pub out: PathBuf,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
     /// The sensor's measuring range to write as `sensor.range`: `Y0,Y1,Z0,Z1` in mm (laser plane, sensor frame), e.g. `-40,40,-40,40`; ml then predicts the error over it.
     #[arg(long, allow_hyphen_values = true, value_parser = super::parse_range)]
     pub range: Option<crate::engine::base::session::SensorRange>,
@@ -275,6 +278,9 @@ fn run_scan(
         .map(|(p, t)| (p.as_path(), t.as_bytes()))
         .collect();
     super::write_outputs(&files, format::Folders::Create)?;
+    if args.quiet {
+        return Ok(());
+    }
     sayln!(
         "simulated a scan of a {part:?} part (seed {}): {} poses -> {}/joints.csv, {}/profiles/, truth {} ({:.0} ms)",
         args.seed,
@@ -391,6 +397,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         .map(|(p, t)| (p.as_path(), t.as_bytes()))
         .collect();
     super::write_outputs(&files, folders)?;
+    if args.quiet {
+        return Ok(());
+    }
     let count = |usage: Use| session.with_use(usage).count();
     sayln!(
         "simulated {} (seed {}): {} measurements ({} translation, {} rotation, {} identify, {} validate), {} reference distances -> {}, truth {} ({:.0} ms)",
