@@ -340,3 +340,69 @@ fn an_unreachable_target_is_an_error_naming_it_and_nothing_is_written() {
         ui_support::status(&h)
     );
 }
+
+/// The flag limits are the command line's options in the view: a tighter
+/// σ tolerance typed in marks the table stale (saying which limit), and
+/// the next compensation flags every target by it; limits wide enough
+/// unflag the far one.
+#[test]
+fn the_flag_limits_are_set_in_the_view_and_mark_the_table_stale() {
+    let (mut h, result) = calibrated();
+    let dir = tempfile::tempdir().unwrap();
+    let t_csv = dir.path().join("T.csv");
+    std::fs::write(&t_csv, table(&targets(&result))).unwrap();
+    compensate_in_view(&mut h, &t_csv);
+    let flagged = |h: &Harness<'_, WorkbenchApp>| match &h.state().state().compensate.outcome {
+        Some(Ok(v)) => v.flagged,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(flagged(&h), 1);
+
+    // σ tolerance 0.25 mm (the default) → 0.001 mm, typed into its field.
+    h.get_by_label("σ tolerance").focus();
+    h.run();
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    h.get_by_label("σ tolerance").type_text("0.001");
+    h.key_press(egui::Key::Enter);
+    h.run();
+    assert_eq!(
+        h.state().forms().compensate.options.sigma_tolerance_mm,
+        0.001
+    );
+    assert!(
+        !labels_with(&h, "σ tolerance 0.25 mm → 0.001 mm").is_empty(),
+        "the stale banner names the limit: {:?}",
+        labels_with(&h, "tolerance")
+    );
+    h.get_by_label("Compensate targets").click();
+    settle(&mut h);
+    assert_eq!(flagged(&h), 5);
+    let view = match &h.state().state().compensate.outcome {
+        Some(Ok(v)) => v.clone(),
+        other => panic!("{other:?}"),
+    };
+    assert!(
+        view.rows
+            .iter()
+            .all(|r| r.flags.iter().any(|f| f.contains("0.001"))),
+        "{:?}",
+        view.rows
+    );
+
+    // Every limit widened past the far target (its σ is about 0.57 mm).
+    {
+        let options = &mut h.state_mut().forms_mut().compensate.options;
+        options.sigma_tolerance_mm = 1.0;
+        options.far_joints_deg = 720.0;
+        options.region_margin_mm = 10_000.0;
+    }
+    h.run();
+    h.get_by_label("Compensate targets").click();
+    settle(&mut h);
+    let view = match &h.state().state().compensate.outcome {
+        Some(Ok(v)) => v.clone(),
+        other => panic!("{other:?}"),
+    };
+    let flags: Vec<_> = view.rows.iter().map(|r| (&r.name, &r.flags)).collect();
+    assert_eq!(view.flagged, 0, "{flags:?}");
+}

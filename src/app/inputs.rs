@@ -16,6 +16,7 @@ use super::state::AppState;
 use crate::engine::base::session::SensorRange;
 use crate::engine::calibrate::solve::Method;
 use crate::engine::tools::result_view::Tolerance;
+use crate::engine::uses::compensate::JointTargets;
 
 /// Left-out ids named in a reading; more are counted.
 const IDS_SHOWN: usize = 3;
@@ -233,6 +234,26 @@ pub fn targets(f: &CompensateForm) -> Reading {
             CompensateForm::convention_label(f.convention),
         ),
         ("TCP".into(), tcp),
+        (
+            "joint targets".into(),
+            match f.options.joint_targets {
+                JointTargets::Compensate => "compensated",
+                JointTargets::Keep => "kept",
+            }
+            .to_string(),
+        ),
+        (
+            "σ tolerance".into(),
+            format!("{} mm", f.options.sigma_tolerance_mm),
+        ),
+        (
+            "far in joints".into(),
+            format!("{}°", f.options.far_joints_deg),
+        ),
+        (
+            "region margin".into(),
+            format!("{} mm", f.options.region_margin_mm),
+        ),
     ];
     let tool = (f.tcp == TcpChoice::ToolFile).then(|| file_stamp(&f.tool));
     Reading::new(fields, (file_stamp(&f.targets), tool))

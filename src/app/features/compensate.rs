@@ -53,11 +53,12 @@ pub struct CompensateRequest {
     pub tcp: TcpChoice,
     /// The tool file, for [`TcpChoice::ToolFile`].
     pub tool: PathBuf,
+    /// Joint targets and the flag limits.
+    pub options: Options,
 }
 
 /// Reads the targets, builds the model of the result and compensates
-/// every target, as `spherecal compensate` with the request's options
-/// and the defaults of the others; `progress` hears of each target,
+/// every target, as `spherecal compensate` with the request's options; `progress` hears of each target,
 /// `cancel` stops at the next one.
 ///
 /// # Errors
@@ -91,7 +92,7 @@ pub fn compensate_targets(
         other => other,
     }
     .map_err(|e| format!("{e} (the result on show)"))?;
-    let done = compensate::compensate(&model, &file, &Options::default(), &mut |p| {
+    let done = compensate::compensate(&model, &file, &request.options, &mut |p| {
         progress(format!("target {}: {} of {}", p.target, p.done, p.total));
         if cancel.load(Ordering::Relaxed) {
             Control::Cancel
@@ -212,6 +213,7 @@ impl Core {
             convention: form.convention,
             tcp: form.tcp,
             tool: PathBuf::from(form.tool.trim()),
+            options: form.options.clone(),
         };
         let stamp = self
             .state

@@ -2,9 +2,11 @@
 //! robot program), how a table writes a pose, the TCP the targets are
 //! poses of, and where the compensated file goes: the inputs of
 //! `spherecal compensate` (`--targets`, `--pose-convention`, `--tcp`,
-//! `--out`) as the widgets edit them.
+//! `--out`, the flag limits and `--joint-targets`) as the widgets edit
+//! them.
 
 use crate::engine::base::robot::controller::FlangeConvention;
+use crate::engine::uses::compensate::Options;
 
 /// The TCP the targets are poses of (`--tcp`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -60,6 +62,10 @@ pub struct CompensateForm {
     pub tool: String,
     /// Where "Write compensated program" writes.
     pub out: String,
+    /// What joint targets mean and when a target is flagged
+    /// (`--joint-targets`, `--sigma-tolerance`, `--far-joints`,
+    /// `--region-margin`).
+    pub options: Options,
 }
 
 impl CompensateForm {

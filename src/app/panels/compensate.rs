@@ -1,6 +1,7 @@
 //! The Compensate view: a pose table or a robot program compensated
 //! through the result on show (`spherecal compensate` in the window).
-//! The inputs (targets file, pose convention, TCP), the Compensate
+//! The inputs (targets file, pose convention, TCP, joint targets and the
+//! flag limits), the Compensate
 //! button with its progress and Cancel, then the summary line, the tool
 //! data to set on the controller (TCP = sensor, with Copy), one row per
 //! target (largest correction first, flagged ones in orange with why)
@@ -17,6 +18,7 @@ use crate::app::provenance::Output;
 use crate::app::state::{AppState, DialogPurpose};
 use crate::app::view::compensate::{CompensationView, TargetRow};
 use crate::engine::base::robot::controller::FlangeConvention;
+use crate::engine::uses::compensate::{JointTargets, Options};
 
 /// Most target rows drawn (largest corrections first); every target is
 /// compensated and written. A robot program has tens to a few hundred
@@ -154,6 +156,7 @@ fn inputs_ui(
                 });
                 ui.end_row();
             }
+            options_rows_ui(ui, &mut form.options);
         });
     ui.add_space(4.0);
     ui.horizontal(|ui| {
@@ -185,6 +188,66 @@ fn inputs_ui(
             ui.label(RichText::new(w).small().color(MUTED));
         }
     });
+}
+
+/// What joint targets mean, and the three limits beyond which a target is
+/// flagged (`--joint-targets`, `--sigma-tolerance`, `--far-joints`,
+/// `--region-margin`); rows of the inputs grid.
+fn options_rows_ui(ui: &mut egui::Ui, options: &mut Options) {
+    ui.label("Joint targets");
+    ui.horizontal(|ui| {
+        ui.radio_value(
+            &mut options.joint_targets,
+            JointTargets::Compensate,
+            "compensated (offline-programmed: the nominal pose of the joints is wanted)",
+        );
+        ui.radio_value(
+            &mut options.joint_targets,
+            JointTargets::Keep,
+            "kept as written (taught on the robot)",
+        );
+    });
+    ui.end_row();
+
+    ui.label("Flag a target");
+    ui.horizontal_wrapped(|ui| {
+        let limits: [(&str, &mut f64, f64, &str, &str); 3] = [
+            (
+                "σ tolerance",
+                &mut options.sigma_tolerance_mm,
+                100.0,
+                " mm",
+                "flagged when its predicted 1σ residual (ml covariance) exceeds this",
+            ),
+            (
+                "far in joints",
+                &mut options.far_joints_deg,
+                720.0,
+                "°",
+                "flagged when farther than this from every identify pose (joint-space norm)",
+            ),
+            (
+                "region margin",
+                &mut options.region_margin_mm,
+                10_000.0,
+                " mm",
+                "flagged when its working point lies farther than this outside the box of the identify working points",
+            ),
+        ];
+        for (label, value, max, unit, hint) in limits {
+            let l = ui.label(label);
+            ui.add(
+                egui::DragValue::new(value)
+                    .range(0.0..=max)
+                    .speed(0.05)
+                    .max_decimals(3)
+                    .suffix(unit),
+            )
+            .labelled_by(l.id)
+            .on_hover_text(hint);
+        }
+    });
+    ui.end_row();
 }
 
 /// What the last compensation gave: its stale mark, the error naming the
