@@ -17,6 +17,10 @@
 //! sensor's own axes and units; an axis map puts them in FORMAT.md's laser
 //! plane, and no-return points are dropped and counted.
 //!
+//! A long import tells its stage ([`progress`]: each profile read, the side
+//! decision, the check) through [`import_with`] and [`import_poses_with`],
+//! and stops when the callback cancels.
+//!
 //! CSV files are read with the `csv` crate
 //! ([`Table`](crate::engine::base::table::Table)): a UTF-8 byte-order
 //! mark, quotes, `,` `;` or tab separators, `#` comment lines; column names
