@@ -561,6 +561,38 @@ fn programs_in_four_languages_keep_every_other_byte_and_match_the_table() {
             assert!(out.contains("PERS tooldata tSpherecal"), "{out}");
         }
     }
+    // The first table as a European spreadsheet writes it (semicolons,
+    // decimal commas): the same poses, written back with decimal commas.
+    let p = &programs(&targets, &model)[0];
+    let e_in = dir.path().join("eu.csv");
+    let e_out = dir.path().join("eu-out.csv");
+    std::fs::write(&e_in, p.table.replace(',', ";").replace('.', ",")).unwrap();
+    let (status, out, err) = run(&[
+        "compensate",
+        "--result",
+        path(&c.result_path),
+        "--targets",
+        path(&e_in),
+        "--pose-convention",
+        p.convention.key(),
+        "--out",
+        path(&e_out),
+    ]);
+    assert_eq!(status, 0, "{out}{err}");
+    let written = std::fs::read_to_string(&e_out).unwrap();
+    assert!(!written.contains('.') && written.contains(';'), "{written}");
+    let from_eu = poses_of(&written.replace(',', "."), "t.csv", Some(p.convention));
+    let dotted = dir.path().join(format!("{}-out.csv", p.name));
+    let from_table = poses_of(
+        &std::fs::read_to_string(&dotted).unwrap(),
+        "t.csv",
+        Some(p.convention),
+    );
+    assert_eq!(from_eu.len(), targets.len());
+    for (a, b) in from_eu.iter().zip(&from_table) {
+        assert!((a.translation.vector - b.translation.vector).norm() < 1e-9);
+        assert!(a.rotation.angle_to(&b.rotation) < 1e-12);
+    }
 }
 
 #[test]

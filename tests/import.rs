@@ -822,3 +822,37 @@ fn an_import_tells_its_progress_and_can_be_cancelled() {
     assert_eq!(calls, 3);
     assert_eq!(e.to_string(), "the import was cancelled");
 }
+
+/// A European cell's files: a joint log separated by semicolons with
+/// decimal commas, profiles with decimal commas (a `y;z` header, or none
+/// and spaces): the same measurements as with decimal points.
+#[test]
+fn decimal_commas_import_like_decimal_points() {
+    let original = simulated();
+    let dir = tempfile::tempdir().unwrap();
+    let o = LogOptions {
+        semicolon: true,
+        ..PLAIN
+    };
+    write_files(&original, dir.path(), &o);
+    let log = dir.path().join("log.csv");
+    let text = fs::read_to_string(&log).unwrap();
+    fs::write(&log, text.replace('.', ",")).unwrap();
+    for (k, m) in original.measurements.iter().enumerate() {
+        let Observation::Stripe(points) = &m.observation else {
+            unreachable!()
+        };
+        let mut p = String::from(if k % 2 == 0 { "y;z\n" } else { "" });
+        for [y, z] in points {
+            let row = if k % 2 == 0 {
+                format!("{y:?};{z:?}")
+            } else {
+                format!("{y:?} {z:?}")
+            };
+            writeln!(p, "{}", row.replace('.', ",")).unwrap();
+        }
+        fs::write(dir.path().join("profiles").join(format!("{}.csv", m.id)), p).unwrap();
+    }
+    let import::Imported { session, .. } = import::import(&spec(dir.path(), &o)).unwrap();
+    assert_same_measurements(&original, &session);
+}

@@ -200,10 +200,19 @@ fn assert_poses(session: &Session, truth: &[Isometry3<f64>], what: &str) {
 fn every_layout_imports_from_the_profile_folder_it_sits_in() {
     let (poses, stripes, truth) = cell(4, 8, false, 3);
     assert_eq!(poses.len(), 12, "a .ls with 12 positions");
-    let layouts: [(&str, String, Option<FlangeConvention>, PoseFormat); 5] = [
+    let layouts: [(&str, String, Option<FlangeConvention>, PoseFormat); 6] = [
         (
             "robot.txt",
             headerless_table(&poses),
+            Some(FlangeConvention::FanucWpr),
+            PoseFormat::Table,
+        ),
+        // A European spreadsheet's export: semicolons, decimal commas.
+        (
+            "robot_eu.csv",
+            headerless_table(&poses)
+                .replace('.', ",")
+                .replace("   ", ";"),
             Some(FlangeConvention::FanucWpr),
             PoseFormat::Table,
         ),

@@ -106,8 +106,39 @@ pub struct TableError {
     pub message: String,
 }
 
+/// Whether `s` is a number written with a decimal comma (`1000,5`,
+/// `-0,25`, `1,5e-3`), as spreadsheets and controllers in many European
+/// locales write them.
+#[must_use]
+pub fn decimal_comma(s: &str) -> bool {
+    let unsigned = s.strip_prefix(['+', '-']).unwrap_or(s);
+    let Some((int, frac)) = unsigned.split_once(',') else {
+        return false;
+    };
+    let digits = |t: &str| !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit());
+    let (frac, exponent) = match frac.split_once(['e', 'E']) {
+        Some((f, e)) => (f, Some(e.strip_prefix(['+', '-']).unwrap_or(e))),
+        None => (frac, None),
+    };
+    digits(int) && digits(frac) && exponent.is_none_or(digits)
+}
+
+/// A cell's number: with a decimal point, or, when `commas_decimal` (a
+/// table whose fields are not separated by commas), a decimal comma.
+#[must_use]
+pub fn parse_number(cell: &str, commas_decimal: bool) -> Option<f64> {
+    if let Ok(v) = cell.parse() {
+        return Some(v);
+    }
+    if commas_decimal && decimal_comma(cell) {
+        return cell.replacen(',', ".", 1).parse().ok();
+    }
+    None
+}
+
 /// The separator the header line implies.
-fn separator(text: &str) -> u8 {
+#[must_use]
+pub fn separator(text: &str) -> u8 {
     let header = text
         .trim_start_matches('\u{feff}')
         .lines()

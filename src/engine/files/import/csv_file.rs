@@ -5,7 +5,9 @@
 use std::path::{Path, PathBuf};
 
 use super::ImportError;
-use crate::engine::base::table::{Table, TableError, excerpt, read_text_file};
+use crate::engine::base::table::{
+    Table, TableError, excerpt, parse_number, read_text_file, separator,
+};
 
 /// A parsed CSV file: header and data rows with their 1-based lines.
 pub(super) struct CsvFile {
@@ -15,6 +17,9 @@ pub(super) struct CsvFile {
     pub header: Vec<String>,
     /// `(line, fields)` of every data row.
     pub rows: Vec<(usize, Vec<String>)>,
+    /// Fields not separated by commas (`;`, tabs): numbers may have
+    /// decimal commas (`12,5`).
+    pub decimal_commas: bool,
 }
 
 impl CsvFile {
@@ -38,6 +43,7 @@ impl CsvFile {
             path: path.to_path_buf(),
             header: table.header,
             rows: table.rows,
+            decimal_commas: separator(text) != b',',
         })
     }
 
@@ -72,6 +78,7 @@ impl CsvFile {
                         path: path.to_path_buf(),
                         header: record.iter().map(str::to_string).collect(),
                         rows: Vec::new(),
+                        decimal_commas: separator(text) != b',',
                     });
                 }
                 Some(f) => each(f, line, record).map_err(Fail::Row)?,
@@ -118,8 +125,8 @@ impl CsvFile {
     /// The finite number in `row[col]`, or a message naming line and column.
     pub fn number(&self, line: usize, row: &[String], col: usize) -> Result<f64, ImportError> {
         let s = &row[col];
-        match s.parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok(v),
+        match parse_number(s, self.decimal_commas) {
+            Some(v) if v.is_finite() => Ok(v),
             _ => Err(ImportError::Csv {
                 path: self.path.clone(),
                 line,

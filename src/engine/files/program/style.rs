@@ -62,11 +62,21 @@ impl NumberStyle {
 
 /// `value` written in full precision (the shortest text that reads back
 /// to the same `f64`), unless it equals `original`'s value, whose text is
-/// then kept as it was: the writing of tables and JSON pose lists.
+/// then kept as it was: the writing of tables and JSON pose lists. An
+/// original with a decimal comma (`1000,5`: a table cell, never JSON)
+/// gets one too.
 #[must_use]
 pub fn full_precision(original: &str, value: f64) -> String {
-    if original.trim().parse::<f64>().ok() == Some(value) {
+    let comma = original.contains(',');
+    let read = if comma {
+        original.trim().replacen(',', ".", 1).parse::<f64>().ok()
+    } else {
+        original.trim().parse::<f64>().ok()
+    };
+    if read == Some(value) {
         original.to_string()
+    } else if comma {
+        format!("{value}").replacen('.', ",", 1)
     } else {
         format!("{value}")
     }
@@ -101,5 +111,9 @@ mod tests {
         );
         let v = 412.123_456_789_012_3_f64;
         assert_eq!(full_precision("412.1", v).parse::<f64>().unwrap(), v);
+        // A decimal comma is kept, and written again.
+        assert_eq!(full_precision("1000,5", 1000.5), "1000,5");
+        assert_eq!(full_precision("1000,5", 1000.75), "1000,75");
+        assert_eq!(full_precision("-1,0", -2.0), "-2");
     }
 }

@@ -1,6 +1,7 @@
 //! Pose tables as controllers and scripts write them: one pose a row, the
 //! convention's numbers, separated by `,`, `;`, tabs or spaces, with or
-//! without a header.
+//! without a header; a table not separated by commas may write its
+//! numbers with decimal commas (`1000,5;20,25;…`, European locales).
 //!
 //! - **With a header** (any field of the first row not a number): the
 //!   pose columns by name (the convention's default names, any case, or
@@ -20,6 +21,7 @@ use super::scan::shown;
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::base::session::Use;
+use crate::engine::base::table::{decimal_comma, parse_number};
 
 /// How the fields of a row are separated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -29,14 +31,22 @@ enum Separator {
 }
 
 impl Separator {
-    /// From the first row: `;` when it has one, else a tab without a
-    /// comma, else `,` when it has one, else runs of spaces.
+    /// From the first row: `;` when it has one, else a tab when the row's
+    /// commas (if any) are decimal commas, else `,` when it has one
+    /// (unless it is a row of space-separated numbers with decimal
+    /// commas), else runs of spaces.
     fn of(line: &str) -> Self {
+        let commas_are_decimal = |mut fields: std::str::Split<'_, char>| {
+            fields.all(|f| !f.contains(',') || decimal_comma(f.trim()))
+        };
+        let spaced: Vec<&str> = line.split_whitespace().collect();
         if line.contains(';') {
             Self::Char(b';')
-        } else if line.contains('\t') && !line.contains(',') {
+        } else if line.contains('\t') && commas_are_decimal(line.split('\t')) {
             Self::Char(b'\t')
-        } else if line.contains(',') {
+        } else if line.contains(',')
+            && !(spaced.len() > 1 && spaced.iter().all(|f| !f.contains(',') || decimal_comma(f)))
+        {
             Self::Char(b',')
         } else {
             Self::Whitespace
@@ -51,6 +61,12 @@ impl Separator {
             Self::Whitespace => "spaces",
         }
     }
+}
+
+/// A cell's number: with a decimal point, or, in a table whose fields are
+/// not separated by commas, a decimal comma.
+fn number(cell: &str, sep: Separator) -> Option<f64> {
+    parse_number(cell, sep != Separator::Char(b','))
 }
 
 /// A row's fields as byte ranges into the text (trimmed, unquoted).
@@ -164,7 +180,7 @@ pub fn read_rows(
     };
     let sep = Separator::of(&text[first.clone()]);
     let first_fields = fields(text, first, sep);
-    let is_number = |r: &Range<usize>| text[r.clone()].parse::<f64>().is_ok();
+    let is_number = |r: &Range<usize>| number(&text[r.clone()], sep).is_some();
     let n = names.len();
     // A header has names; a first row whose only text is its first field
     // with one field more than the numbers need is data with an id first.
@@ -224,7 +240,7 @@ pub fn read_rows(
         let mut spans = Vec::with_capacity(n);
         for (c, &col) in layout.numbers.iter().enumerate() {
             let r = f[col].clone();
-            let v: f64 = text[r.clone()].parse().map_err(|_| {
+            let v = number(&text[r.clone()], sep).ok_or_else(|| {
                 (
                     *line,
                     format!(
@@ -403,6 +419,43 @@ mod tests {
         assert_eq!(values(&p, 1)[0], -669.571);
         assert_eq!(p.targets[1].number, Some(2));
         assert_eq!(&text[p.targets[0].spans[4].clone()], "-0.060");
+    }
+
+    #[test]
+    fn decimal_commas_where_commas_do_not_separate() {
+        let want = [1000.5, -20.25, 500.0, 180.0, 0.125, 1.5e-3];
+        for text in [
+            "1000,5;-20,25;500;180,0;0,125;1,5e-3\n1010,5;-20,25;500;180,0;0,125;1,5e-3\n",
+            "1000,5\t-20,25\t500\t180,0\t0,125\t1,5e-3\n",
+            "1000,5 -20,25 500 180,0 0,125 1,5e-3\n",
+            "x;y;z;a;b;c\n1000,5;-20,25;500;180,0;0,125;1,5e-3\n",
+            "p1 1000,5 -20,25 500 180,0 0,125 1,5e-3\n",
+        ] {
+            let p = read(text, FlangeConvention::KukaAbc, None).unwrap();
+            assert_eq!(values(&p, 0), want, "{text:?}");
+            assert_eq!(&text[p.targets[0].spans[1].clone()], "-20,25");
+        }
+        // Commas that separate stay separators, spaces or not.
+        let p = read(
+            "1000, 20, 500, 180, 0, 0\n",
+            FlangeConvention::KukaAbc,
+            None,
+        )
+        .unwrap();
+        assert_eq!(values(&p, 0), [1000.0, 20.0, 500.0, 180.0, 0.0, 0.0]);
+        let p = read("1000,5,20,25,500,0\n", FlangeConvention::KukaAbc, None).unwrap();
+        assert_eq!(values(&p, 0), [1000.0, 5.0, 20.0, 25.0, 500.0, 0.0]);
+        for (cell, yes) in [
+            ("1000,5", true),
+            ("-0,25", true),
+            ("1,5E+3", true),
+            ("1,", false),
+            (",5", false),
+            ("1,2,3", false),
+            ("a,b", false),
+        ] {
+            assert_eq!(decimal_comma(cell), yes, "{cell}");
+        }
     }
 
     #[test]

@@ -45,7 +45,7 @@ use super::csv_file::CsvFile;
 use super::{ImportError, LengthUnit};
 use crate::engine::base::limits;
 use crate::engine::base::numeric::show;
-use crate::engine::base::table::read_text_file;
+use crate::engine::base::table::{parse_number, read_text_file};
 
 /// Names of the sensor's axes, in order.
 const AXIS_NAMES: [&str; 3] = ["x", "y", "z"];
@@ -277,12 +277,18 @@ impl<'a> Collector<'a> {
 /// A number as sensors and OpenCV write it: Rust's forms plus OpenCV's
 /// `.nan`, `.inf`, `-.inf`.
 fn number(text: &str) -> Option<f64> {
+    number_in(text, false)
+}
+
+/// [`number`], also with a decimal comma when `decimal_commas` (a file
+/// whose fields are not separated by commas).
+fn number_in(text: &str, decimal_commas: bool) -> Option<f64> {
     let t = text.trim();
     match t.to_ascii_lowercase().as_str() {
         ".nan" => Some(f64::NAN),
         ".inf" | "+.inf" => Some(f64::INFINITY),
         "-.inf" => Some(f64::NEG_INFINITY),
-        _ => t.parse().ok(),
+        _ => parse_number(t, decimal_commas),
     }
 }
 

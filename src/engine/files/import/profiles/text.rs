@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use super::{AXIS_NAMES, Collector, ProfileFormat, RawProfile, number};
-use crate::engine::base::table::{excerpt, overlong_line, overlong_line_message};
+use super::{AXIS_NAMES, Collector, ProfileFormat, RawProfile, number_in};
+use crate::engine::base::table::{decimal_comma, excerpt, overlong_line, overlong_line_message};
 use crate::engine::files::import::ImportError;
 use crate::engine::files::import::csv_file::CsvFile;
 
@@ -26,7 +26,8 @@ pub(super) fn read_text_profile(
             message: overlong_line_message(length),
         });
     }
-    let has_header = split_fields(first).iter().any(|f| number(f).is_none());
+    let (first_fields, commas) = split_fields(first);
+    let has_header = first_fields.iter().any(|f| number_in(f, commas).is_none());
     let mut out = Collector::new(format);
     if has_header {
         // Row by row: a profile of millions of points is never held as
@@ -56,10 +57,10 @@ pub(super) fn read_text_profile(
             if l.is_empty() || l.starts_with('#') {
                 continue;
             }
-            let fields = split_fields(l);
+            let (fields, commas) = split_fields(l);
             let values: Vec<f64> = fields
                 .iter()
-                .map(|f| number(f))
+                .map(|f| number_in(f, commas))
                 .collect::<Option<_>>()
                 .ok_or_else(|| ImportError::Csv {
                     path: path.to_path_buf(),
@@ -92,11 +93,29 @@ pub(super) fn read_text_profile(
     Ok(out.finish(path))
 }
 
-/// Fields of a headerless row: separated by `,`, `;`, tabs or spaces.
-fn split_fields(line: &str) -> Vec<&str> {
-    line.split(|c: char| c == ',' || c == ';' || c.is_whitespace())
-        .filter(|f| !f.is_empty())
-        .collect()
+/// Fields of a headerless row, and whether their commas are decimal
+/// commas: separated by `;` (then so), by spaces or tabs with decimal
+/// commas (`1,5 -20,25`), else by `,`, `;`, tabs or spaces.
+fn split_fields(line: &str) -> (Vec<&str>, bool) {
+    let spaced: Vec<&str> = line.split_whitespace().collect();
+    if line.contains(';') {
+        let fields = line
+            .split(|c: char| c == ';' || c.is_whitespace())
+            .filter(|f| !f.is_empty())
+            .collect();
+        (fields, true)
+    } else if spaced.len() > 1
+        && spaced.iter().any(|f| f.contains(','))
+        && spaced.iter().all(|f| !f.contains(',') || decimal_comma(f))
+    {
+        (spaced, true)
+    } else {
+        let fields = line
+            .split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|f| !f.is_empty())
+            .collect();
+        (fields, false)
+    }
 }
 
 /// The columns of `x`, `y`, `z` a profile CSV has (at least two).
@@ -126,7 +145,7 @@ pub(super) fn xyz_of(
     for (v, c) in p.iter_mut().zip(columns) {
         if let Some(c) = *c {
             let cell = row.get(c).unwrap_or("");
-            *v = number(cell).ok_or_else(|| ImportError::Csv {
+            *v = number_in(cell, csv.decimal_commas).ok_or_else(|| ImportError::Csv {
                 path: csv.path.clone(),
                 line,
                 message: format!(
