@@ -179,7 +179,20 @@ pub fn read_rows(
         return Err((0, "the table has no rows".to_string()));
     };
     let sep = Separator::of(&text[first.clone()]);
-    let first_fields = fields(text, first, sep);
+    // A separator closing every row (`1000.5;20.25;…;0;`, as spreadsheets
+    // export) leaves no field after it.
+    let trailing = matches!(sep, Separator::Char(_))
+        && fields(text, first.clone(), sep)
+            .last()
+            .is_some_and(Range::is_empty);
+    let row_fields = |range: Range<usize>| {
+        let mut f = fields(text, range, sep);
+        if trailing && f.len() > 1 && f.last().is_some_and(Range::is_empty) {
+            f.pop();
+        }
+        f
+    };
+    let first_fields = row_fields(first);
     let is_number = |r: &Range<usize>| number(&text[r.clone()], sep).is_some();
     let n = names.len();
     // A header has names; a first row whose only text is its first field
@@ -223,7 +236,7 @@ pub fn read_rows(
     let data = if has_header { &rows[1..] } else { &rows[..] };
     let mut out = Vec::with_capacity(data.len());
     for (k, (line, range)) in data.iter().enumerate() {
-        let f = fields(text, range.clone(), sep);
+        let f = row_fields(range.clone());
         if f.len() != layout.width {
             return Err((
                 *line,
@@ -435,6 +448,15 @@ mod tests {
             assert_eq!(values(&p, 0), want, "{text:?}");
             assert_eq!(&text[p.targets[0].spans[1].clone()], "-20,25");
         }
+        // A separator closing every row, as spreadsheets export.
+        let p = read(
+            "1000,5;-20,25;500;180,0;0,125;1,5e-3;\n1,0;2;3;4;5;6;\n",
+            FlangeConvention::KukaAbc,
+            None,
+        )
+        .unwrap();
+        assert_eq!(values(&p, 0), want);
+        assert_eq!(values(&p, 1), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
         // Commas that separate stay separators, spaces or not.
         let p = read(
             "1000, 20, 500, 180, 0, 0\n",
