@@ -438,6 +438,30 @@ fn dh_ur5e_standard_matches_the_standard_product() {
     );
 }
 
+/// The same table as a European spreadsheet saves it (semicolons,
+/// decimal commas) is the same robot.
+#[test]
+fn a_dh_table_with_decimal_commas_is_the_same_robot() {
+    let dotted = std::fs::read_to_string(data("ur5e_dh.csv")).unwrap();
+    let european: String = dotted
+        .lines()
+        .map(|l| {
+            if l.starts_with('#') {
+                l.to_string()
+            } else {
+                l.replace(',', ";").replace('.', ",")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("ur5e_dh.csv");
+    std::fs::write(&path, european).unwrap();
+    let a = load_dh_csv(&data("ur5e_dh.csv"), DhConvention::Standard).unwrap();
+    let b = load_dh_csv(&path, DhConvention::Standard).unwrap();
+    assert_eq!(a, b);
+}
+
 #[test]
 fn dh_ur5e_standard_is_the_preset() {
     let robot = load_dh_csv(&data("ur5e_dh.csv"), DhConvention::Standard).unwrap();

@@ -57,7 +57,7 @@ use super::kinematics::{Joint, Robot};
 use crate::engine::base::geometry::{rot_x, trans};
 use crate::engine::base::limits;
 use crate::engine::base::numeric::show;
-use crate::engine::base::table::{Table, excerpt};
+use crate::engine::base::table::{Table, excerpt, parse_number, separator};
 
 /// Largest DH table read, bytes (1 MiB): a table has a row per joint.
 pub const MAX_DH_BYTES: u64 = 1 << 20;
@@ -251,6 +251,8 @@ fn read_rows(
         table.header_line,
         convention,
     )?);
+    // Fields separated by `;` or tabs may write decimal commas (`0,5`).
+    let decimal_commas = separator(text) != b',';
     let kept: Vec<&(usize, Vec<String>)> = table
         .rows
         .iter()
@@ -259,7 +261,7 @@ fn read_rows(
     let rows = kept
         .iter()
         .map(|(line, fields)| match &header {
-            Some(h) => parse_row(fields, h, path, *line),
+            Some(h) => parse_row(fields, h, path, *line, decimal_commas),
             None => Err(table_error(path, "no header")),
         })
         .collect::<Result<Vec<_>, _>>()?;
@@ -366,6 +368,7 @@ fn parse_row(
     header: &Header,
     path: &Path,
     line: usize,
+    decimal_commas: bool,
 ) -> Result<Joint, RobotImportError> {
     if record.len() != header.columns.len() {
         return Err(line_error(
@@ -384,9 +387,7 @@ fn parse_row(
         let Some((param, factor, _)) = column else {
             continue;
         };
-        let value = cell
-            .parse::<f64>()
-            .ok()
+        let value = parse_number(cell, decimal_commas)
             .filter(|v| v.is_finite())
             .ok_or_else(|| {
                 line_error(
