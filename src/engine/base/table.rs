@@ -123,6 +123,17 @@ pub fn decimal_comma(s: &str) -> bool {
     digits(int) && digits(frac) && exponent.is_none_or(digits)
 }
 
+/// Whether `line` is fields separated by spaces or tabs whose commas are
+/// all decimal commas (`1000,5 -20,25 500`): at least two fields and one
+/// comma.
+#[must_use]
+pub fn spaced_with_decimal_commas(line: &str) -> bool {
+    let fields: Vec<&str> = line.split_whitespace().collect();
+    fields.len() > 1
+        && fields.iter().any(|f| f.contains(','))
+        && fields.iter().all(|f| !f.contains(',') || decimal_comma(f))
+}
+
 /// A cell's number: with a decimal point, or, when `commas_decimal` (a
 /// table whose fields are not separated by commas), a decimal comma.
 #[must_use]

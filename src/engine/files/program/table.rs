@@ -21,7 +21,7 @@ use super::scan::shown;
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::base::session::Use;
-use crate::engine::base::table::{decimal_comma, parse_number};
+use crate::engine::base::table::{decimal_comma, parse_number, spaced_with_decimal_commas};
 
 /// How the fields of a row are separated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -39,14 +39,11 @@ impl Separator {
         let commas_are_decimal = |mut fields: std::str::Split<'_, char>| {
             fields.all(|f| !f.contains(',') || decimal_comma(f.trim()))
         };
-        let spaced: Vec<&str> = line.split_whitespace().collect();
         if line.contains(';') {
             Self::Char(b';')
         } else if line.contains('\t') && commas_are_decimal(line.split('\t')) {
             Self::Char(b'\t')
-        } else if line.contains(',')
-            && !(spaced.len() > 1 && spaced.iter().all(|f| !f.contains(',') || decimal_comma(f)))
-        {
+        } else if line.contains(',') && !spaced_with_decimal_commas(line) {
             Self::Char(b',')
         } else {
             Self::Whitespace

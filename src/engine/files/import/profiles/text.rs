@@ -4,7 +4,9 @@
 use std::path::Path;
 
 use super::{AXIS_NAMES, Collector, ProfileFormat, RawProfile, number_in};
-use crate::engine::base::table::{decimal_comma, excerpt, overlong_line, overlong_line_message};
+use crate::engine::base::table::{
+    excerpt, overlong_line, overlong_line_message, spaced_with_decimal_commas,
+};
 use crate::engine::files::import::ImportError;
 use crate::engine::files::import::csv_file::CsvFile;
 
@@ -97,18 +99,14 @@ pub(super) fn read_text_profile(
 /// commas: separated by `;` (then so), by spaces or tabs with decimal
 /// commas (`1,5 -20,25`), else by `,`, `;`, tabs or spaces.
 fn split_fields(line: &str) -> (Vec<&str>, bool) {
-    let spaced: Vec<&str> = line.split_whitespace().collect();
     if line.contains(';') {
         let fields = line
             .split(|c: char| c == ';' || c.is_whitespace())
             .filter(|f| !f.is_empty())
             .collect();
         (fields, true)
-    } else if spaced.len() > 1
-        && spaced.iter().any(|f| f.contains(','))
-        && spaced.iter().all(|f| !f.contains(',') || decimal_comma(f))
-    {
-        (spaced, true)
+    } else if spaced_with_decimal_commas(line) {
+        (line.split_whitespace().collect(), true)
     } else {
         let fields = line
             .split(|c: char| c == ',' || c.is_whitespace())
