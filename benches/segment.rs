@@ -2,7 +2,7 @@
 //! 2,500-point profile at 0.03 mm pitch (a stand, the arc of a 40 mm sphere
 //! cut at r = 30 mm, a table with a bump, 2 % clutter, 0.02 mm noise), and
 //! the real 2,529-point profile `p1.yml` of
-//! `shared/realdata/robcalibrator-sphere` when it is there (with the plain
+//! `data/robcalibrator-sphere` when it is there (with the plain
 //! circle fit of it for comparison: most of `find_arc`'s time on it).
 
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
@@ -60,7 +60,7 @@ fn profile() -> Vec<[f64; 2]> {
 fn real_profile() -> Option<Vec<[f64; 2]>> {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../shared/realdata/robcalibrator-sphere/p1.yml"
+        "/data/robcalibrator-sphere/p1.yml"
     );
     let text = std::fs::read_to_string(path).ok()?;
     let rest = &text[text.find("scan_line:")?..];

@@ -1,13 +1,11 @@
 //! Real measured data: RobCalibrator's line-scanner data set (an SSZN
-//! SR7140, an 80 mm sphere, 15 FANUC flange poses; `shared/realdata`,
-//! beside the repository). One command turns it into a pose-only session;
+//! SR7140, an 80 mm sphere, 15 FANUC flange poses; `data/`, copied byte
+//! for byte into the repository). One command turns it into a pose-only session;
 //! the calibrated hand-eye must bring the 15 base-frame sphere centres to
 //! ≤ 0.26 mm rms (RobCalibrator's own hand-eye gives 0.377 mm) and agree
 //! with RobCalibrator's within 3 mm and 2° after the axis map.
 //!
-//! The folder is `../shared/realdata/robcalibrator-sphere` from the
-//! repository. Missing, the tests print a loud skip and pass, unless
-//! `SPHERECAL_REQUIRE_REALDATA=1` (set by `.ci/run`) makes that a failure.
+//! The folder is `data/robcalibrator-sphere`; missing, the tests fail.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::{Path, PathBuf};
@@ -23,24 +21,17 @@ use spherecal::engine::files::import::{
     ProfileFormat, ProfileSource, SideChoice,
 };
 
-/// The data folder, or `None` (after a loud message) when it is absent
-/// and not required.
+/// The data folder in the repository (`data/robcalibrator-sphere`); the
+/// tests fail when it is missing. `Option` so that the callers keep their
+/// shape (`let Some(dir) = data() else { return }`).
 fn data() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realdata/robcalibrator-sphere");
-    if dir.join("RobPoses.rob").is_file() {
-        return Some(dir);
-    }
-    let required = std::env::var("SPHERECAL_REQUIRE_REALDATA").is_ok_and(|v| v == "1");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/robcalibrator-sphere");
     assert!(
-        !required,
-        "the real data set is missing: {} (SPHERECAL_REQUIRE_REALDATA=1)",
+        dir.join("RobPoses.rob").is_file(),
+        "the real data set is missing: {}",
         dir.display()
     );
-    eprintln!(
-        "\n*** SKIPPED: real data not found at {} — these tests did not run ***\n",
-        dir.display()
-    );
-    None
+    Some(dir)
 }
 
 fn spec(dir: &Path) -> PoseImportSpec {

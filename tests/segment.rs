@@ -1,7 +1,7 @@
 //! The sphere's arc in a raw profile (`find_arc`): seeded synthetic profiles
 //! with background (table, stand, a smaller circle, clutter, reflections,
 //! gaps) against the generator's labels, the 15 real profiles of
-//! `shared/realdata/robcalibrator-sphere`, the simulator's clean stripes
+//! `data/robcalibrator-sphere`, the simulator's clean stripes
 //! against the plain circle fit, and every error.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
@@ -272,19 +272,17 @@ fn read_scan_line(text: &str) -> Vec<[f64; 2]> {
 }
 
 fn real_data_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/realdata/robcalibrator-sphere")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/robcalibrator-sphere")
 }
 
 #[test]
 fn real_profiles_have_an_arc() {
     let dir = real_data_dir();
-    if !dir.join("p1.yml").is_file() {
-        eprintln!(
-            "\n*** SKIPPED real_profiles_have_an_arc: no real data at {} ***\n",
-            dir.display()
-        );
-        return;
-    }
+    assert!(
+        dir.join("p1.yml").is_file(),
+        "no real data at {}",
+        dir.display()
+    );
     println!(
         "profile points   kept dropped off-arc outliers   r (mm)   rms (mm) span (°) band (mm) rounds"
     );

@@ -801,20 +801,16 @@ fn a_plan_is_made_exported_simulated_and_calibrated() {
     assert!(result.file.epsilon_after < result.file.epsilon_before);
 }
 
-/// The real data set beside the repository (see tests/realdata.rs), or
-/// `None` after a loud skip when it is absent and not required.
+/// The real data set in the repository (`data/robcalibrator-sphere`, see
+/// tests/realdata.rs); missing, the test fails.
 fn realdata() -> Option<std::path::PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realdata/robcalibrator-sphere");
-    if dir.join("RobPoses.rob").is_file() {
-        return Some(dir);
-    }
-    let required = std::env::var("SPHERECAL_REQUIRE_REALDATA").is_ok_and(|v| v == "1");
-    assert!(!required, "the real data set is missing: {}", dir.display());
-    eprintln!(
-        "\n*** SKIPPED: real data not found at {} ***\n",
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/robcalibrator-sphere");
+    assert!(
+        dir.join("RobPoses.rob").is_file(),
+        "the real data set is missing: {}",
         dir.display()
     );
-    None
+    Some(dir)
 }
 
 #[test]
