@@ -177,6 +177,14 @@ pub struct SimConfig {
     /// paper's spot). Needs `range`. Not echoed when off.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub spread: bool,
+    /// A pose-only session (FORMAT.md `measurements[].flange`, issue 32):
+    /// every measurement reports its flange pose as a controller would,
+    /// the true flange position plus Gaussian error of this σ (mm, each
+    /// base-frame coordinate; the orientation exact), and carries no
+    /// joints and no robot. `None`: joints, as the paper. Not echoed when
+    /// off.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pose_only: Option<f64>,
 }
 
 impl Default for SimConfig {
@@ -220,6 +228,7 @@ impl Default for SimConfig {
             workspace: None,
             range: None,
             spread: false,
+            pose_only: None,
         }
     }
 }
@@ -276,6 +285,16 @@ impl SimConfig {
 
 pub(super) fn validate_config(c: &SimConfig) -> Result<(), SimError> {
     check_numbers(c)?;
+    if let Some(sigma) = c.pose_only {
+        check(
+            sigma.is_finite() && (0.0..=MAX_SENSOR_NOISE_MM).contains(&sigma),
+            || {
+                format!(
+                    "pose_only: the flange poses' σ must lie within 0 to {MAX_SENSOR_NOISE_MM} mm, found {sigma} mm"
+                )
+            },
+        )?;
+    }
     check_sensor_model(c)?;
     check_motion(c)?;
     check_stripes_and_range(c)

@@ -90,6 +90,11 @@ const STREAM_GEOMETRY: u64 = 0;
 const STREAM_ERRORS: u64 = 1;
 /// See [`STREAM_GEOMETRY`].
 const STREAM_NOISE: u64 = 2;
+/// See [`STREAM_GEOMETRY`]: the reported flange poses' error of a
+/// pose-only session ([`SimConfig::pose_only`]), its own stream so that
+/// the stripes of a pose-only session are those of the joint session of
+/// the same seed.
+const STREAM_POSES: u64 = 3;
 
 fn kinematic_errors(c: &SimConfig, dof: usize, rng: &mut ChaCha8Rng) -> Vec<Joint> {
     let scale = |v: f64| round_to(v * c.error_scale, ERROR_DECIMALS);
@@ -303,7 +308,7 @@ pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
         InitialHandEye::Paper => Some(paper_initial_hand_eye()),
         InitialHandEye::Truth => Some(flange_from_sensor),
     };
-    let session = Session {
+    let mut session = Session {
         // The simulator's own robots keep their base and flange unwritten.
         base_given: false,
         flange_given: false,
@@ -317,6 +322,9 @@ pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
             measurements,
         )
     };
+    if let Some(sigma) = config.pose_only {
+        report_flange_poses(&mut session, &true_robot, &plan.poses, sigma, config.seed);
+    }
     let mut echoed = config.clone();
     echoed.name = Some(name.clone());
     echoed.workspace = Some(workspace);
@@ -339,6 +347,31 @@ pub fn simulate(config: &SimConfig) -> Result<(Session, Truth), SimError> {
         measurements: OrderedMap(truths),
     };
     Ok((session, truth))
+}
+
+/// Turns `session` pose-only ([`SimConfig::pose_only`]): each
+/// measurement's flange pose is the true robot's at the pose's actual
+/// joints, its position off by N(0, σ²) in each base-frame coordinate (the
+/// error a controller's reported pose has); joints and robot are dropped.
+/// `poses` are the measurements' poses in order.
+fn report_flange_poses(
+    session: &mut Session,
+    true_robot: &crate::engine::base::robot::Robot,
+    poses: &[Pose],
+    sigma: f64,
+    seed: u64,
+) {
+    let mut rng = stream(seed, STREAM_POSES);
+    for (m, pose) in session.measurements.iter_mut().zip(poses) {
+        let mut flange = true_robot.base_from_flange(&pose.joints);
+        for k in 0..3 {
+            flange.translation.vector[k] += sigma * normal(&mut rng);
+        }
+        m.flange = Some(flange);
+        m.joints.clear();
+    }
+    session.robot_given = false;
+    session.robot = crate::engine::base::robot::Robot::new(String::new(), Vec::new());
 }
 
 /// The session of a simulation: the nominal robot, the simulated sensor
