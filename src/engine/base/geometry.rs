@@ -1,6 +1,7 @@
 //! Rigid-transform helpers shared by the engine: 4×4 matrices of the file
 //! formats to and from [`Isometry3`], the paper's differential-motion
-//! vectors (twists), and the skew matrix.
+//! vectors (twists), the skew matrix, and Kabsch's best rotation and
+//! rigid motion.
 //!
 //! A twist here is the paper's 6-vector `[Δx, Δy, Δz, δx, δy, δz]`
 //! (translation first, mm; then rotation, rad): a point `X` moves by
@@ -177,10 +178,33 @@ pub fn rotation_from_rpy_deg(rpy_deg: [f64; 3]) -> UnitQuaternion<f64> {
     UnitQuaternion::from_euler_angles(r, p, y)
 }
 
+/// The proper rotation `R` minimising `Σ |R·a_k − b_k|²` given the
+/// cross-covariance `m = Σ a_k·b_kᵀ` (Kabsch; the paper's eq. 7 with the
+/// determinant forced to +1): `R = V·diag(1, 1, det(V·Uᵀ))·Uᵀ` from the
+/// SVD `m = U·S·Vᵀ`, taken to the nearest rotation (Müller et al.'s
+/// iteration, nalgebra's `Rotation3::from_matrix`) so that rounding leaves
+/// no scale. `None` for a failed SVD. The one Kabsch of the crate: the
+/// initial hand-eye (eq. 7) and [`kabsch`] call it.
+#[must_use]
+pub fn kabsch_rotation(m: &Matrix3<f64>) -> Option<Rotation3<f64>> {
+    let svd = nalgebra::linalg::SVD::try_new(
+        *m,
+        true,
+        true,
+        f64::EPSILON,
+        crate::engine::base::numeric::MAX_DECOMPOSITION_SWEEPS,
+    )?;
+    let (u, v_t) = (svd.u?, svd.v_t?);
+    let v = v_t.transpose();
+    let d = (v * u.transpose()).determinant().signum();
+    let fix = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, d));
+    Some(Rotation3::from_matrix(&(v * fix * u.transpose())))
+}
+
 /// The rigid motion `T` that best maps `from` onto `to` in least squares
-/// (Kabsch: centroids, then the SVD of the cross-covariance, reflection
-/// excluded). `None` for fewer than 3 pairs, unequal lengths or a failed
-/// SVD.
+/// (Kabsch: centroids, then [`kabsch_rotation`] of the cross-covariance,
+/// reflection excluded). `None` for fewer than 3 pairs, unequal lengths or
+/// a failed SVD.
 #[must_use]
 pub fn kabsch(from: &[Vector3<f64>], to: &[Vector3<f64>]) -> Option<Isometry3<f64>> {
     if from.len() != to.len() || from.len() < 3 {
@@ -193,19 +217,7 @@ pub fn kabsch(from: &[Vector3<f64>], to: &[Vector3<f64>]) -> Option<Isometry3<f6
     for (f, t) in from.iter().zip(to) {
         h += (f - cf) * (t - ct).transpose();
     }
-    let svd = nalgebra::linalg::SVD::try_new(
-        h,
-        true,
-        true,
-        f64::EPSILON,
-        crate::engine::base::numeric::MAX_DECOMPOSITION_SWEEPS,
-    )?;
-    let (u, v_t) = (svd.u?, svd.v_t?);
-    let mut d = Matrix3::identity();
-    if (v_t.transpose() * u.transpose()).determinant() < 0.0 {
-        d[(2, 2)] = -1.0;
-    }
-    let r = Rotation3::from_matrix_unchecked(v_t.transpose() * d * u.transpose());
+    let r = kabsch_rotation(&h)?;
     let t = ct - r * cf;
     Some(Isometry3::from_parts(
         Translation3::from(t),

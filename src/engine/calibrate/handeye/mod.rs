@@ -19,6 +19,7 @@ pub mod general;
 
 use nalgebra::{DMatrix, DVector, Isometry3, Matrix3, SVD, Translation3, UnitQuaternion, Vector3};
 
+use crate::engine::base::geometry::kabsch_rotation;
 use crate::engine::base::numeric::MAX_DECOMPOSITION_SWEEPS;
 
 use crate::engine::base::robot::Robot;
@@ -227,7 +228,9 @@ pub fn initial_rotation(
     }
     // Eq. 7: Rs = V·Uᵀ with A·Bᵀ = U·S·Vᵀ, reflection removed.
     let m: Matrix3<f64> = (&a * b.transpose()).fixed_view::<3, 3>(0, 0).into_owned();
-    let rotation = procrustes(&m);
+    let rotation = kabsch_rotation(&m).map_or_else(UnitQuaternion::identity, |r| {
+        UnitQuaternion::from_rotation_matrix(&r)
+    });
     let residual = {
         let mut sum = 0.0;
         for k in 0..n {
@@ -238,22 +241,6 @@ pub fn initial_rotation(
         (sum / n as f64).sqrt()
     };
     Ok((rotation, residual, spread, drift))
-}
-
-/// The proper rotation `R` minimising `Σ |R·a_k − b_k|²` given
-/// `m = Σ a_k·b_kᵀ` (Kabsch; eq. 7 with the determinant forced to +1).
-fn procrustes(m: &Matrix3<f64>) -> UnitQuaternion<f64> {
-    let Some(svd) = SVD::try_new(*m, true, true, f64::EPSILON, MAX_DECOMPOSITION_SWEEPS) else {
-        return UnitQuaternion::identity();
-    };
-    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
-        return UnitQuaternion::identity();
-    };
-    let v = v_t.transpose();
-    let d = (v * u.transpose()).determinant().signum();
-    let fix = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, d));
-    let r = v * fix * u.transpose();
-    UnitQuaternion::from_matrix(&r)
 }
 
 /// Eq. 8-9: the hand-eye translation from orientation-changing sightings,
