@@ -527,9 +527,11 @@ fn file_kind(meta: &fs::Metadata) -> &'static str {
     "not a regular file"
 }
 
-/// Whether `a` and `b` are the same existing file (Unix: device and
-/// inode, so hard links, `..` and symbolic links are seen through; else
-/// the canonical paths).
+/// Whether `a` and `b` name the same file, the one test of the crate
+/// (outputs against inputs, a profile folder's pose file): on Unix the
+/// device and inode, so hard links, `..` and symbolic links are seen
+/// through; elsewhere the canonical paths. When either cannot be looked
+/// up (not there yet, no permission) the paths as written are compared.
 #[must_use]
 pub fn same_file(a: &Path, b: &Path) -> bool {
     #[cfg(unix)]
@@ -537,14 +539,14 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
         use std::os::unix::fs::MetadataExt as _;
         match (fs::metadata(a), fs::metadata(b)) {
             (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
-            _ => false,
+            _ => a == b,
         }
     }
     #[cfg(not(unix))]
     {
         match (fs::canonicalize(a), fs::canonicalize(b)) {
             (Ok(x), Ok(y)) => x == y,
-            _ => false,
+            _ => a == b,
         }
     }
 }

@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 
 use super::ImportError;
 use super::profiles::PROFILE_EXTENSIONS;
+use crate::engine::files::format::same_file;
 
 /// The profile files of a folder and what was left out.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -97,14 +98,6 @@ fn digit_runs(name: &str) -> Vec<u64> {
     }
     out.extend(current);
     out
-}
-
-/// Whether two paths name the same file.
-fn same_file(a: &Path, b: &Path) -> bool {
-    match (fs::canonicalize(a), fs::canonicalize(b)) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => a == b,
-    }
 }
 
 /// The profile files of `dir`: files of a profile extension named alike,
