@@ -11,6 +11,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::SystemTime;
 
+use crate::engine::base::table::csv_field;
 use crate::engine::files::format::{result_text_checked, write_atomic};
 use crate::engine::tools::report::html::{self, ReportInput, ReportMeta};
 use crate::engine::tools::report::model::{self, ModelFormat};
@@ -85,15 +86,6 @@ pub fn distances_csv(view: &ResultView) -> String {
         );
     }
     s
-}
-
-/// Quotes a CSV field when it holds a comma, quote or line break.
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }
 
 /// Writes a text export of `view` to `path` atomically.

@@ -45,6 +45,24 @@ pub fn read_text_file(path: &std::path::Path) -> std::io::Result<String> {
     std::fs::read_to_string(path)
 }
 
+/// `text` as one CSV field, the one field writer of the crate (histories,
+/// clouds, the workbench's exports): as it is when a reader of any of the
+/// separators above takes it back unchanged, else quoted with its quotes
+/// doubled: when it holds a separator (`,` `;` tab), a quote or a line
+/// break, has surrounding spaces (fields are trimmed) or starts with `#`
+/// (a skipped line).
+#[must_use]
+pub fn csv_field(text: &str) -> String {
+    let plain = !text.contains([',', '"', '\n', '\r', ';', '\t'])
+        && text.trim() == text
+        && !text.starts_with('#');
+    if plain {
+        text.to_string()
+    } else {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    }
+}
+
 /// `text` cut to at most `max` characters for a message: the start, then
 /// `…` and how many characters were left out.
 #[must_use]
@@ -332,6 +350,14 @@ impl Table {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ids_are_quoted_when_needed() {
+        assert_eq!(csv_field("c17"), "c17");
+        assert_eq!(csv_field("a,b"), "\"a,b\"");
+        assert_eq!(csv_field("say \"x\""), "\"say \"\"x\"\"\"");
+        assert_eq!(csv_field(" lead"), "\" lead\"");
+    }
 
     #[test]
     fn tables_parse_and_name_lines() {

@@ -29,6 +29,7 @@ use crate::engine::base::geometry::{rot_x, rot_y, rot_z, rows_from_isometry, tra
 use crate::engine::base::robot::{Joint, Robot};
 use crate::engine::files::format::ResultFile;
 use crate::engine::files::format::result::RobotRecord;
+use crate::engine::tools::report::svg::escape;
 
 /// Millimetres per metre: file lengths are mm, URDF lengths are m.
 const MM_PER_M: f64 = 1000.0;
@@ -249,22 +250,6 @@ pub fn urdf_joint_origins(robot: &Robot) -> Vec<Isometry3<f64>> {
     origins
 }
 
-/// Escapes text for an XML attribute value.
-fn xml_attr(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            _ => out.push(c),
-        }
-    }
-    out
-}
-
 /// Makes text safe inside an XML comment (no `--`, no trailing `-`).
 fn xml_comment(text: &str) -> String {
     let mut out = text.replace("--", "- -").replace("--", "- -");
@@ -320,7 +305,7 @@ fn urdf(result: &ResultFile, robot: &Robot, source: &str) -> String {
         xml_comment(source),
         xml_comment(&result.session),
     );
-    let _ = writeln!(out, "<robot name=\"{}\">", xml_attr(&robot.name));
+    let _ = writeln!(out, "<robot name=\"{}\">", escape(&robot.name));
     let has_base = robot.base != Isometry3::identity();
     if has_base {
         out.push_str("  <link name=\"world\"/>\n");

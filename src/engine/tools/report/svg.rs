@@ -129,7 +129,8 @@ pub fn heat_rgb(t: f64) -> [u8; 3] {
     std::array::from_fn(|k| (a[k] + (b[k] - a[k]) * f).round() as u8)
 }
 
-/// Escapes text for HTML and SVG content and attribute values.
+/// Escapes text for XML: HTML and SVG content and attribute values, the
+/// URDF export's attributes (the one XML escape of the crate).
 #[must_use]
 pub fn escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
