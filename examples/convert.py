@@ -15,9 +15,10 @@ Writes into examples/ (the current folder is the repository's root):
 - log/: the small cell's joint log as a cell writes it (own column names,
   semicolons and decimal commas, joints in radians, KUKA A B C flange
   poses) and its profiles in micrometres, space-separated, no header;
-- targets.csv and path.mod: the sensor poses along the stepped-block scan
-  of examples/scan (its nominal flange poses times the seed-7 cell's
-  calibrated hand-eye), as an ABB table and as a RAPID module.
+- targets.csv, targets-matrix.txt and path.mod: the sensor poses along the
+  stepped-block scan of examples/scan (its nominal flange poses times the
+  seed-7 cell's calibrated hand-eye), as an ABB table, three of them as
+  4x4 matrices, and as a RAPID module.
 """
 
 import csv
@@ -216,6 +217,7 @@ def targets(tmp):
         f"[{hq[0]:.5f},{hq[1]:.5f},{hq[2]:.5f},{hq[3]:.5f}]],[1,[0,0,1],[1,0,0,0],0,0,0]];\n"
     )
     names = []
+    matrices = []
     for k, row in enumerate(rows):
         r = from_quaternion([float(row[c]) for c in ("q1", "q2", "q3", "q4")])
         t = [float(row[c]) for c in ("x", "y", "z")]
@@ -224,6 +226,8 @@ def targets(tmp):
         q = quaternion(rs)
         name = f"T{k + 1}"
         names.append(name)
+        if k in (0, 4, 9):
+            matrices.append((name, [rs[i] + [ts[i]] for i in range(3)]))
         table.append(f"{name},{ts[0]:.3f},{ts[1]:.3f},{ts[2]:.3f}," + ",".join(f"{v:.7f}" for v in q))
         joints = [float(row[f"j{i}"]) for i in range(1, 7)]
         cf = [math.floor(joints[0] / 90), math.floor(joints[3] / 90), math.floor(joints[5] / 90), int(joints[4] < 0)]
@@ -237,6 +241,15 @@ def targets(tmp):
         mod += f"    MoveL {name}, v100, {'fine' if k in (0, len(names) - 1) else 'z1'}, tSensor;\n"
     mod += "  ENDPROC\nENDMODULE\n"
     write("examples/targets.csv", "\n".join(table) + "\n")
+    # Three of them as 4x4 matrices (row-major, mm), an id first, no header.
+    rows = []
+    for name, m in matrices:
+        cells = [f"{v:.9f}" for v in m[0][:3]] + [f"{m[0][3]:.3f}"]
+        cells += [f"{v:.9f}" for v in m[1][:3]] + [f"{m[1][3]:.3f}"]
+        cells += [f"{v:.9f}" for v in m[2][:3]] + [f"{m[2][3]:.3f}"]
+        cells += ["0", "0", "0", "1"]
+        rows.append(" ".join([name] + cells))
+    write("examples/targets-matrix.txt", "\n".join(rows) + "\n")
     write("examples/path.mod", mod)
 
 

@@ -14,7 +14,7 @@ spherecal() { "$SPHERECAL" "$@"; }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 rm -rf examples/scan examples/artefact examples/poses examples/log
-rm -f examples/targets.csv examples/path.mod
+rm -f examples/targets.csv examples/targets-matrix.txt examples/path.mod
 
 # Raw scans taken with the seed-7 cell: a stepped block (10 poses) and a
 # three-sphere artefact (5 poses a sphere), each with the truth of the part.
