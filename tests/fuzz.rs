@@ -632,7 +632,8 @@ fn deep_nesting_is_refused_at_once() {
 /// naming the file and the line.
 #[test]
 fn one_huge_line_gives_a_short_message() {
-    use spherecal::engine::base::robot::{DhConvention, load_dh_csv, robot_from_urdf};
+    use spherecal::engine::base::robot::{DhConvention, robot_from_urdf};
+    use spherecal::engine::files::import::load_dh_csv;
     let dir = tempfile::tempdir().unwrap();
     let junk = "x".repeat(3 << 20);
     let mut messages = Vec::new();

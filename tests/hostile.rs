@@ -379,7 +379,7 @@ fn a_calibration_that_scatters_beyond_any_sensor_fails() {
         "{err}"
     );
     assert!(!out.exists());
-    let (code, _, err) = spherecal_cli(&["calibrate", r, "--out", o, "-q", "--accept-implausible"]);
+    let (code, _, err) = spherecal_cli(&["calibrate", r, "--out", o, "--accept-implausible"]);
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("warning: the calibration failed"), "{err}");
     assert!(out.exists());
@@ -469,4 +469,87 @@ fn huge_numbers_are_shown_short() {
     }
     let e = import::profiles::read_profile(&yml, &ProfileFormat::default()).unwrap_err();
     assert!(e.to_string().contains("1e308"), "{e}");
+}
+
+/// `calibrate /dev/zero` read until 4 GB were in memory (the size caps
+/// asked the file system, which says 0 bytes for a device or a FIFO):
+/// every file is read through one reader bounded by the bytes it reads,
+/// so an endless device as a session, a result, targets or poses is
+/// refused at its cap, naming the file and the cap.
+#[cfg(unix)]
+#[test]
+fn an_endless_device_is_refused_at_the_cap_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = simulated(dir.path());
+    let r = dir.path().join("r.json");
+    let (code, _, err) = spherecal_cli(&[
+        "calibrate",
+        s.to_str().unwrap(),
+        "--out",
+        r.to_str().unwrap(),
+        "--no-cross-validation",
+        "-q",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (x, i) = (dir.path().join("x.json"), dir.path().join("i.json"));
+    let out = dir.path().join("out.csv");
+    let out = out.to_str().unwrap();
+    let zero = "/dev/zero";
+    let runs: [(Vec<&str>, &str); 4] = [
+        (
+            vec!["calibrate", zero, "--out", x.to_str().unwrap()],
+            "the 256 MiB a session or result file may have",
+        ),
+        (
+            vec![
+                "compensate",
+                "--result",
+                zero,
+                "--targets",
+                s.to_str().unwrap(),
+                "--out",
+                out,
+            ],
+            "the 256 MiB a session or result file may have",
+        ),
+        (
+            vec![
+                "compensate",
+                "--result",
+                r.to_str().unwrap(),
+                "--targets",
+                zero,
+                "--pose-convention",
+                "abb",
+                "--out",
+                out,
+            ],
+            "the 256 MiB a pose file or robot program may have",
+        ),
+        (
+            vec![
+                "import",
+                "--poses",
+                zero,
+                "--pose-convention",
+                "abb",
+                "--profiles",
+                dir.path().to_str().unwrap(),
+                "--out",
+                i.to_str().unwrap(),
+            ],
+            "the 256 MiB a pose file or robot program may have",
+        ),
+    ];
+    for (args, cap) in runs {
+        let started = std::time::Instant::now();
+        let (code, _, err) = spherecal_cli(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(cap) && err.contains(zero), "{args:?}: {err}");
+        assert!(
+            started.elapsed().as_secs_f64() < 20.0,
+            "{args:?}: {:?}",
+            started.elapsed()
+        );
+    }
 }

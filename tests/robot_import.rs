@@ -16,9 +16,10 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use spherecal::engine::base::robot::{
-    DhConvention, JointLimit, Robot, RobotImportError, UrdfOptions, irb2400, load_dh_csv,
-    load_urdf, robot_from_dh_csv, robot_from_urdf, robot_from_urdf_with, ur5e,
+    DhConvention, JointLimit, Robot, RobotImportError, UrdfOptions, irb2400, robot_from_dh_csv,
+    robot_from_urdf, robot_from_urdf_with, ur5e,
 };
+use spherecal::engine::files::import::{load_dh_csv, load_urdf};
 
 /// Position agreement required, mm.
 const POS_TOL: f64 = 1e-9;

@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 use crate::engine::base::session::{ExcludeError, Session, exclude_measurements};
 use crate::engine::calibrate::solve::{self, estimate::Estimate};
 use crate::engine::files::format::{
-    FileError, RESULT_FORMAT, ResultFile, parse_result, parse_session, session_to_json,
-    write_atomic,
+    Cap, FileError, RESULT_FORMAT, ResultFile, parse_result, parse_session, read_text,
+    session_to_json, write_atomic,
 };
 
 use super::Core;
@@ -53,7 +53,7 @@ pub fn open_demo() -> Result<LoadedSession, FileError> {
 /// The file cannot be read or breaks a FORMAT.md rule; the message names
 /// the file and, where it applies, the measurement.
 pub fn open_path(path: &Path) -> Result<Opened, FileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| FileError::Io {
+    let text = read_text(path, Cap::SESSION).map_err(|source| FileError::Io {
         action: "reading",
         path: path.to_path_buf(),
         source,

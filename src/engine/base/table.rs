@@ -19,32 +19,6 @@ pub const MAX_ECHO_CHARS: usize = 80;
 /// no more than its text.
 pub const MAX_LINE_BYTES: usize = 1 << 20;
 
-/// Largest text table read (joint logs, profiles, profile tables,
-/// reference distances, station lists), bytes (512 MiB): a calibration's
-/// joint log is a few kB, a table of every profile of a thousand poses a
-/// hundred MB. A larger file is refused before it is read, so a hostile
-/// file of gigabytes costs nothing.
-pub const MAX_TEXT_BYTES: u64 = 512 << 20;
-
-/// The text of a table file, refused unread beyond [`MAX_TEXT_BYTES`].
-///
-/// # Errors
-/// The file cannot be read, is not UTF-8, or is too large
-/// ([`std::io::ErrorKind::InvalidData`], saying so).
-pub fn read_text_file(path: &std::path::Path) -> std::io::Result<String> {
-    let size = std::fs::metadata(path)?.len();
-    if size > MAX_TEXT_BYTES {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!(
-                "the file has {size} bytes, more than the {} MiB a table may have",
-                MAX_TEXT_BYTES >> 20
-            ),
-        ));
-    }
-    std::fs::read_to_string(path)
-}
-
 /// `text` as one CSV field, the one field writer of the crate (histories,
 /// clouds, the workbench's exports): as it is when a reader of any of the
 /// separators above takes it back unchanged, else quoted with its quotes

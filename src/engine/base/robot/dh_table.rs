@@ -77,29 +77,6 @@ pub enum DhConvention {
     Modified,
 }
 
-/// Reads the DH table at `path` ([`robot_from_dh_csv`]).
-///
-/// # Errors
-/// The file cannot be read, or any error of [`robot_from_dh_csv`].
-pub fn load_dh_csv(path: &Path, convention: DhConvention) -> Result<Robot, RobotImportError> {
-    let io = |source| RobotImportError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let size = std::fs::metadata(path).map_err(io)?.len();
-    if size > MAX_DH_BYTES {
-        return Err(table_error(
-            path,
-            &format!(
-                "the file has {size} bytes, more than the {} MiB a DH table may have",
-                MAX_DH_BYTES >> 20
-            ),
-        ));
-    }
-    let text = std::fs::read_to_string(path).map_err(io)?;
-    robot_from_dh_csv(&text, path, convention)
-}
-
 /// The robot of a DH table in CSV (module docs), named after the file.
 /// `source` names the file in errors.
 ///

@@ -13,7 +13,7 @@ pub mod kinematics;
 pub mod presets;
 pub mod urdf;
 
-pub use dh_table::{DhConvention, load_dh_csv, robot_from_dh_csv};
+pub use dh_table::{DhConvention, robot_from_dh_csv};
 pub use import_error::RobotImportError;
 pub use kinematics::{
     Joint, JointLimit, PARAM_IS_ANGLE, PARAM_NAMES, PARAMS_PER_JOINT, Robot, pose_error,
@@ -21,4 +21,4 @@ pub use kinematics::{
 pub use presets::{
     Preset, RobotChoice, TABLE1, irb120, irb2400, preset, presets, table1_errors, ur5e,
 };
-pub use urdf::{UrdfOptions, UrdfRobot, load_urdf, robot_from_urdf, robot_from_urdf_with};
+pub use urdf::{UrdfOptions, UrdfRobot, robot_from_urdf, robot_from_urdf_with};

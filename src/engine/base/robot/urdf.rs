@@ -148,23 +148,6 @@ pub struct UrdfRobot {
     pub tip_link: String,
 }
 
-/// Reads the URDF file at `path` ([`robot_from_urdf_with`]).
-///
-/// # Errors
-/// The file cannot be read, or any error of [`robot_from_urdf_with`].
-pub fn load_urdf(path: &Path, options: &UrdfOptions) -> Result<UrdfRobot, RobotImportError> {
-    let io = |source| RobotImportError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let size = std::fs::metadata(path).map_err(io)?.len();
-    if size > MAX_URDF_BYTES {
-        return Err(too_large(path, size));
-    }
-    let text = std::fs::read_to_string(path).map_err(io)?;
-    robot_from_urdf_with(&text, path, options)
-}
-
 /// The error of a URDF beyond [`MAX_URDF_BYTES`].
 fn too_large(path: &Path, size: u64) -> RobotImportError {
     RobotImportError::UrdfSyntax {

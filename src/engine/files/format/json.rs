@@ -6,7 +6,6 @@
 //! small flat objects on one line).
 
 use std::fmt;
-use std::fs;
 use std::path::Path;
 
 use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion};
@@ -15,6 +14,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 use serde_json::{Map, Value};
 
+use super::read::{Cap, read_text as read_capped};
 use super::{FORMAT_VERSION, FileError, RESULT_FORMAT, SESSION_FORMAT};
 use crate::engine::base::geometry::{isometry_from_rows, rows_from_isometry};
 
@@ -573,7 +573,7 @@ pub(super) fn settle(rows: &[[f64; 4]; 4], iso: Isometry3<f64>) -> Isometry3<f64
 }
 
 pub(super) fn read_text(path: &Path) -> Result<String, FileError> {
-    fs::read_to_string(path).map_err(|source| FileError::Io {
+    read_capped(path, Cap::SESSION).map_err(|source| FileError::Io {
         action: "reading",
         path: path.to_path_buf(),
         source,

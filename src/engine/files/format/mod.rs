@@ -1,12 +1,14 @@
 //! The files of FORMAT.md: session and result files (strict loading that
-//! names every broken rule and where, exact pretty writing), and the atomic
-//! write every output of spherecal goes through.
+//! names every broken rule and where, exact pretty writing), the capped
+//! read every input of spherecal comes in by, and the atomic write every
+//! output goes through.
 
 use std::path::PathBuf;
 
 pub mod atomic;
 mod json;
 mod layout;
+pub mod read;
 pub mod result;
 pub mod session;
 pub mod transform;
@@ -15,6 +17,7 @@ pub use atomic::{
     Folders, check_outputs, interrupted, refuse_inputs, remove_pending, same_file,
     write_all_atomic, write_atomic, write_atomic_with,
 };
+pub use read::{Cap, read_bytes, read_text};
 pub use result::{
     ResultFile, load_result, parse_result, result_text_checked, result_to_json, save_result,
 };

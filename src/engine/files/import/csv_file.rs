@@ -5,9 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use super::ImportError;
-use crate::engine::base::table::{
-    Table, TableError, excerpt, parse_number, read_text_file, separator,
-};
+use crate::engine::base::table::{Table, TableError, excerpt, parse_number, separator};
+use crate::engine::files::format::{Cap, read_text};
 
 /// A parsed CSV file: header and data rows with their 1-based lines.
 pub(super) struct CsvFile {
@@ -25,7 +24,7 @@ pub(super) struct CsvFile {
 impl CsvFile {
     /// Reads and parses `path`.
     pub fn read(path: &Path) -> Result<Self, ImportError> {
-        let text = read_text_file(path).map_err(|source| ImportError::Io {
+        let text = read_text(path, Cap::TABLE).map_err(|source| ImportError::Io {
             path: path.to_path_buf(),
             source,
         })?;

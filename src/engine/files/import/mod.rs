@@ -56,7 +56,7 @@ pub use self::preview::{PairingPreview, PosePreview, preview_pose_import};
 pub use self::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource, RawProfile};
 pub use self::progress::{ImportProgress, ImportStage};
 pub use self::references::{read_references, reference_rows};
-pub use self::robot_source::{RobotSource, load_robot};
+pub use self::robot_source::{RobotSource, load_dh_csv, load_robot, load_urdf};
 pub use self::side::{decide_side, import_poses, import_poses_with};
 pub use self::units::{AngleUnit, LengthUnit};
 pub use crate::engine::base::robot::controller::FlangeConvention;

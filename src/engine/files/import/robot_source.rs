@@ -1,12 +1,14 @@
 //! Where the nominal robot model of an import comes from: a preset, the
 //! `robot` block of a session or result file, a URDF, or a DH table.
 
-use std::fs;
 use std::path::{Path, PathBuf};
 
 use super::ImportError;
-use crate::engine::base::robot::{self, DhConvention, Robot, UrdfOptions};
-use crate::engine::files::format::{parse_result, parse_session};
+use crate::engine::base::robot::{
+    self, DhConvention, Robot, RobotImportError, UrdfOptions, UrdfRobot, robot_from_dh_csv,
+    robot_from_urdf_with,
+};
+use crate::engine::files::format::{Cap, parse_result, parse_session, read_text};
 
 /// Where the nominal robot model comes from.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -85,7 +87,7 @@ pub fn load_robot(source: &RobotSource) -> Result<Robot, ImportError> {
             ))
         }),
         RobotSource::File(path) => {
-            let text = fs::read_to_string(path).map_err(|source| ImportError::Io {
+            let text = read_text(path, Cap::SESSION).map_err(|source| ImportError::Io {
                 path: path.clone(),
                 source,
             })?;
@@ -107,11 +109,39 @@ pub fn load_robot(source: &RobotSource) -> Result<Robot, ImportError> {
                 tip: tip.clone(),
                 ..UrdfOptions::default()
             };
-            robot::load_urdf(path, &options)
+            load_urdf(path, &options)
                 .map(|u| u.robot)
                 .map_err(|e| ImportError::Robot(Box::new(e)))
         }
-        RobotSource::DhTable { path, convention } => robot::load_dh_csv(path, *convention)
+        RobotSource::DhTable { path, convention } => load_dh_csv(path, *convention)
             .map_err(|e| ImportError::Robot(Box::new(e))),
     }
+}
+
+/// Reads the URDF file at `path` (at most [`Cap::URDF`]) and takes its
+/// chain ([`robot_from_urdf_with`]).
+///
+/// # Errors
+/// [`RobotImportError::Io`] for a file that cannot be read or is beyond
+/// the cap, or any error of [`robot_from_urdf_with`].
+pub fn load_urdf(path: &Path, options: &UrdfOptions) -> Result<UrdfRobot, RobotImportError> {
+    let text = read_text(path, Cap::URDF).map_err(|source| RobotImportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    robot_from_urdf_with(&text, path, options)
+}
+
+/// Reads the DH table at `path` (at most [`Cap::DH_TABLE`]) as a robot
+/// ([`robot_from_dh_csv`]).
+///
+/// # Errors
+/// [`RobotImportError::Io`] for a file that cannot be read or is beyond
+/// the cap, or any error of [`robot_from_dh_csv`].
+pub fn load_dh_csv(path: &Path, convention: DhConvention) -> Result<Robot, RobotImportError> {
+    let text = read_text(path, Cap::DH_TABLE).map_err(|source| RobotImportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    robot_from_dh_csv(&text, path, convention)
 }

@@ -34,13 +34,10 @@ use std::path::{Path, PathBuf};
 
 use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::base::session::Use;
+use crate::engine::files::format::{Cap, read_bytes, read_text};
 
 pub use self::scan::MAX_SHOWN_CHARS;
 pub use self::table::Row;
-
-/// Largest pose file read, bytes: a robot program or pose log is
-/// kilobytes to a few megabytes; beyond this it is not one.
-pub const MAX_POSE_FILE_BYTES: u64 = 256 * 1024 * 1024;
 
 /// The layout of a pose file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -378,18 +375,8 @@ pub fn read_pose_file(path: &Path, spec: &ReadSpec) -> Result<PoseFile, ProgramE
         line,
         message,
     };
-    let size = std::fs::metadata(path)
-        .map_err(|e| fail(0, format!("cannot be read: {e}")))?
-        .len();
-    if size > MAX_POSE_FILE_BYTES {
-        return Err(fail(
-            0,
-            format!(
-                "{size} bytes is not a pose file (at most {MAX_POSE_FILE_BYTES} bytes are read)"
-            ),
-        ));
-    }
-    let bytes = std::fs::read(path).map_err(|e| fail(0, format!("cannot be read: {e}")))?;
+    let bytes =
+        read_bytes(path, Cap::POSE_FILE).map_err(|e| fail(0, format!("cannot be read: {e}")))?;
     let text = String::from_utf8(bytes).map_err(|e| {
         #[allow(
             clippy::naive_bytecount,
@@ -511,19 +498,7 @@ pub fn read_number_table(
         line,
         message,
     };
-    let size = std::fs::metadata(path)
-        .map_err(|e| fail(0, format!("cannot be read: {e}")))?
-        .len();
-    if size > MAX_POSE_FILE_BYTES {
-        return Err(fail(
-            0,
-            format!(
-                "{size} bytes is more than a table of this kind (at most {MAX_POSE_FILE_BYTES} bytes are read)"
-            ),
-        ));
-    }
-    let text =
-        std::fs::read_to_string(path).map_err(|e| fail(0, format!("cannot be read: {e}")))?;
+    let text = read_text(path, Cap::TABLE).map_err(|e| fail(0, format!("cannot be read: {e}")))?;
     table::read_rows(&text, names, names_given, what).map_err(|(line, message)| fail(line, message))
 }
 

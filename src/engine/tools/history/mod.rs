@@ -125,10 +125,6 @@ use crate::engine::tools::result_view::HandEyeView;
 /// A library is a folder of cells, robots or dates; 8 levels is far beyond
 /// any such layout and still stops a walk into an unrelated tree.
 pub const MAX_DEPTH: usize = 8;
-/// Largest file [`scan`] reads, bytes. A stripe session of 124
-/// measurements is 240 KB; 64 MiB leaves room for sessions a hundred
-/// times larger and keeps a stray data dump from filling memory.
-pub const MAX_FILE_BYTES: u64 = 64 * 1024 * 1024;
 /// Default `k` of the jump check: a change beyond 3 combined σ. Under
 /// Gaussian noise one parameter passes it by chance in 0.27 % of checks.
 pub const DEFAULT_K: f64 = 3.0;

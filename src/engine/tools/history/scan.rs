@@ -13,8 +13,8 @@ use serde_json::Value;
 
 use super::entry::build_entry;
 use super::{
-    DateSource, HistoryError, Library, MAX_DEPTH, MAX_FILE_BYTES, PairedBy, Problem,
-    RESULT_SUFFIXES, SessionInfo, Timestamp, date_in_name,
+    DateSource, HistoryError, Library, MAX_DEPTH, PairedBy, Problem, RESULT_SUFFIXES, SessionInfo,
+    Timestamp, date_in_name,
 };
 use crate::engine::files::format::FileError;
 use crate::engine::files::format::{self, RESULT_FORMAT, ResultFile, SESSION_FORMAT};
@@ -231,14 +231,9 @@ pub(super) fn read_file(path: &Path) -> Result<Found, String> {
     if meta.is_dir() {
         return Ok(Found::Other(None));
     }
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(format!(
-            "not read: {} bytes, more than the {MAX_FILE_BYTES} a session or result file may have",
-            meta.len()
-        ));
-    }
     let modified = meta.modified().ok();
-    let text = fs::read_to_string(path).map_err(|e| format!("cannot read the file: {e}"))?;
+    let text = format::read_text(path, format::Cap::LIBRARY_FILE)
+        .map_err(|e| format!("cannot read the file: {e}"))?;
     // A UTF-8 byte-order mark (Windows editors) is not part of the JSON;
     // the session and result readers skip it too.
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);

@@ -13,7 +13,8 @@ use crate::engine::base::cell::workspace;
 use crate::engine::base::robot::{self, JointLimit, RobotImportError};
 use crate::engine::base::session::SensorRange;
 use crate::engine::base::table::Table;
-use crate::engine::files::import::{ImportError, RobotSource, load_robot};
+use crate::engine::files::format::{Cap, read_text};
+use crate::engine::files::import::{ImportError, RobotSource, load_robot, load_urdf};
 
 /// Why a request cannot be made into a plan configuration, or a file it
 /// names cannot be read: what and where.
@@ -115,7 +116,7 @@ impl PlanRequest {
                     tip: tip.clone(),
                     ..robot::UrdfOptions::default()
                 };
-                let urdf = robot::load_urdf(path, &options)?;
+                let urdf = load_urdf(path, &options)?;
                 // A continuous joint has no limits: one turn each way.
                 let limits = urdf
                     .limits
@@ -196,12 +197,11 @@ pub fn read_stations(path: &Path) -> Result<StationLayout, RequestError> {
         message: format!("line {line}: {m}"),
         path: path.to_path_buf(),
     };
-    let text =
-        crate::engine::base::table::read_text_file(path).map_err(|e| RequestError::File {
-            what: "stations",
-            message: format!("reading failed: {e}"),
-            path: path.to_path_buf(),
-        })?;
+    let text = read_text(path, Cap::TABLE).map_err(|e| RequestError::File {
+        what: "stations",
+        message: format!("reading failed: {e}"),
+        path: path.to_path_buf(),
+    })?;
     let table = Table::parse(&text).map_err(|e| fail(e.line, e.message))?;
     let col = |name: &str| {
         table

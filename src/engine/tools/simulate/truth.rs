@@ -18,7 +18,7 @@ use crate::engine::base::geometry::{
 };
 use crate::engine::base::robot::{Joint, Robot};
 use crate::engine::base::session::Use;
-use crate::engine::files::format::FileError;
+use crate::engine::files::format::{Cap, FileError, read_text};
 
 /// `"format"` of a truth file.
 pub const TRUTH_FORMAT: &str = "spherecal-truth";
@@ -361,7 +361,7 @@ pub fn parse_truth(text: &str) -> Result<Truth, TruthError> {
 /// [`FileError::Io`] when it cannot be read, [`FileError::Invalid`] with
 /// the [`TruthError`] message otherwise.
 pub fn load_truth(path: &Path) -> Result<Truth, FileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| FileError::Io {
+    let text = read_text(path, Cap::SESSION).map_err(|source| FileError::Io {
         action: "reading",
         path: path.to_path_buf(),
         source,

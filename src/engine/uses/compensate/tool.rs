@@ -10,6 +10,7 @@ use nalgebra::Isometry3;
 
 use crate::engine::base::geometry::isometry_from_rows;
 use crate::engine::base::robot::controller::FlangeConvention;
+use crate::engine::files::format::{Cap, read_text};
 
 /// Reads a tool `flange_from_tcp` from a JSON file: a 4×4 matrix (rows,
 /// mm), alone or under the key `flange_from_tcp`.
@@ -18,7 +19,7 @@ use crate::engine::base::robot::controller::FlangeConvention;
 /// A message naming the file and what is wrong.
 pub fn read_tool(path: &Path) -> Result<Isometry3<f64>, String> {
     let fail = |m: String| format!("tool {}: {m}", path.display());
-    let text = std::fs::read_to_string(path).map_err(|e| fail(format!("reading failed: {e}")))?;
+    let text = read_text(path, Cap::SESSION).map_err(|e| fail(format!("reading failed: {e}")))?;
     let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| fail(e.to_string()))?;
     let matrix = match value {
         serde_json::Value::Object(mut map) => map

@@ -173,8 +173,9 @@ pub fn variance_factor(result: &ResultFile) -> f64 {
 /// 1e-6, last row `0 0 0 1`).
 pub fn load_frame(path: &Path) -> Result<Isometry3<f64>, MeasureError> {
     let fail = |what: String| MeasureError::Input(format!("{what} ({})", path.display()));
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| fail(format!("reading the frame failed: {e}")))?;
+    let text =
+        crate::engine::files::format::read_text(path, crate::engine::files::format::Cap::SESSION)
+            .map_err(|e| fail(format!("reading the frame failed: {e}")))?;
     let value: serde_json::Value = serde_json::from_str(text.trim_start_matches('\u{feff}'))
         .map_err(|e| fail(format!("the frame is not valid JSON: {e}")))?;
     let matrix = match &value {

@@ -23,6 +23,7 @@ use nalgebra::Isometry3;
 use crate::engine::base::robot::Robot;
 use crate::engine::base::session::{Observation, ReferenceDistance, Session, Use};
 use crate::engine::base::table::Table;
+use crate::engine::files::format::{Cap, read_text};
 use crate::engine::files::import::pairing::list_profiles;
 use crate::engine::files::import::poses::PoseValue;
 use crate::engine::files::import::profiles::{self, RawProfile};
@@ -353,7 +354,7 @@ fn joint_log(
     columns: &ScanColumns,
     unit: AngleUnit,
 ) -> Result<Vec<LogPose>, ImportError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ImportError::Io {
+    let text = read_text(path, Cap::TABLE).map_err(|source| ImportError::Io {
         path: path.to_path_buf(),
         source,
     })?;

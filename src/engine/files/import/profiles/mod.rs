@@ -45,7 +45,8 @@ use super::csv_file::CsvFile;
 use super::{ImportError, LengthUnit};
 use crate::engine::base::limits;
 use crate::engine::base::numeric::show;
-use crate::engine::base::table::{parse_number, read_text_file};
+use crate::engine::base::table::parse_number;
+use crate::engine::files::format::{Cap, read_text};
 
 /// Names of the sensor's axes, in order.
 const AXIS_NAMES: [&str; 3] = ["x", "y", "z"];
@@ -299,7 +300,7 @@ fn number_in(text: &str, decimal_commas: bool) -> Option<f64> {
 /// An unreadable file, or content that is not a profile (naming the file
 /// and the line or key).
 pub fn read_profile(path: &Path, format: &ProfileFormat) -> Result<RawProfile, ImportError> {
-    let text = read_text_file(path).map_err(|source| ImportError::Io {
+    let text = read_text(path, Cap::TABLE).map_err(|source| ImportError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -385,7 +386,7 @@ pub fn read_profile_table(
     pose_column: &str,
     format: &ProfileFormat,
 ) -> Result<(Vec<String>, HashMap<String, RawProfile>), ImportError> {
-    let text = read_text_file(path).map_err(|source| ImportError::Io {
+    let text = read_text(path, Cap::TABLE).map_err(|source| ImportError::Io {
         path: path.to_path_buf(),
         source,
     })?;
