@@ -27,7 +27,9 @@
 //!   handler and the engine calls its jobs make;
 //! - [`panels`]: one module per panel or view, each a `*_ui` function
 //!   that reads the state, edits the forms and pushes commands;
-//! - [`workbench`]: the frame loop that ties them together.
+//! - [`workbench`]: the frame loop that ties them together;
+//! - [`screenshot`]: the guide's screenshots, the window driving itself
+//!   through a scenario (`SPHERECAL_SCREENSHOT`, `tools/screenshots.sh`).
 //!
 //! **Staleness: one mechanism.** Everything derived (the plan, the
 //! result with its verdict and views, the report, every file written of
@@ -68,6 +70,7 @@ pub mod inputs;
 pub mod jobs;
 pub mod panels;
 pub mod provenance;
+pub mod screenshot;
 pub mod state;
 pub mod view;
 pub mod workbench;
@@ -88,12 +91,17 @@ pub const NO_DISPLAY_HINT: &str =
 /// No display (neither `DISPLAY` nor `WAYLAND_DISPLAY` set) or a window
 /// that could not be created: one line pointing to `spherecal calibrate`.
 pub fn run(session: Option<PathBuf>, result: Option<PathBuf>) -> Result<(), String> {
+    let shot = screenshot::Request::from_env()?;
+    if shot == Some(screenshot::Request::List) {
+        print!("{}", screenshot::listing());
+        return Ok(());
+    }
     if std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none() {
         return Err(format!(
             "no display (DISPLAY and WAYLAND_DISPLAY are unset); {NO_DISPLAY_HINT}"
         ));
     }
-    let options = eframe::NativeOptions {
+    let mut options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("spherecal workbench")
             .with_app_id("spherecal")
@@ -102,14 +110,34 @@ pub fn run(session: Option<PathBuf>, result: Option<PathBuf>) -> Result<(), Stri
             .with_drag_and_drop(true),
         ..Default::default()
     };
-    eframe::run_native(
+    // A screenshot scenario: default preferences, none stored.
+    let director = match shot {
+        Some(screenshot::Request::Take(spec)) => {
+            let d = screenshot::Director::new(spec, &mut options);
+            d.check_inputs()?;
+            Some(d)
+        }
+        _ => None,
+    };
+    let outcome = director.as_ref().map(screenshot::Director::outcome);
+    let opened = eframe::run_native(
         "spherecal",
         options,
         Box::new(move |cc| {
-            Ok(Box::new(WorkbenchApp::from_storage(
-                cc.storage, session, result,
-            )))
+            Ok(Box::new(match director {
+                Some(d) => {
+                    WorkbenchApp::new(state::Prefs::default(), session, result).with_screenshot(d)
+                }
+                None => WorkbenchApp::from_storage(cc.storage, session, result),
+            }))
         }),
     )
-    .map_err(|e| format!("could not open the workbench window ({e}); {NO_DISPLAY_HINT}"))
+    .map_err(|e| format!("could not open the workbench window ({e}); {NO_DISPLAY_HINT}"));
+    let Some(outcome) = outcome else {
+        return opened;
+    };
+    screenshot::remove_storage();
+    opened?;
+    println!("{}", outcome.result()?);
+    Ok(())
 }

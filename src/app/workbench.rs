@@ -22,6 +22,8 @@ pub struct WorkbenchApp {
     startup: Vec<Command>,
     /// Whether [`install_fonts`] has run.
     fonts_installed: bool,
+    /// A screenshot scenario driving the window ([`super::screenshot`]).
+    screenshot: Option<Box<super::screenshot::Director>>,
 }
 
 /// Adds the default monospace font (Hack) as a fallback of the
@@ -81,7 +83,15 @@ impl WorkbenchApp {
             core: Core::new(state, forms),
             startup: vec![Command::Files(open)],
             fonts_installed: false,
+            screenshot: None,
         }
+    }
+
+    /// The workbench driven by a screenshot scenario (nothing stored).
+    #[must_use]
+    pub fn with_screenshot(mut self, director: super::screenshot::Director) -> Self {
+        self.screenshot = Some(Box::new(director));
+        self
     }
 
     /// A workbench with the preferences kept in eframe's storage.
@@ -190,6 +200,9 @@ impl WorkbenchApp {
         self.core.finish_measure();
         // Fields edited this frame mark what they feed stale at once.
         self.core.observe();
+        if let Some(director) = &mut self.screenshot {
+            director.frame(&ctx, &mut self.core);
+        }
     }
 }
 
@@ -232,7 +245,16 @@ impl eframe::App for WorkbenchApp {
         self.show(ui);
     }
 
+    fn raw_input_hook(&mut self, _ctx: &egui::Context, raw_input: &mut egui::RawInput) {
+        if let Some(director) = &mut self.screenshot {
+            director.raw_input(raw_input);
+        }
+    }
+
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        if self.screenshot.is_some() {
+            return;
+        }
         if let Ok(text) = serde_json::to_string(&self.core.state.prefs) {
             storage.set_string(PREFS_KEY, text);
         }
