@@ -936,7 +936,13 @@ impl Director {
             }
             Act::Expect(f) => match f(&core.state, &core.forms) {
                 Ok(()) => self.advance(),
-                Err(e) => self.fail(ctx, e),
+                Err(e) => {
+                    let why = match &core.state.notice {
+                        Some(n) => format!("{e} (the notice on show: {}: {})", n.title, n.body),
+                        None => e,
+                    };
+                    self.fail(ctx, why);
+                }
             },
             Act::Shot => self.shot(ctx, core),
             Act::CopyExport(name) => {
