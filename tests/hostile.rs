@@ -471,17 +471,10 @@ fn huge_numbers_are_shown_short() {
     assert!(e.to_string().contains("1e308"), "{e}");
 }
 
-/// `calibrate /dev/zero` read until 4 GB were in memory (the size caps
-/// asked the file system, which says 0 bytes for a device or a FIFO):
-/// every file is read through one reader bounded by the bytes it reads,
-/// so an endless device as a session, a result, targets or poses is
-/// refused at its cap, naming the file and the cap.
-#[cfg(unix)]
-#[test]
-fn an_endless_device_is_refused_at_the_cap_naming_the_file() {
-    let dir = tempfile::tempdir().unwrap();
-    let s = simulated(dir.path());
-    let r = dir.path().join("r.json");
+/// A simulated session and its calibration (`dir/s.json`, `dir/r.json`).
+fn calibrated(dir: &Path) -> (PathBuf, PathBuf) {
+    let s = simulated(dir);
+    let r = dir.join("r.json");
     let (code, _, err) = spherecal_cli(&[
         "calibrate",
         s.to_str().unwrap(),
@@ -491,6 +484,19 @@ fn an_endless_device_is_refused_at_the_cap_naming_the_file() {
         "-q",
     ]);
     assert_eq!(code, 0, "{err}");
+    (s, r)
+}
+
+/// `calibrate /dev/zero` read until 4 GB were in memory (the size caps
+/// asked the file system, which says 0 bytes for a device or a FIFO):
+/// every file is read through one reader bounded by the bytes it reads,
+/// so an endless device as a session, a result, targets or poses is
+/// refused at its cap, naming the file and the cap.
+#[cfg(unix)]
+#[test]
+fn an_endless_device_is_refused_at_the_cap_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (s, r) = calibrated(dir.path());
     let (x, i) = (dir.path().join("x.json"), dir.path().join("i.json"));
     let out = dir.path().join("out.csv");
     let out = out.to_str().unwrap();
@@ -552,4 +558,45 @@ fn an_endless_device_is_refused_at_the_cap_naming_the_file() {
             started.elapsed()
         );
     }
+}
+
+/// `compensate --tcp tool.json` with a translation of 1e200 mm ran (IK
+/// on a tool beyond any cell) without end: the three 4×4 readers were
+/// one for `--hand-eye` with a size cap and two without the plausibility
+/// caps. One reader now refuses it at once, naming the key.
+#[test]
+fn an_absurd_tool_is_refused_at_once_naming_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, r) = calibrated(dir.path());
+    let tool = dir.path().join("tool.json");
+    fs::write(
+        &tool,
+        r#"{"flange_from_tcp": [[1,0,0,1e200],[0,1,0,0],[0,0,1,150],[0,0,0,1]]}"#,
+    )
+    .unwrap();
+    let targets = dir.path().join("t.csv");
+    fs::write(&targets, "id,x,y,z,q1,q2,q3,q4\nT1,1000,0,800,0,0,1,0\n").unwrap();
+    let out = dir.path().join("c.csv");
+    let started = std::time::Instant::now();
+    let (code, _, err) = spherecal_cli(&[
+        "compensate",
+        "--result",
+        r.to_str().unwrap(),
+        "--targets",
+        targets.to_str().unwrap(),
+        "--pose-convention",
+        "abb",
+        "--tcp",
+        tool.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("flange_from_tcp: a translation of 1e200 mm is not plausible")
+            && err.contains("tool.json"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    assert!(started.elapsed().as_secs_f64() < 10.0);
 }

@@ -22,7 +22,7 @@ pub use result::{
     ResultFile, load_result, parse_result, result_text_checked, result_to_json, save_result,
 };
 pub use session::{load_session, parse_session, save_session, session_to_json};
-pub use transform::read_transform;
+pub use transform::{TransformError, read_transform};
 
 /// The `format` of a session file.
 pub const SESSION_FORMAT: &str = "spherecal-session";

@@ -1,49 +1,75 @@
-//! A rigid transform in a file of its own: a JSON 4×4 matrix (rows, mm,
-//! FORMAT.md's matrix rules), or a session or result file whose
-//! `hand_eye` is taken. Read by the import (`--hand-eye`, a guess to
-//! start from), the planner (the sensor's hand-eye) and the measuring
-//! command (a workpiece frame).
+//! A rigid transform in a file of its own, the one reader of every 4×4
+//! the commands take: a JSON 4×4 matrix (rows, mm, FORMAT.md's matrix
+//! rules), bare or under its key, or a session or result file whose key
+//! (`hand_eye`) is taken. Read by the import (`--hand-eye`, a guess to
+//! start from), the planner and the simulator (the sensor's hand-eye),
+//! the measuring command (`--frame`, `base_from_workpiece`) and
+//! compensation (`--tcp`, `flange_from_tcp`). Through the capped reader
+//! ([`Cap::SESSION`]), and with the session rules' plausibility caps
+//! (a translation beyond 100 m is refused at once, naming the key, before
+//! anything computes with it).
 
 use std::path::Path;
 
 use nalgebra::Isometry3;
 use serde_json::Value;
 
-use crate::engine::base::geometry::isometry_from_rows;
+use super::read::{Cap, read_text};
+use crate::engine::base::geometry::{MatrixError, isometry_from_rows};
+use crate::engine::base::session::rules;
 
-/// Largest transform file read, bytes: a 4×4 is a few hundred bytes, a
-/// session holding one may be large but is read as a whole anyway.
-const MAX_TRANSFORM_FILE_BYTES: u64 = 1 << 30;
+/// Why a transform file gives no transform. The messages name no file:
+/// the caller names the file and what it is.
+#[derive(Debug, thiserror::Error)]
+pub enum TransformError {
+    /// The file cannot be read, or is beyond the cap.
+    #[error("reading failed: {0}")]
+    Read(#[source] std::io::Error),
+    /// Not JSON.
+    #[error("not valid JSON: {0}")]
+    Json(String),
+    /// A JSON object without the key (nor `matrix`).
+    #[error("the file has no `{0}` (nor `matrix`)")]
+    NoKey(String),
+    /// The key is `null` (a session without a hand-eye).
+    #[error("its `{0}` is null")]
+    Null(String),
+    /// Not four rows of four numbers.
+    #[error("expected a 4x4 matrix of numbers (4 rows of 4, mm): {0}")]
+    NotMatrix(String),
+    /// Not a rigid transform.
+    #[error("not a rigid transform: {0}")]
+    NotRigid(#[from] MatrixError),
+    /// Beyond the session rules' plausibility caps (message names the key).
+    #[error("{0}")]
+    Implausible(String),
+}
 
 /// The transform in `path`: a 4×4 matrix (JSON rows), an object with the
-/// key `key` (e.g. `hand_eye` of a session or result), or an object with
-/// `matrix`.
+/// key `key` (e.g. `hand_eye` of a session or result, `flange_from_tcp`
+/// of a tool), or an object with `matrix`; finite, rigid and plausible
+/// ([`rules::transform`], naming `key`).
 ///
 /// # Errors
-/// A message (without the path: the caller names the file and what it
-/// is): unreadable, not JSON, no matrix, not a rigid transform.
-pub fn read_transform(path: &Path, key: &str) -> Result<Isometry3<f64>, String> {
-    let size = std::fs::metadata(path)
-        .map_err(|e| format!("reading failed: {e}"))?
-        .len();
-    if size > MAX_TRANSFORM_FILE_BYTES {
-        return Err(format!("{size} bytes is not a transform file"));
-    }
-    let text = std::fs::read_to_string(path).map_err(|e| format!("reading failed: {e}"))?;
+/// [`TransformError`]: unreadable, not JSON, no matrix, not a rigid
+/// transform, not plausible.
+pub fn read_transform(path: &Path, key: &str) -> Result<Isometry3<f64>, TransformError> {
+    let text = read_text(path, Cap::SESSION).map_err(TransformError::Read)?;
     let value: Value = serde_json::from_str(text.trim_start_matches('\u{feff}'))
-        .map_err(|e| format!("not valid JSON: {e}"))?;
-    let matrix = match &value {
-        Value::Object(map) => map
-            .get(key)
-            .or_else(|| map.get("matrix"))
-            .cloned()
-            .ok_or_else(|| format!("the file has no `{key}` (nor `matrix`)"))?,
-        other => other.clone(),
+        .map_err(|e| TransformError::Json(e.to_string()))?;
+    let matrix = match value {
+        Value::Object(mut map) => map
+            .remove(key)
+            .or_else(|| map.remove("matrix"))
+            .ok_or_else(|| TransformError::NoKey(key.to_string()))?,
+        other => other,
     };
     if matrix.is_null() {
-        return Err(format!("its `{key}` is null"));
+        return Err(TransformError::Null(key.to_string()));
     }
-    let rows: [[f64; 4]; 4] = serde_json::from_value(matrix)
-        .map_err(|e| format!("expected a 4x4 matrix of numbers: {e}"))?;
-    isometry_from_rows(&rows).map_err(|e| e.to_string())
+    let rows: [[f64; 4]; 4] =
+        serde_json::from_value(matrix).map_err(|e| TransformError::NotMatrix(e.to_string()))?;
+    let transform = isometry_from_rows(&rows)?;
+    rules::transform(key, &transform).map_err(TransformError::Implausible)?;
+    Ok(transform)
 }

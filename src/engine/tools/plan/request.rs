@@ -177,12 +177,10 @@ impl PlanRequest {
 /// # Errors
 /// [`RequestError::File`] naming the file and what is wrong.
 pub fn read_hand_eye(path: &Path) -> Result<Isometry3<f64>, RequestError> {
-    crate::engine::files::format::read_transform(path, "hand_eye").map_err(|message| {
-        RequestError::File {
-            what: "hand-eye",
-            message,
-            path: path.to_path_buf(),
-        }
+    crate::engine::files::format::read_transform(path, "hand_eye").map_err(|e| RequestError::File {
+        what: "hand-eye",
+        message: e.to_string(),
+        path: path.to_path_buf(),
     })
 }
 

@@ -8,28 +8,17 @@ use std::path::Path;
 
 use nalgebra::Isometry3;
 
-use crate::engine::base::geometry::isometry_from_rows;
 use crate::engine::base::robot::controller::FlangeConvention;
-use crate::engine::files::format::{Cap, read_text};
+use crate::engine::files::format::read_transform;
 
 /// Reads a tool `flange_from_tcp` from a JSON file: a 4×4 matrix (rows,
-/// mm), alone or under the key `flange_from_tcp`.
+/// mm), alone or under the key `flange_from_tcp`
+/// ([`read_transform`], with its plausibility caps).
 ///
 /// # Errors
 /// A message naming the file and what is wrong.
 pub fn read_tool(path: &Path) -> Result<Isometry3<f64>, String> {
-    let fail = |m: String| format!("tool {}: {m}", path.display());
-    let text = read_text(path, Cap::SESSION).map_err(|e| fail(format!("reading failed: {e}")))?;
-    let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| fail(e.to_string()))?;
-    let matrix = match value {
-        serde_json::Value::Object(mut map) => map
-            .remove("flange_from_tcp")
-            .ok_or_else(|| fail("no key `flange_from_tcp` (a 4x4 matrix, rows, mm)".into()))?,
-        other => other,
-    };
-    let rows: [[f64; 4]; 4] = serde_json::from_value(matrix)
-        .map_err(|e| fail(format!("expected a 4x4 matrix of numbers (rows, mm): {e}")))?;
-    isometry_from_rows(&rows).map_err(|e| fail(e.to_string()))
+    read_transform(path, "flange_from_tcp").map_err(|e| format!("tool {}: {e}", path.display()))
 }
 
 /// The controllers tool data is written for.

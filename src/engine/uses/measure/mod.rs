@@ -75,11 +75,10 @@ pub use selfcheck::{SelfValidation, self_validate};
 pub use sigma::SigmaForm;
 pub use write::{CloudFormat, Provenance, write_cloud};
 
-use crate::engine::base::geometry::isometry_from_rows;
 use crate::engine::base::robot::Robot;
 use crate::engine::calibrate::solve::Control;
 use crate::engine::calibrate::solve::estimate::Estimate;
-use crate::engine::files::format::{FileError, ResultFile};
+use crate::engine::files::format::{FileError, ResultFile, read_transform};
 use crate::engine::files::import::ImportError;
 
 /// A measurement could not be made.
@@ -165,28 +164,16 @@ pub fn variance_factor(result: &ResultFile) -> f64 {
 }
 
 /// Reads a workpiece frame: a JSON 4×4 matrix (four rows of four numbers,
-/// FORMAT.md's matrices), `base_from_workpiece`, bare or under that key.
+/// FORMAT.md's matrices), `base_from_workpiece`, bare or under that key
+/// ([`read_transform`], with its plausibility caps).
 ///
 /// # Errors
 /// [`MeasureError::Input`] naming the file: unreadable, not JSON, not
-/// 4×4, or not a rigid transform (orthonormal with determinant +1 to
-/// 1e-6, last row `0 0 0 1`).
+/// 4×4, not a rigid transform (orthonormal with determinant +1 to 1e-6,
+/// last row `0 0 0 1`), or a translation beyond the plausibility limit.
 pub fn load_frame(path: &Path) -> Result<Isometry3<f64>, MeasureError> {
-    let fail = |what: String| MeasureError::Input(format!("{what} ({})", path.display()));
-    let text =
-        crate::engine::files::format::read_text(path, crate::engine::files::format::Cap::SESSION)
-            .map_err(|e| fail(format!("reading the frame failed: {e}")))?;
-    let value: serde_json::Value = serde_json::from_str(text.trim_start_matches('\u{feff}'))
-        .map_err(|e| fail(format!("the frame is not valid JSON: {e}")))?;
-    let matrix = match &value {
-        serde_json::Value::Object(map) => map.get("base_from_workpiece").cloned().ok_or_else(|| {
-            fail("the frame is an object without `base_from_workpiece`; give a 4x4 matrix (4 rows of 4 numbers)".into())
-        })?,
-        _ => value,
-    };
-    let rows: [[f64; 4]; 4] = serde_json::from_value(matrix)
-        .map_err(|_| fail("the frame is not a 4x4 matrix (4 rows of 4 numbers, mm)".into()))?;
-    isometry_from_rows(&rows).map_err(|e| fail(format!("the frame is not a rigid transform: {e}")))
+    read_transform(path, "base_from_workpiece")
+        .map_err(|e| MeasureError::Input(format!("the workpiece frame: {e} ({})", path.display())))
 }
 
 /// Measures `scan` with `result` (module doc): checks that the scan
