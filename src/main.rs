@@ -35,18 +35,23 @@ fn main() -> ExitCode {
         // interruption is the news, with its status.
         Err(_) if spherecal::engine::files::format::interrupted() => ExitCode::from(130),
         Err(e) => {
-            eprintln!("error: {}", cli::bounded_message(&e.message));
+            eprintln!("error: {}", cli::error_line(&e.message));
             ExitCode::from(u8::try_from(e.status).unwrap_or(1))
         }
     }
 }
 
+/// The workbench; without a display, status 2 and one sentence naming
+/// DISPLAY/WAYLAND_DISPLAY and the commands that need none. A window
+/// that cannot be opened (a display that does not answer) is the same
+/// kind of failure: the machine's, not spherecal's.
 #[cfg(feature = "gui")]
 fn gui(
     session: Option<std::path::PathBuf>,
     result: Option<std::path::PathBuf>,
 ) -> Result<(), CliError> {
-    spherecal::app::run(session, result).map_err(CliError::internal)
+    cli::check_display()?;
+    spherecal::app::run(session, result).map_err(CliError::input)
 }
 
 #[cfg(not(feature = "gui"))]

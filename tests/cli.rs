@@ -462,7 +462,7 @@ fn hostile_numbers_are_refused_quickly_and_clearly() {
     );
     assert_eq!(code, 2, "{err}");
     assert!(
-        err.contains("--sphere-diameter 1e308 mm is not plausible"),
+        err.contains("'1e308' for '--sphere-diameter <MM>': expected a number of mm"),
         "{err}"
     );
     assert!(!imported.exists());
@@ -638,10 +638,18 @@ fn simulate_refuses_options_that_make_a_session_no_one_can_use() {
         (
             "--stripe-noise",
             "1e6",
-            "stripe_noise 1000000 mm is not plausible",
+            "'1e6' for '--stripe-noise <MM>': expected a number of mm from 0 to 10",
         ),
-        ("--joint-noise", "1e6", "joint_noise"),
-        ("--identify-stations", "0", "at least one identify station"),
+        (
+            "--joint-noise",
+            "1e6",
+            "'1e6' for '--joint-noise <DEG>': expected a number of deg from 0 to 3",
+        ),
+        (
+            "--identify-stations",
+            "0",
+            "'0' for '--identify-stations <IDENTIFY_STATIONS>': expected a whole number from 1",
+        ),
     ] {
         let (code, _, err) = run(&["simulate", "--out", s.to_str().unwrap(), flag, value]);
         assert_eq!(code, 2, "{flag} {value}: {err}");

@@ -704,7 +704,6 @@ fn bad_input_is_refused_and_nothing_is_written() {
         "--out",
         o,
         "--no-sigma",
-        "-q",
     ]);
     assert!(o2.status.success());
     let err = String::from_utf8_lossy(&o2.stderr);

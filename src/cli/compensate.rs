@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 
 use super::CliError;
+use super::values::{Range, number};
 use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
@@ -39,13 +40,13 @@ pub struct CompensateArgs {
     /// Where to write the compensated targets: the same layout, positions replaced, every other byte kept.
     #[arg(long, short)]
     pub out: PathBuf,
-    /// How a table or JSON list writes a pose: abb (x y z mm, q1..q4 quaternion w first), kuka (x y z, A B C deg), fanuc (x y z, W P R deg), ur (x y z m, rotation vector rad) or matrix (16 numbers row-major, mm). A program's language fixes its own.
-    #[arg(long, value_parser = parse_convention)]
+    /// How a pose table or JSON list writes a pose (a robot program's language fixes its own).
+    #[arg(long, value_parser = super::scan_flags::convention_parser())]
     pub pose_convention: Option<FlangeConvention>,
-    /// The layout, when not detected from the content: table, json, fanuc-ls, rapid, krl or urscript.
-    #[arg(long, value_parser = parse_format)]
+    /// Force the targets' layout [default: detected from the content]
+    #[arg(long, value_parser = super::scan_flags::pose_format_parser())]
     pub pose_format: Option<PoseFormat>,
-    /// The pose columns of a table, in the convention's order (default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44).
+    /// The pose columns of a pose table, in the convention's order [default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44]
     #[arg(long, value_delimiter = ',')]
     pub pose_columns: Vec<String>,
     /// The TCP the targets are poses of: `sensor` (the calibrated hand-eye, printed as tool data to set on the controller), `flange`, or a JSON file with a 4x4 matrix `flange_from_tcp` (rows, mm).
@@ -58,39 +59,23 @@ pub struct CompensateArgs {
     #[arg(long, value_enum, default_value = "compensate")]
     pub joint_targets: JointTargetsArg,
     /// Flag a target whose predicted 1σ residual (ml covariance) exceeds this, mm.
-    #[arg(long, default_value_t = compensate::DEFAULT_SIGMA_TOLERANCE_MM)]
+    #[arg(long, value_name = "MM", default_value_t = compensate::DEFAULT_SIGMA_TOLERANCE_MM, value_parser = number(Range::positive("mm")))]
     pub sigma_tolerance: f64,
     /// Flag a target farther than this from every identify pose (joint-space norm, deg; when the joints of the poses are known).
-    #[arg(long, default_value_t = compensate::DEFAULT_FAR_JOINTS_DEG)]
+    #[arg(long, value_name = "DEG", default_value_t = compensate::DEFAULT_FAR_JOINTS_DEG, value_parser = number(Range::positive("deg")))]
     pub far_joints: f64,
     /// Flag a target whose working point lies farther than this outside the box of the working points at the identify poses (for the sensor: the identify sphere positions), mm.
-    #[arg(long, default_value_t = compensate::DEFAULT_REGION_MARGIN_MM)]
+    #[arg(long, value_name = "MM", default_value_t = compensate::DEFAULT_REGION_MARGIN_MM, value_parser = number(Range::non_negative("mm")))]
     pub region_margin: f64,
     /// Refuse (exit 2, nothing written) when a target is flagged, instead of compensating and listing it.
     #[arg(long)]
     pub strict: bool,
-    /// List every target (default: the 20 largest corrections).
-    #[arg(long)]
+    /// List every target (help text with the table's length).
+    #[arg(long, help = format!("List every target, not only the {TABLE_ROWS} largest corrections"))]
     pub all: bool,
-    /// Print nothing but errors.
-    #[arg(long, short)]
+    /// `-q`: [`QUIET_HELP`](super::QUIET_HELP).
+    #[arg(long, short, help = super::QUIET_HELP)]
     pub quiet: bool,
-}
-
-fn parse_convention(s: &str) -> Result<FlangeConvention, String> {
-    FlangeConvention::parse(s).ok_or_else(|| {
-        format!("unknown pose convention `{s}`, expected abb, kuka, fanuc, ur or matrix")
-    })
-}
-
-fn parse_format(s: &str) -> Result<PoseFormat, String> {
-    PoseFormat::parse(s).ok_or_else(|| {
-        let keys: Vec<&str> = PoseFormat::ALL.iter().map(|f| f.key()).collect();
-        format!(
-            "unknown pose format `{s}`, expected one of: {}",
-            keys.join(", ")
-        )
-    })
 }
 
 /// Reads everything, compensates, writes the file atomically, prints the

@@ -6,7 +6,7 @@ use clap::Args;
 
 use super::CliError;
 use crate::engine::tools::evaluate::study::{
-    StudyError, markdown, range_markdown, run_scenario, select, text,
+    SCENARIOS, StudyError, markdown, range_markdown, run_scenario, select, text,
 };
 use crate::engine::tools::plan::range_study::{
     planned_range_markdown, planned_range_study, planned_range_text,
@@ -16,21 +16,33 @@ use crate::engine::tools::plan::range_study::{
 #[derive(Debug, Args)]
 pub struct EvaluateArgs {
     /// Seeds `1..=N` per scenario.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, value_name = "N", default_value_t = 5, value_parser = super::values::count(1, MAX_SEEDS))]
     pub seeds: u64,
-    /// One scenario key (`paper-like`, `random-2x`, `stripe-0.05`,
-    /// `outliers-5pct`, `stations-30`, `range-spot`, `range-spread`) or `all`.
-    #[arg(long, default_value = "all")]
+    /// The scenario to run, or `all`.
+    #[arg(long, default_value = "all", value_parser = scenario_parser())]
     pub scenario: String,
-    /// Print the README table (Markdown) instead of the text report.
+    /// Print the tables (Markdown) instead of the text report.
     #[arg(long)]
     pub markdown: bool,
     /// Instead of the scenarios: the IRB 2400 cell planned for an 80 × 80 mm range with and without spreading the sphere over it, simulated with Table 1 and random errors, the error over the range predicted and realised against the floor.
     #[arg(long)]
     pub planned_range: bool,
-    /// Instead of the scenarios: target compensation validated in simulation (seeds 1..=N, paper-like IRB 2400 cells): targets near the validate poses and far from them, and ISO 9283 poses, driven by a nominal controller before and after `spherecal compensate`, scored on the true robot (the README table, Markdown).
+    /// Instead of the scenarios: target compensation validated in simulation (seeds 1..=N, paper-like IRB 2400 cells): targets near the validate poses and far from them, and ISO 9283 poses, driven by a nominal controller before and after `spherecal compensate`, scored on the true robot (a Markdown table).
     #[arg(long)]
     pub compensation: bool,
+}
+
+/// Most seeds a scenario runs: each is a few calibrations.
+pub const MAX_SEEDS: u64 = 10_000;
+
+/// `--scenario`: the study's scenarios (each with its title) and `all`.
+fn scenario_parser() -> super::values::Keywords<String> {
+    super::values::Keywords::new(
+        std::iter::once(("all", Some("Every scenario")))
+            .chain(SCENARIOS.iter().map(|s| (s.key, Some(s.title))))
+            .collect(),
+        |s| (s == "all" || SCENARIOS.iter().any(|sc| sc.key == s)).then(|| s.to_owned()),
+    )
 }
 
 /// `spherecal evaluate`.
@@ -38,9 +50,6 @@ pub struct EvaluateArgs {
 /// # Errors
 /// Bad arguments (status 2) or a failed simulation or calibration (status 1).
 pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
-    if args.seeds == 0 {
-        return Err(CliError::input("--seeds must be at least 1"));
-    }
     if args.compensation {
         let mut studies = Vec::new();
         for seed in 1..=args.seeds {

@@ -55,8 +55,8 @@ pub struct ExportModelArgs {
     /// Where to write the model.
     #[arg(long, short)]
     pub out: PathBuf,
-    /// Print only errors.
-    #[arg(long, short)]
+    /// `-q`: [`QUIET_HELP`](super::QUIET_HELP).
+    #[arg(long, short, help = super::QUIET_HELP)]
     pub quiet: bool,
 }
 

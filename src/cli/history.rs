@@ -36,9 +36,12 @@ pub struct HistoryArgs {
     /// Kinematic parameters to show as well, comma-separated (e.g. theta3,d4).
     #[arg(long, value_delimiter = ',')]
     pub param: Vec<String>,
-    /// Write every parameter of every result shown, with σ, as CSV (one row per result and parameter; written atomically).
+    /// Also write every parameter of every result shown, with σ, as CSV (one row per result and parameter).
     #[arg(long)]
     pub csv: Option<PathBuf>,
+    /// With --csv: print nothing but errors (without it the tables are the command's output).
+    #[arg(long, short, requires = "csv")]
+    pub quiet: bool,
 }
 
 /// Largest `--k`: a change beyond 1000 combined σ is no test at all (no
@@ -88,9 +91,11 @@ pub fn run(args: &HistoryArgs) -> Result<(), CliError> {
         Some(_) => drifts.iter().flat_map(|d| d.entries.clone()).collect(),
         None => (0..library.entries.len()).collect(),
     };
-    say!("{}", library_text(&library, &shown));
-    for d in &drifts {
-        say!("{}", drift_text(&library, d));
+    if !args.quiet {
+        say!("{}", library_text(&library, &shown));
+        for d in &drifts {
+            say!("{}", drift_text(&library, d));
+        }
     }
     if let Some(path) = &args.csv {
         let inputs: Vec<&Path> = library
@@ -104,7 +109,9 @@ pub fn run(args: &HistoryArgs) -> Result<(), CliError> {
         CliError::guard_output(path, &inputs)?;
         format::write_atomic(path, history::drift_csv(&library, &drifts).as_bytes())
             .map_err(|e| CliError::from_file(&e, false))?;
-        sayln!("\nwrote {}", path.display());
+        if !args.quiet {
+            sayln!("\nwrote {}", path.display());
+        }
     }
     Ok(())
 }

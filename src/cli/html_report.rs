@@ -11,7 +11,7 @@ use std::time::{Instant, SystemTime};
 
 use clap::Args;
 
-use super::{CliError, parse_method};
+use super::{CliError, QUIET_HELP};
 use crate::engine::calibrate::solve::{self, Control, Method, Options};
 use crate::engine::files::format::{self, FileError};
 use crate::engine::tools::report::html::{self, ReportInput, ReportMeta};
@@ -28,18 +28,35 @@ pub struct ReportArgs {
     /// Where to write the HTML report (one file: inline CSS and SVG, no script, no external resource).
     #[arg(long, short)]
     pub out: PathBuf,
-    /// Method of the calibration run when no `--result` is given: `ml` (default) or `paper`.
-    #[arg(long, default_value = "ml", value_parser = parse_method)]
+    /// Method of the calibration run when no `--result` is given.
+    #[arg(long, default_value = "ml", value_parser = super::method_parser())]
     pub method: Method,
     /// Acceptance tolerance on the validation after calibration, `STD,MAX` in mm (e.g. `0.2,0.5`): the report then says PASS or FAIL.
-    #[arg(long, value_parser = result_view::Tolerance::parse)]
+    #[arg(long, value_name = "STD,MAX", value_parser = parse_tolerance)]
     pub tolerance: Option<result_view::Tolerance>,
     /// Without --result: report the calibration even when its identify centres still scatter beyond 10 mm (a failed calibration), as `calibrate --accept-implausible`.
     #[arg(long)]
     pub accept_implausible: bool,
-    /// Print nothing but errors.
-    #[arg(long, short)]
+    /// `-q`: [`QUIET_HELP`](super::QUIET_HELP).
+    #[arg(long, short, help = QUIET_HELP)]
     pub quiet: bool,
+}
+
+/// Largest `--tolerance` figure, mm: a validation error of a metre
+/// accepts any calibration, so a larger one is a slip of the keyboard.
+pub const MAX_TOLERANCE_MM: f64 = 1000.0;
+
+/// `--tolerance STD,MAX`: two positive numbers of mm, at most
+/// [`MAX_TOLERANCE_MM`].
+fn parse_tolerance(s: &str) -> Result<result_view::Tolerance, String> {
+    let t = result_view::Tolerance::parse(s)?;
+    if t.std_mm > MAX_TOLERANCE_MM || t.max_mm > MAX_TOLERANCE_MM {
+        return Err(format!(
+            "`{s}`: a tolerance of more than {} mm accepts any calibration; give STD,MAX in mm, e.g. 0.2,0.5",
+            crate::engine::base::numeric::show(MAX_TOLERANCE_MM)
+        ));
+    }
+    Ok(t)
 }
 
 /// Loads the session (and result), calibrates when needed, renders the
@@ -89,7 +106,12 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         options.method = args.method;
         let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
             .map_err(|e| CliError::from_calibration(&e, &args.session))?;
-        super::check_plausible(&session, &cal, args.accept_implausible, &args.session)?;
+        super::check_plausible(
+            &session,
+            &cal,
+            (args.accept_implausible, args.quiet),
+            &args.session,
+        )?;
         format::ResultFile::from_calibration(&session, &cal)
     };
     let meta = ReportMeta::new(args.session.display().to_string(), SystemTime::now());

@@ -18,14 +18,15 @@ use crate::engine::files::import::{
     Imported, Observations, PoseImportSpec, ProfileSource, SideChoice,
 };
 
-use super::CliError;
 use super::scan_flags::ScanFlags;
+use super::values::{Keywords, Range, number};
+use super::{CliError, QUIET_HELP};
 
 /// `spherecal import`.
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("log").required(true).args(["joints", "poses"])))]
 pub struct ImportArgs {
-    /// The joint log CSV: one row a pose, with id, station, use and joint columns.
+    /// The joint log CSV: one row a pose, with id, station, use and joint columns (see --map); needs --robot.
     #[arg(long)]
     pub joints: Option<PathBuf>,
     /// A pose file instead of a joint log: a table (header optional; commas, semicolons, tabs or spaces), a JSON list (RobCalibrator `.rob`), or a robot program (FANUC .ls, ABB RAPID, KUKA .dat/.src, URScript); the layout is detected from the content and printed. Flange poses give a pose-only session; joint targets need --robot.
@@ -38,59 +39,70 @@ pub struct ImportArgs {
     /// A folder of stripe profiles (`<id>.csv|txt|yml|yaml|json`; for a pose log without ids the files named alike, in the order of the number in their names: p7.yml, 7_3C_line.yml, scan_007.csv; other files, the pose file among them, are skipped and listed) or one CSV with a pose column.
     #[arg(long, required_unless_present = "centres", conflicts_with = "centres")]
     pub profiles: Option<PathBuf>,
-    /// Sphere centres the sensor reported, instead of profiles: a table with one `x y z` a pose (sensor frame, mm; any separator, header optional, an `id` column optional), paired with the poses in order.
-    #[arg(long, requires = "poses")]
+    /// With --poses: the sphere centres the sensor reported, instead of profiles: a table with one `x y z` a pose (sensor frame, mm; any separator, header optional, an `id` column optional), paired with the poses in order.
+    #[arg(long, requires = "poses", conflicts_with = "joints")]
     pub centres: Option<PathBuf>,
     /// A hand-eye guess to start from instead of computing one: a JSON 4x4 matrix (rows, mm), or a session or result file (its `hand_eye`).
     #[arg(long)]
     pub hand_eye: Option<PathBuf>,
-    /// Robot: a preset key (irb2400, irb120, ur5e), a session/result file whose `robot` block is the nominal model, a URDF or a DH table CSV (with --dh). Needed with --joints; optional with --poses.
-    #[arg(long)]
+    /// Robot (help text with the presets' keys).
+    #[arg(long, help = format!("Robot: a preset key ({}), a session/result file whose `robot` block is the nominal model, a URDF or a DH table CSV (with --dh). Needed with --joints; optional with --poses", super::preset_keys()))]
     pub robot: Option<String>,
-    /// Side of the sphere centres for a pose log without a side column: +1, -1 or auto (both calibrated, the clearly better chosen, else refused).
-    #[arg(long, default_value = "auto", allow_hyphen_values = true, value_parser = parse_side)]
+    /// Side of the laser plane the sphere centres lie on, for a pose log without a side column.
+    #[arg(long, default_value = "auto", allow_hyphen_values = true, value_parser = side_parser())]
     pub side: SideChoice,
-    /// Where to write the session file (required unless --preview).
+    /// Where to write the session file (needed unless --preview).
     #[arg(long, short)]
     pub out: Option<PathBuf>,
-    /// Column mapping, e.g. `id=Pose,station=Sphere,use=Use,side=Side,j1=A1,...`
-    /// (defaults: id, station, use, side when the log has a `side` column, j1..jn).
+    /// The joint log's columns, e.g. `id=Pose,station=Sphere,use=Use,side=Side,j1=A1,...`
+    /// [default: id, station, use, side when the log has a `side` column, j1..jn]
     #[arg(long, value_delimiter = ',')]
     pub map: Vec<String>,
     /// Sphere diameter, mm.
-    #[arg(long, default_value_t = DEFAULT_SPHERE_DIAMETER)]
+    #[arg(long, value_name = "MM", default_value_t = DEFAULT_SPHERE_DIAMETER, value_parser = number(Range::positive("mm").at_most(crate::engine::base::limits::SPHERE_DIAMETER_MM)))]
     pub sphere_diameter: f64,
     /// The sensor's measuring range to write as `sensor.range`: `Y0,Y1,Z0,Z1` in mm (laser plane, sensor frame), e.g. `-40,40,-40,40`; ml then predicts the error over it.
-    #[arg(long, allow_hyphen_values = true, value_parser = super::parse_range)]
+    #[arg(long, value_name = "Y0,Y1,Z0,Z1", allow_hyphen_values = true, value_parser = super::parse_range)]
     pub range: Option<crate::engine::base::session::SensorRange>,
-    /// Session name (default: the joint log's file name).
+    /// Session name [default: the name of the joint log or pose file, without its extension]
     #[arg(long)]
     pub name: Option<String>,
-    /// Check the controller's flange poses: ABB (quaternion), KUKA (ABC), FANUC (WPR) or UR (rotation vector).
-    #[arg(long, value_parser = super::scan_flags::parse_convention)]
+    /// With --joints: check the flange poses the controller logged beside the joints against the nominal model, read in this convention.
+    #[arg(long, requires = "joints", value_parser = super::scan_flags::convention_parser())]
     pub flange_poses: Option<FlangeConvention>,
-    /// The flange-pose columns in the convention's order (default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz).
-    #[arg(long, value_delimiter = ',')]
+    /// The flange-pose columns in the convention's order [default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44]
+    #[arg(long, value_delimiter = ',', requires = "flange_poses")]
     pub flange_columns: Vec<String>,
-    /// Flange-pose position tolerance, mm.
-    #[arg(long, default_value_t = DEFAULT_POSITION_TOLERANCE_MM)]
+    /// Flange-pose check: position tolerance, mm.
+    #[arg(long, value_name = "MM", default_value_t = DEFAULT_POSITION_TOLERANCE_MM, value_parser = number(Range::positive("mm")))]
     pub position_tolerance: f64,
-    /// Flange-pose rotation tolerance, deg.
-    #[arg(long, default_value_t = DEFAULT_ROTATION_TOLERANCE_DEG)]
+    /// Flange-pose check: rotation tolerance, deg.
+    #[arg(long, value_name = "DEG", default_value_t = DEFAULT_ROTATION_TOLERANCE_DEG, value_parser = number(Range::positive("deg")))]
     pub rotation_tolerance: f64,
     /// Laser-tracker reference distances between validate stations: a CSV with columns from, to, distance (mm).
     #[arg(long)]
     pub references: Option<PathBuf>,
-    /// Print the first N rows with the mapping applied and exit without writing.
-    #[arg(long)]
+    /// With --joints: print the first N rows with the mapping applied and exit without writing.
+    #[arg(long, value_name = "N", requires = "joints")]
     pub preview: Option<usize>,
-    /// Print only errors.
-    #[arg(long, short)]
+    /// `-q`: [`QUIET_HELP`](super::QUIET_HELP).
+    #[arg(long, short, help = QUIET_HELP)]
     pub quiet: bool,
 }
 
-fn parse_side(s: &str) -> Result<SideChoice, String> {
-    SideChoice::parse(s).ok_or_else(|| format!("unknown side `{s}`, expected +1, -1 or auto"))
+/// `--side`.
+fn side_parser() -> Keywords<SideChoice> {
+    Keywords::new(
+        vec![
+            ("+1", Some("Every centre at sensor x > 0")),
+            ("-1", Some("Every centre at sensor x < 0")),
+            (
+                "auto",
+                Some("Both sides calibrated, the clearly better one chosen, else refused"),
+            ),
+        ],
+        SideChoice::parse,
+    )
 }
 
 /// Where the profiles are, from the flag.
@@ -120,10 +132,7 @@ pub fn pose_spec(args: &ImportArgs, poses: &std::path::Path) -> Result<PoseImpor
     let hand_eye = args
         .hand_eye
         .as_ref()
-        .map(|p| {
-            format::read_transform(p, "hand_eye")
-                .map_err(|m| CliError::input(format!("--hand-eye: {m} ({})", p.display())))
-        })
+        .map(|p| super::hand_eye_file(p))
         .transpose()?;
     Ok(PoseImportSpec {
         poses: poses.to_path_buf(),

@@ -9,8 +9,9 @@ use std::time::Instant;
 
 use clap::Args;
 
-use super::CliError;
 use super::scan_flags::ScanFlags;
+use super::values::{Keywords, Range, number};
+use super::{CliError, QUIET_HELP};
 use crate::engine::base::session::Use;
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
@@ -24,45 +25,37 @@ use crate::engine::uses::measure::{
 /// scan of thousands of poses would bury the summary).
 const LISTED_POSES: usize = 20;
 
-/// `spherecal measure`. The scan flags it shares with the import keep
-/// their measure wording here.
+/// `spherecal measure`.
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("input").required(true).args(["session", "joints", "poses"])))]
-#[command(mut_arg("pose_format", |a| a.help("Force the pose file's layout: table, json, fanuc-ls, rapid, krl or urscript")))]
-#[command(mut_arg("pose_convention", |a| a.help("How a pose table or JSON list writes a pose: ABB, KUKA, FANUC, UR or matrix (a robot program fixes its own)")))]
-#[command(mut_arg("pose_columns", |a| a.help("The pose columns of a CSV pose log, in the convention's order")))]
-#[command(mut_arg("urdf_tip", |a| a.help("The tip link of a URDF robot")))]
-#[command(mut_arg("axes", |a| a.help("Axis map from the sensor's axes to spherecal's (laser plane x = 0): `auto` or e.g. `-y,x,z`")))]
-#[command(mut_arg("no_return", |a| a.help("The sensor's no-return value in the profiles (file units), dropped and counted like NaN")))]
-#[command(mut_arg("profile_key", |a| a.help("Key of the point list in OpenCV YAML/JSON profiles")))]
 pub struct MeasureArgs {
     /// A session file: its stripes are measured as they are (every point of every stripe of the measurements chosen by --use).
     pub session: Option<PathBuf>,
     /// The result file whose calibrated model and hand-eye place the sensor (σ needs an `ml` result).
     #[arg(long)]
     pub result: PathBuf,
-    /// The cloud to write: `.ply` (binary: x y z double mm, sigma_mm float, pose uint), `.e57` (one scan a pose) or `.csv` (id,x,y,z,sigma_mm).
+    /// Where to write the cloud, the extension choosing the format: `.ply` (binary: x y z double mm, sigma_mm float, pose uint), `.e57` (one scan a pose) or `.csv` (id,x,y,z,sigma_mm).
     #[arg(long, short)]
     pub out: PathBuf,
-    /// Which measurements of a session: `all` (default) or a list of translation, rotation, identify, validate.
-    #[arg(long = "use", value_delimiter = ',', default_value = "all")]
-    pub usage: Vec<String>,
-    /// Write the cloud in this workpiece frame: a JSON 4x4 `base_from_workpiece` (4 rows of 4 numbers, mm; bare or under that key); default the robot base frame.
+    /// Which measurements of a session: `all`, or a comma-separated list of their uses.
+    #[arg(long = "use", value_delimiter = ',', default_value = "all", value_parser = use_parser())]
+    pub usage: Vec<Uses>,
+    /// Write the cloud in this workpiece frame: a JSON 4x4 `base_from_workpiece` (4 rows of 4 numbers, mm; bare or under that key) [default: the robot base frame]
     #[arg(long)]
     pub frame: Option<PathBuf>,
     /// Write no σ (sigma_mm NaN in PLY and CSV, left out of E57): for a result without covariance (`--method paper`).
     #[arg(long)]
     pub no_sigma: bool,
     /// The sensor's own noise: 1σ of each in-plane coordinate of a profile point, mm, added to σ in quadrature (2·s²).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, value_name = "MM", default_value_t = 0.0, value_parser = number(Range::non_negative("mm").at_most(MAX_SENSOR_NOISE_MM)))]
     pub sensor_noise: f64,
     /// Use the result's parameter covariance as written, not scaled by its variance factor (`solver.variance_factor`, ≈ 1 when ml's noise model fits the data).
     #[arg(long)]
     pub covariance_as_written: bool,
-    /// Which model of the result: `calibrated` (default) or `nominal` (the nominal model and the initial hand-eye: the cell before calibration; no σ).
-    #[arg(long, default_value = "calibrated", value_parser = parse_model)]
+    /// Which model of the result places the sensor.
+    #[arg(long, default_value = "calibrated", value_parser = model_parser())]
     pub model: ModelChoice,
-    /// The session the result was calibrated from: its identify poses give the joint range the calibration saw (default: the measured session itself; a raw scan without it is not checked).
+    /// The session the result was calibrated from: its identify poses give the joint range the calibration saw [default: the measured session itself; a raw scan without it is not checked]
     #[arg(long)]
     pub calibration: Option<PathBuf>,
     /// Raw scan: a joint log CSV (columns id and j1..jn, optional station and use; see --map).
@@ -78,48 +71,90 @@ pub struct MeasureArgs {
     /// Raw scan: a folder of profiles (`<id>.csv|txt|yml|yaml|json`, or in natural order for a log without ids) or one CSV with a pose column.
     #[arg(long)]
     pub profiles: Option<PathBuf>,
-    /// Raw scan: the nominal robot it was taken with (a preset key, a session/result file, a URDF or a DH table), checked against the result's.
-    #[arg(long)]
+    /// Raw scan: the nominal robot it was taken with, checked against the result's (help text with the presets' keys).
+    #[arg(long, help = format!("Raw scan: the nominal robot it was taken with (a preset key: {}; a session/result file, a URDF or a DH table), checked against the result's", super::preset_keys()))]
     pub robot: Option<String>,
-    /// Joint-log columns, e.g. `id=Pose,j1=A1,...,station=Sphere,use=Use` (defaults: id, j1..jn, station, use).
+    /// Raw scan: the joint log's columns, e.g. `id=Pose,j1=A1,...,station=Sphere,use=Use` [default: id, j1..jn, station, use]
     #[arg(long, value_delimiter = ',')]
     pub map: Vec<String>,
-    /// Raw scan of a sphere artefact: the spheres' diameter (mm), for the self-validation of the poses' stations.
-    #[arg(long)]
+    /// Raw scan of a sphere artefact: the spheres' diameter, mm, for the self-validation of the poses' stations.
+    #[arg(long, value_name = "MM", value_parser = number(Range::positive("mm").at_most(SPHERE_DIAMETER_MM)))]
     pub sphere_diameter: Option<f64>,
     /// Raw scan of a sphere artefact: reference distances between its stations (CSV from,to,distance, mm).
     #[arg(long)]
     pub references: Option<PathBuf>,
-    /// Print nothing but errors and warnings.
-    #[arg(long, short)]
+    /// `-q`: [`QUIET_HELP`](super::QUIET_HELP).
+    #[arg(long, short, help = QUIET_HELP)]
     pub quiet: bool,
 }
 
-fn parse_model(s: &str) -> Result<ModelChoice, String> {
-    match s {
-        "calibrated" => Ok(ModelChoice::Calibrated),
-        "nominal" => Ok(ModelChoice::Nominal),
-        _ => Err(format!(
-            "unknown model `{s}`, expected calibrated or nominal"
-        )),
+/// Largest `--sensor-noise`, mm: the simulator's limit on a sensor's
+/// noise; beyond it σ says nothing about the cloud.
+const MAX_SENSOR_NOISE_MM: f64 = crate::engine::tools::simulate::config::MAX_SENSOR_NOISE_MM;
+
+/// Largest `--sphere-diameter`, mm: the session rules' limit.
+const SPHERE_DIAMETER_MM: f64 = crate::engine::base::limits::SPHERE_DIAMETER_MM;
+
+/// One value of `--use`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Uses {
+    /// Every measurement.
+    All,
+    /// The measurements of one use.
+    One(Use),
+}
+
+impl Uses {
+    fn parse(s: &str) -> Option<Self> {
+        if s.eq_ignore_ascii_case("all") {
+            Some(Self::All)
+        } else {
+            Use::parse(s).map(Self::One)
+        }
     }
 }
 
+/// `--use`: `all` or the session's uses.
+fn use_parser() -> Keywords<Uses> {
+    Keywords::plain(
+        std::iter::once("all").chain(Use::ALL.map(Use::as_str)),
+        Uses::parse,
+    )
+}
+
+/// `--model`: the result's two models.
+fn model_parser() -> Keywords<ModelChoice> {
+    Keywords::new(
+        vec![
+            (
+                ModelChoice::Calibrated.as_str(),
+                Some("The calibrated model and hand-eye"),
+            ),
+            (
+                ModelChoice::Nominal.as_str(),
+                Some(
+                    "The nominal model and the initial hand-eye: the cell before calibration; no σ",
+                ),
+            ),
+        ],
+        |s| match s {
+            "calibrated" => Some(ModelChoice::Calibrated),
+            "nominal" => Some(ModelChoice::Nominal),
+            _ => None,
+        },
+    )
+}
+
 /// The uses `--use` names; empty for all.
-fn uses(args: &MeasureArgs) -> Result<Vec<Use>, CliError> {
-    if args.usage.iter().any(|u| u.eq_ignore_ascii_case("all")) {
-        return Ok(Vec::new());
-    }
+fn uses(args: &MeasureArgs) -> Vec<Use> {
     args.usage
         .iter()
-        .map(|u| {
-            Use::parse(u.trim()).ok_or_else(|| {
-                CliError::input(format!(
-                    "--use `{u}`: expected all, or translation, rotation, identify, validate"
-                ))
-            })
+        .map(|u| match u {
+            Uses::All => None,
+            Uses::One(one) => Some(*one),
         })
-        .collect()
+        .collect::<Option<Vec<Use>>>()
+        .unwrap_or_default()
 }
 
 fn from_measure(e: &MeasureError) -> CliError {
@@ -245,7 +280,7 @@ fn rate(points: usize, seconds: f64) -> String {
 }
 
 /// The output's format from its extension, after refusing an output that
-/// is one of the inputs and a bad `--sensor-noise`.
+/// is one of the inputs.
 fn output_format(args: &MeasureArgs) -> Result<CloudFormat, CliError> {
     let input_files = inputs(args);
     let input_refs: Vec<&Path> = input_files.iter().map(PathBuf::as_path).collect();
@@ -256,11 +291,6 @@ fn output_format(args: &MeasureArgs) -> Result<CloudFormat, CliError> {
             args.out.display()
         ))
     })?;
-    if !(args.sensor_noise.is_finite() && args.sensor_noise >= 0.0) {
-        return Err(CliError::input(
-            "--sensor-noise must be a finite number ≥ 0 (mm)",
-        ));
-    }
     Ok(format)
 }
 
@@ -284,7 +314,7 @@ fn load_scan(
         if args.calibration.is_none() {
             joint_range = JointRange::of_session(&session);
         }
-        Scan::from_session(session, &uses(args)?)
+        Scan::from_session(session, &uses(args))
     } else {
         let dof = result
             .robot
@@ -457,7 +487,10 @@ fn print_summary(
                 format!("× variance factor {:.3}", measure::variance_factor(result))
             },
             if args.sensor_noise > 0.0 {
-                format!(", sensor noise {} mm", args.sensor_noise)
+                format!(
+                    ", sensor noise {} mm",
+                    crate::engine::base::numeric::show(args.sensor_noise)
+                )
             } else {
                 String::new()
             },
@@ -537,10 +570,10 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
         format,
         &provenance,
     )?;
-    print_warnings(&done.measured);
     if args.quiet {
         return Ok(());
     }
+    print_warnings(&done.measured);
     print_summary(
         args,
         &result,

@@ -37,13 +37,14 @@ pub mod measure;
 pub mod plan;
 pub mod scan_flags;
 pub mod simulate;
+pub mod values;
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use clap::{Args, Parser, Subcommand};
 
-use crate::engine::base::session;
+use crate::engine::base::{limits, session};
 use crate::engine::calibrate::solve::ml::{Loss, MlOptions};
 use crate::engine::calibrate::solve::paper::Pairing;
 use crate::engine::calibrate::solve::{
@@ -56,7 +57,14 @@ use crate::engine::tools::report::summary;
 /// spherecal: calibrate a robot-mounted laser-stripe sensor (hand-eye and
 /// kinematic errors) against a reference sphere.
 #[derive(Debug, Parser)]
-#[command(name = "spherecal", version, about, long_about = None)]
+#[command(
+    name = "spherecal",
+    version,
+    about,
+    long_about = None,
+    after_help = "Without a command the workbench opens on the demo session (spherecal gui).\n\
+        Exit status: 0 done, 2 bad input or a refused output (one `error:` line), 1 internal failure, 130 interrupted."
+)]
 pub struct Cli {
     /// What to do; without a command the workbench opens on the demo session.
     #[command(subcommand)]
@@ -81,50 +89,141 @@ impl Cli {
         I: IntoIterator<Item = T>,
         T: Into<std::ffi::OsString> + Clone,
     {
-        use clap::{CommandFactory, FromArgMatches};
-        let matches = negative_numbers(Self::command()).get_matches_from(args);
+        use clap::FromArgMatches;
+        let matches = command().get_matches_from(args);
         Self::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
     }
 }
 
-/// `command` with every value-taking option accepting negative numbers,
-/// in every subcommand.
-fn negative_numbers(command: clap::Command) -> clap::Command {
+/// The command line as the binary parses it (and as `--help` and the
+/// guide's reference show it): [`Cli`]'s definitions with every
+/// value-taking option accepting negative numbers, and every default
+/// shown alike ([`default_paragraph`]).
+#[must_use]
+pub fn command() -> clap::Command {
+    finish(<Cli as clap::CommandFactory>::command())
+}
+
+/// `command` with every value-taking option accepting negative numbers
+/// and every default shown alike, in every subcommand.
+fn finish(command: clap::Command) -> clap::Command {
     command
         .mut_args(|a| {
+            let a = default_paragraph(a);
             if a.get_action().takes_values() {
                 a.allow_negative_numbers(true)
             } else {
                 a
             }
         })
-        .mut_subcommands(negative_numbers)
+        .mut_subcommands(finish)
 }
 
-/// The subcommands.
+/// An option whose default depends on the input says so at the end of
+/// its help, `… [default: the session's solver.threshold]`; in the long
+/// help (`--help`) that bracket is set apart as clap sets apart a fixed
+/// default (`[default: 0.15]`), so that every default reads alike.
+fn default_paragraph(arg: clap::Arg) -> clap::Arg {
+    let Some(help) = arg.get_help().map(ToString::to_string) else {
+        return arg;
+    };
+    // With a list of values (clap puts its own default after it) the
+    // bracket stays where it is written.
+    if arg.get_long_help().is_some()
+        || !help.ends_with(']')
+        || !arg.get_possible_values().is_empty()
+    {
+        return arg;
+    }
+    match help.rfind(" [default: ") {
+        Some(at) => {
+            let long = format!("{}\n\n{}", &help[..at], &help[at + 1..]);
+            arg.long_help(long)
+        }
+        None => arg,
+    }
+}
+
+/// The help of every `-q`/`--quiet`: one meaning on every command that
+/// writes files.
+pub const QUIET_HELP: &str = "Print nothing but errors (no summary, no progress, no warnings)";
+
+/// The subcommands. The first paragraph of each is the summary that
+/// `spherecal --help` lists; the rest is shown by `spherecal <command> --help`.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Run the whole calibration headless and write the result file.
+    /// Calibrate a session: identify the hand-eye and the kinematic errors, write the result file
+    ///
+    /// Runs the whole calibration headless with method `ml` (the default) or
+    /// `paper`, prints ε after each update and the validation before and
+    /// after, and writes the result (FORMAT.md `spherecal-result`). A
+    /// calibration whose identify centres still scatter beyond 10 mm is
+    /// refused (nothing written) unless --accept-implausible.
     Calibrate(CalibrateArgs),
-    /// Write a simulated session with a known truth (for tests, demos and what-if studies).
+    /// Write a simulated session and its truth (for tests, demos and what-if studies)
+    ///
+    /// Seeded: the same arguments give byte-identical files. The poses are
+    /// generated for the --robot preset, or taken from a plan CSV (--plan);
+    /// --csv-out also writes the files `spherecal import` reads; --scan
+    /// simulates a raw scan of a part instead of a session.
     Simulate(simulate::SimulateArgs),
-    /// Open the workbench, optionally on a session file.
+    /// Open the workbench, optionally on a session file (the default without a command)
+    ///
+    /// Needs a display (DISPLAY or WAYLAND_DISPLAY); every other command runs
+    /// without one.
     Gui(GuiArgs),
-    /// Compare the paper's method, `ml` and the noise floor on simulated scenarios (README evidence).
+    /// Compare the paper's method, `ml` and the noise floor on simulated scenarios (the evidence tables)
+    ///
+    /// Prints a text report, or with --markdown the tables of the guide's
+    /// evidence chapters; --planned-range and --compensation run the other
+    /// two studies instead. Writes no file; the progress goes to stderr.
     Evaluate(evaluate::EvaluateArgs),
-    /// Write the calibrated model of a result file as JSON (the session `robot` block), CSV (MDH table) or URDF.
+    /// Write the calibrated model of a result file as JSON (a session's `robot` block), CSV (MDH table) or URDF
     ExportModel(export_model::ExportModelArgs),
-    /// Build a session file from a joint log CSV and stripe profile files (mm, deg in the session; units of the inputs chosen by flags).
+    /// Build a session file from a pose log and what the sensor saw: stripe profiles or sphere centres
+    ///
+    /// The pose log is a joint log CSV (--joints, with --robot) or a pose
+    /// file of any layout (--poses: a table, a JSON list, or a FANUC, ABB
+    /// RAPID, KUKA or URScript program; flange poses or joint targets). What
+    /// the sensor saw is a folder or a CSV of stripe profiles (--profiles)
+    /// or, with --poses, a table of sphere centres (--centres). The session
+    /// is in mm and deg; the units of the inputs are set by flags.
     Import(import::ImportArgs),
-    /// Plan the poses to teach (translation, rotation, identify and validate groups) for a robot, a rough sphere position and a hand-eye guess; export CSV and the controller program (RAPID, URScript).
+    /// Plan the poses to teach for a calibration, predict its accuracy, export them for the controller
+    ///
+    /// From a robot, a rough sphere position and a hand-eye guess: the
+    /// translation, rotation, identify and validate poses; --predict N
+    /// scores the plan by simulated calibrations; --csv writes the joint
+    /// log `spherecal import` reads, --rapid and --program the controller
+    /// programs (ABB RAPID, URScript).
     Plan(plan::PlanArgs),
-    /// Write a self-contained HTML report (figures as inline SVG): calibrates the session first, or reports `--result` as it is.
+    /// Write a self-contained HTML report of a calibration (figures as inline SVG)
+    ///
+    /// Calibrates the session first (as `spherecal calibrate`, with
+    /// --method), or reports --result as it is after checking that it
+    /// belongs to the session; --tolerance adds a PASS or FAIL verdict.
     Report(html_report::ReportArgs),
-    /// Measure with the calibrated cell: a session's stripes or a raw scan (pose log and profiles) into a point cloud in the base (or a workpiece) frame through a result's model and hand-eye, each point with its σ (PLY, E57 or CSV by extension); the sphere self-validation before and after calibration.
+    /// Measure with the calibrated cell: stripes into a point cloud, each point with its σ
+    ///
+    /// A session's stripes or a raw scan (a pose log and profiles) into a
+    /// point cloud in the base (or a workpiece) frame through a result's
+    /// model and hand-eye (PLY, E57 or CSV by the extension of --out); with
+    /// a sphere diameter, the sphere self-validation before and after
+    /// calibration.
     Measure(measure::MeasureArgs),
-    /// Library of a folder of sessions and results: per robot the drift of the hand-eye and kinematic deviations over time, jumps beyond k combined σ flagged.
+    /// Follow a cell's drift: the library of a folder of sessions and results
+    ///
+    /// Per robot, the hand-eye and the main kinematic deviations over time;
+    /// a change between consecutive results beyond k combined σ is flagged.
+    /// Prints the tables; --csv also writes every parameter.
     History(history::HistoryArgs),
-    /// Compensate robot targets through a calibration: a pose table or a robot program (RAPID, KUKA KRL, FANUC .ls, URScript) rewritten so that a controller running the nominal model drives the TCP onto each target; prints the calibrated hand-eye as the controller's tool data.
+    /// Compensate robot targets (a pose table or a robot program) through a calibration
+    ///
+    /// The targets of a pose table or a robot program (RAPID, KUKA KRL,
+    /// FANUC .ls, URScript) rewritten so that a controller running the
+    /// nominal model drives the TCP onto each target, every other byte
+    /// kept; prints the calibrated hand-eye as the controller's tool data
+    /// and flags targets outside what the calibration saw.
     Compensate(compensate::CompensateArgs),
 }
 
@@ -201,6 +300,92 @@ pub fn bounded_message(message: &str) -> String {
     format!("{head}… ({} characters left out) …{tail}", n - 2 * keep)
 }
 
+/// The one line printed after `error: `: numbers written out in full by
+/// an engine message shown as people write them ([`readable_numbers`]),
+/// then cut to [`MAX_MESSAGE_CHARS`] ([`bounded_message`]).
+#[must_use]
+pub fn error_line(message: &str) -> String {
+    bounded_message(&readable_numbers(message))
+}
+
+/// Digits a number may have before it is rewritten in scientific
+/// notation: more than any measurement in mm or deg has.
+const LONG_NUMBER_DIGITS: usize = 18;
+
+/// `message` with every number of more than [`LONG_NUMBER_DIGITS`]
+/// digits (a `1e308` that a message printed in full, 309 digits, or a
+/// `1e-300` with 300 zeros) shown as [`numeric::show`] writes it:
+/// `1e308`. Other text, and numbers inside words (`p123…`), are kept.
+///
+/// [`numeric::show`]: crate::engine::base::numeric::show
+#[must_use]
+pub fn readable_numbers(message: &str) -> String {
+    let bytes = message.as_bytes();
+    let mut out = String::with_capacity(message.len());
+    let mut last = 0;
+    let mut i = 0;
+    while i < bytes.len() {
+        let starts_number = bytes[i].is_ascii_digit()
+            && (i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_'));
+        if !starts_number {
+            i += 1;
+            continue;
+        }
+        let start = if i > 0 && bytes[i - 1] == b'-' {
+            i - 1
+        } else {
+            i
+        };
+        let mut end = i;
+        while end < bytes.len() && (bytes[end].is_ascii_digit() || bytes[end] == b'.') {
+            end += 1;
+        }
+        let token = message[start..end].trim_end_matches('.');
+        let digits = token.bytes().filter(u8::is_ascii_digit).count();
+        let followed_by_word =
+            end < bytes.len() && (bytes[end].is_ascii_alphabetic() || bytes[end] == b'_');
+        match token.parse::<f64>() {
+            Ok(v) if digits > LONG_NUMBER_DIGITS && !followed_by_word => {
+                out.push_str(&message[last..start]);
+                out.push_str(&crate::engine::base::numeric::show(v));
+                last = start + token.len();
+            }
+            _ => {}
+        }
+        i = end.max(i + 1);
+    }
+    out.push_str(&message[last..]);
+    out
+}
+
+/// `message` with the engine's names of settings replaced by the flags
+/// that set them (`names`: engine name, flag), so that an option error
+/// names what the user typed. A name is replaced where it stands as a
+/// word of its own (`stripe_noise`, not `max_stripe_noise_x`).
+#[must_use]
+pub fn name_flags(message: &str, names: &[(&str, &str)]) -> String {
+    let word = |b: u8| b.is_ascii_alphanumeric() || b == b'_' || b == b'-';
+    let mut text = message.to_owned();
+    for (name, flag) in names {
+        let mut out = String::with_capacity(text.len());
+        let mut rest = text.as_str();
+        while let Some(at) = rest.find(name) {
+            let before = rest[..at].bytes().last();
+            let after = rest[at + name.len()..].bytes().next();
+            out.push_str(&rest[..at]);
+            if before.is_some_and(word) || after.is_some_and(word) {
+                out.push_str(name);
+            } else {
+                out.push_str(flag);
+            }
+            rest = &rest[at + name.len()..];
+        }
+        out.push_str(rest);
+        text = out;
+    }
+    text
+}
+
 /// Refuses, before any work, outputs that could not be written (a
 /// device, a folder, a read-only file, a missing folder, two outputs that
 /// are one file), with status 2.
@@ -224,11 +409,33 @@ pub fn write_outputs(files: &[(&Path, &[u8])], folders: format::Folders) -> Resu
 /// `spherecal gui`.
 #[derive(Debug, Args)]
 pub struct GuiArgs {
-    /// Session file to open (default: the embedded demo session).
+    /// Session file to open [default: the embedded demo session]
     pub session: Option<PathBuf>,
     /// A result file to review beside the session (no solver run).
     #[arg(long)]
     pub result: Option<PathBuf>,
+}
+
+/// The sentence of `spherecal gui` (and of `spherecal` alone) where no
+/// display is.
+pub const NO_DISPLAY: &str = "the workbench needs a display and neither DISPLAY nor WAYLAND_DISPLAY is set: log in to a graphical session, or use the commands that need none (spherecal calibrate, import, plan, measure, compensate, report: see spherecal --help)";
+
+/// Refuses to open the workbench where there is no display to open it
+/// on (Linux and the BSDs: neither `DISPLAY` nor `WAYLAND_DISPLAY` set),
+/// with status 2 and [`NO_DISPLAY`].
+///
+/// # Errors
+/// No display.
+pub fn check_display() -> Result<(), CliError> {
+    if cfg!(any(target_os = "macos", target_os = "windows")) {
+        return Ok(());
+    }
+    let set = |key: &str| std::env::var_os(key).is_some_and(|v| !v.is_empty());
+    if set("DISPLAY") || set("WAYLAND_DISPLAY") {
+        Ok(())
+    } else {
+        Err(CliError::input(NO_DISPLAY))
+    }
 }
 
 /// `spherecal calibrate`.
@@ -239,26 +446,23 @@ pub struct CalibrateArgs {
     /// Where to write the result file (FORMAT.md `spherecal-result`).
     #[arg(long, short)]
     pub out: PathBuf,
-    /// Identification method: `ml` (maximum likelihood, the default: nearer the noise floor in every simulated scenario) or `paper` (the paper's section 3.2, the baseline).
-    #[arg(long, default_value = "ml", value_parser = parse_method)]
+    /// Identification method: `ml` (maximum likelihood: nearer the noise floor in every simulated scenario) or `paper` (the paper's section 3.2, the baseline).
+    #[arg(long, default_value = "ml", value_parser = method_parser())]
     pub method: Method,
     /// Leave these measurements out (comma-separated ids), e.g. the outliers `ml` listed.
     #[arg(long, value_delimiter = ',')]
     pub exclude: Vec<String>,
-    /// Settings of the `ml` method.
-    #[command(flatten)]
-    pub ml: MlArgs,
-    /// Stop when ε falls to this (mm); default: the session's `solver.threshold` (0.15).
-    #[arg(long)]
+    /// Stop when ε falls to this, mm [default: the session's `solver.threshold`]
+    #[arg(long, value_name = "MM", value_parser = values::number(values::Range::non_negative("mm").at_most(limits::THRESHOLD_MM)))]
     pub threshold: Option<f64>,
-    /// Most updates; default: the session's `solver.max_iterations` (20).
-    #[arg(long)]
+    /// Most updates [default: the session's `solver.max_iterations`]
+    #[arg(long, value_name = "N", value_parser = values::count(0, MAX_ITERATIONS))]
     pub max_iterations: Option<usize>,
     /// Relative SVD tolerance of the paper's method (fraction of the largest singular value).
-    #[arg(long, default_value_t = crate::engine::calibrate::solve::paper::DEFAULT_SVD_TOLERANCE)]
+    #[arg(long, default_value_t = crate::engine::calibrate::solve::paper::DEFAULT_SVD_TOLERANCE, value_parser = values::number(values::Range::fraction_open()))]
     pub svd_tolerance: f64,
-    /// Pairing of a station's measurements: `disjoint` (the paper's (1,2),(3,4),(5,6)) or `all`.
-    #[arg(long, default_value = "disjoint", value_parser = parse_pairing)]
+    /// Pairing of a station's measurements in the paper's method: `disjoint` (the paper's (1,2),(3,4),(5,6)) or `all`.
+    #[arg(long, default_value = "disjoint", value_parser = values::Keywords::plain(["disjoint", "all"], Pairing::parse))]
     pub pairs: Pairing,
     /// Write the result even when the identify centres still scatter beyond 10 mm after calibration (a failed calibration: wrong pose convention, joint unit, robot model or side), e.g. to study it.
     #[arg(long)]
@@ -266,14 +470,25 @@ pub struct CalibrateArgs {
     /// Skip the held-out figure (each identify measurement's centre predicted by a calibration made without it; ml: one Gauss-Newton step per measurement, paper: its loop rerun without each, 10-fold above 50 measurements).
     #[arg(long)]
     pub no_held_out: bool,
-    /// Print nothing but errors.
-    #[arg(long, short)]
+    /// `-q`: [`QUIET_HELP`].
+    #[arg(long, short, help = QUIET_HELP)]
     pub quiet: bool,
+    /// Settings of the `ml` method (last: their own heading in the help).
+    #[command(flatten)]
+    pub ml: MlArgs,
 }
+
+/// Most updates `--max-iterations` takes: the engine's plausibility limit.
+#[allow(
+    clippy::cast_possible_truncation,
+    clippy::cast_sign_loss,
+    reason = "a whole, positive number far below usize::MAX"
+)]
+const MAX_ITERATIONS: usize = limits::MAX_ITERATIONS as usize;
 
 /// Refuses a finished calibration whose identify centres scatter beyond
 /// any sensor and robot ([`plausible::check_calibration`]), unless
-/// `accept` (then it is a warning on stderr).
+/// `accept` (then it is a warning on stderr, unless `quiet`).
 ///
 /// # Errors
 /// Status 2 naming the scatter and the likely causes, and the flag that
@@ -281,13 +496,15 @@ pub struct CalibrateArgs {
 pub fn check_plausible(
     session: &session::Session,
     cal: &solve::Calibration,
-    accept: bool,
+    (accept, quiet): (bool, bool),
     path: &Path,
 ) -> Result<(), CliError> {
     match plausible::check_calibration(session, cal) {
         Ok(()) => Ok(()),
         Err(e) if accept => {
-            eprintln!("warning: {e} (written anyway: --accept-implausible)");
+            if !quiet {
+                eprintln!("warning: {e} (written anyway: --accept-implausible)");
+            }
             Ok(())
         }
         Err(e) => Err(CliError::input(format!(
@@ -299,39 +516,48 @@ pub fn check_plausible(
 
 /// Settings of the `ml` method (defaults: [`MlOptions::default`]).
 #[derive(Debug, Args)]
+#[command(next_help_heading = "Options of the ml method")]
 pub struct MlArgs {
-    /// ml: σ of the joint readings, deg (default 0.003).
-    #[arg(long)]
-    pub joint_sigma: Option<f64>,
-    /// ml: σ of a centre given in the session, mm (default 0.01).
-    #[arg(long)]
-    pub centre_sigma: Option<f64>,
-    /// ml: floor of each principal σ of a stripe centre's covariance, mm (default 0.002).
-    #[arg(long)]
-    pub sensor_sigma_floor: Option<f64>,
-    /// ml: no prior on the kinematic deviations.
+    /// σ of the joint readings, deg.
+    #[arg(long, value_name = "DEG", default_value_t = MlOptions::default().joint_sigma_deg, value_parser = values::number(values::Range::non_negative("deg")))]
+    pub joint_sigma: f64,
+    /// σ of a centre given in the session, mm.
+    #[arg(long, value_name = "MM", default_value_t = MlOptions::default().centre_sigma, value_parser = values::number(values::Range::positive("mm")))]
+    pub centre_sigma: f64,
+    /// Floor of each principal σ of a stripe centre's covariance, mm.
+    #[arg(long, value_name = "MM", default_value_t = MlOptions::default().sensor_sigma_floor, value_parser = values::number(values::Range::positive("mm")))]
+    pub sensor_sigma_floor: f64,
+    /// No prior on the kinematic deviations.
     #[arg(long)]
     pub no_prior: bool,
-    /// ml: prior σ of angle deviations, deg (default 0.2).
-    #[arg(long)]
-    pub prior_angle: Option<f64>,
-    /// ml: prior σ of length deviations, mm (default 0.5).
-    #[arg(long)]
-    pub prior_length: Option<f64>,
-    /// ml: robust loss, `squared`, `huber` or `cauchy` (default huber).
-    #[arg(long, value_parser = parse_loss)]
-    pub loss: Option<Loss>,
-    /// ml: robust loss scale, σ of the whitened residual norm (default 3.37, the 99 % point of χ(3)).
-    #[arg(long)]
+    /// Prior σ of angle deviations, deg.
+    #[arg(long, value_name = "DEG", default_value_t = MlOptions::default().prior_angle_deg, value_parser = values::number(values::Range::positive("deg")))]
+    pub prior_angle: f64,
+    /// Prior σ of length deviations, mm.
+    #[arg(long, value_name = "MM", default_value_t = MlOptions::default().prior_length, value_parser = values::number(values::Range::positive("mm")))]
+    pub prior_length: f64,
+    /// Robust loss.
+    #[arg(long, default_value = MlOptions::default().loss.as_str(), value_parser = values::Keywords::plain(Loss::ALL.map(Loss::as_str), Loss::parse))]
+    pub loss: Loss,
+    /// Robust loss scale (help text with the engine's default).
+    #[arg(
+        long,
+        value_name = "SIGMA",
+        value_parser = values::number(values::Range::positive("σ")),
+        help = format!(
+            "Robust loss scale, σ of the whitened residual norm [default: {}, the 99 % point of χ(3)]",
+            crate::engine::base::numeric::approx(MlOptions::default().loss_scale)
+        )
+    )]
     pub loss_scale: Option<f64>,
-    /// ml: relative pivot tolerance of the identifiability QR (default 1e-7).
-    #[arg(long)]
-    pub rank_tolerance: Option<f64>,
-    /// ml: skip the leave-one-station-out cross-validation.
+    /// Relative pivot tolerance of the identifiability QR.
+    #[arg(long, default_value = crate::engine::base::numeric::show(MlOptions::default().rank_tolerance), value_parser = values::number(values::Range::fraction_open()))]
+    pub rank_tolerance: f64,
+    /// Skip the leave-one-station-out cross-validation.
     #[arg(long)]
     pub no_cross_validation: bool,
-    /// ml, pose-only sessions: σ of each base-frame coordinate from the error of the flange poses the controller reports (the robot's accuracy), mm (default: estimated from the scatter of the station centres at the start).
-    #[arg(long)]
+    /// Pose-only sessions: σ of each base-frame coordinate from the error of the flange poses the controller reports (the robot's accuracy), mm [default: estimated from the scatter of the station centres at the start]
+    #[arg(long, value_name = "MM", value_parser = values::number(values::Range::positive("mm")))]
     pub pose_sigma: Option<f64>,
 }
 
@@ -341,35 +567,78 @@ impl MlArgs {
     pub fn options(&self) -> MlOptions {
         let d = MlOptions::default();
         MlOptions {
-            joint_sigma_deg: self.joint_sigma.unwrap_or(d.joint_sigma_deg),
-            centre_sigma: self.centre_sigma.unwrap_or(d.centre_sigma),
-            sensor_sigma_floor: self.sensor_sigma_floor.unwrap_or(d.sensor_sigma_floor),
+            joint_sigma_deg: self.joint_sigma,
+            centre_sigma: self.centre_sigma,
+            sensor_sigma_floor: self.sensor_sigma_floor,
             prior: d.prior && !self.no_prior,
-            prior_angle_deg: self.prior_angle.unwrap_or(d.prior_angle_deg),
-            prior_length: self.prior_length.unwrap_or(d.prior_length),
-            loss: self.loss.unwrap_or(d.loss),
+            prior_angle_deg: self.prior_angle,
+            prior_length: self.prior_length,
+            loss: self.loss,
             loss_scale: self.loss_scale.unwrap_or(d.loss_scale),
-            rank_tolerance: self.rank_tolerance.unwrap_or(d.rank_tolerance),
+            rank_tolerance: self.rank_tolerance,
             cross_validation: d.cross_validation && !self.no_cross_validation,
             pose_sigma: self.pose_sigma.or(d.pose_sigma),
         }
     }
 }
 
-/// `standard` or `modified` (a DH table's convention).
-fn parse_dh(s: &str) -> Result<crate::engine::base::robot::DhConvention, String> {
-    match s.to_ascii_lowercase().as_str() {
-        "standard" | "dh" => Ok(crate::engine::base::robot::DhConvention::Standard),
-        "modified" | "mdh" => Ok(crate::engine::base::robot::DhConvention::Modified),
-        _ => Err(format!(
-            "unknown DH convention `{s}`, expected standard or modified"
-        )),
-    }
+/// A `--hand-eye` file (a JSON 4x4, or a session or result file's
+/// `hand_eye`), read by the engine's one transform reader (capped, held
+/// to the session rules), its errors led by the flag.
+///
+/// # Errors
+/// Status 2: the file cannot be read, or its transform is not plausible.
+pub fn hand_eye_file(path: &Path) -> Result<nalgebra::Isometry3<f64>, CliError> {
+    use crate::engine::tools::plan::RequestError;
+    crate::engine::tools::plan::read_hand_eye(path).map_err(|e| match e {
+        RequestError::File { message, .. } => {
+            let message = message.strip_prefix("hand_eye: ").unwrap_or(&message);
+            CliError::input(format!("--hand-eye: {message} ({})", path.display()))
+        }
+        other => CliError::input(other.to_string()),
+    })
 }
 
-fn parse_loss(s: &str) -> Result<Loss, String> {
-    Loss::parse(s)
-        .ok_or_else(|| format!("unknown loss `{s}`, expected `squared`, `huber` or `cauchy`"))
+/// The robot presets' keys, for the help of every `--robot`:
+/// `irb2400, irb120, ur5e`.
+#[must_use]
+pub fn preset_keys() -> String {
+    crate::engine::base::robot::RobotChoice::ALL
+        .map(crate::engine::base::robot::RobotChoice::key)
+        .join(", ")
+}
+
+/// `--method`: the engine's methods, the default first.
+fn method_parser() -> values::Keywords<Method> {
+    values::Keywords::plain(Method::ALL.map(Method::as_str), Method::parse)
+}
+
+/// `--dh`: a DH table's convention.
+fn dh_parser() -> values::Keywords<crate::engine::base::robot::DhConvention> {
+    values::Keywords::new(
+        vec![
+            (
+                "standard",
+                Some("Denavit-Hartenberg: Rz(theta)·Tz(d)·Tx(a)·Rx(alpha) per row"),
+            ),
+            (
+                "modified",
+                Some(
+                    "Craig's modified DH (with Hayati's optional beta), the model's own: Rx(alpha)·Tx(a)·Ry(beta)·Rz(theta)·Tz(d) per row",
+                ),
+            ),
+        ],
+        parse_dh,
+    )
+}
+
+/// `standard` or `modified` (a DH table's convention).
+fn parse_dh(s: &str) -> Option<crate::engine::base::robot::DhConvention> {
+    match s.to_ascii_lowercase().as_str() {
+        "standard" | "dh" => Some(crate::engine::base::robot::DhConvention::Standard),
+        "modified" | "mdh" => Some(crate::engine::base::robot::DhConvention::Modified),
+        _ => None,
+    }
 }
 
 /// Parses `--range Y0,Y1,Z0,Z1` (mm, sensor frame) into a `sensor.range`.
@@ -392,20 +661,6 @@ pub fn parse_range(s: &str) -> Result<crate::engine::base::session::SensorRange,
         y: [*y0, *y1],
         z: [*z0, *z1],
     })
-}
-
-fn parse_method(s: &str) -> Result<Method, String> {
-    Method::parse(s).ok_or_else(|| {
-        let names: Vec<&str> = Method::ALL.iter().map(|m| m.as_str()).collect();
-        format!(
-            "unknown method `{s}`, expected one of: {}",
-            names.join(", ")
-        )
-    })
-}
-
-fn parse_pairing(s: &str) -> Result<Pairing, String> {
-    Pairing::parse(s).ok_or_else(|| format!("unknown pairing `{s}`, expected `disjoint` or `all`"))
 }
 
 /// A failure of a command, with its exit status.
@@ -553,6 +808,7 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
         threshold,
         updates: 0,
     } = cal.stop
+        && !quiet
     {
         // Said plainly: a threshold at or above the starting ε calibrates
         // nothing.
@@ -562,7 +818,12 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
             crate::engine::base::numeric::show(threshold)
         );
     }
-    check_plausible(&session, &cal, args.accept_implausible, &args.session)?;
+    check_plausible(
+        &session,
+        &cal,
+        (args.accept_implausible, quiet),
+        &args.session,
+    )?;
     let result = format::ResultFile::from_calibration(&session, &cal);
     format::save_result(&result, &args.out).map_err(|e| CliError::from_file(&e, false))?;
     if !quiet {
@@ -616,6 +877,53 @@ mod tests {
             assert_eq!(CliError::from_file(&io(kind), false).status, 2);
             assert_eq!(CliError::from_file(&io(kind), true).status, 2);
         }
+    }
+
+    /// Issue 31: `1e308` was printed as 309 digits.
+    #[test]
+    fn long_numbers_are_shown_in_scientific_notation() {
+        let long = format!("{}", 1e308_f64);
+        assert_eq!(long.len(), 309);
+        assert_eq!(
+            readable_numbers(&format!("tolerance must be in (0, 1), got {long}")),
+            "tolerance must be in (0, 1), got 1e308"
+        );
+        assert_eq!(
+            readable_numbers(&format!("found -{long} mm")),
+            "found -1e308 mm"
+        );
+        let tiny = format!("{}", 1e-300_f64);
+        assert_eq!(readable_numbers(&format!("got {tiny}.")), "got 1e-300.");
+        // Everyday numbers, ids and numbers inside words are kept.
+        let kept = "pose p123456789012345678901 at 1050.25 mm, line 12: 0.001 (file_2026.csv)";
+        assert_eq!(readable_numbers(kept), kept);
+        assert_eq!(
+            readable_numbers("1234567890123456789x"),
+            "1234567890123456789x"
+        );
+    }
+
+    #[test]
+    fn engine_names_become_flags() {
+        let names = [
+            (
+                "n_identify + n_validate",
+                "--identify-stations + --validate-stations",
+            ),
+            ("stripe_noise", "--stripe-noise"),
+        ];
+        assert_eq!(
+            name_flags("stripe_noise 100 mm is not plausible", &names),
+            "--stripe-noise 100 mm is not plausible"
+        );
+        assert_eq!(
+            name_flags("n_identify + n_validate is 600: at most 500", &names),
+            "--identify-stations + --validate-stations is 600: at most 500"
+        );
+        assert_eq!(
+            name_flags("max_stripe_noise and stripe_noise_x stay", &names),
+            "max_stripe_noise and stripe_noise_x stay"
+        );
     }
 
     #[test]

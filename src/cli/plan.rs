@@ -9,40 +9,53 @@ use std::time::Instant;
 
 use clap::Args;
 
-use super::{CliError, PROGRESS_EVERY};
+use super::values::{Range, count, number};
+use super::{CliError, PROGRESS_EVERY, QUIET_HELP};
 use crate::engine::base::robot::{self, JointLimit};
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
 use crate::engine::files::import::RobotSource;
 use crate::engine::tools::plan::{
     self, Controller, PlanConfig, PlanDesign, PlanError, PlanRequest, PlanStage, PredictConfig,
-    RequestError, Selection, defaults, read_hand_eye, read_stations,
+    RequestError, Selection, defaults, read_stations,
 };
 use crate::engine::tools::simulate;
 
 /// `spherecal plan`.
 #[derive(Debug, Args)]
 pub struct PlanArgs {
-    /// Robot: a preset key (irb2400, irb120, ur5e), a session/result file whose `robot` block is the nominal model, a URDF (joint limits from its <limit> tags) or a DH table CSV (with --dh).
-    #[arg(long, default_value = "irb2400")]
+    /// Robot (help text with the presets' keys).
+    #[arg(
+        long,
+        default_value = "irb2400",
+        help = format!(
+            "Robot: a preset key ({}), a session/result file whose `robot` block is the nominal model, a URDF (joint limits from its <limit> tags) or a DH table CSV (with --dh)",
+            super::preset_keys()
+        )
+    )]
     pub robot: String,
-    /// The tip link of a URDF robot (default: the chain's only end link), e.g. tool0.
+    /// The tip link of a URDF robot, e.g. tool0 [default: the chain's only end link]
     #[arg(long)]
     pub urdf_tip: Option<String>,
-    /// The convention of a DH table robot: standard or modified.
-    #[arg(long, value_parser = super::parse_dh)]
+    /// The convention of a DH table robot.
+    #[arg(long, value_parser = super::dh_parser())]
     pub dh: Option<crate::engine::base::robot::DhConvention>,
-    /// Joint limits, deg, `min:max` per joint, comma-separated (default: the preset's; a robot from a file needs them unless it is named like a preset).
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    /// Joint limits, deg, `min:max` per joint, comma-separated [default: the preset's; a robot from a file needs them unless it is named like a preset]
+    #[arg(
+        long,
+        value_name = "MIN:MAX",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
     pub limits: Vec<String>,
     /// Rough sphere position `x,y,z` (mm, base frame): station P0 and the middle of the station box.
-    #[arg(long, value_parser = parse_triple, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_triple, allow_hyphen_values = true)]
     pub sphere: [f64; 3],
-    /// Hand-eye guess: a JSON file with a 4x4 matrix (rows, mm) or a session/result file with `hand_eye` (default: the paper's initial hand-eye).
+    /// Hand-eye guess: a JSON file with a 4x4 matrix (rows, mm) or a session/result file with `hand_eye` [default: the paper's initial hand-eye]
     #[arg(long)]
     pub hand_eye: Option<PathBuf>,
     /// Sphere diameter, mm.
-    #[arg(long, default_value_t = defaults::DIAMETER_MM)]
+    #[arg(long, value_name = "MM", default_value_t = defaults::DIAMETER_MM, value_parser = number(Range::positive("mm").at_most(crate::engine::base::limits::SPHERE_DIAMETER_MM)))]
     pub diameter: f64,
     /// Translation poses at P0 (0, or at least 3).
     #[arg(long, default_value_t = defaults::TRANSLATIONS)]
@@ -62,23 +75,23 @@ pub struct PlanArgs {
     /// Poses per validate station.
     #[arg(long, default_value_t = defaults::VALIDATE_POSES)]
     pub validate_poses: usize,
-    /// Station box `dx,dy,dz` (mm, base axes) centred on --sphere (default: the preset's simulator box, e.g. 400,600,450 for the IRB 2400; 300 mm cube otherwise).
-    #[arg(long, value_parser = parse_triple)]
+    /// Station box `dx,dy,dz` (mm, base axes) centred on --sphere [default: the preset's simulator box, e.g. 400,600,450 for the IRB 2400; a 300 mm cube otherwise]
+    #[arg(long, value_name = "DX,DY,DZ", value_parser = parse_triple)]
     pub box_size: Option<[f64; 3]>,
     /// Explicit stations instead of the box: a CSV with columns use (identify|validate), x, y, z (mm, base frame).
     #[arg(long)]
     pub stations: Option<PathBuf>,
     /// Cut angle, deg: the laser plane cuts the sphere with its centre at sensor x = ±R·sin(angle).
-    #[arg(long, default_value_t = plan::DEFAULT_CUT_ANGLE_DEG)]
+    #[arg(long, value_name = "DEG", default_value_t = plan::DEFAULT_CUT_ANGLE_DEG)]
     pub angle: f64,
     /// Half-angle of the cone of approach directions, deg.
-    #[arg(long, default_value_t = plan::DEFAULT_CONE_DEG)]
+    #[arg(long, value_name = "DEG", default_value_t = plan::DEFAULT_CONE_DEG)]
     pub cone: f64,
     /// Flange orientations drawn per station (each with every IK branch and both sides).
     #[arg(long, default_value_t = plan::DEFAULT_CANDIDATES)]
     pub candidates: usize,
     /// The sensor's measuring range `Y0,Y1,Z0,Z1` (mm, laser plane, sensor frame), e.g. `-40,40,-40,40`: the plan spreads the sphere over it (identify and validate poses see the sphere anywhere in the range, identify poses chosen for the smallest predicted error over it), compares with the plan without the spread, and --predict scores the error over it.
-    #[arg(long, allow_hyphen_values = true, value_parser = super::parse_range)]
+    #[arg(long, value_name = "Y0,Y1,Z0,Z1", allow_hyphen_values = true, value_parser = super::parse_range)]
     pub range: Option<crate::engine::base::session::SensorRange>,
     /// With --range: keep the sphere at the paper's one spot (±2, ±3 mm) and choose by ln det; the range is only predicted.
     #[arg(long, requires = "range")]
@@ -95,15 +108,76 @@ pub struct PlanArgs {
     /// Write the plan as an ABB RAPID module (MODULE SpherecalPlan).
     #[arg(long)]
     pub rapid: Option<PathBuf>,
-    /// Write a controller program: `KEY=FILE` (keys: rapid for ABB, urscript for Universal Robots); may be repeated.
-    #[arg(long)]
+    /// Controller programs to write (help text with the controllers' keys).
+    #[arg(
+        long,
+        value_name = "KEY=FILE",
+        help = format!(
+            "Write a controller program, KEY one of: {}; may be repeated",
+            Controller::ALL
+                .iter()
+                .map(|c| format!("{} ({})", c.key(), c.label()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    )]
     pub program: Vec<String>,
     /// Predict the calibrated accuracy from N simulated calibrations (random kinematic errors, default noise, ml); 0 skips.
-    #[arg(long, default_value_t = PredictConfig::default().runs)]
+    #[arg(long, value_name = "N", default_value_t = PredictConfig::default().runs, value_parser = count(0, MAX_PREDICT_RUNS))]
     pub predict: usize,
-    /// Print nothing but errors.
-    #[arg(long, short)]
+    /// `-q`: [`QUIET_HELP`](super::QUIET_HELP).
+    #[arg(long, short, help = QUIET_HELP)]
     pub quiet: bool,
+}
+
+/// Most simulated calibrations of `--predict`: a few seconds each at
+/// most, and the spread of the prediction settles long before.
+pub const MAX_PREDICT_RUNS: usize = 1000;
+
+/// The flags behind each of the plan's setting errors: a phrase of the
+/// engine's message and the flags that set what it names.
+const FLAGS_OF_SETTINGS: [(&str, &str); 21] = [
+    (
+        "stations asked for",
+        "--identify-stations + --validate-stations",
+    ),
+    (
+        "stations ×",
+        "--identify-stations + --validate-stations, --candidates",
+    ),
+    (
+        "candidate orientations per station asked for",
+        "--candidates",
+    ),
+    ("at least one candidate orientation", "--candidates"),
+    ("translation poses asked for", "--translations"),
+    ("rotation poses asked for", "--rotations"),
+    ("the rotation group needs", "--rotations"),
+    ("identify poses per station asked for", "--identify-poses"),
+    ("an identify station needs", "--identify-poses"),
+    ("validate poses per station asked for", "--validate-poses"),
+    ("validate stations need", "--validate-poses"),
+    ("at least one identify station", "--identify-stations"),
+    ("the cut angle", "--angle"),
+    ("the cone angle", "--cone"),
+    ("the sphere diameter", "--diameter"),
+    ("the sphere position", "--sphere"),
+    ("the station box", "--box-size"),
+    ("station positions", "--stations"),
+    ("joint limit", "--limits"),
+    ("the sensor range", "--range"),
+    ("joints", "--robot"),
+];
+
+/// A plan setting's error, led by the flag that set it.
+fn setting_error(message: &str) -> CliError {
+    match FLAGS_OF_SETTINGS
+        .iter()
+        .find(|(phrase, _)| message.contains(phrase))
+    {
+        Some((_, flags)) => CliError::input(format!("{flags}: {message}")),
+        None => CliError::input(message.to_owned()),
+    }
 }
 
 fn parse_triple(s: &str) -> Result<[f64; 3], String> {
@@ -175,9 +249,8 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
         hand_eye: args
             .hand_eye
             .as_deref()
-            .map(read_hand_eye)
-            .transpose()
-            .map_err(input)?,
+            .map(super::hand_eye_file)
+            .transpose()?,
         box_size: args.box_size,
         stations: args
             .stations
@@ -199,14 +272,17 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
 /// [`CliError`] (status 2) for an unknown robot, bad limits, an unreadable
 /// hand-eye or stations file.
 pub fn config(args: &PlanArgs) -> Result<PlanConfig, CliError> {
-    request(args)?
+    let config = request(args)?
         .config()
-        .map_err(|e| CliError::input(e.to_string()))
+        .map_err(|e| CliError::input(e.to_string()))?;
+    config.validate().map_err(|e| plan_error(&e))?;
+    Ok(config)
 }
 
 fn plan_error(e: &PlanError) -> CliError {
     match e {
         PlanError::Analysis(_) => CliError::internal(e.to_string()),
+        PlanError::InvalidConfig(message) => setting_error(message),
         _ => CliError::input(e.to_string()),
     }
 }
@@ -507,9 +583,11 @@ mod tests {
         ] {
             let mut argv = vec!["--sphere", "1050,0,475"];
             argv.extend(flags.iter().copied());
-            let c = config(&parse(&argv)).unwrap();
-            let e = c.validate().unwrap_err().to_string();
-            assert!(e.contains(needle), "{flags:?}: {e}");
+            let e = config(&parse(&argv)).unwrap_err();
+            assert_eq!(e.status, 2);
+            assert!(e.message.contains(needle), "{flags:?}: {}", e.message);
+            // The flag that set it leads the message.
+            assert!(e.message.starts_with(flags[0]), "{flags:?}: {}", e.message);
         }
     }
 

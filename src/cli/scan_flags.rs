@@ -12,44 +12,44 @@ use crate::engine::files::import::{
 };
 
 use super::CliError;
+use super::values::Keywords;
 
-/// How to read a raw scan's pose file and profiles (help text as
-/// `spherecal import` shows it; `spherecal measure` words some of it for
-/// its own use with `mut_arg`).
+/// How to read a raw scan's pose file and profiles (one help text for
+/// both commands).
 #[derive(Debug, Args)]
 pub struct ScanFlags {
-    /// Force the pose file's layout: table, json, fanuc-ls, rapid, krl or urscript (default: detected from the content).
-    #[arg(long, value_parser = parse_pose_format)]
+    /// Force the pose file's layout [default: detected from the content]
+    #[arg(long, value_parser = pose_format_parser())]
     pub pose_format: Option<PoseFormat>,
-    /// How a pose table or JSON list writes a pose: ABB (x y z q1..q4), KUKA (x y z A B C), FANUC (x y z W P R), UR (x y z m, rotation vector) or matrix (16 numbers row-major). A robot program's language fixes its own.
-    #[arg(long, value_parser = parse_convention)]
+    /// How a pose table or JSON list writes a pose (a robot program's language fixes its own).
+    #[arg(long, value_parser = convention_parser())]
     pub pose_convention: Option<FlangeConvention>,
-    /// The pose columns of a CSV pose log, in the convention's order (default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44).
+    /// The pose columns of a pose table, in the convention's order [default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44]
     #[arg(long, value_delimiter = ',')]
     pub pose_columns: Vec<String>,
     /// Column of the pose id in a single profile file.
     #[arg(long, default_value = "pose")]
     pub pose_column: String,
-    /// The tip link of a URDF robot (default: the chain's only end link), e.g. tool0.
+    /// The tip link of a URDF robot, e.g. tool0 [default: the chain's only end link]
     #[arg(long)]
     pub urdf_tip: Option<String>,
-    /// The convention of a DH table robot: standard or modified.
-    #[arg(long, value_parser = super::parse_dh)]
+    /// The convention of a DH table robot.
+    #[arg(long, value_parser = super::dh_parser())]
     pub dh: Option<DhConvention>,
     /// Axis map from the sensor's axes to spherecal's (laser plane x = 0): `auto` (the constant coordinate is the plane's normal) or e.g. `-y,x,z` (spherecal x = -y, y = x, z = z). A mirroring map is refused.
     #[arg(long, default_value = "auto", allow_hyphen_values = true)]
     pub axes: String,
-    /// The sensor's no-return value in the profiles (file units), dropped like NaN.
+    /// The sensor's no-return value in the profiles (file units): such points are dropped and counted, as NaN ones are.
     #[arg(long, allow_hyphen_values = true)]
     pub no_return: Option<f64>,
-    /// Key of the point list in OpenCV YAML/JSON profiles (default: scan_line, profile, points, data, or the only list).
+    /// Key of the point list in OpenCV YAML/JSON profiles [default: scan_line, profile, points, data, or the only list]
     #[arg(long)]
     pub profile_key: Option<String>,
-    /// Unit of the joint columns: deg or rad.
-    #[arg(long, default_value = "deg", value_parser = parse_angle_unit)]
+    /// Unit of the joint columns.
+    #[arg(long, default_value = "deg", value_parser = Keywords::plain(["deg", "rad"], AngleUnit::parse))]
     pub joint_unit: AngleUnit,
-    /// Unit of the profile coordinates: mm, um or m.
-    #[arg(long, default_value = "mm", value_parser = parse_length_unit)]
+    /// Unit of the profile coordinates.
+    #[arg(long, default_value = "mm", value_parser = Keywords::plain(["mm", "um", "m"], LengthUnit::parse))]
     pub profile_unit: LengthUnit,
 }
 
@@ -88,27 +88,25 @@ impl ScanFlags {
     }
 }
 
-/// `--pose-format`.
-pub(super) fn parse_pose_format(s: &str) -> Result<PoseFormat, String> {
-    PoseFormat::parse(s).ok_or_else(|| {
-        format!("unknown pose format `{s}`, expected table, json, fanuc-ls, rapid, krl or urscript")
-    })
+/// `--pose-format`: the engine's layouts.
+pub(super) fn pose_format_parser() -> Keywords<PoseFormat> {
+    Keywords::new(
+        PoseFormat::ALL
+            .iter()
+            .map(|f| (f.key(), Some(f.describe())))
+            .collect(),
+        PoseFormat::parse,
+    )
 }
 
-/// `--joint-unit`.
-fn parse_angle_unit(s: &str) -> Result<AngleUnit, String> {
-    AngleUnit::parse(s).ok_or_else(|| format!("unknown joint unit `{s}`, expected `deg` or `rad`"))
-}
-
-/// `--profile-unit`.
-fn parse_length_unit(s: &str) -> Result<LengthUnit, String> {
-    LengthUnit::parse(s)
-        .ok_or_else(|| format!("unknown profile unit `{s}`, expected `mm`, `um` or `m`"))
-}
-
-/// `--pose-convention` (and the import's `--flange-poses`).
-pub(super) fn parse_convention(s: &str) -> Result<FlangeConvention, String> {
-    FlangeConvention::parse(s).ok_or_else(|| {
-        format!("unknown pose convention `{s}`, expected ABB, KUKA, FANUC, UR or matrix")
-    })
+/// `--pose-convention` (and the import's `--flange-poses`): the engine's
+/// conventions, each with what its values are.
+pub(super) fn convention_parser() -> Keywords<FlangeConvention> {
+    Keywords::new(
+        FlangeConvention::ALL
+            .iter()
+            .map(|c| (c.key(), Some(c.describe())))
+            .collect(),
+        FlangeConvention::parse,
+    )
 }

@@ -11,14 +11,19 @@ use std::time::Instant;
 
 use clap::ValueEnum;
 
-use super::CliError;
+use super::values::{Keywords, Range, count, number};
+use super::{CliError, QUIET_HELP};
 use crate::engine::base::cell::sensor;
 use crate::engine::base::robot::{self, RobotChoice};
 use crate::engine::base::session::{Session, Use};
 use crate::engine::files::format;
 use crate::engine::tools::plan;
+use crate::engine::tools::simulate::config::{
+    MAX_GROUP_POSES, MAX_JOINT_NOISE_DEG, MAX_SENSOR_NOISE_MM, MAX_STATIONS, MAX_TRACKER_NOISE_MM,
+};
 use crate::engine::tools::simulate::{
     self, ErrorModel, InitialHandEye, PartKind, PlanExecution, ScanConfig, SideChoice, SimConfig,
+    SimError,
 };
 
 /// Robot preset (`--robot`).
@@ -91,19 +96,19 @@ pub struct SimulateArgs {
     /// Where to write the session file (FORMAT.md `spherecal-session`); with --scan, the scan's truth.
     #[arg(long, short)]
     pub out: PathBuf,
-    /// Print nothing but errors.
-    #[arg(long, short)]
+    /// `-q`: [`QUIET_HELP`](super::QUIET_HELP).
+    #[arg(long, short, help = QUIET_HELP)]
     pub quiet: bool,
     /// The sensor's measuring range to write as `sensor.range`: `Y0,Y1,Z0,Z1` in mm (laser plane, sensor frame), e.g. `-40,40,-40,40`; ml then predicts the error over it.
-    #[arg(long, allow_hyphen_values = true, value_parser = super::parse_range)]
+    #[arg(long, value_name = "Y0,Y1,Z0,Z1", allow_hyphen_values = true, value_parser = super::parse_range)]
     pub range: Option<crate::engine::base::session::SensorRange>,
     /// Spread the sphere over --range: identify and validate measurements
     /// see the sphere centre anywhere in the range (uniform along the line
     /// and in depth) instead of the paper's ±2, ±3 mm spot.
     #[arg(long, requires = "range", conflicts_with = "plan")]
     pub spread: bool,
-    /// Where to write the truth file (default: the session path with
-    /// `.json` replaced by `.truth.json`).
+    /// Where to write the truth file [default: the session path with
+    /// `.json` replaced by `.truth.json`]
     #[arg(long)]
     pub truth: Option<PathBuf>,
     /// Seed of every random choice; the same arguments give byte-identical files.
@@ -118,23 +123,23 @@ pub struct SimulateArgs {
     /// Multiplies the kinematic errors (table1 and random).
     #[arg(long, default_value_t = 1.0)]
     pub error_scale: f64,
-    /// Number of identify stations (P1..), 6 poses each by default.
-    #[arg(long, default_value_t = 9)]
+    /// Number of identify stations (P1..), --poses measurements each.
+    #[arg(long, default_value_t = SimConfig::default().n_identify, value_parser = count(1, MAX_STATIONS))]
     pub identify_stations: usize,
     /// Number of validate stations (V1..); consecutive ones get a reference distance.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = SimConfig::default().n_validate, value_parser = count(0, MAX_STATIONS))]
     pub validate_stations: usize,
     /// Measurements per identify or validate station.
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, default_value_t = SimConfig::default().poses_per_station, value_parser = count(2, MAX_GROUP_POSES))]
     pub poses: usize,
-    /// σ of the joint reading noise, degrees.
-    #[arg(long, default_value_t = 0.003)]
+    /// σ of the joint reading noise, deg.
+    #[arg(long, value_name = "DEG", default_value_t = SimConfig::default().joint_noise, value_parser = number(Range::non_negative("deg").at_most(MAX_JOINT_NOISE_DEG)))]
     pub joint_noise: f64,
     /// σ of the stripe point noise on each coordinate, mm.
-    #[arg(long, default_value_t = 0.02)]
+    #[arg(long, value_name = "MM", default_value_t = SimConfig::default().stripe_noise, value_parser = number(Range::non_negative("mm").at_most(MAX_SENSOR_NOISE_MM)))]
     pub stripe_noise: f64,
-    /// Fraction (0..1) of stripe points made outliers, displaced 0.3-3 mm.
-    #[arg(long, default_value_t = 0.0)]
+    /// Fraction (0 to 1) of stripe points made outliers, displaced 0.3-3 mm.
+    #[arg(long, default_value_t = SimConfig::default().outlier_fraction, value_parser = number(Range::fraction()))]
     pub outliers: f64,
     /// Side of the laser plane the sphere centres lie on.
     #[arg(long, value_enum, default_value_t = SideArg::Mixed)]
@@ -143,28 +148,27 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub centres: bool,
     /// σ of the centre noise on each coordinate with --centres, mm.
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, value_name = "MM", default_value_t = SimConfig::default().centre_noise, value_parser = number(Range::non_negative("mm").at_most(MAX_SENSOR_NOISE_MM)))]
     pub centre_noise: f64,
     /// σ of the laser-tracker reference distances, mm.
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, value_name = "MM", default_value_t = SimConfig::default().tracker_noise, value_parser = number(Range::non_negative("mm").at_most(MAX_TRACKER_NOISE_MM)))]
     pub tracker_noise: f64,
-    /// Session name (default: "simulated <robot>, seed <seed>").
+    /// Session name [default: `simulated <robot>, seed <seed>`]
     #[arg(long)]
     pub name: Option<String>,
-    /// Write the paper's initial hand-eye into the session (default: none,
-    /// the engine computes it from the translation and rotation measurements).
+    /// Write the paper's initial hand-eye into the session; without it the session has none and the engine computes it from the translation and rotation measurements.
     #[arg(long)]
     pub with_hand_eye: bool,
     /// Sphere diameter, mm.
-    #[arg(long, default_value_t = 38.1)]
+    #[arg(long, value_name = "MM", default_value_t = SimConfig::default().diameter, value_parser = number(Range::positive("mm").at_most(crate::engine::base::limits::SPHERE_DIAMETER_MM)))]
     pub diameter: f64,
     /// Spacing of the stripe points along the arc, mm (0.5: ~57 points a stripe; 0.1: ~280, as the demo session).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, value_name = "MM", default_value_t = SimConfig::default().point_spacing, value_parser = number(Range::positive("mm")))]
     pub point_spacing: f64,
     /// Simulate the poses of a plan CSV (`spherecal plan --csv`) on the --robot preset with --errors, instead of generating poses: the robot goes to the plan's joints, the sphere stands where it then sees the planned centres on average.
     #[arg(long)]
     pub plan: Option<PathBuf>,
-    /// With --plan: the true hand-eye, a JSON 4x4 (rows, mm) or a session/result file's `hand_eye` (default: the paper's calibrated hand-eye, the paper's guess error applied to its initial one).
+    /// With --plan: the true hand-eye, a JSON 4x4 (rows, mm) or a session/result file's `hand_eye` [default: the paper's calibrated hand-eye, the paper's guess error applied to its initial one]
     #[arg(long, requires = "plan")]
     pub hand_eye: Option<PathBuf>,
     /// With --plan: touch every pose up as when teaching (the smallest joint change that puts the sphere at the planned sensor-frame centre on the true robot) instead of running the plan's joints as written.
@@ -173,17 +177,42 @@ pub struct SimulateArgs {
     /// Also write what `spherecal import` reads: DIR/joints.csv (joint log with the nominal ABB flange pose), DIR/profiles/<id>.csv (y,z mm) and DIR/references.csv (from,to,distance mm).
     #[arg(long)]
     pub csv_out: Option<PathBuf>,
-    /// Simulate a raw scan of a part instead of a session, with the cell of the same seed, robot and errors: `plane`, `spheres` (three spheres of --diameter: a sphere artefact) or `steps` (a stepped block on a table). Writes the joint log and profiles (`nan,nan` where a ray meets nothing) into --csv-out and the scan's truth (`spherecal-scan-truth`: the part in the base frame, the true robot, hand-eye and actual joints) to --out.
-    #[arg(long, value_parser = parse_part, requires = "csv_out", conflicts_with_all = ["plan", "centres", "spread"])]
+    /// Simulate a raw scan of this part instead of a session, with the cell of the same seed, robot and errors. Writes the joint log and profiles (`nan,nan` where a ray meets nothing) into --csv-out and the scan's truth (`spherecal-scan-truth`: the part in the base frame, the true robot, hand-eye and actual joints) to --out.
+    #[arg(long, value_parser = Keywords::new(vec![("plane", Some("A plane")), ("spheres", Some("Three spheres of --diameter: a sphere artefact")), ("steps", Some("A stepped block on a table"))], PartKind::parse), requires = "csv_out", conflicts_with_all = ["plan", "centres", "spread"])]
     pub scan: Option<PartKind>,
-    /// With --scan: poses along the path (per sphere for `spheres`; default 40).
-    #[arg(long, requires = "scan")]
-    pub scan_poses: Option<usize>,
+    /// With --scan: poses along the path (per sphere for `spheres`).
+    #[arg(long, requires = "scan", default_value_t = ScanConfig::default().poses, value_parser = count(1, MAX_SCAN_POSES))]
+    pub scan_poses: usize,
 }
 
-fn parse_part(s: &str) -> Result<PartKind, String> {
-    PartKind::parse(s)
-        .ok_or_else(|| format!("unknown part `{s}`, expected plane, spheres or steps"))
+/// Most poses of a simulated scan (per sphere for `spheres`): a scan of
+/// hundreds of thousands of profiles is no longer a test input.
+pub const MAX_SCAN_POSES: usize = 100_000;
+
+/// The engine's names of the settings in a simulation error, and the
+/// flags that set them.
+const FLAG_NAMES: [(&str, &str); 13] = [
+    (
+        "n_identify + n_validate",
+        "--identify-stations + --validate-stations",
+    ),
+    ("error_scale", "--error-scale"),
+    ("joint_noise", "--joint-noise"),
+    ("stripe_noise", "--stripe-noise"),
+    ("outlier_fraction", "--outliers"),
+    ("point_spacing", "--point-spacing"),
+    ("centre_noise", "--centre-noise"),
+    ("tracker_noise", "--tracker-noise"),
+    ("poses_per_station", "--poses"),
+    ("pose_only", "--pose-only"),
+    ("range z", "--range Z1"),
+    ("view_z", "the simulated camera's distance"),
+    ("arc_half_angle", "the stripe's half-angle"),
+];
+
+/// A simulation error, the settings named by their flags.
+fn sim_error(e: &SimError) -> CliError {
+    CliError::input(super::name_flags(&e.to_string(), &FLAG_NAMES))
 }
 
 impl SimulateArgs {
@@ -255,11 +284,10 @@ fn run_scan(
     let defaults = ScanConfig::default();
     let scan = ScanConfig {
         part,
-        poses: args.scan_poses.unwrap_or(defaults.poses),
+        poses: args.scan_poses,
         range: args.range.unwrap_or(defaults.range),
     };
-    let sim = simulate::simulate_scan(&args.to_config(), &scan)
-        .map_err(|e| CliError::input(e.to_string()))?;
+    let sim = simulate::simulate_scan(&args.to_config(), &scan).map_err(|e| sim_error(&e))?;
     let truth = serde_json::to_string_pretty(&sim.truth)
         .map_err(|e| CliError::internal(format!("the scan truth: {e}")))?;
     let truth = format!("{truth}\n");
@@ -345,11 +373,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     };
     super::check_outputs(&outputs, folders)?;
     let config = args.to_config();
-    config
-        .validate()
-        .map_err(|e| CliError::input(e.to_string()))?;
+    config.validate().map_err(|e| sim_error(&e))?;
     let (mut session, truth) = match &args.plan {
-        None => simulate::simulate(&config).map_err(|e| CliError::input(e.to_string()))?,
+        None => simulate::simulate(&config).map_err(|e| sim_error(&e))?,
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|e| {
                 CliError::input(format!("reading failed ({}): {e}", path.display()))
@@ -360,7 +386,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 .map(|p| p.robot)
                 .ok_or_else(|| CliError::input(format!("unknown robot {}", config.robot.key())))?;
             let hand_eye = match &args.hand_eye {
-                Some(he) => plan::read_hand_eye(he).map_err(|e| CliError::input(e.to_string()))?,
+                Some(he) => super::hand_eye_file(he)?,
                 None => sensor::paper_hand_eye(),
             };
             let execution = if args.touch_up {
