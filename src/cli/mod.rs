@@ -879,6 +879,35 @@ mod tests {
         }
     }
 
+    /// The defaults `--help` shows for the ml method are the engine's.
+    #[test]
+    fn ml_defaults_are_the_engines() {
+        let args: CalibrateArgs = parse_flags(&["calibrate", "s.json", "-o", "r.json"]);
+        assert_eq!(args.ml.options(), MlOptions::default());
+        assert_eq!(
+            args.svd_tolerance,
+            crate::engine::calibrate::solve::paper::DEFAULT_SVD_TOLERANCE
+        );
+        assert_eq!(args.method, Method::Ml);
+        let args: CalibrateArgs = parse_flags(&[
+            "calibrate",
+            "s.json",
+            "-o",
+            "r.json",
+            "--rank-tolerance",
+            "1e-9",
+            "--loss",
+            "cauchy",
+            "--loss-scale",
+            "2.5",
+        ]);
+        let o = args.ml.options();
+        assert_eq!(
+            (o.rank_tolerance, o.loss, o.loss_scale),
+            (1e-9, Loss::Cauchy, 2.5)
+        );
+    }
+
     /// Issue 31: `1e308` was printed as 309 digits.
     #[test]
     fn long_numbers_are_shown_in_scientific_notation() {
