@@ -183,6 +183,9 @@ pub struct SimulateArgs {
     /// With --scan: poses along the path (per sphere for `spheres`).
     #[arg(long, requires = "scan", default_value_t = ScanConfig::default().poses, value_parser = count(1, MAX_SCAN_POSES))]
     pub scan_poses: usize,
+    /// A pose-only session: every measurement reports its flange pose (the true flange position plus Gaussian error of this σ, mm, each base-frame coordinate) instead of joints, and the session has no robot (as a cell whose controller reports poses).
+    #[arg(long, value_name = "MM", conflicts_with_all = ["plan", "scan", "csv_out"], value_parser = number(Range::non_negative("mm").at_most(MAX_SENSOR_NOISE_MM)))]
+    pub pose_only: Option<f64>,
 }
 
 /// Most poses of a simulated scan (per sphere for `spheres`): a scan of
@@ -199,6 +202,7 @@ const FLAG_NAMES: [(&str, &str); 13] = [
     ("error_scale", "--error-scale"),
     ("joint_noise", "--joint-noise"),
     ("stripe_noise", "--stripe-noise"),
+    ("pose_only", "--pose-only"),
     ("outlier_fraction", "--outliers"),
     ("point_spacing", "--point-spacing"),
     ("centre_noise", "--centre-noise"),
@@ -244,6 +248,7 @@ impl SimulateArgs {
             point_spacing: self.point_spacing,
             range: self.range,
             spread: self.spread,
+            pose_only: self.pose_only,
             ..SimConfig::default()
         }
     }
