@@ -208,7 +208,6 @@ const FLAG_NAMES: [(&str, &str); 13] = [
     ("centre_noise", "--centre-noise"),
     ("tracker_noise", "--tracker-noise"),
     ("poses_per_station", "--poses"),
-    ("pose_only", "--pose-only"),
     ("range z", "--range Z1"),
     ("view_z", "the simulated camera's distance"),
     ("arc_half_angle", "the stripe's half-angle"),
