@@ -7,7 +7,9 @@
 //! (translation first, mm; then rotation, rad): a point `X` moves by
 //! `Δ + δ × X` (paper eq. 13-16).
 
-use nalgebra::{Isometry3, Matrix3, Matrix4, Rotation3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{
+    Isometry3, Matrix3, Matrix3x6, Matrix4, Rotation3, Translation3, UnitQuaternion, Vector3,
+};
 
 /// Tolerance on `RᵀR = I` and `det R = 1` when a 4×4 matrix is read from a
 /// file (FORMAT.md: "checked to 1e-6 on load"). Files are written with ~12
@@ -83,6 +85,18 @@ pub fn rows_from_isometry(iso: &Isometry3<f64>) -> [[f64; 4]; 4] {
 #[must_use]
 pub fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+/// `[I | −[x]×]` (3 × 6): the first-order motion `Δ + δ × x` of the
+/// point `x` under a small twist `[Δ; δ]` (module doc): the paper's `Q_i`
+/// (eq. 16), and the rows of the rigid motion an aligned σ takes out.
+#[must_use]
+pub fn twist_rows(x: &Vector3<f64>) -> Matrix3x6<f64> {
+    let mut q = Matrix3x6::zeros();
+    q.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&Matrix3::identity());
+    q.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew(x)));
+    q
 }
 
 /// The rigid motion `exp(twist)`: rotation by the rotation vector

@@ -16,7 +16,7 @@
 
 use nalgebra::{DMatrix, Isometry3, Matrix3, Point3, Vector3};
 
-use crate::engine::base::geometry::{isometry_from_twist, skew};
+use crate::engine::base::geometry::{isometry_from_twist, skew, twist_rows};
 use crate::engine::base::robot::{PARAM_IS_ANGLE, PARAMS_PER_JOINT, Robot};
 use crate::engine::calibrate::handeye::Sighting;
 
@@ -129,10 +129,19 @@ impl PoseSensitivity {
     /// The pose of sighting `s` under `est`.
     #[must_use]
     pub fn new(est: &Estimate, s: &Sighting) -> Self {
-        let (base_from_flange, jac) = match &s.flange {
+        Self::at_pose(est, &s.joints, s.flange.as_ref())
+    }
+
+    /// The pose of the joint readings `joints` (deg) under `est`, or the
+    /// given flange pose `flange` (`base_from_flange`, mm; the kinematic
+    /// parameters then have no effect): a pose without a sighting, as a
+    /// compensated target or a measured profile has.
+    #[must_use]
+    pub fn at_pose(est: &Estimate, joints: &[f64], flange: Option<&Isometry3<f64>>) -> Self {
+        let (base_from_flange, jac) = match flange {
             // A given flange pose does not depend on the kinematic parameters.
             Some(pose) => (*pose, nalgebra::Matrix6xX::zeros(est.robot.n_params())),
-            None => est.robot.flange_jacobian(&s.joints),
+            None => est.robot.flange_jacobian(joints),
         };
         Self {
             base_from_flange,
@@ -153,11 +162,7 @@ impl PoseSensitivity {
         a.fixed_view_mut::<3, 3>(0, 3)
             .copy_from(&(-(r_bs * skew(x_s))));
         // Kinematic block: Q_i · J_i = [I | −[X_b]×] · J_i   (eq. 15-16)
-        let mut q = nalgebra::Matrix3x6::zeros();
-        q.fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&Matrix3::identity());
-        q.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew(&x_b)));
-        let qj = q * &self.jac;
+        let qj = twist_rows(&x_b) * &self.jac;
         a.view_mut((0, 6), (3, n - 6)).copy_from(&qj);
         (x_b, a)
     }

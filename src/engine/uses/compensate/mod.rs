@@ -70,11 +70,12 @@ use nalgebra::{Isometry3, Vector3};
 
 use self::arms::{Arms, BranchRule};
 use self::region::Region;
-use self::uncertainty::{Covariance, Predictor};
+use self::uncertainty::Predictor;
 use crate::engine::base::robot::Robot;
 use crate::engine::base::robot::ik::DOF;
 use crate::engine::base::session::{Session, Use};
 use crate::engine::calibrate::solve::Control;
+use crate::engine::calibrate::solve::ml::covariance::ParameterCovariance;
 use crate::engine::files::format::ResultFile;
 use crate::engine::files::program::PoseFile;
 
@@ -408,7 +409,11 @@ impl Model {
             Tcp::Flange => Isometry3::identity(),
             Tcp::Tool(t) => *t,
         };
-        let predictor = Covariance::of(&result.solver, DOF).map(|c| {
+        // A malformed covariance is as none: no σ, said below.
+        let covariance = ParameterCovariance::read(&result.solver, DOF)
+            .ok()
+            .flatten();
+        let predictor = covariance.as_ref().map(|c| {
             Predictor::new(
                 c,
                 calibrated.clone(),

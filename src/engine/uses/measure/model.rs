@@ -5,14 +5,13 @@
 //! the same joint count, poses within the joint range the calibration
 //! saw.
 
-use nalgebra::{DMatrix, Isometry3};
+use nalgebra::Isometry3;
 
 use super::MeasureError;
 use super::scan::{Placement, Scan};
-use crate::engine::base::robot::{PARAM_IS_ANGLE, PARAM_NAMES, PARAMS_PER_JOINT, Robot};
+use crate::engine::base::robot::{PARAM_NAMES, Robot};
 use crate::engine::base::session::{Session, Use};
-use crate::engine::calibrate::solve::SolverReport;
-use crate::engine::calibrate::solve::estimate::HAND_EYE_LABELS;
+pub use crate::engine::calibrate::solve::ml::covariance::ParameterCovariance;
 use crate::engine::files::format::ResultFile;
 
 /// The nominal model of the scan and of the result agree to this (mm and
@@ -94,81 +93,17 @@ pub fn nominal_robot(result: &ResultFile) -> Option<Robot> {
     }
 }
 
-/// The covariance of the calibrated parameters as the result gives it
-/// (`ml`'s `solver.covariance`), on the unknowns of
-/// [`crate::engine::calibrate::solve::estimate`]'s update vector.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ParameterCovariance {
-    /// Index of each row in the update vector `ΔY` (hand-eye twist first,
-    /// then the `5·n` MDH parameters).
-    pub unknowns: Vec<usize>,
-    /// Raw units (mm or rad) per file unit (mm or deg) of each row.
-    pub raw_per_file_unit: Vec<f64>,
-    /// The covariance, file units (`mm`, `deg`; entry `(i, j)` in
-    /// `unit_i · unit_j`).
-    pub matrix: DMatrix<f64>,
-}
-
-/// The index in `ΔY` of a covariance label (`he_x` … `he_rz`, `alpha1` …
-/// `d<n>`) for a robot of `dof` joints, and whether it is an angle.
-fn unknown_of_label(label: &str, dof: usize) -> Option<(usize, bool)> {
-    if let Some(k) = HAND_EYE_LABELS.iter().position(|l| *l == label) {
-        return Some((k, k >= 3));
-    }
-    PARAM_NAMES.iter().enumerate().find_map(|(p, name)| {
-        let joint: usize = label.strip_prefix(name)?.parse().ok()?;
-        (1..=dof)
-            .contains(&joint)
-            .then(|| (6 + (joint - 1) * PARAMS_PER_JOINT + p, PARAM_IS_ANGLE[p]))
-    })
-}
-
-/// The result's parameter covariance: `Ok(None)` when the result has none
-/// (the paper's method, or an `ml` run that stopped before its
-/// diagnostics).
+/// The result's parameter covariance ([`ParameterCovariance::read`] for
+/// the result's model): `Ok(None)` when the result has none (the paper's
+/// method, or an `ml` run that stopped before its diagnostics).
 ///
 /// # Errors
 /// [`MeasureError::Input`] when the block names a parameter the result's
 /// model does not have, or is not square, symmetric and finite.
 pub fn covariance_of(result: &ResultFile) -> Result<Option<ParameterCovariance>, MeasureError> {
-    let SolverReport::Ml(report) = &result.solver else {
-        return Ok(None);
-    };
-    let c = &report.covariance;
-    if c.labels.is_empty() {
-        return Ok(None);
-    }
-    let dof = result.robot.as_ref().map_or(0, Robot::dof);
-    let k = c.labels.len();
-    let mut unknowns = Vec::with_capacity(k);
-    let mut raw_per_file_unit = Vec::with_capacity(k);
-    for label in &c.labels {
-        let (u, angle) = unknown_of_label(label, dof).ok_or_else(|| {
-            MeasureError::Input(format!(
-                "solver.covariance names `{label}`, not a parameter of the result's model ({dof} joints)"
-            ))
-        })?;
-        unknowns.push(u);
-        raw_per_file_unit.push(if angle { 1.0_f64.to_radians() } else { 1.0 });
-    }
-    if c.matrix.len() != k || c.matrix.iter().any(|row| row.len() != k) {
-        return Err(MeasureError::Input(format!(
-            "solver.covariance is not {k} × {k} like its labels"
-        )));
-    }
-    let matrix = DMatrix::from_fn(k, k, |i, j| c.matrix[i][j]);
-    let scale = matrix.amax().max(f64::MIN_POSITIVE);
-    let asymmetric = (&matrix - matrix.transpose()).amax() > 1e-9 * scale;
-    if matrix.iter().any(|v| !v.is_finite()) || asymmetric {
-        return Err(MeasureError::Input(
-            "solver.covariance is not a finite symmetric matrix".into(),
-        ));
-    }
-    Ok(Some(ParameterCovariance {
-        unknowns,
-        raw_per_file_unit,
-        matrix,
-    }))
+    let joints = result.robot.as_ref().map_or(0, Robot::dof);
+    ParameterCovariance::read(&result.solver, joints)
+        .map_err(|e| MeasureError::Input(e.to_string()))
 }
 
 /// Refuses a scan that does not belong to the result: joint readings
@@ -343,22 +278,5 @@ impl JointRange {
             }
         }
         out
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn labels_map_to_the_update_vector() {
-        assert_eq!(unknown_of_label("he_x", 6), Some((0, false)));
-        assert_eq!(unknown_of_label("he_rz", 6), Some((5, true)));
-        assert_eq!(unknown_of_label("alpha1", 6), Some((6, true)));
-        assert_eq!(unknown_of_label("a1", 6), Some((7, false)));
-        assert_eq!(unknown_of_label("d6", 6), Some((6 + 29, false)));
-        assert_eq!(unknown_of_label("theta3", 6), Some((6 + 10 + 3, true)));
-        assert_eq!(unknown_of_label("d7", 6), None);
-        assert_eq!(unknown_of_label("x1", 6), None);
     }
 }

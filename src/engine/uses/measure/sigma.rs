@@ -14,7 +14,9 @@
 //! best rigid motion of the whole cloud is taken out: with `Rᵢ = [I |
 //! −[Xᵢ − c]×]` a point's motion under a small rigid motion `(τ, ω)` about
 //! the centroid `c`, fitted to all points by least squares, `M =
-//! (Σ RᵢᵀRᵢ)⁻¹ Σ RᵢᵀGᵢ` and `Hᵢ = Gᵢ − Rᵢ·M`. The set is **every point of
+//! (Σ RᵢᵀRᵢ)⁺ Σ RᵢᵀGᵢ` and `Hᵢ = Gᵢ − Rᵢ·M` (the aligned σ of
+//! [`covariance`](crate::engine::calibrate::solve::ml::covariance), whose
+//! rows and fit this uses). The set is **every point of
 //! the measured cloud** (every pose, every point, each weighted alike, as
 //! a user aligns a measured part once). `Rᵢ` is affine in `(y, z)` as
 //! well, so the sums need only the moments `Σ1, Σy, Σz, Σy², Σyz, Σz²`
@@ -22,17 +24,19 @@
 //!
 //! With `C = L·Lᵀ` and `Kₐ = Hₐ·L`, `σ²(y, z) = tr(H·C·Hᵀ)` is a quadratic
 //! form in `(1, y, z)` whose six coefficients `⟨Kₐ, K_b⟩` are computed
-//! once per pose ([`SigmaForm`]).
+//! once per pose ([`SigmaForm`]): the same σ as the point form, evaluated
+//! in O(1) a point (a test checks them against each other).
 
 use nalgebra::{DMatrix, Isometry3, Matrix3, Matrix3x6, Matrix6, SymmetricEigen, Vector3};
 
-use super::model::ParameterCovariance;
 use super::scan::Placement;
-use crate::engine::base::geometry::skew;
+use crate::engine::base::geometry::twist_rows;
 use crate::engine::base::numeric::MAX_DECOMPOSITION_SWEEPS;
-use crate::engine::calibrate::handeye::Sighting;
 use crate::engine::calibrate::solve::Control;
 use crate::engine::calibrate::solve::estimate::{Estimate, PoseSensitivity};
+use crate::engine::calibrate::solve::ml::covariance::{
+    ParameterCovariance, rigid_fit, rotation_rows,
+};
 
 /// The variance of a point's position at one pose as a quadratic form in
 /// its profile coordinates: `σ²(y, z) = c₀ + c₁·y + c₂·z + c₃·y² +
@@ -100,17 +104,10 @@ fn pose_rows(
     cov: &ParameterCovariance,
     placement: &Placement,
 ) -> [DMatrix<f64>; 3] {
-    let (joints, flange) = match placement {
-        Placement::Joints(q) => (q.clone(), None),
-        Placement::Flange(pose) => (Vec::new(), Some(*pose)),
+    let pose = match placement {
+        Placement::Joints(q) => PoseSensitivity::at_pose(est, q, None),
+        Placement::Flange(flange) => PoseSensitivity::at_pose(est, &[], Some(flange)),
     };
-    let sighting = Sighting {
-        id: String::new(),
-        joints,
-        flange,
-        centre_in_sensor: Vector3::zeros(),
-    };
-    let pose = PoseSensitivity::new(est, &sighting);
     let (_, a0) = pose.at(est, &Vector3::zeros());
     let (_, ay) = pose.at(est, &Vector3::y());
     let (_, az) = pose.at(est, &Vector3::z());
@@ -129,22 +126,17 @@ fn pose_rows(
     ]
 }
 
-/// `R₀, R₁, R₂` of a pose about the centroid `c` (module doc).
-fn rigid_rows(base_from_sensor: &Isometry3<f64>, c: &Vector3<f64>) -> [Matrix3x6<f64>; 3] {
+/// `R₀, R₁, R₂` of a pose about the centroid `c` (module doc): the
+/// rigid rows of the sensor origin, and the rotation rows of the offsets
+/// along the sensor's `y` and `z` axes.
+fn pose_rigid_rows(base_from_sensor: &Isometry3<f64>, c: &Vector3<f64>) -> [Matrix3x6<f64>; 3] {
     let r = base_from_sensor.rotation.to_rotation_matrix().into_inner();
     let t = base_from_sensor.translation.vector;
-    let mut r0 = Matrix3x6::zeros();
-    r0.fixed_view_mut::<3, 3>(0, 0)
-        .copy_from(&Matrix3::identity());
-    r0.fixed_view_mut::<3, 3>(0, 3)
-        .copy_from(&(-skew(&(t - c))));
-    let mut r1 = Matrix3x6::zeros();
-    r1.fixed_view_mut::<3, 3>(0, 3)
-        .copy_from(&(-skew(&r.column(1).into_owned())));
-    let mut r2 = Matrix3x6::zeros();
-    r2.fixed_view_mut::<3, 3>(0, 3)
-        .copy_from(&(-skew(&r.column(2).into_owned())));
-    [r0, r1, r2]
+    [
+        twist_rows(&(t - c)),
+        rotation_rows(&r.column(1).into_owned()),
+        rotation_rows(&r.column(2).into_owned()),
+    ]
 }
 
 /// A square root `L` of a symmetric positive semi-definite `C` (`C =
@@ -194,7 +186,7 @@ pub(super) fn sigma_forms(
     let mut rows = Vec::with_capacity(poses.len());
     for (i, p) in poses.iter().enumerate() {
         let g = pose_rows(est, cov, p.placement);
-        let r = rigid_rows(&p.base_from_sensor, &centroid);
+        let r = pose_rigid_rows(&p.base_from_sensor, &centroid);
         let m = &p.moments.0;
         for b in 0..3 {
             let mut w = nalgebra::Matrix6x3::zeros();
@@ -212,16 +204,12 @@ pub(super) fn sigma_forms(
     // A degenerate cloud (one line of points) leaves a rotation free: the
     // pseudo-inverse takes out what can be taken out.
     let rtr = DMatrix::from_fn(6, 6, |i, j| rtr[(i, j)]);
-    let pinv = rtr
-        .clone()
-        .pseudo_inverse(1e-12 * rtr.norm().max(1e-300))
-        .unwrap_or_else(|_| DMatrix::zeros(6, 6));
     let l = square_root(&cov.matrix)?;
-    let ml = pinv * rtg * &l;
+    let ml = rigid_fit(&rtr, rtg) * &l;
     // Pass 2: Kₐ = Gₐ·L − Rₐ·(M·L), and the six inner products.
     let mut forms = Vec::with_capacity(poses.len());
     for (i, (p, g)) in poses.iter().zip(&rows).enumerate() {
-        let r = rigid_rows(&p.base_from_sensor, &centroid);
+        let r = pose_rigid_rows(&p.base_from_sensor, &centroid);
         let kk: Vec<DMatrix<f64>> = (0..3)
             .map(|a| &g[a] * &l - DMatrix::from_fn(3, 6, |x, y| r[a][(x, y)]) * &ml)
             .collect();
@@ -245,7 +233,8 @@ pub(super) fn sigma_forms(
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
-    use crate::engine::base::geometry::isometry_from_twist;
+    use crate::engine::base::geometry::{isometry_from_twist, skew};
+    use crate::engine::calibrate::handeye::Sighting;
     use nalgebra::Point3;
 
     /// The O(1) form equals the direct `tr(H·C·Hᵀ)` of each point, with

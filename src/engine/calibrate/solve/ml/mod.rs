@@ -97,6 +97,7 @@
 //! the same blocks ([`held_out`](super::held_out)): the one figure a set
 //! of a single station has.
 
+pub mod covariance;
 mod diagnostics;
 pub mod identifiability;
 pub mod noise;

@@ -3,11 +3,11 @@
 //! frame, rotated, plus the joint noise carried through the kinematics), its
 //! whitening, and the Huber and Cauchy losses with their χ(3) scales.
 
-use nalgebra::{Matrix3, Matrix3x6, SymmetricEigen};
+use nalgebra::{Matrix3, SymmetricEigen};
 use serde::{Deserialize, Serialize};
 
 use super::MlOptions;
-use crate::engine::base::geometry::skew;
+use crate::engine::base::geometry::twist_rows;
 use crate::engine::calibrate::handeye::Sighting;
 use crate::engine::calibrate::solve::estimate::Estimate;
 use crate::engine::calibrate::solve::prepare::PreparedMeasurement;
@@ -175,11 +175,7 @@ pub fn base_covariance(
     let base_from_sensor = base_from_flange * est.flange_from_sensor;
     let x_b = (base_from_sensor * nalgebra::Point3::from(sighting.centre_in_sensor)).coords;
     let r: Matrix3<f64> = base_from_sensor.rotation.to_rotation_matrix().into_inner();
-    let mut q = Matrix3x6::zeros();
-    q.fixed_view_mut::<3, 3>(0, 0)
-        .copy_from(&Matrix3::identity());
-    q.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew(&x_b)));
-    let g = q * jq;
+    let g = twist_rows(&x_b) * jq;
     let sq = joint_sigma_deg.to_radians().powi(2);
     r * sensor_cov * r.transpose() + &g * g.transpose() * sq
 }

@@ -10,14 +10,16 @@
 //! its rms, mean, maximum and where, and the same at the mean sphere
 //! position. To first order the error of point `i` is `G_i·δθ`; the best
 //! rigid motion `R_i·(t, ω)`, `R_i = [I | −[p_i − c]×]`, is fitted to all
-//! of them by least squares and removed: `H_i = G_i − R_i·(RᵀR)⁻¹RᵀG`,
-//! `σ_i² = tr(H_i·C·H_iᵀ)`. The grid covers `sensor.range` when the
+//! of them by least squares and removed: `H_i = G_i − R_i·(RᵀR)⁺RᵀG`,
+//! `σ_i² = tr(H_i·C·H_iᵀ)` (the aligned σ of
+//! [`covariance`](super::covariance), its one home). The grid covers `sensor.range` when the
 //! session has one, else the region the sphere positions covered (and
 //! says so).
 
 use nalgebra::{DMatrix, Vector3};
 use serde::{Deserialize, Serialize};
 
+use super::covariance::{RigidFit, aligned_sigma};
 use super::problem::Problem;
 use crate::engine::base::session::{SensorRange, Session, Use};
 use crate::engine::calibrate::solve::Prepared;
@@ -112,18 +114,6 @@ fn point_rows(
     (rows, p)
 }
 
-/// `R_i = [I | −[p − c]×]`: a point's motion under a small rigid motion
-/// `(t, ω)` about `c`.
-fn rigid_rows(p: &Vector3<f64>, c: &Vector3<f64>) -> DMatrix<f64> {
-    let d = p - c;
-    let mut r = DMatrix::zeros(3, 6);
-    r.view_mut((0, 0), (3, 3))
-        .copy_from(&nalgebra::Matrix3::identity());
-    let skew = nalgebra::Matrix3::new(0.0, -d.z, d.y, d.z, 0.0, -d.x, -d.y, d.x, 0.0);
-    r.view_mut((0, 3), (3, 3)).copy_from(&(-skew));
-    r
-}
-
 /// The grid over a range at a set of poses, with the common rigid motion
 /// fitted: `H_i = G_i − R_i·M`, `M = (RᵀR)⁻¹RᵀG` (module doc). One home
 /// for the prediction of the result and the planner's criterion.
@@ -133,9 +123,8 @@ pub(crate) struct AlignedGrid {
     points: Vec<([f64; 2], DMatrix<f64>, Vector3<f64>)>,
     /// Poses per grid point.
     poses: usize,
-    centroid: Vector3<f64>,
-    /// The rigid-motion fit `M`, 6 × k.
-    m: DMatrix<f64>,
+    /// The rigid motion fitted to every point at every pose.
+    fit: RigidFit,
 }
 
 impl AlignedGrid {
@@ -154,40 +143,24 @@ impl AlignedGrid {
                 points.push(([y, z], g, p));
             }
         }
-        let k = estimated.len();
-        let centroid =
-            points.iter().map(|(_, _, p)| p).sum::<Vector3<f64>>() / points.len().max(1) as f64;
-        let mut rtr = DMatrix::zeros(6, 6);
-        let mut rtg = DMatrix::zeros(6, k);
-        for (_, g, p) in &points {
-            let r = rigid_rows(p, &centroid);
-            rtr += r.transpose() * &r;
-            rtg += r.transpose() * g;
-        }
-        // A degenerate set (every point on one line) leaves a rotation
-        // free: the pseudo-inverse takes out what can be taken out.
-        let pinv = rtr
-            .clone()
-            .pseudo_inverse(1e-12 * rtr.norm().max(1e-300))
-            .unwrap_or_else(|_| DMatrix::zeros(6, 6));
+        let fit = RigidFit::new(points.iter().map(|(_, g, p)| (p, g)), estimated.len());
         Self {
             points,
             poses: poses.len(),
-            centroid,
-            m: pinv * rtg,
+            fit,
         }
     }
 
     /// `H` of a point with sensitivity `g` at base position `p`.
     fn aligned(&self, g: &DMatrix<f64>, p: &Vector3<f64>) -> DMatrix<f64> {
-        g - rigid_rows(p, &self.centroid) * &self.m
+        self.fit.aligned(g, p)
     }
 
     /// `Q = Σ H_iᵀH_i / n` (k × k): `tr(Q·C)` is the mean square predicted
     /// error over the grid for a covariance `C` of the (scaled) estimated
     /// parameters: the planner's criterion.
     pub(crate) fn weight(&self) -> DMatrix<f64> {
-        let k = self.m.ncols();
+        let k = self.fit.columns();
         let mut q = DMatrix::zeros(k, k);
         for (_, g, p) in &self.points {
             let h = self.aligned(g, p);
@@ -195,11 +168,6 @@ impl AlignedGrid {
         }
         q / self.points.len().max(1) as f64
     }
-}
-
-/// `σ` (mm) of a point's aligned error `h` under covariance `cov`.
-fn sigma(h: &DMatrix<f64>, cov: &DMatrix<f64>) -> f64 {
-    (h * cov * h.transpose()).trace().max(0.0).sqrt()
 }
 
 /// The prediction (see the module doc); `None` without working poses.
@@ -266,7 +234,7 @@ pub(super) fn range_error(
     for chunk in grid.points.chunks(grid.poses.max(1)) {
         let mut point_sq = 0.0;
         for (yz, g, p) in chunk {
-            let sigma = sigma(&grid.aligned(g, p), cov);
+            let sigma = aligned_sigma(&grid.aligned(g, p), cov);
             sum_sq += sigma * sigma;
             point_sq += sigma * sigma;
             sum += sigma;
@@ -284,7 +252,7 @@ pub(super) fn range_error(
         .map(|s| {
             let centre = Vector3::new(0.0, mean.y, mean.z);
             let (g, p) = point_rows(est, s, &problem.estimated, &problem.scale, centre);
-            sigma(&grid.aligned(&g, &p), cov).powi(2)
+            aligned_sigma(&grid.aligned(&g, &p), cov).powi(2)
         })
         .sum();
     let nf = grid.points.len().max(1) as f64;
