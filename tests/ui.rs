@@ -12,6 +12,7 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
 use spherecal::app::forms::Tab;
+use spherecal::app::job::Slot;
 use spherecal::engine::calibrate::solve::{Options, calibrate};
 use spherecal::engine::files::format::parse_session;
 use spherecal::engine::tools::report::model::{self, ModelFormat};
@@ -242,7 +243,7 @@ fn cancel_stops_a_run() {
     h.get_by_label("Cancel").click();
     settle(&mut h);
     let state = h.state().state();
-    assert!(state.run.is_none());
+    assert!(state.jobs.get(&Slot::Run).is_none());
     assert!(state.result.is_none(), "a cancelled run shows no result");
     let status = state
         .status
@@ -803,21 +804,19 @@ fn a_plan_is_made_exported_simulated_and_calibrated() {
 
 /// The real data set in the repository (`data/robcalibrator-sphere`, see
 /// tests/realdata.rs); missing, the test fails.
-fn realdata() -> Option<std::path::PathBuf> {
+fn realdata() -> std::path::PathBuf {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/robcalibrator-sphere");
     assert!(
         dir.join("RobPoses.rob").is_file(),
         "the real data set is missing: {}",
         dir.display()
     );
-    Some(dir)
+    dir
 }
 
 #[test]
 fn the_wizard_imports_flange_poses_and_the_run_calibrates_the_hand_eye_only() {
-    let Some(dir) = realdata() else {
-        return;
-    };
+    let dir = realdata();
     let mut h = demo_app();
     h.get_by_label("Import").click();
     h.run();

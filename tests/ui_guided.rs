@@ -14,6 +14,7 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
 use spherecal::app::forms::Tab;
+use spherecal::app::job::Slot;
 
 mod ui_support;
 use ui_support::{demo_app, open_path, settle, small_plan, step_label};
@@ -166,13 +167,18 @@ fn cancel_in_the_last_phase_keeps_the_previous_result() {
     let mut reached = false;
     for _ in 0..20_000 {
         h.step();
-        let phase = h.state().state().run.as_ref().map(|r| r.phase.clone());
+        let phase = h
+            .state()
+            .state()
+            .jobs
+            .get(&Slot::Run)
+            .map(|r| r.phase.clone());
         if phase.is_some_and(|p| p.starts_with("leave-one-station-out")) {
             reached = true;
             break;
         }
         assert!(
-            h.state().state().run.is_some(),
+            h.state().state().jobs.get(&Slot::Run).is_some(),
             "the run ended before its last phase"
         );
         std::thread::sleep(Duration::from_millis(1));
@@ -193,7 +199,7 @@ fn cancel_in_the_last_phase_keeps_the_previous_result() {
         "stopped within a second"
     );
     let state = h.state().state();
-    assert!(state.run.is_none());
+    assert!(state.jobs.get(&Slot::Run).is_none());
     let shown = state
         .result
         .as_ref()

@@ -18,6 +18,7 @@ use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use spherecal::app::WorkbenchApp;
 use spherecal::app::forms::Tab;
 use spherecal::app::forms::import::{HandEyeChoice, ObservationKind};
+use spherecal::app::job::Slot;
 use spherecal::engine::base::geometry::{rigid_from_rows, roll_pitch_yaw_deg};
 use spherecal::engine::base::session::Observation;
 use spherecal::engine::files::import::{FlangeConvention, PoseFormat, PosePreview, SideChoice};
@@ -486,7 +487,7 @@ fn a_long_import_shows_its_progress_and_cancel_keeps_what_is_open() {
     h.step();
     h.step();
     assert!(
-        h.state().state().import_job.cancel.is_some(),
+        h.state().state().jobs.get(&Slot::Import).is_some(),
         "{} {:?}",
         ui_support::status(&h),
         h.state().state().import.outcome
@@ -507,7 +508,7 @@ fn a_long_import_shows_its_progress_and_cancel_keeps_what_is_open() {
     );
     h.get_by_label("Cancel import").click();
     h.step();
-    assert!(h.state().state().import_job.cancel.is_none());
+    assert!(h.state().state().jobs.get(&Slot::Import).is_none());
     assert!(
         ui_support::status(&h).contains("import cancelled"),
         "{}",

@@ -22,6 +22,7 @@ use spherecal::app::features::measure::{
 };
 use spherecal::app::forms::Tab;
 use spherecal::app::forms::measure::ScanChoice;
+use spherecal::app::job::Slot;
 use spherecal::app::state::measure::MeasureFailure;
 use spherecal::engine::base::session::Observation;
 use spherecal::engine::calibrate::solve::Method;
@@ -213,12 +214,15 @@ fn cancel_stops_the_job_and_keeps_the_previous_cloud() {
     let ctx = h.ctx.clone();
     h.state_mut()
         .command(&ctx, Command::Measure(MeasureCommand::Start));
-    assert!(h.state().state().measure.job.is_some(), "started");
+    assert!(
+        h.state().state().jobs.get(&Slot::Measure).is_some(),
+        "started"
+    );
     h.state_mut()
         .command(&ctx, Command::Measure(MeasureCommand::Cancel));
     settle(&mut h);
     let m = &h.state().state().measure;
-    assert!(m.job.is_none());
+    assert!(h.state().state().jobs.get(&Slot::Measure).is_none());
     let kept = m.shown.as_ref().expect("the previous cloud");
     assert!(Arc::ptr_eq(&kept.cloud, &first.cloud), "the same cloud");
     assert!(status(&h).contains("cancelled"), "{}", status(&h));

@@ -17,8 +17,9 @@ use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
 use spherecal::app::commands::{Command, PlanCommand, RunCommand, ViewCommand};
 use spherecal::app::features::run::calibrate_session;
+use spherecal::app::features::run::{RunFailure, RunStage};
 use spherecal::app::forms::Tab;
-use spherecal::app::jobs::{RunFailure, RunStage};
+use spherecal::app::job::Slot;
 use spherecal::app::state::PlanExport;
 use spherecal::engine::calibrate::solve::{Options, Phase};
 use spherecal::engine::tools::plan::Controller;
@@ -217,7 +218,13 @@ fn cancel_always_wins_and_the_previous_result_stays() {
         }
         // A frame drawn with the state as it is now.
         h.step();
-        let Some(phase) = h.state().state().run.as_ref().map(|r| r.phase.clone()) else {
+        let Some(phase) = h
+            .state()
+            .state()
+            .jobs
+            .get(&Slot::Run)
+            .map(|r| r.phase.clone())
+        else {
             continue;
         };
         // The phase by name over the run's progress bar.
@@ -229,7 +236,7 @@ fn cancel_always_wins_and_the_previous_result_stays() {
         h.step();
         let state = h.state().state();
         assert!(
-            state.run.is_none(),
+            state.jobs.get(&Slot::Run).is_none(),
             "{phase}: stopped in the frame of the click"
         );
         assert!(status(&h).contains("cancelled"), "{phase}: {}", status(&h));
@@ -262,7 +269,7 @@ fn a_result_that_arrives_after_cancel_is_dropped() {
     h.state_mut().forms_mut().solver.threshold = 0.01;
     h.get_by_label("▶ Run").click();
     h.step();
-    assert!(h.state().state().run.is_some());
+    assert!(h.state().state().jobs.get(&Slot::Run).is_some());
     std::thread::sleep(Duration::from_secs(2));
     command(&mut h, Command::Run(RunCommand::Cancel));
     settle(&mut h);
@@ -592,7 +599,7 @@ fn steps_go_stale_when_their_inputs_change() {
     // Run again: during the run Next writes nothing.
     h.get_by_label("Next: ▶ Run again").click();
     h.step();
-    assert!(h.state().state().run.is_some());
+    assert!(h.state().state().jobs.get(&Slot::Run).is_some());
     assert_eq!(
         h.query_all_by_label_contains("Next: Write the report")
             .count(),

@@ -5,14 +5,17 @@
 
 use std::path::PathBuf;
 
+use super::dialog::Purpose;
 use super::forms::Tab;
-use super::state::{DialogPurpose, ExportKind, PlanExport};
+use super::state::{ExportKind, PlanExport};
 
 /// A request from the UI, by the feature that handles it.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
     /// Opening and saving files.
     Files(FilesCommand),
+    /// Show a native file dialog (on a job thread) for a path field.
+    Browse(Purpose),
     /// The session on show: views, selection, measurements left out.
     View(ViewCommand),
     /// The calibration run.
@@ -39,8 +42,6 @@ pub enum FilesCommand {
     /// Open a file: a session, or a result to review (told apart by its
     /// `format` key).
     OpenPath(PathBuf),
-    /// Show a native file dialog (on a background thread).
-    Browse(DialogPurpose),
     /// Write the session without the left-out measurements to the path
     /// field's file (atomic; asks before overwriting).
     SaveSession,
@@ -166,7 +167,4 @@ pub enum MeasureCommand {
     /// Write the cloud on show to the form's export path (format by its
     /// extension).
     Export,
-    /// Show a file dialog for one of the view's paths (an export: a save
-    /// dialog that writes once a file is chosen).
-    Browse(super::state::measure::MeasureDialog),
 }

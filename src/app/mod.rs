@@ -19,8 +19,10 @@
 //! - [`commands`]: what the panels ask for, by feature;
 //! - [`error`]: why a job failed ([`error::JobError`], the engine's error
 //!   as its source);
-//! - [`jobs`]: named background threads and the messages they send, by
-//!   feature;
+//! - [`job`]: the one job slot type: named background threads, their
+//!   progress, Cancel, and the rule that a late answer is dropped;
+//! - [`dialog`]: the native file dialogs, one mechanism for every
+//!   Browse… button;
 //! - [`features`]: one module per feature (files, view, run, export,
 //!   import and import_poses, history, plan, measure, compensate), each
 //!   with its command handler, its message
@@ -63,11 +65,12 @@
 //! the bottom.
 
 pub mod commands;
+pub mod dialog;
 pub mod error;
 pub mod features;
 pub mod forms;
 pub mod inputs;
-pub mod jobs;
+pub mod job;
 pub mod panels;
 pub mod provenance;
 pub mod screenshot;

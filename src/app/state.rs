@@ -8,9 +8,6 @@ pub mod measure;
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
-use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
@@ -23,16 +20,15 @@ use crate::engine::tools::plan::Controller;
 use crate::engine::tools::plan::{Plan, PlanError, Prediction};
 use crate::engine::tools::result_view::Tolerance;
 
+use super::dialog::Purpose;
 use super::forms::{Forms, Grouping};
-use super::provenance::{Provenance, Stamp};
+use super::job::Jobs;
+use super::provenance::Provenance;
 use super::view::compensate::CompensationView;
 use super::view::{CentreSet, ResultView};
 
 /// How many recent files the start list keeps.
 pub const RECENT_MAX: usize = 8;
-
-/// What the status line says when a file dialog returned nothing.
-pub const NO_DIALOG: &str = "no file chosen — or no file dialog is available on this machine (no desktop portal); type the path instead";
 
 /// Where a session came from.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -170,33 +166,6 @@ impl LoadedSession {
     }
 }
 
-/// A run on the background thread.
-#[derive(Debug, Clone)]
-pub struct RunState {
-    /// Its number (messages of other runs are not its own).
-    pub id: u64,
-    /// ε after 0, 1, … updates as reported so far, mm.
-    pub epsilons: Vec<f64>,
-    /// Threshold of this run, mm.
-    pub threshold: f64,
-    /// Iteration bound of this run.
-    pub max_iterations: usize,
-    /// Set to ask the solver to stop at the start of its next phase.
-    pub cancel: Arc<AtomicBool>,
-    /// When the run started.
-    pub started: Instant,
-    /// Measurements left out of this run.
-    pub excluded: usize,
-    /// What the run is doing now, naming its phase (setting up, an
-    /// update or its inner step, a diagnostic, the result's views).
-    pub phase: String,
-    /// The fraction of the whole run done, phases weighted by their
-    /// usual share of the time (the job's `RunStage::fraction`).
-    pub fraction: f64,
-    /// The inputs the run was started from (its result's provenance).
-    pub stamp: Stamp,
-}
-
 /// How serious a status line is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Level {
@@ -225,37 +194,6 @@ pub struct Notice {
     pub title: String,
     /// The engine's message, naming file and measurement.
     pub body: String,
-}
-
-/// What a file dialog is for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum DialogPurpose {
-    /// Open a session or result file.
-    Open,
-    /// Choose where to save the edited session.
-    SaveSession,
-    /// Choose the export folder.
-    ExportFolder,
-    /// Import wizard: the joint log CSV.
-    ImportJoints,
-    /// Import wizard: the flange-pose log (JSON, `.rob`, CSV).
-    ImportPoses,
-    /// Import wizard: the profiles folder (or file, as the form says).
-    ImportProfiles,
-    /// Import wizard: the reference distances CSV.
-    ImportReferences,
-    /// History: the library folder.
-    HistoryFolder,
-    /// Compensate: the targets file (a pose table or a robot program).
-    CompensateTargets,
-    /// Compensate: the tool file (`flange_from_tcp`).
-    CompensateTool,
-    /// Compensate: where the compensated file goes.
-    CompensateOut,
-    /// Import wizard: the sphere centres the sensor reported.
-    ImportCentres,
-    /// Import wizard: a hand-eye guess file (4×4 JSON, session or result).
-    ImportHandEye,
 }
 
 /// What the Plan view writes.
@@ -379,36 +317,15 @@ pub struct ImportView {
     /// [`crate::app::forms::ImportForm::pose_scan_key`]): a form that
     /// reads otherwise is scanned again.
     pub scanned: Option<PoseImportSpec>,
-    /// The latest scan's number; an older scan's answer is dropped.
-    pub scan_generation: u64,
     /// The last import found no initial hand-eye: why (a guess is needed).
     pub guess_needed: Option<String>,
-}
-
-/// The import job (Import and open) while it runs.
-#[derive(Debug, Default)]
-pub struct ImportJob {
-    /// Its last stage, in words (`reading profiles: 120 of 9600`).
-    pub progress: Option<String>,
-    /// Set to stop it; `Some` while it runs.
-    pub cancel: Option<Arc<AtomicBool>>,
-    /// The number of the latest job (a message of another is dropped).
-    pub job: u64,
 }
 
 /// What the Plan view shows.
 #[derive(Debug, Default)]
 pub struct PlanView {
-    /// The planning job's last stage, in words, while it runs.
-    pub progress: Option<String>,
-    /// Set to stop the planning job; `Some` while it runs.
-    pub cancel: Option<Arc<AtomicBool>>,
     /// The last plan, or why planning failed (the message).
     pub outcome: Option<Result<PlanOutcome, String>>,
-    /// Plan files being written or a plan being simulated.
-    pub writing: usize,
-    /// The inputs the planning job in flight started from.
-    pub pending: Option<Stamp>,
 }
 
 /// What the History view shows.
@@ -422,11 +339,6 @@ pub struct HistoryView {
     pub drift: Option<Result<Drift, String>>,
     /// The library the drift's entry indices refer to (the ticked results).
     pub drift_of: Option<Library>,
-    /// The latest drift request; a drift job's answer to an older one is
-    /// dropped.
-    pub drift_generation: u64,
-    /// A drift job is in flight.
-    pub drifting: bool,
 }
 
 /// What lasts across runs of the program (eframe storage).
@@ -459,36 +371,6 @@ impl Prefs {
     }
 }
 
-/// Background work the frame loop waits on (to show it and to know when
-/// the app is idle).
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct Busy {
-    /// Session or result files being read.
-    pub loading: usize,
-    /// The file being opened, for people ("sessions/big.json").
-    pub opening: Option<String>,
-    /// A file dialog is open.
-    pub dialog: bool,
-    /// The edited session is being written.
-    pub saving: bool,
-    /// Exports being written.
-    pub exporting: usize,
-    /// Import previews or imports in flight.
-    pub importing: usize,
-    /// A library folder is being scanned.
-    pub scanning: bool,
-}
-
-impl Busy {
-    /// A file finished loading (or failed to).
-    pub fn done_loading(&mut self) {
-        self.loading = self.loading.saturating_sub(1);
-        if self.loading == 0 {
-            self.opening = None;
-        }
-    }
-}
-
 /// Everything the workbench shows. Changed only by commands and job
 /// messages; the `*_ui` functions read it.
 #[derive(Debug, Default)]
@@ -499,13 +381,8 @@ pub struct AppState {
     pub excluded: BTreeSet<String>,
     /// Index of the selected measurement in `loaded.session.measurements`.
     pub selected: Option<usize>,
-    /// The run in progress.
-    pub run: Option<RunState>,
-    /// Runs started so far (each run's number).
-    pub runs_started: u64,
-    /// Cancelled runs whose thread has not ended yet: forgotten by the
-    /// workbench at the Cancel, their messages dropped when they come.
-    pub stopping: BTreeSet<u64>,
+    /// The background jobs: one a slot, with their progress.
+    pub jobs: Jobs,
     /// The result on show (from a run or a reviewed file).
     pub result: Option<ResultView>,
     /// A run finished while another view was on show: the Results tab
@@ -519,19 +396,15 @@ pub struct AppState {
     pub notice: Option<Notice>,
     /// The last file dialog returned nothing (cancelled or unavailable):
     /// what it was for, so that the note shows beside its Browse button.
-    pub dialog_empty: Option<DialogPurpose>,
+    pub dialog_empty: Option<Purpose>,
     /// "Save as" would overwrite this existing file: a second click confirms.
     pub confirm_overwrite: Option<PathBuf>,
-    /// Background work in flight.
-    pub busy: Busy,
     /// What lasts across runs.
     pub prefs: Prefs,
     /// A result file to open once the session given with it has loaded.
     pub pending_result: Option<PathBuf>,
     /// What the import wizard shows (header, preview, flange checks).
     pub import: ImportView,
-    /// The import job in flight: its progress and its Cancel.
-    pub import_job: ImportJob,
     /// The scanned library and the drift on show.
     pub history: HistoryView,
     /// The plan on show and the planning job.
@@ -565,20 +438,7 @@ impl AppState {
     /// True while any background work is in flight.
     #[must_use]
     pub fn is_busy(&self) -> bool {
-        self.run.is_some()
-            || !self.stopping.is_empty()
-            || self.busy.loading > 0
-            || self.busy.dialog
-            || self.busy.saving
-            || self.busy.exporting > 0
-            || self.busy.importing > 0
-            || self.import_job.cancel.is_some()
-            || self.busy.scanning
-            || self.history.drifting
-            || self.plan.cancel.is_some()
-            || self.plan.writing > 0
-            || self.compensate.is_busy()
-            || self.measure.is_busy()
+        self.jobs.is_busy()
     }
 
     /// Indices of the measurements the session table shows, in its order
@@ -644,30 +504,10 @@ impl AppState {
     }
 }
 
-/// The Compensate view's job and what it shows.
+/// What the Compensate view shows.
 #[derive(Debug, Default)]
 pub struct CompensateState {
-    /// The job's last progress, in words, while it runs.
-    pub progress: Option<String>,
-    /// Set to stop the job; `Some` while it runs.
-    pub cancel: Option<Arc<AtomicBool>>,
-    /// The number of the latest job (a message of another is dropped).
-    pub job: u64,
-    /// The inputs the job in flight started from.
-    pub pending: Option<Stamp>,
     /// The last compensation, or why there is none (an unreachable
     /// target named, a file that cannot be read).
     pub outcome: Option<Result<CompensationView, String>>,
-    /// Compensated files being written.
-    pub writing: usize,
-    /// The last file written.
-    pub written: Option<PathBuf>,
-}
-
-impl CompensateState {
-    /// A job or a write is in flight.
-    #[must_use]
-    pub fn is_busy(&self) -> bool {
-        self.cancel.is_some() || self.writing > 0
-    }
 }

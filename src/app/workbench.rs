@@ -139,16 +139,14 @@ impl WorkbenchApp {
     }
 
     /// The non-drawing part of a frame: the start-up commands, the job
-    /// messages. Also run while the window is
+    /// reports (answers wait for [`Core::finish`]). Also run while the window is
     /// hidden (eframe's `logic`), so that a long run never waits on a full
     /// channel.
     pub fn pump(&mut self, ctx: &egui::Context) {
         for c in std::mem::take(&mut self.startup) {
             self.core.apply(ctx, c);
         }
-        for message in self.core.jobs.drain() {
-            self.core.on_message(ctx, message);
-        }
+        self.core.state.jobs.drain();
         self.core.observe();
     }
 
@@ -194,10 +192,9 @@ impl WorkbenchApp {
         for c in commands {
             self.core.apply(&ctx, c);
         }
-        // A run's outcome is shown after the frame's commands: a Cancel
-        // clicked in the frame it arrived in wins.
-        self.core.finish_run();
-        self.core.finish_measure();
+        // Answers are shown after the frame's commands: a Cancel clicked
+        // in the frame an answer arrived in wins.
+        self.core.finish(&ctx);
         // Fields edited this frame mark what they feed stale at once.
         self.core.observe();
         if let Some(director) = &mut self.screenshot {

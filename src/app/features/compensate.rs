@@ -7,7 +7,6 @@
 //! stale or the targets had errors.
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::engine::base::robot::controller::FlangeConvention;
@@ -22,16 +21,10 @@ use crate::engine::uses::compensate::{
 use super::Core;
 use crate::app::commands::CompensateCommand;
 use crate::app::forms::compensate::TcpChoice;
-use crate::app::jobs::{CompensateMessage, JobMessage};
+use crate::app::job::{Job, Slot};
 use crate::app::provenance::{Input, Output};
-use crate::app::state::{DialogPurpose, Level, Notice};
+use crate::app::state::{Level, Notice};
 use crate::app::view::compensate::CompensationView;
-
-/// The extensions the targets dialog offers: tables, JSON pose lists,
-/// RAPID modules, KUKA files, FANUC TP programs, URScript.
-pub const TARGET_EXTENSIONS: &[&str] = &[
-    "csv", "txt", "json", "rob", "mod", "modx", "prg", "src", "dat", "ls", "script", "urscript",
-];
 
 /// What "Write compensated program" calls the file it writes (status
 /// line, list of files written).
@@ -68,7 +61,7 @@ pub struct CompensateRequest {
 pub fn compensate_targets(
     request: &CompensateRequest,
     cancel: &AtomicBool,
-    progress: &mut dyn FnMut(String),
+    progress: &mut dyn FnMut(String, f64),
 ) -> Result<CompensationView, String> {
     let tcp = match request.tcp {
         TcpChoice::Sensor => Tcp::Sensor,
@@ -93,7 +86,10 @@ pub fn compensate_targets(
     }
     .map_err(|e| format!("{e} (the result on show)"))?;
     let done = compensate::compensate(&model, &file, &request.options, &mut |p| {
-        progress(format!("target {}: {} of {}", p.target, p.done, p.total));
+        progress(
+            format!("target {}: {} of {}", p.target, p.done, p.total),
+            p.done as f64 / p.total.max(1) as f64,
+        );
         if cancel.load(Ordering::Relaxed) {
             Control::Cancel
         } else {
@@ -156,10 +152,7 @@ impl Core {
         match command {
             CompensateCommand::Run => self.compensate_run(ctx),
             CompensateCommand::Cancel => {
-                if let Some(c) = self.state.compensate.cancel.take() {
-                    c.store(true, Ordering::Relaxed);
-                    self.state.compensate.pending = None;
-                    self.state.compensate.progress = None;
+                if self.state.jobs.cancel(&Slot::Compensate).is_some() {
                     self.state.say(
                         Level::Warning,
                         "compensation cancelled: what is on show did not change",
@@ -170,8 +163,8 @@ impl Core {
         }
     }
 
-    fn compensate_run(&mut self, ctx: &egui::Context) {
-        if self.state.compensate.cancel.is_some() {
+    pub(super) fn compensate_run(&mut self, ctx: &egui::Context) {
+        if self.state.jobs.runs(&Slot::Compensate) {
             return;
         }
         let Some(view) = &self.state.result else {
@@ -229,28 +222,14 @@ impl Core {
                 Input::Targets,
                 self.state.provenance.reading(Input::Targets),
             );
-        let job = self.state.compensate.job + 1;
-        let cancel = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&cancel);
-        let started = self.spawn(ctx, "compensate", move |rep| {
-            let outcome = compensate_targets(&request, &flag, &mut |text| {
-                rep.send(JobMessage::Compensate(CompensateMessage::Progress {
-                    job,
-                    text,
-                }));
+        if self.start(ctx, Slot::Compensate, stamp, move |w| {
+            compensate_targets(&request, w.flag(), &mut |text, fraction| {
+                w.progress(text, Some(fraction));
             })
-            .map(Box::new);
-            rep.send(JobMessage::Compensate(CompensateMessage::Finished {
-                job,
-                outcome,
-            }));
-        });
-        if started {
-            let c = &mut self.state.compensate;
-            c.job = job;
-            c.cancel = Some(cancel);
-            c.pending = Some(stamp);
-            c.progress = Some("reading the targets…".to_string());
+            .map(Box::new)
+        }) && let Some(job) = self.state.jobs.get_mut(&Slot::Compensate)
+        {
+            job.phase = "reading the targets…".to_string();
             self.state.say(Level::Info, "compensating the targets…");
         }
     }
@@ -293,7 +272,7 @@ impl Core {
         Some((text, targets, stamp))
     }
 
-    fn compensate_write(&mut self, ctx: &egui::Context) {
+    pub(super) fn compensate_write(&mut self, ctx: &egui::Context) {
         let Some((text, targets, stamp)) = self.compensation_to_write() else {
             return;
         };
@@ -308,21 +287,14 @@ impl Core {
         let path = PathBuf::from(out);
         let tool = (self.forms.compensate.tcp == TcpChoice::ToolFile)
             .then(|| PathBuf::from(self.forms.compensate.tool.trim()));
-        let started = self.spawn(ctx, "compensate-write", move |rep| {
+        let what = (WRITTEN_WHAT.to_string(), Some(Output::Compensation), stamp);
+        self.write(ctx, path, what, move |path| {
             let mut inputs: Vec<&Path> = vec![targets.as_path()];
             if let Some(t) = &tool {
                 inputs.push(t.as_path());
             }
-            let outcome = write_compensated(&text, &path, &inputs);
-            rep.send(JobMessage::Compensate(CompensateMessage::Written {
-                path,
-                outcome,
-                stamp,
-            }));
+            write_compensated(&text, path, &inputs).map(|()| None)
         });
-        if started {
-            self.state.compensate.writing += 1;
-        }
     }
 
     /// The file name the save dialog offers: the output field's, else
@@ -337,98 +309,42 @@ impl Core {
             })
     }
 
-    /// A file dialog of the Compensate view chose `path`: a targets file
-    /// is compensated at once (when a result is on show), an output is
-    /// written.
-    pub(super) fn compensate_dialog(
+    /// The compensation's answer: on show (recorded with the inputs it
+    /// started from), or why there is none.
+    pub(super) fn on_compensated(
         &mut self,
-        ctx: &egui::Context,
-        purpose: DialogPurpose,
-        path: PathBuf,
+        job: &Job,
+        outcome: Result<Box<CompensationView>, String>,
     ) {
-        let text = path.display().to_string();
-        match purpose {
-            DialogPurpose::CompensateTargets => {
-                self.forms.compensate.targets = text;
-                if self.state.result.is_some() {
-                    self.observe();
-                    self.compensate_run(ctx);
+        match outcome {
+            Ok(view) => {
+                self.state
+                    .provenance
+                    .record(Output::Compensation, job.stamp.clone());
+                let level = if view.flagged > 0 {
+                    Level::Warning
+                } else {
+                    Level::Info
+                };
+                self.state.say(level, view.summary.clone());
+                // Where the compensated file goes by default: beside the
+                // targets.
+                if self.forms.compensate.out.trim().is_empty()
+                    && let Some(dir) = view.targets.parent()
+                {
+                    self.forms.compensate.out =
+                        dir.join(view.default_file_name()).display().to_string();
                 }
+                self.state.compensate.outcome = Some(Ok(*view));
             }
-            DialogPurpose::CompensateTool => self.forms.compensate.tool = text,
-            DialogPurpose::CompensateOut => {
-                self.forms.compensate.out = text;
-                self.compensate_write(ctx);
-            }
-            _ => {}
-        }
-    }
-
-    /// Handles a [`CompensateMessage`].
-    pub(super) fn on_compensate(&mut self, message: CompensateMessage) {
-        match message {
-            CompensateMessage::Progress { job, text } => {
-                let c = &mut self.state.compensate;
-                if c.job == job && c.cancel.is_some() {
-                    c.progress = Some(text);
-                }
-            }
-            CompensateMessage::Finished { job, outcome } => {
-                let c = &mut self.state.compensate;
-                // A cancelled job's outcome is not shown.
-                if c.job != job || c.cancel.is_none() {
-                    return;
-                }
-                c.cancel = None;
-                c.progress = None;
-                let stamp = c.pending.take().unwrap_or_default();
-                match outcome {
-                    Ok(view) => {
-                        self.state.provenance.record(Output::Compensation, stamp);
-                        let level = if view.flagged > 0 {
-                            Level::Warning
-                        } else {
-                            Level::Info
-                        };
-                        self.state.say(level, view.summary.clone());
-                        // Where the compensated file goes by default:
-                        // beside the targets.
-                        if self.forms.compensate.out.trim().is_empty()
-                            && let Some(dir) = view.targets.parent()
-                        {
-                            self.forms.compensate.out =
-                                dir.join(view.default_file_name()).display().to_string();
-                        }
-                        self.state.compensate.outcome = Some(Ok(*view));
-                    }
-                    Err(e) => {
-                        self.state.provenance.forget(Output::Compensation);
-                        // Several failed targets: their count in the status
-                        // line, the list in the view.
-                        let first = e.lines().next().unwrap_or_default();
-                        self.state
-                            .say(Level::Error, format!("not compensated: {first}"));
-                        self.state.compensate.outcome = Some(Err(e));
-                    }
-                }
-            }
-            CompensateMessage::Written {
-                path,
-                outcome,
-                stamp,
-            } => {
-                let c = &mut self.state.compensate;
-                c.writing = c.writing.saturating_sub(1);
-                if outcome.is_ok() {
-                    c.written = Some(path.clone());
-                    self.state.provenance.wrote(
-                        WRITTEN_WHAT,
-                        path.clone(),
-                        Output::Compensation,
-                        stamp,
-                    );
-                }
-                self.say_written(WRITTEN_WHAT, &path, outcome);
+            Err(e) => {
+                self.state.provenance.forget(Output::Compensation);
+                // Several failed targets: their count in the status line,
+                // the list in the view.
+                let first = e.lines().next().unwrap_or_default();
+                self.state
+                    .say(Level::Error, format!("not compensated: {first}"));
+                self.state.compensate.outcome = Some(Err(e));
             }
         }
     }

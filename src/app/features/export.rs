@@ -20,9 +20,8 @@ use crate::engine::tools::result_view::{self, Tolerance};
 
 use super::Core;
 use crate::app::error::JobError;
-use crate::app::jobs::{ExportMessage, JobMessage};
 use crate::app::provenance::{Input, Output};
-use crate::app::state::{ExportKind, Level, LoadedSession, Notice};
+use crate::app::state::{ExportKind, Level, LoadedSession};
 use crate::app::view::{ResultOrigin, ResultView};
 
 /// CSV of every sphere centre: sensor frame and base frame before and
@@ -266,12 +265,12 @@ impl Core {
         };
         // A stale result is never written as if it were current.
         if let Err(why) = self.state.provenance.check(Output::Result) {
-            self.state
-                .say(Level::Warning, format!("{} not written", kind.label()));
-            self.state.notice = Some(Notice {
-                title: format!("{} not written", kind.label()),
-                body: format!("{why}: run the calibration again, then export"),
-            });
+            let title = format!("{} not written", kind.label());
+            self.refuse(
+                &title,
+                &title,
+                format!("{why}: run the calibration again, then export"),
+            );
             return;
         }
         let view = view.clone();
@@ -281,21 +280,16 @@ impl Core {
             .made(Output::Result)
             .cloned()
             .unwrap_or_default();
-        if kind == ExportKind::ReportHtml {
+        let from = if kind == ExportKind::ReportHtml {
             // The report judges by the tolerance: it is an input of it.
             stamp = stamp.with(
                 Input::Tolerance,
                 self.state.provenance.reading(Input::Tolerance),
             );
-        }
-        let Some(dir) = self.export_folder() else {
-            return;
+            Output::Report
+        } else {
+            Output::Result
         };
-        let stem = match &self.state.loaded {
-            Some(l) => l.source.stem(),
-            None => "result".to_string(),
-        };
-        let path = dir.join(kind.file_name(&stem));
         let loaded = if kind == ExportKind::ReportHtml {
             let Some(loaded) = &self.state.loaded else {
                 self.state
@@ -306,48 +300,23 @@ impl Core {
         } else {
             None
         };
+        let Some(dir) = self.export_folder() else {
+            return;
+        };
+        let stem = self
+            .state
+            .loaded
+            .as_ref()
+            .map_or_else(|| "result".to_string(), |l| l.source.stem());
+        let path = dir.join(kind.file_name(&stem));
         let tolerance = self.forms.tolerance;
-        let started = self.spawn(ctx, "export", move |rep| {
-            let outcome = match &loaded {
-                Some(loaded) => write_report(&view, loaded, tolerance, &path),
-                None => write_text(kind, &view, &path),
-            };
-            rep.send(JobMessage::Export(ExportMessage::Written {
-                kind,
-                path,
-                outcome,
-                stamp,
-            }));
-        });
-        if started {
-            self.state.busy.exporting += 1;
-        }
-    }
-
-    /// Handles an [`ExportMessage`].
-    pub(super) fn on_export(&mut self, message: ExportMessage) {
-        match message {
-            ExportMessage::Written {
-                kind,
-                path,
-                outcome,
-                stamp,
-            } => {
-                self.state.busy.exporting = self.state.busy.exporting.saturating_sub(1);
-                if outcome.is_ok() {
-                    let from = if kind == ExportKind::ReportHtml {
-                        self.state.reported = Some(path.clone());
-                        self.state.provenance.record(Output::Report, stamp.clone());
-                        Output::Report
-                    } else {
-                        Output::Result
-                    };
-                    self.state
-                        .provenance
-                        .wrote(kind.label(), path.clone(), from, stamp);
-                }
-                self.say_written(kind.label(), &path, outcome);
+        let what = (kind.label().to_string(), Some(from), stamp);
+        self.write(ctx, path, what, move |path| {
+            match &loaded {
+                Some(loaded) => write_report(&view, loaded, tolerance, path),
+                None => write_text(kind, &view, path),
             }
-        }
+            .map(|()| None)
+        });
     }
 }

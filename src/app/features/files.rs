@@ -17,11 +17,10 @@ use crate::engine::files::format::{
 use super::Core;
 use crate::app::commands::FilesCommand;
 use crate::app::error::JobError;
-use crate::app::forms::import::LogKind;
-use crate::app::forms::{ProfilesKind, SolverForm, Tab};
-use crate::app::jobs::{FilesMessage, JobMessage};
-use crate::app::provenance::{Input, Output};
-use crate::app::state::{DialogPurpose, Level, LoadedSession, NO_DIALOG, Notice, Source};
+use crate::app::forms::{SolverForm, Tab};
+use crate::app::job::Slot;
+use crate::app::provenance::{Input, Output, Stamp};
+use crate::app::state::{Level, LoadedSession, Notice, Source};
 use crate::app::view::{CentrePoint, CentreSet, ResultOrigin, ResultView};
 
 /// What a file turned out to be.
@@ -152,36 +151,54 @@ pub fn save_without(
     Ok(kept.measurements.len())
 }
 
+/// What a load job answers.
+#[derive(Debug)]
+pub enum Loaded {
+    /// A session, analysed.
+    Session(Box<LoadedSession>),
+    /// A result file for review, with its view (matched against the
+    /// session open when it was read).
+    Result(PathBuf, Box<ResultView>),
+    /// The file (or the demo's name) could not be opened, and why.
+    Failed(String, JobError),
+}
+
 impl Core {
     /// Handles a [`FilesCommand`].
     pub(super) fn files(&mut self, ctx: &egui::Context, command: FilesCommand) {
         match command {
-            FilesCommand::OpenDemo => self.open_demo(ctx),
+            FilesCommand::OpenDemo => {
+                self.state.say(Level::Info, "opening the demo session…");
+                self.load(
+                    ctx,
+                    crate::DEMO_SESSION_NAME.to_string(),
+                    || match open_demo() {
+                        Ok(l) => Loaded::Session(Box::new(l)),
+                        Err(e) => Loaded::Failed(crate::DEMO_SESSION_NAME.into(), e.into()),
+                    },
+                );
+            }
             FilesCommand::OpenPath(path) => self.open_path(ctx, path),
-            FilesCommand::Browse(purpose) => self.browse(ctx, purpose),
             FilesCommand::SaveSession => self.save_session(ctx, false),
             FilesCommand::ClearRecent => self.state.prefs.recent.clear(),
         }
     }
 
-    fn open_demo(&mut self, ctx: &egui::Context) {
-        self.state.say(Level::Info, "opening the demo session…");
-        let started = self.spawn(ctx, "load", |rep| {
-            rep.send(JobMessage::Files(match open_demo() {
-                Ok(l) => FilesMessage::SessionLoaded(Box::new(l)),
-                Err(e) => FilesMessage::LoadFailed {
-                    what: crate::DEMO_SESSION_NAME.to_string(),
-                    error: e.into(),
-                },
-            }));
-        });
-        if started {
-            self.state.busy.loading += 1;
-            self.state.busy.opening = Some(crate::DEMO_SESSION_NAME.to_string());
+    /// Reads a file (named `what` for people) on the load job.
+    fn load(
+        &mut self,
+        ctx: &egui::Context,
+        what: String,
+        work: impl FnOnce() -> Loaded + Send + 'static,
+    ) {
+        if self.start(ctx, Slot::Load, Stamp::default(), move |_| work())
+            && let Some(job) = self.state.jobs.get_mut(&Slot::Load)
+        {
+            job.phase = format!("opening {what}…");
         }
     }
 
-    fn open_path(&mut self, ctx: &egui::Context, path: PathBuf) {
+    pub(super) fn open_path(&mut self, ctx: &egui::Context, path: PathBuf) {
         if path.as_os_str().is_empty() {
             self.state.say(
                 Level::Warning,
@@ -193,134 +210,20 @@ impl Core {
         self.state
             .say(Level::Info, format!("opening {}…", path.display()));
         let session = self.state.loaded.as_ref().map(|l| l.session.clone());
-        let shown = path.display().to_string();
-        let started = self.spawn(ctx, "load", move |rep| {
-            let message = match open_path(&path) {
-                Ok(Opened::Session(l)) => FilesMessage::SessionLoaded(l),
+        self.load(ctx, path.display().to_string(), move || {
+            match open_path(&path) {
+                Ok(Opened::Session(l)) => Loaded::Session(l),
                 Ok(Opened::Result(file)) => {
-                    let view = ResultView::new(
-                        *file,
-                        ResultOrigin::Review(path.clone()),
-                        session.as_ref(),
-                    );
-                    FilesMessage::ResultLoaded {
-                        path,
-                        view: Box::new(view),
-                    }
+                    let origin = ResultOrigin::Review(path.clone());
+                    let view = ResultView::new(*file, origin, session.as_ref());
+                    Loaded::Result(path, Box::new(view))
                 }
-                Err(e) => FilesMessage::LoadFailed {
-                    what: path.display().to_string(),
-                    error: e.into(),
-                },
-            };
-            rep.send(JobMessage::Files(message));
+                Err(e) => Loaded::Failed(path.display().to_string(), e.into()),
+            }
         });
-        if started {
-            self.state.busy.loading += 1;
-            self.state.busy.opening = Some(shown);
-        }
     }
 
-    fn browse(&mut self, ctx: &egui::Context, purpose: DialogPurpose) {
-        if self.state.busy.dialog {
-            return;
-        }
-        let folder = match purpose {
-            DialogPurpose::ExportFolder => Some(PathBuf::from(self.forms.export_dir.trim())),
-            DialogPurpose::HistoryFolder => self
-                .state
-                .prefs
-                .history_folder
-                .clone()
-                .or_else(|| self.state.prefs.last_folder.clone()),
-            DialogPurpose::ImportProfiles
-            | DialogPurpose::ImportReferences
-            | DialogPurpose::ImportCentres
-            | DialogPurpose::ImportHandEye => {
-                let log = match self.forms.import.log_kind {
-                    LogKind::Joints => &self.forms.import.joints,
-                    LogKind::FlangePoses => &self.forms.import.poses,
-                };
-                Path::new(log.trim())
-                    .parent()
-                    .map(Path::to_path_buf)
-                    .filter(|d| !d.as_os_str().is_empty())
-                    .or_else(|| self.state.prefs.last_folder.clone())
-            }
-            _ => self.state.prefs.last_folder.clone(),
-        };
-        let profiles_folder = self.forms.import.profiles_kind == ProfilesKind::Folder;
-        let file_name = Path::new(self.forms.save_path.trim())
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned());
-        let compensated_name = self.compensated_file_name();
-        let started = self.spawn(ctx, "file-dialog", move |rep| {
-            let mut dialog = rfd::FileDialog::new();
-            if let Some(dir) = folder.filter(|d| d.is_dir()) {
-                dialog = dialog.set_directory(dir);
-            }
-            let path = match purpose {
-                DialogPurpose::Open => dialog
-                    .add_filter("spherecal session or result", &["json"])
-                    .pick_file(),
-                DialogPurpose::SaveSession => {
-                    let dialog = dialog.add_filter("spherecal session", &["json"]);
-                    match file_name {
-                        Some(n) => dialog.set_file_name(n),
-                        None => dialog,
-                    }
-                    .save_file()
-                }
-                DialogPurpose::ExportFolder | DialogPurpose::HistoryFolder => dialog.pick_folder(),
-                DialogPurpose::ImportJoints | DialogPurpose::ImportReferences => {
-                    dialog.add_filter("CSV", &["csv", "txt"]).pick_file()
-                }
-                DialogPurpose::ImportPoses => dialog
-                    .add_filter(
-                        "pose file",
-                        &[
-                            "ls", "mod", "modx", "prg", "dat", "src", "script", "urscript", "rob",
-                            "json", "csv", "txt",
-                        ],
-                    )
-                    .add_filter("any file", &["*"])
-                    .pick_file(),
-                DialogPurpose::ImportCentres => dialog
-                    .add_filter("centres table", &["csv", "txt"])
-                    .add_filter("any file", &["*"])
-                    .pick_file(),
-                DialogPurpose::ImportHandEye => dialog
-                    .add_filter("4×4 JSON, session or result", &["json"])
-                    .pick_file(),
-                DialogPurpose::ImportProfiles if profiles_folder => dialog.pick_folder(),
-                DialogPurpose::ImportProfiles => {
-                    dialog.add_filter("CSV", &["csv", "txt"]).pick_file()
-                }
-                DialogPurpose::CompensateTargets => dialog
-                    .add_filter(
-                        "pose table or robot program",
-                        super::compensate::TARGET_EXTENSIONS,
-                    )
-                    .add_filter("all files", &["*"])
-                    .pick_file(),
-                DialogPurpose::CompensateTool => {
-                    dialog.add_filter("tool (JSON)", &["json"]).pick_file()
-                }
-                DialogPurpose::CompensateOut => match compensated_name {
-                    Some(n) => dialog.set_file_name(n),
-                    None => dialog,
-                }
-                .save_file(),
-            };
-            rep.send(JobMessage::Files(FilesMessage::Dialog { purpose, path }));
-        });
-        self.state.busy.dialog = started;
-        if started {
-            self.state.say(Level::Info, "waiting for the file dialog…");
-        }
-    }
-
-    fn save_session(&mut self, ctx: &egui::Context, confirmed: bool) {
+    pub(super) fn save_session(&mut self, ctx: &egui::Context, confirmed: bool) {
         let Some(loaded) = &self.state.loaded else {
             self.state.say(Level::Warning, "no session to save");
             return;
@@ -353,22 +256,21 @@ impl Core {
         self.state.confirm_overwrite = None;
         let session = loaded.session.clone();
         let excluded = self.state.excluded.clone();
-        let started = self.spawn(ctx, "save", move |rep| {
-            let outcome = save_without(&session, &excluded, &path);
-            rep.send(JobMessage::Files(FilesMessage::Saved { path, outcome }));
+        let what = ("the session".to_string(), None, Stamp::default());
+        self.write(ctx, path, what, move |path| {
+            let n = save_without(&session, &excluded, path)?;
+            Ok(Some(format!(
+                "saved {n} measurements to {} (atomic write)",
+                path.display()
+            )))
         });
-        self.state.busy.saving = started;
     }
 
-    /// Handles a [`FilesMessage`].
-    pub(super) fn on_files(&mut self, ctx: &egui::Context, message: FilesMessage) {
-        match message {
-            FilesMessage::SessionLoaded(loaded) => {
-                self.state.busy.done_loading();
-                self.on_session(ctx, *loaded);
-            }
-            FilesMessage::ResultLoaded { path, view } => {
-                self.state.busy.done_loading();
+    /// A load job's answer: the session or result shown, or why not.
+    pub(super) fn on_loaded(&mut self, ctx: &egui::Context, loaded: Loaded) {
+        match loaded {
+            Loaded::Session(l) => self.on_session(ctx, *l),
+            Loaded::Result(path, view) => {
                 self.state.prefs.remember(&path);
                 let notes = view.notes.join("; ");
                 self.forms.centres.magnify = view.centres.suggested_magnify;
@@ -401,8 +303,7 @@ impl Core {
                     );
                 }
             }
-            FilesMessage::LoadFailed { what, error } => {
-                self.state.busy.done_loading();
+            Loaded::Failed(what, error) => {
                 self.state
                     .say(Level::Error, format!("could not open {what}"));
                 self.state.notice = Some(Notice {
@@ -413,77 +314,6 @@ impl Core {
                     self.open_path(ctx, p);
                 }
             }
-            FilesMessage::Dialog { purpose, path } => self.on_dialog(ctx, purpose, path),
-            FilesMessage::Saved { path, outcome } => {
-                self.state.busy.saving = false;
-                match outcome {
-                    Ok(n) => {
-                        self.state.prefs.remember(&path);
-                        self.state.say(
-                            Level::Info,
-                            format!(
-                                "saved {n} measurements to {} (atomic write)",
-                                path.display()
-                            ),
-                        );
-                    }
-                    Err(e) => {
-                        self.state.say(Level::Error, "the session was not saved");
-                        self.state.notice = Some(Notice {
-                            title: format!("Could not save {}", path.display()),
-                            body: format!("not saved: {e}"),
-                        });
-                    }
-                }
-            }
-        }
-    }
-
-    fn on_dialog(&mut self, ctx: &egui::Context, purpose: DialogPurpose, path: Option<PathBuf>) {
-        self.state.busy.dialog = false;
-        self.state.dialog_empty = path.is_none().then_some(purpose);
-        let Some(path) = path else {
-            self.state.say(Level::Warning, NO_DIALOG);
-            return;
-        };
-        match purpose {
-            DialogPurpose::Open => self.open_path(ctx, path),
-            DialogPurpose::SaveSession => {
-                self.forms.save_path = path.display().to_string();
-                // The dialog has asked about replacing a file already.
-                self.save_session(ctx, true);
-            }
-            DialogPurpose::ExportFolder => {
-                self.forms.export_dir = path.display().to_string();
-                self.state
-                    .say(Level::Info, format!("exports go to {}", path.display()));
-            }
-            DialogPurpose::ImportJoints => {
-                self.forms.import.joints = path.display().to_string();
-                self.import_preview(ctx, true);
-            }
-            DialogPurpose::ImportPoses => {
-                self.forms.import.poses = path.display().to_string();
-            }
-            DialogPurpose::ImportProfiles => {
-                self.forms.import.profiles = path.display().to_string();
-            }
-            DialogPurpose::ImportReferences => {
-                self.forms.import.references = path.display().to_string();
-            }
-            DialogPurpose::HistoryFolder => {
-                self.forms.history.folder = path.display().to_string();
-                self.history_scan(ctx);
-            }
-            DialogPurpose::CompensateTargets
-            | DialogPurpose::CompensateTool
-            | DialogPurpose::CompensateOut => self.compensate_dialog(ctx, purpose, path),
-            DialogPurpose::ImportCentres => {
-                self.forms.import.centres = path.display().to_string();
-            }
-            DialogPurpose::ImportHandEye => {
-                self.forms.import.hand_eye_file = path.display().to_string();
-            }
         }
     }
 
@@ -492,7 +322,7 @@ impl Core {
     /// waiting for it.
     pub(super) fn on_session(&mut self, ctx: &egui::Context, loaded: LoadedSession) {
         // A run of the previous session: stopped and forgotten.
-        let _ = self.stop_run();
+        self.state.jobs.cancel(&Slot::Run);
         if let Some(p) = loaded.source.path() {
             self.state.prefs.remember(p);
             self.forms.open_path = p.display().to_string();

@@ -1,16 +1,21 @@
 //! The library of past results: scan a folder, then the drift of the
 //! chosen robot over the ticked results, each on a job thread. A drift
-//! answer to anything but the latest request is dropped.
+//! asked for again replaces the last (whose answer is dropped).
 
 use std::path::PathBuf;
 
-use crate::engine::tools::history::{self, DriftOptions, HistoryError, Library};
+use crate::engine::tools::history::{self, Drift, DriftOptions, HistoryError, Library};
 
 use super::Core;
 use crate::app::commands::HistoryCommand;
 use crate::app::error::JobError;
-use crate::app::jobs::{HistoryMessage, JobMessage};
+use crate::app::job::Slot;
+use crate::app::provenance::Stamp;
 use crate::app::state::Level;
+
+/// What a drift job answers: the robot, the library of the ticked
+/// results (what the drift's entry indices refer to), and the drift.
+type DriftAnswer = (String, Box<Library>, Result<Box<Drift>, JobError>);
 
 impl Core {
     /// Handles a [`HistoryCommand`].
@@ -29,20 +34,16 @@ impl Core {
                 .say(Level::Warning, "type or choose the library folder first");
             return;
         }
-        if self.state.busy.scanning {
+        if self.state.jobs.runs(&Slot::Library) {
             return;
         }
         let folder = PathBuf::from(text);
         self.state
             .say(Level::Info, format!("scanning {}…", folder.display()));
-        let started = self.spawn(ctx, "history", move |rep| {
-            let outcome = history::scan(&folder).map(Box::new).map_err(Into::into);
-            rep.send(JobMessage::History(HistoryMessage::Scanned {
-                folder,
-                outcome,
-            }));
+        self.start(ctx, Slot::Library, Stamp::default(), move |_| {
+            let outcome = history::scan(&folder).map(Box::new).map_err(JobError::from);
+            (folder, outcome)
         });
-        self.state.busy.scanning = started;
     }
 
     /// Starts the drift of the chosen robot over the ticked results on a
@@ -50,10 +51,10 @@ impl Core {
     /// frame); without a library or a robot there is none.
     pub(super) fn history_drift(&mut self, ctx: &egui::Context) {
         let view = &mut self.state.history;
-        view.drift_generation += 1;
         let (Some(Ok(library)), Some(robot)) = (&view.library, &self.forms.history.robot) else {
             view.drift = None;
             view.drift_of = None;
+            self.state.jobs.cancel(&Slot::Drift);
             return;
         };
         let mut ticked = library.clone();
@@ -65,56 +66,34 @@ impl Core {
             k: self.forms.history.k,
             ..DriftOptions::default()
         };
-        let generation = view.drift_generation;
         let robot = robot.clone();
-        let started = self.spawn(ctx, "drift", move |rep| {
-            let outcome = history::drift(&ticked, &robot, &options)
-                .map(Box::new)
-                .map_err(Into::into);
-            rep.send(JobMessage::History(HistoryMessage::Drift {
-                generation,
-                robot,
-                ticked: Box::new(ticked),
-                outcome,
-            }));
+        self.start(ctx, Slot::Drift, Stamp::default(), move |_| {
+            let outcome = history::drift(&ticked, &robot, &options);
+            let outcome = outcome.map(Box::new).map_err(JobError::from);
+            (robot, Box::new(ticked), outcome)
         });
-        self.state.history.drifting |= started;
     }
 
-    /// Handles a [`HistoryMessage`].
-    pub(super) fn on_history(&mut self, ctx: &egui::Context, message: HistoryMessage) {
-        match message {
-            HistoryMessage::Scanned { folder, outcome } => self.on_scanned(ctx, folder, outcome),
-            HistoryMessage::Drift {
-                generation,
-                robot,
-                ticked,
-                outcome,
-            } => {
-                let view = &mut self.state.history;
-                if generation != view.drift_generation {
-                    return; // a later request is on its way
-                }
-                view.drifting = false;
-                view.drift = Some(match outcome {
-                    Ok(d) => Ok(*d),
-                    Err(JobError::History(HistoryError::UnknownRobot { .. })) => Err(format!(
-                        "no ticked result of {robot}: tick some in the table"
-                    )),
-                    Err(e) => Err(e.to_string()),
-                });
-                view.drift_of = Some(*ticked);
-            }
-        }
+    /// The drift's answer (the latest request's: an older one was
+    /// replaced).
+    pub(super) fn on_drift(&mut self, (robot, ticked, outcome): DriftAnswer) {
+        let view = &mut self.state.history;
+        view.drift = Some(match outcome {
+            Ok(d) => Ok(*d),
+            Err(JobError::History(HistoryError::UnknownRobot { .. })) => Err(format!(
+                "no ticked result of {robot}: tick some in the table"
+            )),
+            Err(e) => Err(e.to_string()),
+        });
+        view.drift_of = Some(*ticked);
     }
 
-    fn on_scanned(
+    /// A scan's answer: the library on show, then its drift.
+    pub(super) fn on_scanned(
         &mut self,
         ctx: &egui::Context,
-        folder: PathBuf,
-        outcome: Result<Box<Library>, JobError>,
+        (folder, outcome): (PathBuf, Result<Box<Library>, JobError>),
     ) {
-        self.state.busy.scanning = false;
         match outcome {
             Ok(library) => {
                 self.state.prefs.history_folder = Some(folder.clone());

@@ -4,7 +4,6 @@
 //! an opened file.
 
 use std::path::Path;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -17,20 +16,35 @@ use crate::app::commands::ImportCommand;
 use crate::app::error::JobError;
 use crate::app::forms::import::{LogKind, PREVIEW_ROWS};
 use crate::app::forms::{ImportForm, Tab};
-use crate::app::jobs::{ImportMessage, Imported, JobMessage};
-use crate::app::state::{Level, Source};
+use crate::app::job::Slot;
+use crate::app::provenance::Stamp;
+use crate::app::state::{Level, LoadedSession, Source};
+
+/// What a preview job answers: the joint log's header (empty when it
+/// cannot be read), the form with the guessed mapping (when asked), and
+/// the mapped rows or why not.
+pub type Previewed = (
+    Vec<String>,
+    Option<Box<ImportForm>>,
+    Result<String, JobError>,
+);
+
+/// The outcome of an import job.
+#[derive(Debug)]
+pub struct Imported {
+    /// The session, analysed like an opened file.
+    pub loaded: Box<LoadedSession>,
+    /// The flange-pose checks (empty without a check).
+    pub checks: Vec<crate::engine::files::import::PoseCheck>,
+    /// What the import decided, in words (axis map, side, initial
+    /// hand-eye).
+    pub notes: Vec<String>,
+}
 
 /// The wizard's preview: the joint log's header (empty when it cannot be
 /// read), the form with the mapping guessed from it (when `guess`), and
 /// the first rows mapped.
-pub fn import_preview(
-    mut form: ImportForm,
-    guess: bool,
-) -> (
-    Vec<String>,
-    Option<Box<ImportForm>>,
-    Result<String, JobError>,
-) {
+pub fn import_preview(mut form: ImportForm, guess: bool) -> Previewed {
     if form.joints.trim().is_empty() {
         return (
             Vec::new(),
@@ -68,7 +82,7 @@ const PROGRESS_EVERY: Duration = Duration::from_millis(100);
 pub fn import_session(
     form: &ImportForm,
     cancel: &AtomicBool,
-    progress: &mut dyn FnMut(String),
+    progress: &mut dyn FnMut(String, Option<f64>),
 ) -> Result<Imported, JobError> {
     // Told at most every 0.1 s, and at every stage that is not a profile.
     let mut told: Option<Instant> = None;
@@ -79,7 +93,11 @@ pub fn import_session(
         let profile = matches!(s, ImportStage::Profiles { done, total } if done < total);
         if !profile || told.is_none_or(|t| t.elapsed() >= PROGRESS_EVERY) {
             told = Some(Instant::now());
-            progress(s.describe());
+            let fraction = match s {
+                ImportStage::Profiles { done, total } => Some(done as f64 / total.max(1) as f64),
+                _ => None,
+            };
+            progress(s.describe(), fraction);
         }
         Control::Continue
     };
@@ -99,7 +117,7 @@ pub fn import_session(
     if cancel.load(Ordering::Relaxed) {
         return Err(ImportError::Cancelled.into());
     }
-    progress("fitting the stripes".to_string());
+    progress("fitting the stripes".to_string(), None);
     let mut session = imported.session;
     let mut notes = imported.notes;
     if form.log_kind == LogKind::FlangePoses
@@ -131,7 +149,14 @@ impl Core {
         match command {
             ImportCommand::Preview { guess } => self.import_preview(ctx, guess),
             ImportCommand::Run => self.import_run(ctx),
-            ImportCommand::Cancel => self.import_cancel(),
+            ImportCommand::Cancel => {
+                if self.state.jobs.cancel(&Slot::Import).is_some() {
+                    self.state.say(
+                        Level::Warning,
+                        "import cancelled: nothing was opened, what is open stays",
+                    );
+                }
+            }
             ImportCommand::Scan => self.import_scan(ctx),
             ImportCommand::Edited => {
                 let view = &mut self.state.import;
@@ -146,17 +171,29 @@ impl Core {
     /// dialog).
     pub(super) fn import_preview(&mut self, ctx: &egui::Context, guess: bool) {
         let form = self.forms.import.clone();
-        let started = self.spawn(ctx, "import", move |rep| {
-            let (header, guessed, preview) = import_preview(form, guess);
-            rep.send(JobMessage::Import(ImportMessage::Previewed {
-                header,
-                guessed,
-                preview,
-            }));
+        self.start(ctx, Slot::ImportPreview, Stamp::default(), move |_| {
+            import_preview(form, guess)
         });
-        if started {
-            self.state.busy.importing += 1;
+    }
+
+    /// The preview's answer: the header, the guessed mapping, the rows.
+    pub(super) fn on_previewed(&mut self, (header, guessed, preview): Previewed) {
+        if let Some(form) = guessed {
+            let f = &mut self.forms.import;
+            f.id_column = form.id_column;
+            f.station_column = form.station_column;
+            f.use_column = form.use_column;
+            f.side_column = form.side_column;
+            f.joint_columns = form.joint_columns;
         }
+        self.state.import.header = header;
+        match &preview {
+            Ok(_) => self
+                .state
+                .say(Level::Info, "preview of the mapped rows below"),
+            Err(e) => self.state.say(Level::Warning, format!("preview: {e}")),
+        }
+        self.state.import.preview = Some(preview.map_err(|e| e.to_string()));
     }
 
     fn import_run(&mut self, ctx: &egui::Context) {
@@ -171,91 +208,15 @@ impl Core {
             return;
         }
         self.state.say(Level::Info, "importing…");
-        let job = self.state.import_job.job + 1;
-        let cancel = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&cancel);
-        let started = self.spawn(ctx, "import", move |rep| {
-            let outcome = import_session(&form, &flag, &mut |text| {
-                rep.send(JobMessage::Import(ImportMessage::Progress { job, text }));
-            });
-            rep.send(JobMessage::Import(ImportMessage::Imported { job, outcome }));
+        self.start(ctx, Slot::Import, Stamp::default(), move |w| {
+            import_session(&form, w.flag(), &mut |text, fraction| {
+                w.progress(text, fraction);
+            })
         });
-        if started {
-            let run = &mut self.state.import_job;
-            run.job = job;
-            run.cancel = Some(cancel);
-            run.progress = Some("starting".to_string());
-        }
-    }
-
-    /// Stops the import in flight: its answer, if it comes, is dropped and
-    /// what is open stays.
-    fn import_cancel(&mut self) {
-        let run = &mut self.state.import_job;
-        if let Some(c) = run.cancel.take() {
-            c.store(true, Ordering::Relaxed);
-            run.progress = None;
-            self.state.say(
-                Level::Warning,
-                "import cancelled: nothing was opened, what is open stays",
-            );
-        }
-    }
-
-    /// Handles an [`ImportMessage`].
-    pub(super) fn on_import(&mut self, ctx: &egui::Context, message: ImportMessage) {
-        match message {
-            ImportMessage::Progress { job, text } => {
-                let run = &mut self.state.import_job;
-                if run.job == job && run.cancel.is_some() {
-                    run.progress = Some(text);
-                }
-            }
-            ImportMessage::Imported { job, outcome } => {
-                let run = &mut self.state.import_job;
-                // A cancelled job's answer is not shown.
-                if run.job != job || run.cancel.is_none() {
-                    return;
-                }
-                run.cancel = None;
-                run.progress = None;
-                self.on_imported(ctx, outcome);
-            }
-            ImportMessage::Scanned {
-                generation,
-                outcome,
-            } => {
-                self.state.busy.importing = self.state.busy.importing.saturating_sub(1);
-                self.on_import_scanned(generation, outcome);
-            }
-            ImportMessage::Previewed {
-                header,
-                guessed,
-                preview,
-            } => {
-                self.state.busy.importing = self.state.busy.importing.saturating_sub(1);
-                if let Some(form) = guessed {
-                    let f = &mut self.forms.import;
-                    f.id_column = form.id_column;
-                    f.station_column = form.station_column;
-                    f.use_column = form.use_column;
-                    f.side_column = form.side_column;
-                    f.joint_columns = form.joint_columns;
-                }
-                self.state.import.header = header;
-                match &preview {
-                    Ok(_) => self
-                        .state
-                        .say(Level::Info, "preview of the mapped rows below"),
-                    Err(e) => self.state.say(Level::Warning, format!("preview: {e}")),
-                }
-                self.state.import.preview = Some(preview.map_err(|e| e.to_string()));
-            }
-        }
     }
 
     /// Shows an import's outcome: the session opened, or why not.
-    fn on_imported(&mut self, ctx: &egui::Context, outcome: Result<Imported, JobError>) {
+    pub(super) fn on_imported(&mut self, ctx: &egui::Context, outcome: Result<Imported, JobError>) {
         match outcome {
             Ok(imported) => {
                 let flagged = imported.checks.iter().filter(|c| c.flagged).count();

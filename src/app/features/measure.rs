@@ -26,11 +26,10 @@ use super::Core;
 use crate::app::commands::MeasureCommand;
 use crate::app::error::JobError;
 use crate::app::forms::measure::ScanChoice;
-use crate::app::jobs::JobMessage;
-use crate::app::jobs::measure::MeasureMessage;
+use crate::app::job::{Job, Slot};
 use crate::app::provenance::Output;
-use crate::app::state::measure::{MeasureDialog, MeasureFailure, MeasureJob, MeasuredCloud};
-use crate::app::state::{Level, NO_DIALOG, Notice};
+use crate::app::state::measure::{MeasureFailure, MeasuredCloud};
+use crate::app::state::{Level, Notice};
 use crate::app::view::ResultOrigin;
 
 /// Most points the view draws of a cloud (spread evenly over it,
@@ -325,7 +324,7 @@ impl Core {
         match command {
             MeasureCommand::Start => self.start_measure(ctx),
             MeasureCommand::Cancel => {
-                if let Some(job) = self.stop_measure() {
+                if let Some(job) = self.state.jobs.cancel(&Slot::Measure) {
                     self.state.say(
                         Level::Warning,
                         format!(
@@ -337,22 +336,7 @@ impl Core {
                 }
             }
             MeasureCommand::Export => self.export_cloud(ctx),
-            MeasureCommand::Browse(purpose) => self.measure_browse(ctx, purpose),
         }
-    }
-
-    /// Stops the measuring job in flight and forgets it: whatever it
-    /// still sends is dropped, so the cloud on show stays.
-    fn stop_measure(&mut self) -> Option<MeasureJob> {
-        let m = &mut self.state.measure;
-        let job = m.job.take()?;
-        job.cancel.store(true, Ordering::Relaxed);
-        if m.arrived.as_ref().is_some_and(|(id, _)| *id == job.id) {
-            m.arrived = None;
-        } else {
-            m.stopping.insert(job.id);
-        }
-        Some(job)
     }
 
     /// The job's request from the form and the result on show, or why
@@ -428,7 +412,7 @@ impl Core {
     }
 
     fn start_measure(&mut self, ctx: &egui::Context) {
-        if self.state.measure.job.is_some() {
+        if self.state.jobs.runs(&Slot::Measure) {
             return;
         }
         let request = match self.measure_request() {
@@ -440,48 +424,25 @@ impl Core {
             }
         };
         let stamp = self.state.provenance.stamp(Output::Cloud);
-        let cancel = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&cancel);
-        self.state.measure.jobs_started += 1;
-        let id = self.state.measure.jobs_started;
-        let started = self.spawn(ctx, "measure", move |rep| {
-            let outcome = measure_scan(request, &flag, &mut |phase, fraction| {
-                rep.send(JobMessage::Measure(MeasureMessage::Progress {
-                    job: id,
-                    phase: phase.to_string(),
-                    fraction,
-                }))
-            });
-            rep.send(JobMessage::Measure(MeasureMessage::Finished {
-                job: id,
-                outcome: outcome.map(Box::new),
-            }));
-        });
-        if started {
+        if self.start(ctx, Slot::Measure, stamp, move |w| {
+            measure_scan(request, w.flag(), &mut |phase, fraction| {
+                w.progress(phase, Some(fraction))
+            })
+            .map(Box::new)
+        }) {
             self.state.measure.failure = None;
-            self.state.measure.job = Some(MeasureJob {
-                id,
-                cancel,
-                started: Instant::now(),
-                phase: "starting".to_string(),
-                fraction: 0.0,
-                stamp,
-            });
             self.state.say(Level::Info, "measuring the scan…");
         }
     }
 
-    /// Shows the cloud that arrived this frame, unless its job was
-    /// cancelled in the frame (the workbench calls this after the
-    /// frame's commands).
-    pub fn finish_measure(&mut self) {
+    /// Shows the cloud of a measuring job (after the frame's commands: a
+    /// job cancelled in the frame it arrived in is not shown).
+    pub(super) fn on_measured(
+        &mut self,
+        job: &Job,
+        outcome: Result<Box<MeasuredCloud>, MeasureFailure>,
+    ) {
         let m = &mut self.state.measure;
-        let Some((id, outcome)) = m.arrived.take() else {
-            return;
-        };
-        let Some(job) = m.job.take_if(|j| j.id == id) else {
-            return;
-        };
         match outcome {
             Ok(cloud) => {
                 let text = format!(
@@ -491,7 +452,9 @@ impl Core {
                     cloud.seconds
                 );
                 m.shown = Some(*cloud);
-                self.state.provenance.record(Output::Cloud, job.stamp);
+                self.state
+                    .provenance
+                    .record(Output::Cloud, job.stamp.clone());
                 self.state.say(Level::Info, text);
             }
             Err(MeasureFailure::Cancelled) => self.state.say(
@@ -536,13 +499,9 @@ impl Core {
 
     /// Writes the cloud on show to the form's path, refused when it is
     /// stale or the path is not a cloud file.
-    fn export_cloud(&mut self, ctx: &egui::Context) {
+    pub(super) fn export_cloud(&mut self, ctx: &egui::Context) {
         let refuse = |core: &mut Self, why: String| {
-            core.state.say(Level::Warning, "cloud not written");
-            core.state.notice = Some(Notice {
-                title: "Cloud not written".to_string(),
-                body: why,
-            });
+            core.refuse("Cloud not written", "cloud not written", why);
         };
         let Some(shown) = &self.state.measure.shown else {
             refuse(self, "no cloud to write: measure a scan first".into());
@@ -589,143 +548,33 @@ impl Core {
             .made(Output::Cloud)
             .cloned()
             .unwrap_or_default();
-        let started = self.spawn(ctx, "measure-export", move |rep| {
-            let outcome =
-                measure::write_cloud(&cloud, &path, format, &provenance).map_err(JobError::from);
-            rep.send(JobMessage::Measure(MeasureMessage::Written {
-                path,
-                format,
-                outcome,
-                stamp,
-            }));
+        let what = (format_label(format).to_string(), Some(Output::Cloud), stamp);
+        self.write(ctx, path, what, move |path| {
+            measure::write_cloud(&cloud, path, format, &provenance)?;
+            Ok(None)
         });
-        if started {
-            self.state.measure.writing += 1;
-            self.state.say(
-                Level::Info,
-                format!("writing the {}…", format_label(format)),
-            );
-        }
-    }
-
-    /// A file dialog for one of the view's paths, on its own thread.
-    fn measure_browse(&mut self, ctx: &egui::Context, purpose: MeasureDialog) {
-        if self.state.measure.dialog {
-            return;
-        }
-        let folder = self.state.prefs.last_folder.clone();
-        let form = &self.forms.measure;
-        let file_name = Path::new(form.out.trim()).file_name().map_or_else(
-            || {
-                let stem = self
-                    .state
-                    .loaded
-                    .as_ref()
-                    .map_or_else(|| "scan".to_string(), |l| l.source.stem());
-                format!("{stem}-cloud.ply")
-            },
-            |n| n.to_string_lossy().into_owned(),
+        self.state.say(
+            Level::Info,
+            format!("writing the {}…", format_label(format)),
         );
-        let started = self.spawn(ctx, "file-dialog", move |rep| {
-            let mut dialog = rfd::FileDialog::new();
-            if let Some(dir) = folder.filter(|d| d.is_dir()) {
-                dialog = dialog.set_directory(dir);
-            }
-            let path = match purpose {
-                MeasureDialog::SessionFile | MeasureDialog::Frame => {
-                    dialog.add_filter("JSON", &["json"]).pick_file()
-                }
-                MeasureDialog::References => dialog.add_filter("CSV", &["csv", "txt"]).pick_file(),
-                MeasureDialog::Log => dialog
-                    .add_filter(
-                        "pose log",
-                        &[
-                            "csv", "txt", "json", "ls", "mod", "modx", "prg", "dat", "src",
-                            "script", "urscript",
-                        ],
-                    )
-                    .pick_file(),
-                MeasureDialog::Profiles => dialog.pick_folder(),
-                MeasureDialog::Export => dialog
-                    .add_filter("PLY", &["ply"])
-                    .add_filter("E57", &["e57"])
-                    .add_filter("CSV", &["csv"])
-                    .set_file_name(file_name)
-                    .save_file(),
-            };
-            rep.send(JobMessage::Measure(MeasureMessage::Dialog {
-                purpose,
-                path,
-            }));
-        });
-        self.state.measure.dialog = started;
-        if started {
-            self.state.say(Level::Info, "waiting for the file dialog…");
-        }
     }
 
-    /// Handles a [`MeasureMessage`].
-    pub(super) fn on_measure(&mut self, ctx: &egui::Context, message: MeasureMessage) {
-        match message {
-            MeasureMessage::Progress {
-                job: id,
-                phase,
-                fraction,
-            } => {
-                if let Some(job) = self.state.measure.job.as_mut().filter(|j| j.id == id) {
-                    job.phase = phase;
-                    job.fraction = job.fraction.max(fraction);
-                }
-            }
-            MeasureMessage::Finished { job: id, outcome } => {
-                let m = &mut self.state.measure;
-                if m.stopping.remove(&id) {
-                    return;
-                }
-                if m.job.as_ref().is_some_and(|j| j.id == id) {
-                    m.arrived = Some((id, outcome));
-                }
-            }
-            MeasureMessage::Written {
-                path,
-                format,
-                outcome,
-                stamp,
-            } => {
-                self.state.measure.writing = self.state.measure.writing.saturating_sub(1);
-                if outcome.is_ok() {
-                    self.state.provenance.wrote(
-                        format_label(format),
-                        path.clone(),
-                        Output::Cloud,
-                        stamp,
-                    );
-                }
-                self.say_written(format_label(format), &path, outcome);
-            }
-            MeasureMessage::Dialog { purpose, path } => {
-                self.state.measure.dialog = false;
-                self.state.measure.dialog_empty = path.is_none().then_some(purpose);
-                let Some(path) = path else {
-                    self.state.say(Level::Warning, NO_DIALOG);
-                    return;
-                };
-                let text = path.display().to_string();
-                let form = &mut self.forms.measure;
-                match purpose {
-                    MeasureDialog::SessionFile => form.session_file = text,
-                    MeasureDialog::Log => form.log = text,
-                    MeasureDialog::Profiles => form.profiles = text,
-                    MeasureDialog::Frame => form.frame = text,
-                    MeasureDialog::References => form.references = text,
-                    MeasureDialog::Export => {
-                        form.out = text;
-                        // The dialog has asked about replacing a file.
-                        self.export_cloud(ctx);
-                    }
-                }
-            }
-        }
+    /// The name the export's save dialog offers: the export field's, else
+    /// `<session stem>-cloud.ply`.
+    pub(super) fn cloud_file_name(&self) -> String {
+        Path::new(self.forms.measure.out.trim())
+            .file_name()
+            .map_or_else(
+                || {
+                    let stem = self
+                        .state
+                        .loaded
+                        .as_ref()
+                        .map_or_else(|| "scan".to_string(), |l| l.source.stem());
+                    format!("{stem}-cloud.ply")
+                },
+                |n| n.to_string_lossy().into_owned(),
+            )
     }
 }
 

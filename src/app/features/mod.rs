@@ -1,12 +1,11 @@
 //! What the workbench does, one module per feature. Each feature has the
-//! handler of its [`Command`]s (checks the forms, starts a job), the
-//! handler of its jobs' [`JobMessage`]s (updates the state, says what
-//! happened) and the plain functions its jobs run (engine calls; the
-//! plots PNG reads egui's built-in fonts):
+//! handler of its [`Command`]s (checks the forms, starts a job in its
+//! [`Slot`]), the handler of its jobs' answers (updates the state, says
+//! what happened) and the plain functions its jobs run (engine calls):
 //!
 //! | feature | commands | job work |
 //! |---|---|---|
-//! | [`files`] | open, browse, save | read and fit a session, read a result, save without the left-out measurements |
+//! | [`files`] | open, save, the file dialogs | read and fit a session, read a result, save without the left-out measurements |
 //! | [`view`] | tab, selection, measurements left out | — |
 //! | [`run`] | run, cancel | the calibration |
 //! | [`export`] | the Results view's exports | result JSON, CSV, PNG, HTML report, model |
@@ -15,9 +14,11 @@
 //! | [`history`] | scan, drift | scan a library folder |
 //! | [`plan`] | plan, cancel, export, simulate | the pose planner and its prediction |
 //! | [`compensate`] | compensate, cancel, write | targets and programs through the result on show |
-//! | [`measure`] | measure, cancel, export, browse | a scan into a point cloud, its self-validation, PLY/E57/CSV |
+//! | [`measure`] | measure, cancel, export | a scan into a point cloud, its self-validation, PLY/E57/CSV |
 //!
-//! [`Core`] holds what they share: the state, the forms and the job runner.
+//! [`Core`] holds what they share (the state with its job table, the
+//! forms) and what every feature does alike: start a job, hand its
+//! answer back, write a file, show a file dialog.
 
 pub mod compensate;
 pub mod export;
@@ -30,40 +31,44 @@ pub mod plan;
 pub mod run;
 pub mod view;
 
+use std::any::Any;
 use std::path::{Path, PathBuf};
 
 use super::commands::Command;
+use super::dialog::{self, Ask, NO_DIALOG, Purpose};
 use super::error::JobError;
 use super::forms::Forms;
-use super::jobs::{JobMessage, Jobs, Reporter, RunFailure};
+use super::job::{Job, Slot, Worker};
+use super::provenance::{Output, Stamp};
 use super::state::{AppState, Level, Notice};
-use super::view::ResultView;
 
-/// The state, the forms and the job runner, with every feature's
+/// The state (with the job table) and the forms, with every feature's
 /// handlers. The workbench owns one and draws the panels from it.
 pub struct Core {
     /// What the workbench knows.
     pub state: AppState,
     /// The fields the widgets edit.
     pub forms: Forms,
-    /// The job runner.
-    pub jobs: Jobs,
-    /// The outcome of the run in flight, arrived this frame: shown by
-    /// [`Core::finish_run`] once the frame's commands are applied, so that
-    /// a Cancel clicked in the frame it arrives in still wins.
-    arrived: Option<(u64, Result<Box<ResultView>, RunFailure>)>,
+}
+
+/// What a write job answers: what was written, of which output, and
+/// whether it was (a status line of its own, or why not).
+struct WriteAnswer {
+    what: String,
+    from: Option<Output>,
+    outcome: Result<Option<String>, JobError>,
+}
+
+/// A job's answer as its feature's type.
+fn take<T: 'static>(answer: Box<dyn Any + Send>) -> Option<T> {
+    answer.downcast::<T>().ok().map(|b| *b)
 }
 
 impl Core {
     /// A core with these state and forms and no job in flight.
     #[must_use]
     pub fn new(state: AppState, forms: Forms) -> Self {
-        Self {
-            state,
-            forms,
-            jobs: Jobs::default(),
-            arrived: None,
-        }
+        Self { state, forms }
     }
 
     /// Reads every input into the provenance (each frame, and before each
@@ -78,6 +83,7 @@ impl Core {
         self.observe();
         match command {
             Command::Files(c) => self.files(ctx, c),
+            Command::Browse(purpose) => self.browse(ctx, purpose),
             Command::View(c) => self.view(c),
             Command::Run(c) => self.run(ctx, c),
             Command::Export(kind) => self.export(ctx, kind),
@@ -89,35 +95,214 @@ impl Core {
         }
     }
 
-    /// Hands a job's message to its feature.
-    pub fn on_message(&mut self, ctx: &egui::Context, message: JobMessage) {
-        match message {
-            JobMessage::Files(m) => self.on_files(ctx, m),
-            JobMessage::Run(m) => self.on_run(m),
-            JobMessage::Export(m) => self.on_export(m),
-            JobMessage::Import(m) => self.on_import(ctx, m),
-            JobMessage::History(m) => self.on_history(ctx, m),
-            JobMessage::Plan(m) => self.on_plan(ctx, m),
-            JobMessage::Compensate(m) => self.on_compensate(m),
-            JobMessage::Measure(m) => self.on_measure(ctx, m),
+    /// Starts `work` in `slot` with `stamp`; says why when it cannot.
+    fn start<T: Send + 'static>(
+        &mut self,
+        ctx: &egui::Context,
+        slot: Slot,
+        stamp: Stamp,
+        work: impl FnOnce(&Worker) -> T + Send + 'static,
+    ) -> bool {
+        match self.state.jobs.start(slot, stamp, ctx, work) {
+            Ok(()) => true,
+            Err(e) => {
+                self.state.say(Level::Error, e);
+                false
+            }
         }
     }
 
-    /// Starts a job, or says why it could not start.
-    fn spawn(
-        &mut self,
-        ctx: &egui::Context,
-        name: &str,
-        work: impl FnOnce(&Reporter) + Send + 'static,
-    ) -> bool {
-        match self.jobs.spawn(name, ctx, work) {
-            Ok(()) => true,
-            Err(e) => {
+    /// Hands every answer arrived to its feature (the workbench calls
+    /// this after the frame's commands: a Cancel in the same frame wins).
+    pub fn finish(&mut self, ctx: &egui::Context) {
+        for (slot, job, answer) in self.state.jobs.finish() {
+            let Some(a) = answer else {
                 self.state.say(
                     Level::Error,
-                    format!("could not start the {name} job (no thread: {e})"),
+                    format!("the {slot:?} job stopped without an answer"),
                 );
-                false
+                continue;
+            };
+            match slot {
+                Slot::Load => take(a).map(|l| self.on_loaded(ctx, l)),
+                Slot::Run => take(a).map(|o| self.on_run(&job, o)),
+                Slot::Plan => take(a).map(|o| self.on_plan(&job, o)),
+                Slot::Simulate => take(a).map(|o| self.on_simulated(ctx, o)),
+                Slot::Import => take(a).map(|o| self.on_imported(ctx, o)),
+                Slot::ImportPreview => take(a).map(|p| self.on_previewed(p)),
+                Slot::PoseScan => take(a).map(|o| self.on_import_scanned(o)),
+                Slot::Library => take(a).map(|o| self.on_scanned(ctx, o)),
+                Slot::Drift => take(a).map(|o| self.on_drift(o)),
+                Slot::Compensate => take(a).map(|o| self.on_compensated(&job, o)),
+                Slot::Measure => take(a).map(|o| self.on_measured(&job, o)),
+                Slot::Dialog => take(a).map(|(p, path)| self.on_dialog(ctx, p, path)),
+                Slot::Write(path) => take(a).map(|w| self.on_written(path, &job, w)),
+            };
+        }
+    }
+
+    /// A native file dialog for `purpose` on a job thread; its answer
+    /// goes to the field (or the write) it is for.
+    fn browse(&mut self, ctx: &egui::Context, purpose: Purpose) {
+        if self.state.jobs.runs(&Slot::Dialog) {
+            return;
+        }
+        let ask = self.ask(purpose);
+        if self.start(ctx, Slot::Dialog, Stamp::default(), move |_| {
+            (purpose, dialog::show(&ask))
+        }) {
+            self.state.say(Level::Info, "waiting for the file dialog…");
+        }
+    }
+
+    /// Where the dialog for `purpose` opens and the name it offers.
+    fn ask(&self, purpose: Purpose) -> Ask {
+        let prefs = &self.state.prefs;
+        let last = prefs.last_folder.clone();
+        let import = &self.forms.import;
+        let beside_log = || {
+            let log = match import.log_kind {
+                crate::app::forms::import::LogKind::Joints => &import.joints,
+                crate::app::forms::import::LogKind::FlangePoses => &import.poses,
+            };
+            Path::new(log.trim())
+                .parent()
+                .map(Path::to_path_buf)
+                .filter(|d| !d.as_os_str().is_empty())
+                .or_else(|| last.clone())
+        };
+        let name_of = |field: &str| {
+            Path::new(field.trim())
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+        };
+        let (folder, file_name) = match purpose {
+            Purpose::ExportFolder => (Some(PathBuf::from(self.forms.export_dir.trim())), None),
+            Purpose::HistoryFolder => (prefs.history_folder.clone().or(last), None),
+            Purpose::ImportProfiles
+            | Purpose::ImportReferences
+            | Purpose::ImportCentres
+            | Purpose::ImportHandEye => (beside_log(), None),
+            Purpose::SaveSession => (last, name_of(&self.forms.save_path)),
+            Purpose::CompensateOut => (last, self.compensated_file_name()),
+            Purpose::MeasureExport => (last, Some(self.cloud_file_name())),
+            _ => (last, None),
+        };
+        Ask {
+            purpose,
+            folder,
+            file_name,
+            folder_only: matches!(
+                purpose,
+                Purpose::ExportFolder | Purpose::HistoryFolder | Purpose::MeasureProfiles
+            ) || (purpose == Purpose::ImportProfiles
+                && import.profiles_kind == crate::app::forms::ProfilesKind::Folder),
+        }
+    }
+
+    /// A dialog closed: the chosen path goes to its field (a save dialog
+    /// writes at once: it has asked about replacing a file itself).
+    fn on_dialog(&mut self, ctx: &egui::Context, purpose: Purpose, path: Option<PathBuf>) {
+        self.state.dialog_empty = path.is_none().then_some(purpose);
+        let Some(path) = path else {
+            self.state.say(Level::Warning, NO_DIALOG);
+            return;
+        };
+        let text = path.display().to_string();
+        let f = &mut self.forms;
+        match purpose {
+            Purpose::Open => self.open_path(ctx, path),
+            Purpose::SaveSession => {
+                f.save_path = text;
+                self.save_session(ctx, true);
+            }
+            Purpose::ExportFolder => {
+                f.export_dir = text;
+                self.state
+                    .say(Level::Info, format!("exports go to {}", path.display()));
+            }
+            Purpose::ImportJoints => {
+                f.import.joints = text;
+                self.import_preview(ctx, true);
+            }
+            Purpose::ImportPoses => f.import.poses = text,
+            Purpose::ImportProfiles => f.import.profiles = text,
+            Purpose::ImportReferences => f.import.references = text,
+            Purpose::ImportCentres => f.import.centres = text,
+            Purpose::ImportHandEye => f.import.hand_eye_file = text,
+            Purpose::HistoryFolder => {
+                f.history.folder = text;
+                self.history_scan(ctx);
+            }
+            Purpose::CompensateTargets => {
+                f.compensate.targets = text;
+                if self.state.result.is_some() {
+                    self.observe();
+                    self.compensate_run(ctx);
+                }
+            }
+            Purpose::CompensateTool => f.compensate.tool = text,
+            Purpose::CompensateOut => {
+                f.compensate.out = text;
+                self.compensate_write(ctx);
+            }
+            Purpose::MeasureSession => f.measure.session_file = text,
+            Purpose::MeasureLog => f.measure.log = text,
+            Purpose::MeasureProfiles => f.measure.profiles = text,
+            Purpose::MeasureFrame => f.measure.frame = text,
+            Purpose::MeasureReferences => f.measure.references = text,
+            Purpose::MeasureExport => {
+                f.measure.out = text;
+                self.export_cloud(ctx);
+            }
+        }
+    }
+
+    /// Writes `path` on a job thread (one write a file at a time): `work`
+    /// writes it (atomically) and may give a status line of its own; a
+    /// file written of `from` is remembered with `stamp`.
+    fn write(
+        &mut self,
+        ctx: &egui::Context,
+        path: PathBuf,
+        (what, from, stamp): (String, Option<Output>, Stamp),
+        work: impl FnOnce(&Path) -> Result<Option<String>, JobError> + Send + 'static,
+    ) {
+        let to = path.clone();
+        self.start(ctx, Slot::Write(path), stamp, move |_| WriteAnswer {
+            what,
+            from,
+            outcome: work(&to),
+        });
+    }
+
+    /// A write ended: remembered with its output's stamp, or why not.
+    fn on_written(&mut self, path: PathBuf, job: &Job, answer: WriteAnswer) {
+        let WriteAnswer {
+            what,
+            from,
+            outcome,
+        } = answer;
+        match outcome {
+            Ok(line) => {
+                if let Some(from) = from {
+                    if from == Output::Report {
+                        self.state.reported = Some(path.clone());
+                        self.state
+                            .provenance
+                            .record(Output::Report, job.stamp.clone());
+                    }
+                    self.state
+                        .provenance
+                        .wrote(&what, path.clone(), from, job.stamp.clone());
+                }
+                let line = line.unwrap_or_else(|| format!("wrote {what} to {}", path.display()));
+                self.state.say(Level::Info, line);
+            }
+            Err(e) => {
+                let status = format!("{what} not written");
+                self.refuse(&format!("Could not write {what}"), &status, e.to_string());
+                self.state.say(Level::Error, status);
             }
         }
     }
@@ -137,19 +322,13 @@ impl Core {
         Some(dir)
     }
 
-    /// The status line for a written file, or the notice of why not.
-    fn say_written(&mut self, what: &str, path: &Path, outcome: Result<(), JobError>) {
-        match outcome {
-            Ok(()) => self
-                .state
-                .say(Level::Info, format!("wrote {what} to {}", path.display())),
-            Err(e) => {
-                self.state.say(Level::Error, format!("{what} not written"));
-                self.state.notice = Some(Notice {
-                    title: format!("Could not write {what}"),
-                    body: e.to_string(),
-                });
-            }
-        }
+    /// Says in the status line that something was not done, and why in a
+    /// notice titled `title`.
+    fn refuse(&mut self, title: &str, status: &str, why: String) {
+        self.state.say(Level::Warning, status);
+        self.state.notice = Some(Notice {
+            title: title.to_string(),
+            body: why,
+        });
     }
 }

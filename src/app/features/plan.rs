@@ -5,7 +5,6 @@
 //! plan, to try the whole workflow without a robot.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::engine::base::robot::RobotChoice;
@@ -23,9 +22,9 @@ use crate::app::commands::PlanCommand;
 use crate::app::error::JobError;
 use crate::app::forms::Tab;
 use crate::app::inputs::plan_hand_eye;
-use crate::app::jobs::{JobMessage, PlanMessage};
+use crate::app::job::{Job, Slot};
 use crate::app::provenance::{Output, Stamp};
-use crate::app::state::{Level, Notice, PlanExport, PlanOutcome, Source};
+use crate::app::state::{Level, LoadedSession, Notice, PlanExport, PlanOutcome, Source};
 
 /// Plans and predicts, reporting each stage in words; `cancel` stops at
 /// the next stage or prediction run.
@@ -38,7 +37,7 @@ pub fn make_plan(
     config: &PlanConfig,
     runs: usize,
     cancel: &AtomicBool,
-    report: &mut dyn FnMut(String),
+    report: &mut dyn FnMut(String, Option<f64>),
 ) -> Result<PlanOutcome, PlanError> {
     let control = || {
         if cancel.load(Ordering::Relaxed) {
@@ -47,8 +46,15 @@ pub fn make_plan(
             Control::Continue
         }
     };
+    // The candidates take most of the planning; a prediction, when
+    // asked for, the second half of the bar.
+    let share = if runs > 0 { 0.5 } else { 1.0 };
     let plan = plan::plan(config, &mut |stage| {
-        report(stage_text(stage));
+        let done = match stage {
+            PlanStage::Candidates { done, of } => 0.8 * done as f64 / of.max(1) as f64,
+            _ => 0.9,
+        };
+        report(stage_text(stage), Some(share * done));
         control()
     })?;
     let prediction = (runs > 0).then(|| {
@@ -57,9 +63,10 @@ pub fn make_plan(
             ..PredictConfig::default()
         };
         plan::predict(&plan, &predict, &mut |done, of| {
-            report(format!(
-                "predicting the accuracy: {done} of {of} simulated calibrations"
-            ));
+            report(
+                format!("predicting the accuracy: {done} of {of} simulated calibrations"),
+                Some(0.5 + 0.5 * done as f64 / of.max(1) as f64),
+            );
             control()
         })
     });
@@ -144,9 +151,9 @@ impl Core {
         match command {
             PlanCommand::Make => self.plan_make(ctx),
             PlanCommand::Cancel => {
-                if let Some(c) = &self.state.plan.cancel {
-                    c.store(true, Ordering::Relaxed);
-                    self.state.plan.progress = Some("cancelling…".to_string());
+                if self.state.jobs.cancel(&Slot::Plan).is_some() {
+                    self.state
+                        .say(Level::Warning, "planning cancelled: no plan was made");
                 }
             }
             PlanCommand::Export(kind) => self.plan_export(ctx, kind),
@@ -174,7 +181,7 @@ impl Core {
     }
 
     fn plan_make(&mut self, ctx: &egui::Context) {
-        if self.state.plan.cancel.is_some() {
+        if self.state.jobs.runs(&Slot::Plan) {
             return;
         }
         let session_hand_eye = plan_hand_eye(&self.state);
@@ -188,20 +195,13 @@ impl Core {
             }
         };
         let runs = self.forms.plan.request.predict_runs;
-        let cancel = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&cancel);
-        let started = self.spawn(ctx, "plan", move |rep| {
-            let outcome = make_plan(&config, runs, &flag, &mut |text| {
-                rep.send(JobMessage::Plan(PlanMessage::Progress(text)));
-            });
-            rep.send(JobMessage::Plan(PlanMessage::Finished(
-                outcome.map_err(Into::into),
-            )));
-        });
-        if started {
-            self.state.plan.cancel = Some(cancel);
-            self.state.plan.pending = Some(self.state.provenance.stamp(Output::Plan));
-            self.state.plan.progress = Some("planning…".to_string());
+        let stamp = self.state.provenance.stamp(Output::Plan);
+        if self.start(ctx, Slot::Plan, stamp, move |w| {
+            make_plan(&config, runs, w.flag(), &mut |text, fraction| {
+                w.progress(text, fraction);
+            })
+            .map_err(JobError::from)
+        }) {
             self.state.say(Level::Info, "planning the poses…");
         }
     }
@@ -237,22 +237,15 @@ impl Core {
             return;
         };
         let path: PathBuf = dir.join(kind.file_name(&self.forms.plan.robot));
-        let started = self.spawn(ctx, "export", move |rep| {
+        let what = (kind.label().to_string(), Some(Output::Plan), stamp);
+        self.write(ctx, path, what, move |path| {
             let text = match kind {
                 PlanExport::Csv => plan::plan_csv(&plan),
                 PlanExport::Program(c) => c.render(&plan),
             };
-            let outcome = write_atomic(&path, text.as_bytes()).map_err(Into::into);
-            rep.send(JobMessage::Plan(PlanMessage::Written {
-                kind,
-                path,
-                outcome,
-                stamp,
-            }));
+            write_atomic(path, text.as_bytes())?;
+            Ok(None)
         });
-        if started {
-            self.state.plan.writing += 1;
-        }
     }
 
     fn plan_simulate(&mut self, ctx: &egui::Context) {
@@ -261,90 +254,69 @@ impl Core {
         };
         let robot = self.forms.plan.robot.clone();
         let seed = self.forms.plan.request.design.seed;
-        let started = self.spawn(ctx, "simulate", move |rep| {
-            let outcome = simulate_plan(&plan, &robot, seed)
-                .map(|session| Box::new(analyse(session, Source::Simulated)));
-            rep.send(JobMessage::Plan(PlanMessage::Simulated(outcome)));
-        });
-        if started {
-            self.state.plan.writing += 1;
+        if self.start(ctx, Slot::Simulate, Stamp::default(), move |_| {
+            simulate_plan(&plan, &robot, seed)
+                .map(|session| Box::new(analyse(session, Source::Simulated)))
+        }) {
             self.state
                 .say(Level::Info, "simulating a session of the plan…");
         }
     }
 
-    /// Handles a [`PlanMessage`].
-    pub(super) fn on_plan(&mut self, ctx: &egui::Context, message: PlanMessage) {
-        match message {
-            PlanMessage::Progress(text) => {
-                if self.state.plan.cancel.is_some() {
-                    self.state.plan.progress = Some(text);
-                }
-            }
-            PlanMessage::Finished(outcome) => {
-                self.state.plan.cancel = None;
-                self.state.plan.progress = None;
-                let stamp = self.state.plan.pending.take().unwrap_or_default();
-                if outcome.is_ok() {
-                    self.state.provenance.record(Output::Plan, stamp);
-                } else {
-                    self.state.provenance.forget(Output::Plan);
-                }
-                match &outcome {
-                    Ok(o) => {
-                        let line = match &o.prediction {
-                            Some(Ok(p)) => format!(
-                                "planned {} poses; predicted validation std after {:.3} ± {:.3} mm",
-                                o.plan.poses.len(),
-                                p.after_mean,
-                                p.after_spread
-                            ),
-                            Some(Err(e)) => {
-                                format!("planned {} poses; no prediction: {e}", o.plan.poses.len())
-                            }
-                            None => format!("planned {} poses", o.plan.poses.len()),
-                        };
-                        self.state.say(Level::Info, line);
+    /// The planner's answer: the plan on show (recorded with the inputs
+    /// it started from), or why there is none.
+    pub(super) fn on_plan(&mut self, job: &Job, outcome: Result<PlanOutcome, JobError>) {
+        if outcome.is_ok() {
+            self.state
+                .provenance
+                .record(Output::Plan, job.stamp.clone());
+        } else {
+            self.state.provenance.forget(Output::Plan);
+        }
+        match &outcome {
+            Ok(o) => {
+                let line = match &o.prediction {
+                    Some(Ok(p)) => format!(
+                        "planned {} poses; predicted validation std after {:.3} ± {:.3} mm",
+                        o.plan.poses.len(),
+                        p.after_mean,
+                        p.after_spread
+                    ),
+                    Some(Err(e)) => {
+                        format!("planned {} poses; no prediction: {e}", o.plan.poses.len())
                     }
-                    Err(e) => self
-                        .state
-                        .say(Level::Warning, format!("no plan: {}", plan_error_text(e))),
-                }
-                self.state.plan.outcome = Some(outcome.map_err(|e| plan_error_text(&e)));
+                    None => format!("planned {} poses", o.plan.poses.len()),
+                };
+                self.state.say(Level::Info, line);
             }
-            PlanMessage::Written {
-                kind,
-                path,
-                outcome,
-                stamp,
-            } => {
-                self.state.plan.writing = self.state.plan.writing.saturating_sub(1);
-                if outcome.is_ok() {
-                    self.state
-                        .provenance
-                        .wrote(kind.label(), path.clone(), Output::Plan, stamp);
-                }
-                self.say_written(kind.label(), &path, outcome);
+            Err(e) => self
+                .state
+                .say(Level::Warning, format!("no plan: {}", plan_error_text(e))),
+        }
+        self.state.plan.outcome = Some(outcome.map_err(|e| plan_error_text(&e)));
+    }
+
+    /// A session simulated from the plan: opened, or why not.
+    pub(super) fn on_simulated(
+        &mut self,
+        ctx: &egui::Context,
+        outcome: Result<Box<LoadedSession>, JobError>,
+    ) {
+        match outcome {
+            Ok(loaded) => {
+                self.on_session(ctx, *loaded);
+                self.state.say(
+                    Level::Info,
+                    "opened a session simulated from the plan (not saved yet): press Run to calibrate it",
+                );
             }
-            PlanMessage::Simulated(outcome) => {
-                self.state.plan.writing = self.state.plan.writing.saturating_sub(1);
-                match outcome {
-                    Ok(loaded) => {
-                        self.on_session(ctx, *loaded);
-                        self.state.say(
-                            Level::Info,
-                            "opened a session simulated from the plan (not saved yet): press Run to calibrate it",
-                        );
-                    }
-                    Err(e) => {
-                        self.state
-                            .say(Level::Error, "the plan could not be simulated");
-                        self.state.notice = Some(Notice {
-                            title: "Could not simulate the plan".to_string(),
-                            body: e.to_string(),
-                        });
-                    }
-                }
+            Err(e) => {
+                self.state
+                    .say(Level::Error, "the plan could not be simulated");
+                self.state.notice = Some(Notice {
+                    title: "Could not simulate the plan".to_string(),
+                    body: e.to_string(),
+                });
             }
         }
     }

@@ -3,11 +3,10 @@
 //! every ε and stopping at the next one after Cancel.
 
 use std::collections::BTreeSet;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use crate::engine::calibrate::solve::{self, Control, Options, Phase, StopReason};
+use crate::engine::calibrate::solve::{self, Control, Options, Phase, Progress, StopReason};
 use crate::engine::files::format::ResultFile;
 
 use super::Core;
@@ -15,10 +14,51 @@ use super::files::without;
 use crate::app::commands::RunCommand;
 use crate::app::error::JobError;
 use crate::app::forms::Tab;
-use crate::app::jobs::{JobMessage, RunFailure, RunMessage, RunStage};
+use crate::app::job::{Job, Slot};
 use crate::app::provenance::Output;
-use crate::app::state::{Level, LoadedSession, Notice, RunState};
+use crate::app::state::{Level, LoadedSession, Notice};
 use crate::app::view::{ResultOrigin, ResultView};
+
+/// Why a run gave no result.
+#[derive(Debug)]
+pub enum RunFailure {
+    /// Cancel was pressed; the solver stopped after this many updates.
+    Cancelled(usize),
+    /// The session or the solver failed.
+    Failed(JobError),
+}
+
+/// Where a run job is: a phase of the engine's run, or the workbench's
+/// own last step (the result file and its views).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RunStage {
+    /// The engine's progress report.
+    Solver(Progress),
+    /// The engine is done: the result file and the views of it are
+    /// being built.
+    Views,
+}
+
+impl RunStage {
+    /// What the run is doing, in words that name the phase.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        match self {
+            Self::Solver(p) => p.phase.describe(p.updates),
+            Self::Views => "the result file and its views".to_string(),
+        }
+    }
+
+    /// The fraction of the whole run done, phases weighted
+    /// ([`Progress::run_fraction`]; the views take the rest of the bar).
+    #[must_use]
+    pub fn fraction(&self) -> f64 {
+        match self {
+            Self::Solver(p) => p.run_fraction(),
+            Self::Views => crate::engine::calibrate::solve::progress::RUN_END,
+        }
+    }
+}
 
 /// The whole calibration of the loaded session without the `excluded`
 /// measurements: the stripes fitted when it was loaded (none is fitted
@@ -87,8 +127,8 @@ impl Core {
         match command {
             RunCommand::Start => self.start_run(ctx),
             RunCommand::Cancel => {
-                if let Some(run) = self.stop_run() {
-                    let updates = run.epsilons.len().saturating_sub(1);
+                if let Some(run) = self.state.jobs.cancel(&Slot::Run) {
+                    let updates = run.series.len().saturating_sub(1);
                     self.state.say(
                         Level::Warning,
                         format!(
@@ -102,24 +142,8 @@ impl Core {
         }
     }
 
-    /// Stops the run in flight, if any, and forgets it at once: Cancel
-    /// always wins. Its thread stops at the start of its next phase;
-    /// whatever it still sends is dropped, a result included, so the
-    /// result on show stays.
-    pub(super) fn stop_run(&mut self) -> Option<RunState> {
-        let run = self.state.run.take()?;
-        run.cancel.store(true, Ordering::Relaxed);
-        if self.arrived.as_ref().is_some_and(|(id, _)| *id == run.id) {
-            // Its thread has ended: what it sent is dropped.
-            self.arrived = None;
-        } else {
-            self.state.stopping.insert(run.id);
-        }
-        Some(run)
-    }
-
     fn start_run(&mut self, ctx: &egui::Context) {
-        if self.state.run.is_some() {
+        if self.state.jobs.runs(&Slot::Run) {
             return;
         }
         let Some(loaded) = &self.state.loaded else {
@@ -129,48 +153,27 @@ impl Core {
         let options = self.forms.solver.options(&loaded.session);
         let loaded = loaded.clone();
         let excluded = self.state.excluded.clone();
-        let cancel = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&cancel);
-        let n_excluded = self.state.excluded_count();
         let stamp = self.state.provenance.stamp(Output::Result);
-        self.state.runs_started += 1;
-        let id = self.state.runs_started;
-        let started = self.spawn(ctx, "solver", move |rep| {
-            let outcome = calibrate_session(&loaded, &excluded, &options, &flag, &mut |stage| {
-                rep.send(JobMessage::Run(RunMessage::Progress { run: id, stage }))
-            });
-            rep.send(JobMessage::Run(RunMessage::Finished {
-                run: id,
-                outcome: outcome.map(Box::new),
-            }));
-        });
-        if started {
-            self.state.run = Some(RunState {
-                id,
-                epsilons: Vec::new(),
-                threshold: options.threshold,
-                max_iterations: options.max_iterations,
-                cancel,
-                started: Instant::now(),
-                excluded: n_excluded,
-                phase: "preparing the run".to_string(),
-                fraction: 0.0,
-                stamp,
-            });
+        if self.start(ctx, Slot::Run, stamp, move |w| {
+            calibrate_session(&loaded, &excluded, &options, w.flag(), &mut |stage| {
+                if let RunStage::Solver(p) = stage
+                    && p.phase == Phase::Loop
+                {
+                    w.point(p.updates, p.epsilon);
+                }
+                w.progress(stage.describe(), Some(stage.fraction()))
+            })
+        }) && let Some(job) = self.state.jobs.get_mut(&Slot::Run)
+        {
+            job.phase = "preparing the run".to_string();
+            job.fraction = Some(0.0);
             self.state.say(Level::Info, "running the calibration…");
         }
     }
 
-    /// Shows the outcome of the run that arrived this frame, unless the
-    /// run was cancelled in the frame (the workbench calls this after the
-    /// frame's commands).
-    pub fn finish_run(&mut self) {
-        let Some((id, outcome)) = self.arrived.take() else {
-            return;
-        };
-        let Some(run) = self.state.run.take_if(|r| r.id == id) else {
-            return;
-        };
+    /// Shows the outcome of a run (after the frame's commands: a run
+    /// cancelled in the frame it arrived in is not shown).
+    pub(super) fn on_run(&mut self, run: &Job, outcome: Result<ResultView, RunFailure>) {
         let seconds = run.started.elapsed().as_secs_f64();
         match outcome {
             Ok(mut view) => {
@@ -180,11 +183,13 @@ impl Core {
                     *s = seconds;
                 }
                 self.forms.centres.magnify = view.centres.suggested_magnify;
-                self.state.result = Some(*view);
+                self.state.result = Some(view);
                 self.state.results_shown += 1;
                 self.state.reported = None;
                 self.state.outliers_seen = false;
-                self.state.provenance.record(Output::Result, run.stamp);
+                self.state
+                    .provenance
+                    .record(Output::Result, run.stamp.clone());
                 self.state.provenance.forget(Output::Report);
                 // The operator stays where they are; the status line and
                 // the Results tab say a result is ready.
@@ -204,34 +209,6 @@ impl Core {
                     title: "The calibration failed".to_string(),
                     body: e.to_string(),
                 });
-            }
-        }
-    }
-
-    /// Handles a [`RunMessage`].
-    pub(super) fn on_run(&mut self, message: RunMessage) {
-        match message {
-            RunMessage::Progress { run: id, stage } => {
-                if let Some(run) = self.state.run.as_mut().filter(|r| r.id == id) {
-                    if let RunStage::Solver(p) = stage
-                        && p.phase == Phase::Loop
-                    {
-                        run.epsilons.truncate(p.updates);
-                        run.epsilons.push(p.epsilon);
-                    }
-                    run.phase = stage.describe();
-                    run.fraction = run.fraction.max(stage.fraction());
-                }
-            }
-            RunMessage::Finished { run: id, outcome } => {
-                // A cancelled run (or one whose session was replaced) has
-                // ended: what it sends is not shown.
-                if self.state.stopping.remove(&id) {
-                    return;
-                }
-                if self.state.run.as_ref().is_some_and(|r| r.id == id) {
-                    self.arrived = Some((id, outcome));
-                }
             }
         }
     }

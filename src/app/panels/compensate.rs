@@ -11,11 +11,13 @@
 use egui::RichText;
 
 use super::{BAD, MUTED, WARN, dialog_note_ui, labelled_field, stale_banner_ui};
-use crate::app::commands::{Command, CompensateCommand, FilesCommand};
+use crate::app::commands::{Command, CompensateCommand};
+use crate::app::dialog::Purpose;
 use crate::app::forms::Forms;
 use crate::app::forms::compensate::{CompensateForm, TcpChoice};
+use crate::app::job::Slot;
 use crate::app::provenance::Output;
-use crate::app::state::{AppState, DialogPurpose};
+use crate::app::state::AppState;
 use crate::app::view::compensate::{CompensationView, TargetRow};
 use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::uses::compensate::{JointTargets, Options};
@@ -72,7 +74,7 @@ fn inputs_ui(
     form: &mut CompensateForm,
     commands: &mut Vec<Command>,
 ) {
-    let dialog_busy = state.busy.dialog;
+    let dialog_busy = state.jobs.runs(&Slot::Dialog);
     egui::Grid::new("compensate_inputs")
         .num_columns(2)
         .spacing([8.0, 6.0])
@@ -90,11 +92,9 @@ fn inputs_ui(
                     .add_enabled(!dialog_busy, egui::Button::new("Open targets…"))
                     .clicked()
                 {
-                    commands.push(Command::Files(FilesCommand::Browse(
-                        DialogPurpose::CompensateTargets,
-                    )));
+                    commands.push(Command::Browse(Purpose::CompensateTargets));
                 }
-                dialog_note_ui(ui, state, &[DialogPurpose::CompensateTargets]);
+                dialog_note_ui(ui, state, &[Purpose::CompensateTargets]);
             });
             ui.end_row();
 
@@ -148,11 +148,9 @@ fn inputs_ui(
                         .add_enabled(!dialog_busy, egui::Button::new("Open tool…"))
                         .clicked()
                     {
-                        commands.push(Command::Files(FilesCommand::Browse(
-                            DialogPurpose::CompensateTool,
-                        )));
+                        commands.push(Command::Browse(Purpose::CompensateTool));
                     }
-                    dialog_note_ui(ui, state, &[DialogPurpose::CompensateTool]);
+                    dialog_note_ui(ui, state, &[Purpose::CompensateTool]);
                 });
                 ui.end_row();
             }
@@ -160,10 +158,8 @@ fn inputs_ui(
         });
     ui.add_space(4.0);
     ui.horizontal(|ui| {
-        let c = &state.compensate;
-        if c.cancel.is_some() {
-            ui.spinner();
-            ui.label(c.progress.as_deref().unwrap_or("compensating…"));
+        if let Some(job) = state.jobs.get(&Slot::Compensate) {
+            super::job_ui(ui, job);
             if ui.button("Cancel").clicked() {
                 commands.push(Command::Compensate(CompensateCommand::Cancel));
             }
@@ -350,7 +346,7 @@ fn write_ui(
     stale: bool,
     commands: &mut Vec<Command>,
 ) {
-    let busy = state.compensate.writing > 0 || state.busy.dialog;
+    let busy = state.jobs.writing() || state.jobs.runs(&Slot::Dialog);
     let why_not = stale.then_some("the compensation is stale: press Compensate targets again");
     ui.horizontal_wrapped(|ui| {
         labelled_field(
@@ -379,26 +375,18 @@ fn write_ui(
             dialog.clone().on_disabled_hover_text(w);
         }
         if dialog.clicked() {
-            commands.push(Command::Files(FilesCommand::Browse(
-                DialogPurpose::CompensateOut,
-            )));
+            commands.push(Command::Browse(Purpose::CompensateOut));
         }
         if let Some(w) = why_not {
             ui.label(RichText::new(w).small().color(WARN));
         }
     });
-    dialog_note_ui(ui, state, &[DialogPurpose::CompensateOut]);
-    if let Some(p) = &state.compensate.written {
-        let mark = state
-            .provenance
-            .written
-            .iter()
-            .rev()
-            .find(|w| &w.path == p)
-            .and_then(|w| state.provenance.written_stale(w));
-        let text = match mark {
-            Some(_) => format!("last written: {} (stale now)", p.display()),
-            None => format!("last written: {}", p.display()),
+    dialog_note_ui(ui, state, &[Purpose::CompensateOut]);
+    let mut written = state.provenance.written.iter().rev();
+    if let Some(w) = written.find(|w| w.from == Output::Compensation) {
+        let text = match state.provenance.written_stale(w) {
+            Some(_) => format!("last written: {} (stale now)", w.path.display()),
+            None => format!("last written: {}", w.path.display()),
         };
         ui.label(RichText::new(text).small().color(MUTED));
     }

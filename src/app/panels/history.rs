@@ -9,9 +9,11 @@ use egui_plot::{Line, LineStyle, MarkerShape, Plot, PlotPoints, Points};
 
 use super::plots::{DATE_LABEL_GAP, labelled_x, readable_y};
 use super::{AFTER, BAD, MUTED, WARN, labelled_field};
-use crate::app::commands::{Command, FilesCommand, HistoryCommand};
+use crate::app::commands::{Command, HistoryCommand};
+use crate::app::dialog::Purpose;
 use crate::app::forms::Forms;
-use crate::app::state::{AppState, DialogPurpose};
+use crate::app::job::Slot;
+use crate::app::state::AppState;
 use crate::engine::tools::history::{Drift, Entry, Library, Series, Verdict};
 
 /// Height of one drift plot, points.
@@ -45,13 +47,13 @@ pub fn history_ui(
                     420.0,
                 );
                 let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
-                let busy = state.busy.scanning;
+                let busy = state.jobs.runs(&Slot::Library);
                 if ui
-                    .add_enabled(!state.busy.dialog, egui::Button::new("Browse…"))
+                    .add_enabled(!state.jobs.runs(&Slot::Dialog), egui::Button::new("Browse…"))
                     .on_hover_text("choose the folder with the desktop's dialog")
                     .clicked()
                 {
-                    commands.push(Command::Files(FilesCommand::Browse(DialogPurpose::HistoryFolder)));
+                    commands.push(Command::Browse(Purpose::HistoryFolder));
                 }
                 if ui
                     .add_enabled(!busy, egui::Button::new("Scan"))
@@ -65,7 +67,7 @@ pub fn history_ui(
                     ui.spinner();
                 }
             });
-            super::dialog_note_ui(ui, state, &[DialogPurpose::HistoryFolder]);
+            super::dialog_note_ui(ui, state, &[Purpose::HistoryFolder]);
             match &state.history.library {
                 None => {
                     ui.label(
@@ -81,7 +83,7 @@ pub fn history_ui(
                 Some(Ok(library)) => {
                     library_ui(ui, library, forms, commands);
                     ui.separator();
-                    if state.history.drifting {
+                    if state.jobs.runs(&Slot::Drift) {
                         ui.horizontal(|ui| {
                             ui.spinner();
                             ui.label("computing the drift of the ticked results…");

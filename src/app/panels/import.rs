@@ -15,9 +15,11 @@ use super::{
     BAD, DEFAULT_RANGE, GOOD, PATH_WIDTH, WARN, labelled_field, path_row, range_fields, range_of,
 };
 use crate::app::commands::{Command, ImportCommand};
+use crate::app::dialog::Purpose;
 use crate::app::forms::Forms;
 use crate::app::forms::import::{CONVENTIONS, ImportForm, LogKind, ObservationKind, ProfilesKind};
-use crate::app::state::{AppState, DialogPurpose};
+use crate::app::job::Slot;
+use crate::app::state::AppState;
 use crate::engine::base::robot::{self, DhConvention};
 use crate::engine::files::import::{AngleUnit, LengthUnit, SideChoice};
 
@@ -58,12 +60,12 @@ fn import_form_ui(
         ui,
         state,
         &[
-            DialogPurpose::ImportJoints,
-            DialogPurpose::ImportPoses,
-            DialogPurpose::ImportProfiles,
-            DialogPurpose::ImportReferences,
-            DialogPurpose::ImportCentres,
-            DialogPurpose::ImportHandEye,
+            Purpose::ImportJoints,
+            Purpose::ImportPoses,
+            Purpose::ImportProfiles,
+            Purpose::ImportReferences,
+            Purpose::ImportCentres,
+            Purpose::ImportHandEye,
         ],
     );
     ui.label(
@@ -74,7 +76,10 @@ fn import_form_ui(
         )
         .weak(),
     );
-    let busy = state.busy.importing > 0 || state.busy.dialog || state.import_job.cancel.is_some();
+    let jobs = &state.jobs;
+    let busy = [Slot::Import, Slot::ImportPreview, Slot::Dialog]
+        .iter()
+        .any(|s| jobs.runs(s));
     let joints = forms.import.log_kind == LogKind::Joints;
     // The actions stay in view above the form (it is taller than the
     // window at 1366×768); the full outcome is at the form's end.
@@ -139,11 +144,8 @@ fn actions_ui(
                 commands.push(Command::Import(ImportCommand::Preview { guess: true }));
             }
         }
-        if state.import_job.cancel.is_some() {
-            ui.spinner();
-            if let Some(p) = &state.import_job.progress {
-                ui.label(p);
-            }
+        if let Some(job) = state.jobs.get(&Slot::Import) {
+            super::job_ui(ui, job);
             if ui
                 .button("Cancel import")
                 .on_hover_text("stop the import: nothing is opened, what is open stays")
@@ -151,7 +153,7 @@ fn actions_ui(
             {
                 commands.push(Command::Import(ImportCommand::Cancel));
             }
-        } else if state.busy.importing > 0 {
+        } else if state.jobs.runs(&Slot::ImportPreview) {
             ui.spinner();
         }
         if let Some(Ok(text)) = &state.import.outcome {
@@ -210,7 +212,7 @@ fn files_ui(
                     &mut f.joints,
                     "/path/to/joints.csv",
                     busy,
-                    DialogPurpose::ImportJoints,
+                    Purpose::ImportJoints,
                     commands,
                 );
             } else {
@@ -245,7 +247,7 @@ fn files_ui(
                     &mut f.profiles,
                     hint,
                     busy,
-                    DialogPurpose::ImportProfiles,
+                    Purpose::ImportProfiles,
                     commands,
                 );
                 ui.label("");
@@ -274,7 +276,7 @@ fn files_ui(
                 &mut f.references,
                 "optional: from,to,distance (mm), from the laser tracker",
                 busy,
-                DialogPurpose::ImportReferences,
+                Purpose::ImportReferences,
                 commands,
             );
         });

@@ -13,8 +13,10 @@ use egui::RichText;
 use super::path_row;
 use super::{BAD, GOOD, MUTED, WARN};
 use crate::app::commands::{Command, ImportCommand};
+use crate::app::dialog::Purpose;
 use crate::app::forms::import::{HandEyeChoice, ImportForm, ObservationKind};
-use crate::app::state::{AppState, DialogPurpose};
+use crate::app::job::Slot;
+use crate::app::state::AppState;
 use crate::engine::files::import::{FlangeConvention, PairingPreview, PoseFormat, PosePreview};
 
 /// Height of the pairing list, points: a dozen rows, the rest scrolled
@@ -46,7 +48,7 @@ pub fn pose_file_rows(
         &mut f.poses,
         "program (.ls .mod .dat .script) or pose table, .rob",
         busy,
-        DialogPurpose::ImportPoses,
+        Purpose::ImportPoses,
         commands,
     );
     let l = ui.label("Layout");
@@ -142,7 +144,7 @@ pub fn pose_file_rows(
             &mut f.centres,
             "x y z a pose (sensor frame, mm), paired with the poses in order",
             busy,
-            DialogPurpose::ImportCentres,
+            Purpose::ImportCentres,
             commands,
         );
     }
@@ -152,7 +154,7 @@ pub fn pose_file_rows(
 /// Files grid.
 pub fn detected_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
     let view = &state.import;
-    let scanning = state.busy.importing > 0;
+    let scanning = state.jobs.runs(&Slot::PoseScan);
     ui.horizontal(|ui| {
         ui.label(RichText::new("Read in the pose file").strong());
         if scanning {
@@ -419,7 +421,7 @@ pub fn hand_eye_ui(
                         &mut f.hand_eye_file,
                         "a 4×4 JSON matrix (rows, mm), or a session or result file",
                         busy,
-                        DialogPurpose::ImportHandEye,
+                        Purpose::ImportHandEye,
                         commands,
                     );
                 });

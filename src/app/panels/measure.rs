@@ -14,13 +14,15 @@ use egui_plot::{Plot, PlotPoint};
 
 use super::{AFTER, BAD, GOOD, MUTED, WARN, labelled_field, number_field, stale_banner_ui};
 use crate::app::commands::{Command, MeasureCommand};
+use crate::app::dialog::Purpose;
 use crate::app::features::measure::{DRAWN_MAX, group, has_covariance};
 use crate::app::forms::Forms;
 use crate::app::forms::import::CONVENTIONS;
 use crate::app::forms::measure::{MAX_SENSOR_NOISE_MM, RawLog, ScanChoice};
+use crate::app::job::Slot;
 use crate::app::provenance::Output;
 use crate::app::state::AppState;
-use crate::app::state::measure::{MeasureDialog, MeasuredCloud};
+use crate::app::state::measure::MeasuredCloud;
 use crate::engine::base::session::Use;
 use crate::engine::files::import::{AngleUnit, LengthUnit};
 use crate::engine::uses::measure::selfcheck::ModelCheck;
@@ -120,20 +122,23 @@ fn path_row(
     label: &str,
     text: &mut String,
     hint: &str,
-    purpose: MeasureDialog,
+    purpose: Purpose,
     commands: &mut Vec<Command>,
 ) {
     ui.horizontal(|ui| {
         labelled_field(ui, label, text, hint, 420.0);
         if ui
-            .add_enabled(!state.measure.dialog, egui::Button::new("Browse…"))
+            .add_enabled(
+                !state.jobs.runs(&Slot::Dialog),
+                egui::Button::new("Browse…"),
+            )
             .clicked()
         {
-            commands.push(Command::Measure(MeasureCommand::Browse(purpose)));
+            commands.push(Command::Browse(purpose));
         }
-        if state.measure.dialog_empty == Some(purpose) {
+        if state.dialog_empty == Some(purpose) {
             ui.label(
-                RichText::new(crate::app::state::NO_DIALOG)
+                RichText::new(crate::app::dialog::NO_DIALOG)
                     .small()
                     .color(WARN),
             );
@@ -200,7 +205,7 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
         ui.checkbox(&mut form.no_sigma, "no σ (as --no-sigma)")
             .on_hover_text("measure without σ: for a result without covariance (method paper)");
         ui.add_space(12.0);
-        let running = state.measure.job.is_some();
+        let running = state.jobs.runs(&Slot::Measure);
         if ui
             .add_enabled(
                 !running && state.result.is_some(),
@@ -219,13 +224,8 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
         {
             commands.push(Command::Measure(MeasureCommand::Cancel));
         }
-        if let Some(job) = &state.measure.job {
-            ui.add(
-                egui::ProgressBar::new(job.fraction as f32)
-                    .desired_width(160.0)
-                    .show_percentage(),
-            );
-            ui.label(RichText::new(&job.phase).small());
+        if let Some(job) = state.jobs.get(&Slot::Measure) {
+            super::job_ui(ui, job);
         }
     });
     if let Some(why) = &state.measure.failure {
@@ -280,7 +280,7 @@ fn scan_ui(
             "Session file",
             &mut form.session_file,
             "a session .json",
-            MeasureDialog::SessionFile,
+            Purpose::MeasureSession,
             commands,
         ),
         ScanChoice::RawScan => {
@@ -296,7 +296,7 @@ fn scan_ui(
                 "Pose log",
                 &mut form.log,
                 "joint log CSV or pose file",
-                MeasureDialog::Log,
+                Purpose::MeasureLog,
                 commands,
             );
             path_row(
@@ -305,7 +305,7 @@ fn scan_ui(
                 "Profiles",
                 &mut form.profiles,
                 "a folder of <id>.csv…, or one CSV with a pose column",
-                MeasureDialog::Profiles,
+                Purpose::MeasureProfiles,
                 commands,
             );
             raw_units_ui(ui, form);
@@ -315,7 +315,7 @@ fn scan_ui(
                 "References",
                 &mut form.references,
                 "optional: the artefact's distances CSV (from,to,distance mm)",
-                MeasureDialog::References,
+                Purpose::MeasureReferences,
                 commands,
             );
         }
@@ -326,7 +326,7 @@ fn scan_ui(
         "Workpiece frame",
         &mut form.frame,
         "optional: a JSON 4×4 base_from_workpiece (mm); empty: robot base frame",
-        MeasureDialog::Frame,
+        Purpose::MeasureFrame,
         commands,
     );
 }
@@ -724,7 +724,7 @@ fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
             .on_hover_text(
                 "PLY (binary: x y z double mm, sigma_mm float, pose), E57 (a scan per pose with its sensor pose) or CSV (id,x,y,z,sigma_mm), by the extension; written whole or not at all",
             );
-        let busy = state.measure.writing > 0 || state.measure.dialog;
+        let busy = state.jobs.writing() || state.jobs.runs(&Slot::Dialog);
         let why = stale.as_ref().map_or_else(
             || "write the cloud on show to the typed file".to_string(),
             |s| format!("refused: {s}; measure again first"),
@@ -741,12 +741,12 @@ fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
             .on_hover_text("choose the file (.ply, .e57, .csv) in a dialog, then write it")
             .clicked()
         {
-            commands.push(Command::Measure(MeasureCommand::Browse(MeasureDialog::Export)));
+            commands.push(Command::Browse(Purpose::MeasureExport));
         }
         ui.label(RichText::new(".ply · .e57 · .csv").small().color(MUTED));
-        if state.measure.dialog_empty == Some(MeasureDialog::Export) {
+        if state.dialog_empty == Some(Purpose::MeasureExport) {
             ui.label(
-                RichText::new(crate::app::state::NO_DIALOG)
+                RichText::new(crate::app::dialog::NO_DIALOG)
                     .small()
                     .color(WARN),
             );

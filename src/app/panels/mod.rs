@@ -20,8 +20,10 @@ pub mod stripe;
 use egui::{Color32, RichText};
 
 use super::commands::{Command, ViewCommand};
+use super::dialog::{NO_DIALOG, Purpose};
 use super::forms::{Forms, Tab};
-use super::state::{AppState, DialogPurpose, NO_DIALOG};
+use super::job::{Job, Slot};
+use super::state::AppState;
 
 /// Colour of "before calibration" series (nominal model, initial hand-eye).
 pub const BEFORE: Color32 = Color32::from_rgb(230, 120, 40);
@@ -180,11 +182,11 @@ const NUMBER_FIELD_WIDTH: f32 = 56.0;
 /// What a view says with no session: that one is being opened (with a
 /// spinner), else how to open one.
 pub fn no_session_ui(ui: &mut egui::Ui, state: &AppState) {
-    match &state.busy.opening {
-        Some(what) => {
+    match state.jobs.get(&Slot::Load) {
+        Some(job) => {
             ui.horizontal(|ui| {
                 ui.spinner();
-                ui.label(format!("Opening {what}…"));
+                ui.label(&job.phase);
             });
         }
         None => {
@@ -195,9 +197,34 @@ pub fn no_session_ui(ui: &mut egui::Ui, state: &AppState) {
 
 /// The note that the last file dialog for one of `purposes` chose
 /// nothing (or none is available), beside that dialog's Browse button.
-pub fn dialog_note_ui(ui: &mut egui::Ui, state: &AppState, purposes: &[DialogPurpose]) {
+pub fn dialog_note_ui(ui: &mut egui::Ui, state: &AppState, purposes: &[Purpose]) {
     if state.dialog_empty.is_some_and(|p| purposes.contains(&p)) {
         ui.label(RichText::new(NO_DIALOG).small().color(WARN));
+    }
+}
+
+/// A job under way: a spinner, or the bar of its fraction, and its phase
+/// by name (the bar never sits still without saying what it does).
+pub fn job_ui(ui: &mut egui::Ui, job: &Job) {
+    match job.fraction {
+        Some(f) => {
+            ui.add(
+                egui::ProgressBar::new(f as f32)
+                    .desired_width(160.0)
+                    .show_percentage(),
+            );
+        }
+        None => {
+            ui.spinner();
+        }
+    }
+    ui.add(egui::Label::new(RichText::new(&job.phase).small()).wrap());
+}
+
+/// The job in `slot`, when one runs, as [`job_ui`] on one line.
+pub fn slot_ui(ui: &mut egui::Ui, state: &AppState, slot: &Slot) {
+    if let Some(job) = state.jobs.get(slot) {
+        ui.horizontal_wrapped(|ui| job_ui(ui, job));
     }
 }
 
@@ -392,7 +419,7 @@ pub fn path_row(
     text: &mut String,
     hint: &str,
     busy: bool,
-    purpose: DialogPurpose,
+    purpose: Purpose,
     commands: &mut Vec<Command>,
 ) {
     let l = ui.label(label);
@@ -410,9 +437,7 @@ pub fn path_row(
         ))
         .clicked()
     {
-        commands.push(Command::Files(crate::app::commands::FilesCommand::Browse(
-            purpose,
-        )));
+        commands.push(Command::Browse(purpose));
     }
     ui.end_row();
 }

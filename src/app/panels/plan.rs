@@ -10,10 +10,12 @@ use egui_plot::{MarkerShape, Plot, PlotPoints, Points};
 use super::{
     AFTER, BAD, BEFORE, DEFAULT_RANGE, MUTED, labelled_field, range_fields, range_of, range_values,
 };
-use crate::app::commands::{Command, FilesCommand, PlanCommand};
+use crate::app::commands::{Command, PlanCommand};
+use crate::app::dialog::Purpose;
 use crate::app::forms::{Forms, plan::default_sphere};
+use crate::app::job::Slot;
 use crate::app::provenance::{Output, Stale};
-use crate::app::state::{AppState, DialogPurpose, PlanExport, PlanOutcome};
+use crate::app::state::{AppState, PlanExport, PlanOutcome};
 use crate::engine::base::robot;
 use crate::engine::tools::plan::{Plan, PlanStats, StationRole};
 
@@ -170,7 +172,7 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
     .on_hover_text("the calibrated hand-eye of the result on show, else the open session's; unticked: the paper's initial hand-eye");
     ui.add_space(6.0);
     ui.horizontal(|ui| {
-        let running = state.plan.cancel.is_some();
+        let running = state.jobs.runs(&Slot::Plan);
         if ui
             .add_enabled(
                 !running,
@@ -186,13 +188,8 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
         {
             commands.push(Command::Plan(PlanCommand::Cancel));
         }
-        if running {
-            ui.spinner();
-        }
     });
-    if let Some(p) = &state.plan.progress {
-        ui.label(p);
-    }
+    super::slot_ui(ui, state, &Slot::Plan);
 }
 
 /// The predicted validation std after calibration (simulated
@@ -329,6 +326,7 @@ fn export_ui(
         || "a file is being written".to_string(),
         |s| format!("refused: {s}; press Make plan"),
     );
+    let busy = state.jobs.writing() || state.jobs.runs(&Slot::Simulate);
     ui.horizontal_wrapped(|ui| {
         labelled_field(
             ui,
@@ -338,7 +336,7 @@ fn export_ui(
             240.0,
         );
         if ui.button("Browse…").clicked() {
-            commands.push(Command::Files(FilesCommand::Browse(DialogPurpose::ExportFolder)));
+            commands.push(Command::Browse(Purpose::ExportFolder));
         }
         let robot_name = crate::engine::base::robot::presets::preset(&forms.plan.robot)
             .map(|p| p.robot.name)
@@ -360,7 +358,7 @@ fn export_ui(
             };
             if ui
                 .add_enabled(
-                    state.plan.writing == 0 && stale.is_none(),
+                    !busy && stale.is_none(),
                     egui::Button::new(kind.label()),
                 )
                 .on_hover_text(hint)
@@ -372,7 +370,7 @@ fn export_ui(
         }
         if ui
             .add_enabled(
-                state.plan.writing == 0 && stale.is_none(),
+                !busy && stale.is_none(),
                 egui::Button::new("Simulate and open"),
             )
             .on_hover_text("a session of this plan on a simulated robot with kinematic errors, each pose touched up as when teaching: try the calibration before going to the cell")
@@ -406,7 +404,7 @@ fn outcome_ui(
     stats_ui(ui, st);
     ui.separator();
     export_ui(ui, state, forms, stale.as_ref(), commands);
-    super::dialog_note_ui(ui, state, &[DialogPurpose::ExportFolder]);
+    super::dialog_note_ui(ui, state, &[Purpose::ExportFolder]);
     ui.separator();
     ui.label(RichText::new("Stations seen from above (base frame x, y in mm)").strong());
     map_ui(ui, plan);

@@ -9,8 +9,9 @@ use super::{
     BAD, DEFAULT_RANGE, MUTED, WARN, labelled_field, range_fields, range_of, range_values,
 };
 use crate::app::commands::{Command, FilesCommand, ViewCommand};
+use crate::app::dialog::Purpose;
 use crate::app::forms::{Forms, Grouping};
-use crate::app::state::{AppState, DialogPurpose, Fit, LoadedSession};
+use crate::app::state::{AppState, Fit, LoadedSession};
 use crate::engine::base::session::Use;
 
 /// A row of the table: a group header or a measurement.
@@ -54,7 +55,7 @@ pub fn session_ui(
     });
     range_ui(ui, loaded, forms, commands);
     save_ui(ui, state, forms, commands);
-    super::dialog_note_ui(ui, state, &[DialogPurpose::SaveSession]);
+    super::dialog_note_ui(ui, state, &[Purpose::SaveSession]);
     ui.separator();
     table_ui(ui, state, loaded, forms, commands);
 }
@@ -202,13 +203,11 @@ fn save_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
             .on_hover_text("choose the file with the desktop's dialog")
             .clicked()
         {
-            commands.push(Command::Files(FilesCommand::Browse(
-                DialogPurpose::SaveSession,
-            )));
+            commands.push(Command::Browse(Purpose::SaveSession));
         }
         let label = if replace { "Replace" } else { "Save" };
         let save = ui
-            .add_enabled(!state.busy.saving, egui::Button::new(label))
+            .add_enabled(!state.jobs.writing(), egui::Button::new(label))
             .on_hover_text("write the session without the left-out measurements (atomic write)");
         let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
         if save.clicked() || entered {

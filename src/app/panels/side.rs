@@ -10,9 +10,11 @@ use crate::engine::calibrate::solve::paper::Pairing;
 
 use super::{AFTER, BAD, BEFORE, labelled_field};
 use crate::app::commands::{Command, FilesCommand, RunCommand, ViewCommand};
+use crate::app::dialog::{NO_DIALOG, Purpose};
 use crate::app::forms::Forms;
+use crate::app::job::Slot;
 use crate::app::provenance::Output;
-use crate::app::state::{AppState, DialogPurpose, NO_DIALOG};
+use crate::app::state::AppState;
 
 /// The whole left panel.
 pub fn side_ui(
@@ -67,8 +69,8 @@ pub fn load_ui(
         );
         whole(ui, RichText::new(text).small());
     } else {
-        match &state.busy.opening {
-            Some(what) => name_ui(ui, &format!("opening {what}…")),
+        match state.jobs.get(&Slot::Load) {
+            Some(job) => name_ui(ui, &job.phase),
             None => name_ui(ui, "no session open"),
         }
         line(ui, RichText::new(" ").small());
@@ -100,10 +102,10 @@ pub fn load_ui(
             )));
         }
         let dialog = ui
-            .add_enabled(!state.busy.dialog, egui::Button::new("Open…"))
+            .add_enabled(!state.jobs.runs(&Slot::Dialog), egui::Button::new("Open…"))
             .on_hover_text("choose a file with the desktop's file dialog");
         if dialog.clicked() {
-            commands.push(Command::Files(FilesCommand::Browse(DialogPurpose::Open)));
+            commands.push(Command::Browse(Purpose::Open));
         }
         if ui
             .button("Demo")
@@ -114,7 +116,7 @@ pub fn load_ui(
         }
     });
     // One line either way: the dialog's note replaces the drop hint.
-    let hint = if state.dialog_empty == Some(DialogPurpose::Open) {
+    let hint = if state.dialog_empty == Some(Purpose::Open) {
         NO_DIALOG
     } else {
         "or drop a file onto the window"
@@ -207,7 +209,8 @@ pub fn solver_ui(
     commands: &mut Vec<Command>,
 ) {
     ui.heading("Solver");
-    let running = state.run.is_some();
+    let run = state.jobs.get(&Slot::Run);
+    let running = run.is_some();
     ui.add_enabled_ui(!running, |ui| settings_ui(ui, forms));
     ui.add_space(6.0);
     // A session whose stripes do not all fit can still run once the
@@ -251,27 +254,29 @@ pub fn solver_ui(
     if excluded > 0 && !running {
         ui.label(RichText::new(format!("{excluded} measurement(s) will be left out")).small());
     }
-    if let Some(run) = &state.run {
+    if let Some(run) = run {
         // Always the phase by name and the whole run's fraction: the bar
         // never sits still without saying what the run is doing.
         ui.horizontal(|ui| {
             ui.spinner();
             let text = {
-                match run.epsilons.last() {
+                match run.series.last() {
                     Some(eps) if run.phase.starts_with("update") && !run.phase.contains(':') => {
-                        format!("{} of ≤ {}: ε = {eps:.4} mm", run.phase, run.max_iterations)
+                        let most = forms.solver.max_iterations;
+                        format!("{} of ≤ {most}: ε = {eps:.4} mm", run.phase)
                     }
                     _ => run.phase.clone(),
                 }
             };
             ui.add(egui::Label::new(text).wrap());
         });
-        ui.add(egui::ProgressBar::new(run.fraction as f32).show_percentage());
+        let fraction = run.fraction.unwrap_or_default() as f32;
+        ui.add(egui::ProgressBar::new(fraction).show_percentage());
         epsilon_plot_ui(
             ui,
             "live_epsilon",
-            &run.epsilons,
-            Some(run.threshold),
+            &run.series,
+            Some(forms.solver.threshold),
             SIDE_EPSILON_HEIGHT,
         );
     } else if let Some(result) = &state.result {

@@ -13,6 +13,7 @@ use egui::RichText;
 use super::{AFTER, BAD, GOOD, MUTED, WARN};
 use crate::app::commands::{Command, PlanCommand, RunCommand, ViewCommand};
 use crate::app::forms::{Forms, Tab};
+use crate::app::job::Slot;
 use crate::app::provenance::Output;
 use crate::app::state::{AppState, ExportKind};
 use crate::engine::tools::result_view::Verdict;
@@ -96,7 +97,9 @@ pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
     let failed = loaded.map_or(0, |l| l.analysis.failures().count());
     let warned = loaded.map_or(0, |l| l.analysis.warnings.len());
     let result_stale = prov.stale(Output::Result);
-    let running = state.run.is_some();
+    let run = state.jobs.get(&Slot::Run);
+    let running = run.is_some();
+    let loading = state.jobs.get(&Slot::Load);
     let verdict = verdict(state, forms);
     let report_stale = prov.stale(Output::Report);
     let reported = state.reported.is_some() && prov.made(Output::Report).is_some();
@@ -125,18 +128,15 @@ pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
         },
         Step {
             name: "Data in",
-            state: if state.busy.loading > 0 {
+            state: if loading.is_some() {
                 StepState::Running
             } else if loaded.is_some() {
                 StepState::Done
             } else {
                 StepState::Todo
             },
-            detail: if state.busy.loading > 0 {
-                state.busy.opening.as_ref().map_or_else(
-                    || "opening a file…".to_string(),
-                    |w| format!("opening {w}…"),
-                )
+            detail: if let Some(job) = loading {
+                job.phase.clone()
             } else {
                 loaded.map_or_else(
                     || "import the robot's log and the sensor's profiles, or open a session".into(),
@@ -175,7 +175,7 @@ pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
                 (_, _, Some(_)) => StepState::Done,
                 _ => StepState::Todo,
             },
-            detail: match (&result_stale, &state.run, &state.result) {
+            detail: match (&result_stale, run, &state.result) {
                 (_, Some(run), _) => format!("calibrating: {}", run.phase),
                 (Some(s), _, Some(_)) => format!("{s}: run again"),
                 (_, _, Some(r)) => format!("method {}", r.method),
@@ -264,9 +264,12 @@ pub fn next_action(state: &AppState, forms: &Forms, all: &[Step]) -> Option<Next
             others: Vec::new(),
         })
     };
-    if let Some(run) = &state.run {
+    if let Some(run) = state.jobs.get(&Slot::Run) {
         return Some(NextAction {
-            label: format!("calibrating… {:.0} %", run.fraction * 100.0),
+            label: format!(
+                "calibrating… {:.0} %",
+                run.fraction.unwrap_or_default() * 100.0
+            ),
             command: None,
             why: format!(
                 "{}: wait for the run, or press Cancel in the solver panel (the result on show stays)",
@@ -275,7 +278,7 @@ pub fn next_action(state: &AppState, forms: &Forms, all: &[Step]) -> Option<Next
             others: Vec::new(),
         });
     }
-    if state.busy.loading > 0 {
+    if state.jobs.runs(&Slot::Load) {
         return Some(NextAction {
             label: "opening…".into(),
             command: None,
@@ -387,7 +390,7 @@ pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &m
                 .size(14.0)
                 .color(colour(step));
             // A step is a link to its view (or does its action).
-            let busy = state.run.is_some() && matches!(step.action.1, Command::Run(_));
+            let busy = state.jobs.runs(&Slot::Run) && matches!(step.action.1, Command::Run(_));
             let hover = match &step.state {
                 StepState::Stale(_) => format!("stale: {} ({})", step.detail, step.action.0),
                 _ => format!("{} ({})", step.detail, step.action.0),
@@ -458,10 +461,14 @@ pub fn measure_step(state: &AppState) -> Step {
     let m = &state.measure;
     let stale = state.provenance.stale(Output::Cloud);
     let show = Command::View(ViewCommand::ShowTab(Tab::Measure));
-    let (step_state, detail) = match (&m.job, &m.shown, &stale) {
+    let (step_state, detail) = match (state.jobs.get(&Slot::Measure), &m.shown, &stale) {
         (Some(job), _, _) => (
             StepState::Running,
-            format!("measuring: {} ({:.0} %)", job.phase, job.fraction * 100.0),
+            format!(
+                "measuring: {} ({:.0} %)",
+                job.phase,
+                job.fraction.unwrap_or_default() * 100.0
+            ),
         ),
         (None, Some(_), Some(s)) => (
             StepState::Stale(s.what_changed()),

@@ -1,15 +1,10 @@
-//! What the Measure view shows: the measuring job in flight, the cloud
-//! on show with its decimated view and figures (made on the job thread,
-//! never per frame), and the exports in flight. Changed only by the
+//! What the Measure view shows: the cloud on show with its decimated
+//! view and figures (made on the job thread, never per frame). Changed only by the
 //! Measure feature's commands and job messages.
 
-use std::collections::BTreeSet;
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
-use std::time::Instant;
 
 use crate::app::error::JobError;
-use crate::app::provenance::Stamp;
 use crate::engine::uses::measure::{Cloud, CloudPoint, Dropped, SelfValidation, SigmaStats};
 
 /// A cloud measured in the workbench, with what the view draws of it.
@@ -72,74 +67,11 @@ pub enum MeasureFailure {
     Failed(JobError),
 }
 
-/// The measuring job in flight.
-#[derive(Debug, Clone)]
-pub struct MeasureJob {
-    /// Its number (messages of other jobs are not its own).
-    pub id: u64,
-    /// Set to stop it at its next pose.
-    pub cancel: Arc<AtomicBool>,
-    /// When it started.
-    pub started: Instant,
-    /// What it is doing, in words.
-    pub phase: String,
-    /// Fraction of the job done, 0…1.
-    pub fraction: f64,
-    /// The inputs it started from (its cloud's provenance).
-    pub stamp: Stamp,
-}
-
-/// What a Measure view file dialog is for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MeasureDialog {
-    /// The session file to measure.
-    SessionFile,
-    /// A raw scan's pose log.
-    Log,
-    /// A raw scan's profiles folder.
-    Profiles,
-    /// The workpiece frame file.
-    Frame,
-    /// A sphere artefact's reference distances CSV.
-    References,
-    /// Where to export the cloud (a save dialog; writes once chosen).
-    Export,
-}
-
 /// The Measure view's state.
 #[derive(Debug, Default)]
 pub struct MeasureView {
-    /// The job in flight.
-    pub job: Option<MeasureJob>,
-    /// Jobs started so far (each job's number).
-    pub jobs_started: u64,
-    /// Cancelled jobs whose thread has not ended yet: what they send is
-    /// dropped.
-    pub stopping: BTreeSet<u64>,
-    /// The outcome of the job in flight, arrived this frame: shown after
-    /// the frame's commands, so that a Cancel clicked in that frame wins.
-    pub arrived: Option<(u64, Result<Box<MeasuredCloud>, MeasureFailure>)>,
     /// The cloud on show.
     pub shown: Option<MeasuredCloud>,
     /// The last job's error, until the next job.
     pub failure: Option<String>,
-    /// Exports being written.
-    pub writing: usize,
-    /// A file dialog of the view is open.
-    pub dialog: bool,
-    /// The last dialog of the view chose nothing (or none is available).
-    pub dialog_empty: Option<MeasureDialog>,
-}
-
-impl MeasureView {
-    /// True while a job, a cancelled job's thread, an export or a dialog
-    /// is in flight.
-    #[must_use]
-    pub fn is_busy(&self) -> bool {
-        self.job.is_some()
-            || !self.stopping.is_empty()
-            || self.arrived.is_some()
-            || self.writing > 0
-            || self.dialog
-    }
 }

@@ -39,7 +39,7 @@ pub(super) fn after_fail_ui(
         .ml()
         .map(|m| m.outliers.as_slice())
         .unwrap_or_default();
-    let running = state.run.is_some();
+    let running = state.jobs.runs(&crate::app::job::Slot::Run);
     let response = egui::Frame::group(ui.style())
         .stroke(egui::Stroke::new(1.5, BAD))
         .show(ui, |ui| {

@@ -21,10 +21,11 @@ mod tables;
 use egui::RichText;
 
 use super::{AFTER, BAD, GOOD, MUTED, WARN, labelled_field, number_field, ratio_text};
-use crate::app::commands::{Command, FilesCommand, ViewCommand};
+use crate::app::commands::{Command, ViewCommand};
+use crate::app::dialog::Purpose;
 use crate::app::forms::Forms;
 use crate::app::provenance::{Output, Stale};
-use crate::app::state::{AppState, DialogPurpose, ExportKind};
+use crate::app::state::{AppState, ExportKind};
 use crate::app::view::{ResultOrigin, ResultView};
 use crate::engine::tools::result_view::Verdict;
 
@@ -263,9 +264,7 @@ fn export_ui(
             .on_hover_text("choose the folder with the desktop's dialog")
             .clicked()
         {
-            commands.push(Command::Files(FilesCommand::Browse(
-                DialogPurpose::ExportFolder,
-            )));
+            commands.push(Command::Browse(Purpose::ExportFolder));
         }
         ui.separator();
         let hand_eye_only = state
@@ -292,7 +291,7 @@ fn export_ui(
             }
         }
     });
-    super::dialog_note_ui(ui, state, &[DialogPurpose::ExportFolder]);
+    super::dialog_note_ui(ui, state, &[Purpose::ExportFolder]);
     written_ui(ui, state);
 }
 
