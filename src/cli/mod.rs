@@ -60,7 +60,7 @@ use crate::engine::tools::report::summary;
 #[command(
     name = "spherecal",
     version,
-    about,
+    about = "Calibrate a robot-mounted laser-stripe sensor against a reference sphere (hand-eye and kinematic errors); plan the poses, measure parts and compensate programs with the calibration, follow a cell's drift",
     long_about = None,
     after_help = "Without a command the workbench opens on the demo session (spherecal gui).\n\
         Exit status: 0 done, 2 bad input or a refused output (one `error:` line), 1 internal failure, 130 interrupted."
