@@ -1,13 +1,19 @@
 //! The joint log: one CSV row a pose with its id, station, use, side and
 //! joint readings (the column names mapped by [`ColumnMap`]), and optional
-//! flange-pose columns for the check. [`header`] and [`preview`] serve a
-//! mapping form (the workbench's import wizard).
+//! flange-pose columns for the check. [`JointLog`] is the one reader of
+//! joint logs, the import's and a raw scan's (`measure`): the file through
+//! the capped reader, the columns found by name, every row's cells read
+//! and checked. [`header`] and [`preview`] serve a mapping form (the
+//! workbench's import wizard).
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
 use super::csv_file::CsvFile;
+use super::units::{self, AngleUnit};
 use super::{ImportError, ImportSpec, load_robot};
+use crate::engine::base::session::Use;
 
 /// The side column read when the mapping names none.
 pub const DEFAULT_SIDE_COLUMN: &str = "side";
@@ -28,14 +34,182 @@ pub struct ColumnMap {
     pub joints: Vec<String>,
 }
 
-/// Column indices of the joint log.
+/// Column indices of a joint log: the id and the joints always; station,
+/// use and side where the log has them (the import requires station and
+/// use); the flange pose when it is checked.
 pub(super) struct LogColumns {
     pub id: usize,
-    pub station: usize,
-    pub usage: usize,
+    pub station: Option<usize>,
+    pub usage: Option<usize>,
     pub side: Option<usize>,
     pub joints: Vec<usize>,
     pub flange: Vec<usize>,
+}
+
+impl LogColumns {
+    /// The columns of a raw scan's log: `id` and `joints` required,
+    /// `station` and `usage` read when the header has them.
+    fn of_scan(
+        log: &CsvFile,
+        id: &str,
+        joints: &[String],
+        station: &str,
+        usage: &str,
+    ) -> Result<Self, ImportError> {
+        Ok(Self {
+            id: log.column(id)?,
+            station: log.optional_column(station),
+            usage: log.optional_column(usage),
+            side: None,
+            joints: joints
+                .iter()
+                .map(|c| log.column(c))
+                .collect::<Result<_, _>>()?,
+            flange: Vec::new(),
+        })
+    }
+}
+
+/// One pose of a joint log as read.
+pub(crate) struct LogRow {
+    /// 1-based line.
+    pub line: usize,
+    /// Pose id.
+    pub id: String,
+    /// Station; `None` when the log has no station column or the cell is
+    /// blank.
+    pub station: Option<String>,
+    /// Use; `None` when the log has no use column or the cell is blank.
+    pub usage: Option<Use>,
+    /// Side (+1 or −1); `None` when not given.
+    pub side: Option<i8>,
+    /// Joint readings as written (the log's unit).
+    pub joints: Vec<f64>,
+    /// Flange-pose values as written, when checked.
+    pub flange: Vec<f64>,
+}
+
+/// A joint log: the file and its columns.
+pub(crate) struct JointLog {
+    /// The file (header and rows).
+    pub(super) file: CsvFile,
+    /// Its columns.
+    pub(super) cols: LogColumns,
+}
+
+impl JointLog {
+    /// The header of `path` read (through the capped reader) and its
+    /// columns found by `columns`.
+    ///
+    /// # Errors
+    /// The file cannot be read or parsed, or `columns` fails.
+    pub(super) fn read(
+        path: &Path,
+        columns: impl FnOnce(&CsvFile) -> Result<LogColumns, ImportError>,
+    ) -> Result<Self, ImportError> {
+        let file = CsvFile::read(path)?;
+        let cols = columns(&file)?;
+        Ok(Self { file, cols })
+    }
+
+    /// A raw scan's log (`measure`): `id` and the `joints` columns
+    /// required, `station` and `usage` read when the header has them.
+    ///
+    /// # Errors
+    /// The file cannot be read or parsed, or a required column is missing
+    /// (naming the header).
+    pub(crate) fn read_scan(
+        path: &Path,
+        id: &str,
+        joints: &[String],
+        station: &str,
+        usage: &str,
+    ) -> Result<Self, ImportError> {
+        Self::read(path, |f| LogColumns::of_scan(f, id, joints, station, usage))
+    }
+
+    /// Every row, read and checked: at least one row, no id twice, a use
+    /// and a side that are one, finite numbers (decimal commas where the
+    /// separator allows them), joint readings plausible in `unit`.
+    ///
+    /// # Errors
+    /// [`ImportError`] naming the file, the line, the pose and the column.
+    pub(crate) fn rows(&self, unit: AngleUnit) -> Result<Vec<LogRow>, ImportError> {
+        let log = &self.file;
+        let cols = &self.cols;
+        if log.rows.is_empty() {
+            return Err(ImportError::File {
+                path: log.path.clone(),
+                message: "the joint log has a header but no pose rows".into(),
+            });
+        }
+        let mut seen: HashMap<&str, usize> = HashMap::new();
+        for (line, row) in &log.rows {
+            let id = row[cols.id].as_str();
+            if let Some(first) = seen.insert(id, *line) {
+                return Err(ImportError::Csv {
+                    path: log.path.clone(),
+                    line: *line,
+                    message: format!("pose id `{id}` is used twice (first at line {first})"),
+                });
+            }
+        }
+        let mut out = Vec::with_capacity(log.rows.len());
+        for (line, row) in &log.rows {
+            let id = row[cols.id].clone();
+            let csv_error = |message: String| ImportError::Csv {
+                path: log.path.clone(),
+                line: *line,
+                message: format!("pose {id}: {message}"),
+            };
+            let usage = match cols.usage {
+                Some(c) if !row[c].is_empty() => Some(
+                    Use::parse(&row[c])
+                        .ok_or_else(|| csv_error(usage_message(&log.header[c], &row[c])))?,
+                ),
+                _ => None,
+            };
+            let side = match cols.side {
+                None => None,
+                Some(c) => side_cell(&row[c])
+                    .map_err(|m| csv_error(format!("column `{}`: {m}", log.header[c])))?,
+            };
+            let numbers = |columns: &[usize]| -> Result<Vec<f64>, ImportError> {
+                columns.iter().map(|&c| log.number(*line, row, c)).collect()
+            };
+            out.push(LogRow {
+                line: *line,
+                station: cols
+                    .station
+                    .map(|c| row[c].clone())
+                    .filter(|s| !s.is_empty()),
+                usage,
+                side,
+                joints: numbers(&cols.joints)?,
+                flange: numbers(&cols.flange)?,
+                id,
+            });
+        }
+        units::check_joint_unit(
+            unit,
+            out.iter()
+                .map(|r| (r.line, r.id.as_str(), r.joints.as_slice())),
+        )
+        .map_err(|(line, message)| ImportError::Csv {
+            path: log.path.clone(),
+            line,
+            message,
+        })?;
+        Ok(out)
+    }
+}
+
+/// "column `use`: `x` is not translation, rotation, identify or validate".
+pub(crate) fn usage_message(column: &str, cell: &str) -> String {
+    format!(
+        "column `{column}`: `{}` is not translation, rotation, identify or validate",
+        crate::engine::base::table::excerpt(cell)
+    )
 }
 
 pub(super) fn log_columns(
@@ -68,8 +242,8 @@ pub(super) fn log_columns(
     check_extra_joints(spec, log, dof)?;
     Ok(LogColumns {
         id: log.column(&spec.columns.id)?,
-        station: log.column(&spec.columns.station)?,
-        usage: log.column(&spec.columns.usage)?,
+        station: Some(log.column(&spec.columns.station)?),
+        usage: Some(log.column(&spec.columns.usage)?),
         side: match &spec.columns.side {
             Some(s) => Some(log.column(s)?),
             None => log
@@ -170,10 +344,14 @@ pub fn preview(spec: &ImportSpec, rows: usize) -> Result<String, ImportError> {
     let _ = writeln!(out, "{header}");
     for (line, row) in log.rows.iter().take(rows) {
         let side = cols.side.map_or("-", |c| row[c].as_str());
+        let cell = |c: Option<usize>| c.map_or("", |c| row[c].as_str());
         let _ = write!(
             out,
             "{:<10} {:<8} {:<12} {:>4}",
-            row[cols.id], row[cols.station], row[cols.usage], side
+            row[cols.id],
+            cell(cols.station),
+            cell(cols.usage),
+            side
         );
         for &c in &cols.joints {
             let v = spec.joint_unit.to_deg(log.number(*line, row, c)?);
@@ -188,7 +366,7 @@ pub fn preview(spec: &ImportSpec, rows: usize) -> Result<String, ImportError> {
 ///
 /// # Errors
 /// Anything else, in words.
-pub(super) fn side_cell(cell: &str) -> Result<Option<i8>, String> {
+pub(crate) fn side_cell(cell: &str) -> Result<Option<i8>, String> {
     match cell.trim() {
         "" => Ok(None),
         "1" | "+1" | "1.0" | "+1.0" => Ok(Some(1)),

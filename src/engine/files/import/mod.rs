@@ -62,9 +62,9 @@ pub use self::units::{AngleUnit, LengthUnit};
 pub use crate::engine::base::robot::controller::FlangeConvention;
 pub use crate::engine::files::program::PoseFormat;
 
-use self::csv_file::CsvFile;
+use self::log::JointLog;
 use crate::engine::base::robot::Robot;
-use crate::engine::base::session::{MIN_STRIPE_POINTS, Measurement, Observation, Session, Use};
+use crate::engine::base::session::{MIN_STRIPE_POINTS, Measurement, Observation, Session};
 use crate::engine::files::format::FileError;
 
 /// Default sphere diameter, mm: the 1.5 inch sphere of the paper.
@@ -233,64 +233,31 @@ pub fn read_profiles(
     ids: &[String],
     progress: &mut ImportProgress<'_>,
 ) -> Result<(Vec<PlaneProfile>, ProfileReport), ImportError> {
-    let total = ids.len();
-    let raws: Vec<RawProfile> = match source {
-        ProfileSource::Folder(dir) => {
-            let file = |id: &String| {
-                profiles::file_of(dir, id).ok_or_else(|| ImportError::MissingProfile {
-                    id: id.clone(),
-                    path: dir.join(format!("{id}.csv")),
-                })
-            };
-            if let Some(axes) = format.axes {
-                // The map is known: each file is read and put in the plane
-                // on its own, one raw profile in memory at a time.
-                let mut planes = Vec::with_capacity(ids.len());
-                let mut poses = Vec::with_capacity(ids.len());
-                for (k, id) in ids.iter().enumerate() {
-                    let raw = profiles::read_profile(&file(id)?, format)?;
-                    let (plane, count) = plane_of(&raw, &axes, id)?;
-                    planes.push(plane);
-                    poses.push(count);
-                    progress::report(progress, ImportStage::Profiles { done: k + 1, total })?;
-                }
-                return Ok((
-                    planes,
-                    ProfileReport {
-                        axes,
-                        axes_guessed: false,
-                        poses,
-                    },
-                ));
-            }
-            let mut raws = Vec::with_capacity(total);
-            for (k, id) in ids.iter().enumerate() {
-                raws.push(profiles::read_profile(&file(id)?, format)?);
-                progress::report(progress, ImportStage::Profiles { done: k + 1, total })?;
-            }
-            raws
-        }
-        ProfileSource::File { path, pose_column } => {
-            let (order, mut by_id) = profiles::read_profile_table(path, pose_column, format)?;
-            if let Some(stray) = order.iter().find(|id| !ids.contains(id)) {
-                return Err(ImportError::File {
-                    path: path.clone(),
-                    message: format!("pose `{stray}` is not in the pose log"),
-                });
-            }
-            let raws = ids
-                .iter()
-                .map(|id| {
-                    by_id.remove(id).ok_or_else(|| ImportError::MissingProfile {
-                        id: id.clone(),
-                        path: path.clone(),
-                    })
-                })
-                .collect::<Result<_, _>>()?;
-            progress::report(progress, ImportStage::Profiles { done: total, total })?;
-            raws
-        }
-    };
+    if let Some(axes) = format.axes {
+        // The map is known: each profile is put in the plane as it is
+        // read, one raw profile in memory at a time.
+        let mut planes = Vec::with_capacity(ids.len());
+        let mut poses = Vec::with_capacity(ids.len());
+        pairing::read_by_id(source, format, ids, progress, |id, raw| {
+            let (plane, count) = plane_of(&raw, &axes, id)?;
+            planes.push(plane);
+            poses.push(count);
+            Ok(())
+        })?;
+        return Ok((
+            planes,
+            ProfileReport {
+                axes,
+                axes_guessed: false,
+                poses,
+            },
+        ));
+    }
+    let mut raws = Vec::with_capacity(ids.len());
+    pairing::read_by_id(source, format, ids, progress, |_, raw| {
+        raws.push(raw);
+        Ok(())
+    })?;
     planar(raws, format, ids)
 }
 
@@ -430,84 +397,52 @@ pub fn import_with(
 ) -> Result<Imported, ImportError> {
     check_sphere_diameter(spec.sphere_diameter)?;
     let robot = load_robot(&spec.robot)?;
-    let log = CsvFile::read(&spec.joint_log)?;
-    let cols = log::log_columns(spec, &log, robot.dof())?;
-    if log.rows.is_empty() {
-        return Err(ImportError::File {
-            path: log.path.clone(),
-            message: "the joint log has a header but no pose rows".into(),
-        });
-    }
-    let ids: Vec<String> = log.rows.iter().map(|(_, r)| r[cols.id].clone()).collect();
-    let mut seen: HashMap<&str, usize> = HashMap::new();
-    for ((line, _), id) in log.rows.iter().zip(&ids) {
-        if let Some(first) = seen.insert(id.as_str(), *line) {
-            return Err(ImportError::Csv {
-                path: log.path.clone(),
-                line: *line,
-                message: format!("pose id `{id}` is used twice (first at line {first})"),
-            });
-        }
-    }
+    let log = JointLog::read(&spec.joint_log, |f| log::log_columns(spec, f, robot.dof()))?;
+    let rows = log.rows(spec.joint_unit)?;
+    let ids: Vec<String> = rows.iter().map(|r| r.id.clone()).collect();
     let (planes, report) = read_profiles(&spec.profiles, &spec.profile_format, &ids, progress)?;
     check_profile_size(&planes, &spec.profile_format, spec.sphere_diameter)?;
-    let mut measurements = Vec::with_capacity(log.rows.len());
+    let mut measurements = Vec::with_capacity(rows.len());
     let mut checks = Vec::new();
-    for (((line, row), id), plane) in log.rows.iter().zip(ids).zip(planes) {
+    for (r, plane) in rows.iter().zip(planes) {
         let csv_error = |message: String| ImportError::Csv {
-            path: log.path.clone(),
-            line: *line,
-            message: format!("pose {id}: {message}"),
+            path: log.file.path.clone(),
+            line: r.line,
+            message: format!("pose {}: {message}", r.id),
         };
-        let usage = Use::parse(&row[cols.usage]).ok_or_else(|| {
-            csv_error(format!(
-                "column `{}`: `{}` is not translation, rotation, identify or validate",
-                log.header[cols.usage], row[cols.usage]
-            ))
-        })?;
-        let side_given = match cols.side {
-            None => None,
-            Some(c) => log::side_cell(&row[c])
-                .map_err(|m| csv_error(format!("column `{}`: {m}", log.header[c])))?,
+        // The import's log has a use column (log_columns requires it).
+        let usage = match (r.usage, log.cols.usage) {
+            (Some(u), _) => u,
+            (None, c) => {
+                let column = c.map_or("use", |c| log.file.header[c].as_str());
+                return Err(csv_error(log::usage_message(column, "")));
+            }
         };
-        let raw: Vec<f64> = cols
+        let joints: Vec<f64> = r
             .joints
             .iter()
-            .map(|&c| log.number(*line, row, c))
-            .collect::<Result<_, _>>()?;
-        units::check_joint_unit(spec.joint_unit, [(*line, id.as_str(), raw.as_slice())]).map_err(
-            |(line, message)| ImportError::Csv {
-                path: log.path.clone(),
-                line,
-                message,
-            },
-        )?;
-        let joints: Vec<f64> = raw.iter().map(|&v| spec.joint_unit.to_deg(v)).collect();
+            .map(|&v| spec.joint_unit.to_deg(v))
+            .collect();
         if let Some(f) = &spec.flange {
-            let values: Vec<f64> = cols
-                .flange
-                .iter()
-                .map(|&c| log.number(*line, row, c))
-                .collect::<Result<_, _>>()?;
             let pose = f
                 .convention
-                .pose_from_values(&values)
+                .pose_from_values(&r.flange)
                 .map_err(|m| csv_error(format!("flange pose: {m}")))?;
             checks.push(check::check_pose(
                 &robot,
                 f,
                 spec.joint_unit,
-                &id,
-                &raw,
+                &r.id,
+                &r.joints,
                 &pose,
             ));
         }
         measurements.push(Measurement {
-            id,
-            station: row[cols.station].clone(),
+            id: r.id.clone(),
+            station: r.station.clone().unwrap_or_default(),
             usage,
-            side_given,
-            side: side_given.unwrap_or(1),
+            side_given: r.side,
+            side: r.side.unwrap_or(1),
             joints,
             flange: None,
             observation: Observation::Stripe(plane.points),
@@ -527,11 +462,7 @@ pub fn import_with(
         spec.references.as_deref(),
         measurements,
     )?;
-    let lines: HashMap<&str, usize> = log
-        .rows
-        .iter()
-        .map(|(line, row)| (row[cols.id].as_str(), *line))
-        .collect();
+    let lines: HashMap<&str, usize> = rows.iter().map(|r| (r.id.as_str(), r.line)).collect();
     let session = recheck(
         session,
         &Sources {

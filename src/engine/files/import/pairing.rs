@@ -1,5 +1,8 @@
-//! Profile folders as cells publish them, and the pairing of their files
-//! with the poses of a log that has no ids.
+//! Profile folders as cells publish them, and the one pairing of profiles
+//! with the poses of a log, the import's and a raw scan's (`measure`): by
+//! id when the log's ids name the profiles ([`ids_naming_profiles`],
+//! [`read_by_id`]), else pose `k` with the `k`-th profile
+//! ([`read_in_order`]).
 //!
 //! A folder holds the profiles and often more: the pose file itself, the
 //! sensor vendor's or another tool's calibration output, notes. The
@@ -19,7 +22,8 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use super::ImportError;
-use super::profiles::PROFILE_EXTENSIONS;
+use super::profiles::{self, PROFILE_EXTENSIONS, ProfileFormat, ProfileSource, RawProfile};
+use super::progress::{self, ImportProgress, ImportStage};
 use crate::engine::files::format::same_file;
 
 /// The profile files of a folder and what was left out.
@@ -60,6 +64,158 @@ impl FolderListing {
         }
         out
     }
+}
+
+/// The poses' ids when the profiles are paired by them: every pose has
+/// an id and, for a folder, each names a profile file (`<id>.<ext>`; a
+/// single profile table has a pose column). `None`: pose `k` goes with the
+/// `k`-th profile ([`read_in_order`]).
+#[must_use]
+pub fn ids_naming_profiles<'a>(
+    source: &ProfileSource,
+    ids: impl IntoIterator<Item = Option<&'a str>>,
+) -> Option<Vec<String>> {
+    let ids: Vec<String> = ids
+        .into_iter()
+        .map(|id| id.map(str::to_string))
+        .collect::<Option<_>>()?;
+    let named = match source {
+        ProfileSource::Folder(dir) => ids.iter().all(|id| profiles::file_of(dir, id).is_some()),
+        ProfileSource::File { .. } => true,
+    };
+    named.then_some(ids)
+}
+
+/// Reads the profiles of the poses `ids` from `source` in that order (a
+/// folder's `<id>.<ext>`, or the id's rows of one table, which may name
+/// no pose the log does not have), handing each to `each` as it is read:
+/// a caller that converts them keeps one raw profile in memory at a
+/// time. `progress` is told of each profile read.
+///
+/// # Errors
+/// A profile missing or unreadable, a table pose not in the log,
+/// [`ImportError::Cancelled`], or the first error of `each`.
+pub fn read_by_id(
+    source: &ProfileSource,
+    format: &ProfileFormat,
+    ids: &[String],
+    progress: &mut ImportProgress<'_>,
+    mut each: impl FnMut(&str, RawProfile) -> Result<(), ImportError>,
+) -> Result<(), ImportError> {
+    let total = ids.len();
+    match source {
+        ProfileSource::Folder(dir) => {
+            for (k, id) in ids.iter().enumerate() {
+                let file =
+                    profiles::file_of(dir, id).ok_or_else(|| ImportError::MissingProfile {
+                        id: id.clone(),
+                        path: dir.join(format!("{id}.csv")),
+                    })?;
+                each(id, profiles::read_profile(&file, format)?)?;
+                progress::report(progress, ImportStage::Profiles { done: k + 1, total })?;
+            }
+        }
+        ProfileSource::File { path, pose_column } => {
+            let (order, mut by_id) = profiles::read_profile_table(path, pose_column, format)?;
+            if let Some(stray) = order.iter().find(|id| !ids.contains(id)) {
+                return Err(ImportError::File {
+                    path: path.clone(),
+                    message: format!("pose `{stray}` is not in the pose log"),
+                });
+            }
+            for id in ids {
+                let raw = by_id
+                    .remove(id)
+                    .ok_or_else(|| ImportError::MissingProfile {
+                        id: id.clone(),
+                        path: path.clone(),
+                    })?;
+                each(id, raw)?;
+            }
+            progress::report(progress, ImportStage::Profiles { done: total, total })?;
+        }
+    }
+    Ok(())
+}
+
+/// Profiles paired with a log's poses in order.
+#[derive(Debug)]
+pub struct InOrder {
+    /// Each pose's id, from its profile's file name.
+    pub ids: Vec<String>,
+    /// Each pose's profile.
+    pub raws: Vec<RawProfile>,
+    /// The folder as listed (a folder source).
+    pub listing: Option<FolderListing>,
+}
+
+/// Pose `k` of a log of `poses` poses with the `k`-th profile: a folder's
+/// profile files in the order of the number in their names (the log file
+/// `log` and other files skipped, [`list_profiles`]), or a table's poses
+/// in its order; the counts must match. `progress` is told of each
+/// profile read.
+///
+/// # Errors
+/// The folder or a profile cannot be read, the counts differ (naming
+/// both), [`ImportError::Cancelled`].
+pub fn read_in_order(
+    source: &ProfileSource,
+    format: &ProfileFormat,
+    log: &Path,
+    poses: usize,
+    progress: &mut ImportProgress<'_>,
+) -> Result<InOrder, ImportError> {
+    let (raws, listing) = match source {
+        ProfileSource::Folder(dir) => {
+            let listing = list_profiles(dir, &[log], Some(poses))?;
+            if listing.profiles.len() != poses {
+                return Err(ImportError::File {
+                    path: dir.clone(),
+                    message: format!(
+                        "{} profiles for {poses} poses of {}: pose k is paired with the k-th profile in the order of the number in their names, so the counts must match ({})",
+                        listing.profiles.len(),
+                        log.display(),
+                        listing.summary()
+                    ),
+                });
+            }
+            let total = listing.profiles.len();
+            let mut raws = Vec::with_capacity(total);
+            for (k, p) in listing.profiles.iter().enumerate() {
+                raws.push(profiles::read_profile(p, format)?);
+                progress::report(progress, ImportStage::Profiles { done: k + 1, total })?;
+            }
+            (raws, Some(listing))
+        }
+        ProfileSource::File { path, pose_column } => {
+            let (order, mut by_id) = profiles::read_profile_table(path, pose_column, format)?;
+            if order.len() != poses {
+                return Err(ImportError::File {
+                    path: path.clone(),
+                    message: format!(
+                        "{} profiles for {poses} poses of {}: a log without ids pairs pose k with the k-th profile, so the counts must match",
+                        order.len(),
+                        log.display()
+                    ),
+                });
+            }
+            let total = order.len();
+            progress::report(progress, ImportStage::Profiles { done: total, total })?;
+            (
+                order.iter().filter_map(|id| by_id.remove(id)).collect(),
+                None,
+            )
+        }
+    };
+    let ids = raws
+        .iter()
+        .map(|r: &RawProfile| {
+            r.source
+                .file_stem()
+                .map_or_else(|| "pose".into(), |s| s.to_string_lossy().into_owned())
+        })
+        .collect();
+    Ok(InOrder { ids, raws, listing })
 }
 
 /// A file name's shape: lower case, each digit run as `#`.

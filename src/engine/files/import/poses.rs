@@ -40,9 +40,9 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Isometry3, Vector3};
 
-use super::pairing::{FolderListing, list_profiles};
-use super::profiles::{self, AxisMap, PlaneProfile, ProfileFormat, ProfileSource};
-use super::progress::{self, ImportProgress, ImportStage};
+use super::pairing::{self, FolderListing};
+use super::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource};
+use super::progress::{self, ImportProgress};
 use super::{FlangeConvention, ImportError, Imported, ProfileReport, RobotSource, load_robot};
 use crate::engine::base::robot::Robot;
 use crate::engine::base::session::{Measurement, Observation, Use};
@@ -495,21 +495,12 @@ fn read_centres(
 /// the pairing in words.
 type Paired = (Vec<String>, Vec<PlaneProfile>, ProfileReport, Vec<String>);
 
-/// The pose ids, when the profiles are paired by them: the pose file
-/// has an id for every pose, and they name the folder's profile files
-/// (or the single profile file has a pose column); `None`: pose `k` goes
-/// with the `k`-th profile.
+/// The pose ids, when the profiles are paired by them
+/// ([`pairing::ids_naming_profiles`]); `None`: pose `k` goes with the
+/// `k`-th profile.
 #[must_use]
 pub fn paired_by_id(source: &ProfileSource, records: &[PoseRecord]) -> Option<Vec<String>> {
-    let ids: Vec<String> = records
-        .iter()
-        .map(|r| r.id.clone())
-        .collect::<Option<_>>()?;
-    let named = match source {
-        ProfileSource::Folder(dir) => ids.iter().all(|id| profiles::file_of(dir, id).is_some()),
-        ProfileSource::File { .. } => true,
-    };
-    named.then_some(ids)
+    pairing::ids_naming_profiles(source, records.iter().map(|r| r.id.as_deref()))
 }
 
 /// Whether a pose's own number (`P[3]` → 3) differs from its profile's
@@ -554,48 +545,13 @@ fn pair_profiles(
             vec!["profiles paired by pose id".to_string()],
         ));
     }
-    let (raws, listing) = match source {
-        ProfileSource::Folder(dir) => {
-            let listing = list_profiles(dir, &[spec.poses.as_path()], Some(records.len()))?;
-            check_count(spec, dir, &listing, records)?;
-            let total = listing.profiles.len();
-            let mut raws = Vec::with_capacity(total);
-            for (k, p) in listing.profiles.iter().enumerate() {
-                raws.push(profiles::read_profile(p, &spec.profile_format)?);
-                progress::report(progress, ImportStage::Profiles { done: k + 1, total })?;
-            }
-            (raws, Some(listing))
-        }
-        ProfileSource::File { path, pose_column } => {
-            let (order, mut by_id) =
-                profiles::read_profile_table(path, pose_column, &spec.profile_format)?;
-            if order.len() != records.len() {
-                return Err(ImportError::File {
-                    path: path.clone(),
-                    message: format!(
-                        "{} profiles for {} poses of {}: a log without ids pairs pose k with the k-th profile, so the counts must match",
-                        order.len(),
-                        records.len(),
-                        spec.poses.display()
-                    ),
-                });
-            }
-            let total = order.len();
-            progress::report(progress, ImportStage::Profiles { done: total, total })?;
-            (
-                order.iter().filter_map(|id| by_id.remove(id)).collect(),
-                None,
-            )
-        }
-    };
-    let ids: Vec<String> = raws
-        .iter()
-        .map(|r| {
-            r.source
-                .file_stem()
-                .map_or_else(|| "pose".into(), |s| s.to_string_lossy().into_owned())
-        })
-        .collect();
+    let pairing::InOrder { ids, raws, listing } = pairing::read_in_order(
+        source,
+        &spec.profile_format,
+        &spec.poses,
+        records.len(),
+        progress,
+    )?;
     let mut notes = Vec::new();
     if let Some(listing) = &listing {
         notes.push(listing.summary());
@@ -603,28 +559,6 @@ fn pair_profiles(
     }
     let (planes, report) = super::planar(raws, &spec.profile_format, &ids)?;
     Ok((ids, planes, report, notes))
-}
-
-/// The count of profiles must be the count of poses: else both are named.
-fn check_count(
-    spec: &PoseImportSpec,
-    dir: &Path,
-    listing: &FolderListing,
-    records: &[PoseRecord],
-) -> Result<(), ImportError> {
-    if listing.profiles.len() == records.len() {
-        return Ok(());
-    }
-    Err(ImportError::File {
-        path: dir.to_path_buf(),
-        message: format!(
-            "{} profiles for {} poses of {}: pose k is paired with the k-th profile in the order of the number in their names, so the counts must match ({})",
-            listing.profiles.len(),
-            records.len(),
-            spec.poses.display(),
-            listing.summary()
-        ),
-    })
 }
 
 /// The warning of a pairing whose pose and profile numbers differ.

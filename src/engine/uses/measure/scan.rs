@@ -15,19 +15,18 @@
 //!   raw scan files, so that a change of the pose-log readers touches it
 //!   alone.
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use nalgebra::Isometry3;
 
 use crate::engine::base::robot::Robot;
 use crate::engine::base::session::{Observation, ReferenceDistance, Session, Use};
-use crate::engine::base::table::Table;
-use crate::engine::files::format::{Cap, read_text};
-use crate::engine::files::import::pairing::list_profiles;
+use crate::engine::files::import::log::JointLog;
+use crate::engine::files::import::pairing;
 use crate::engine::files::import::poses::PoseValue;
-use crate::engine::files::import::profiles::{self, RawProfile};
-use crate::engine::files::import::units::{self, AngleUnit};
+use crate::engine::files::import::profiles::RawProfile;
+use crate::engine::files::import::progress;
+use crate::engine::files::import::units::AngleUnit;
 use crate::engine::files::import::{
     AxisMap, FlangeConvention, ImportError, PoseFormat, ProfileFormat, ProfileSource,
     read_references,
@@ -347,190 +346,69 @@ pub fn scan_from_files(spec: &ScanFiles) -> Result<Scan, ImportError> {
     })
 }
 
-/// The poses of a raw scan's joint log: `id` and the joint columns
-/// required, `station` and `use` read when the log has them.
+/// The poses of a raw scan's joint log, read by the import's joint-log
+/// reader ([`JointLog`]): `id` and the joint columns required, `station`
+/// and `use` read when the log has them.
 fn joint_log(
     path: &Path,
     columns: &ScanColumns,
     unit: AngleUnit,
 ) -> Result<Vec<LogPose>, ImportError> {
-    let text = read_text(path, Cap::TABLE).map_err(|source| ImportError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let table = Table::parse(&text).map_err(|e| ImportError::Csv {
-        path: path.to_path_buf(),
-        line: e.line,
-        message: e.message,
-    })?;
-    let file_error = |message: String| ImportError::File {
-        path: path.to_path_buf(),
-        message,
-    };
-    let column = |name: &str| {
-        table
-            .column(name)
-            .ok_or_else(|| file_error(table.no_column(name)))
-    };
-    let id = column(&columns.id)?;
-    let joints: Vec<usize> = columns
-        .joints
-        .iter()
-        .map(|c| column(c))
-        .collect::<Result<_, _>>()?;
-    let station = table.column(&columns.station);
-    let usage = table.column(&columns.usage);
-    if table.rows.is_empty() {
-        return Err(file_error(
-            "the joint log has a header but no pose rows".into(),
-        ));
-    }
-    let mut raw_rows: Vec<(usize, String, Vec<f64>)> = Vec::with_capacity(table.rows.len());
-    let mut out = Vec::with_capacity(table.rows.len());
-    let mut seen: HashMap<String, usize> = HashMap::new();
-    for (line, row) in &table.rows {
-        let csv_error = |message: String| ImportError::Csv {
-            path: path.to_path_buf(),
-            line: *line,
-            message,
-        };
-        let pose_id = row[id].clone();
-        if let Some(first) = seen.insert(pose_id.clone(), *line) {
-            return Err(csv_error(format!(
-                "pose id `{pose_id}` is used twice (first at line {first})"
-            )));
-        }
-        let raw: Vec<f64> = joints
-            .iter()
-            .map(|&c| match row[c].parse::<f64>() {
-                Ok(v) if v.is_finite() => Ok(v),
-                _ => Err(csv_error(format!(
-                    "pose {pose_id}: column `{}`: `{}` is not a finite number",
-                    table.header[c], row[c]
-                ))),
-            })
-            .collect::<Result<_, _>>()?;
-        let usage = match usage.map(|c| row[c].as_str()) {
-            None | Some("") => None,
-            Some(text) => Some(Use::parse(text).ok_or_else(|| {
-                csv_error(format!(
-                    "pose {pose_id}: `{text}` is not translation, rotation, identify or validate"
-                ))
-            })?),
-        };
-        out.push(LogPose {
-            id: Some(pose_id.clone()),
-            station: station.map(|c| row[c].clone()).filter(|s| !s.is_empty()),
-            usage,
-            placement: Placement::Joints(raw.iter().map(|&v| unit.to_deg(v)).collect()),
-        });
-        raw_rows.push((*line, pose_id, raw));
-    }
-    units::check_joint_unit(
-        unit,
-        raw_rows
-            .iter()
-            .map(|(line, id, raw)| (*line, id.as_str(), raw.as_slice())),
-    )
-    .map_err(|(line, message)| ImportError::Csv {
-        path: path.to_path_buf(),
-        line,
-        message,
-    })?;
-    Ok(out)
+    let log = JointLog::read_scan(
+        path,
+        &columns.id,
+        &columns.joints,
+        &columns.station,
+        &columns.usage,
+    )?;
+    Ok(log
+        .rows(unit)?
+        .into_iter()
+        .map(|r| LogPose {
+            id: Some(r.id),
+            station: r.station,
+            usage: r.usage,
+            placement: Placement::Joints(r.joints.iter().map(|&v| unit.to_deg(v)).collect()),
+        })
+        .collect())
 }
 
-/// Each pose's raw profile and id: by id (`<id>.<ext>` in the folder, or
-/// the id's rows of one CSV) when the log has ids, else the folder's
-/// profile files in natural order, one a pose, ids from the file names.
+/// Each pose's raw profile and id, by the import's pairing
+/// ([`pairing`]): by id (`<id>.<ext>` in the folder, or the id's rows of
+/// one table) when the log's ids name the profiles, else pose `k` with the
+/// `k`-th profile file in the order of their numbers (ids from the file
+/// names).
 fn pair_profiles(
     spec: &ScanFiles,
     log: &[LogPose],
     notes: &mut Vec<String>,
 ) -> Result<(Vec<String>, Vec<RawProfile>), ImportError> {
-    let named = match &spec.profiles {
-        ProfileSource::Folder(dir) => log.iter().all(|p| {
-            p.id.as_ref()
-                .is_some_and(|id| profiles::file_of(dir, id).is_some())
-        }),
-        ProfileSource::File { .. } => log.iter().all(|p| p.id.is_some()),
-    };
-    if named {
-        let ids: Vec<String> = log.iter().filter_map(|p| p.id.clone()).collect();
-        let raws = match &spec.profiles {
-            ProfileSource::Folder(dir) => ids
-                .iter()
-                .map(|id| {
-                    let file =
-                        profiles::file_of(dir, id).ok_or_else(|| ImportError::MissingProfile {
-                            id: id.clone(),
-                            path: dir.join(format!("{id}.csv")),
-                        })?;
-                    profiles::read_profile(&file, &spec.profile_format)
-                })
-                .collect::<Result<Vec<_>, _>>()?,
-            ProfileSource::File { path, pose_column } => {
-                let (_, mut by_id) =
-                    profiles::read_profile_table(path, pose_column, &spec.profile_format)?;
-                ids.iter()
-                    .map(|id| {
-                        by_id.remove(id).ok_or_else(|| ImportError::MissingProfile {
-                            id: id.clone(),
-                            path: path.clone(),
-                        })
-                    })
-                    .collect::<Result<Vec<_>, _>>()?
-            }
-        };
+    let quiet = &mut progress::quiet;
+    if let Some(ids) =
+        pairing::ids_naming_profiles(&spec.profiles, log.iter().map(|p| p.id.as_deref()))
+    {
+        let mut raws = Vec::with_capacity(ids.len());
+        pairing::read_by_id(
+            &spec.profiles,
+            &spec.profile_format,
+            &ids,
+            quiet,
+            |_, raw| {
+                raws.push(raw);
+                Ok(())
+            },
+        )?;
         return Ok((ids, raws));
     }
-    let raws: Vec<RawProfile> = match &spec.profiles {
-        ProfileSource::Folder(dir) => {
-            // The folder as published: the pose file and other files
-            // skipped, the profiles in the order of their number.
-            let listing = list_profiles(dir, &[spec.log.path()], Some(log.len()))?;
-            notes.push(listing.summary());
-            if listing.profiles.len() != log.len() {
-                return Err(ImportError::File {
-                    path: dir.clone(),
-                    message: format!(
-                        "{} profiles for {} poses of {}: a log without ids pairs pose k with the k-th profile in the order of the number in their names, so the counts must match",
-                        listing.profiles.len(),
-                        log.len(),
-                        spec.log.path().display()
-                    ),
-                });
-            }
-            listing
-                .profiles
-                .iter()
-                .map(|p| profiles::read_profile(p, &spec.profile_format))
-                .collect::<Result<_, _>>()?
-        }
-        ProfileSource::File { path, pose_column } => {
-            let (order, mut by_id) =
-                profiles::read_profile_table(path, pose_column, &spec.profile_format)?;
-            if order.len() != log.len() {
-                return Err(ImportError::File {
-                    path: path.clone(),
-                    message: format!(
-                        "{} profiles for {} poses of {}: a log without ids pairs pose k with the k-th profile, so the counts must match",
-                        order.len(),
-                        log.len(),
-                        spec.log.path().display()
-                    ),
-                });
-            }
-            order.iter().filter_map(|id| by_id.remove(id)).collect()
-        }
-    };
-    let ids = raws
-        .iter()
-        .map(|r| {
-            r.source
-                .file_stem()
-                .map_or_else(|| "pose".into(), |s| s.to_string_lossy().into_owned())
-        })
-        .collect();
-    Ok((ids, raws))
+    let order = pairing::read_in_order(
+        &spec.profiles,
+        &spec.profile_format,
+        spec.log.path(),
+        log.len(),
+        quiet,
+    )?;
+    // The folder as published: the pose file and other files skipped,
+    // the profiles in the order of their number.
+    notes.extend(order.listing.as_ref().map(pairing::FolderListing::summary));
+    Ok((order.ids, order.raws))
 }
