@@ -22,16 +22,15 @@ use spherecal::engine::files::import::{
 };
 
 /// The data folder in the repository (`data/robcalibrator-sphere`); the
-/// tests fail when it is missing. `Option` so that the callers keep their
-/// shape (`let Some(dir) = data() else { return }`).
-fn data() -> Option<PathBuf> {
+/// tests fail when it is missing.
+fn data() -> PathBuf {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/robcalibrator-sphere");
     assert!(
         dir.join("RobPoses.rob").is_file(),
         "the real data set is missing: {}",
         dir.display()
     );
-    Some(dir)
+    dir
 }
 
 fn spec(dir: &Path) -> PoseImportSpec {
@@ -65,9 +64,7 @@ fn robcalibrator_hand_eye(dir: &Path) -> Isometry3<f64> {
 
 #[test]
 fn robcalibrator_data_calibrates_below_the_reference_scatter() {
-    let Some(dir) = data() else {
-        return;
-    };
+    let dir = data();
     let imported = import::import_poses(&spec(&dir)).unwrap();
     let session = &imported.session;
     assert!(session.pose_only());
@@ -147,9 +144,7 @@ fn run(args: &[&str]) -> (i32, String, String) {
 
 #[test]
 fn the_documented_commands_import_and_calibrate_the_data_set() {
-    let Some(dir) = data() else {
-        return;
-    };
+    let dir = data();
     let tmp = tempfile::tempdir().unwrap();
     let session = tmp.path().join("robcalibrator.json");
     let result = tmp.path().join("robcalibrator-result.json");
@@ -219,9 +214,7 @@ fn copy_of(dir: &Path) -> tempfile::TempDir {
 
 #[test]
 fn bad_real_inputs_exit_2_naming_the_file_and_write_nothing() {
-    let Some(dir) = data() else {
-        return;
-    };
+    let dir = data();
     let try_import = |folder: &Path, extra: &[&str]| {
         let out = folder.join("out.json");
         let d = folder.display().to_string();
@@ -283,9 +276,7 @@ fn bad_real_inputs_exit_2_naming_the_file_and_write_nothing() {
 /// on this set, says so and names what to run instead.
 #[test]
 fn the_real_set_gets_a_held_out_figure_and_the_papers_rise_is_a_warning() {
-    let Some(dir) = data() else {
-        return;
-    };
+    let dir = data();
     let session = import::import_poses(&spec(&dir)).unwrap().session;
     let mut options = Options::from_session(&session);
     let (prepared, cal) = solve::calibrate(&session, &options).unwrap();
@@ -351,9 +342,7 @@ fn printed_scatter(stdout: &str) -> f64 {
 /// initial hand-eye. Both calibrate to ≤ 0.26 mm.
 #[test]
 fn the_set_imports_from_its_own_folder_with_and_without_pure_translations() {
-    let Some(dir) = data() else {
-        return;
-    };
+    let dir = data();
     let check = |folder: &Path, poses: &str| -> (f64, String) {
         let tmp = tempfile::tempdir().unwrap();
         let session = tmp.path().join("s.json");
