@@ -234,7 +234,7 @@ fn targets_are_compensated_largest_first_flagged_written_and_refused_when_stale(
     assert!(
         h.state()
             .state()
-            .provenance
+            .ledger
             .written
             .iter()
             .any(|w| w.path == out && w.what == "compensated program")
@@ -262,11 +262,14 @@ fn targets_are_compensated_largest_first_flagged_written_and_refused_when_stale(
             && notice.body.contains("the calibration result changed"),
         "{notice:?}"
     );
-    // Compensated again through the new result: current, and written.
+    // Compensated again through the new result: current, and written
+    // (over a file written of other inputs: once the operator agrees).
     h.get_by_label("Compensate targets").click();
     settle(&mut h);
     assert!(labels_with(&h, "STALE").is_empty());
     h.get_by_label("Write").click();
+    settle(&mut h);
+    h.get_by_label("Replace").click();
     settle(&mut h);
     assert_ne!(std::fs::read_to_string(&out).unwrap(), "old\n");
 
@@ -405,4 +408,85 @@ fn the_flag_limits_are_set_in_the_view_and_mark_the_table_stale() {
     };
     let flags: Vec<_> = view.rows.iter().map(|r| (&r.name, &r.flags)).collect();
     assert_eq!(view.flagged, 0, "{flags:?}");
+}
+
+/// The operator's defect (issue 30): after the targets changed, Write
+/// wrote the new compensation under the previous program's name,
+/// replacing that file without a word. The output's name now follows the
+/// targets; a file this window did not write of these inputs (the
+/// previous program's, or one edited since) is replaced only once the
+/// operator says so, and kept when they say so.
+#[test]
+fn the_output_follows_the_targets_and_another_programs_file_is_replaced_only_when_asked() {
+    let (mut h, result) = calibrated();
+    let dir = tempfile::tempdir().unwrap();
+    let all = targets(&result);
+    let read = |p: &Path| std::fs::read_to_string(p).unwrap();
+    let out = |h: &Harness<'_, WorkbenchApp>| PathBuf::from(&h.state().forms().compensate.out);
+
+    let first = dir.path().join("cell-a.csv");
+    std::fs::write(&first, table(&all)).unwrap();
+    compensate_in_view(&mut h, &first);
+    let first_out = dir.path().join("cell-a-compensated.csv");
+    assert_eq!(out(&h), first_out, "named after the targets");
+    h.get_by_label("Write").click();
+    settle(&mut h);
+    let first_text = read(&first_out);
+    assert_eq!(first_text, engine_text(&result, &first));
+
+    // Other targets: the output's name follows them; the first program
+    // stays as it was.
+    let second = dir.path().join("cell-b.csv");
+    std::fs::write(&second, table(&all[..3])).unwrap();
+    compensate_in_view(&mut h, &second);
+    let second_out = dir.path().join("cell-b-compensated.csv");
+    assert_eq!(out(&h), second_out, "the name follows the targets");
+    h.get_by_label("Write").click();
+    settle(&mut h);
+    assert_eq!(read(&second_out), engine_text(&result, &second));
+    assert_eq!(read(&first_out), first_text, "the first program untouched");
+
+    // The previous program's name typed back: asked first, nothing
+    // written; kept when the operator says so, replaced when they do.
+    h.state_mut().forms_mut().compensate.out = first_out.display().to_string();
+    h.get_by_label("Write").click();
+    settle(&mut h);
+    assert!(h.query_by_label("Replace").is_some(), "asked first");
+    assert!(
+        !labels_with(&h, "this window wrote it of the compensation").is_empty(),
+        "why it asks"
+    );
+    assert_eq!(read(&first_out), first_text, "nothing written yet");
+    h.get_by_label("Keep the file").click();
+    settle(&mut h);
+    assert!(h.query_by_label("Replace").is_none());
+    assert_eq!(read(&first_out), first_text, "kept");
+    assert!(ui_support::status(&h).contains("kept"));
+    h.get_by_label("Write").click();
+    settle(&mut h);
+    h.get_by_label("Replace").click();
+    settle(&mut h);
+    assert_eq!(read(&first_out), engine_text(&result, &second), "replaced");
+
+    // The targets edited in place (same name, other targets): stale, the
+    // write refused; compensated again, the file written of the old
+    // targets is replaced only once the operator agrees.
+    h.state_mut().forms_mut().compensate.out = second_out.display().to_string();
+    std::fs::write(&second, table(&all[..2])).unwrap();
+    h.run();
+    assert!(!labels_with(&h, "STALE").is_empty());
+    let before = read(&second_out);
+    command(&mut h, Command::Compensate(CompensateCommand::Write));
+    settle(&mut h);
+    assert_eq!(read(&second_out), before, "a stale compensation is refused");
+    h.get_by_label("Compensate targets").click();
+    settle(&mut h);
+    assert_eq!(out(&h), second_out);
+    h.get_by_label("Write").click();
+    settle(&mut h);
+    assert!(h.query_by_label("Replace").is_some(), "asked first");
+    assert_eq!(read(&second_out), before);
+    h.get_by_label("Replace").click();
+    settle(&mut h);
+    assert_eq!(read(&second_out), engine_text(&result, &second));
 }

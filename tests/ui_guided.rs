@@ -80,7 +80,12 @@ fn the_step_bar_walks_the_job_in_order() {
     h.get_by_label("Next: Write the report").click();
     settle(&mut h);
     assert!(step_label(&h, "6. Reported").starts_with('●'));
-    let written = h.state().state().reported.clone().expect("a report");
+    let written = h
+        .state()
+        .state()
+        .reported()
+        .map(Path::to_path_buf)
+        .expect("a report");
     let html = std::fs::read_to_string(&written).expect("the report");
     assert!(
         html.contains("id=\"verdict\">PASS"),

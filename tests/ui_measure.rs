@@ -16,7 +16,7 @@ use std::sync::atomic::AtomicBool;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
 use spherecal::app::WorkbenchApp;
-use spherecal::app::commands::{Command, MeasureCommand};
+use spherecal::app::commands::{Command, MeasureCommand, ViewCommand};
 use spherecal::app::features::measure::{
     DRAWN_MAX, MeasureRequest, ScanInput, group, measure_scan,
 };
@@ -415,4 +415,73 @@ fn a_raw_scan_of_an_artefact_is_measured_through_the_form() {
         assert!((p.position[1] - q.position[1]).abs() < 1e-9);
         assert!((p.position[2] - q.position[2]).abs() < 1e-9);
     }
+}
+
+/// The operator's defect (issue 30): a measurement left out after the
+/// cloud was measured made the result STALE while step 7 stayed ● and
+/// the cloud was written all the same. A cloud starts from its result's
+/// stamp: whatever makes the result stale makes it stale too, at once;
+/// its export is refused and nothing is written; with the input as it
+/// was, it is current again and written.
+#[test]
+fn a_cloud_is_stale_and_its_export_refused_once_its_result_is_stale() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = calibrated(dir.path(), Method::Ml);
+    measure(&mut h);
+    assert!(step_label(&h, "7. Measured").starts_with('●'));
+    let id = h
+        .state()
+        .state()
+        .loaded
+        .as_ref()
+        .unwrap()
+        .session
+        .measurements[3]
+        .id
+        .clone();
+    let include = |h: &mut Harness<'static, WorkbenchApp>, included: bool| {
+        let ctx = h.ctx.clone();
+        let c = Command::View(ViewCommand::SetIncluded {
+            id: id.clone(),
+            included,
+        });
+        h.state_mut().command(&ctx, c);
+        h.run();
+    };
+    include(&mut h, false);
+    assert!(step_label(&h, "4. Calibrated").starts_with('!'));
+    assert!(
+        step_label(&h, "7. Measured").starts_with('!'),
+        "the cloud is stale with its result"
+    );
+    assert!(h.query_by_label("STALE").is_some());
+    let ply = dir.path().join("left-out.ply");
+    h.state_mut().forms_mut().measure.out = ply.display().to_string();
+    h.get_by_label("Write cloud").click();
+    settle(&mut h);
+    let notice = h.state().state().notice.clone().expect("refused");
+    assert_eq!(notice.title, "Cloud not written");
+    assert!(
+        notice.body.contains("the cloud is stale")
+            && notice.body.contains("the left-out measurements changed"),
+        "{}",
+        notice.body
+    );
+    assert!(!ply.exists(), "nothing written");
+    // The solver settings the result was made with: the same.
+    include(&mut h, true);
+    assert!(step_label(&h, "7. Measured").starts_with('●'));
+    let threshold = h.state().forms().solver.threshold;
+    h.state_mut().forms_mut().solver.threshold = threshold * 2.0;
+    h.run();
+    assert!(step_label(&h, "7. Measured").starts_with('!'), "the solver");
+    h.state_mut().forms_mut().solver.threshold = threshold;
+    h.run();
+    assert!(
+        step_label(&h, "7. Measured").starts_with('●'),
+        "current again"
+    );
+    h.get_by_label("Write cloud").click();
+    settle(&mut h);
+    assert!(ply.exists(), "written once current");
 }

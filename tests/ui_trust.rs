@@ -15,12 +15,12 @@ use std::time::{Duration, Instant};
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
+use spherecal::app::commands::PlanExport;
 use spherecal::app::commands::{Command, PlanCommand, RunCommand, ViewCommand};
 use spherecal::app::features::run::calibrate_session;
 use spherecal::app::features::run::{RunFailure, RunStage};
 use spherecal::app::forms::Tab;
 use spherecal::app::job::Slot;
-use spherecal::app::state::PlanExport;
 use spherecal::engine::calibrate::solve::{Options, Phase};
 use spherecal::engine::tools::plan::Controller;
 use spherecal::engine::tools::result_view::Tolerance;
@@ -77,9 +77,7 @@ fn a_stale_plan_is_marked_and_its_program_refused() {
     // Even asked for directly, nothing is written, and the notice says why.
     command(
         &mut h,
-        Command::Plan(PlanCommand::Export(PlanExport::Program(
-            Controller::UrScript,
-        ))),
+        Command::Plan(PlanCommand::Export(PlanExport::Program(Controller::Ur))),
     );
     settle(&mut h);
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);

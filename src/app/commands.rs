@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use super::dialog::Purpose;
 use super::forms::Tab;
-use super::state::{ExportKind, PlanExport};
+use crate::engine::tools::plan::Controller;
 
 /// A request from the UI, by the feature that handles it.
 #[derive(Debug, Clone, PartialEq)]
@@ -16,6 +16,9 @@ pub enum Command {
     Files(FilesCommand),
     /// Show a native file dialog (on a job thread) for a path field.
     Browse(Purpose),
+    /// The answer to "replace this file?": replace it (the write is
+    /// asked for again), or keep it.
+    Confirm(bool),
     /// The session on show: views, selection, measurements left out.
     View(ViewCommand),
     /// The calibration run.
@@ -112,9 +115,6 @@ pub enum ImportCommand {
     Run,
     /// Stop the import in flight; nothing is opened.
     Cancel,
-    /// A field of the form changed: the preview, the last outcome and the
-    /// flange checks no longer describe it and are cleared.
-    Edited,
     /// Read the pose file and pair it with the profiles or centres (the
     /// preview shown before Import).
     Scan,
@@ -123,10 +123,8 @@ pub enum ImportCommand {
 /// The library of past results.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum HistoryCommand {
-    /// Scan the History form's folder.
+    /// Scan the History form's folder (its drift follows).
     Scan,
-    /// Recompute the drift after the robot, the ticks or `k` changed.
-    Drift,
 }
 
 /// The pose planner.
@@ -167,4 +165,98 @@ pub enum MeasureCommand {
     /// Write the cloud on show to the form's export path (format by its
     /// extension).
     Export,
+}
+
+/// What the Plan view writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlanExport {
+    /// The plan as the joint-log CSV `spherecal import` reads.
+    Csv,
+    /// The robot controller's program (RAPID for ABB, URScript for UR).
+    Program(Controller),
+}
+
+impl PlanExport {
+    /// The button text.
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Csv => "Plan CSV",
+            Self::Program(c) => c.label(),
+        }
+    }
+
+    /// The file name for a robot key.
+    #[must_use]
+    pub fn file_name(self, robot: &str) -> String {
+        match self {
+            Self::Csv => format!("plan-{robot}.csv"),
+            Self::Program(c) => format!("plan-{robot}.{}", c.extension()),
+        }
+    }
+}
+
+/// Things to export from the Results view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExportKind {
+    /// The FORMAT.md result file.
+    ResultJson,
+    /// Every sphere centre, before and after, CSV.
+    CentresCsv,
+    /// Reference-distance and within-station distance errors, CSV.
+    DistancesCsv,
+    /// The Results view's plots as an image.
+    PlotsPng,
+    /// The calibrated model as the FORMAT.md `robot` block (deg, mm).
+    ModelJson,
+    /// The calibrated MDH table and matrices, CSV (deg, mm).
+    ModelCsv,
+    /// A URDF fragment with the calibrated joint origins (m, rad).
+    ModelUrdf,
+    /// The self-contained HTML report (inline SVG figures).
+    ReportHtml,
+}
+
+impl ExportKind {
+    /// All kinds, in the order of the export buttons.
+    pub const ALL: [Self; 8] = [
+        Self::ReportHtml,
+        Self::ResultJson,
+        Self::CentresCsv,
+        Self::DistancesCsv,
+        Self::PlotsPng,
+        Self::ModelJson,
+        Self::ModelCsv,
+        Self::ModelUrdf,
+    ];
+
+    /// The button text.
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::ResultJson => "Result JSON",
+            Self::CentresCsv => "Centres CSV",
+            Self::DistancesCsv => "Distances CSV",
+            Self::PlotsPng => "Plots PNG",
+            Self::ModelJson => "Model JSON",
+            Self::ModelCsv => "Model CSV",
+            Self::ModelUrdf => "Model URDF",
+            Self::ReportHtml => "Report HTML",
+        }
+    }
+
+    /// The file name for a session stem.
+    #[must_use]
+    pub fn file_name(self, stem: &str) -> String {
+        match self {
+            Self::ResultJson => format!("{stem}-result.json"),
+            Self::CentresCsv => format!("{stem}-centres.csv"),
+            Self::DistancesCsv => format!("{stem}-distances.csv"),
+            Self::PlotsPng => format!("{stem}-plots.png"),
+            Self::ModelJson => format!("{stem}-model.json"),
+            Self::ModelCsv => format!("{stem}-model.csv"),
+            Self::ModelUrdf => format!("{stem}-model.urdf"),
+            Self::ReportHtml => format!("{stem}-report.html"),
+        }
+    }
 }

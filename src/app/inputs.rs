@@ -1,9 +1,9 @@
 //! The readings of the workbench's inputs ([`Input`]) from the state and
-//! the forms, taken every frame for the [`Provenance`] of everything
+//! the forms, taken every frame for the [`Ledger`] of every artefact
 //! derived: what each is, in the fields people read, and a fingerprint
 //! of all of it.
 //!
-//! [`Provenance`]: super::provenance::Provenance
+//! [`Ledger`]: super::ledger::Ledger
 
 use std::collections::BTreeSet;
 
@@ -11,7 +11,7 @@ use nalgebra::Isometry3;
 
 use super::forms::compensate::{CompensateForm, TcpChoice};
 use super::forms::{Forms, PlanForm, SolverForm};
-use super::provenance::{Input, Reading};
+use super::ledger::{Input, Reading};
 use super::state::AppState;
 use crate::engine::base::session::SensorRange;
 use crate::engine::calibrate::solve::Method;
@@ -36,7 +36,38 @@ pub fn readings(state: &AppState, forms: &Forms) -> Vec<(Input, Reading)> {
         (Input::Calibration, calibration(state)),
         (Input::Targets, targets(&forms.compensate)),
         (Input::MeasureForm, measure_form(&forms.measure)),
+        (
+            Input::ImportForm,
+            Reading::new(Vec::new(), format!("{:?}", forms.import)),
+        ),
+        (
+            Input::PoseFile,
+            Reading::new(Vec::new(), format!("{:?}", forms.import.pose_scan_key())),
+        ),
+        (
+            Input::Library,
+            Reading::new(
+                vec![(
+                    "library".into(),
+                    format!("{} (scan {})", forms.history.folder, state.history.scans),
+                )],
+                state.history.scans,
+            ),
+        ),
+        (Input::HistoryChoice, history_choice(&forms.history)),
     ]
+}
+
+/// The History view's choice: the robot, the results left out, `k`.
+fn history_choice(f: &super::forms::HistoryForm) -> Reading {
+    Reading::new(
+        vec![
+            ("robot".into(), f.robot.clone().unwrap_or_default()),
+            ("unticked".into(), f.unselected.len().to_string()),
+            ("k".into(), f.k.to_string()),
+        ],
+        (&f.unselected, f.k.to_bits()),
+    )
 }
 
 /// The hand-eye guess "from the open calibration": the result's on show,

@@ -18,7 +18,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
 use std::time::Instant;
 
-use super::provenance::Stamp;
+use super::ledger::{Artefact, Stamp};
 
 /// Messages a job may have in flight before it waits for the UI: far
 /// more than a run's ε reports, so a job never waits on a UI that keeps up.
@@ -53,6 +53,23 @@ pub enum Slot {
     Dialog,
     /// A file written (one write a file at a time).
     Write(PathBuf),
+}
+
+impl Slot {
+    /// The slot of the job that makes `artefact`, when a job makes it.
+    #[must_use]
+    pub fn of(artefact: Artefact) -> Option<Self> {
+        match artefact {
+            Artefact::Plan => Some(Self::Plan),
+            Artefact::Result => Some(Self::Run),
+            Artefact::Compensation => Some(Self::Compensate),
+            Artefact::Cloud => Some(Self::Measure),
+            Artefact::PoseScan => Some(Self::PoseScan),
+            Artefact::Drift => Some(Self::Drift),
+            Artefact::ImportView => Some(Self::ImportPreview),
+            Artefact::Report | Artefact::EditedSession => None,
+        }
+    }
 }
 
 /// A job in its slot: what the views show of it and what its answer

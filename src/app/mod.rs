@@ -9,9 +9,10 @@
 //!   result file both go through the FORMAT.md result);
 //! - [`forms`]: the fields widgets edit in place, with the import wizard's
 //!   and the planner's forms and the engine requests they build;
-//! - [`provenance`]: the one staleness mechanism: what each derived
-//!   output (plan, result, report, every file written of them) was made
-//!   from, and whether it still holds (read there how to add an output);
+//! - [`ledger`]: the one artefact ledger: what each artefact (plan,
+//!   result, report, cloud, compensation, every file written of them)
+//!   was made from, whether it still holds, and whether a file may be
+//!   replaced without asking;
 //! - [`state`]: what the app knows ([`state::AppState`], changed only by
 //!   commands and job messages);
 //! - [`inputs`]: the readings of the inputs (session, left-out
@@ -33,31 +34,19 @@
 //! - [`screenshot`]: the guide's screenshots, the window driving itself
 //!   through a scenario (`SPHERECAL_SCREENSHOT`, `tools/screenshots.sh`).
 //!
-//! **Staleness: one mechanism.** Everything derived (the plan, the
-//! result with its verdict and views, the report, every file written of
-//! them) is recorded in [`provenance::Provenance`] (in the state) with a
-//! [`provenance::Stamp`]: the readings of the inputs it was made from
-//! ([`provenance::Input`]: session, left-out measurements, solver
-//! settings, Plan form, tolerance), taken by [`inputs::readings`] every
-//! frame. When an input reads otherwise, the output is stale at once; the
-//! step bar, the views and the export handlers all ask the provenance,
-//! none keeps a flag of its own. To register a new derived output (a
-//! Measure step's point clouds, a Compensate view's programs):
-//!
-//! 1. if it depends on an input not listed, add it to
-//!    [`provenance::Input`] (and [`provenance::Input::ALL`]) and read it in
-//!    [`inputs::readings`] (its fields in words, a fingerprint of all of
-//!    it);
-//! 2. add a variant to [`provenance::Output`] with its
-//!    [`provenance::Output::inputs`] and [`provenance::Output::name`];
-//! 3. when its job starts, take `state.provenance.stamp(Output::X)` and
-//!    carry it with the job; when the job's output arrives,
-//!    `record(Output::X, stamp)`; when it is cleared, `forget(Output::X)`;
-//! 4. before writing any of its files, `check(Output::X)` and refuse with
-//!    the error's text; after writing one, `wrote(what, path,
-//!    Output::X, stamp)`;
-//! 5. where it is on show, `stale(Output::X)` gives what changed (the
-//!    views show it with `panels::stale_banner_ui`).
+//! **Staleness: one ledger.** Every artefact is recorded in
+//! [`ledger::Ledger`] (in the state) with a [`ledger::Stamp`]: the
+//! readings of the inputs it was made from, taken by [`inputs::readings`]
+//! every frame; an artefact made from another (a cloud, a compensation, a
+//! report from the result) starts from that one's stamp. When an input
+//! reads otherwise, the artefact and everything made from it are stale
+//! at once; the step bar, the views and every write ask the ledger, none
+//! keeps a flag of its own. To add an artefact: a variant of
+//! [`ledger::Artefact`] with its inputs (new inputs read in
+//! [`inputs::readings`]); its job started with `ledger.stamp(..)`, its
+//! answer `record`ed with the job's stamp; its files written through
+//! `Core::write`, which refuses nothing stale and asks before replacing a
+//! file not written of the same inputs.
 //!
 //! Layout of the window, for an operator at 1366×768: the load and solver
 //! panel on the left, the Plan, Import, Session, Stripe, Centres, Results,
@@ -72,7 +61,7 @@ pub mod forms;
 pub mod inputs;
 pub mod job;
 pub mod panels;
-pub mod provenance;
+pub mod ledger;
 pub mod screenshot;
 pub mod state;
 pub mod view;

@@ -35,13 +35,14 @@ use std::time::{Duration, Instant};
 
 use egui::{Pos2, pos2};
 
+use super::commands::ExportKind;
 use super::commands::{
     Command, CompensateCommand, FilesCommand, HistoryCommand, ImportCommand, MeasureCommand,
     PlanCommand, RunCommand, ViewCommand,
 };
 use super::features::Core;
 use super::forms::{Forms, Tab};
-use super::state::{AppState, ExportKind};
+use super::state::AppState;
 use crate::engine::base::session::SensorRange;
 use crate::engine::tools::result_view::Tolerance;
 
@@ -432,8 +433,8 @@ fn stale_plan() -> Vec<Act> {
         }),
         Act::Pause(Duration::from_millis(300)),
         Act::Expect(|s, _| {
-            s.provenance
-                .stale(super::provenance::Output::Plan)
+            s.ledger
+                .stale(super::ledger::Artefact::Plan)
                 .map(|_| ())
                 .ok_or_else(|| "the plan is not marked stale".to_string())
         }),

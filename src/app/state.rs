@@ -14,16 +14,15 @@ use serde::{Deserialize, Serialize};
 use crate::engine::base::session::Session;
 use crate::engine::calibrate::solve::{Analysis, SolveError};
 use crate::engine::calibrate::stripe::{StripeError, StripeResult};
-use crate::engine::files::import::{PoseCheck, PoseImportSpec, PosePreview};
+use crate::engine::files::import::{PoseCheck, PosePreview};
 use crate::engine::tools::history::{Drift, Library};
-use crate::engine::tools::plan::Controller;
 use crate::engine::tools::plan::{Plan, PlanError, Prediction};
 use crate::engine::tools::result_view::Tolerance;
 
 use super::dialog::Purpose;
 use super::forms::{Forms, Grouping};
 use super::job::Jobs;
-use super::provenance::Provenance;
+use super::ledger::{Artefact, Ledger};
 use super::view::compensate::CompensationView;
 use super::view::{CentreSet, ResultView};
 
@@ -196,100 +195,6 @@ pub struct Notice {
     pub body: String,
 }
 
-/// What the Plan view writes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PlanExport {
-    /// The plan as the joint-log CSV `spherecal import` reads.
-    Csv,
-    /// The robot controller's program (RAPID for ABB, URScript for UR).
-    Program(Controller),
-}
-
-impl PlanExport {
-    /// The button text.
-    #[must_use]
-    pub fn label(self) -> &'static str {
-        match self {
-            Self::Csv => "Plan CSV",
-            Self::Program(c) => c.label(),
-        }
-    }
-
-    /// The file name for a robot key.
-    #[must_use]
-    pub fn file_name(self, robot: &str) -> String {
-        match self {
-            Self::Csv => format!("plan-{robot}.csv"),
-            Self::Program(c) => format!("plan-{robot}.{}", c.extension()),
-        }
-    }
-}
-
-/// Things to export from the Results view.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ExportKind {
-    /// The FORMAT.md result file.
-    ResultJson,
-    /// Every sphere centre, before and after, CSV.
-    CentresCsv,
-    /// Reference-distance and within-station distance errors, CSV.
-    DistancesCsv,
-    /// The Results view's plots as an image.
-    PlotsPng,
-    /// The calibrated model as the FORMAT.md `robot` block (deg, mm).
-    ModelJson,
-    /// The calibrated MDH table and matrices, CSV (deg, mm).
-    ModelCsv,
-    /// A URDF fragment with the calibrated joint origins (m, rad).
-    ModelUrdf,
-    /// The self-contained HTML report (inline SVG figures).
-    ReportHtml,
-}
-
-impl ExportKind {
-    /// All kinds, in the order of the export buttons.
-    pub const ALL: [Self; 8] = [
-        Self::ReportHtml,
-        Self::ResultJson,
-        Self::CentresCsv,
-        Self::DistancesCsv,
-        Self::PlotsPng,
-        Self::ModelJson,
-        Self::ModelCsv,
-        Self::ModelUrdf,
-    ];
-
-    /// The button text.
-    #[must_use]
-    pub fn label(self) -> &'static str {
-        match self {
-            Self::ResultJson => "Result JSON",
-            Self::CentresCsv => "Centres CSV",
-            Self::DistancesCsv => "Distances CSV",
-            Self::PlotsPng => "Plots PNG",
-            Self::ModelJson => "Model JSON",
-            Self::ModelCsv => "Model CSV",
-            Self::ModelUrdf => "Model URDF",
-            Self::ReportHtml => "Report HTML",
-        }
-    }
-
-    /// The file name for a session stem.
-    #[must_use]
-    pub fn file_name(self, stem: &str) -> String {
-        match self {
-            Self::ResultJson => format!("{stem}-result.json"),
-            Self::CentresCsv => format!("{stem}-centres.csv"),
-            Self::DistancesCsv => format!("{stem}-distances.csv"),
-            Self::PlotsPng => format!("{stem}-plots.png"),
-            Self::ModelJson => format!("{stem}-model.json"),
-            Self::ModelCsv => format!("{stem}-model.csv"),
-            Self::ModelUrdf => format!("{stem}-model.urdf"),
-            Self::ReportHtml => format!("{stem}-report.html"),
-        }
-    }
-}
-
 /// A finished plan.
 #[derive(Debug, Clone)]
 pub struct PlanOutcome {
@@ -313,10 +218,6 @@ pub struct ImportView {
     /// The pose file's preview (layout, pairing, eq. 6-9 group) of the
     /// latest scan, or why the pose file cannot be read.
     pub pose_preview: Option<Result<PosePreview, String>>,
-    /// What the latest scan was started from (the form's
-    /// [`crate::app::forms::ImportForm::pose_scan_key`]): a form that
-    /// reads otherwise is scanned again.
-    pub scanned: Option<PoseImportSpec>,
     /// The last import found no initial hand-eye: why (a guess is needed).
     pub guess_needed: Option<String>,
 }
@@ -339,6 +240,8 @@ pub struct HistoryView {
     pub drift: Option<Result<Drift, String>>,
     /// The library the drift's entry indices refer to (the ticked results).
     pub drift_of: Option<Library>,
+    /// Libraries scanned so far (a new scan is another library).
+    pub scans: u64,
 }
 
 /// What lasts across runs of the program (eframe storage).
@@ -371,6 +274,18 @@ impl Prefs {
     }
 }
 
+/// A write that waits for the operator: the file exists and was not
+/// written by this window of the same artefact from the same inputs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Confirm {
+    /// The file.
+    pub path: PathBuf,
+    /// Why the operator is asked, in words.
+    pub why: String,
+    /// The command that writes it, asked for again once agreed.
+    pub again: super::commands::Command,
+}
+
 /// Everything the workbench shows. Changed only by commands and job
 /// messages; the `*_ui` functions read it.
 #[derive(Debug, Default)]
@@ -388,8 +303,6 @@ pub struct AppState {
     /// A run finished while another view was on show: the Results tab
     /// is marked until it is opened.
     pub result_unseen: bool,
-    /// Where the HTML report of the result on show was written.
-    pub reported: Option<PathBuf>,
     /// The status line.
     pub status: Option<Status>,
     /// An error shown until dismissed.
@@ -397,8 +310,8 @@ pub struct AppState {
     /// The last file dialog returned nothing (cancelled or unavailable):
     /// what it was for, so that the note shows beside its Browse button.
     pub dialog_empty: Option<Purpose>,
-    /// "Save as" would overwrite this existing file: a second click confirms.
-    pub confirm_overwrite: Option<PathBuf>,
+    /// A write waits for the operator: replace a file that exists?
+    pub confirm: Option<Confirm>,
     /// What lasts across runs.
     pub prefs: Prefs,
     /// A result file to open once the session given with it has loaded.
@@ -409,8 +322,9 @@ pub struct AppState {
     pub history: HistoryView,
     /// The plan on show and the planning job.
     pub plan: PlanView,
-    /// What every derived output was made from: whether it is stale.
-    pub provenance: Provenance,
+    /// What every artefact was made from (whether it is stale) and the
+    /// files written of them.
+    pub ledger: Ledger,
     /// Sessions opened so far (a new one makes everything of the last
     /// stale, even under the same name).
     pub session_loads: u64,
@@ -433,6 +347,16 @@ impl AppState {
             text: text.into(),
             level,
         });
+    }
+
+    /// Where the report of the result on show was written, while it is.
+    #[must_use]
+    pub fn reported(&self) -> Option<&Path> {
+        self.ledger.made(Artefact::Report)?;
+        let mut written = self.ledger.written.iter().rev();
+        written
+            .find(|w| w.from == Artefact::Report)
+            .map(|w| w.path.as_path())
     }
 
     /// True while any background work is in flight.
@@ -510,4 +434,7 @@ pub struct CompensateState {
     /// The last compensation, or why there is none (an unreachable
     /// target named, a file that cannot be read).
     pub outcome: Option<Result<CompensationView, String>>,
+    /// The output path last derived from the targets: while the output
+    /// field holds it, it follows the targets.
+    pub derived_out: Option<String>,
 }

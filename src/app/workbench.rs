@@ -147,7 +147,7 @@ impl WorkbenchApp {
             self.core.apply(ctx, c);
         }
         self.core.state.jobs.drain();
-        self.core.observe();
+        self.core.observe(ctx);
     }
 
     /// One frame: drain job messages, draw everything, apply the commands.
@@ -189,6 +189,7 @@ impl WorkbenchApp {
             }
         });
         panels::drop_overlay_ui(&ctx);
+        panels::confirm_ui(&ctx, state, &mut commands);
         for c in commands {
             self.core.apply(&ctx, c);
         }
@@ -196,7 +197,7 @@ impl WorkbenchApp {
         // in the frame an answer arrived in wins.
         self.core.finish(&ctx);
         // Fields edited this frame mark what they feed stale at once.
-        self.core.observe();
+        self.core.observe(&ctx);
         if let Some(director) = &mut self.screenshot {
             director.frame(&ctx, &mut self.core);
         }

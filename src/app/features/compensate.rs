@@ -18,11 +18,11 @@ use crate::engine::uses::compensate::{
     self, CompensateError, Model, Options, TargetFailure, Tcp, tool,
 };
 
-use super::Core;
-use crate::app::commands::CompensateCommand;
+use super::{Core, Write};
+use crate::app::commands::{Command, CompensateCommand};
 use crate::app::forms::compensate::TcpChoice;
 use crate::app::job::{Job, Slot};
-use crate::app::provenance::{Input, Output};
+use crate::app::ledger::Artefact;
 use crate::app::state::{Level, Notice};
 use crate::app::view::compensate::CompensationView;
 
@@ -176,7 +176,7 @@ impl Core {
         };
         // Targets are never compensated through a result that is out of
         // date.
-        if let Err(why) = self.state.provenance.check(Output::Result) {
+        if let Err(why) = self.state.ledger.check(Artefact::Result) {
             self.state
                 .say(Level::Warning, format!("not compensated: {why}"));
             self.state.notice = Some(Notice {
@@ -208,20 +208,7 @@ impl Core {
             tool: PathBuf::from(form.tool.trim()),
             options: form.options.clone(),
         };
-        let stamp = self
-            .state
-            .provenance
-            .made(Output::Result)
-            .cloned()
-            .unwrap_or_default()
-            .with(
-                Input::Calibration,
-                self.state.provenance.reading(Input::Calibration),
-            )
-            .with(
-                Input::Targets,
-                self.state.provenance.reading(Input::Targets),
-            );
+        let stamp = self.state.ledger.stamp(Artefact::Compensation);
         if self.start(ctx, Slot::Compensate, stamp, move |w| {
             compensate_targets(&request, w.flag(), &mut |text, fraction| {
                 w.progress(text, Some(fraction));
@@ -236,9 +223,7 @@ impl Core {
 
     /// The compensated text and its stamp when it may be written; `None`
     /// (with the reason in a notice) when it is stale, failed or not made.
-    fn compensation_to_write(
-        &mut self,
-    ) -> Option<(String, PathBuf, crate::app::provenance::Stamp)> {
+    fn compensation_to_write(&mut self) -> Option<(String, PathBuf, crate::app::ledger::Stamp)> {
         let refuse = |state: &mut crate::app::state::AppState, why: String| {
             state.say(Level::Warning, format!("{WRITTEN_WHAT} not written: {why}"));
             state.notice = Some(Notice {
@@ -261,15 +246,16 @@ impl Core {
                 return None;
             }
         };
-        if let Err(why) = self.state.provenance.check(Output::Compensation) {
-            refuse(
-                &mut self.state,
-                format!("{why}: press Compensate targets again"),
-            );
-            return None;
+        match self.state.ledger.check(Artefact::Compensation) {
+            Ok(stamp) => Some((text, targets, stamp)),
+            Err(why) => {
+                refuse(
+                    &mut self.state,
+                    format!("{why}: press Compensate targets again"),
+                );
+                None
+            }
         }
-        let stamp = self.state.provenance.made(Output::Compensation).cloned()?;
-        Some((text, targets, stamp))
     }
 
     pub(super) fn compensate_write(&mut self, ctx: &egui::Context) {
@@ -287,8 +273,13 @@ impl Core {
         let path = PathBuf::from(out);
         let tool = (self.forms.compensate.tcp == TcpChoice::ToolFile)
             .then(|| PathBuf::from(self.forms.compensate.tool.trim()));
-        let what = (WRITTEN_WHAT.to_string(), Some(Output::Compensation), stamp);
-        self.write(ctx, path, what, move |path| {
+        let write = Write {
+            what: WRITTEN_WHAT.to_string(),
+            from: Artefact::Compensation,
+            stamp,
+            again: Command::Compensate(CompensateCommand::Write),
+        };
+        self.write(ctx, path, write, move |path| {
             let mut inputs: Vec<&Path> = vec![targets.as_path()];
             if let Some(t) = &tool {
                 inputs.push(t.as_path());
@@ -318,27 +309,34 @@ impl Core {
     ) {
         match outcome {
             Ok(view) => {
+                let what = view.summary.clone();
                 self.state
-                    .provenance
-                    .record(Output::Compensation, job.stamp.clone());
+                    .ledger
+                    .record(Artefact::Compensation, job.stamp.clone(), what);
                 let level = if view.flagged > 0 {
                     Level::Warning
                 } else {
                     Level::Info
                 };
                 self.state.say(level, view.summary.clone());
-                // Where the compensated file goes by default: beside the
-                // targets.
-                if self.forms.compensate.out.trim().is_empty()
-                    && let Some(dir) = view.targets.parent()
-                {
-                    self.forms.compensate.out =
-                        dir.join(view.default_file_name()).display().to_string();
+                // Where the compensated file goes: beside the targets,
+                // named after them; the name follows the targets unless
+                // the operator typed another.
+                let derived = view
+                    .targets
+                    .with_file_name(view.default_file_name())
+                    .display()
+                    .to_string();
+                let c = &mut self.state.compensate;
+                let out = &mut self.forms.compensate.out;
+                if out.trim().is_empty() || c.derived_out.as_deref() == Some(out.trim()) {
+                    out.clone_from(&derived);
                 }
+                c.derived_out = Some(derived);
                 self.state.compensate.outcome = Some(Ok(*view));
             }
             Err(e) => {
-                self.state.provenance.forget(Output::Compensation);
+                self.state.ledger.forget(Artefact::Compensation);
                 // Several failed targets: their count in the status line,
                 // the list in the view.
                 let first = e.lines().next().unwrap_or_default();

@@ -18,10 +18,12 @@ use crate::engine::tools::report::model::{self, ModelFormat};
 use crate::engine::tools::report::sheet::{self, SheetInput};
 use crate::engine::tools::result_view::{self, Tolerance};
 
-use super::Core;
+use super::{Core, Write};
+use crate::app::commands::Command;
+use crate::app::commands::ExportKind;
 use crate::app::error::JobError;
-use crate::app::provenance::{Input, Output};
-use crate::app::state::{ExportKind, Level, LoadedSession};
+use crate::app::ledger::Artefact;
+use crate::app::state::{Level, LoadedSession};
 use crate::app::view::{ResultOrigin, ResultView};
 
 /// CSV of every sphere centre: sensor frame and base frame before and
@@ -264,31 +266,21 @@ impl Core {
             return;
         };
         // A stale result is never written as if it were current.
-        if let Err(why) = self.state.provenance.check(Output::Result) {
-            let title = format!("{} not written", kind.label());
-            self.refuse(
-                &title,
-                &title,
-                format!("{why}: run the calibration again, then export"),
-            );
-            return;
-        }
+        let stamp = match self.state.ledger.check(Artefact::Result) {
+            Ok(stamp) => stamp,
+            Err(why) => {
+                let title = format!("{} not written", kind.label());
+                let why = format!("{why}: run the calibration again, then export");
+                self.refuse(&title, &title, why);
+                return;
+            }
+        };
         let view = view.clone();
-        let mut stamp = self
-            .state
-            .provenance
-            .made(Output::Result)
-            .cloned()
-            .unwrap_or_default();
-        let from = if kind == ExportKind::ReportHtml {
-            // The report judges by the tolerance: it is an input of it.
-            stamp = stamp.with(
-                Input::Tolerance,
-                self.state.provenance.reading(Input::Tolerance),
-            );
-            Output::Report
+        // The report judges by the tolerance: made from the result and it.
+        let (from, stamp) = if kind == ExportKind::ReportHtml {
+            (Artefact::Report, self.state.ledger.stamp(Artefact::Report))
         } else {
-            Output::Result
+            (Artefact::Result, stamp)
         };
         let loaded = if kind == ExportKind::ReportHtml {
             let Some(loaded) = &self.state.loaded else {
@@ -310,8 +302,13 @@ impl Core {
             .map_or_else(|| "result".to_string(), |l| l.source.stem());
         let path = dir.join(kind.file_name(&stem));
         let tolerance = self.forms.tolerance;
-        let what = (kind.label().to_string(), Some(from), stamp);
-        self.write(ctx, path, what, move |path| {
+        let write = Write {
+            what: kind.label().to_string(),
+            from,
+            stamp,
+            again: Command::Export(kind),
+        };
+        self.write(ctx, path, write, move |path| {
             match &loaded {
                 Some(loaded) => write_report(&view, loaded, tolerance, path),
                 None => write_text(kind, &view, path),

@@ -15,11 +15,12 @@ use crate::engine::files::format::{
 };
 
 use super::Core;
-use crate::app::commands::FilesCommand;
+use super::Write;
+use crate::app::commands::{Command, FilesCommand};
 use crate::app::error::JobError;
 use crate::app::forms::{SolverForm, Tab};
 use crate::app::job::Slot;
-use crate::app::provenance::{Input, Output, Stamp};
+use crate::app::ledger::{Artefact, Input, Stamp};
 use crate::app::state::{Level, LoadedSession, Notice, Source};
 use crate::app::view::{CentrePoint, CentreSet, ResultOrigin, ResultView};
 
@@ -179,7 +180,7 @@ impl Core {
                 );
             }
             FilesCommand::OpenPath(path) => self.open_path(ctx, path),
-            FilesCommand::SaveSession => self.save_session(ctx, false),
+            FilesCommand::SaveSession => self.save_session(ctx),
             FilesCommand::ClearRecent => self.state.prefs.recent.clear(),
         }
     }
@@ -223,7 +224,7 @@ impl Core {
         });
     }
 
-    pub(super) fn save_session(&mut self, ctx: &egui::Context, confirmed: bool) {
+    pub(super) fn save_session(&mut self, ctx: &egui::Context) {
         let Some(loaded) = &self.state.loaded else {
             self.state.say(Level::Warning, "no session to save");
             return;
@@ -235,29 +236,15 @@ impl Core {
             return;
         }
         let path = PathBuf::from(text);
-        let confirmed = confirmed || self.state.confirm_overwrite.as_ref() == Some(&path);
-        if path.exists() && !confirmed {
-            let opened = loaded.source.path() == Some(path.as_path());
-            self.state.say(
-                Level::Warning,
-                format!(
-                    "{} exists{}: press Save again to replace it",
-                    path.display(),
-                    if opened {
-                        " (it is the opened session file)"
-                    } else {
-                        ""
-                    }
-                ),
-            );
-            self.state.confirm_overwrite = Some(path);
-            return;
-        }
-        self.state.confirm_overwrite = None;
         let session = loaded.session.clone();
         let excluded = self.state.excluded.clone();
-        let what = ("the session".to_string(), None, Stamp::default());
-        self.write(ctx, path, what, move |path| {
+        let write = Write {
+            what: "the session".to_string(),
+            from: Artefact::EditedSession,
+            stamp: self.state.ledger.stamp(Artefact::EditedSession),
+            again: Command::Files(FilesCommand::SaveSession),
+        };
+        self.write(ctx, path, write, move |path| {
             let n = save_without(&session, &excluded, path)?;
             Ok(Some(format!(
                 "saved {n} measurements to {} (atomic write)",
@@ -273,20 +260,21 @@ impl Core {
             Loaded::Result(path, view) => {
                 self.state.prefs.remember(&path);
                 let notes = view.notes.join("; ");
+                let view_method = view.method.clone();
                 self.forms.centres.magnify = view.centres.suggested_magnify;
                 self.state.result = Some(*view);
                 self.state.results_shown += 1;
-                self.state.reported = None;
                 self.state.result_unseen = false;
                 self.state.outliers_seen = false;
                 // Made elsewhere: not with this window's solver settings.
                 let stamp = self
                     .state
-                    .provenance
-                    .stamp(Output::Result)
+                    .ledger
+                    .stamp(Artefact::Result)
                     .without(Input::Solver);
-                self.state.provenance.record(Output::Result, stamp);
-                self.state.provenance.forget(Output::Report);
+                let what = format!("method {view_method} (reviewed)");
+                self.state.ledger.record(Artefact::Result, stamp, what);
+                self.state.ledger.forget(Artefact::Report);
                 self.forms.tab = Tab::Results;
                 if notes.is_empty() {
                     self.state.say(
@@ -368,15 +356,14 @@ impl Core {
             self.forms.tab = Tab::Session;
         }
         self.state.excluded.clear();
-        self.state.confirm_overwrite = None;
+        self.state.confirm = None;
         self.state.selected = (!loaded.session.measurements.is_empty()).then_some(0);
         self.state.result = None;
         self.state.result_unseen = false;
-        self.state.reported = None;
         self.state.notice = None;
         self.state.session_loads += 1;
-        self.state.provenance.forget(Output::Result);
-        self.state.provenance.forget(Output::Report);
+        self.state.ledger.forget(Artefact::Result);
+        self.state.ledger.forget(Artefact::Report);
         let (level, text) = opened_line(&loaded);
         self.state.say(level, text);
         if let Ok(set) = &loaded.before {

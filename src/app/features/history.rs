@@ -9,8 +9,8 @@ use crate::engine::tools::history::{self, Drift, DriftOptions, HistoryError, Lib
 use super::Core;
 use crate::app::commands::HistoryCommand;
 use crate::app::error::JobError;
-use crate::app::job::Slot;
-use crate::app::provenance::Stamp;
+use crate::app::job::{Job, Slot};
+use crate::app::ledger::{Artefact, Stamp};
 use crate::app::state::Level;
 
 /// What a drift job answers: the robot, the library of the ticked
@@ -22,7 +22,6 @@ impl Core {
     pub(super) fn history(&mut self, ctx: &egui::Context, command: HistoryCommand) {
         match command {
             HistoryCommand::Scan => self.history_scan(ctx),
-            HistoryCommand::Drift => self.history_drift(ctx),
         }
     }
 
@@ -50,11 +49,13 @@ impl Core {
     /// job thread (a library of hundreds of results takes longer than a
     /// frame); without a library or a robot there is none.
     pub(super) fn history_drift(&mut self, ctx: &egui::Context) {
+        let stamp = self.state.ledger.stamp(Artefact::Drift);
         let view = &mut self.state.history;
         let (Some(Ok(library)), Some(robot)) = (&view.library, &self.forms.history.robot) else {
             view.drift = None;
             view.drift_of = None;
             self.state.jobs.cancel(&Slot::Drift);
+            self.state.ledger.record(Artefact::Drift, stamp, "no drift");
             return;
         };
         let mut ticked = library.clone();
@@ -67,7 +68,7 @@ impl Core {
             ..DriftOptions::default()
         };
         let robot = robot.clone();
-        self.start(ctx, Slot::Drift, Stamp::default(), move |_| {
+        self.start(ctx, Slot::Drift, stamp, move |_| {
             let outcome = history::drift(&ticked, &robot, &options);
             let outcome = outcome.map(Box::new).map_err(JobError::from);
             (robot, Box::new(ticked), outcome)
@@ -76,7 +77,11 @@ impl Core {
 
     /// The drift's answer (the latest request's: an older one was
     /// replaced).
-    pub(super) fn on_drift(&mut self, (robot, ticked, outcome): DriftAnswer) {
+    pub(super) fn on_drift(&mut self, job: &Job, (robot, ticked, outcome): DriftAnswer) {
+        let what = format!("the drift of {robot}");
+        self.state
+            .ledger
+            .record(Artefact::Drift, job.stamp.clone(), what);
         let view = &mut self.state.history;
         view.drift = Some(match outcome {
             Ok(d) => Ok(*d),
@@ -88,12 +93,14 @@ impl Core {
         view.drift_of = Some(*ticked);
     }
 
-    /// A scan's answer: the library on show, then its drift.
+    /// A scan's answer: the library on show (its drift follows: a new
+    /// library makes the last drift stale, and the ledger has it made
+    /// again).
     pub(super) fn on_scanned(
         &mut self,
-        ctx: &egui::Context,
         (folder, outcome): (PathBuf, Result<Box<Library>, JobError>),
     ) {
+        self.state.history.scans += 1;
         match outcome {
             Ok(library) => {
                 self.state.prefs.history_folder = Some(folder.clone());
@@ -137,6 +144,5 @@ impl Core {
                 self.state.history.library = Some(Err(e.to_string()));
             }
         }
-        self.history_drift(ctx);
     }
 }

@@ -16,8 +16,8 @@ use crate::app::commands::ImportCommand;
 use crate::app::error::JobError;
 use crate::app::forms::import::{LogKind, PREVIEW_ROWS};
 use crate::app::forms::{ImportForm, Tab};
-use crate::app::job::Slot;
-use crate::app::provenance::Stamp;
+use crate::app::job::{Job, Slot};
+use crate::app::ledger::Artefact;
 use crate::app::state::{Level, LoadedSession, Source};
 
 /// What a preview job answers: the joint log's header (empty when it
@@ -158,12 +158,6 @@ impl Core {
                 }
             }
             ImportCommand::Scan => self.import_scan(ctx),
-            ImportCommand::Edited => {
-                let view = &mut self.state.import;
-                view.preview = None;
-                view.outcome = None;
-                view.checks.clear();
-            }
         }
     }
 
@@ -171,13 +165,20 @@ impl Core {
     /// dialog).
     pub(super) fn import_preview(&mut self, ctx: &egui::Context, guess: bool) {
         let form = self.forms.import.clone();
-        self.start(ctx, Slot::ImportPreview, Stamp::default(), move |_| {
+        let stamp = self.state.ledger.stamp(Artefact::ImportView);
+        self.start(ctx, Slot::ImportPreview, stamp, move |_| {
             import_preview(form, guess)
         });
     }
 
     /// The preview's answer: the header, the guessed mapping, the rows.
-    pub(super) fn on_previewed(&mut self, (header, guessed, preview): Previewed) {
+    pub(super) fn on_previewed(
+        &mut self,
+        ctx: &egui::Context,
+        job: &Job,
+        (header, guessed, preview): Previewed,
+    ) {
+        let mut stamp = job.stamp.clone();
         if let Some(form) = guessed {
             let f = &mut self.forms.import;
             f.id_column = form.id_column;
@@ -185,7 +186,14 @@ impl Core {
             f.use_column = form.use_column;
             f.side_column = form.side_column;
             f.joint_columns = form.joint_columns;
+            // Previewed with the mapping guessed: made from the form as
+            // it reads now.
+            self.observe(ctx);
+            stamp = self.state.ledger.stamp(Artefact::ImportView);
         }
+        self.state
+            .ledger
+            .record(Artefact::ImportView, stamp, "the import preview");
         self.state.import.header = header;
         match &preview {
             Ok(_) => self
@@ -202,13 +210,17 @@ impl Core {
             LogKind::Joints => form.spec().map(|_| ()),
             LogKind::FlangePoses => form.pose_spec().map(|_| ()),
         };
+        let stamp = self.state.ledger.stamp(Artefact::ImportView);
         if let Err(e) = ready {
             self.state.import.outcome = Some(Err(e.clone()));
+            self.state
+                .ledger
+                .record(Artefact::ImportView, stamp, "why not");
             self.state.say(Level::Warning, e);
             return;
         }
         self.state.say(Level::Info, "importing…");
-        self.start(ctx, Slot::Import, Stamp::default(), move |w| {
+        self.start(ctx, Slot::Import, stamp, move |w| {
             import_session(&form, w.flag(), &mut |text, fraction| {
                 w.progress(text, fraction);
             })
@@ -216,7 +228,16 @@ impl Core {
     }
 
     /// Shows an import's outcome: the session opened, or why not.
-    pub(super) fn on_imported(&mut self, ctx: &egui::Context, outcome: Result<Imported, JobError>) {
+    pub(super) fn on_imported(
+        &mut self,
+        ctx: &egui::Context,
+        job: &Job,
+        outcome: Result<Imported, JobError>,
+    ) {
+        let what = "the import's outcome";
+        self.state
+            .ledger
+            .record(Artefact::ImportView, job.stamp.clone(), what);
         match outcome {
             Ok(imported) => {
                 let flagged = imported.checks.iter().filter(|c| c.flagged).count();

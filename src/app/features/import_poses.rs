@@ -8,31 +8,32 @@ use crate::engine::files::import::{self, PosePreview};
 
 use super::Core;
 use crate::app::error::JobError;
-use crate::app::job::Slot;
-use crate::app::provenance::Stamp;
+use crate::app::job::{Job, Slot};
+use crate::app::ledger::Artefact;
 
 impl Core {
     /// Starts a scan of the form's pose file (or forgets the last one
     /// when there is nothing to scan).
     pub(super) fn import_scan(&mut self, ctx: &egui::Context) {
-        let key = self.forms.import.pose_scan_key();
+        let stamp = self.state.ledger.stamp(Artefact::PoseScan);
         let view = &mut self.state.import;
-        view.scanned.clone_from(&key);
-        let spec = match (self.forms.import.pose_preview_spec(), key) {
+        let form = &self.forms.import;
+        let spec = match (form.pose_preview_spec(), form.pose_scan_key()) {
             (Ok(spec), Some(_)) => spec,
-            (Err(why), _) => {
-                view.pose_preview =
-                    (!self.forms.import.poses.trim().is_empty()).then_some(Err(why));
+            (spec, _) => {
+                // Nothing to read: why, or nothing at all.
+                view.pose_preview = match spec {
+                    Err(why) if !form.poses.trim().is_empty() => Some(Err(why)),
+                    _ => None,
+                };
                 self.state.jobs.cancel(&Slot::PoseScan);
-                return;
-            }
-            (Ok(_), None) => {
-                view.pose_preview = None;
-                self.state.jobs.cancel(&Slot::PoseScan);
+                self.state
+                    .ledger
+                    .record(Artefact::PoseScan, stamp, "nothing");
                 return;
             }
         };
-        self.start(ctx, Slot::PoseScan, Stamp::default(), move |_| {
+        self.start(ctx, Slot::PoseScan, stamp, move |_| {
             import::preview_pose_import(&spec)
                 .map(Box::new)
                 .map_err(JobError::from)
@@ -40,7 +41,15 @@ impl Core {
     }
 
     /// The latest scan's answer.
-    pub(super) fn on_import_scanned(&mut self, outcome: Result<Box<PosePreview>, JobError>) {
+    pub(super) fn on_import_scanned(
+        &mut self,
+        job: &Job,
+        outcome: Result<Box<PosePreview>, JobError>,
+    ) {
+        let what = "the pose file's preview";
+        self.state
+            .ledger
+            .record(Artefact::PoseScan, job.stamp.clone(), what);
         self.state.import.pose_preview = Some(outcome.map(|p| *p).map_err(|e| e.to_string()));
     }
 }

@@ -22,12 +22,12 @@ use crate::engine::uses::measure::{
     ModelChoice, Scan, ScanFiles, Stage,
 };
 
-use super::Core;
-use crate::app::commands::MeasureCommand;
+use super::{Core, Write};
+use crate::app::commands::{Command, MeasureCommand};
 use crate::app::error::JobError;
 use crate::app::forms::measure::ScanChoice;
 use crate::app::job::{Job, Slot};
-use crate::app::provenance::Output;
+use crate::app::ledger::Artefact;
 use crate::app::state::measure::{MeasureFailure, MeasuredCloud};
 use crate::app::state::{Level, Notice};
 use crate::app::view::ResultOrigin;
@@ -346,8 +346,8 @@ impl Core {
             return Err("no result on show: run the calibration or open a result first".into());
         };
         self.state
-            .provenance
-            .check(Output::Result)
+            .ledger
+            .check(Artefact::Result)
             .map_err(|why| format!("{why}: run the calibration again, then measure"))?;
         let form = &self.forms.measure;
         let sigma = !form.no_sigma;
@@ -423,7 +423,7 @@ impl Core {
                 return;
             }
         };
-        let stamp = self.state.provenance.stamp(Output::Cloud);
+        let stamp = self.state.ledger.stamp(Artefact::Cloud);
         if self.start(ctx, Slot::Measure, stamp, move |w| {
             measure_scan(request, w.flag(), &mut |phase, fraction| {
                 w.progress(phase, Some(fraction))
@@ -451,10 +451,11 @@ impl Core {
                     group(cloud.poses),
                     cloud.seconds
                 );
+                let what = format!("{} points measured of {}", group(cloud.points), cloud.scan);
                 m.shown = Some(*cloud);
                 self.state
-                    .provenance
-                    .record(Output::Cloud, job.stamp.clone());
+                    .ledger
+                    .record(Artefact::Cloud, job.stamp.clone(), what);
                 self.state.say(Level::Info, text);
             }
             Err(MeasureFailure::Cancelled) => self.state.say(
@@ -508,10 +509,13 @@ impl Core {
             return;
         };
         // A stale cloud is never written as if it were current.
-        if let Err(why) = self.state.provenance.check(Output::Cloud) {
-            refuse(self, format!("{why}: measure again, then export"));
-            return;
-        }
+        let stamp = match self.state.ledger.check(Artefact::Cloud) {
+            Ok(stamp) => stamp,
+            Err(why) => {
+                refuse(self, format!("{why}: measure again, then export"));
+                return;
+            }
+        };
         let text = self.forms.measure.out.trim();
         if text.is_empty() {
             refuse(
@@ -542,21 +546,20 @@ impl Core {
             result: shown.result.clone(),
             scan: shown.scan.clone(),
         };
-        let stamp = self
-            .state
-            .provenance
-            .made(Output::Cloud)
-            .cloned()
-            .unwrap_or_default();
-        let what = (format_label(format).to_string(), Some(Output::Cloud), stamp);
-        self.write(ctx, path, what, move |path| {
-            measure::write_cloud(&cloud, path, format, &provenance)?;
-            Ok(None)
-        });
+        let write = Write {
+            what: format_label(format).to_string(),
+            from: Artefact::Cloud,
+            stamp,
+            again: Command::Measure(MeasureCommand::Export),
+        };
         self.state.say(
             Level::Info,
             format!("writing the {}…", format_label(format)),
         );
+        self.write(ctx, path, write, move |path| {
+            measure::write_cloud(&cloud, path, format, &provenance)?;
+            Ok(None)
+        });
     }
 
     /// The name the export's save dialog offers: the export field's, else

@@ -39,8 +39,8 @@ use super::dialog::{self, Ask, NO_DIALOG, Purpose};
 use super::error::JobError;
 use super::forms::Forms;
 use super::job::{Job, Slot, Worker};
-use super::provenance::{Output, Stamp};
-use super::state::{AppState, Level, Notice};
+use super::ledger::{Artefact, Stamp, WhenStale};
+use super::state::{AppState, Confirm, Level, Notice};
 
 /// The state (with the job table) and the forms, with every feature's
 /// handlers. The workbench owns one and draws the panels from it.
@@ -55,8 +55,18 @@ pub struct Core {
 /// whether it was (a status line of its own, or why not).
 struct WriteAnswer {
     what: String,
-    from: Option<Output>,
+    from: Artefact,
     outcome: Result<Option<String>, JobError>,
+}
+
+/// A file to write: what it is, the artefact and its stamp, and the
+/// command that writes it (asked for again once the operator agrees to
+/// replace a file).
+struct Write {
+    what: String,
+    from: Artefact,
+    stamp: Stamp,
+    again: Command,
 }
 
 /// A job's answer as its feature's type.
@@ -71,17 +81,61 @@ impl Core {
         Self { state, forms }
     }
 
-    /// Reads every input into the provenance (each frame, and before each
-    /// command, so that a job stamps the inputs as they are).
-    pub fn observe(&mut self) {
+    /// Reads every input into the ledger (each frame, and before each
+    /// command, so that a job stamps the inputs as they are); then an
+    /// artefact that went stale is cleared or made again, as it says
+    /// ([`WhenStale`]).
+    pub fn observe(&mut self, ctx: &egui::Context) {
         let readings = crate::app::inputs::readings(&self.state, &self.forms);
-        self.state.provenance.observe(readings);
+        self.state.ledger.observe(readings);
+        for a in Artefact::ALL {
+            let ledger = &self.state.ledger;
+            match a.when_stale() {
+                WhenStale::Mark => {}
+                WhenStale::Clear => {
+                    if ledger.stale(a).is_some() {
+                        self.state.ledger.forget(a);
+                        self.clear(a);
+                    }
+                }
+                WhenStale::Redo => {
+                    let now = ledger.stamp(a);
+                    let made = ledger.made(a).is_some_and(|m| m.stamp == now);
+                    let making = Slot::of(a)
+                        .and_then(|s| self.state.jobs.get(&s))
+                        .is_some_and(|j| j.stamp == now);
+                    if !(made || making) {
+                        self.redo(ctx, a);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Clears an artefact that went stale (its [`WhenStale::Clear`]).
+    fn clear(&mut self, artefact: Artefact) {
+        if artefact == Artefact::ImportView {
+            let view = &mut self.state.import;
+            view.preview = None;
+            view.outcome = None;
+            view.checks.clear();
+        }
+    }
+
+    /// Makes an artefact again (its [`WhenStale::Redo`]).
+    fn redo(&mut self, ctx: &egui::Context, artefact: Artefact) {
+        match artefact {
+            Artefact::PoseScan => self.import_scan(ctx),
+            Artefact::Drift => self.history_drift(ctx),
+            _ => {}
+        }
     }
 
     /// Hands a command to its feature.
     pub fn apply(&mut self, ctx: &egui::Context, command: Command) {
-        self.observe();
+        self.observe(ctx);
         match command {
+            Command::Confirm(replace) => self.confirm(ctx, replace),
             Command::Files(c) => self.files(ctx, c),
             Command::Browse(purpose) => self.browse(ctx, purpose),
             Command::View(c) => self.view(c),
@@ -128,11 +182,11 @@ impl Core {
                 Slot::Run => take(a).map(|o| self.on_run(&job, o)),
                 Slot::Plan => take(a).map(|o| self.on_plan(&job, o)),
                 Slot::Simulate => take(a).map(|o| self.on_simulated(ctx, o)),
-                Slot::Import => take(a).map(|o| self.on_imported(ctx, o)),
-                Slot::ImportPreview => take(a).map(|p| self.on_previewed(p)),
-                Slot::PoseScan => take(a).map(|o| self.on_import_scanned(o)),
-                Slot::Library => take(a).map(|o| self.on_scanned(ctx, o)),
-                Slot::Drift => take(a).map(|o| self.on_drift(o)),
+                Slot::Import => take(a).map(|o| self.on_imported(ctx, &job, o)),
+                Slot::ImportPreview => take(a).map(|p| self.on_previewed(ctx, &job, p)),
+                Slot::PoseScan => take(a).map(|o| self.on_import_scanned(&job, o)),
+                Slot::Library => take(a).map(|o| self.on_scanned(o)),
+                Slot::Drift => take(a).map(|o| self.on_drift(&job, o)),
                 Slot::Compensate => take(a).map(|o| self.on_compensated(&job, o)),
                 Slot::Measure => take(a).map(|o| self.on_measured(&job, o)),
                 Slot::Dialog => take(a).map(|(p, path)| self.on_dialog(ctx, p, path)),
@@ -214,7 +268,8 @@ impl Core {
             Purpose::Open => self.open_path(ctx, path),
             Purpose::SaveSession => {
                 f.save_path = text;
-                self.save_session(ctx, true);
+                self.state.ledger.allow(path);
+                self.save_session(ctx);
             }
             Purpose::ExportFolder => {
                 f.export_dir = text;
@@ -237,13 +292,14 @@ impl Core {
             Purpose::CompensateTargets => {
                 f.compensate.targets = text;
                 if self.state.result.is_some() {
-                    self.observe();
+                    self.observe(ctx);
                     self.compensate_run(ctx);
                 }
             }
             Purpose::CompensateTool => f.compensate.tool = text,
             Purpose::CompensateOut => {
                 f.compensate.out = text;
+                self.state.ledger.allow(path);
                 self.compensate_write(ctx);
             }
             Purpose::MeasureSession => f.measure.session_file = text,
@@ -253,27 +309,63 @@ impl Core {
             Purpose::MeasureReferences => f.measure.references = text,
             Purpose::MeasureExport => {
                 f.measure.out = text;
+                self.state.ledger.allow(path);
                 self.export_cloud(ctx);
             }
         }
     }
 
-    /// Writes `path` on a job thread (one write a file at a time): `work`
-    /// writes it (atomically) and may give a status line of its own; a
-    /// file written of `from` is remembered with `stamp`.
+    /// Writes `path` of `write.from` on a job thread (one write a file at
+    /// a time): `work` writes it (atomically) and may give a status line
+    /// of its own; the file is remembered with the artefact's stamp. A
+    /// file that exists and was not written by this window of the same
+    /// artefact and inputs is replaced only once the operator says so
+    /// ([`Command::Confirm`]); `write.again` is the command that asks
+    /// for it again then.
     fn write(
         &mut self,
         ctx: &egui::Context,
         path: PathBuf,
-        (what, from, stamp): (String, Option<Output>, Stamp),
+        write: Write,
         work: impl FnOnce(&Path) -> Result<Option<String>, JobError> + Send + 'static,
     ) {
+        let Write {
+            what,
+            from,
+            stamp,
+            again,
+        } = write;
+        if let Err(why) = self.state.ledger.may_write(&path, from, &stamp) {
+            self.state.say(
+                Level::Warning,
+                format!("{what} not written yet: {why}; replace it?"),
+            );
+            self.state.confirm = Some(Confirm { path, why, again });
+            return;
+        }
         let to = path.clone();
         self.start(ctx, Slot::Write(path), stamp, move |_| WriteAnswer {
             what,
             from,
             outcome: work(&to),
         });
+    }
+
+    /// The operator answered the question of [`Core::write`]: the file is
+    /// replaced (the write is asked for again), or kept.
+    fn confirm(&mut self, ctx: &egui::Context, replace: bool) {
+        let Some(c) = self.state.confirm.take() else {
+            return;
+        };
+        if replace {
+            self.state.ledger.allow(c.path);
+            self.apply(ctx, c.again);
+        } else {
+            self.state.say(
+                Level::Info,
+                format!("{} kept: nothing written", c.path.display()),
+            );
+        }
     }
 
     /// A write ended: remembered with its output's stamp, or why not.
@@ -285,17 +377,13 @@ impl Core {
         } = answer;
         match outcome {
             Ok(line) => {
-                if let Some(from) = from {
-                    if from == Output::Report {
-                        self.state.reported = Some(path.clone());
-                        self.state
-                            .provenance
-                            .record(Output::Report, job.stamp.clone());
-                    }
-                    self.state
-                        .provenance
-                        .wrote(&what, path.clone(), from, job.stamp.clone());
+                if from == Artefact::Report {
+                    let made = format!("report written: {}", path.display());
+                    self.state.ledger.record(from, job.stamp.clone(), made);
                 }
+                self.state
+                    .ledger
+                    .wrote(&what, path.clone(), from, job.stamp.clone());
                 let line = line.unwrap_or_else(|| format!("wrote {what} to {}", path.display()));
                 self.state.say(Level::Info, line);
             }

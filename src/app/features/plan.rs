@@ -17,14 +17,16 @@ use crate::engine::tools::plan::{
 use crate::engine::tools::simulate::{self, PlanExecution, SimConfig};
 
 use super::Core;
+use super::Write;
 use super::files::analyse;
-use crate::app::commands::PlanCommand;
+use crate::app::commands::PlanExport;
+use crate::app::commands::{Command, PlanCommand};
 use crate::app::error::JobError;
 use crate::app::forms::Tab;
 use crate::app::inputs::plan_hand_eye;
 use crate::app::job::{Job, Slot};
-use crate::app::provenance::{Output, Stamp};
-use crate::app::state::{Level, LoadedSession, Notice, PlanExport, PlanOutcome, Source};
+use crate::app::ledger::{Artefact, Stamp};
+use crate::app::state::{Level, LoadedSession, Notice, PlanOutcome, Source};
 
 /// Plans and predicts, reporting each stage in words; `cancel` stops at
 /// the next stage or prediction run.
@@ -189,13 +191,13 @@ impl Core {
             Ok(c) => c,
             Err(e) => {
                 self.state.plan.outcome = Some(Err(e.clone()));
-                self.state.provenance.forget(Output::Plan);
+                self.state.ledger.forget(Artefact::Plan);
                 self.state.say(Level::Warning, e);
                 return;
             }
         };
         let runs = self.forms.plan.request.predict_runs;
-        let stamp = self.state.provenance.stamp(Output::Plan);
+        let stamp = self.state.ledger.stamp(Artefact::Plan);
         if self.start(ctx, Slot::Plan, stamp, move |w| {
             make_plan(&config, runs, w.flag(), &mut |text, fraction| {
                 w.progress(text, fraction);
@@ -216,7 +218,7 @@ impl Core {
             self.state.say(Level::Warning, "make a plan first");
             return None;
         };
-        if let Err(why) = self.state.provenance.check(Output::Plan) {
+        if let Err(why) = self.state.ledger.check(Artefact::Plan) {
             self.state
                 .say(Level::Warning, format!("{what} refused: {why}"));
             self.state.notice = Some(Notice {
@@ -225,7 +227,7 @@ impl Core {
             });
             return None;
         }
-        let stamp = self.state.provenance.made(Output::Plan).cloned()?;
+        let stamp = self.state.ledger.check(Artefact::Plan).ok()?;
         Some((plan, stamp))
     }
 
@@ -237,11 +239,16 @@ impl Core {
             return;
         };
         let path: PathBuf = dir.join(kind.file_name(&self.forms.plan.robot));
-        let what = (kind.label().to_string(), Some(Output::Plan), stamp);
-        self.write(ctx, path, what, move |path| {
+        let write = Write {
+            what: kind.label().to_string(),
+            from: Artefact::Plan,
+            stamp,
+            again: Command::Plan(PlanCommand::Export(kind)),
+        };
+        self.write(ctx, path, write, move |path| {
             let text = match kind {
                 PlanExport::Csv => plan::plan_csv(&plan),
-                PlanExport::Program(c) => c.render(&plan),
+                PlanExport::Program(c) => plan::render_program(c, &plan)?,
             };
             write_atomic(path, text.as_bytes())?;
             Ok(None)
@@ -266,12 +273,18 @@ impl Core {
     /// The planner's answer: the plan on show (recorded with the inputs
     /// it started from), or why there is none.
     pub(super) fn on_plan(&mut self, job: &Job, outcome: Result<PlanOutcome, JobError>) {
-        if outcome.is_ok() {
-            self.state
-                .provenance
-                .record(Output::Plan, job.stamp.clone());
-        } else {
-            self.state.provenance.forget(Output::Plan);
+        match &outcome {
+            Ok(o) => {
+                let what = format!(
+                    "{} poses planned for {}",
+                    o.plan.poses.len(),
+                    self.forms.plan.robot
+                );
+                self.state
+                    .ledger
+                    .record(Artefact::Plan, job.stamp.clone(), what);
+            }
+            Err(_) => self.state.ledger.forget(Artefact::Plan),
         }
         match &outcome {
             Ok(o) => {

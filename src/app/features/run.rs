@@ -15,7 +15,7 @@ use crate::app::commands::RunCommand;
 use crate::app::error::JobError;
 use crate::app::forms::Tab;
 use crate::app::job::{Job, Slot};
-use crate::app::provenance::Output;
+use crate::app::ledger::Artefact;
 use crate::app::state::{Level, LoadedSession, Notice};
 use crate::app::view::{ResultOrigin, ResultView};
 
@@ -153,7 +153,7 @@ impl Core {
         let options = self.forms.solver.options(&loaded.session);
         let loaded = loaded.clone();
         let excluded = self.state.excluded.clone();
-        let stamp = self.state.provenance.stamp(Output::Result);
+        let stamp = self.state.ledger.stamp(Artefact::Result);
         if self.start(ctx, Slot::Run, stamp, move |w| {
             calibrate_session(&loaded, &excluded, &options, w.flag(), &mut |stage| {
                 if let RunStage::Solver(p) = stage
@@ -183,14 +183,14 @@ impl Core {
                     *s = seconds;
                 }
                 self.forms.centres.magnify = view.centres.suggested_magnify;
+                let what = format!("method {}", view.method);
                 self.state.result = Some(view);
                 self.state.results_shown += 1;
-                self.state.reported = None;
                 self.state.outliers_seen = false;
                 self.state
-                    .provenance
-                    .record(Output::Result, run.stamp.clone());
-                self.state.provenance.forget(Output::Report);
+                    .ledger
+                    .record(Artefact::Result, run.stamp.clone(), what);
+                self.state.ledger.forget(Artefact::Report);
                 // The operator stays where they are; the status line and
                 // the Results tab say a result is ready.
                 self.state.result_unseen = self.forms.tab != Tab::Results;

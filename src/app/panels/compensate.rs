@@ -16,7 +16,7 @@ use crate::app::dialog::Purpose;
 use crate::app::forms::Forms;
 use crate::app::forms::compensate::{CompensateForm, TcpChoice};
 use crate::app::job::Slot;
-use crate::app::provenance::Output;
+use crate::app::ledger::Artefact;
 use crate::app::state::AppState;
 use crate::app::view::compensate::{CompensationView, TargetRow};
 use crate::engine::base::robot::controller::FlangeConvention;
@@ -254,7 +254,7 @@ fn outcome_ui(
     form: &mut CompensateForm,
     commands: &mut Vec<Command>,
 ) {
-    let stale = state.provenance.stale(Output::Compensation);
+    let stale = state.ledger.stale(Artefact::Compensation);
     match &state.compensate.outcome {
         None => {
             ui.label(
@@ -382,9 +382,9 @@ fn write_ui(
         }
     });
     dialog_note_ui(ui, state, &[Purpose::CompensateOut]);
-    let mut written = state.provenance.written.iter().rev();
-    if let Some(w) = written.find(|w| w.from == Output::Compensation) {
-        let text = match state.provenance.written_stale(w) {
+    let mut written = state.ledger.written.iter().rev();
+    if let Some(w) = written.find(|w| w.from == Artefact::Compensation) {
+        let text = match state.ledger.written_stale(w) {
             Some(_) => format!("last written: {} (stale now)", w.path.display()),
             None => format!("last written: {}", w.path.display()),
         };

@@ -81,7 +81,7 @@ pub fn history_ui(
                     ui.label(RichText::new(format!("Could not scan: {e}")).color(BAD));
                 }
                 Some(Ok(library)) => {
-                    library_ui(ui, library, forms, commands);
+                    library_ui(ui, library, forms);
                     ui.separator();
                     if state.jobs.runs(&Slot::Drift) {
                         ui.horizontal(|ui| {
@@ -104,12 +104,7 @@ pub fn history_ui(
         });
 }
 
-fn library_ui(
-    ui: &mut egui::Ui,
-    library: &Library,
-    forms: &mut Forms,
-    commands: &mut Vec<Command>,
-) {
+fn library_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) {
     let waiting = library.sessions_without_result().count();
     ui.label(format!(
         "{} results, {} sessions ({} not calibrated yet), {} other JSON files ignored",
@@ -134,7 +129,8 @@ fn library_ui(
         });
     }
     let robots = library.robots();
-    let mut changed = false;
+    // A choice made here makes the drift on show stale: the ledger has
+    // it made again.
     ui.horizontal(|ui| {
         let l = ui.label("Robot");
         let text = forms.history.robot.clone().unwrap_or_default();
@@ -142,42 +138,31 @@ fn library_ui(
             .selected_text(text)
             .show_ui(ui, |ui| {
                 for (name, n) in &robots {
-                    changed |= ui
-                        .selectable_value(
-                            &mut forms.history.robot,
-                            Some(name.clone()),
-                            format!("{name} ({n} results)"),
-                        )
-                        .changed();
+                    ui.selectable_value(
+                        &mut forms.history.robot,
+                        Some(name.clone()),
+                        format!("{name} ({n} results)"),
+                    );
                 }
             })
             .response
             .labelled_by(l.id);
         let l = ui.label("Jump beyond");
-        changed |= ui
-            .add(
-                egui::DragValue::new(&mut forms.history.k)
-                    .range(0.5..=20.0)
-                    .speed(0.05)
-                    .max_decimals(2)
-                    .suffix(" σ combined"),
-            )
-            .labelled_by(l.id)
-            .on_hover_text(
-                "flag a change between consecutive results larger than k·sqrt(σ₁² + σ₂²)",
-            )
-            .changed();
+        ui.add(
+            egui::DragValue::new(&mut forms.history.k)
+                .range(0.5..=20.0)
+                .speed(0.05)
+                .max_decimals(2)
+                .suffix(" σ combined"),
+        )
+        .labelled_by(l.id)
+        .on_hover_text("flag a change between consecutive results larger than k·sqrt(σ₁² + σ₂²)");
     });
-    changed |= table_ui(ui, library, forms);
-    if changed {
-        commands.push(Command::History(HistoryCommand::Drift));
-    }
+    table_ui(ui, library, forms);
 }
 
 /// The library table; the ticks choose the results of the drift.
-/// Returns whether a tick changed.
-fn table_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) -> bool {
-    let mut changed = false;
+fn table_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) {
     // Solid scroll bars take their own space: a floating one would cover
     // the last row's tick box.
     ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
@@ -205,14 +190,13 @@ fn table_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) -> bool {
                     }
                     ui.end_row();
                     for e in &library.entries {
-                        changed |= entry_row(ui, e, forms);
+                        entry_row(ui, e, forms);
                     }
                 });
         });
-    changed
 }
 
-fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) -> bool {
+fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) {
     let of_robot = forms.history.robot.as_deref() == Some(e.robot.as_str());
     let name = e.path.file_name().map_or_else(
         || e.path.display().to_string(),
@@ -258,7 +242,6 @@ fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) -> bool {
     let r = e.hand_eye.rpy_deg;
     ui.label(dim(format!("{:.4} {:.4} {:.4}", r[0], r[1], r[2])));
     ui.end_row();
-    changed
 }
 
 fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {

@@ -36,17 +36,10 @@ pub fn import_ui(
     forms: &mut Forms,
     commands: &mut Vec<Command>,
 ) {
-    // An edit makes the preview, the last outcome and the checks stale.
-    let before = forms.import.clone();
+    // An edit makes the preview, the last outcome and the checks stale
+    // (the ledger clears them); a pose file that reads otherwise than at
+    // the last scan is read and paired again (the ledger asks for it).
     import_form_ui(ui, state, forms, commands);
-    if forms.import != before {
-        commands.push(Command::Import(ImportCommand::Edited));
-    }
-    // A pose file (or its layout, convention, profiles) that reads
-    // otherwise than at the last scan is read and paired again.
-    if forms.import.pose_scan_key() != state.import.scanned {
-        commands.push(Command::Import(ImportCommand::Scan));
-    }
 }
 
 fn import_form_ui(

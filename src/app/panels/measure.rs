@@ -20,7 +20,7 @@ use crate::app::forms::Forms;
 use crate::app::forms::import::CONVENTIONS;
 use crate::app::forms::measure::{MAX_SENSOR_NOISE_MM, RawLog, ScanChoice};
 use crate::app::job::Slot;
-use crate::app::provenance::Output;
+use crate::app::ledger::Artefact;
 use crate::app::state::AppState;
 use crate::app::state::measure::MeasuredCloud;
 use crate::engine::base::session::Use;
@@ -103,7 +103,7 @@ pub fn measure_ui(
                 return;
             };
             ui.separator();
-            if let Some(s) = state.provenance.stale(Output::Cloud) {
+            if let Some(s) = state.ledger.stale(Artefact::Cloud) {
                 stale_banner_ui(ui, &s, "Press ▶ Measure again; its export is refused until then.");
             }
             summary_ui(ui, cloud);
@@ -170,7 +170,7 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
                         .color(WARN),
                     );
                 }
-                if let Some(s) = state.provenance.stale(Output::Result) {
+                if let Some(s) = state.ledger.stale(Artefact::Result) {
                     ui.label(RichText::new(format!("{s}")).color(WARN));
                 }
             }
@@ -717,7 +717,7 @@ fn distances_ui(ui: &mut egui::Ui, before: &ModelCheck, after: &ModelCheck) {
 /// and Save as… (a dialog); refused with the reason while the cloud is
 /// stale; the files written of it below.
 fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mut Vec<Command>) {
-    let stale = state.provenance.stale(Output::Cloud);
+    let stale = state.ledger.stale(Artefact::Cloud);
     ui.horizontal_wrapped(|ui| {
         ui.label(RichText::new("Export:").strong());
         labelled_field(ui, "Export to", &mut forms.measure.out, "cloud.ply", 260.0)
@@ -760,14 +760,14 @@ fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
         );
     }
     for w in state
-        .provenance
+        .ledger
         .written
         .iter()
         .rev()
-        .filter(|w| w.from == Output::Cloud)
+        .filter(|w| w.from == Artefact::Cloud)
         .take(2)
     {
-        let mark = if state.provenance.written_stale(w).is_some() {
+        let mark = if state.ledger.written_stale(w).is_some() {
             RichText::new(format!(
                 "! wrote {} {} (now stale)",
                 w.what,

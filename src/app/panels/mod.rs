@@ -230,7 +230,7 @@ pub fn slot_ui(ui: &mut egui::Ui, state: &AppState, slot: &Slot) {
 
 /// The mark over a stale output: what changed since it was made, and
 /// what to do; its exports are refused (the buttons say why).
-pub fn stale_banner_ui(ui: &mut egui::Ui, stale: &crate::app::provenance::Stale, todo: &str) {
+pub fn stale_banner_ui(ui: &mut egui::Ui, stale: &crate::app::ledger::Stale, todo: &str) {
     egui::Frame::group(ui.style())
         .stroke(egui::Stroke::new(2.0, WARN))
         .show(ui, |ui| {
@@ -346,6 +346,27 @@ pub fn tabs_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mu
         ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
             if let Some(l) = &state.loaded {
                 ui.label(RichText::new(&l.session.name).weak());
+            }
+        });
+    });
+}
+
+/// The question of a write that would replace a file this window did not
+/// write of the same artefact from the same inputs: Replace, or Keep.
+pub fn confirm_ui(ctx: &egui::Context, state: &AppState, commands: &mut Vec<Command>) {
+    let Some(c) = &state.confirm else {
+        return;
+    };
+    egui::Modal::new(egui::Id::unique("confirm_replace")).show(ctx, |ui| {
+        ui.set_max_width(520.0);
+        ui.label(RichText::new(format!("Replace {}?", c.path.display())).strong());
+        ui.add(egui::Label::new(RichText::new(&c.why).color(WARN)).wrap());
+        ui.horizontal(|ui| {
+            if ui.button("Replace").clicked() {
+                commands.push(Command::Confirm(true));
+            }
+            if ui.button("Keep the file").clicked() {
+                commands.push(Command::Confirm(false));
             }
         });
     });

@@ -10,12 +10,13 @@ use egui_plot::{MarkerShape, Plot, PlotPoints, Points};
 use super::{
     AFTER, BAD, BEFORE, DEFAULT_RANGE, MUTED, labelled_field, range_fields, range_of, range_values,
 };
+use crate::app::commands::PlanExport;
 use crate::app::commands::{Command, PlanCommand};
 use crate::app::dialog::Purpose;
 use crate::app::forms::{Forms, plan::default_sphere};
 use crate::app::job::Slot;
-use crate::app::provenance::{Output, Stale};
-use crate::app::state::{AppState, PlanExport, PlanOutcome};
+use crate::app::ledger::{Artefact, Stale};
+use crate::app::state::{AppState, PlanOutcome};
 use crate::engine::base::robot;
 use crate::engine::tools::plan::{Plan, PlanStats, StationRole};
 
@@ -341,7 +342,7 @@ fn export_ui(
         let robot_name = crate::engine::base::robot::presets::preset(&forms.plan.robot)
             .map(|p| p.robot.name)
             .unwrap_or_default();
-        let controller = crate::engine::tools::plan::Controller::for_robot(&robot_name);
+        let controller = crate::engine::tools::plan::program_controller(&robot_name);
         if controller.is_none() {
             ui.label(
                 RichText::new(format!(
@@ -353,8 +354,10 @@ fn export_ui(
         for kind in std::iter::once(PlanExport::Csv).chain(controller.map(PlanExport::Program)) {
             let hint = match kind {
                 PlanExport::Csv => "the joint-log CSV that `spherecal import` reads (id, station, use, side, joints, nominal ABB flange pose)",
-                PlanExport::Program(crate::engine::tools::plan::Controller::AbbRapid) => "an ABB RAPID module: one jointtarget per pose, MoveAbsJ in plan order, a stop per measurement",
-                PlanExport::Program(crate::engine::tools::plan::Controller::UrScript) => "a URScript program for a Universal Robots controller: one movej per pose (rad), a popup per station, a measure hook",
+                PlanExport::Program(crate::engine::tools::plan::Controller::Abb) => "an ABB RAPID module: one jointtarget per pose, MoveAbsJ in plan order, a stop per measurement",
+                PlanExport::Program(crate::engine::tools::plan::Controller::Ur) => "a URScript program for a Universal Robots controller: one movej per pose (rad), a popup per station, a measure hook",
+                // Only the controllers of plan::PROGRAMS are offered.
+                PlanExport::Program(_) => "the controller's program",
             };
             if ui
                 .add_enabled(
@@ -391,7 +394,7 @@ fn outcome_ui(
 ) {
     let plan = &o.plan;
     let st = &plan.stats;
-    let stale = state.provenance.stale(Output::Plan);
+    let stale = state.ledger.stale(Artefact::Plan);
     if let Some(s) = &stale {
         super::stale_banner_ui(
             ui,

@@ -194,10 +194,6 @@ fn save_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
             "/path/to/edited-session.json",
             width,
         );
-        let replace = state
-            .confirm_overwrite
-            .as_ref()
-            .is_some_and(|p| p.as_os_str() == forms.save_path.trim());
         if ui
             .button("Browse…")
             .on_hover_text("choose the file with the desktop's dialog")
@@ -205,9 +201,8 @@ fn save_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
         {
             commands.push(Command::Browse(Purpose::SaveSession));
         }
-        let label = if replace { "Replace" } else { "Save" };
         let save = ui
-            .add_enabled(!state.jobs.writing(), egui::Button::new(label))
+            .add_enabled(!state.jobs.writing(), egui::Button::new("Save"))
             .on_hover_text("write the session without the left-out measurements (atomic write)");
         let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
         if save.clicked() || entered {

@@ -13,7 +13,7 @@ use crate::app::commands::{Command, FilesCommand, RunCommand, ViewCommand};
 use crate::app::dialog::{NO_DIALOG, Purpose};
 use crate::app::forms::Forms;
 use crate::app::job::Slot;
-use crate::app::provenance::Output;
+use crate::app::ledger::Artefact;
 use crate::app::state::AppState;
 
 /// The whole left panel.
@@ -280,7 +280,7 @@ pub fn solver_ui(
             SIDE_EPSILON_HEIGHT,
         );
     } else if let Some(result) = &state.result {
-        match state.provenance.stale(Output::Result) {
+        match state.ledger.stale(Artefact::Result) {
             Some(s) => ui
                 .label(
                     RichText::new("ε of the result on show (stale)")

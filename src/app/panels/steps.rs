@@ -11,11 +11,12 @@
 use egui::RichText;
 
 use super::{AFTER, BAD, GOOD, MUTED, WARN};
+use crate::app::commands::ExportKind;
 use crate::app::commands::{Command, PlanCommand, RunCommand, ViewCommand};
 use crate::app::forms::{Forms, Tab};
 use crate::app::job::Slot;
-use crate::app::provenance::Output;
-use crate::app::state::{AppState, ExportKind};
+use crate::app::ledger::Artefact;
+use crate::app::state::AppState;
 use crate::engine::tools::result_view::Verdict;
 
 /// Where one step stands.
@@ -86,56 +87,107 @@ fn outliers(state: &AppState) -> usize {
         .map_or(0, |m| m.outliers.len())
 }
 
+/// Where the step of `artefact` stands, from the ledger and the job
+/// table alone: under way (its phase), stale (what changed), done (what
+/// it is), or not made.
+#[must_use]
+pub fn standing(state: &AppState, artefact: Artefact) -> (StepState, String) {
+    let ledger = &state.ledger;
+    if let Some(job) = Slot::of(artefact).and_then(|s| state.jobs.get(&s)) {
+        return (StepState::Running, job.phase.clone());
+    }
+    match (ledger.made(artefact), ledger.stale(artefact)) {
+        (Some(_), Some(s)) => (StepState::Stale(s.what_changed()), s.to_string()),
+        (Some(m), None) => (StepState::Done, m.what.clone()),
+        (None, _) => (StepState::Todo, String::new()),
+    }
+}
+
+/// A step of `artefact` ([`standing`]) with its words for each state:
+/// `todo` before it is made, `again` added to what makes it stale.
+fn step(
+    state: &AppState,
+    artefact: Artefact,
+    name: &'static str,
+    (todo, again): (&str, &str),
+    action: (String, Command),
+) -> Step {
+    let (state, words) = standing(state, artefact);
+    let detail = match &state {
+        StepState::Todo => todo.to_string(),
+        StepState::Stale(_) => format!("{words}: {again}"),
+        _ => words,
+    };
+    Step {
+        name,
+        state,
+        detail,
+        action,
+    }
+}
+
 /// The steps of the job for the current state (the Measure step, the
-/// cell's use once calibrated, last).
+/// cell's use once calibrated, last). Whether an artefact's step is done,
+/// under way or stale comes from the ledger and the job table only.
 #[must_use]
 pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
-    let prov = &state.provenance;
-    let planned = state.plan.outcome.as_ref().is_some_and(Result::is_ok);
-    let plan_stale = prov.stale(Output::Plan);
     let loaded = state.loaded.as_ref();
     let failed = loaded.map_or(0, |l| l.analysis.failures().count());
     let warned = loaded.map_or(0, |l| l.analysis.warnings.len());
-    let result_stale = prov.stale(Output::Result);
-    let run = state.jobs.get(&Slot::Run);
-    let running = run.is_some();
-    let loading = state.jobs.get(&Slot::Load);
-    let verdict = verdict(state, forms);
-    let report_stale = prov.stale(Output::Report);
-    let reported = state.reported.is_some() && prov.made(Output::Report).is_some();
+    let calibrated = standing(state, Artefact::Result).0;
+    let again = |label: &str, state: &StepState, first: &str| match state {
+        StepState::Stale(_) => label.to_string(),
+        _ => first.to_string(),
+    };
+    let mut plan = step(
+        state,
+        Artefact::Plan,
+        "Plan",
+        (
+            "plan the poses for the robot and the sphere",
+            "make it again before writing its program",
+        ),
+        (String::new(), show(Tab::Plan)),
+    );
+    plan.action.0 = again("Make the plan again", &plan.state, "Plan the poses");
+    if plan.state == StepState::Todo && loaded.is_some() {
+        plan.state = StepState::Done;
+        plan.detail = "a session is open (its poses were planned elsewhere)".into();
+    }
+    let mut calibrate = step(
+        state,
+        Artefact::Result,
+        "Calibrated",
+        ("run the calibration", "run again"),
+        (String::new(), Command::Run(RunCommand::Start)),
+    );
+    if calibrate.state == StepState::Running {
+        calibrate.detail = format!("calibrating: {}", calibrate.detail);
+    }
+    calibrate.action.0 = again("▶ Run again", &calibrate.state, "▶ Run the calibration");
+    let mut report = step(
+        state,
+        Artefact::Report,
+        "Reported",
+        (
+            "write the HTML report",
+            "it no longer says what is on show; write it again",
+        ),
+        (String::new(), Command::Export(ExportKind::ReportHtml)),
+    );
+    report.action.0 = again("Write the report again", &report.state, "Write the report");
     vec![
-        Step {
-            name: "Plan",
-            state: match (&plan_stale, planned, loaded.is_some()) {
-                (Some(s), true, _) => StepState::Stale(s.what_changed()),
-                (_, true, _) | (_, false, true) => StepState::Done,
-                _ => StepState::Todo,
-            },
-            detail: match (&plan_stale, planned, loaded.is_some()) {
-                (Some(s), true, _) => format!("{s}: make it again before writing its program"),
-                (_, true, _) => "a pose plan is made".into(),
-                (_, false, true) => "a session is open (its poses were planned elsewhere)".into(),
-                _ => "plan the poses for the robot and the sphere".into(),
-            },
-            action: (
-                if plan_stale.is_some() {
-                    "Make the plan again".into()
-                } else {
-                    "Plan the poses".into()
-                },
-                show(Tab::Plan),
-            ),
-        },
+        plan,
         Step {
             name: "Data in",
-            state: if loading.is_some() {
+            state: if state.jobs.runs(&Slot::Load) {
                 StepState::Running
             } else if loaded.is_some() {
                 StepState::Done
             } else {
                 StepState::Todo
             },
-            detail: if let Some(job) = loading {
+            detail: if let Some(job) = state.jobs.get(&Slot::Load) {
                 job.phase.clone()
             } else {
                 loaded.map_or_else(
@@ -167,74 +219,38 @@ pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
             },
             action: ("Check the stripes".into(), show(Tab::Stripe)),
         },
-        Step {
-            name: "Calibrated",
-            state: match (&result_stale, running, &state.result) {
-                (_, true, _) => StepState::Running,
-                (Some(s), _, Some(_)) => StepState::Stale(s.what_changed()),
-                (_, _, Some(_)) => StepState::Done,
-                _ => StepState::Todo,
-            },
-            detail: match (&result_stale, run, &state.result) {
-                (_, Some(run), _) => format!("calibrating: {}", run.phase),
-                (Some(s), _, Some(_)) => format!("{s}: run again"),
-                (_, _, Some(r)) => format!("method {}", r.method),
-                _ => "run the calibration".into(),
-            },
-            action: (
-                if result_stale.is_some() {
-                    "▶ Run again".into()
-                } else {
-                    "▶ Run the calibration".into()
-                },
-                Command::Run(RunCommand::Start),
-            ),
-        },
-        Step {
-            name: "Validated",
-            state: match (&result_stale, running, &verdict) {
-                (_, true, _) | (_, _, None) => StepState::Todo,
-                (Some(s), _, Some(_)) => StepState::Stale(s.what_changed()),
-                (_, _, Some(Verdict::Pass)) => StepState::Done,
-                (_, _, Some(Verdict::Fail(_))) => StepState::Attention,
-                (_, _, Some(Verdict::NotChecked)) => StepState::Skipped,
-            },
-            detail: match (&result_stale, &verdict) {
-                (_, None) => "calibrate first".into(),
-                (Some(s), Some(_)) => format!("{s}: its verdict no longer holds"),
-                (_, Some(Verdict::NotChecked)) => {
-                    "skipped: no validate data (the session has no validate measurements)".into()
-                }
-                (_, Some(v)) => v.describe(&forms.tolerance),
-            },
-            action: ("See the verdict".into(), show(Tab::Results)),
-        },
-        Step {
-            name: "Reported",
-            state: match (&report_stale, reported) {
-                (Some(s), true) => StepState::Stale(s.what_changed()),
-                (_, true) => StepState::Done,
-                _ => StepState::Todo,
-            },
-            detail: match (&report_stale, &state.reported) {
-                (Some(s), Some(p)) => format!(
-                    "{s}: the report at {} no longer says what is on show; write it again",
-                    p.display()
-                ),
-                (_, Some(p)) if reported => format!("report written: {}", p.display()),
-                _ => "write the HTML report".into(),
-            },
-            action: (
-                if report_stale.is_some() {
-                    "Write the report again".into()
-                } else {
-                    "Write the report".into()
-                },
-                Command::Export(ExportKind::ReportHtml),
-            ),
-        },
+        calibrate,
+        validated(state, forms, calibrated),
+        report,
         measure_step(state),
     ]
+}
+
+/// The Validated step: the verdict of the result on show against the
+/// tolerance, stale with the result.
+fn validated(state: &AppState, forms: &Forms, calibrated: StepState) -> Step {
+    let verdict = verdict(state, forms);
+    let (state, detail) = match (calibrated, &verdict) {
+        (StepState::Running | StepState::Todo, _) | (_, None) => {
+            (StepState::Todo, "calibrate first".to_string())
+        }
+        (StepState::Stale(s), Some(_)) => (
+            StepState::Stale(s.clone()),
+            format!("the result is stale: {s}; its verdict no longer holds"),
+        ),
+        (_, Some(Verdict::Pass)) => (StepState::Done, Verdict::Pass.describe(&forms.tolerance)),
+        (_, Some(v @ Verdict::Fail(_))) => (StepState::Attention, v.describe(&forms.tolerance)),
+        (_, Some(Verdict::NotChecked)) => (
+            StepState::Skipped,
+            "skipped: no validate data (the session has no validate measurements)".to_string(),
+        ),
+    };
+    Step {
+        name: "Validated",
+        state,
+        detail,
+        action: ("See the verdict".into(), show(Tab::Results)),
+    }
 }
 
 /// What the Next button offers: its text, its command (`None`: shown
@@ -455,42 +471,25 @@ pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &m
 }
 
 /// The Measure step of the step bar: to do, under way, done or stale
-/// (the cloud's provenance).
+/// (the cloud's standing in the ledger).
 #[must_use]
 pub fn measure_step(state: &AppState) -> Step {
-    let m = &state.measure;
-    let stale = state.provenance.stale(Output::Cloud);
-    let show = Command::View(ViewCommand::ShowTab(Tab::Measure));
-    let (step_state, detail) = match (state.jobs.get(&Slot::Measure), &m.shown, &stale) {
-        (Some(job), _, _) => (
-            StepState::Running,
-            format!(
-                "measuring: {} ({:.0} %)",
-                job.phase,
-                job.fraction.unwrap_or_default() * 100.0
-            ),
+    let mut m = step(
+        state,
+        Artefact::Cloud,
+        "Measured",
+        (
+            "measure a scan with the calibrated cell (optional)",
+            "measure again before exporting",
         ),
-        (None, Some(_), Some(s)) => (
-            StepState::Stale(s.what_changed()),
-            format!("{s}: measure again before exporting"),
+        (
+            "Measure a scan".to_string(),
+            Command::View(ViewCommand::ShowTab(Tab::Measure)),
         ),
-        (None, Some(c), None) => (
-            StepState::Done,
-            format!(
-                "{} points measured of {}",
-                crate::app::features::measure::group(c.points),
-                c.scan
-            ),
-        ),
-        (None, None, _) => (
-            StepState::Todo,
-            "measure a scan with the calibrated cell (optional)".to_string(),
-        ),
-    };
-    Step {
-        name: "Measured",
-        state: step_state,
-        detail,
-        action: ("Measure a scan".to_string(), show),
+    );
+    if let (StepState::Running, Some(job)) = (&m.state, state.jobs.get(&Slot::Measure)) {
+        let percent = job.fraction.unwrap_or_default() * 100.0;
+        m.detail = format!("measuring: {} ({percent:.0} %)", job.phase);
     }
+    m
 }

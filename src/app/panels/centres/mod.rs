@@ -21,7 +21,7 @@ use super::plots::readable;
 use super::station_style;
 use crate::app::commands::{Command, ViewCommand};
 use crate::app::forms::{Camera, CentresForm, Forms};
-use crate::app::provenance::Output;
+use crate::app::ledger::Artefact;
 use crate::app::state::AppState;
 use crate::app::view::CentreSet;
 pub use orbit::{ORBIT_LABEL, length_text, orbit_positions, scale_bar};
@@ -103,7 +103,7 @@ pub fn centres_ui(
         .show(ui, |ui| {
             let top = ui.cursor().min.y;
             if state.result.is_some()
-                && let Some(s) = state.provenance.stale(Output::Result)
+                && let Some(s) = state.ledger.stale(Artefact::Result)
             {
                 super::stale_banner_ui(
                     ui,

@@ -21,11 +21,12 @@ mod tables;
 use egui::RichText;
 
 use super::{AFTER, BAD, GOOD, MUTED, WARN, labelled_field, number_field, ratio_text};
+use crate::app::commands::ExportKind;
 use crate::app::commands::{Command, ViewCommand};
 use crate::app::dialog::Purpose;
 use crate::app::forms::Forms;
-use crate::app::provenance::{Output, Stale};
-use crate::app::state::{AppState, ExportKind};
+use crate::app::ledger::{Artefact, Stale};
+use crate::app::state::AppState;
 use crate::app::view::{ResultOrigin, ResultView};
 use crate::engine::tools::result_view::Verdict;
 
@@ -45,7 +46,7 @@ pub fn results_ui(
         ui.label("Press ▶ Run in the solver panel on the left, or open a result file (path field or Open…) to review it beside its session.");
         return;
     };
-    let stale = state.provenance.stale(Output::Result);
+    let stale = state.ledger.stale(Artefact::Result);
     egui::ScrollArea::vertical()
         .auto_shrink([false, false])
         .show(ui, |ui| {
@@ -298,11 +299,11 @@ fn export_ui(
 /// The files written of the result on show this session, each marked
 /// stale when an input of it has changed since.
 fn written_ui(ui: &mut egui::Ui, state: &AppState) {
-    let prov = &state.provenance;
+    let prov = &state.ledger;
     let mine: Vec<_> = prov
         .written
         .iter()
-        .filter(|w| matches!(w.from, Output::Result | Output::Report))
+        .filter(|w| matches!(w.from, Artefact::Result | Artefact::Report))
         .rev()
         .take(WRITTEN_SHOWN)
         .collect();
