@@ -466,8 +466,8 @@ fn simulated_data_from_a_plan_imports_through_the_csv_path_and_calibrates() {
 #[test]
 fn rapid_module_has_one_joint_target_per_pose_in_plan_order() {
     let plan = small_plan();
-    let text = Controller::AbbRapid.render(plan);
-    assert_eq!(Controller::parse("rapid"), Some(Controller::AbbRapid));
+    let text = plan::render_program(Controller::Abb, plan).unwrap();
+    assert_eq!(plan::parse_program("rapid"), Some(Controller::Abb));
     assert!(text.is_ascii());
     let lines: Vec<&str> = text.lines().map(str::trim).collect();
     assert_eq!(lines.first(), Some(&"MODULE SpherecalPlan"));
@@ -769,17 +769,17 @@ fn plan_then_simulate_import_and_calibrate_on_the_command_line() {
 #[test]
 fn urscript_program_has_one_movej_per_pose_in_plan_order() {
     let plan = small_plan();
-    assert_eq!(Controller::parse("urscript"), Some(Controller::UrScript));
+    assert_eq!(plan::parse_program("urscript"), Some(Controller::Ur));
     assert_eq!(
-        Controller::for_robot("Universal Robots UR5e"),
-        Some(Controller::UrScript)
+        plan::program_controller("Universal Robots UR5e"),
+        Some(Controller::Ur)
     );
     assert_eq!(
-        Controller::for_robot("ABB IRB 2400/16"),
-        Some(Controller::AbbRapid)
+        plan::program_controller("ABB IRB 2400/16"),
+        Some(Controller::Abb)
     );
-    assert_eq!(Controller::for_robot("KUKA KR 16"), None);
-    let text = Controller::UrScript.render(plan);
+    assert_eq!(plan::program_controller("KUKA KR 16"), None);
+    let text = plan::render_program(Controller::Ur, plan).unwrap();
     assert!(text.is_ascii());
     let lines: Vec<&str> = text.lines().map(str::trim).collect();
     assert_eq!(lines.first(), Some(&"def spherecal_plan():"));

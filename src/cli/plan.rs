@@ -114,7 +114,7 @@ pub struct PlanArgs {
         value_name = "KEY=FILE",
         help = format!(
             "Write a controller program, KEY one of: {}; may be repeated",
-            Controller::ALL
+            plan::PROGRAMS
                 .iter()
                 .map(|c| format!("{} ({})", c.key(), c.label()))
                 .collect::<Vec<_>>()
@@ -353,14 +353,14 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     let started = Instant::now();
     let mut programs: Vec<(Controller, PathBuf)> = Vec::new();
     if let Some(path) = &args.rapid {
-        programs.push((Controller::AbbRapid, path.clone()));
+        programs.push((Controller::Abb, path.clone()));
     }
     for item in &args.program {
         let parsed = item
             .split_once('=')
-            .and_then(|(k, f)| Some((Controller::parse(k.trim())?, PathBuf::from(f.trim()))));
+            .and_then(|(k, f)| Some((plan::parse_program(k.trim())?, PathBuf::from(f.trim()))));
         let Some(p) = parsed else {
-            let keys: Vec<&str> = Controller::ALL.iter().map(|c| c.key()).collect();
+            let keys: Vec<&str> = plan::PROGRAMS.iter().map(|c| c.key()).collect();
             return Err(CliError::input(format!(
                 "--program `{item}` is not KEY=FILE with KEY one of: {}",
                 keys.join(", ")
@@ -470,7 +470,9 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     }
     for (controller, path) in &programs {
         let what = format!("{} program", controller.key());
-        files.push((path, controller.render(&made), what));
+        let text =
+            plan::render_program(*controller, &made).map_err(|e| CliError::input(e.to_string()))?;
+        files.push((path, text, what));
     }
     let bytes: Vec<(&Path, &[u8])> = files.iter().map(|(p, t, _)| (*p, t.as_bytes())).collect();
     super::write_outputs(&bytes, format::Folders::Existing)?;

@@ -87,7 +87,7 @@ impl CompensationView {
                 .into_iter()
                 .map(|c| {
                     (
-                        c.describe().to_string(),
+                        c.tool_data_kind().to_string(),
                         c.tool_data(&model.tool, TOOL_NAME),
                     )
                 })

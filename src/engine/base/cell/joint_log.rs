@@ -10,17 +10,8 @@ use std::fmt::Write as _;
 
 use nalgebra::Isometry3;
 
+use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::base::session::Use;
-
-/// The flange pose as an ABB controller reports it: `x, y, z` (mm) and the
-/// unit quaternion `q1..q4 = w, x, y, z`, with `w ≥ 0`.
-#[must_use]
-pub fn abb_pose(pose: &Isometry3<f64>) -> [f64; 7] {
-    let t = pose.translation.vector;
-    let q = pose.rotation.into_inner();
-    let q = if q.w < 0.0 { -q } else { q };
-    [t.x, t.y, t.z, q.w, q.i, q.j, q.k]
-}
 
 /// One row of a joint log to write.
 #[derive(Debug, Clone, PartialEq)]
@@ -56,7 +47,8 @@ fn joint_text(q: f64) -> String {
 /// A joint log: `#` comment lines, the header
 /// `id,station,use,side,j1..jn,x,y,z,q1,q2,q3,q4` plus `extra_header`, and
 /// one line per row (joints to 1e-9°, the flange position to 1e-6 mm, the
-/// quaternion to 12 decimals; see [`abb_pose`]).
+/// quaternion to 12 decimals, `w ≥ 0`: ABB's encoding,
+/// [`FlangeConvention::values_from_pose`]).
 #[must_use]
 pub fn write(comments: &[String], n_joints: usize, extra_header: &[&str], rows: &[Row]) -> String {
     let mut out = String::new();
@@ -84,7 +76,7 @@ pub fn write(comments: &[String], n_joints: usize, extra_header: &[&str], rows: 
         for &q in r.joints {
             let _ = write!(out, ",{}", joint_text(q));
         }
-        let f = abb_pose(&r.flange);
+        let f = FlangeConvention::AbbQuaternion.values_from_pose(&r.flange);
         let _ = write!(
             out,
             ",{:.6},{:.6},{:.6},{:.12},{:.12},{:.12},{:.12}",

@@ -1,7 +1,13 @@
-//! How robot controllers write a flange pose (`bT_e`, base frame): ABB's
-//! quaternion, KUKA's A B C, FANUC's W P R, UR's rotation vector in metres,
-//! or a plain 4×4 matrix. One implementation for every reader of
-//! controller poses: the import's flange-pose check and pose-only logs.
+//! The robot controllers spherecal reads and writes for ([`Controller`],
+//! the one list of them: the planner's program export, compensation's
+//! tool data and programs, the pose readers) and how each writes a pose
+//! ([`FlangeConvention`]: ABB's quaternion, KUKA's A B C, FANUC's W P R,
+//! UR's rotation vector in metres, or a plain 4×4 matrix). One encoding
+//! per controller, for every reader and writer of controller poses: the
+//! import's flange-pose check and pose-only logs, joint logs, compensated
+//! targets, tool data. An ABB quaternion is written with `w ≥ 0`.
+
+use std::fmt::Write as _;
 
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
@@ -9,6 +15,177 @@ use crate::engine::base::geometry::{isometry_from_rows, rows_from_isometry};
 
 /// Largest accepted deviation of an ABB quaternion's norm from 1.
 const QUATERNION_NORM_TOLERANCE: f64 = 1e-3;
+
+/// A robot controller, by maker: its pose convention, the language and
+/// file of its programs, its tool data.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Controller {
+    /// ABB IRC5 / OmniCore: RAPID, quaternion poses.
+    Abb,
+    /// KUKA KR C4: KRL, A B C angles.
+    Kuka,
+    /// FANUC R-30iB: TP programs (`.ls`), W P R angles.
+    Fanuc,
+    /// Universal Robots (CB3, e-Series): URScript, rotation vectors in m.
+    Ur,
+}
+
+impl Controller {
+    /// Every controller, in the order they are listed.
+    pub const ALL: [Self; 4] = [Self::Abb, Self::Kuka, Self::Fanuc, Self::Ur];
+
+    /// The maker: "ABB", "KUKA", "FANUC", "Universal Robots".
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Abb => "ABB",
+            Self::Kuka => "KUKA",
+            Self::Fanuc => "FANUC",
+            Self::Ur => "Universal Robots",
+        }
+    }
+
+    /// How it writes a pose.
+    #[must_use]
+    pub fn convention(self) -> FlangeConvention {
+        match self {
+            Self::Abb => FlangeConvention::AbbQuaternion,
+            Self::Kuka => FlangeConvention::KukaAbc,
+            Self::Fanuc => FlangeConvention::FanucWpr,
+            Self::Ur => FlangeConvention::UrRotationVector,
+        }
+    }
+
+    /// The controller whose convention is `c`; `None` for a matrix.
+    #[must_use]
+    pub fn of(c: FlangeConvention) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.convention() == c)
+    }
+
+    /// The key of its program language, as `--pose-format` and
+    /// `plan --program` take it: `rapid`, `krl`, `fanuc-ls`, `urscript`.
+    #[must_use]
+    pub fn key(self) -> &'static str {
+        match self {
+            Self::Abb => "rapid",
+            Self::Kuka => "krl",
+            Self::Fanuc => "fanuc-ls",
+            Self::Ur => "urscript",
+        }
+    }
+
+    /// The controller of a program language's [`Self::key`].
+    #[must_use]
+    pub fn parse(key: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|c| c.key() == key)
+    }
+
+    /// The usual extension of its program files.
+    #[must_use]
+    pub fn extension(self) -> &'static str {
+        match self {
+            Self::Abb => "mod",
+            Self::Kuka => "src",
+            Self::Fanuc => "ls",
+            Self::Ur => "script",
+        }
+    }
+
+    /// What its program is, for a button or a message: "RAPID module".
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Abb => "RAPID module",
+            Self::Kuka => "KRL program",
+            Self::Fanuc => "TP program",
+            Self::Ur => "URScript program",
+        }
+    }
+
+    /// The controller of a robot, by its model name (`ABB …` or `IRB …`,
+    /// `KUKA …`, `FANUC …`, `Universal Robots …` or `UR…`).
+    #[must_use]
+    pub fn for_robot(name: &str) -> Option<Self> {
+        let n = name.to_ascii_lowercase();
+        if n.starts_with("abb") || n.contains("irb") {
+            Some(Self::Abb)
+        } else if n.starts_with("kuka") {
+            Some(Self::Kuka)
+        } else if n.starts_with("fanuc") {
+            Some(Self::Fanuc)
+        } else if n.starts_with("universal robots") || n.starts_with("ur") {
+            Some(Self::Ur)
+        } else {
+            None
+        }
+    }
+
+    /// What its tool data is, for people: "ABB RAPID tooldata".
+    #[must_use]
+    pub fn tool_data_kind(self) -> &'static str {
+        match self {
+            Self::Abb => "ABB RAPID tooldata",
+            Self::Kuka => "KUKA TOOL_DATA",
+            Self::Fanuc => "FANUC user tool frame (UTOOL)",
+            Self::Ur => "Universal Robots TCP",
+        }
+    }
+
+    /// The tool `flange_from_tcp` (mm) as this controller's tool data,
+    /// named `name` where the syntax has a name (RAPID), tool number 1
+    /// where it has a number; a few lines with the controller's comments.
+    #[must_use]
+    pub fn tool_data(self, flange_from_tcp: &Isometry3<f64>, name: &str) -> String {
+        let v = self.convention().values_from_pose(flange_from_tcp);
+        let mut s = String::new();
+        match self {
+            Self::Abb => {
+                let _ = writeln!(
+                    s,
+                    "! TCP of {name} (mm, quaternion w x y z); the load [1,[0,0,1],…] is a placeholder: enter the sensor's mass (kg) and centre of gravity (mm)"
+                );
+                let _ = writeln!(
+                    s,
+                    "PERS tooldata {name} := [TRUE,[[{:.4},{:.4},{:.4}],[{:.9},{:.9},{:.9},{:.9}]],[1,[0,0,1],[1,0,0,0],0,0,0]];",
+                    v[0], v[1], v[2], v[3], v[4], v[5], v[6]
+                );
+            }
+            Self::Kuka => {
+                let _ = writeln!(
+                    s,
+                    "; TCP of {name} (mm; A, B, C deg), in $config.dat or the numeric tool input"
+                );
+                let _ = writeln!(
+                    s,
+                    "TOOL_DATA[1]={{X {:.4},Y {:.4},Z {:.4},A {:.5},B {:.5},C {:.5}}}",
+                    v[0], v[1], v[2], v[3], v[4], v[5]
+                );
+            }
+            Self::Fanuc => {
+                let _ = writeln!(
+                    s,
+                    "! TCP of {name}: SETUP > Frames > Tool Frame > Direct Entry, or in a TP program (mm; W, P, R deg):"
+                );
+                for (k, label) in ["X", "Y", "Z", "W", "P", "R"].iter().enumerate() {
+                    let _ = writeln!(s, "PR[1,{}]={:.4} ; ! {label}", k + 1, v[k]);
+                }
+                let _ = writeln!(s, "UTOOL[1]=PR[1] ;");
+            }
+            Self::Ur => {
+                let _ = writeln!(
+                    s,
+                    "# TCP of {name} (m; rotation vector rad): Installation > TCP, or in URScript:"
+                );
+                let _ = writeln!(
+                    s,
+                    "set_tcp(p[{:.7}, {:.7}, {:.7}, {:.7}, {:.7}, {:.7}])",
+                    v[0], v[1], v[2], v[3], v[4], v[5]
+                );
+            }
+        }
+        s
+    }
+}
 
 /// How a controller writes the flange pose.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -161,13 +338,19 @@ impl FlangeConvention {
     }
 
     /// The controller's values for a flange pose `bT_e` (mm): the inverse
-    /// of [`Self::pose_from_values`] (for tests and simulated logs).
+    /// of [`Self::pose_from_values`], the one encoding of each controller's
+    /// poses (an ABB quaternion with `w ≥ 0`, as the controller reports
+    /// it).
     #[must_use]
     pub fn values_from_pose(self, pose: &Isometry3<f64>) -> Vec<f64> {
         let t = pose.translation.vector;
         let r = pose.rotation;
         match self {
-            Self::AbbQuaternion => vec![t.x, t.y, t.z, r.w, r.i, r.j, r.k],
+            Self::AbbQuaternion => {
+                let q = r.into_inner();
+                let q = if q.w < 0.0 { -q } else { q };
+                vec![t.x, t.y, t.z, q.w, q.i, q.j, q.k]
+            }
             Self::KukaAbc => {
                 let (roll, pitch, yaw) = r.euler_angles();
                 vec![
@@ -203,6 +386,39 @@ impl FlangeConvention {
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tool_data_reads_back() {
+        let tool = trans(-7.4, -1.0, 287.8) * rot_z(0.5) * rot_x(3.0);
+        let abb = Controller::Abb.tool_data(&tool, "tSensor");
+        assert!(
+            abb.contains("PERS tooldata tSensor := [TRUE,[[-7.4000,-1.0000,287.8000],"),
+            "{abb}"
+        );
+        let kuka = Controller::Kuka.tool_data(&tool, "sensor");
+        let line = kuka.lines().nth(1).unwrap();
+        let numbers: Vec<f64> = line
+            .trim_start_matches("TOOL_DATA[1]={")
+            .trim_end_matches('}')
+            .split(',')
+            .map(|f| f.split_whitespace().nth(1).unwrap().parse().unwrap())
+            .collect();
+        let back = FlangeConvention::KukaAbc
+            .pose_from_values(&numbers)
+            .unwrap();
+        assert!((back.translation.vector - tool.translation.vector).norm() < 1e-4);
+        assert!(back.rotation.angle_to(&tool.rotation) < 1e-6);
+        let fanuc = Controller::Fanuc.tool_data(&tool, "sensor");
+        assert!(
+            fanuc.contains("PR[1,3]=287.8000") && fanuc.contains("UTOOL[1]=PR[1]"),
+            "{fanuc}"
+        );
+        let ur = Controller::Ur.tool_data(&tool, "sensor");
+        assert!(
+            ur.contains("set_tcp(p[-0.0074000, -0.0010000, 0.2878000,"),
+            "{ur}"
+        );
+    }
     use crate::engine::base::geometry::{rot_x, rot_y, rot_z, trans};
 
     #[test]

@@ -1,6 +1,6 @@
 //! A plan's exports: the joint log CSV that `spherecal import` reads (and
-//! `spherecal simulate --plan` reads back), and robot programs behind
-//! [`Controller`], one `render` arm per controller.
+//! `spherecal simulate --plan` reads back), and robot programs for the
+//! controllers of [`PROGRAMS`], one [`render_program`] arm per controller.
 
 use std::fmt::Write as _;
 
@@ -8,6 +8,7 @@ use nalgebra::Vector3;
 
 use super::{Plan, PlanError};
 use crate::engine::base::cell::joint_log;
+use crate::engine::base::robot::controller::Controller;
 use crate::engine::base::session::Use;
 use crate::engine::base::table::Table;
 use crate::engine::tools::simulate::PlanPose;
@@ -149,80 +150,36 @@ pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPose>, PlanError> {
     Ok(out)
 }
 
-/// A robot controller a plan can be exported to as a program. To add one
-/// (KUKA KRL, Fanuc TP): a variant here, its [`Self::key`],
-/// [`Self::extension`] and a `render` arm writing the program from
+/// The controllers a plan is exported to as a program. To add one (KUKA
+/// KRL, FANUC TP): its arm in [`render_program`] writing the program from
 /// [`Plan::poses`] (joint targets in deg, in plan order; ids and stations
-/// for comments), then list it in [`Self::ALL`]; the command line's
-/// `--program KEY=FILE` picks it up.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Controller {
-    /// ABB IRC5 / OmniCore: a RAPID module of `jointtarget`s and
-    /// `MoveAbsJ`.
-    AbbRapid,
-    /// Universal Robots (CB3, e-Series): a URScript program of `movej`.
-    UrScript,
+/// for comments), then list it here; the command line's `--program
+/// KEY=FILE` ([`Controller::key`]) picks it up.
+pub const PROGRAMS: [Controller; 2] = [Controller::Abb, Controller::Ur];
+
+/// The controller of [`PROGRAMS`] whose program key is `key`.
+#[must_use]
+pub fn parse_program(key: &str) -> Option<Controller> {
+    PROGRAMS.into_iter().find(|c| c.key() == key)
 }
 
-impl Controller {
-    /// Every controller.
-    pub const ALL: [Self; 2] = [Self::AbbRapid, Self::UrScript];
+/// The controller of a robot (by its model name) when a plan can be
+/// exported to it as a program; `None` otherwise (the plan CSV still
+/// works).
+#[must_use]
+pub fn program_controller(robot_name: &str) -> Option<Controller> {
+    Controller::for_robot(robot_name).filter(|c| PROGRAMS.contains(c))
+}
 
-    /// The command-line key.
-    #[must_use]
-    pub fn key(self) -> &'static str {
-        match self {
-            Self::AbbRapid => "rapid",
-            Self::UrScript => "urscript",
-        }
-    }
-
-    /// The usual file extension.
-    #[must_use]
-    pub fn extension(self) -> &'static str {
-        match self {
-            Self::AbbRapid => "mod",
-            Self::UrScript => "script",
-        }
-    }
-
-    /// What the program is, for a button or a message.
-    #[must_use]
-    pub fn label(self) -> &'static str {
-        match self {
-            Self::AbbRapid => "RAPID module",
-            Self::UrScript => "URScript program",
-        }
-    }
-
-    /// The controller of a robot, by its model name (`ABB …`,
-    /// `Universal Robots …`); `None` for a robot whose controller has no
-    /// program export yet (the plan CSV still works).
-    #[must_use]
-    pub fn for_robot(name: &str) -> Option<Self> {
-        let n = name.to_ascii_lowercase();
-        if n.starts_with("abb") || n.contains("irb") {
-            Some(Self::AbbRapid)
-        } else if n.starts_with("universal robots") || n.starts_with("ur") {
-            Some(Self::UrScript)
-        } else {
-            None
-        }
-    }
-
-    /// Parses a key.
-    #[must_use]
-    pub fn parse(key: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|c| c.key() == key)
-    }
-
-    /// The program text.
-    #[must_use]
-    pub fn render(self, plan: &Plan) -> String {
-        match self {
-            Self::AbbRapid => rapid_module(plan),
-            Self::UrScript => ur_script(plan),
-        }
+/// The plan as `controller`'s program.
+///
+/// # Errors
+/// [`PlanError::NoProgram`] for a controller not in [`PROGRAMS`].
+pub fn render_program(controller: Controller, plan: &Plan) -> Result<String, PlanError> {
+    match controller {
+        Controller::Abb => Ok(rapid_module(plan)),
+        Controller::Ur => Ok(ur_script(plan)),
+        other @ (Controller::Kuka | Controller::Fanuc) => Err(PlanError::NoProgram(other)),
     }
 }
 

@@ -104,6 +104,7 @@ pub mod range_study;
 mod request;
 mod select;
 
+pub use crate::engine::base::robot::controller::Controller;
 pub use candidates::stripe_centre_covariance;
 use candidates::{
     Candidate, Group, Planner, STREAM_BASELINE, STREAM_GEOMETRY, Site, joint_gap, provisional_id,
@@ -115,7 +116,10 @@ pub use config::{
     DEFAULT_ROTATION_MIN_DEG, DEFAULT_TRANSLATION_STEP_MM, MAX_CANDIDATES, MAX_GROUP_POSES,
     MAX_ORIENTATIONS, MAX_STATIONS, PlanConfig, PlanDesign, Selection, StationLayout, defaults,
 };
-pub use export::{Controller, RAPID_MODULE, plan_csv, rapid_module, read_plan_csv, ur_script};
+pub use export::{
+    PROGRAMS, RAPID_MODULE, parse_program, plan_csv, program_controller, rapid_module,
+    read_plan_csv, render_program, ur_script,
+};
 use order::{Metric, order_groups};
 pub use predict::{
     PredictConfig, Prediction, RangePrediction, RunScore, predict, simulated_true_hand_eye,
@@ -196,6 +200,13 @@ pub enum PlanError {
         /// What is wrong.
         message: String,
     },
+    /// No program export for this controller.
+    #[error(
+        "no program export for {} controllers (a {} is not written yet): use the plan CSV",
+        .0.name(),
+        .0.label()
+    )]
+    NoProgram(Controller),
 }
 
 /// What a station is for.

@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use super::TargetReport;
-use super::tool::Controller;
+use crate::engine::base::robot::controller::Controller;
 use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::files::program::PoseFile;
 

@@ -202,8 +202,10 @@ pub(super) fn compensate_target(
     })
 }
 
-/// `new` (a pose's values in `convention`) moved to the representation
-/// nearest `old`: the quaternion's sign, Euler angles by whole turns, a
+/// `new` (a pose's values in `convention`, its encoding: an ABB
+/// quaternion with `w ≥ 0`) moved to the representation nearest `old`, so
+/// that a rewritten target changes by its correction only: the
+/// quaternion's sign as the target had it, Euler angles by whole turns, a
 /// rotation vector to its equivalent on the other side of π.
 fn nearest(convention: FlangeConvention, new: &[f64], old: &[f64]) -> Vec<f64> {
     let mut v = new.to_vec();
