@@ -727,3 +727,209 @@ fn a_read_only_output_is_refused_by_every_command() {
         assert_eq!(std::fs::read_to_string(&locked).unwrap(), "keep");
     }
 }
+
+/// What a Ctrl-C at a random moment left behind: temporary files
+/// (`.NAME.PID.N.tmp`) and empty folders under `dir`, as paths.
+fn leftovers(dir: &Path) -> Vec<String> {
+    let mut found = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let entries: Vec<_> = std::fs::read_dir(&d).unwrap().map(Result::unwrap).collect();
+        if entries.is_empty() && d != dir {
+            found.push(format!("empty folder {}", d.display()));
+        }
+        for e in entries {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if e.file_type().unwrap().is_dir() {
+                stack.push(e.path());
+            } else if name.starts_with('.') && name.ends_with(".tmp") {
+                found.push(format!("temporary file {}", e.path().display()));
+            }
+        }
+    }
+    found
+}
+
+/// Each writing command, its arguments writing under `out` (a folder that
+/// does not exist yet where the command creates folders).
+fn writing_commands(inputs: &Path, out: &Path) -> Vec<(&'static str, Vec<String>)> {
+    let i = |name: &str| inputs.join(name).to_str().unwrap().to_string();
+    let o = |name: &str| out.join(name).to_str().unwrap().to_string();
+    let v = |a: &[&str]| a.iter().map(ToString::to_string).collect::<Vec<_>>();
+    vec![
+        (
+            "simulate --csv-out",
+            v(&[
+                "simulate",
+                "--csv-out",
+                &o("new/csv"),
+                "--out",
+                &o("s.json"),
+                "-q",
+            ]),
+        ),
+        (
+            "export-model",
+            v(&[
+                "export-model",
+                &i("r.json"),
+                "--format",
+                "urdf",
+                "--out",
+                &o("m.urdf"),
+                "-q",
+            ]),
+        ),
+        (
+            "measure",
+            v(&[
+                "measure",
+                &i("s.json"),
+                "--result",
+                &i("r.json"),
+                "--out",
+                &o("c.e57"),
+                "-q",
+            ]),
+        ),
+        (
+            "plan",
+            v(&[
+                "plan",
+                "--sphere",
+                "1050,0,475",
+                "--csv",
+                &o("p.csv"),
+                "--rapid",
+                &o("p.mod"),
+                "-q",
+            ]),
+        ),
+        (
+            "import",
+            v(&[
+                "import",
+                "--joints",
+                &i("csv/joints.csv"),
+                "--profiles",
+                &i("csv/profiles"),
+                "--robot",
+                "irb2400",
+                "--out",
+                &o("i.json"),
+                "-q",
+            ]),
+        ),
+    ]
+}
+
+/// Per writing command: its name, how many runs a SIGINT interrupted, how
+/// many ended before it, and what any run left behind. `moments` SIGINTs a
+/// command, each at a random moment of its run (uniform over 1.2× its
+/// uninterrupted time).
+#[cfg(unix)]
+fn interrupted_runs(moments: usize, seed: u64) -> Vec<(&'static str, usize, usize, Vec<String>)> {
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = dir.path().join("inputs");
+    std::fs::create_dir(&inputs).unwrap();
+    let at = |n: &str| inputs.join(n).to_str().unwrap().to_string();
+    let run = |a: &[&str]| {
+        assert!(
+            spherecal().args(a).output().unwrap().status.success(),
+            "{a:?}"
+        );
+    };
+    run(&[
+        "simulate",
+        "--csv-out",
+        &at("csv"),
+        "--out",
+        &at("s.json"),
+        "-q",
+    ]);
+    run(&[
+        "calibrate",
+        &at("s.json"),
+        "--out",
+        &at("r.json"),
+        "--no-cross-validation",
+        "-q",
+    ]);
+    let mut state = seed;
+    let mut uniform = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1_u64 << 53) as f64
+    };
+    let mut report = Vec::new();
+    for (k, (name, _)) in writing_commands(&inputs, dir.path())
+        .into_iter()
+        .enumerate()
+    {
+        let probe = dir.path().join(format!("probe{k}"));
+        std::fs::create_dir(&probe).unwrap();
+        let args = writing_commands(&inputs, &probe).swap_remove(k).1;
+        let started = std::time::Instant::now();
+        let status = spherecal().args(&args).status().unwrap();
+        assert!(status.success(), "{name}: {status}");
+        let took = started.elapsed().as_secs_f64();
+        let (mut stopped, mut finished, mut left) = (0, 0, Vec::new());
+        for m in 0..moments {
+            let out = dir.path().join(format!("run{k}-{m}"));
+            std::fs::create_dir(&out).unwrap();
+            let args = writing_commands(&inputs, &out).swap_remove(k).1;
+            let mut child = spherecal()
+                .args(&args)
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::null())
+                .spawn()
+                .unwrap();
+            std::thread::sleep(std::time::Duration::from_secs_f64(uniform() * took * 1.2));
+            let _ = Command::new("kill")
+                .args(["-INT", &child.id().to_string()])
+                .status();
+            let status = child.wait().unwrap();
+            match status.code() {
+                Some(0) => finished += 1,
+                Some(130) | None => stopped += 1,
+                other => panic!("{name}: status {other:?} after SIGINT"),
+            }
+            left.extend(leftovers(&out));
+            let _ = std::fs::remove_dir_all(&out);
+        }
+        report.push((name, stopped, finished, left));
+    }
+    report
+}
+
+/// Issue 31: Ctrl-C at random moments left an empty `.NAME.PID.0.tmp`
+/// (export-model, measure, `simulate --csv-out`) and empty folders. Five
+/// SIGINTs at random moments to each writing command leave neither.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_at_any_moment_leaves_no_temporary_file_or_empty_folder() {
+    for (name, stopped, finished, left) in interrupted_runs(5, 31) {
+        assert!(
+            left.is_empty(),
+            "{name} ({stopped} stopped, {finished} finished): {left:?}"
+        );
+    }
+}
+
+/// The stress version of the above: 300 moments a command (minutes).
+#[cfg(unix)]
+#[test]
+#[ignore = "stress: 300 SIGINTs to each writing command"]
+fn ctrl_c_at_300_moments_a_command_leaves_nothing() {
+    let report = interrupted_runs(300, 3131);
+    for (name, stopped, finished, left) in &report {
+        println!(
+            "{name}: {stopped} stopped, {finished} finished, {} left behind",
+            left.len()
+        );
+    }
+    for (name, _, _, left) in report {
+        assert!(left.is_empty(), "{name}: {left:?}");
+    }
+}

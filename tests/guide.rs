@@ -412,7 +412,10 @@ fn the_readme_is_two_screens() {
     );
     let text = String::from_utf8(readme).unwrap();
     for command in ["cargo run --release", "cargo test"] {
-        assert!(text.contains(command), "README.md does not give `{command}`");
+        assert!(
+            text.contains(command),
+            "README.md does not give `{command}`"
+        );
     }
 }
 
@@ -424,7 +427,10 @@ fn wildcards_match_and_can_fail() {
     assert!(line_matches("rms [..] mm", "rms 0.083 mm"));
     assert!(!line_matches("rms [..] mm", "rms 0.083 µm"));
     assert!(line_matches("[..]", "anything"));
-    assert!(output_matches(&exp(&["a", "...", "z"]), &exp(&["a", "b", "c", "z"])));
+    assert!(output_matches(
+        &exp(&["a", "...", "z"]),
+        &exp(&["a", "b", "c", "z"])
+    ));
     assert!(output_matches(&exp(&["...", "z"]), &exp(&["z"])));
     assert!(!output_matches(&exp(&["a", "z"]), &exp(&["a", "b", "z"])));
     assert!(!output_matches(&exp(&["a"]), &exp(&["a", "b"])));
@@ -456,6 +462,11 @@ fn a_failing_command_is_reported() {
 
 #[test]
 fn a_link_to_a_missing_file_is_found() {
-    let t = local_targets("see [a](x.md) and ![b](../assets/n.png \"t\") [c](https://e.org)\n```\n[d](no.md)\n```");
-    assert_eq!(t, [(1, "x.md".to_string()), (1, "../assets/n.png".to_string())]);
+    let t = local_targets(
+        "see [a](x.md) and ![b](../assets/n.png \"t\") [c](https://e.org)\n```\n[d](no.md)\n```",
+    );
+    assert_eq!(
+        t,
+        [(1, "x.md".to_string()), (1, "../assets/n.png".to_string())]
+    );
 }

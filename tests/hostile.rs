@@ -603,3 +603,352 @@ fn an_absurd_tool_is_refused_at_once_naming_the_key() {
     assert!(!out.exists());
     assert!(started.elapsed().as_secs_f64() < 10.0);
 }
+
+/// Issue 31, high: `compensate --tcp tcp0.json --out tcp0.json` exited 0
+/// having overwritten the tool file with the compensated table. Every
+/// input of every command, side files too (`--tcp`, `--frame`,
+/// `--hand-eye`, `--centres`, `--references`, `--plan`, `--stations`), is
+/// refused as an output, before any work, and is left as it was.
+#[test]
+fn every_input_of_every_command_is_refused_as_an_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let (s, r) = calibrated(dir.path());
+    let at = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let tool = at("tcp0.json");
+    let eye = r#"{"flange_from_tcp": [[1,0,0,0],[0,1,0,0],[0,0,1,150],[0,0,0,1]]}"#;
+    fs::write(&tool, eye).unwrap();
+    let frame = at("frame.json");
+    fs::write(
+        &frame,
+        r#"{"matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}"#,
+    )
+    .unwrap();
+    let targets = at("t.csv");
+    fs::write(&targets, "id,x,y,z,q1,q2,q3,q4\nT1,1000,0,800,0,0,1,0\n").unwrap();
+    let poses = at("poses.csv");
+    fs::write(&poses, "id,x,y,z,q1,q2,q3,q4\np1,1000,0,800,0,0,1,0\n").unwrap();
+    let centres = at("centres.csv");
+    fs::write(&centres, "id,x,y,z\np1,30,0,100\n").unwrap();
+    let references = at("references.csv");
+    fs::write(&references, "a,b,distance\nV1,V2,100\n").unwrap();
+    let csv_dir = at("csv");
+    fs::create_dir(&csv_dir).unwrap();
+    let plan_in_csv = format!("{csv_dir}/joints.csv");
+    fs::write(&plan_in_csv, "id,station,use,j1\n").unwrap();
+    let (s, r) = (s.to_str().unwrap(), r.to_str().unwrap());
+    let import = |extra: &[&str], out: &str| -> Vec<String> {
+        let mut a: Vec<&str> = vec!["import", "--poses", &poses, "--pose-convention", "abb"];
+        a.extend(extra);
+        a.extend(["--out", out]);
+        a.iter().map(ToString::to_string).collect()
+    };
+    let runs: Vec<(Vec<String>, &str)> = vec![
+        (
+            [
+                "compensate",
+                "--result",
+                r,
+                "--targets",
+                &targets,
+                "--pose-convention",
+                "abb",
+                "--tcp",
+                &tool,
+                "--out",
+                &tool,
+            ]
+            .iter()
+            .map(ToString::to_string)
+            .collect(),
+            &tool,
+        ),
+        (
+            [
+                "measure", s, "--result", r, "--frame", &frame, "--out", &frame,
+            ]
+            .iter()
+            .map(ToString::to_string)
+            .collect(),
+            &frame,
+        ),
+        (import(&["--centres", &centres], &centres), &centres),
+        (
+            import(&["--centres", &centres, "--hand-eye", &tool], &tool),
+            &tool,
+        ),
+        (
+            import(
+                &["--centres", &centres, "--references", &references],
+                &references,
+            ),
+            &references,
+        ),
+        (
+            [
+                "simulate",
+                "--plan",
+                &plan_in_csv,
+                "--csv-out",
+                &csv_dir,
+                "--out",
+                &at("sim.json"),
+            ]
+            .iter()
+            .map(ToString::to_string)
+            .collect(),
+            &plan_in_csv,
+        ),
+        (
+            [
+                "plan",
+                "--sphere",
+                "1050,0,475",
+                "--hand-eye",
+                &tool,
+                "--csv",
+                &tool,
+            ]
+            .iter()
+            .map(ToString::to_string)
+            .collect(),
+            &tool,
+        ),
+        (
+            ["report", s, "--result", r, "-o", r]
+                .iter()
+                .map(ToString::to_string)
+                .collect(),
+            r,
+        ),
+    ];
+    for (args, input) in runs {
+        let before = fs::read(input).unwrap();
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, _, err) = spherecal_cli(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(
+            err.contains("the output is the input") && err.contains(input),
+            "{args:?}: {err}"
+        );
+        assert_eq!(fs::read(input).unwrap(), before, "{args:?} changed {input}");
+    }
+}
+
+/// Issue 31, high: `import --poses P --pose-convention matrix --centres
+/// c.csv` with one centre `1e308,1,2` ran without end. A centres table
+/// goes through the session's plausibility rules (10 m from the sensor),
+/// refused at once naming the file and the line.
+#[test]
+fn a_centre_of_1e308_is_refused_at_once_naming_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let poses = dir.path().join("poses.csv");
+    let mut text = String::new();
+    for k in 0..6 {
+        let (c, s) = (
+            f64::from(k).to_radians().cos(),
+            f64::from(k).to_radians().sin(),
+        );
+        text += &format!(
+            "{c} {} 0 {} {s} {c} 0 {} 0 0 1 800 0 0 0 1\n",
+            -s,
+            1000 + 10 * k,
+            20 * k
+        );
+    }
+    fs::write(&poses, text).unwrap();
+    for (centre, shown) in [
+        ("1e308,1,2", "1e308"),
+        ("20000,1,2", "20000"),
+        ("1,nan,2", "NaN"),
+    ] {
+        let centres = dir.path().join("c.csv");
+        let mut rows: Vec<String> = (0..6).map(|k| format!("{},0,100", 30 + k)).collect();
+        rows[3] = centre.to_string();
+        fs::write(&centres, rows.join("\n") + "\n").unwrap();
+        let out = dir.path().join("s.json");
+        let started = std::time::Instant::now();
+        let (code, _, err) = spherecal_cli(&[
+            "import",
+            "--poses",
+            poses.to_str().unwrap(),
+            "--pose-convention",
+            "matrix",
+            "--centres",
+            centres.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{centre}: {err}");
+        assert!(
+            err.contains("line 4") && err.contains("c.csv") && err.contains(shown),
+            "{centre}: {err}"
+        );
+        assert!(!out.exists());
+        assert!(started.elapsed().as_secs_f64() < 10.0, "{centre}");
+    }
+}
+
+/// A program of `plain` motions to its first target, then `modified` (the
+/// motion under test), in `language`: its text, file name, and the line of
+/// the modified motion.
+fn program_with(language: usize, plain: usize, modified: &str) -> (String, &'static str, usize) {
+    match language {
+        0 => {
+            let mut t = String::from("/PROG  CALIB\n/MN\n");
+            for k in 0..plain {
+                t += &format!("{:>4}:J P[1] 100% FINE    ;\n", k + 1);
+            }
+            t += &format!("{:>4}:{modified}    ;\n/POS\n", plain + 1);
+            for k in 1..=2 {
+                t += &format!(
+                    "P[{k}]{{\n   GP1:\n\tUF : 0, UT : 0,\n\tX = {k}00.0  mm,\tY = 2.0  mm,\tZ = 3.0  mm,\n\tW = 0.0 deg,\tP = 0.0 deg,\tR = 0.0 deg\n}};\n"
+                );
+            }
+            (t + "/END\n", "c.ls", plain + 3)
+        }
+        1 => {
+            let mut t = String::from("MODULE M\n");
+            for k in 1..=2 {
+                t += &format!(
+                    "  CONST robtarget p{k} := [[{k}00,2,3],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
+                );
+            }
+            t += "  PROC main()\n";
+            t += &"    MoveL p1, v100, fine, tool0;\n".repeat(plain);
+            (
+                t + &format!("    {modified};\n  ENDPROC\nENDMODULE\n"),
+                "c.mod",
+                plain + 5,
+            )
+        }
+        2 => {
+            let mut t = String::from(
+                "def calib():\n  p1 = p[0.4, 0, 0.3, 0, 0, 0]\n  p2 = p[0.5, 0, 0.3, 0, 0, 0]\n",
+            );
+            t += &"  movel(p1, a=0.5, v=0.05)\n".repeat(plain);
+            (t + &format!("  {modified}\nend\n"), "c.script", plain + 4)
+        }
+        _ => {
+            let mut t = String::from("DEF calib( )\n");
+            t += &"  PTP {X 400,Y 2,Z 3,A 0,B 0,C 0}\n".repeat(plain);
+            (t + &format!("  {modified}\nEND\n"), "c.src", plain + 2)
+        }
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 64, failure_persistence: None, rng_seed: proptest::test_runner::RngSeed::Fixed(31), ..proptest::prelude::ProptestConfig::default() })]
+    /// Issue 31, medium: program motion modifiers (RAPID `Offs`/`RelTool`,
+    /// URScript `pose_trans`, FANUC `INC`, `Offset,PR[1]`, `Tool_Offset`,
+    /// KRL `LIN_REL`) were dropped as "never moved to" or read as the plain
+    /// target. In every language, each is refused naming its line.
+    #[test]
+    fn motion_modifiers_are_refused_naming_their_line(case in 0_usize..9, plain in 0_usize..5) {
+        let (language, modified, named) = [
+            (0, "L P[2] 100mm/sec FINE Offset,PR[1]", "Offset"),
+            (0, "J P[2] 100% FINE INC", "INC"),
+            (0, "L P[2] 100mm/sec FINE Tool_Offset,PR[2]", "Tool_Offset"),
+            (0, "L P[2] 100mm/sec FINE VOFFSET,VR[1]", "VOFFSET"),
+            (1, "MoveL Offs(p2,0,0,10), v100, fine, tool0", "Offs"),
+            (1, "MoveJ RelTool(p2,0,0,10), v100, fine, tool0", "RelTool"),
+            (2, "movel(pose_trans(p2, p[0, 0, 0.01, 0, 0, 0]), a=0.5, v=0.05)", "pose_trans"),
+            (2, "movej(pose_add(p2, p[0, 0, 0.01, 0, 0, 0]), a=0.5, v=0.05)", "pose_add"),
+            (3, "LIN_REL {X 10}", "LIN_REL"),
+        ][case];
+        let (text, name, line) = program_with(language, plain, modified);
+        let e = spherecal::engine::files::program::parse_pose_text(text, Path::new(name), &spherecal::engine::files::program::ReadSpec::default()).unwrap_err();
+        proptest::prop_assert_eq!(e.line, line, "{}", e);
+        proptest::prop_assert!(e.to_string().contains(named) && e.to_string().contains(name), "{}", e);
+    }
+}
+
+/// Issue 31, medium: malformed position blocks were skipped (FANUC
+/// `P[3] junk {`, a KUKA E6POS without A, B, C), a motion to a position
+/// the file does not hold (`P[99]`) went unreported, and a RAPID target
+/// declared twice was read from its later declaration; a RAPID `\WObj`
+/// or a second tool was not warned. Each is refused or warned naming the line.
+#[test]
+fn malformed_positions_and_doubtful_motions_are_named_with_their_line() {
+    let read = |text: String, name: &str| {
+        spherecal::engine::files::program::parse_pose_text(
+            text,
+            Path::new(name),
+            &spherecal::engine::files::program::ReadSpec::default(),
+        )
+    };
+    let (fanuc, _, _) = program_with(0, 1, "J P[2] 100% FINE");
+    let junk = fanuc.replace("/END\n", "P[3] junk {\n   GP1:\n\tX = 1.0 mm\n};\n/END\n");
+    let e = read(junk, "c.ls").unwrap_err();
+    assert!(
+        e.line == 18 && e.message.contains("P[3]") && e.message.contains("junk"),
+        "{e}"
+    );
+    let (missing, _, _) = program_with(0, 1, "J P[99] 100% FINE");
+    let e = read(missing, "c.ls").unwrap_err();
+    assert!(e.line == 4 && e.message.contains("P[99]"), "{e}");
+    let dat = "DEFDAT CALIB\nDECL E6POS XP1={X 1,Y 2,Z 3,A 0,B 0,C 0}\nDECL E6POS XP2={X 1,Y 2,Z 3,S 6,T 27}\nENDDAT\n";
+    let e = read(dat.to_string(), "c.dat").unwrap_err();
+    assert!(
+        e.line == 3 && e.message.contains("XP2") && e.message.contains("no A, B, C"),
+        "{e}"
+    );
+    let (twice, _, _) = program_with(1, 0, "MoveL p2, v100, fine, tool0");
+    let twice = twice.replace(
+        "  PROC",
+        "  CONST robtarget P1 := [[9,9,9],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n  PROC",
+    );
+    let e = read(twice, "c.mod").unwrap_err();
+    assert!(
+        e.line == 4 && e.message.contains("declared twice (also at line 2)"),
+        "{e}"
+    );
+    let (wobj, _, _) = program_with(1, 1, "MoveL p2, v100, fine, tSensor\\WObj:=wobj1");
+    let file = read(wobj, "c.mod").unwrap();
+    let warned = file.warnings.join("\n");
+    assert!(
+        warned.contains("line 6: moves in work object `wobj1`")
+            && warned.contains("2 tools, `tool0` (line 5), `tsensor` (line 6)"),
+        "{warned}"
+    );
+}
+
+/// Issue 31, medium: `measure` took a result whose `variance_factor` was
+/// −4 (as 1) and a covariance with 1e300, one beyond its variances (not
+/// positive semi-definite) or a label twice. The result reader refuses
+/// each, naming the key.
+#[test]
+fn a_result_with_an_implausible_covariance_or_variance_factor_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, r) = calibrated(dir.path());
+    let text = fs::read_to_string(&r).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert!(format::parse_result(&text, Path::new("r.json")).is_ok());
+    type Edit = fn(&mut serde_json::Value);
+    let edits: [(&str, Edit); 4] = [
+        ("variance_factor` = -4", |v| {
+            v["solver"]["variance_factor"] = serde_json::json!(-4.0);
+        }),
+        ("= 1e300 is not plausible", |v| {
+            v["solver"]["covariance"]["matrix"][0][0] = serde_json::json!(1e300);
+        }),
+        ("not positive semi-definite", |v| {
+            let d = v["solver"]["covariance"]["matrix"][0][0].as_f64().unwrap();
+            let e = v["solver"]["covariance"]["matrix"][1][1].as_f64().unwrap();
+            let big = serde_json::json!(2.0 * (d * e).sqrt() + 1.0);
+            v["solver"]["covariance"]["matrix"][0][1] = big.clone();
+            v["solver"]["covariance"]["matrix"][1][0] = big;
+        }),
+        ("twice", |v| {
+            let first = v["solver"]["covariance"]["labels"][0].clone();
+            v["solver"]["covariance"]["labels"][1] = first;
+        }),
+    ];
+    for (want, edit) in edits {
+        let mut bad = v.clone();
+        edit(&mut bad);
+        let e = format::parse_result(&bad.to_string(), Path::new("r.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(want) && e.contains("r.json"), "{want}: {e}");
+    }
+}

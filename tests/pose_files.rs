@@ -419,8 +419,8 @@ fn plan_programs_import_back_to_the_planned_poses() {
     use spherecal::engine::calibrate::solve::Control;
     use spherecal::engine::tools::plan::{self, Controller, PlanConfig};
     for (key, preset, controller) in [
-        ("irb2400", robot::irb2400(), Controller::AbbRapid),
-        ("ur5e", robot::ur5e(), Controller::UrScript),
+        ("irb2400", robot::irb2400(), Controller::Abb),
+        ("ur5e", robot::ur5e(), Controller::Ur),
     ] {
         let w = Workspace::for_robot(RobotChoice::from_key(key).unwrap());
         let sphere = [0, 1, 2].map(|i| f64::midpoint(w.min[i], w.max[i]));
@@ -434,7 +434,7 @@ fn plan_programs_import_back_to_the_planned_poses() {
         let robot = key;
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join(format!("plan.{}", controller.extension()));
-        std::fs::write(&path, controller.render(&plan)).unwrap();
+        std::fs::write(&path, plan::render_program(controller, &plan).unwrap()).unwrap();
         let file = program::read_pose_file(&path, &ReadSpec::default()).unwrap();
         let nominal = plan.robot.clone();
         let targets: Vec<_> = file.ordered().collect();
@@ -714,4 +714,183 @@ fn a_pose_import_tells_its_stages_and_can_be_cancelled_at_the_side() {
     })
     .unwrap_err();
     assert!(matches!(e, ImportError::Cancelled), "{e}");
+}
+
+/// The values of every target of a pose file, and their ids.
+fn table_values(file: &program::PoseFile) -> (Vec<Vec<f64>>, Vec<Option<String>>) {
+    file.ordered()
+        .map(|t| match &t.value {
+            program::TargetValue::Pose { values, .. } => (values.clone(), t.id.clone()),
+            program::TargetValue::Joints { .. } => panic!("joints in a pose table"),
+        })
+        .unzip()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, rng_seed: proptest::test_runner::RngSeed::Fixed(31), failure_persistence: None, ..ProptestConfig::default() })]
+    /// Issue 31, high: a headerless pose table with one extra numeric
+    /// column (six pose values and a trailing `100`) had its first number
+    /// taken as the id and every value shifted one column. In every
+    /// convention, an extra column last is refused naming both readings
+    /// and `--pose-columns`; ids first are read as ids only when nothing
+    /// else fits, else refused the same way; `--pose-columns` reads either
+    /// exactly. No value is ever shifted.
+    #[test]
+    fn a_headerless_pose_table_with_one_extra_column_is_never_shifted(
+        convention in 0_usize..5,
+        rows in proptest::collection::vec((-2000.0_f64..2000.0, -2000.0_f64..2000.0, -2000.0_f64..2000.0, -179.0_f64..179.0, -89.0_f64..89.0, -179.0_f64..179.0), 1..6),
+        extra in -1e4_f64..1e4,
+        start in 0_u32..100,
+        step in 1_u32..10,
+    ) {
+        let convention = FlangeConvention::ALL[convention];
+        let poses: Vec<Vec<f64>> = rows
+            .iter()
+            .map(|&(x, y, z, a, b, c)| {
+                let pose = Isometry3::new(
+                    nalgebra::Vector3::new(x, y, z),
+                    nalgebra::UnitQuaternion::from_euler_angles(a.to_radians(), b.to_radians(), c.to_radians()).scaled_axis(),
+                );
+                convention.values_from_pose(&pose)
+            })
+            .collect();
+        let names = convention.default_columns();
+        let write = |row: &dyn Fn(usize, &[f64]) -> Vec<f64>| {
+            poses
+                .iter()
+                .enumerate()
+                .map(|(k, v)| row(k, v).iter().map(ToString::to_string).collect::<Vec<_>>().join(" ") + "\n")
+                .collect::<String>()
+        };
+        let read = |text: &str, columns: Option<Vec<String>>| {
+            program::parse_pose_text(
+                text.to_string(),
+                Path::new("poses.txt"),
+                &ReadSpec { convention: Some(convention), columns, ..ReadSpec::default() },
+            )
+        };
+        let with = |extra_name: &str, first: bool| {
+            let mut c = names.clone();
+            if first { c.insert(0, extra_name.to_string()); } else { c.push(extra_name.to_string()); }
+            Some(c)
+        };
+        // An extra column last: refused, naming the file, both readings and the option.
+        let last = write(&|_, v| [v, &[extra][..]].concat());
+        let e = read(&last, None).expect_err("an extra column last must not be read as an id").to_string();
+        prop_assert!(e.contains("poses.txt") && e.contains(&format!("`id,{}`", names.join(","))) && e.contains(&format!("`{},-`", names.join(","))) && e.contains("--pose-columns"), "{e}");
+        let (values, ids) = table_values(&read(&last, with("-", false)).unwrap());
+        prop_assert_eq!(&values, &poses);
+        prop_assert!(ids.iter().all(Option::is_none));
+        // Ids counting up first: read as ids with the values unshifted, or refused.
+        let id = |k: usize| f64::from(start) + f64::from(step) * k as f64;
+        let first = write(&|k, v| [&[id(k)][..], v].concat());
+        match read(&first, None) {
+            Ok(file) => {
+                let (values, ids) = table_values(&file);
+                prop_assert_eq!(&values, &poses);
+                prop_assert_eq!(ids[0].clone(), Some(id(0).to_string()));
+            }
+            Err(e) => prop_assert!(e.to_string().contains("--pose-columns"), "{e}"),
+        }
+        let (values, ids) = table_values(&read(&first, with("id", true)).unwrap());
+        prop_assert_eq!(&values, &poses);
+        prop_assert_eq!(ids.last().cloned().flatten(), Some(id(poses.len() - 1).to_string()));
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, rng_seed: proptest::test_runner::RngSeed::Fixed(31), failure_persistence: None, ..ProptestConfig::default() })]
+    /// Issue 31, medium: pose values beyond the 100 m limit (FANUC
+    /// `X = 1e308`, KUKA `X 1E308`, a table's `1e10`, URScript positions in
+    /// mm) gave "no initial hand-eye … numbers not finite" with no line. In
+    /// every layout the pose is refused naming the file, the line and the
+    /// limit.
+    #[test]
+    fn a_pose_beyond_100_m_is_refused_naming_its_line(layout in 0_usize..5, k in 0_usize..4, exponent in 5.1_f64..308.0, axis in 0_usize..3) {
+        let (mut poses, _, _) = cell(4, 8, false, 3);
+        poses.truncate(4);
+        let huge = 10_f64.powf(exponent);
+        // URScript in mm: metres read a thousand times too large.
+        let scale = if layout == 3 { 1000.0 } else { 1.0 };
+        poses[k].translation.vector[axis] = huge.min(1e300) / scale;
+        let (text, name, convention) = match layout {
+            0 => (fanuc_ls(&poses, 0), "c.ls", None),
+            1 => (kuka_dat(&poses), "c.dat", None),
+            2 => (headerless_table(&poses), "t.txt", Some(FlangeConvention::FanucWpr)),
+            3 => (urscript(&poses), "c.script", None),
+            _ => (rapid(&poses), "c.mod", None),
+        };
+        let file = program::parse_pose_text(text, Path::new(name), &ReadSpec { convention, ..ReadSpec::default() }).unwrap();
+        let line = file.ordered().nth(k).unwrap().line;
+        let e = import::poses::records_of(&file).unwrap_err().to_string();
+        prop_assert!(e.contains(&format!("line {line}")) && e.contains(name) && e.contains("at most 100000 mm"), "{e}");
+    }
+}
+
+/// Issue 31, medium: `import` wrote sessions whose initial scatter was
+/// 25 mm to 25 m, exit 0 and no warning (UR rotation vectors in degrees,
+/// among others). The import applies calibrate's verdict and warns, with
+/// the likely causes (calibrate then refuses the session). A pose-only import applies
+/// calibrate's verdict: beyond 10 mm it is refused with the likely causes.
+#[test]
+fn an_import_whose_centres_scatter_beyond_any_sensor_is_warned() {
+    let (poses, stripes, truth) = cell(4, 8, false, 7);
+    let he = rigid_from_rows(&truth.hand_eye);
+    let station = *truth.stations.iter().find(|(k, _)| *k == "P0").unwrap().1;
+    let mut centres = String::from("x;y;z\n");
+    for p in &poses {
+        let c = (p * he).inverse() * Point3::from(nalgebra::Vector3::from(station));
+        writeln!(centres, "{:.9};{:.9};{:.9}", c.x, c.y, c.z).unwrap();
+    }
+    // UR rotation vectors written in degrees, not radians.
+    let mut degrees = String::new();
+    for p in &poses {
+        let mut v = FlangeConvention::UrRotationVector.values_from_pose(p);
+        for a in &mut v[3..] {
+            *a = a.to_degrees();
+        }
+        let cells: Vec<String> = v.iter().map(|x| format!("{x:.9}")).collect();
+        writeln!(degrees, "{}", cells.join(" ")).unwrap();
+    }
+    let (dir, path) = folder(&stripes, "robot.txt", &degrees);
+    let centres_path = dir.path().join("centres.txt");
+    std::fs::write(&centres_path, centres).unwrap();
+    let mut s = spec(&path, Observations::Centres(centres_path));
+    s.convention = Some(FlangeConvention::UrRotationVector);
+    let notes = import::import_poses(&s).unwrap().notes.join("\n");
+    assert!(
+        notes.contains(
+            "warning: with the initial hand-eye that fits them best the sphere centres scatter by"
+        ) && notes.contains("`calibrate` will refuse this session; likely causes")
+            && notes.contains("robot.txt"),
+        "{notes}"
+    );
+}
+
+/// Issue 31, medium: a profile folder with `p1..p15.yml` and
+/// `old_p1..15.yml` paired the poses with `old_p#` silently. Two sets of
+/// profiles that could both be the ones are refused, naming both.
+#[test]
+fn two_sets_of_profiles_named_alike_are_refused_naming_both() {
+    let (poses, stripes, _) = cell(4, 8, false, 3);
+    let (dir, path) = folder(&stripes, "robot.txt", &headerless_table(&poses));
+    for k in 1..=poses.len() {
+        std::fs::copy(
+            dir.path().join(format!("p{k}.csv")),
+            dir.path().join(format!("old_p{k}.csv")),
+        )
+        .unwrap();
+    }
+    let mut s = spec(
+        &path,
+        Observations::Profiles(ProfileSource::Folder(dir.path().to_path_buf())),
+    );
+    s.convention = Some(FlangeConvention::FanucWpr);
+    let e = import::import_poses(&s).unwrap_err().to_string();
+    assert!(
+        e.contains("2 sets of 12 files named alike")
+            && e.contains("old_p#.csv (old_p1.csv")
+            && e.contains(" and p#.csv (p1.csv"),
+        "{e}"
+    );
 }

@@ -159,3 +159,168 @@ fn with_noise_the_hand_eye_error_is_at_the_noise_floor() {
     // may sit a little above the floor.
     assert!(after <= floor * 1.1, "ε after {after} mm, floor {floor} mm");
 }
+
+/// The `ml` report of a calibration.
+fn ml_report(cal: &solve::Calibration) -> &spherecal::engine::calibrate::solve::ml::MlReport {
+    match &cal.report {
+        solve::SolverReport::Ml(r) => r,
+        other => panic!("not an ml report: {other:?}"),
+    }
+}
+
+/// ‖A − B‖_F / ‖B‖_F of two labelled matrices with the same labels.
+fn relative_difference(
+    a: &spherecal::engine::calibrate::solve::ml::LabelledMatrix,
+    b: &spherecal::engine::calibrate::solve::ml::LabelledMatrix,
+) -> f64 {
+    assert_eq!(a.labels, b.labels);
+    let (mut diff, mut norm) = (0.0, 0.0);
+    for (ra, rb) in a.matrix.iter().zip(&b.matrix) {
+        for (x, y) in ra.iter().zip(rb) {
+            diff += (x - y).powi(2);
+            norm += y.powi(2);
+        }
+    }
+    (diff / norm).sqrt()
+}
+
+/// A simulated pose-only session whose flange poses err by `sigma` mm.
+fn reported_poses(seed: u64, sigma: f64) -> (Session, Truth) {
+    simulate::simulate(&SimConfig {
+        seed,
+        pose_only: Some(sigma),
+        ..SimConfig::default()
+    })
+    .unwrap()
+}
+
+#[test]
+fn the_uncertainty_does_not_depend_on_the_start() {
+    // Issue 32: the eq. 6-9 start, the general start (no translation or
+    // rotation group) and a guess 5 mm and 3° off reach the same solution
+    // and must report the same pose σ, variance factor and covariance.
+    let (session, truth) = reported_poses(5, 0.1);
+    let mut general = session.clone();
+    general.measurements.retain(|m| {
+        !matches!(
+            m.usage,
+            spherecal::engine::base::session::Use::Translation
+                | spherecal::engine::base::session::Use::Rotation
+        )
+    });
+    // The general initial hand-eye (all poses at once), as the import
+    // computes it for a set with no translation group.
+    let analysis = solve::analyse(&general);
+    let mut index = std::collections::HashMap::new();
+    let sightings: Vec<_> = general
+        .measurements
+        .iter()
+        .zip(&analysis.measurements)
+        .filter_map(|(m, a)| {
+            let next = index.len();
+            let station = *index.entry(m.station.clone()).or_insert(next);
+            a.as_ref().ok().map(|p| {
+                spherecal::engine::calibrate::handeye::general::GeneralSighting {
+                    id: m.id.clone(),
+                    station,
+                    base_from_flange: m.flange.unwrap(),
+                    centre_in_sensor: p.centre_in_sensor,
+                }
+            })
+        })
+        .collect();
+    let start =
+        spherecal::engine::calibrate::handeye::general::general_hand_eye(&sightings, index.len())
+            .unwrap();
+    let mut guessed = general.clone();
+    general.hand_eye = Some(start.flange_from_sensor);
+    let off = Isometry3::new(
+        nalgebra::Vector3::new(3.0, -4.0, 0.0),
+        nalgebra::Vector3::new(0.0, 3f64.to_radians(), 0.0),
+    );
+    guessed.hand_eye = Some(truth.true_hand_eye() * off);
+    let solve = |s: &Session| {
+        let (_, cal) = solve::calibrate(s, &Options::from_session(s)).unwrap();
+        cal
+    };
+    let runs = [solve(&session), solve(&general), solve(&guessed)];
+    let reference = ml_report(&runs[0]);
+    let sigma0 = reference.noise_model.pose_sigma_mm.unwrap();
+    assert!(reference.noise_model.pose_sigma_rounds.unwrap() >= 1);
+    for (k, cal) in runs.iter().enumerate().skip(1) {
+        let r = ml_report(cal);
+        let sigma = r.noise_model.pose_sigma_mm.unwrap();
+        assert!(
+            (sigma / sigma0 - 1.0).abs() < 0.01,
+            "start {k}: σ {sigma} vs {sigma0} mm"
+        );
+        assert!(
+            (r.variance_factor / reference.variance_factor - 1.0).abs() < 0.01,
+            "start {k}: variance factor {} vs {}",
+            r.variance_factor,
+            reference.variance_factor
+        );
+        let d = relative_difference(&r.covariance, &reference.covariance);
+        assert!(
+            d < 0.01,
+            "start {k}: covariances differ by {d:.4} (Frobenius, relative)"
+        );
+        let (dt, _) = hand_eye_error(&cal.hand_eye, &runs[0].hand_eye);
+        assert!(dt < 0.01, "start {k}: hand-eye {dt} mm from the first");
+    }
+}
+
+#[test]
+fn the_estimated_pose_sigma_finds_the_true_one() {
+    // Issue 32: over 10 seeds the mean within 10 % of the simulator's σ,
+    // each seed within 30 %.
+    let truth_sigma = 0.1;
+    let mut estimates = Vec::new();
+    for seed in 1..=10 {
+        let (session, _) = reported_poses(seed, truth_sigma);
+        let (_, cal) = solve::calibrate(&session, &Options::from_session(&session)).unwrap();
+        let s = ml_report(&cal).noise_model.pose_sigma_mm.unwrap();
+        assert!(
+            (s / truth_sigma - 1.0).abs() < 0.3,
+            "seed {seed}: σ {s:.4} mm for a true {truth_sigma} mm"
+        );
+        estimates.push(s);
+    }
+    let mean = estimates.iter().sum::<f64>() / estimates.len() as f64;
+    assert!(
+        (mean / truth_sigma - 1.0).abs() < 0.1,
+        "mean σ {mean:.4} mm for a true {truth_sigma} mm: {estimates:?}"
+    );
+}
+
+#[test]
+fn a_given_pose_sigma_is_kept_and_said() {
+    let (session, _) = reported_poses(2, 0.1);
+    let mut options = Options::from_session(&session);
+    options.ml.pose_sigma = Some(0.2);
+    let (_, cal) = solve::calibrate(&session, &options).unwrap();
+    let r = ml_report(&cal);
+    assert_eq!(r.noise_model.pose_sigma_mm, Some(0.2));
+    assert_eq!(r.noise_model.pose_sigma_rounds, None);
+    // Given twice the true σ, the data say so: a variance factor near ¼.
+    assert!(r.variance_factor < 0.5, "{}", r.variance_factor);
+    assert!(
+        r.summary()
+            .contains("flange pose σ 0.2000 mm each base coordinate, given (--pose-sigma)")
+    );
+}
+
+#[test]
+fn a_pose_only_result_written_before_the_noise_was_settled_still_loads() {
+    // The real set's result as spherecal wrote it before issue 32: the
+    // pose σ estimated at the start, no `pose_sigma_rounds`.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/v1/result-pose-only.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let file = format::parse_result(&text, &path).unwrap();
+    let solve::SolverReport::Ml(r) = &file.solver else {
+        panic!("an ml result")
+    };
+    assert!((r.noise_model.pose_sigma_mm.unwrap() - 0.150_272).abs() < 1e-6);
+    assert_eq!(r.noise_model.pose_sigma_rounds, None);
+    assert!(r.summary().contains("flange pose σ 0.1503 mm each base coordinate, given (--pose-sigma), or in a result written before"));
+}

@@ -46,7 +46,7 @@ pub struct CompensateArgs {
     /// Force the targets' layout [default: detected from the content]
     #[arg(long, value_parser = super::scan_flags::pose_format_parser())]
     pub pose_format: Option<PoseFormat>,
-    /// The pose columns of a pose table, in the convention's order [default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44]
+    /// The pose columns of a pose table, in the convention's order [default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44]; without a header, every column in order, `id` the id and `-` one to skip (e.g. id,x,y,z,w,p,r or x,y,z,w,p,r,-)
     #[arg(long, value_delimiter = ',')]
     pub pose_columns: Vec<String>,
     /// The TCP the targets are poses of: `sensor` (the calibrated hand-eye, printed as tool data to set on the controller), `flange`, or a JSON file with a 4x4 matrix `flange_from_tcp` (rows, mm).
@@ -89,6 +89,9 @@ pub fn run(args: &CompensateArgs) -> Result<(), CliError> {
     let mut inputs = vec![args.result.as_path(), args.targets.as_path()];
     if let Some(s) = &args.session {
         inputs.push(s.as_path());
+    }
+    if !matches!(args.tcp.as_str(), "sensor" | "flange") {
+        inputs.push(std::path::Path::new(&args.tcp));
     }
     CliError::guard_output(&args.out, &inputs)?;
     let result = format::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;

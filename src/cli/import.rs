@@ -309,8 +309,9 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         if args.preview.is_some() {
             return Err(CliError::input("--preview reads a joint log (--joints)"));
         }
-        let spec = pose_spec(args, poses)?;
+        // Every input refused as the output before any is read.
         let out = out_path(args)?;
+        let spec = pose_spec(args, poses)?;
         // Read and pair every input once; then the side, given or decided
         // from the data (a step of its own, which calibrates both sides).
         let mut progress = progress_lines(args.quiet, Instant::now());
@@ -331,12 +332,13 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         .map_err(|e| input(&e))?;
         (imported, out)
     } else {
-        let spec = spec(args)?;
         if let Some(n) = args.preview {
+            let spec = spec(args)?;
             say!("{}", import::preview(&spec, n).map_err(|e| input(&e))?);
             return Ok(());
         }
         let out = out_path(args)?;
+        let spec = spec(args)?;
         let mut progress = progress_lines(args.quiet, Instant::now());
         (
             import::import_with(&spec, &mut progress).map_err(|e| input(&e))?,

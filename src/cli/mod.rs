@@ -556,7 +556,7 @@ pub struct MlArgs {
     /// Skip the leave-one-station-out cross-validation.
     #[arg(long)]
     pub no_cross_validation: bool,
-    /// Pose-only sessions: σ of each base-frame coordinate from the error of the flange poses the controller reports (the robot's accuracy), mm [default: estimated from the scatter of the station centres at the start]
+    /// Pose-only sessions: σ of each base-frame coordinate from the error of the flange poses the controller reports (the robot's accuracy), mm [default: estimated from the data at the solution (variance-component estimation)]
     #[arg(long, value_name = "MM", value_parser = values::number(values::Range::positive("mm")))]
     pub pose_sigma: Option<f64>,
 }

@@ -24,7 +24,7 @@ pub struct ScanFlags {
     /// How a pose table or JSON list writes a pose (a robot program's language fixes its own).
     #[arg(long, value_parser = convention_parser())]
     pub pose_convention: Option<FlangeConvention>,
-    /// The pose columns of a pose table, in the convention's order [default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44]
+    /// The pose columns of a pose table, in the convention's order [default: x,y,z,q1..q4 | a,b,c | w,p,r | rx,ry,rz | m11..m44]; without a header, every column in order, `id` the id and `-` one to skip (e.g. id,x,y,z,w,p,r or x,y,z,w,p,r,-)
     #[arg(long, value_delimiter = ',')]
     pub pose_columns: Vec<String>,
     /// Column of the pose id in a single profile file.

@@ -345,7 +345,22 @@ fn default_truth_path(out: &Path) -> PathBuf {
 /// written (naming it).
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let started = Instant::now();
+    let inputs: Vec<&Path> = args
+        .plan
+        .iter()
+        .chain(&args.hand_eye)
+        .map(PathBuf::as_path)
+        .collect();
+    // Folders may yet be created: only the inputs are refused here.
+    let refuse = |out: &Path| {
+        format::refuse_inputs(out, &inputs).map_err(|e| CliError::input(e.to_string()))
+    };
+    if let Some(dir) = &args.csv_out {
+        refuse(&dir.join("joints.csv"))?;
+        refuse(&dir.join("references.csv"))?;
+    }
     if let (Some(part), Some(dir)) = (args.scan, &args.csv_out) {
+        refuse(&args.out)?;
         return run_scan(args, part, dir, started);
     }
     let truth_path = args.truth_path();
@@ -355,12 +370,6 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             args.out.display()
         )));
     }
-    let inputs: Vec<&Path> = args
-        .plan
-        .iter()
-        .chain(&args.hand_eye)
-        .map(PathBuf::as_path)
-        .collect();
     CliError::guard_output(&args.out, &inputs)?;
     CliError::guard_output(&truth_path, &inputs)?;
     let mut outputs: Vec<&Path> = vec![&args.out, &truth_path];

@@ -60,7 +60,7 @@ pub fn isometry_from_rows(rows: &[[f64; 4]; 4]) -> Result<Isometry3<f64>, Matrix
     if (det - 1.0).abs() > ROTATION_TOLERANCE {
         return Err(MatrixError::Reflection(det));
     }
-    let rotation = UnitQuaternion::from_matrix(&r);
+    let rotation = nearest_rotation(&r);
     Ok(Isometry3::from_parts(
         Translation3::new(rows[0][3], rows[1][3], rows[2][3]),
         rotation,
@@ -171,7 +171,22 @@ pub fn rigid_from_rows(rows: &[[f64; 4]; 4]) -> Isometry3<f64> {
     let r = Matrix3::from_fn(|i, j| rows[i][j]);
     Isometry3::from_parts(
         Translation3::new(rows[0][3], rows[1][3], rows[2][3]),
-        UnitQuaternion::from_matrix(&r),
+        nearest_rotation(&r),
+    )
+}
+
+/// The rotation nearest `m` (Müller et al.'s iteration, nalgebra's
+/// `from_matrix`), its iterations bounded by
+/// [`MAX_DECOMPOSITION_SWEEPS`](crate::engine::base::numeric::MAX_DECOMPOSITION_SWEEPS):
+/// nalgebra's own loops until convergence, which a NaN or an overflowed
+/// matrix never reaches (an import with a centre of 1e308 ran without end).
+#[must_use]
+pub fn nearest_rotation(m: &Matrix3<f64>) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_matrix_eps(
+        m,
+        f64::EPSILON,
+        crate::engine::base::numeric::MAX_DECOMPOSITION_SWEEPS,
+        UnitQuaternion::identity(),
     )
 }
 
@@ -196,11 +211,14 @@ pub fn rotation_from_rpy_deg(rpy_deg: [f64; 3]) -> UnitQuaternion<f64> {
 /// cross-covariance `m = Σ a_k·b_kᵀ` (Kabsch; the paper's eq. 7 with the
 /// determinant forced to +1): `R = V·diag(1, 1, det(V·Uᵀ))·Uᵀ` from the
 /// SVD `m = U·S·Vᵀ`, taken to the nearest rotation (Müller et al.'s
-/// iteration, nalgebra's `Rotation3::from_matrix`) so that rounding leaves
-/// no scale. `None` for a failed SVD. The one Kabsch of the crate: the
+/// iteration, bounded as in [`nearest_rotation`]) so that rounding leaves
+/// no scale. `None` for a failed SVD or a matrix that is not finite. The one Kabsch of the crate: the
 /// initial hand-eye (eq. 7) and [`kabsch`] call it.
 #[must_use]
 pub fn kabsch_rotation(m: &Matrix3<f64>) -> Option<Rotation3<f64>> {
+    if m.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
     let svd = nalgebra::linalg::SVD::try_new(
         *m,
         true,
@@ -212,7 +230,12 @@ pub fn kabsch_rotation(m: &Matrix3<f64>) -> Option<Rotation3<f64>> {
     let v = v_t.transpose();
     let d = (v * u.transpose()).determinant().signum();
     let fix = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, d));
-    Some(Rotation3::from_matrix(&(v * fix * u.transpose())))
+    Some(Rotation3::from_matrix_eps(
+        &(v * fix * u.transpose()),
+        f64::EPSILON,
+        crate::engine::base::numeric::MAX_DECOMPOSITION_SWEEPS,
+        Rotation3::identity(),
+    ))
 }
 
 /// The rigid motion `T` that best maps `from` onto `to` in least squares
@@ -242,6 +265,23 @@ pub fn kabsch(from: &[Vector3<f64>], to: &[Vector3<f64>]) -> Option<Isometry3<f6
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 31: nalgebra's nearest rotation loops until convergence, which
+    /// a matrix of NaN or 1e308 never reaches (an import hung on it).
+    #[test]
+    fn the_nearest_rotation_of_a_matrix_beyond_reason_ends() {
+        for bad in [f64::NAN, 1e308, f64::INFINITY] {
+            let m = Matrix3::new(bad, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+            let started = std::time::Instant::now();
+            let _ = nearest_rotation(&m);
+            let kabsch = kabsch_rotation(&m);
+            assert!(bad.is_finite() || kabsch.is_none());
+            assert!(started.elapsed().as_secs_f64() < 5.0, "{bad}");
+        }
+        let r = UnitQuaternion::from_euler_angles(0.1, -0.2, 0.3);
+        let m = r.to_rotation_matrix().into_inner() * 1.000_001;
+        assert!(nearest_rotation(&m).angle_to(&r) < 1e-9);
+    }
 
     #[test]
     fn kabsch_recovers_a_rigid_motion() {

@@ -186,6 +186,13 @@ impl<'a> LineCounter<'a> {
             *self = Self::new(self.text);
         }
         let bytes = self.text.as_bytes();
+        // After a `\r\n`, the reader says its record starts at the `\n`
+        // (the `\r` ended the row): no record starts at a line's end.
+        let byte = if bytes.get(byte) == Some(&b'\n') {
+            byte + 1
+        } else {
+            byte
+        };
         while let Some(nl) = bytes[self.start..byte].iter().position(|&b| b == b'\n') {
             self.start += nl + 1;
             self.line += 1;
@@ -343,6 +350,18 @@ mod tests {
         let e = Table::parse("id,use\na\n").unwrap_err();
         assert_eq!(e.line, 2);
         assert!(Table::parse("# only a comment\n").is_err());
+    }
+
+    /// Issue 31: in CRLF files (joint logs, profiles, references) every
+    /// error's line was one too low.
+    #[test]
+    fn crlf_files_name_the_right_line() {
+        let t = Table::parse("# c\r\nid,use\r\n\r\na,identify\r\nb,validate\r\n").unwrap();
+        assert_eq!(t.header_line, 2);
+        assert_eq!(t.rows[0].0, 4);
+        assert_eq!(t.rows[1].0, 5);
+        let e = Table::parse("id,use\r\na,identify\r\nb\r\n").unwrap_err();
+        assert_eq!(e.line, 3);
     }
 
     #[test]

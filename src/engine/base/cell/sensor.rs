@@ -2,7 +2,7 @@
 //! initial hand-eye `eT_s` as printed, made rigid. The simulator's truth and
 //! the planner's default hand-eye guess.
 
-use nalgebra::{Isometry3, Matrix3, UnitQuaternion};
+use nalgebra::{Isometry3, Matrix3};
 
 use crate::engine::base::geometry::rigid_from_rows;
 use crate::engine::base::numeric::round_to;
@@ -33,7 +33,7 @@ const HAND_EYE_DECIMALS: i32 = 12;
 /// and rounded to [`HAND_EYE_DECIMALS`].
 pub(crate) fn orthonormal_rows(printed: &[[f64; 4]; 3]) -> [[f64; 4]; 4] {
     let r = Matrix3::from_fn(|i, j| printed[i][j]);
-    let rotation = UnitQuaternion::from_matrix(&r).to_rotation_matrix();
+    let rotation = crate::engine::base::geometry::nearest_rotation(&r).to_rotation_matrix();
     let mut rows = [[0.0, 0.0, 0.0, 1.0]; 4];
     for i in 0..3 {
         for j in 0..3 {

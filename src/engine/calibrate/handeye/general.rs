@@ -383,7 +383,7 @@ pub fn general_hand_eye(
             crate::engine::base::numeric::approx(sigma_w)
         )));
     }
-    let rotation = UnitQuaternion::from_matrix(&r_s);
+    let rotation = crate::engine::base::geometry::nearest_rotation(&r_s);
     let flange_from_sensor = Isometry3::from_parts(Translation3::from(t_s), rotation);
     let mut sums = vec![Vector3::zeros(); stations];
     let mut counts = vec![0.0; stations];

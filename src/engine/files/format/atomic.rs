@@ -13,10 +13,14 @@
 //! - [`refuse_inputs`] refuses an output that **is one of the command's
 //!   inputs** (the same file by device and inode, whatever the path says);
 //!   [`check_outputs`] lets a command refuse its outputs before any work.
-//! - The temporary files are removed on every error path, and on SIGINT or
-//!   SIGTERM by [`remove_pending`] (called by the program's signal
-//!   handler, which then exits with 130; a write that has not yet renamed
-//!   its files then renames none, and reports [`io::ErrorKind::Interrupted`]).
+//! - The temporary files, and the folders a write created, are removed on
+//!   every error path, and on SIGINT, SIGTERM or SIGHUP by
+//!   [`remove_pending`] (called by the program's signal handler, which
+//!   then exits with 130; a write that has not yet renamed its files then
+//!   renames none, and reports [`io::ErrorKind::Interrupted`]). Each is
+//!   created and recorded under one lock, so no signal falls between the
+//!   two. SIGPIPE is ignored by the Rust runtime: a closed reader is an
+//!   error of the write to it, not a kill.
 //!   Leftovers of a process that was killed outright (a dead process id in
 //!   their name) are removed by the next write into the same folder.
 
@@ -32,10 +36,24 @@ use super::FileError;
 /// Symbolic links followed at most before a target is called a loop.
 const MAX_LINKS: usize = 40;
 
-/// Temporary files being written now, for [`remove_pending`]. Its lock is
-/// also held while a write renames its files, so that a signal's clean-up
-/// and a rename never interleave.
-static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// What a write under way has made and not yet committed: its temporary
+/// files and the folders it created for its outputs.
+struct Pending {
+    /// Temporary files being written now.
+    files: Vec<PathBuf>,
+    /// Folders created for outputs not yet renamed into them, outermost
+    /// first.
+    folders: Vec<PathBuf>,
+}
+
+/// What [`remove_pending`] removes. Its lock is held while a temporary
+/// file or a folder is created and recorded (so a signal never falls
+/// between the two), and while a write renames its files (so a signal's
+/// clean-up and a rename never interleave).
+static PENDING: Mutex<Pending> = Mutex::new(Pending {
+    files: Vec::new(),
+    folders: Vec::new(),
+});
 
 /// Set by [`remove_pending`]: the process is being interrupted, no write
 /// may rename its files any more.
@@ -176,11 +194,13 @@ pub fn write_all_atomic(files: &[(&Path, &[u8])], folders: Folders) -> Result<()
         }
     }
     // Commit: rename them all, or put back what was renamed.
-    let guard = lock_pending();
+    let mut guard = lock_pending();
     if let Err((k, e)) = commit(&plans, &temps, &INTERRUPTED, &guard) {
         drop(guard);
         return Err(fail(&temps, &created, paths[k], e));
     }
+    // The folders now hold the outputs: no longer the write's to remove.
+    guard.folders.retain(|d| !created.contains(d));
     drop(guard);
     for t in &temps {
         forget(t);
@@ -291,8 +311,17 @@ fn create_folders(dir: &Path, created: &mut Vec<PathBuf>) -> io::Result<()> {
         at = d.parent();
     }
     for d in missing.into_iter().rev() {
+        // Created and recorded under the lock: a signal's clean-up sees
+        // the folder, or stops the write before it is made.
+        let mut pending = lock_pending();
+        if interrupted() {
+            return Err(interrupted_error());
+        }
         match fs::create_dir(&d) {
-            Ok(()) => created.push(d),
+            Ok(()) => {
+                pending.folders.push(d.clone());
+                created.push(d);
+            }
             Err(e) if e.kind() == io::ErrorKind::AlreadyExists && d.is_dir() => {}
             Err(e) => {
                 return Err(io::Error::new(
@@ -308,9 +337,19 @@ fn create_folders(dir: &Path, created: &mut Vec<PathBuf>) -> io::Result<()> {
 /// Removes the folders a failed write created (innermost first; only
 /// while empty).
 fn remove_folders(created: &[PathBuf]) {
+    let mut pending = lock_pending();
     for d in created.iter().rev() {
         let _ = fs::remove_dir(d);
     }
+    pending.folders.retain(|d| !created.contains(d));
+}
+
+/// The error of a write stopped by a signal before it renamed anything.
+fn interrupted_error() -> io::Error {
+    io::Error::new(
+        io::ErrorKind::Interrupted,
+        "interrupted: nothing was written",
+    )
 }
 
 /// Writes `bytes` to a new temporary file beside the plan's target,
@@ -352,16 +391,10 @@ fn commit(
     plans: &[TargetPlan],
     temps: &[PathBuf],
     interrupted: &AtomicBool,
-    _pending: &MutexGuard<'_, Vec<PathBuf>>,
+    _pending: &MutexGuard<'_, Pending>,
 ) -> Result<(), (usize, io::Error)> {
     if interrupted.load(Ordering::SeqCst) {
-        return Err((
-            0,
-            io::Error::new(
-                io::ErrorKind::Interrupted,
-                "interrupted: nothing was written",
-            ),
-        ));
+        return Err((0, interrupted_error()));
     }
     // (target, backup of its old content if it had one) of each rename done.
     let mut done: Vec<(&Path, Option<PathBuf>)> = Vec::with_capacity(plans.len());
@@ -573,7 +606,7 @@ pub fn refuse_inputs(output: &Path, inputs: &[&Path]) -> Result<(), FileError> {
 }
 
 /// The [`PENDING`] lock, poisoned or not.
-fn lock_pending() -> MutexGuard<'static, Vec<PathBuf>> {
+fn lock_pending() -> MutexGuard<'static, Pending> {
     PENDING
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner)
@@ -587,17 +620,17 @@ fn lock_pending() -> MutexGuard<'static, Vec<PathBuf>> {
 pub fn remove_pending() {
     INTERRUPTED.store(true, Ordering::SeqCst);
     let mut pending = lock_pending();
-    for p in pending.drain(..) {
+    for p in pending.files.drain(..) {
         let _ = fs::remove_file(p);
+    }
+    // Innermost first; a folder that holds anything else stays.
+    for d in pending.folders.drain(..).rev() {
+        let _ = fs::remove_dir(d);
     }
 }
 
-fn remember(temp: &Path) {
-    lock_pending().push(temp.to_path_buf());
-}
-
 fn forget(temp: &Path) {
-    lock_pending().retain(|x| x != temp);
+    lock_pending().files.retain(|x| x != temp);
 }
 
 /// Distinguishes temporary files of concurrent saves in one process.
@@ -628,11 +661,11 @@ fn temp_owner(name: &str) -> Option<u32> {
 /// hence same file system, so the rename is atomic), and remembers it for
 /// [`remove_pending`].
 fn create_temp(dir: &Path, file_name: &std::ffi::OsStr) -> io::Result<(PathBuf, fs::File)> {
+    // Created and recorded under the lock: a signal's clean-up sees the
+    // file, or stops the write before it is made.
+    let mut pending = lock_pending();
     if interrupted() {
-        return Err(io::Error::new(
-            io::ErrorKind::Interrupted,
-            "interrupted: nothing was written",
-        ));
+        return Err(interrupted_error());
     }
     let mut last_error = None;
     for _ in 0..100 {
@@ -646,7 +679,7 @@ fn create_temp(dir: &Path, file_name: &std::ffi::OsStr) -> io::Result<(PathBuf, 
             .open(&temp)
         {
             Ok(file) => {
-                remember(&temp);
+                pending.files.push(temp.clone());
                 return Ok((temp, file));
             }
             Err(e) if e.kind() == io::ErrorKind::AlreadyExists => last_error = Some(e),

@@ -539,6 +539,9 @@ pub fn implausible_number(r: &ResultFile) -> Option<String> {
             }
         }
     }
+    if let (None, SolverReport::Ml(ml)) = (&f.0, &r.solver) {
+        f.0 = ml.implausible();
+    }
     f.0
 }
 

@@ -16,11 +16,13 @@ use std::path::Path;
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::{ImportError, ProfileReport};
+use crate::engine::base::numeric::approx;
 use crate::engine::base::session::{Session, Use};
 use crate::engine::calibrate::handeye::general::{
     GeneralHandEye, GeneralSighting, general_hand_eye,
 };
 use crate::engine::calibrate::handeye::{Sighting, initial_hand_eye};
+use crate::engine::calibrate::solve::plausible::{MAX_PLAUSIBLE_SCATTER_MM, check_scatter};
 use crate::engine::calibrate::solve::{Analysis, analyse};
 
 /// Largest orientation difference (deg) between poses counted as "the
@@ -224,6 +226,19 @@ pub(crate) fn settle(
             });
         }
     };
+    // Calibrate's verdict, before calibrating: poses and centres that no
+    // hand-eye brings together are misread, not a cell. A warning, not a
+    // refusal: the side decision tries the wrong side on purpose, and
+    // `calibrate` refuses such a session unless told to accept it.
+    let own = scatter(&poses, &centres, &stations, &chosen);
+    if let Err(e) = check_scatter(own, session.pose_only()) {
+        notes.push(format!(
+            "warning: with the initial hand-eye that fits them best the sphere centres scatter by {} mm (3-D rms about each station's mean), beyond what any sensor and robot give (at most {MAX_PLAUSIBLE_SCATTER_MM} mm): `calibrate` will refuse this session; likely causes: {}, or poses and centres that do not belong together (another unit, another session) ({})",
+            approx(own),
+            e.causes,
+            poses_file.display()
+        ));
+    }
     session.hand_eye = Some(chosen);
     notes.push("every pose is `identify`".to_string());
     Ok((session, notes))

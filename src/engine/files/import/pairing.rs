@@ -326,6 +326,36 @@ pub fn list_profiles(
             ),
         });
     }
+    // Two groups that could both be the profiles: refused, naming them.
+    let sized: Vec<(&String, &Vec<PathBuf>)> = groups
+        .iter()
+        .filter(|(_, v)| expected.is_some_and(|n| v.len() == n))
+        .collect();
+    if sized.len() > 1 {
+        let name = |p: &PathBuf| {
+            p.file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+        };
+        let named: Vec<String> = sized
+            .iter()
+            .map(|(shape, v)| {
+                format!(
+                    "{shape} ({} … {})",
+                    v.first().map(name).unwrap_or_default(),
+                    v.last().map(name).unwrap_or_default()
+                )
+            })
+            .collect();
+        return Err(ImportError::File {
+            path: dir.to_path_buf(),
+            message: format!(
+                "{} sets of {} files named alike could be the profiles: {}; move the set that is not out of the folder, or give the profiles' folder alone",
+                sized.len(),
+                sized[0].1.len(),
+                named.join(" and ")
+            ),
+        });
+    }
     // The group of profiles: as many files as poses, else the largest
     // (ties: the first shape in order).
     let chosen = expected

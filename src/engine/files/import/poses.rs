@@ -44,8 +44,9 @@ use super::pairing::{self, FolderListing};
 use super::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource};
 use super::progress::{self, ImportProgress};
 use super::{FlangeConvention, ImportError, Imported, ProfileReport, RobotSource, load_robot};
+use crate::engine::base::limits;
 use crate::engine::base::robot::Robot;
-use crate::engine::base::session::{Measurement, Observation, Use};
+use crate::engine::base::session::{Measurement, Observation, Use, rules};
 use crate::engine::files::program::{
     self, PoseFile, PoseFormat, ProgramError, ReadSpec, TargetValue, read_number_table,
 };
@@ -266,12 +267,20 @@ pub fn records_of(file: &PoseFile) -> Result<Vec<PoseRecord>, ImportError> {
                 let pose = convention
                     .pose_from_values(values)
                     .map_err(|m| fail(format!("{m} ({})", convention.describe())))?;
+                for (axis, v) in ["x", "y", "z"].iter().zip(pose.translation.vector.iter()) {
+                    rules::plausible(*v, limits::LENGTH_MM, &format!("flange {axis}"), "mm")
+                        .map_err(|m| fail(format!("{m}; read as {}", convention.describe())))?;
+                }
                 PoseValue::Flange(pose)
             }
             TargetValue::Joints { deg, .. } => {
                 joints += 1;
                 if deg.iter().any(|v| !v.is_finite()) {
                     return Err(fail("a joint value is not a finite number".to_string()));
+                }
+                for (k, v) in deg.iter().enumerate() {
+                    rules::plausible(*v, limits::ANGLE_DEG, &format!("joint {}", k + 1), "deg")
+                        .map_err(fail)?;
                 }
                 PoseValue::Joints(deg.clone())
             }
@@ -427,7 +436,14 @@ pub fn read_pose_inputs_with(
 /// The table cannot be read (naming the line).
 pub fn centre_rows(path: &Path) -> Result<Vec<program::Row>, ImportError> {
     let names: Vec<String> = ["x", "y", "z"].iter().map(|s| (*s).to_string()).collect();
-    read_number_table(path, &names, false, "x, y, z (sensor frame, mm)").map_err(program_error)
+    read_number_table(
+        path,
+        &names,
+        false,
+        "x, y, z (sensor frame, mm)",
+        "give the table a header (`id,x,y,z` or `x,y,z,extra`)",
+    )
+    .map_err(program_error)
 }
 
 /// The centres of a centres table, paired with the records: by id when
@@ -438,6 +454,14 @@ fn read_centres(
     poses: &Path,
 ) -> Result<(Vec<String>, Vec<Vector3<f64>>), ImportError> {
     let rows = centre_rows(path)?;
+    for row in &rows {
+        let c = Vector3::new(row.values[0], row.values[1], row.values[2]);
+        rules::centre("the centre (x, y, z)", &c).map_err(|message| ImportError::Csv {
+            path: path.to_path_buf(),
+            line: row.line,
+            message,
+        })?;
+    }
     let record_ids: Vec<Option<&String>> = records.iter().map(|r| r.id.as_ref()).collect();
     let by_id = rows.iter().all(|r| r.id.is_some()) && record_ids.iter().all(Option::is_some);
     let mut out = Vec::with_capacity(records.len());
@@ -476,17 +500,6 @@ fn read_centres(
                     .unwrap_or_else(|| record_id(r, k + 1)),
             );
         }
-    }
-    if let Some((k, c)) = out
-        .iter()
-        .enumerate()
-        .find(|(_, c)| c.iter().any(|v| !v.is_finite()))
-    {
-        return Err(ImportError::Csv {
-            path: path.to_path_buf(),
-            line: rows.get(k).map_or(0, |r| r.line),
-            message: format!("centre {:?} is not finite", c.as_slice()),
-        });
     }
     Ok((ids, out))
 }

@@ -83,6 +83,26 @@ pub(super) fn read(text: &str) -> Result<Parsed, ParseError> {
         })?;
         let open = skip_blanks(text, close + 1);
         if text.as_bytes().get(open) != Some(&b'{') {
+            // A position's head starts its line: anything but its `{`
+            // after it is a malformed block, never skipped.
+            let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
+            if text[line_start..start]
+                .trim_start_matches('\u{feff}')
+                .trim()
+                .is_empty()
+            {
+                let rest: String = text[close + 1..]
+                    .chars()
+                    .take_while(|c| *c != '\n')
+                    .collect();
+                return Err((
+                    line,
+                    format!(
+                        "position P[{index}]: `{}` where its block's `{{` should be",
+                        shown(rest.trim())
+                    ),
+                ));
+            }
             // A reference such as `P[1]` inside a comment: not a block.
             at = close + 1;
             continue;
@@ -143,7 +163,7 @@ pub(super) fn read(text: &str) -> Result<Parsed, ParseError> {
         .enumerate()
         .filter_map(|(i, t)| t.number.map(|n| (n, i)))
         .collect();
-    let visits = motion_visits(text, pos_start, &by_index);
+    let visits = motion_visits(text, &lines, pos_start, &by_index)?;
     Ok(Parsed {
         targets,
         visits,
@@ -324,19 +344,35 @@ fn integer(v: f64) -> Option<i64> {
     ((n as f64 - v).abs() < 1e-9).then_some(n)
 }
 
+/// Motion options that send the robot elsewhere than the position
+/// written: incremental motion and offsets by a position register.
+const MOVED_ELSEWHERE: [&str; 4] = ["INC", "OFFSET", "TOOL_OFFSET", "VOFFSET"];
+
 /// The positions the `/MN` lines move to, in program order (indices into
 /// the targets by P number). Remarks (`!…`) are skipped; position
 /// registers (`PR[n]`) are not positions of this program.
-fn motion_visits(text: &str, pos_start: usize, by_index: &HashMap<u64, usize>) -> Vec<usize> {
+///
+/// # Errors
+/// A motion to a position `/POS` does not hold, or one that `INC` or an
+/// offset (`Offset,PR[n]`, `Tool_Offset,PR[n]`) moves elsewhere than the
+/// position written: naming the line.
+fn motion_visits(
+    text: &str,
+    lines: &Lines,
+    pos_start: usize,
+    by_index: &HashMap<u64, usize>,
+) -> Result<Vec<usize>, ParseError> {
     let Some(mn) = text[..pos_start]
         .find("\n/MN")
         .map(|i| i + 1)
         .or_else(|| text.starts_with("/MN").then_some(0))
     else {
-        return Vec::new();
+        return Ok(Vec::new());
     };
     let mut visits = Vec::new();
-    for line in text[mn..pos_start].lines().skip(1) {
+    let first_line = lines.line(mn);
+    for (k, line) in text[mn..pos_start].lines().enumerate().skip(1) {
+        let here = first_line + k;
         let body = line.split_once(':').map_or(line, |(n, rest)| {
             if n.trim().chars().all(|c| c.is_ascii_digit()) {
                 rest
@@ -357,12 +393,31 @@ fn motion_visits(text: &str, pos_start: usize, by_index: &HashMap<u64, usize>) -
                 .chars()
                 .take_while(char::is_ascii_digit)
                 .collect();
-            if let Some(&t) = digits.parse().ok().and_then(|n: u64| by_index.get(&n)) {
-                visits.push(t);
+            let Ok(n) = digits.parse::<u64>() else {
+                continue;
+            };
+            let Some(&t) = by_index.get(&n) else {
+                return Err((
+                    here,
+                    format!("a motion to P[{n}], which /POS does not hold"),
+                ));
+            };
+            if let Some(option) = body
+                .split(|c: char| c.is_whitespace() || c == ',' || c == ';')
+                .find(|w| MOVED_ELSEWHERE.iter().any(|o| w.eq_ignore_ascii_case(o)))
+            {
+                return Err((
+                    here,
+                    format!(
+                        "the motion to P[{n}] has `{}`: the robot goes elsewhere than P[{n}] as written, so its pose is not known; remove the option or record the pose reached",
+                        shown(option)
+                    ),
+                ));
             }
+            visits.push(t);
         }
     }
-    visits
+    Ok(visits)
 }
 
 #[cfg(test)]

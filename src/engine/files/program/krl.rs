@@ -14,7 +14,9 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
-use super::scan::{Lines, MotionArguments, inside, line_comments, number_at, shown, skip_space};
+use super::scan::{
+    Lines, MotionArguments, computed_motion, inside, line_comments, number_at, shown, skip_space,
+};
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 
@@ -131,7 +133,27 @@ pub(super) fn read(text: &str) -> Result<Parsed, ParseError> {
         let get = |k: &str| fields.iter().find(|f| f.key == k);
         let declared = declared_name(text, i);
         let name = declared.clone().unwrap_or_else(|| format!("line {line}"));
-        let target = if POSE_KEYS.iter().all(|k| get(k).is_some()) {
+        let present: Vec<&str> = POSE_KEYS
+            .iter()
+            .copied()
+            .filter(|k| get(k).is_some())
+            .collect();
+        if !present.is_empty() && present.len() < POSE_KEYS.len() {
+            let missing: Vec<&str> = POSE_KEYS
+                .iter()
+                .copied()
+                .filter(|k| get(k).is_none())
+                .collect();
+            return Err((
+                line,
+                format!(
+                    "{name}: a position with {} but no {}: a position needs X, Y, Z, A, B, C (a relative motion such as LIN_REL is not a pose either)",
+                    present.join(", "),
+                    missing.join(", ")
+                ),
+            ));
+        }
+        let target = if present.len() == POSE_KEYS.len() {
             let mut values = Vec::new();
             let mut spans = Vec::new();
             for k in POSE_KEYS {
@@ -225,7 +247,8 @@ pub(super) fn read(text: &str) -> Result<Parsed, ParseError> {
             ));
         }
     }
-    let visits = motion_visits(text, &comments, &targets, &inline_at);
+    let visits = motion_visits(text, &comments, &targets, &inline_at)
+        .map_err(|call| computed_motion(text, &lines, call))?;
     Ok(Parsed {
         targets,
         visits,
@@ -239,7 +262,7 @@ fn motion_visits(
     comments: &[Range<usize>],
     targets: &[Target],
     inline_at: &HashMap<usize, usize>,
-) -> Vec<usize> {
+) -> Result<Vec<usize>, Range<usize>> {
     let by_name: HashMap<String, usize> = targets
         .iter()
         .enumerate()
@@ -283,9 +306,9 @@ fn motion_visits(
             |b| b.is_ascii_alphanumeric() || b == b'_',
             |name| by_name.get(name).copied(),
             &mut visits,
-        );
+        )?;
     }
-    visits
+    Ok(visits)
 }
 
 #[cfg(test)]

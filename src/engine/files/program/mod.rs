@@ -481,7 +481,9 @@ pub fn parse_pose_text(
 /// Reads a table of numbers from `path` (a header optional, any
 /// separator; see the pose tables): the columns `names` (by name under a
 /// header, in order without one) and optionally `id`, `station`, `use`,
-/// `side`. `what` describes the numbers for messages. Used for tables
+/// `side`. `what` describes the numbers for messages, `hint` how to say
+/// which reading a headerless table with one number more means (any
+/// numbers fit these values, so such a table needs a header). Used for tables
 /// that are not poses, such as sphere centres reported by a sensor.
 ///
 /// # Errors
@@ -492,6 +494,7 @@ pub fn read_number_table(
     names: &[String],
     names_given: bool,
     what: &str,
+    hint: &str,
 ) -> Result<Vec<Row>, ProgramError> {
     let fail = |line: usize, message: String| ProgramError {
         path: path.to_path_buf(),
@@ -499,7 +502,8 @@ pub fn read_number_table(
         message,
     };
     let text = read_text(path, Cap::TABLE).map_err(|e| fail(0, format!("cannot be read: {e}")))?;
-    table::read_rows(&text, names, names_given, what).map_err(|(line, message)| fail(line, message))
+    table::read_rows(&text, names, names_given, what, &|_| true, hint)
+        .map_err(|(line, message)| fail(line, message))
 }
 
 /// What a layout's reader returns: the targets, the motion instructions'

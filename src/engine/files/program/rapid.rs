@@ -11,7 +11,9 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
-use super::scan::{Lines, MotionArguments, inside, line_comments, number_at, shown, skip_space};
+use super::scan::{
+    Lines, MotionArguments, computed_motion, inside, line_comments, number_at, shown, skip_space,
+};
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 
@@ -202,22 +204,76 @@ pub(super) fn read(text: &str) -> Result<Parsed, ParseError> {
         }
         i = next;
     }
-    let visits = motion_visits(text, &comments, &targets, &inline_at);
+    let mut first: HashMap<String, usize> = HashMap::new();
+    for t in &targets {
+        if let Some(line) = first.insert(t.name.to_ascii_lowercase(), t.line)
+            && !t.name.starts_with("line ")
+        {
+            return Err((
+                t.line,
+                format!(
+                    "target `{}` is declared twice (also at line {line}): which one the robot goes to is not known",
+                    shown(&t.name)
+                ),
+            ));
+        }
+    }
+    let (visits, warnings) = motion_visits(text, &lines, &comments, &targets, &inline_at)?;
     Ok(Parsed {
         targets,
         visits,
-        warnings: Vec::new(),
+        warnings,
     })
+}
+
+/// A `Move…` instruction's tool and `\WObj`, from the byte after its
+/// word to its `;` (in the lower-cased text): the last argument, without
+/// its optional arguments, and the work object named.
+fn tool_and_wobj(lower: &str, from: usize) -> (Option<String>, Option<String>) {
+    let end = lower[from..].find(';').map_or(lower.len(), |i| from + i);
+    let statement = &lower[from..end];
+    let mut depth = 0_i32;
+    let mut last = 0;
+    for (i, b) in statement.bytes().enumerate() {
+        match b {
+            b'[' | b'(' => depth += 1,
+            b']' | b')' => depth -= 1,
+            b',' if depth == 0 => last = i + 1,
+            _ => {}
+        }
+    }
+    let tail = &statement[last..];
+    let tool = tail.split('\\').next().unwrap_or("").trim();
+    let wobj = statement.find("\\wobj").map(|i| {
+        statement[i + 5..]
+            .trim_start_matches([' ', ':', '='])
+            .chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect::<String>()
+    });
+    (
+        (!tool.is_empty() && last > 0).then(|| tool.to_string()),
+        wobj.filter(|w| !w.is_empty()),
+    )
 }
 
 /// The targets the `Move…` instructions go to, in program order: a named
 /// target, or an inline literal (`MoveC` names two).
+///
+/// # Errors
+/// A motion to a computed position (`Offs(…)`, `RelTool(…)`), naming its
+/// line. A work object other than `wobj0`, or moves with more than one
+/// tool, are warned about (the targets are then not flange poses in the
+/// base frame, or not of one tool).
 fn motion_visits(
     text: &str,
+    lines: &Lines,
     comments: &[Range<usize>],
     targets: &[Target],
     inline_at: &HashMap<usize, usize>,
-) -> Vec<usize> {
+) -> Result<(Vec<usize>, Vec<String>), ParseError> {
+    let mut tools: Vec<(String, usize)> = Vec::new();
+    let mut wobjs: Vec<(String, usize)> = Vec::new();
     let by_name: HashMap<String, usize> = targets
         .iter()
         .enumerate()
@@ -250,19 +306,52 @@ fn motion_visits(
         } else {
             1
         };
-        arguments.read(
-            word_end,
-            count,
-            |b| b.is_ascii_alphanumeric() || b == b'_' || b == b'{' || b == b'}',
-            // An indexed name (`p{3}`) as itself, or its array.
-            |indexed| {
-                let name = indexed.split('{').next().unwrap_or("");
-                by_name.get(indexed).or_else(|| by_name.get(name)).copied()
-            },
-            &mut visits,
-        );
+        arguments
+            .read(
+                word_end,
+                count,
+                |b| b.is_ascii_alphanumeric() || b == b'_' || b == b'{' || b == b'}',
+                // An indexed name (`p{3}`) as itself, or its array.
+                |indexed| {
+                    let name = indexed.split('{').next().unwrap_or("");
+                    by_name.get(indexed).or_else(|| by_name.get(name)).copied()
+                },
+                &mut visits,
+            )
+            .map_err(|call| computed_motion(text, lines, call))?;
+        let (tool, wobj) = tool_and_wobj(&lower, word_end);
+        let line = lines.line(at);
+        // A joint move's tool does not change where the joints go.
+        if let Some(tool) = tool.filter(|_| !instruction.starts_with("moveabsj"))
+            && !tools.iter().any(|(t, _)| *t == tool)
+        {
+            tools.push((tool, line));
+        }
+        if let Some(w) = wobj
+            && w != "wobj0"
+            && !wobjs.iter().any(|(x, _)| *x == w)
+        {
+            wobjs.push((w, line));
+        }
     }
-    visits
+    let mut warnings = Vec::new();
+    for (w, line) in &wobjs {
+        warnings.push(format!(
+            "line {line}: moves in work object `{w}`: their targets are then not in the robot's base frame; every pose must share one frame for a calibration"
+        ));
+    }
+    if tools.len() > 1 {
+        let named: Vec<String> = tools
+            .iter()
+            .map(|(t, line)| format!("`{t}` (line {line})"))
+            .collect();
+        warnings.push(format!(
+            "moves with {} tools, {}: targets of different tools are not poses of one flange or sensor",
+            tools.len(),
+            named.join(", ")
+        ));
+    }
+    Ok((visits, warnings))
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
-use super::Target;
+use super::{ParseError, Target};
 
 /// Longest piece of a file quoted in a message, characters: a message
 /// names what is wrong, it does not echo a megabyte line.
@@ -289,6 +289,11 @@ impl MotionArguments<'_> {
     /// inline literal (which ends the list), or a name of `name_byte`
     /// bytes that `lookup` knows. Anything but a comma after a name ends
     /// the list.
+    ///
+    /// # Errors
+    /// The byte range of a function called where a target should be
+    /// (`Offs(p2, 0, 0, 10)`, `RelTool(…)`, `pose_trans(…)`): the robot
+    /// goes to a position computed at run time, not to one in the file.
     pub(super) fn read(
         &self,
         at: usize,
@@ -296,7 +301,7 @@ impl MotionArguments<'_> {
         name_byte: impl Fn(u8) -> bool,
         lookup: impl Fn(&str) -> Option<usize>,
         visits: &mut Vec<usize>,
-    ) {
+    ) -> Result<(), Range<usize>> {
         let bytes = self.folded.as_bytes();
         let mut i = skip_space(self.folded, at);
         for _ in 0..count {
@@ -304,9 +309,12 @@ impl MotionArguments<'_> {
                 if let Some(&t) = self.inline_at.get(&i) {
                     visits.push(t);
                 }
-                return;
+                return Ok(());
             }
             let end = i + bytes[i..].iter().take_while(|b| name_byte(**b)).count();
+            if end > i && bytes.get(skip_space(self.folded, end)) == Some(&b'(') {
+                return Err(i..end);
+            }
             if let Some(t) = lookup(&self.folded[i..end]) {
                 visits.push(t);
             }
@@ -314,10 +322,23 @@ impl MotionArguments<'_> {
             if bytes.get(i) == Some(&b',') {
                 i = skip_space(self.folded, i + 1);
             } else {
-                return;
+                return Ok(());
             }
         }
+        Ok(())
     }
+}
+
+/// The error of a motion to a computed position: naming the function and
+/// its line.
+pub(super) fn computed_motion(text: &str, lines: &Lines, call: Range<usize>) -> ParseError {
+    (
+        lines.line(call.start),
+        format!(
+            "a motion to `{}(…)`, a position computed when the program runs (an offset or a tool-relative move): its pose is not in the file; write the position reached as a target",
+            shown(&text[call])
+        ),
+    )
 }
 
 /// Whether byte `at` lies in one of the sorted, disjoint `ranges`.

@@ -7,8 +7,13 @@
 //!   pose columns by name (the convention's default names, any case, or
 //!   the names given), and optionally `id`, `station`, `use`, `side`.
 //! - **Without a header**: the convention's numbers in its order, e.g.
-//!   `x y z w p r` for FANUC; a row with one more field takes the first as
-//!   the pose id.
+//!   `x y z w p r` for FANUC; a row with one more field whose first is
+//!   text takes it as the pose id. All numbers, the row reads two ways
+//!   (an id first, or an extra column last): the id reading is taken only
+//!   when the first column counts up by a fixed integer step and the other
+//!   reading is no pose (angles beyond a turn, a quaternion not unit);
+//!   otherwise the table is refused, and `--pose-columns` says which
+//!   (`id,x,y,z,w,p,r`, or `x,y,z,w,p,r,-` with `-` a column skipped).
 //!
 //! Blank lines and lines starting with `#` or `//` are skipped; a UTF-8
 //! byte-order mark is allowed; fields may be quoted. Pose `k` of a table
@@ -157,20 +162,45 @@ pub struct Row {
     pub side: Option<i8>,
 }
 
+/// The name, in `--pose-columns`, of a headerless table's id column.
+pub const ID_COLUMN: &str = "id";
+/// The name, in `--pose-columns`, of a headerless table's column to skip.
+pub const SKIPPED_COLUMN: &str = "-";
+
+/// Whether a given column name is a value column (not `id` or `-`).
+fn is_value_name(n: &str) -> bool {
+    !(n.trim().eq_ignore_ascii_case(ID_COLUMN) || n.trim() == SKIPPED_COLUMN)
+}
+
+/// The value columns of given column names: without `id` and `-`.
+#[must_use]
+pub fn value_names(names: &[String]) -> Vec<String> {
+    names.iter().filter(|n| is_value_name(n)).cloned().collect()
+}
+
 /// Reads a table of numbers: the columns `names` (by name when the table
-/// has a header; in order without one, `names_given` then being an error),
-/// and optionally `id`, `station`, `use`, `side`. `what` names the
-/// numbers in messages ("FANUC x, y, z (mm), W, P, R (deg)").
+/// has a header; in order without one, where given names may also hold
+/// `id` and `-` for a column to skip), and optionally `id`, `station`,
+/// `use`, `side`. `what` names the numbers in messages ("FANUC x, y, z
+/// (mm), W, P, R (deg)"); `fits` says whether a row's numbers can be
+/// the values at all (for a headerless row with one number more than the
+/// values: the id-first reading is taken only when the first column
+/// counts up by a fixed integer step and the values-first reading does
+/// not fit).
 ///
 /// # Errors
 /// No rows, a missing column, a row of another width, a cell that is not
-/// a number: each naming the line.
+/// a number, a headerless table with one number more that can be read
+/// two ways: each naming the line.
 pub fn read_rows(
     text: &str,
     names: &[String],
     names_given: bool,
     what: &str,
+    fits: &dyn Fn(&[f64]) -> bool,
+    hint: &str,
 ) -> Result<Vec<Row>, ParseError> {
+    let all_names = names;
     let rows = rows(text);
     let Some((first_line, first)) = rows.first().cloned() else {
         return Err((0, "the table has no rows".to_string()));
@@ -191,6 +221,8 @@ pub fn read_rows(
     };
     let first_fields = row_fields(first);
     let is_number = |r: &Range<usize>| number(&text[r.clone()], sep).is_some();
+    let value_names = value_names(names);
+    let names = value_names.as_slice();
     let n = names.len();
     // A header has names; a first row whose only text is its first field
     // with one field more than the numbers need is data with an id first.
@@ -205,19 +237,32 @@ pub fn read_rows(
             .map(|r| text[r.clone()].to_string())
             .collect();
         Layout::named(&header, names, what).map_err(|m| (first_line, m))?
+    } else if names_given {
+        Layout::positional(all_names, first_fields.len(), sep).map_err(|m| (first_line, m))?
     } else {
-        if names_given {
-            return Err((
-                first_line,
-                format!(
-                    "columns were named, but the table has no header (its first row is numbers separated by {})",
-                    sep.describe()
-                ),
-            ));
-        }
         match first_fields.len() {
             w if w == n => Layout::ordered(0, None, w),
-            w if w == n + 1 => Layout::ordered(1, Some(0), w),
+            w if w == n + 1 && text_fields == [0] => Layout::ordered(1, Some(0), w),
+            w if w == n + 1 => {
+                let numbers = |line: &Range<usize>| -> Vec<f64> {
+                    row_fields(line.clone())
+                        .iter()
+                        .map(|r| number(&text[r.clone()], sep).unwrap_or(f64::NAN))
+                        .collect()
+                };
+                let table: Vec<Vec<f64>> = rows.iter().map(|(_, r)| numbers(r)).collect();
+                two_readings(&table, n, fits).map_err(|m| {
+                    (
+                        first_line,
+                        format!(
+                            "{w} numbers a row separated by {} and no header: one more than {what}, so two readings: an id first (`id,{names}`) or an extra column last (`{names},-`); {m}; {hint}",
+                            sep.describe(),
+                            names = names.join(",")
+                        ),
+                    )
+                })?;
+                Layout::ordered(1, Some(0), w)
+            }
             w => {
                 return Err((
                     first_line,
@@ -305,18 +350,30 @@ pub(super) fn read(
     columns: Option<&[String]>,
 ) -> Result<Parsed, ParseError> {
     let names = columns.map_or_else(|| convention.default_columns(), <[String]>::to_vec);
-    if names.len() != convention.n_columns() {
+    let values = value_names(&names);
+    if values.len() != convention.n_columns() {
         return Err((
             0,
             format!(
                 "{} pose columns named, {} needs {}",
-                names.len(),
+                values.len(),
                 convention.describe(),
                 convention.n_columns()
             ),
         ));
     }
-    let rows = read_rows(text, &names, columns.is_some(), convention.describe())?;
+    let hint = format!(
+        "say which with --pose-columns (e.g. `id,{v}` or `{v},-`: `id` names the id column, `-` a column to skip)",
+        v = values.join(",")
+    );
+    let rows = read_rows(
+        text,
+        &names,
+        columns.is_some(),
+        convention.describe(),
+        &|v| pose_fits(convention, v),
+        &hint,
+    )?;
     let targets = rows
         .into_iter()
         .map(|row| {
@@ -348,6 +405,65 @@ pub(super) fn read(
         visits: Vec::new(),
         warnings: Vec::new(),
     })
+}
+
+/// Whether a headerless table with one number more than the values reads
+/// as an id first: only when the first column holds distinct integers
+/// counting up by a fixed step and the values-first reading does not fit;
+/// else what speaks against it.
+fn two_readings(table: &[Vec<f64>], n: usize, fits: &dyn Fn(&[f64]) -> bool) -> Result<(), String> {
+    let first: Vec<f64> = table
+        .iter()
+        .map(|r| r.first().copied().unwrap_or(f64::NAN))
+        .collect();
+    let integers = first
+        .iter()
+        .all(|v| v.is_finite() && v.fract() == 0.0 && v.abs() < 1e15);
+    let step = if first.len() > 1 {
+        first[1] - first[0]
+    } else {
+        1.0
+    };
+    let counting = integers && step > 0.0 && first.windows(2).all(|w| w[1] - w[0] == step);
+    let values_fit = table.iter().all(|r| r.len() > n && fits(&r[..n]));
+    match (counting, values_fit) {
+        (true, false) => Ok(()),
+        (false, _) => Err(format!(
+            "the first column ({}) does not count up by a fixed integer step, so it is no id",
+            shown_numbers(&first)
+        )),
+        (true, true) => Err(
+            "the first column counts up like an id, but the other numbers also read as values with an extra column last"
+                .to_string(),
+        ),
+    }
+}
+
+/// The first numbers of a column, for messages.
+fn shown_numbers(v: &[f64]) -> String {
+    let mut s: Vec<String> = v.iter().take(4).map(|x| format!("{x}")).collect();
+    if v.len() > 4 {
+        s.push("…".to_string());
+    }
+    s.join(", ")
+}
+
+/// Whether `v` can be a pose in `convention` at all: a rigid transform
+/// whose angles are within a turn (Euler angles within ±360°, a rotation
+/// vector within 2π rad).
+fn pose_fits(convention: FlangeConvention, v: &[f64]) -> bool {
+    if convention.pose_from_values(v).is_err() {
+        return false;
+    }
+    match convention {
+        FlangeConvention::KukaAbc | FlangeConvention::FanucWpr => {
+            v[3..6].iter().all(|a| a.abs() <= 360.0)
+        }
+        FlangeConvention::UrRotationVector => {
+            v[3..6].iter().map(|a| a * a).sum::<f64>().sqrt() <= std::f64::consts::TAU
+        }
+        FlangeConvention::AbbQuaternion | FlangeConvention::Matrix => true,
+    }
 }
 
 /// A `side` cell: `+1`/`1`, `-1`, or blank for the session default.
@@ -382,6 +498,37 @@ impl Layout {
             usage: None,
             side: None,
         }
+    }
+
+    /// A headerless table's columns as given, in order: value names,
+    /// `id` and `-` (skipped).
+    fn positional(given: &[String], width: usize, sep: Separator) -> Result<Self, String> {
+        if given.len() != width {
+            return Err(format!(
+                "{} columns named ({}), the table's first row has {width} numbers separated by {}",
+                given.len(),
+                given.join(","),
+                sep.describe()
+            ));
+        }
+        let ids: Vec<usize> = (0..width)
+            .filter(|&i| given[i].trim().eq_ignore_ascii_case(ID_COLUMN))
+            .collect();
+        if ids.len() > 1 {
+            return Err(format!(
+                "`{ID_COLUMN}` named {} times in the columns",
+                ids.len()
+            ));
+        }
+        Ok(Self {
+            width,
+            numbers: (0..width).filter(|&i| is_value_name(&given[i])).collect(),
+            names: value_names(given),
+            id: ids.first().copied(),
+            station: None,
+            usage: None,
+            side: None,
+        })
     }
 
     fn named(header: &[String], names: &[String], what: &str) -> Result<Self, String> {
@@ -489,12 +636,44 @@ mod tests {
             assert_eq!(values(&p, 0), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
         }
         let p = read(
-            "1, 10,20,30,0,0,0\n2, 11,21,31,0,0,1\n",
+            "1, 10,20,530,0,0,0\n2, 11,21,531,0,0,1\n",
             FlangeConvention::KukaAbc,
             None,
         )
         .unwrap();
         assert_eq!(p.targets[1].id.as_deref(), Some("2"));
+        // Ids whose other reading is also a pose, or a first column that
+        // does not count: refused, naming both readings and the option.
+        for text in [
+            "1, 10,20,30,0,0,0\n2, 11,21,31,0,0,1\n",
+            "10,20,530,0,0,0,100\n11,21,531,0,0,1,100\n",
+        ] {
+            let (line, m) = read(text, FlangeConvention::KukaAbc, None).unwrap_err();
+            assert_eq!(line, 1);
+            assert!(
+                m.contains("`id,x,y,z,a,b,c`")
+                    && m.contains("`x,y,z,a,b,c,-`")
+                    && m.contains("--pose-columns"),
+                "{m}"
+            );
+        }
+        let given = |c: &str| c.split(',').map(str::to_string).collect::<Vec<_>>();
+        let p = read(
+            "10,20,530,0,0,0,100\n11,21,531,0,0,1,100\n",
+            FlangeConvention::KukaAbc,
+            Some(&given("x,y,z,a,b,c,-")),
+        )
+        .unwrap();
+        assert_eq!(values(&p, 1), [11.0, 21.0, 531.0, 0.0, 0.0, 1.0]);
+        assert_eq!(p.targets[1].id, None);
+        let p = read(
+            "1, 10,20,30,0,0,0\n2, 11,21,31,0,0,1\n",
+            FlangeConvention::KukaAbc,
+            Some(&given("id,x,y,z,a,b,c")),
+        )
+        .unwrap();
+        assert_eq!(p.targets[1].id.as_deref(), Some("2"));
+        assert_eq!(values(&p, 1), [11.0, 21.0, 31.0, 0.0, 0.0, 1.0]);
         let p = read(
             "p1 10 20 30 0 0 0\np2 11 21 31 0 0 1\n",
             FlangeConvention::KukaAbc,

@@ -7,7 +7,9 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
-use super::scan::{Lines, inside, line_comments, number_at, skip_space, ur_pose_starts};
+use super::scan::{
+    Lines, computed_motion, inside, line_comments, number_at, skip_space, ur_pose_starts,
+};
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 
@@ -136,7 +138,8 @@ pub(super) fn read(text: &str) -> Result<Parsed, ParseError> {
         ));
     }
     targets.sort_by_key(|t| t.spans.first().map_or(0, |s| s.start));
-    let visits = motion_visits(text, &comments, &targets);
+    let visits = motion_visits(text, &comments, &targets)
+        .map_err(|call| computed_motion(text, &Lines::new(text), call))?;
     // Named joint lists never moved to are variables, not targets.
     let moved: Vec<bool> = (0..targets.len()).map(|i| visits.contains(&i)).collect();
     let keep: Vec<usize> = (0..targets.len())
@@ -183,7 +186,15 @@ fn move_before(text: &str, at: usize) -> Option<&'static str> {
 }
 
 /// The targets the move calls go to, in program order.
-fn motion_visits(text: &str, comments: &[Range<usize>], targets: &[Target]) -> Vec<usize> {
+///
+/// # Errors
+/// The byte range of a function called where a target should be
+/// (`pose_trans(p2, …)`, `pose_add(…)`): a position computed at run time.
+fn motion_visits(
+    text: &str,
+    comments: &[Range<usize>],
+    targets: &[Target],
+) -> Result<Vec<usize>, Range<usize>> {
     let by_name: HashMap<&str, usize> = targets
         .iter()
         .enumerate()
@@ -224,6 +235,9 @@ fn motion_visits(text: &str, comments: &[Range<usize>], targets: &[Target]) -> V
                         .iter()
                         .take_while(|b| b.is_ascii_alphanumeric() || **b == b'_')
                         .count();
+                    if end > i && bytes.get(skip_space(text, end)) == Some(&b'(') {
+                        return Err(i..end);
+                    }
                     if let Some(&t) = by_name.get(&text[i..end]) {
                         visits.push((at, t));
                     }
@@ -237,7 +251,7 @@ fn motion_visits(text: &str, comments: &[Range<usize>], targets: &[Target]) -> V
         }
     }
     visits.sort_by_key(|(at, _)| *at);
-    visits.into_iter().map(|(_, t)| t).collect()
+    Ok(visits.into_iter().map(|(_, t)| t).collect())
 }
 
 /// The `,` after the argument that starts at `at` (brackets balanced),

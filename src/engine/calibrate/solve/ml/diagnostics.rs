@@ -118,9 +118,10 @@ pub(super) fn settings(solver: &MlUpdate<'_>, stop: &StopReason) -> MlReport {
         noise_model: NoiseModel {
             joint_sigma_deg: mo.joint_sigma_deg,
             pose_sigma_mm: mo.pose_sigma,
+            pose_sigma_rounds: solver.noise_rounds,
             centre_sigma_mm: mo.centre_sigma,
             sensor_sigma_floor_mm: mo.sensor_sigma_floor,
-            whitening: "each centre residual (base frame) multiplied by the inverse Cholesky factor of R_bs·Σ_sensor·R_bsᵀ + G·σ_q²·Gᵀ (for a given flange pose: + σ_pose²·I instead of the joint term), computed once from the initial model and hand-eye".into(),
+            whitening: "each centre residual (base frame) multiplied by the inverse Cholesky factor of R_bs·Σ_sensor·R_bsᵀ + G·σ_q²·Gᵀ (for a given flange pose: + σ_pose²·I instead of the joint term), computed from the initial model and hand-eye; where σ_pose is estimated, again at the solution with the σ_pose estimated there, until it settles".into(),
         },
         prior: PriorRecord {
             enabled: mo.prior,

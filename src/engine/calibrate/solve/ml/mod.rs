@@ -105,6 +105,7 @@ mod prior;
 mod problem;
 pub mod range;
 pub mod report;
+pub mod variance;
 
 use nalgebra::Vector3;
 
@@ -130,11 +131,7 @@ pub use report::{
     CrossStation, CrossValidation, DistanceStd, IterationRecord, LabelledMatrix, MlReport,
     OutlierRecord, ParameterRecord,
 };
-
-/// Smallest σ of a reported flange pose's error estimated from the data,
-/// mm: a station whose centres agree to the micrometre says nothing finer
-/// about a robot's accuracy.
-const MIN_POSE_SIGMA_MM: f64 = 0.005;
+use variance::MIN_POSE_SIGMA_MM;
 
 /// The σ (mm, each base-frame coordinate) of the flange poses' error
 /// implied by the scatter of the station centres under `start`: the
@@ -160,6 +157,29 @@ fn pose_sigma_at(start: &Estimate, stations: &[Station]) -> f64 {
         return MIN_POSE_SIGMA_MM;
     }
     (sum / dof as f64).sqrt().max(MIN_POSE_SIGMA_MM)
+}
+
+/// The whitening of a sighting's residual under `est` and the noise of
+/// `mo` (see [`base_covariance`]).
+fn whiten_at(
+    est: &Estimate,
+    sighting: &crate::engine::calibrate::handeye::Sighting,
+    sensor_cov: &nalgebra::Matrix3<f64>,
+    mo: &MlOptions,
+) -> Result<nalgebra::Matrix3<f64>, SolveError> {
+    let cov = base_covariance(
+        est,
+        sighting,
+        sensor_cov,
+        mo.joint_sigma_deg,
+        mo.pose_sigma.unwrap_or(0.0),
+    );
+    whitening(&cov).ok_or_else(|| {
+        SolveError::InvalidOption(format!(
+            "measurement {}: the noise model gives a covariance that is not positive definite",
+            sighting.id
+        ))
+    })
 }
 
 /// Stations between two looks at the cancel while the problem is set up.
@@ -194,7 +214,8 @@ pub struct MlOptions {
     pub cross_validation: bool,
     /// σ of each base-frame coordinate of a centre from the error of a
     /// flange pose the controller reports (pose-only sessions), mm; `None`:
-    /// estimated from the scatter of the station centres at the start.
+    /// estimated from the data at the solution ([`variance`]: the scatter
+    /// at the start only begins the iteration).
     pub pose_sigma: Option<f64>,
 }
 
@@ -264,6 +285,9 @@ pub struct MlUpdate<'a> {
     state: State,
     lambda: f64,
     history: Vec<IterationRecord>,
+    /// Rounds of variance-component estimation of the flange poses' σ so
+    /// far; `None` when nothing is estimated (a σ given, or joints).
+    noise_rounds: Option<usize>,
 }
 
 impl<'a> MlUpdate<'a> {
@@ -288,9 +312,10 @@ impl<'a> MlUpdate<'a> {
         options.ml.validate()?;
         let mut go_on = || phase(Phase::Setup) == Control::Continue;
         let mut options = *options;
-        if session.pose_only() {
-            let estimated = pose_sigma_at(start, &stations);
-            options.ml.pose_sigma = Some(options.ml.pose_sigma.unwrap_or(estimated));
+        let estimate_noise = session.pose_only() && options.ml.pose_sigma.is_none();
+        if estimate_noise {
+            // Where the iteration begins; settled at the solution.
+            options.ml.pose_sigma = Some(pose_sigma_at(start, &stations));
         }
         let mo = &options.ml;
         let groups = session.stations(Use::Identify);
@@ -305,23 +330,13 @@ impl<'a> MlUpdate<'a> {
             }
             for &i in idx {
                 let sighting = prepared.sighting(session, i);
-                let cov = base_covariance(
-                    start,
-                    &sighting,
-                    &sensor_covariance(&prepared.measurements[i], mo),
-                    mo.joint_sigma_deg,
-                    mo.pose_sigma.unwrap_or(0.0),
-                );
-                let whiten = whitening(&cov).ok_or_else(|| {
-                    SolveError::InvalidOption(format!(
-                        "measurement {}: the noise model gives a covariance that is not positive definite",
-                        sighting.id
-                    ))
-                })?;
+                let sensor_cov = sensor_covariance(&prepared.measurements[i], mo);
+                let whiten = whiten_at(start, &sighting, &sensor_cov, mo)?;
                 obs.push(Obs {
                     station: s,
                     sighting,
                     whiten,
+                    sensor_cov,
                 });
             }
         }
@@ -373,7 +388,82 @@ impl<'a> MlUpdate<'a> {
             },
             lambda: LAMBDA_START,
             history: Vec::new(),
+            noise_rounds: estimate_noise.then_some(0),
         }))
+    }
+
+    /// One round of the noise estimated at the solution ([`variance`]):
+    /// the flange poses' σ from the residuals at the current state, every
+    /// observation whitened again there. `Ok(true)` when σ moved by more
+    /// than [`variance::SETTLED`] (the solve must run again); `Ok(false)`
+    /// when nothing is estimated, σ has settled, or the rounds ran out.
+    fn settle_noise(&mut self) -> Result<bool, SolveError> {
+        let Some(rounds) = self.noise_rounds else {
+            return Ok(false);
+        };
+        if rounds >= variance::MAX_ROUNDS {
+            return Ok(false);
+        }
+        let mo = self.options.ml;
+        let est = &self.state.est;
+        let residuals: Vec<_> = self
+            .problem
+            .obs
+            .iter()
+            .map(|o| {
+                let r = est.centre_in_base(&o.sighting) - self.state.centres[o.station];
+                let stated =
+                    base_covariance(est, &o.sighting, &o.sensor_cov, mo.joint_sigma_deg, 0.0);
+                (r, stated)
+            })
+            .collect();
+        let redundancy = (3 * self.problem.obs.len())
+            .saturating_sub(3 * self.problem.stations.len() + self.problem.estimated.len());
+        let Some(sigma) = variance::pose_sigma(&residuals, redundancy) else {
+            return Ok(false);
+        };
+        let before = mo.pose_sigma.unwrap_or(0.0);
+        self.options.ml.pose_sigma = Some(sigma);
+        let mo = self.options.ml;
+        for o in &mut self.problem.obs {
+            o.whiten = whiten_at(&self.state.est, &o.sighting, &o.sensor_cov, &mo)?;
+        }
+        self.noise_rounds = Some(rounds + 1);
+        Ok((sigma - before).abs() > variance::SETTLED * before.max(MIN_POSE_SIGMA_MM))
+    }
+
+    /// LM steps until LM converges or `MAX_LM_STEPS` steps were taken.
+    fn lm_solve(&mut self, phase: &mut dyn FnMut(Phase) -> Control) -> Step {
+        let mut taken = 0;
+        while taken < MAX_LM_STEPS {
+            let Some(step) = self.problem.lm_step(&self.state, &mut self.lambda) else {
+                let relative_change = self.last_relative_change();
+                return if taken == 0 {
+                    Step::Stuck { relative_change }
+                } else {
+                    Step::Converged { relative_change }
+                };
+            };
+            taken += 1;
+            let done = step.converged();
+            self.history.push(IterationRecord {
+                cost: step.cost_after,
+                lm_lambda: step.lambda,
+                step_max_mm: step.step_max,
+                relative_decrease: step.relative_decrease(),
+                epsilon: epsilon(&step.state.est.station_centres(&self.stations)),
+            });
+            self.state = step.state;
+            if phase(Phase::Step { step: taken }) == Control::Cancel {
+                return Step::Cancelled;
+            }
+            if done {
+                return Step::Converged {
+                    relative_change: self.last_relative_change(),
+                };
+            }
+        }
+        Step::Moved
     }
 
     /// Relative cost decrease of the last LM step (0 when none was taken).
@@ -417,42 +507,26 @@ impl Update for MlUpdate<'_> {
         &self.state.est
     }
 
-    /// LM steps until LM converges or `MAX_LM_STEPS` steps were taken.
+    /// LM steps until LM converges or `MAX_LM_STEPS` steps were taken;
+    /// where the noise is estimated, then again with the noise estimated
+    /// at the solution until it settles ([`variance`]).
     fn update(
         &mut self,
         _update: usize,
         phase: &mut dyn FnMut(Phase) -> Control,
     ) -> Result<Step, SolveError> {
-        let mut taken = 0;
-        while taken < MAX_LM_STEPS {
-            let Some(step) = self.problem.lm_step(&self.state, &mut self.lambda) else {
-                let relative_change = self.last_relative_change();
-                return Ok(if taken == 0 {
-                    Step::Stuck { relative_change }
-                } else {
-                    Step::Converged { relative_change }
-                });
-            };
-            taken += 1;
-            let done = step.converged();
-            self.history.push(IterationRecord {
-                cost: step.cost_after,
-                lm_lambda: step.lambda,
-                step_max_mm: step.step_max,
-                relative_decrease: step.relative_decrease(),
-                epsilon: epsilon(&step.state.est.station_centres(&self.stations)),
-            });
-            self.state = step.state;
-            if phase(Phase::Step { step: taken }) == Control::Cancel {
-                return Ok(Step::Cancelled);
-            }
-            if done {
-                return Ok(Step::Converged {
-                    relative_change: self.last_relative_change(),
-                });
+        let first = self.lm_solve(phase);
+        if !matches!(first, Step::Converged { .. } | Step::Stuck { .. }) {
+            return Ok(first);
+        }
+        while self.settle_noise()? {
+            match self.lm_solve(phase) {
+                Step::Cancelled => return Ok(Step::Cancelled),
+                Step::Moved => return Ok(Step::Moved),
+                Step::Converged { .. } | Step::Stuck { .. } => {}
             }
         }
-        Ok(Step::Moved)
+        Ok(first)
     }
 
     /// Leave-one-pose-out by one Gauss-Newton step each

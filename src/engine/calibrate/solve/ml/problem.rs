@@ -73,6 +73,9 @@ pub(super) struct Obs {
     pub(super) sighting: Sighting,
     /// `C⁻¹` with `Σ = C·Cᵀ` (base frame): whitens a residual.
     pub(super) whiten: Matrix3<f64>,
+    /// The stated covariance of the sensor-frame centre (mm²), kept to
+    /// whiten again where the noise is estimated at the solution.
+    pub(super) sensor_cov: Matrix3<f64>,
 }
 
 /// The current point of the solve: model, hand-eye and station centres.

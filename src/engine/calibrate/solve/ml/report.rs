@@ -131,6 +131,11 @@ pub struct NoiseModel {
     /// set).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pose_sigma_mm: Option<f64>,
+    /// Rounds of variance-component estimation that settled
+    /// `pose_sigma_mm` at the solution (issue 32); absent when the σ was
+    /// given, and in results written before it was estimated there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pose_sigma_rounds: Option<usize>,
     /// σ of each coordinate of a given centre, mm.
     pub centre_sigma_mm: f64,
     /// Floor of each principal σ of the sensor-frame covariance, mm.
@@ -244,7 +249,65 @@ pub struct MlReport {
     pub extra: Map<String, Value>,
 }
 
+/// Largest |entry| of a parameter covariance read back, in file units
+/// (mm², mm·deg, deg²): a σ of 10,000 km is no calibration (a weakly
+/// identified parameter's σ stays far below it).
+const MAX_COVARIANCE: f64 = 1e20;
+
 impl MlReport {
+    /// What makes this block, read back from a result file, no
+    /// calibration's: a variance factor that is negative or not finite
+    /// (0 is a fit without residuals: a noise-free simulation), a
+    /// covariance with a label twice, an entry beyond [`MAX_COVARIANCE`]
+    /// or not finite, a negative variance, or a covariance beyond its
+    /// variances (`|c_ij| > √(c_ii·c_jj)`: not positive semi-definite).
+    /// `None` when it is plausible.
+    #[must_use]
+    pub fn implausible(&self) -> Option<String> {
+        let v = self.variance_factor;
+        if !(v.is_finite() && v >= 0.0) {
+            return Some(format!(
+                "`solver.variance_factor` = {v} is not plausible: Σ r² / degrees of freedom is a number of at least 0"
+            ));
+        }
+        let c = &self.covariance;
+        for (i, l) in c.labels.iter().enumerate() {
+            if let Some(j) = c.labels[..i].iter().position(|x| x == l) {
+                return Some(format!(
+                    "`solver.covariance` has the label `{l}` twice (rows {j} and {i})"
+                ));
+            }
+        }
+        let n = c.labels.len();
+        if c.matrix.len() != n || c.matrix.iter().any(|r| r.len() != n) {
+            return Some(format!(
+                "`solver.covariance` is not {n}×{n}, as its {n} labels say"
+            ));
+        }
+        for i in 0..n {
+            for j in 0..n {
+                let x = c.matrix[i][j];
+                let key = format!("`solver.covariance` ({}, {})", c.labels[i], c.labels[j]);
+                if !(x.is_finite() && x.abs() <= MAX_COVARIANCE) {
+                    return Some(format!(
+                        "{key} = {x:e} is not plausible (at most {MAX_COVARIANCE:e})"
+                    ));
+                }
+                let (a, b) = (c.matrix[i][i], c.matrix[j][j]);
+                if i == j && x < 0.0 {
+                    return Some(format!("{key} = {x:e}: a variance is not negative"));
+                }
+                if x.abs() > (a * b).max(0.0).sqrt() * (1.0 + 1e-6) + 1e-12 {
+                    return Some(format!(
+                        "{key} = {x:e} exceeds √(variance·variance) = {:e}: the covariance is not positive semi-definite",
+                        (a * b).max(0.0).sqrt()
+                    ));
+                }
+            }
+        }
+        None
+    }
+
     /// A few lines for people (the command line's summary).
     #[must_use]
     pub fn summary(&self) -> String {
@@ -264,6 +327,19 @@ impl MlReport {
         );
         for c in &self.inseparable {
             let _ = writeln!(s, "  cannot separate: {c}");
+        }
+        if let Some(pose) = self.noise_model.pose_sigma_mm {
+            let how = match self.noise_model.pose_sigma_rounds {
+                Some(n) => format!(
+                    "estimated at the solution (variance-component estimation, {n} round{})",
+                    if n == 1 { "" } else { "s" }
+                ),
+                None => "given (--pose-sigma), or in a result written before 2026-11-27 estimated at the start".to_string(),
+            };
+            let _ = writeln!(
+                s,
+                "  flange pose σ {pose:.4} mm each base coordinate, {how}"
+            );
         }
         let _ = writeln!(
             s,
