@@ -11,7 +11,7 @@ use std::time::Duration;
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
-use spherecal::app::forms::Tab;
+use spherecal::app::command::Tab;
 use spherecal::app::job::Slot;
 use spherecal::engine::calibrate::solve::{Options, calibrate};
 use spherecal::engine::files::format::parse_session;
@@ -296,8 +296,8 @@ fn left_out_measurements_are_saved_and_a_bad_exclusion_is_refused() {
     {
         h.state_mut().command(
             &ctx,
-            spherecal::app::commands::Command::View(
-                spherecal::app::commands::ViewCommand::SetIncluded {
+            spherecal::app::command::Command::View(
+                spherecal::app::command::ViewCommand::SetIncluded {
                     id: m.id.clone(),
                     included: false,
                 },
@@ -350,7 +350,7 @@ fn a_result_file_is_reviewed_without_running_the_solver() {
         .expect("the result is shown");
     assert!(matches!(
         view.origin,
-        spherecal::app::view::ResultOrigin::Review(_)
+        spherecal::app::results::ResultOrigin::Review(_)
     ));
     assert!(
         view.notes.is_empty(),
@@ -444,7 +444,7 @@ fn clicking_a_centre_in_the_3d_view_selects_its_measurement() {
     h.get_by_label("Centres").click();
     h.run();
     let rect = h
-        .get_by_label(spherecal::app::panels::centres::ORBIT_LABEL)
+        .get_by_label(spherecal::app::results::centres::ORBIT_LABEL)
         .rect();
     let positions = {
         let app = h.state();
@@ -454,7 +454,7 @@ fn clicking_a_centre_in_the_3d_view_selects_its_measurement() {
             .as_ref()
             .and_then(|l| l.before.as_ref().ok())
             .expect("centres before calibration");
-        spherecal::app::panels::centres::orbit_positions(set, &app.forms().centres, rect)
+        spherecal::app::results::centres::orbit_positions(set, &app.forms().centres, rect)
     };
     // A centre well inside the view that no other centre covers: a click on
     // it picks the nearest marker, itself.
@@ -601,7 +601,7 @@ fn the_import_wizard_guesses_the_mapping_previews_and_opens_the_session() {
     let loaded = h.state().state().loaded.as_ref().expect("a session");
     assert!(matches!(
         loaded.source,
-        spherecal::app::state::Source::Imported(_)
+        spherecal::app::session::Source::Imported(_)
     ));
     assert_eq!(
         loaded.session.measurements.len(),
@@ -738,7 +738,7 @@ fn a_missing_library_folder_is_reported() {
 
 #[test]
 fn a_plan_is_made_exported_simulated_and_calibrated() {
-    use spherecal::app::state::Source;
+    use spherecal::app::session::Source;
     use spherecal::engine::tools::plan;
     let mut h = demo_app();
     h.get_by_label("Plan").click();
@@ -822,7 +822,7 @@ fn the_wizard_imports_flange_poses_and_the_run_calibrates_the_hand_eye_only() {
     h.run();
     {
         let form = &mut h.state_mut().forms_mut().import;
-        form.log_kind = spherecal::app::forms::import::LogKind::FlangePoses;
+        form.log_kind = spherecal::app::import::form::LogKind::FlangePoses;
         form.poses = dir.join("RobPoses.rob").display().to_string();
         form.profiles = dir.display().to_string();
         form.pose_convention = Some(spherecal::engine::files::import::FlangeConvention::FanucWpr);

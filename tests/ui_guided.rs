@@ -13,7 +13,7 @@ use std::time::Duration;
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
-use spherecal::app::forms::Tab;
+use spherecal::app::command::Tab;
 use spherecal::app::job::Slot;
 
 mod ui_support;
@@ -124,8 +124,8 @@ fn the_headline_says_pass_or_fail_against_the_tolerance() {
         let t = spherecal::engine::tools::result_view::Tolerance { std_mm, max_mm };
         h.state_mut().command(
             &ctx,
-            spherecal::app::commands::Command::View(
-                spherecal::app::commands::ViewCommand::SetTolerance(t),
+            spherecal::app::command::Command::View(
+                spherecal::app::command::ViewCommand::SetTolerance(t),
             ),
         );
         h.run();
@@ -258,7 +258,7 @@ fn the_plan_view_follows_the_open_sessions_robot() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("sessions/ur5e.json");
     h.state_mut().command(
         &ctx,
-        spherecal::app::commands::Command::Files(spherecal::app::commands::FilesCommand::OpenPath(
+        spherecal::app::command::Command::Files(spherecal::app::command::FilesCommand::OpenPath(
             path,
         )),
     );
@@ -447,8 +447,8 @@ fn the_plots_png_is_whole_and_light() {
     assert_eq!(files, ["demo-irb2400-plots.png"], "one file, no temporary");
     let png = image::open(dir.path().join(&files[0])).unwrap().to_rgb8();
     let view = h.state().state().result.clone().expect("result");
-    let sheet = spherecal::app::features::export::plots_sheet(&view);
-    let scale = f64::from(spherecal::app::features::export::PNG_SCALE);
+    let sheet = spherecal::app::results::export::plots_sheet(&view);
+    let scale = f64::from(spherecal::app::results::export::PNG_SCALE);
     assert_eq!(
         (png.width(), png.height()),
         (

@@ -10,7 +10,7 @@ use std::path::Path;
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
-use spherecal::app::forms::Tab;
+use spherecal::app::command::Tab;
 use spherecal::engine::calibrate::solve::{Method, Options, calibrate};
 use spherecal::engine::files::format::{parse_session, save_session};
 

@@ -16,14 +16,12 @@ use std::sync::atomic::AtomicBool;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
 use spherecal::app::WorkbenchApp;
-use spherecal::app::commands::{Command, MeasureCommand, ViewCommand};
-use spherecal::app::features::measure::{
-    DRAWN_MAX, MeasureRequest, ScanInput, group, measure_scan,
-};
-use spherecal::app::forms::Tab;
-use spherecal::app::forms::measure::ScanChoice;
+use spherecal::app::command::Tab;
+use spherecal::app::command::{Command, MeasureCommand, ViewCommand};
 use spherecal::app::job::Slot;
-use spherecal::app::state::measure::MeasureFailure;
+use spherecal::app::measure::ScanChoice;
+use spherecal::app::measure::job::MeasureFailure;
+use spherecal::app::measure::job::{DRAWN_MAX, MeasureRequest, ScanInput, group, measure_scan};
 use spherecal::engine::base::session::Observation;
 use spherecal::engine::calibrate::solve::Method;
 use spherecal::engine::tools::simulate::SimConfig;

@@ -7,7 +7,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use egui_kittest::kittest::Queryable as _;
-use spherecal::app::forms::Tab;
+use spherecal::app::command::Tab;
 use spherecal::engine::base::session::SensorRange;
 
 mod ui_support;
@@ -148,7 +148,7 @@ fn the_import_wizard_sets_the_measuring_range() {
     let ctx = h.ctx.clone();
     h.state_mut().command(
         &ctx,
-        spherecal::app::commands::Command::Import(spherecal::app::commands::ImportCommand::Run),
+        spherecal::app::command::Command::Import(spherecal::app::command::ImportCommand::Run),
     );
     settle(&mut h);
     let outcome = h.state().state().import.outcome.clone().expect("outcome");

@@ -15,12 +15,12 @@ use std::time::{Duration, Instant};
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use spherecal::app::WorkbenchApp;
-use spherecal::app::commands::PlanExport;
-use spherecal::app::commands::{Command, PlanCommand, RunCommand, ViewCommand};
-use spherecal::app::features::run::calibrate_session;
-use spherecal::app::features::run::{RunFailure, RunStage};
-use spherecal::app::forms::Tab;
+use spherecal::app::command::PlanExport;
+use spherecal::app::command::Tab;
+use spherecal::app::command::{Command, PlanCommand, RunCommand, ViewCommand};
 use spherecal::app::job::Slot;
+use spherecal::app::run::calibrate_session;
+use spherecal::app::run::{RunFailure, RunStage};
 use spherecal::engine::calibrate::solve::{Options, Phase};
 use spherecal::engine::tools::plan::Controller;
 use spherecal::engine::tools::result_view::Tolerance;
@@ -86,7 +86,7 @@ fn a_stale_plan_is_marked_and_its_program_refused() {
     command(&mut h, Command::Plan(PlanCommand::Simulate));
     settle(&mut h);
     assert!(
-        h.state().state().loaded.as_ref().unwrap().source == spherecal::app::state::Source::Demo
+        h.state().state().loaded.as_ref().unwrap().source == spherecal::app::session::Source::Demo
     );
 
     // Back on the robot it was made for: current, and written.
@@ -120,9 +120,9 @@ fn cancel_session(dir: &std::path::Path) -> std::path::PathBuf {
 fn a_cancel_in_any_phase_stops_the_run_within_a_fifth_of_a_second() {
     let dir = tempfile::tempdir().expect("temp dir");
     let path = cancel_session(dir.path());
-    let loaded = match spherecal::app::features::files::open_path(&path).expect("open") {
-        spherecal::app::features::files::Opened::Session(l) => *l,
-        spherecal::app::features::files::Opened::Result(_) => panic!("a session"),
+    let loaded = match spherecal::app::session::open_path(&path).expect("open") {
+        spherecal::app::session::Opened::Session(l) => *l,
+        spherecal::app::session::Opened::Result(_) => panic!("a session"),
     };
     let options = Options::from_session(&loaded.session);
     let phase_of = |stage: &RunStage| -> &'static str {
@@ -293,9 +293,9 @@ fn progress_names_its_phase_and_never_stalls() {
             ..SimConfig::default()
         },
     );
-    let loaded = match spherecal::app::features::files::open_path(&path).expect("open") {
-        spherecal::app::features::files::Opened::Session(l) => *l,
-        spherecal::app::features::files::Opened::Result(_) => panic!("a session"),
+    let loaded = match spherecal::app::session::open_path(&path).expect("open") {
+        spherecal::app::session::Opened::Session(l) => *l,
+        spherecal::app::session::Opened::Result(_) => panic!("a session"),
     };
     let options = Options::from_session(&loaded.session);
     let started = Instant::now();
@@ -382,7 +382,7 @@ fn the_centres_of_3000_stations_are_readable() {
         .len();
     assert!(stations > 3000);
     assert!(
-        h.query_all_by_label_contains(&spherecal::app::panels::centres::collapsed_key_text(
+        h.query_all_by_label_contains(&spherecal::app::results::centres::collapsed_key_text(
             stations
         ))
         .next()
@@ -394,7 +394,7 @@ fn the_centres_of_3000_stations_are_readable() {
         "no 3,000 names in the key"
     );
     let screen = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1366.0, 768.0));
-    for label in spherecal::app::panels::centres::PROJECTION_LABELS {
+    for label in spherecal::app::results::centres::PROJECTION_LABELS {
         let rect = h.get_by_label(label).rect();
         // The plot's frame and its axis labels below it.
         assert!(
@@ -408,7 +408,7 @@ fn the_centres_of_3000_stations_are_readable() {
         );
     }
     let orbit = h
-        .get_by_label(spherecal::app::panels::centres::ORBIT_LABEL)
+        .get_by_label(spherecal::app::results::centres::ORBIT_LABEL)
         .rect();
     assert!(
         screen.contains_rect(orbit) && orbit.height() > 400.0,
@@ -613,7 +613,7 @@ fn steps_go_stale_when_their_inputs_change() {
     assert!(h.query_by_label("Results ●").is_some());
     command(
         &mut h,
-        Command::Files(spherecal::app::commands::FilesCommand::OpenDemo),
+        Command::Files(spherecal::app::command::FilesCommand::OpenDemo),
     );
     settle(&mut h);
     assert!(h.state().state().result.is_none());
@@ -701,8 +701,8 @@ fn the_predicted_error_map_has_an_absolute_colour_bar() {
         scroll_to(&mut h, egui::pos2(800.0, 500.0), "Colours from 0 mm"),
         "the map's caption"
     );
-    let top = spherecal::app::panels::results::range_map::scale_top(hi);
-    let scale = spherecal::app::panels::results::range_map::scale_text(top);
+    let top = spherecal::app::results::range_map::scale_top(hi);
+    let scale = spherecal::app::results::range_map::scale_text(top);
     assert!(
         h.query_all_by_label_contains(&format!("Colours from 0 mm (green) to {scale} mm (red)"))
             .next()

@@ -35,14 +35,15 @@ use std::time::{Duration, Instant};
 
 use egui::{Pos2, pos2};
 
-use super::commands::ExportKind;
-use super::commands::{
+use super::AppState;
+use super::Core;
+use super::Forms;
+use super::command::ExportKind;
+use super::command::Tab;
+use super::command::{
     Command, CompensateCommand, FilesCommand, HistoryCommand, ImportCommand, MeasureCommand,
     PlanCommand, RunCommand, ViewCommand,
 };
-use super::features::Core;
-use super::forms::{Forms, Tab};
-use super::state::AppState;
 use crate::engine::base::session::SensorRange;
 use crate::engine::tools::result_view::Tolerance;
 
@@ -429,7 +430,7 @@ fn stale_plan() -> Vec<Act> {
         // (the sphere follows the robot), and no Make plan.
         Act::Edit(|f| {
             f.plan.robot = "ur5e".into();
-            f.plan.request.design.sphere = super::forms::plan::default_sphere("ur5e");
+            f.plan.request.design.sphere = super::plan::form::default_sphere("ur5e");
         }),
         Act::Pause(Duration::from_millis(300)),
         Act::Expect(|s, _| {
@@ -496,7 +497,7 @@ fn realdata_stripe() -> Vec<Act> {
         show(Tab::Import),
         Act::Edit(|f| {
             let dir = "data/robcalibrator-sphere";
-            f.import.log_kind = super::forms::import::LogKind::FlangePoses;
+            f.import.log_kind = super::import::form::LogKind::FlangePoses;
             f.import.poses = format!("{dir}/RobPoses.rob");
             f.import.profiles = dir.into();
             f.import.pose_convention =
@@ -541,7 +542,7 @@ fn measure() -> Vec<Act> {
         vec![
             show(Tab::Measure),
             Act::Edit(|f| {
-                use super::forms::measure::{RawLog, ScanChoice};
+                use super::measure::{RawLog, ScanChoice};
                 let m = &mut f.measure;
                 m.choice = ScanChoice::RawScan;
                 m.raw_log = RawLog::Joints;

@@ -1,16 +1,20 @@
-//! The workbench: owns the [`Core`] (state, forms, job runner). Each frame
-//! it drains the job messages, draws the panels (which push commands),
-//! hands the commands to their features, and only then shows a run's
-//! outcome that arrived in the frame (so that Cancel, clicked while the
-//! run was on screen, always wins).
+//! The frame loop: owns the [`Core`] (state with its job table, forms).
+//! Each frame it takes the jobs' reports, draws the left panel, the step
+//! bar, the tabs and the view on show (which push commands), hands the
+//! commands to their features, and only then shows the answers that
+//! arrived in the frame (so that Cancel, clicked while a job's answer was
+//! on its way, always wins).
 
 use std::path::PathBuf;
 
-use super::commands::{Command, FilesCommand, ViewCommand};
-use super::features::Core;
-use super::forms::{Forms, Tab};
-use super::panels;
-use super::state::{AppState, Prefs};
+use super::AppState;
+use super::Core;
+use super::Forms;
+use super::command::Tab;
+use super::command::{Command, FilesCommand, ViewCommand};
+use super::state::Prefs;
+use super::{compensate, history, import, steps};
+use super::{measure, plan, results, run, session, widgets};
 
 /// Key of the preferences in eframe's storage (JSON text).
 pub const PREFS_KEY: &str = "spherecal.prefs";
@@ -162,34 +166,34 @@ impl WorkbenchApp {
         let mut commands = Vec::new();
         input_commands(&ctx, &self.core.forms, &mut commands);
         let Core { state, forms, .. } = &mut self.core;
-        egui::Panel::bottom("status").show(ui, |ui| panels::status::status_ui(ui, state));
+        egui::Panel::bottom("status").show(ui, |ui| widgets::status_ui(ui, state));
         egui::Panel::left("side")
             .resizable(true)
             .default_size(290.0)
             .size_range(240.0..=420.0)
             .show(ui, |ui| {
-                panels::side::side_ui(ui, state, forms, &mut commands);
+                side_ui(ui, state, forms, &mut commands);
             });
         egui::CentralPanel::default().show(ui, |ui| {
-            panels::steps::steps_ui(ui, state, forms, &mut commands);
-            panels::tabs_ui(ui, state, forms, &mut commands);
+            steps::steps_ui(ui, state, forms, &mut commands);
+            widgets::tabs_ui(ui, state, forms, &mut commands);
             ui.separator();
             match forms.tab {
-                Tab::Session => panels::session::session_ui(ui, state, forms, &mut commands),
-                Tab::Stripe => panels::stripe::stripe_ui(ui, state, forms, &mut commands),
-                Tab::Centres => panels::centres::centres_ui(ui, state, forms, &mut commands),
-                Tab::Results => panels::results::results_ui(ui, state, forms, &mut commands),
-                Tab::Import => panels::import::import_ui(ui, state, forms, &mut commands),
-                Tab::Plan => panels::plan::plan_ui(ui, state, forms, &mut commands),
-                Tab::History => panels::history::history_ui(ui, state, forms, &mut commands),
+                Tab::Session => session::ui::session_ui(ui, state, forms, &mut commands),
+                Tab::Stripe => session::stripe::stripe_ui(ui, state, forms, &mut commands),
+                Tab::Centres => results::centres::centres_ui(ui, state, forms, &mut commands),
+                Tab::Results => results::ui::results_ui(ui, state, forms, &mut commands),
+                Tab::Import => import::ui::import_ui(ui, state, forms, &mut commands),
+                Tab::Plan => plan::ui::plan_ui(ui, state, forms, &mut commands),
+                Tab::History => history::ui::history_ui(ui, state, forms, &mut commands),
                 Tab::Compensate => {
-                    panels::compensate::compensate_ui(ui, state, forms, &mut commands);
+                    compensate::ui::compensate_ui(ui, state, forms, &mut commands);
                 }
-                Tab::Measure => panels::measure::measure_ui(ui, state, forms, &mut commands),
+                Tab::Measure => measure::ui::measure_ui(ui, state, forms, &mut commands),
             }
         });
-        panels::drop_overlay_ui(&ctx);
-        panels::confirm_ui(&ctx, state, &mut commands);
+        widgets::drop_overlay_ui(&ctx);
+        widgets::confirm_ui(&ctx, state, &mut commands);
         for c in commands {
             self.core.apply(&ctx, c);
         }
@@ -257,4 +261,25 @@ impl eframe::App for WorkbenchApp {
             storage.set_string(PREFS_KEY, text);
         }
     }
+}
+
+/// The whole left panel.
+pub fn side_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    egui::ScrollArea::vertical()
+        .auto_shrink([false, false])
+        .show(ui, |ui| {
+            ui.add_space(4.0);
+            session::ui::load_ui(ui, state, forms, commands);
+            ui.separator();
+            run::ui::solver_ui(ui, state, forms, commands);
+            // What comes and goes sits below the solver, so that Run and
+            // the ε plot stay where they are (and on screen at 1366×768).
+            session::ui::notice_ui(ui, state, commands);
+            session::ui::recent_ui(ui, state, commands);
+        });
 }

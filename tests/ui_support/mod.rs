@@ -48,7 +48,7 @@ pub fn open_path(h: &mut Harness<'_, WorkbenchApp>, path: std::path::PathBuf) {
     let ctx = h.ctx.clone();
     h.state_mut().command(
         &ctx,
-        spherecal::app::commands::Command::Files(spherecal::app::commands::FilesCommand::OpenPath(
+        spherecal::app::command::Command::Files(spherecal::app::command::FilesCommand::OpenPath(
             path,
         )),
     );

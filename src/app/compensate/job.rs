@@ -1,0 +1,274 @@
+//! The Compensate view's job work: the targets read, the model of the
+//! result on show built and every target compensated by the engine's
+//! [`compensate`](crate::engine::uses::compensate::compensate), as
+//! `spherecal compensate` runs it (same reading, model and default
+//! options); the view of it (one row per target, largest correction
+//! first, the flags in words, the summary line and the tool data the
+//! command line prints) with the compensated text; the file written
+//! atomically, never over an input.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::engine::base::robot::controller::FlangeConvention;
+use crate::engine::base::session::Session;
+use crate::engine::calibrate::solve::Control;
+use crate::engine::files::format::{ResultFile, refuse_inputs, write_atomic};
+use crate::engine::files::program::{self, PoseFile, ReadSpec};
+use crate::engine::uses::compensate::{
+    self, CompensateError, Compensation, Model, Options, TargetFailure, Tcp, report, tool,
+};
+
+use super::form::TcpChoice;
+
+/// Everything a compensation job needs, taken when it starts.
+#[derive(Debug, Clone)]
+pub struct CompensateRequest {
+    /// The result on show.
+    pub result: ResultFile,
+    /// The open session, for a result that does not record the joints of
+    /// its poses (`pose_joints`, older results): as `--session`.
+    pub session: Option<Session>,
+    /// The targets file.
+    pub targets: PathBuf,
+    /// A table's pose convention (`--pose-convention`).
+    pub convention: Option<FlangeConvention>,
+    /// The TCP (`--tcp`).
+    pub tcp: TcpChoice,
+    /// The tool file, for [`TcpChoice::ToolFile`].
+    pub tool: PathBuf,
+    /// Joint targets and the flag limits.
+    pub options: Options,
+}
+
+/// Reads the targets, builds the model of the result and compensates
+/// every target, as `spherecal compensate` with the request's options; `progress` hears of each target,
+/// `cancel` stops at the next one.
+///
+/// # Errors
+/// The message, naming the file (and the target and line): a file that
+/// cannot be read, a result without a 6-axis robot, an unreachable
+/// target, "cancelled".
+pub fn compensate_targets(
+    request: &CompensateRequest,
+    cancel: &AtomicBool,
+    progress: &mut dyn FnMut(String, f64),
+) -> Result<CompensationView, String> {
+    let tcp = match request.tcp {
+        TcpChoice::Sensor => Tcp::Sensor,
+        TcpChoice::Flange => Tcp::Flange,
+        TcpChoice::ToolFile => Tcp::Tool(tool::read_tool(&request.tool)?),
+    };
+    let spec = ReadSpec {
+        format: None,
+        convention: request.convention,
+        columns: None,
+    };
+    let file = program::read_pose_file(&request.targets, &spec).map_err(|e| e.to_string())?;
+    let mut notes = Vec::new();
+    let model = match Model::new(&request.result, request.session.as_ref(), tcp.clone()) {
+        // The open session is not the result's: go on without it, as the
+        // command line without `--session`.
+        Err(CompensateError::Session(why)) => {
+            notes.push(format!("the open session is not used: {why}"));
+            Model::new(&request.result, None, tcp)
+        }
+        other => other,
+    }
+    .map_err(|e| format!("{e} (the result on show)"))?;
+    let done = compensate::compensate(&model, &file, &request.options, &mut |p| {
+        progress(
+            format!("target {}: {} of {}", p.target, p.done, p.total),
+            p.done as f64 / p.total.max(1) as f64,
+        );
+        if cancel.load(Ordering::Relaxed) {
+            Control::Cancel
+        } else {
+            Control::Continue
+        }
+    })
+    .map_err(|e| match e {
+        CompensateError::Targets(failed) if failed.len() > 1 => {
+            failures_text(&failed, &request.targets)
+        }
+        e => format!("{e} ({})", request.targets.display()),
+    })?;
+    let mut view = CompensationView::new(done, &file, &model, request.convention);
+    view.notes.extend(notes);
+    Ok(view)
+}
+
+/// Most failed targets the view lists, one a line; the rest are counted.
+const MAX_LISTED_FAILURES: usize = 500;
+
+/// Several failed targets for the view: a first line with their count and
+/// the file, then one line each (name, line, why).
+fn failures_text(failed: &[TargetFailure], targets: &Path) -> String {
+    let mut text = format!(
+        "{} targets cannot be compensated ({}):",
+        failed.len(),
+        targets.display()
+    );
+    for f in failed.iter().take(MAX_LISTED_FAILURES) {
+        text.push('\n');
+        text.push_str(&f.to_string());
+    }
+    if failed.len() > MAX_LISTED_FAILURES {
+        text.push_str(&format!(
+            "\nand {} more",
+            failed.len() - MAX_LISTED_FAILURES
+        ));
+    }
+    text
+}
+
+/// Writes the compensated text to `path` atomically (all or nothing),
+/// refusing to write over the targets or tool file it was made from.
+///
+/// # Errors
+/// The output is an input, or the write failed (the old file, if any,
+/// is left as it was).
+pub fn write_compensated(
+    text: &str,
+    path: &Path,
+    inputs: &[&Path],
+) -> Result<(), crate::app::error::JobError> {
+    refuse_inputs(path, inputs)?;
+    Ok(write_atomic(path, text.as_bytes())?)
+}
+
+/// Name of the tool in the tool data shown (RAPID's `tooldata` name).
+pub const TOOL_NAME: &str = "tSpherecal";
+
+/// One target of the table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TargetRow {
+    /// Its name (`P[3]`, `p10`, a table's id).
+    pub name: String,
+    /// Its 1-based line in the targets file.
+    pub line: usize,
+    /// TCP position correction `|commanded − wanted|`, mm.
+    pub correction_mm: f64,
+    /// Rotation correction, deg.
+    pub correction_deg: f64,
+    /// Largest joint change between the nominal and the calibrated
+    /// solution, deg.
+    pub joint_change_deg: f64,
+    /// Predicted 1σ residual of the TCP position after compensation, mm
+    /// (`ml` results only).
+    pub sigma_mm: Option<f64>,
+    /// Joint-space distance to the nearest identify pose, deg (when the
+    /// joints of the poses are known).
+    pub nearest_identify_deg: Option<f64>,
+    /// Why it lies outside what the calibration saw, in words (empty:
+    /// inside).
+    pub flags: Vec<String>,
+    /// A joint target left as written.
+    pub kept: bool,
+    /// What to know about it (a configuration kept or updated).
+    pub notes: Vec<String>,
+}
+
+/// A compensation as the view shows it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompensationView {
+    /// The targets file.
+    pub targets: PathBuf,
+    /// What the file is and how it was read: "pose table T.csv: in file
+    /// order (layout detected)".
+    pub file_line: String,
+    /// The reader's warnings.
+    pub warnings: Vec<String>,
+    /// The TCP, for people.
+    pub tcp: String,
+    /// The tool data to set on the controller, per controller
+    /// (description, text), when the TCP is the calibrated sensor.
+    pub tool_data: Vec<(String, String)>,
+    /// Every target, largest position correction first.
+    pub rows: Vec<TargetRow>,
+    /// The command line's summary line (targets, largest correction,
+    /// flagged).
+    pub summary: String,
+    /// Targets flagged outside what the calibration saw.
+    pub flagged: usize,
+    /// What to know about the run as a whole.
+    pub notes: Vec<String>,
+    /// The compensated file: positions rewritten, every other byte kept.
+    pub text: String,
+}
+
+impl CompensationView {
+    /// The view of `done`, the compensation of `file` through `model`;
+    /// `convention` is the one given for a table (it picks the
+    /// controller whose tool data is shown; all four without one).
+    #[must_use]
+    pub fn new(
+        done: Compensation,
+        file: &PoseFile,
+        model: &Model,
+        convention: Option<FlangeConvention>,
+    ) -> Self {
+        let file_line = report::file_line(file);
+        let tool_data = if model.tcp == Tcp::Sensor {
+            report::tool_controllers(file, convention)
+                .into_iter()
+                .map(|c| {
+                    (
+                        c.tool_data_kind().to_string(),
+                        c.tool_data(&model.tool, TOOL_NAME),
+                    )
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let mut rows: Vec<TargetRow> = done
+            .targets
+            .iter()
+            .map(|t| TargetRow {
+                name: t.name.clone(),
+                line: t.line,
+                correction_mm: t.correction_mm,
+                correction_deg: t.correction_deg,
+                joint_change_deg: t.joint_change_deg,
+                sigma_mm: t.sigma_mm,
+                nearest_identify_deg: t.nearest_identify_deg,
+                flags: t
+                    .flags
+                    .iter()
+                    .map(crate::engine::uses::compensate::Flag::describe)
+                    .collect(),
+                kept: !t.written,
+                notes: t.notes.clone(),
+            })
+            .collect();
+        // Largest first, as the command line's table.
+        rows.sort_by(|a, b| b.correction_mm.total_cmp(&a.correction_mm));
+        Self {
+            targets: file.path.clone(),
+            file_line,
+            warnings: file.warnings.clone(),
+            tcp: model.tcp.describe().to_string(),
+            tool_data,
+            rows,
+            summary: done.summary.line(),
+            flagged: done.summary.flagged,
+            notes: done.notes,
+            text: done.text,
+        }
+    }
+
+    /// The default name of the compensated file: `<stem>-compensated`
+    /// with the targets file's extension.
+    #[must_use]
+    pub fn default_file_name(&self) -> String {
+        let stem = self.targets.file_stem().map_or_else(
+            || "targets".to_string(),
+            |s| s.to_string_lossy().into_owned(),
+        );
+        match self.targets.extension() {
+            Some(e) => format!("{stem}-compensated.{}", e.to_string_lossy()),
+            None => format!("{stem}-compensated"),
+        }
+    }
+}

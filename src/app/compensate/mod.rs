@@ -1,0 +1,297 @@
+//! Compensating targets through the calibration: a pose table or a
+//! robot program compensated through the result on show (`spherecal
+//! compensate` in the window) on a job thread with progress and Cancel
+//! ([`job`]); the compensated file written under a name that follows the
+//! targets, refused while the compensation is stale or the targets had
+//! errors. The form is [`form`], the view [`ui`].
+
+pub mod form;
+pub mod job;
+pub mod ui;
+
+use std::path::{Path, PathBuf};
+
+use super::command::{Command, CompensateCommand};
+use super::job::{Job, Slot};
+use super::ledger::{Artefact, Reading};
+use super::state::{Level, Notice};
+use super::{Core, Write};
+use crate::engine::uses::compensate::JointTargets;
+use form::{CompensateForm, TcpChoice};
+use job::{CompensateRequest, CompensationView, compensate_targets, write_compensated};
+
+/// What "Write compensated program" calls the file it writes (status
+/// line, list of files written).
+pub const WRITTEN_WHAT: &str = "compensated program";
+
+/// What the Compensate view shows.
+#[derive(Debug, Default)]
+pub struct CompensateState {
+    /// The last compensation, or why there is none (an unreachable
+    /// target named, a file that cannot be read).
+    pub outcome: Option<Result<CompensationView, String>>,
+    /// The output path last derived from the targets: while the output
+    /// field holds it, it follows the targets.
+    pub derived_out: Option<String>,
+}
+
+impl Core {
+    /// Handles a [`CompensateCommand`].
+    pub(super) fn compensate(&mut self, ctx: &egui::Context, command: CompensateCommand) {
+        match command {
+            CompensateCommand::Run => self.compensate_run(ctx),
+            CompensateCommand::Cancel => {
+                if self.state.jobs.cancel(&Slot::Compensate).is_some() {
+                    self.state.say(
+                        Level::Warning,
+                        "compensation cancelled: what is on show did not change",
+                    );
+                }
+            }
+            CompensateCommand::Write => self.compensate_write(ctx),
+        }
+    }
+
+    pub(super) fn compensate_run(&mut self, ctx: &egui::Context) {
+        if self.state.jobs.runs(&Slot::Compensate) {
+            return;
+        }
+        let Some(view) = &self.state.result else {
+            self.state.say(
+                Level::Warning,
+                "nothing to compensate with: run the calibration or open a result first",
+            );
+            return;
+        };
+        // Targets are never compensated through a result that is out of
+        // date.
+        if let Err(why) = self.state.ledger.check(Artefact::Result) {
+            self.state
+                .say(Level::Warning, format!("not compensated: {why}"));
+            self.state.notice = Some(Notice {
+                title: "Not compensated".to_string(),
+                body: format!("{why}: run the calibration again, then compensate"),
+            });
+            return;
+        }
+        let form = &self.forms.compensate;
+        if form.targets.trim().is_empty() {
+            self.state.say(
+                Level::Warning,
+                "choose a targets file first (a pose table or a robot program)",
+            );
+            return;
+        }
+        let result = view.file.clone();
+        let session = if result.pose_joints.is_empty() {
+            self.state.loaded.as_ref().map(|l| l.session.clone())
+        } else {
+            None
+        };
+        let request = CompensateRequest {
+            result,
+            session,
+            targets: PathBuf::from(form.targets.trim()),
+            convention: form.convention,
+            tcp: form.tcp,
+            tool: PathBuf::from(form.tool.trim()),
+            options: form.options.clone(),
+        };
+        let stamp = self.state.ledger.stamp(Artefact::Compensation);
+        if self.start(ctx, Slot::Compensate, stamp, move |w| {
+            compensate_targets(&request, w.flag(), &mut |text, fraction| {
+                w.progress(text, Some(fraction));
+            })
+            .map(Box::new)
+        }) && let Some(job) = self.state.jobs.get_mut(&Slot::Compensate)
+        {
+            job.phase = "reading the targets…".to_string();
+            self.state.say(Level::Info, "compensating the targets…");
+        }
+    }
+
+    /// The compensated text and its stamp when it may be written; `None`
+    /// (with the reason in a notice) when it is stale, failed or not made.
+    fn compensation_to_write(&mut self) -> Option<(String, PathBuf, crate::app::ledger::Stamp)> {
+        let refuse = |state: &mut crate::app::AppState, why: String| {
+            state.say(Level::Warning, format!("{WRITTEN_WHAT} not written: {why}"));
+            state.notice = Some(Notice {
+                title: format!("{WRITTEN_WHAT} not written"),
+                body: why,
+            });
+        };
+        let (text, targets) = match &self.state.compensate.outcome {
+            Some(Ok(v)) => (v.text.clone(), v.targets.clone()),
+            Some(Err(e)) => {
+                let why = format!("the targets had errors, nothing is written: {e}");
+                refuse(&mut self.state, why);
+                return None;
+            }
+            None => {
+                refuse(
+                    &mut self.state,
+                    "compensate the targets first (press Compensate targets)".to_string(),
+                );
+                return None;
+            }
+        };
+        match self.state.ledger.check(Artefact::Compensation) {
+            Ok(stamp) => Some((text, targets, stamp)),
+            Err(why) => {
+                refuse(
+                    &mut self.state,
+                    format!("{why}: press Compensate targets again"),
+                );
+                None
+            }
+        }
+    }
+
+    pub(super) fn compensate_write(&mut self, ctx: &egui::Context) {
+        let Some((text, targets, stamp)) = self.compensation_to_write() else {
+            return;
+        };
+        let out = self.forms.compensate.out.trim().to_string();
+        if out.is_empty() {
+            self.state.say(
+                Level::Warning,
+                "type where to write the compensated file, or press Write compensated program…",
+            );
+            return;
+        }
+        let path = PathBuf::from(out);
+        let tool = (self.forms.compensate.tcp == TcpChoice::ToolFile)
+            .then(|| PathBuf::from(self.forms.compensate.tool.trim()));
+        let write = Write {
+            what: WRITTEN_WHAT.to_string(),
+            from: Artefact::Compensation,
+            stamp,
+            again: Command::Compensate(CompensateCommand::Write),
+        };
+        self.write(ctx, path, write, move |path| {
+            let mut inputs: Vec<&Path> = vec![targets.as_path()];
+            if let Some(t) = &tool {
+                inputs.push(t.as_path());
+            }
+            write_compensated(&text, path, &inputs).map(|()| None)
+        });
+    }
+
+    /// The file name the save dialog offers: the output field's, else
+    /// `<targets stem>-compensated.<ext>`.
+    pub(super) fn compensated_file_name(&self) -> Option<String> {
+        Path::new(self.forms.compensate.out.trim())
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .or_else(|| match &self.state.compensate.outcome {
+                Some(Ok(v)) => Some(v.default_file_name()),
+                _ => None,
+            })
+    }
+
+    /// The compensation's answer: on show (recorded with the inputs it
+    /// started from), or why there is none.
+    pub(super) fn on_compensated(
+        &mut self,
+        job: &Job,
+        outcome: Result<Box<CompensationView>, String>,
+    ) {
+        match outcome {
+            Ok(view) => {
+                let what = view.summary.clone();
+                self.state
+                    .ledger
+                    .record(Artefact::Compensation, job.stamp.clone(), what);
+                let level = if view.flagged > 0 {
+                    Level::Warning
+                } else {
+                    Level::Info
+                };
+                self.state.say(level, view.summary.clone());
+                // Where the compensated file goes: beside the targets,
+                // named after them; the name follows the targets unless
+                // the operator typed another.
+                let derived = view
+                    .targets
+                    .with_file_name(view.default_file_name())
+                    .display()
+                    .to_string();
+                let c = &mut self.state.compensate;
+                let out = &mut self.forms.compensate.out;
+                if out.trim().is_empty() || c.derived_out.as_deref() == Some(out.trim()) {
+                    out.clone_from(&derived);
+                }
+                c.derived_out = Some(derived);
+                self.state.compensate.outcome = Some(Ok(*view));
+            }
+            Err(e) => {
+                self.state.ledger.forget(Artefact::Compensation);
+                // Several failed targets: their count in the status line,
+                // the list in the view.
+                let first = e.lines().next().unwrap_or_default();
+                self.state
+                    .say(Level::Error, format!("not compensated: {first}"));
+                self.state.compensate.outcome = Some(Err(e));
+            }
+        }
+    }
+}
+
+/// Size and modification time of a file, when it can be read: a file
+/// rewritten in place reads otherwise.
+fn file_stamp(path: &str) -> Option<(u64, std::time::SystemTime)> {
+    let path = path.trim();
+    if path.is_empty() {
+        return None;
+    }
+    let m = std::fs::metadata(path).ok()?;
+    Some((m.len(), m.modified().ok()?))
+}
+
+/// The Compensate view's targets file and options: the fields it shows,
+/// and (unseen) the size and time of the targets and tool files.
+#[must_use]
+pub fn reading(f: &CompensateForm) -> Reading {
+    let tcp = match f.tcp {
+        TcpChoice::ToolFile if f.tool.trim().is_empty() => "tool file (none chosen)".to_string(),
+        TcpChoice::ToolFile => format!("tool {}", f.tool.trim()),
+        other => other.key().to_string(),
+    };
+    let fields = vec![
+        (
+            "file".into(),
+            if f.targets.trim().is_empty() {
+                "none".to_string()
+            } else {
+                f.targets.trim().to_string()
+            },
+        ),
+        (
+            "pose convention".into(),
+            CompensateForm::convention_label(f.convention),
+        ),
+        ("TCP".into(), tcp),
+        (
+            "joint targets".into(),
+            match f.options.joint_targets {
+                JointTargets::Compensate => "compensated",
+                JointTargets::Keep => "kept",
+            }
+            .to_string(),
+        ),
+        (
+            "σ tolerance".into(),
+            format!("{} mm", f.options.sigma_tolerance_mm),
+        ),
+        (
+            "far in joints".into(),
+            format!("{}°", f.options.far_joints_deg),
+        ),
+        (
+            "region margin".into(),
+            format!("{} mm", f.options.region_margin_mm),
+        ),
+    ];
+    let tool = (f.tcp == TcpChoice::ToolFile).then(|| file_stamp(&f.tool));
+    Reading::new(fields, (file_stamp(&f.targets), tool))
+}

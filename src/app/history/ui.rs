@@ -1,0 +1,425 @@
+//! The History view: the library of a folder of sessions and results
+//! ([`crate::engine::tools::history::scan`]) as a table, and for one robot the
+//! drift of the hand-eye and of its main kinematic deviations over the
+//! ticked results, with every change beyond `k` combined σ flagged
+//! ([`crate::engine::tools::history::drift`]). Nothing is computed here.
+
+use egui::RichText;
+use egui_plot::{Line, LineStyle, MarkerShape, Plot, PlotPoints, Points};
+
+use crate::app::AppState;
+use crate::app::Forms;
+use crate::app::command::{Command, HistoryCommand};
+use crate::app::dialog::Purpose;
+use crate::app::job::Slot;
+use crate::app::widgets::plots::{DATE_LABEL_GAP, labelled_x, readable_y};
+use crate::app::widgets::{AFTER, BAD, MUTED, WARN, labelled_field};
+use crate::engine::tools::history::{Drift, Entry, Library, Series, Verdict};
+
+/// Height of one drift plot, points.
+const DRIFT_PLOT_HEIGHT: f32 = 170.0;
+/// Room left of the first and right of the last result on a drift plot's
+/// x axis, in results.
+const DATE_ROOM: f64 = 0.6;
+/// Drift plots per row.
+const PLOTS_PER_ROW: usize = 3;
+/// Most rows of the library table before it scrolls.
+const TABLE_HEIGHT: f32 = 220.0;
+
+/// The whole History view.
+pub fn history_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    egui::ScrollArea::vertical()
+        .id_salt("history_scroll")
+        .auto_shrink([false, false])
+        .show(ui, |ui| {
+            ui.heading("History: past calibrations of a cell");
+            ui.horizontal(|ui| {
+                let field = labelled_field(
+                    ui,
+                    "Library folder",
+                    &mut forms.history.folder,
+                    "/path/to/folder with sessions and results",
+                    420.0,
+                );
+                let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+                let busy = state.jobs.runs(&Slot::Library);
+                if ui
+                    .add_enabled(!state.jobs.runs(&Slot::Dialog), egui::Button::new("Browse…"))
+                    .on_hover_text("choose the folder with the desktop's dialog")
+                    .clicked()
+                {
+                    commands.push(Command::Browse(Purpose::HistoryFolder));
+                }
+                if ui
+                    .add_enabled(!busy, egui::Button::new("Scan"))
+                    .on_hover_text("read every session and result file in the folder and its subfolders")
+                    .clicked()
+                    || (entered && !busy)
+                {
+                    commands.push(Command::History(HistoryCommand::Scan));
+                }
+                if busy {
+                    ui.spinner();
+                }
+            });
+            crate::app::widgets::dialog_note_ui(ui, state, &[Purpose::HistoryFolder]);
+            match &state.history.library {
+                None => {
+                    ui.label(
+                        RichText::new(
+                            "Choose a folder of session and result files (e.g. sessions/history) and press Scan.",
+                        )
+                        .weak(),
+                    );
+                }
+                Some(Err(e)) => {
+                    ui.label(RichText::new(format!("Could not scan: {e}")).color(BAD));
+                }
+                Some(Ok(library)) => {
+                    library_ui(ui, library, forms);
+                    ui.separator();
+                    if state.jobs.runs(&Slot::Drift) {
+                        ui.horizontal(|ui| {
+                            ui.spinner();
+                            ui.label("computing the drift of the ticked results…");
+                        });
+                    }
+                    if let (Some(drift), Some(of)) =
+                        (&state.history.drift, &state.history.drift_of)
+                    {
+                        match drift {
+                            Ok(d) => drift_ui(ui, d, of),
+                            Err(e) => {
+                                ui.label(RichText::new(e).color(WARN));
+                            }
+                        }
+                    }
+                }
+            }
+        });
+}
+
+fn library_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) {
+    let waiting = library.sessions_without_result().count();
+    ui.label(format!(
+        "{} results, {} sessions ({} not calibrated yet), {} other JSON files ignored",
+        library.entries.len(),
+        library.sessions.len(),
+        waiting,
+        library.ignored.len()
+    ));
+    if !library.problems.is_empty() {
+        egui::CollapsingHeader::new(
+            RichText::new(format!(
+                "{} file(s) could not be used",
+                library.problems.len()
+            ))
+            .color(WARN),
+        )
+        .id_salt("history_problems")
+        .show(ui, |ui| {
+            for p in &library.problems {
+                ui.label(p.to_string());
+            }
+        });
+    }
+    let robots = library.robots();
+    // A choice made here makes the drift on show stale: the ledger has
+    // it made again.
+    ui.horizontal(|ui| {
+        let l = ui.label("Robot");
+        let text = forms.history.robot.clone().unwrap_or_default();
+        egui::ComboBox::from_id_salt("history_robot")
+            .selected_text(text)
+            .show_ui(ui, |ui| {
+                for (name, n) in &robots {
+                    ui.selectable_value(
+                        &mut forms.history.robot,
+                        Some(name.clone()),
+                        format!("{name} ({n} results)"),
+                    );
+                }
+            })
+            .response
+            .labelled_by(l.id);
+        let l = ui.label("Jump beyond");
+        ui.add(
+            egui::DragValue::new(&mut forms.history.k)
+                .range(0.5..=20.0)
+                .speed(0.05)
+                .max_decimals(2)
+                .suffix(" σ combined"),
+        )
+        .labelled_by(l.id)
+        .on_hover_text("flag a change between consecutive results larger than k·sqrt(σ₁² + σ₂²)");
+    });
+    table_ui(ui, library, forms);
+}
+
+/// The library table; the ticks choose the results of the drift.
+fn table_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) {
+    // Solid scroll bars take their own space: a floating one would cover
+    // the last row's tick box.
+    ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
+    egui::ScrollArea::both()
+        .id_salt("history_table")
+        .max_height(TABLE_HEIGHT)
+        .show(ui, |ui| {
+            egui::Grid::new("history_entries")
+                .striped(true)
+                .num_columns(9)
+                .spacing([12.0, 4.0])
+                .show(ui, |ui| {
+                    for h in [
+                        "result file",
+                        "date",
+                        "robot",
+                        "session",
+                        "method",
+                        "validation std after",
+                        "ε after",
+                        "hand-eye x y z (mm)",
+                        "roll pitch yaw (deg)",
+                    ] {
+                        ui.label(RichText::new(h).strong());
+                    }
+                    ui.end_row();
+                    for e in &library.entries {
+                        entry_row(ui, e, forms);
+                    }
+                });
+        });
+}
+
+fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) {
+    let of_robot = forms.history.robot.as_deref() == Some(e.robot.as_str());
+    let name = e.path.file_name().map_or_else(
+        || e.path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let mut ticked = !forms.history.unselected.contains(&e.path);
+    let changed = ui
+        .add_enabled(of_robot, egui::Checkbox::new(&mut ticked, name))
+        .on_hover_text(e.path.display().to_string())
+        .on_disabled_hover_text("another robot: choose it above to plot its drift")
+        .changed();
+    if changed {
+        if ticked {
+            forms.history.unselected.remove(&e.path);
+        } else {
+            forms.history.unselected.insert(e.path.clone());
+        }
+    }
+    let dim = |t: String| {
+        if of_robot {
+            RichText::new(t)
+        } else {
+            RichText::new(t).color(MUTED)
+        }
+    };
+    let source = if e.date_source.is_from_name() {
+        String::new()
+    } else {
+        format!(" ({})", e.date_source.as_str())
+    };
+    ui.label(dim(format!("{}{source}", e.date)))
+        .on_hover_text(format!("date from the {}", e.date_source.as_str()));
+    ui.label(dim(e.robot.clone()));
+    ui.label(dim(e.session.clone()));
+    ui.label(dim(e.method.clone()));
+    ui.label(dim(e.validation_std_after().map_or_else(
+        || "no validation".to_string(),
+        |s| format!("{s:.3} mm"),
+    )));
+    ui.label(dim(format!("{:.4} mm", e.epsilon_after)));
+    let t = e.hand_eye.translation;
+    ui.label(dim(format!("{:.3} {:.3} {:.3}", t[0], t[1], t[2])));
+    let r = e.hand_eye.rpy_deg;
+    ui.label(dim(format!("{:.4} {:.4} {:.4}", r[0], r[1], r[2])));
+    ui.end_row();
+}
+
+fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {
+    let jumps: Vec<_> = drift.jumps().collect();
+    ui.horizontal(|ui| {
+        ui.heading(format!("Drift of {}", drift.robot));
+        ui.label(format!(
+            "{} results · jump = change beyond {} combined σ",
+            drift.entries.len(),
+            drift.k
+        ));
+    });
+    if jumps.is_empty() {
+        ui.label(
+            RichText::new("No jump: every checked change is within its combined uncertainty.")
+                .color(AFTER),
+        );
+    } else {
+        ui.label(
+            RichText::new(format!("{} jump(s) flagged", jumps.len()))
+                .color(BAD)
+                .strong()
+                .size(16.0),
+        );
+        egui::Grid::new("history_jumps")
+            .striped(true)
+            .num_columns(6)
+            .show(ui, |ui| {
+                for h in [
+                    "parameter",
+                    "between",
+                    "change",
+                    "combined σ",
+                    "ratio",
+                    "notes",
+                ] {
+                    ui.label(RichText::new(h).strong());
+                }
+                ui.end_row();
+                for j in &jumps {
+                    let date = |i: usize| {
+                        library
+                            .entries
+                            .get(i)
+                            .map_or_else(String::new, |e| e.date.to_string())
+                    };
+                    ui.label(RichText::new(&j.parameter).color(BAD));
+                    ui.label(format!("{} → {}", date(j.from), date(j.to)));
+                    ui.label(format!("{:+.4} {}", j.change, j.unit.as_str()));
+                    ui.label(
+                        j.combined
+                            .map_or("–".into(), |c| format!("{c:.4} {}", j.unit.as_str())),
+                    );
+                    ui.label(j.ratio.map_or("–".into(), |r| format!("{r:.1}")));
+                    let notes = j.notes.join("; ");
+                    ui.add(egui::Label::new(&notes).truncate())
+                        .on_hover_text(notes);
+                    ui.end_row();
+                }
+            });
+    }
+    let unchecked: Vec<_> = drift
+        .checks
+        .iter()
+        .filter_map(|c| match &c.verdict {
+            Verdict::NotChecked(why) => Some((c, why)),
+            _ => None,
+        })
+        .collect();
+    if !unchecked.is_empty() {
+        egui::CollapsingHeader::new(format!(
+            "{} change(s) could not be checked",
+            unchecked.len()
+        ))
+        .id_salt("history_unchecked")
+        .show(ui, |ui| {
+            for (c, why) in unchecked {
+                ui.label(format!("{}: {why}", c.parameter));
+            }
+        });
+    }
+    for note in &drift.notes {
+        ui.label(RichText::new(note).color(WARN));
+    }
+    let dates: Vec<String> = drift
+        .entries
+        .iter()
+        .map(|&i| {
+            library
+                .entries
+                .get(i)
+                .map_or_else(String::new, |e| e.date.to_string())
+        })
+        .collect();
+    ui.label(
+        RichText::new("Each plot: the value per result in date order, bars ±1σ; a red segment is a flagged jump. Kinematic values are calibrated − the earliest result's nominal.")
+            .small()
+            .weak(),
+    );
+    for row in drift.series.chunks(PLOTS_PER_ROW) {
+        ui.columns(PLOTS_PER_ROW, |cols| {
+            for (col, series) in cols.iter_mut().zip(row) {
+                series_plot_ui(col, series, drift, &dates);
+            }
+        });
+    }
+}
+
+fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[String]) {
+    ui.label(
+        RichText::new(format!(
+            "{} ({}) · {}",
+            series.name,
+            series.unit.as_str(),
+            series.kind.label()
+        ))
+        .strong(),
+    );
+    // x = position in date order; the tick labels are the dates.
+    let position = |entry: usize| drift.entries.iter().position(|&e| e == entry);
+    let points: Vec<[f64; 2]> = series
+        .points
+        .iter()
+        .filter_map(|p| position(p.entry).map(|x| [x as f64, p.value]))
+        .collect();
+    let jumps: Vec<[[f64; 2]; 2]> = drift
+        .jumps()
+        .filter(|j| j.parameter == series.name)
+        .filter_map(|j| {
+            Some([
+                [position(j.from)? as f64, j.before],
+                [position(j.to)? as f64, j.after],
+            ])
+        })
+        .collect();
+    // Half a result of room each side: the first and last dates, centred
+    // on their ticks, stay inside the plot.
+    let last = dates.len().saturating_sub(1) as f64;
+    let plot = Plot::new(("drift", series.name.as_str()))
+        .height(DRIFT_PLOT_HEIGHT)
+        .include_x(-DATE_ROOM)
+        .include_x(last + DATE_ROOM)
+        .allow_scroll(false);
+    labelled_x(readable_y(plot), dates.to_vec(), DATE_LABEL_GAP)
+        .y_axis_label(series.unit.as_str())
+        .show(ui, |p| {
+            for pt in &series.points {
+                let (Some(x), Some(s)) = (position(pt.entry), pt.sigma) else {
+                    continue;
+                };
+                let x = x as f64;
+                p.line(
+                    Line::new(
+                        "",
+                        PlotPoints::from(vec![[x, pt.value - s], [x, pt.value + s]]),
+                    )
+                    .color(MUTED)
+                    .width(1.5),
+                );
+            }
+            p.line(
+                Line::new(series.name.as_str(), PlotPoints::from(points.clone()))
+                    .color(AFTER)
+                    .style(LineStyle::dotted_loose())
+                    .width(1.0),
+            );
+            p.points(
+                Points::new(series.name.as_str(), PlotPoints::from(points))
+                    .color(AFTER)
+                    .shape(MarkerShape::Circle)
+                    .radius(3.5),
+            );
+            for seg in jumps {
+                p.line(
+                    Line::new("jump", PlotPoints::from(seg.to_vec()))
+                        .color(BAD)
+                        .width(2.5),
+                );
+            }
+        });
+}

@@ -1,0 +1,573 @@
+//! The Import view: a wizard that turns a pose log and stripe profile
+//! files into a session (the engine's [`crate::engine::files::import`], as
+//! `spherecal import`). A joint log CSV, or a pose file in any layout the
+//! engine reads (tables with or without a header, `.rob`, FANUC `.ls`,
+//! RAPID, KUKA, URScript; [`super::poses_ui`]: layout detected,
+//! pairing shown before the import, a hand-eye guess, centres); profiles
+//! as CSV/TXT or OpenCV YAML/JSON in the sensor's axes. Steps on one page:
+//! files, robot, units and axes, column mapping with a preview of the
+//! first rows (joint logs); then Import opens the session and says what it
+//! decided (axis map, side, initial hand-eye) and the flange-pose checks.
+
+use egui::RichText;
+
+use crate::app::AppState;
+use crate::app::Forms;
+use crate::app::command::{Command, ImportCommand};
+use crate::app::dialog::Purpose;
+use crate::app::import::form::{CONVENTIONS, ImportForm, LogKind, ObservationKind, ProfilesKind};
+use crate::app::job::Slot;
+use crate::app::widgets::{
+    BAD, DEFAULT_RANGE, GOOD, PATH_WIDTH, WARN, labelled_field, path_row, range_fields, range_of,
+};
+use crate::engine::base::robot::{self, DhConvention};
+use crate::engine::files::import::{AngleUnit, LengthUnit, SideChoice};
+
+/// Largest height of the import's error above the form, points: a long
+/// message scrolls rather than push the form off a 768-pixel screen.
+const ERROR_HEIGHT: f32 = 90.0;
+/// Width of a column-name field, points.
+const COLUMN_WIDTH: f32 = 90.0;
+
+/// The whole Import view.
+pub fn import_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    // An edit makes the preview, the last outcome and the checks stale
+    // (the ledger clears them); a pose file that reads otherwise than at
+    // the last scan is read and paired again (the ledger asks for it).
+    import_form_ui(ui, state, forms, commands);
+}
+
+fn import_form_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    ui.heading("Import a pose log and stripe profiles");
+    crate::app::widgets::dialog_note_ui(
+        ui,
+        state,
+        &[
+            Purpose::ImportJoints,
+            Purpose::ImportPoses,
+            Purpose::ImportProfiles,
+            Purpose::ImportReferences,
+            Purpose::ImportCentres,
+            Purpose::ImportHandEye,
+        ],
+    );
+    ui.label(
+        RichText::new(
+            "A joint log (id, station, use, joints a row) or a pose file as the cell wrote it (program or table; \
+             flange poses give a pose-only session); one profile file a pose (CSV/TXT, OpenCV YAML/JSON), one file \
+             with a pose column, or the sensor's sphere centres. Checked by the session file's rules.",
+        )
+        .weak(),
+    );
+    let jobs = &state.jobs;
+    let busy = [Slot::Import, Slot::ImportPreview, Slot::Dialog]
+        .iter()
+        .any(|s| jobs.runs(s));
+    let joints = forms.import.log_kind == LogKind::Joints;
+    // The actions stay in view above the form (it is taller than the
+    // window at 1366×768); the full outcome is at the form's end.
+    actions_ui(ui, state, busy, joints, commands);
+    ui.separator();
+    egui::ScrollArea::vertical()
+        .auto_shrink([false, false])
+        .show(ui, |ui| {
+            files_ui(ui, state, busy, &mut forms.import, commands);
+            ui.separator();
+            if !joints {
+                super::poses_ui::detected_ui(ui, state, commands);
+                ui.separator();
+                super::poses_ui::hand_eye_ui(ui, state, busy, &mut forms.import, commands);
+                ui.separator();
+            }
+            robot_ui(ui, &mut forms.import);
+            ui.separator();
+            if joints {
+                mapping_ui(ui, state, &mut forms.import);
+                ui.separator();
+                flange_ui(ui, &mut forms.import);
+                ui.separator();
+            }
+            outcome_ui(ui, state);
+            preview_ui(ui, state);
+        });
+}
+
+/// Preview and Guess mapping (joint logs), Import and open, and the last
+/// outcome in one line.
+fn actions_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    busy: bool,
+    joints: bool,
+    commands: &mut Vec<Command>,
+) {
+    ui.horizontal_wrapped(|ui| {
+        let import = ui
+            .add_enabled(
+                !busy,
+                egui::Button::new(RichText::new("Import and open").strong().size(16.0)),
+            )
+            .on_hover_text("build the session and open it (save it with Save as… afterwards)");
+        if import.clicked() {
+            commands.push(Command::Import(ImportCommand::Run));
+        }
+        if joints {
+            if ui
+                .add_enabled(!busy, egui::Button::new("Preview"))
+                .on_hover_text("read the header and show the first rows with this mapping")
+                .clicked()
+            {
+                commands.push(Command::Import(ImportCommand::Preview { guess: false }));
+            }
+            if ui
+                .add_enabled(!busy, egui::Button::new("Guess mapping"))
+                .on_hover_text("fill the column names from the header where they are obvious")
+                .clicked()
+            {
+                commands.push(Command::Import(ImportCommand::Preview { guess: true }));
+            }
+        }
+        if let Some(job) = state.jobs.get(&Slot::Import) {
+            crate::app::widgets::job_ui(ui, job);
+            if ui
+                .button("Cancel import")
+                .on_hover_text("stop the import: nothing is opened, what is open stays")
+                .clicked()
+            {
+                commands.push(Command::Import(ImportCommand::Cancel));
+            }
+        } else if state.jobs.runs(&Slot::ImportPreview) {
+            ui.spinner();
+        }
+        if let Some(Ok(text)) = &state.import.outcome {
+            ui.label(RichText::new(text.lines().next().unwrap_or_default()).color(GOOD));
+        }
+    });
+    if let Some(Err(e)) = &state.import.outcome {
+        egui::Frame::group(ui.style())
+            .stroke(egui::Stroke::new(1.5, BAD))
+            .show(ui, |ui| {
+                ui.set_width(ui.available_width());
+                ui.label(RichText::new("The import failed").strong().color(BAD));
+                if state.import.guess_needed.is_some() {
+                    ui.label(
+                        RichText::new(
+                            "A hand-eye guess is needed: give one under \"Initial hand-eye\" below (numbers or a file).",
+                        )
+                        .strong(),
+                    );
+                }
+                egui::ScrollArea::vertical()
+                    .id_salt("import_error")
+                    .max_height(ERROR_HEIGHT)
+                    .show(ui, |ui| {
+                        ui.label(e);
+                    });
+            });
+    }
+}
+
+fn files_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    busy: bool,
+    f: &mut ImportForm,
+    commands: &mut Vec<Command>,
+) {
+    ui.label(RichText::new("1 · Files").strong());
+    ui.horizontal(|ui| {
+        ui.label("Pose log");
+        ui.radio_value(&mut f.log_kind, LogKind::Joints, "joint log (CSV)");
+        ui.radio_value(
+            &mut f.log_kind,
+            LogKind::FlangePoses,
+            "a pose file (robot program or pose table)",
+        );
+    });
+    egui::Grid::new("import_files")
+        .num_columns(3)
+        .spacing([8.0, 6.0])
+        .show(ui, |ui| {
+            if f.log_kind == LogKind::Joints {
+                path_row(
+                    ui,
+                    "Joint log CSV",
+                    &mut f.joints,
+                    "/path/to/joints.csv",
+                    busy,
+                    Purpose::ImportJoints,
+                    commands,
+                );
+            } else {
+                let preview = state
+                    .import
+                    .pose_preview
+                    .as_ref()
+                    .and_then(|p| p.as_ref().ok());
+                super::poses_ui::pose_file_rows(ui, busy, f, preview, commands);
+                if f.observations == ObservationKind::Profiles {
+                    ui.label("Sphere side");
+                    ui.horizontal(|ui| {
+                        ui.radio_value(&mut f.side, SideChoice::Auto, "decide from the data");
+                        ui.radio_value(&mut f.side, SideChoice::Plus, "+1 (sensor x > 0)");
+                        ui.radio_value(&mut f.side, SideChoice::Minus, "−1");
+                    });
+                    ui.end_row();
+                }
+            }
+            let centres =
+                f.log_kind == LogKind::FlangePoses && f.observations == ObservationKind::Centres;
+            if !centres {
+                let hint = match f.profiles_kind {
+                    ProfilesKind::Folder => {
+                        "/path/to/profiles/ (one file per pose: <id>.csv, .yml …)"
+                    }
+                    ProfilesKind::File => "/path/to/profiles.csv (with a pose column)",
+                };
+                path_row(
+                    ui,
+                    "Stripe profiles",
+                    &mut f.profiles,
+                    hint,
+                    busy,
+                    Purpose::ImportProfiles,
+                    commands,
+                );
+                ui.label("");
+                ui.horizontal(|ui| {
+                    ui.radio_value(
+                        &mut f.profiles_kind,
+                        ProfilesKind::Folder,
+                        "a folder, one file per pose",
+                    );
+                    ui.radio_value(&mut f.profiles_kind, ProfilesKind::File, "one file");
+                    let l = ui.label("pose column");
+                    // Sized, not squeezed by the grid's column.
+                    ui.add_enabled_ui(f.profiles_kind == ProfilesKind::File, |ui| {
+                        ui.add_sized(
+                            [COLUMN_WIDTH, ui.spacing().interact_size.y],
+                            egui::TextEdit::singleline(&mut f.pose_column),
+                        )
+                        .labelled_by(l.id);
+                    });
+                });
+                ui.end_row();
+            }
+            path_row(
+                ui,
+                "Reference distances CSV",
+                &mut f.references,
+                "optional: from,to,distance (mm), from the laser tracker",
+                busy,
+                Purpose::ImportReferences,
+                commands,
+            );
+        });
+}
+
+fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
+    ui.label(RichText::new("2 · Robot, units, sphere").strong());
+    egui::Grid::new("import_robot")
+        .num_columns(2)
+        .spacing([8.0, 6.0])
+        .show(ui, |ui| {
+            let l = ui.label("Nominal robot");
+            ui.horizontal(|ui| {
+                let from_file = !f.robot_file.trim().is_empty();
+                ui.add_enabled_ui(!from_file, |ui| {
+                    egui::ComboBox::from_id_salt("import_robot_preset")
+                        .selected_text(&f.robot_preset)
+                        .show_ui(ui, |ui| {
+                            for p in robot::presets() {
+                                ui.selectable_value(
+                                    &mut f.robot_preset,
+                                    p.key.to_string(),
+                                    format!("{} ({})", p.key, p.robot.name),
+                                );
+                            }
+                        })
+                        .response
+                        .labelled_by(l.id);
+                });
+                labelled_field(
+                    ui,
+                    "or robot file",
+                    &mut f.robot_file,
+                    "session/result file, URDF or DH table CSV",
+                    260.0,
+                );
+                if f.robot_file.trim().to_ascii_lowercase().ends_with(".csv") {
+                    ui.radio_value(&mut f.dh, DhConvention::Standard, "standard DH");
+                    ui.radio_value(&mut f.dh, DhConvention::Modified, "modified DH");
+                }
+            });
+            ui.end_row();
+            if f.log_kind == LogKind::FlangePoses {
+                ui.label("");
+                ui.label(
+                    RichText::new(
+                        "pose-only: no robot model is needed (no kinematic parameter is identified); a robot given here is kept in the session",
+                    )
+                    .weak(),
+                );
+                ui.end_row();
+            }
+            ui.label("Joint unit");
+            ui.horizontal(|ui| {
+                for u in [AngleUnit::Deg, AngleUnit::Rad] {
+                    ui.radio_value(&mut f.joint_unit, u, u.as_str());
+                }
+            });
+            ui.end_row();
+            ui.label("Profile unit");
+            ui.horizontal(|ui| {
+                for u in [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M] {
+                    ui.radio_value(&mut f.profile_unit, u, u.symbol());
+                }
+            });
+            ui.end_row();
+            let l = ui.label("Profile axes");
+            ui.horizontal(|ui| {
+                ui.add(
+                    egui::TextEdit::singleline(&mut f.axes)
+                        .hint_text("auto")
+                        .desired_width(COLUMN_WIDTH),
+                )
+                .labelled_by(l.id)
+                .on_hover_text(
+                    "auto: the coordinate that is constant is the laser plane's normal; or a map such as -y,x,z (spherecal x = −y, y = x, z = z); a mirroring map is refused",
+                );
+                labelled_field(
+                    ui,
+                    "no-return value",
+                    &mut f.no_return,
+                    "none",
+                    COLUMN_WIDTH,
+                );
+            });
+            ui.end_row();
+            let l = ui.label("Sphere diameter");
+            ui.horizontal(|ui| {
+                ui.add(
+                    egui::DragValue::new(&mut f.sphere_diameter)
+                        .range(1.0..=500.0)
+                        .speed(0.01)
+                        .max_decimals(4)
+                        .suffix(" mm"),
+                )
+                .labelled_by(l.id);
+                let mut known = f.range.is_some();
+                if ui
+                    .checkbox(&mut known, "measuring range known (sensor.range)")
+                    .on_hover_text("the part of the laser plane the sensor measures in: ml predicts the error over it, the planner spreads the sphere over it")
+                    .changed()
+                {
+                    f.range = known.then_some(DEFAULT_RANGE);
+                }
+            });
+            ui.end_row();
+            if let Some(v) = &mut f.range {
+                ui.label("Measuring range");
+                ui.vertical(|ui| {
+                    range_fields(ui, "import_range", v, true);
+                    if let Err(why) = range_of(v) {
+                        ui.label(RichText::new(why).color(BAD));
+                    }
+                });
+                ui.end_row();
+            }
+            let l = ui.label("Session name");
+            ui.add(
+                egui::TextEdit::singleline(&mut f.name)
+                    .hint_text("default: the pose log's file name")
+                    .desired_width(PATH_WIDTH),
+            )
+            .labelled_by(l.id);
+            ui.end_row();
+        });
+}
+
+fn mapping_ui(ui: &mut egui::Ui, state: &AppState, f: &mut ImportForm) {
+    ui.label(RichText::new("3 · Columns of the joint log").strong());
+    if state.import.header.is_empty() {
+        ui.label(
+            RichText::new("Preview reads the header; Guess mapping fills the fields from it.")
+                .weak(),
+        );
+    } else {
+        ui.label(format!("Header: {}", state.import.header.join(", ")));
+    }
+    let header = &state.import.header;
+    ui.horizontal_wrapped(|ui| {
+        column_field(ui, "id", &mut f.id_column, header);
+        column_field(ui, "station", &mut f.station_column, header);
+        column_field(ui, "use", &mut f.use_column, header);
+        column_field(ui, "side", &mut f.side_column, header);
+    });
+    ui.horizontal_wrapped(|ui| {
+        for (k, c) in f.joint_columns.iter_mut().enumerate() {
+            column_field(ui, &format!("joint {}", k + 1), c, header);
+        }
+    });
+    let missing: Vec<&str> = [&f.id_column, &f.station_column, &f.use_column]
+        .into_iter()
+        .chain(&f.joint_columns)
+        .chain(std::iter::once(&f.side_column).filter(|s| !s.trim().is_empty()))
+        .map(|s| s.trim())
+        .filter(|c| !header.is_empty() && !header.iter().any(|h| h.eq_ignore_ascii_case(c)))
+        .collect();
+    if !missing.is_empty() {
+        ui.label(RichText::new(format!("not in the header: {}", missing.join(", "))).color(WARN));
+    }
+}
+
+/// A column-name field with a menu of the header's names.
+fn column_field(ui: &mut egui::Ui, label: &str, value: &mut String, header: &[String]) {
+    let l = ui.label(label);
+    ui.add(egui::TextEdit::singleline(value).desired_width(COLUMN_WIDTH))
+        .labelled_by(l.id);
+    if !header.is_empty() {
+        egui::ComboBox::from_id_salt(("import_column", label))
+            .selected_text("")
+            .width(18.0)
+            .show_ui(ui, |ui| {
+                if label == "side" {
+                    ui.selectable_value(value, String::new(), "(none: every side +1)");
+                }
+                for h in header {
+                    ui.selectable_value(value, h.clone(), h);
+                }
+            })
+            .response
+            .on_hover_text(format!("choose the {label} column from the header"));
+    }
+    ui.add_space(8.0);
+}
+
+fn flange_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
+    ui.label(RichText::new("4 · Flange poses from the controller (optional)").strong());
+    ui.horizontal(|ui| {
+        let text = f
+            .flange
+            .and_then(|c| CONVENTIONS.iter().find(|(k, _)| *k == c))
+            .map_or("no check", |(_, l)| l);
+        egui::ComboBox::from_id_salt("import_flange")
+            .selected_text(text)
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut f.flange, None, "no check");
+                for (c, l) in CONVENTIONS {
+                    ui.selectable_value(&mut f.flange, Some(c), l);
+                }
+            })
+            .response
+            .on_hover_text(
+                "compare the controller's flange poses with the nominal model's forward kinematics",
+            );
+        if let Some(c) = f.flange {
+            labelled_field(
+                ui,
+                "columns",
+                &mut f.flange_columns,
+                &c.default_columns().join(","),
+                180.0,
+            );
+            let l = ui.label("tolerance");
+            ui.add(
+                egui::DragValue::new(&mut f.tolerance_mm)
+                    .range(0.01..=100.0)
+                    .speed(0.05)
+                    .suffix(" mm"),
+            )
+            .labelled_by(l.id);
+            ui.add(
+                egui::DragValue::new(&mut f.tolerance_deg)
+                    .range(0.01..=45.0)
+                    .speed(0.01)
+                    .suffix(" deg"),
+            );
+        }
+    });
+}
+
+/// The preview of the mapped rows, below the buttons.
+fn preview_ui(ui: &mut egui::Ui, state: &AppState) {
+    if let Some(preview) = &state.import.preview {
+        match preview {
+            Ok(text) => {
+                egui::ScrollArea::horizontal()
+                    .id_salt("import_preview")
+                    .show(ui, |ui| {
+                        ui.label(RichText::new(text).monospace());
+                    });
+            }
+            Err(e) => {
+                ui.label(RichText::new(format!("Preview failed: {e}")).color(BAD));
+            }
+        }
+    }
+}
+
+fn outcome_ui(ui: &mut egui::Ui, state: &AppState) {
+    let view = &state.import;
+    // The first line says what was imported; then what the import
+    // decided, the side and the initial hand-eye marked, warnings in
+    // orange. A failure is shown above the form, beside Import.
+    if let Some(Ok(text)) = &view.outcome {
+        for (k, line) in text.lines().enumerate() {
+            let decided = line.starts_with("initial hand-eye")
+                || line.starts_with("side ")
+                || line.starts_with("pose file:");
+            let text = RichText::new(line);
+            ui.label(if k == 0 || decided {
+                text.strong()
+            } else if line.contains("warning") {
+                text.color(WARN)
+            } else {
+                text
+            });
+        }
+    }
+    let flagged: Vec<_> = view.checks.iter().filter(|c| c.flagged).collect();
+    if view.checks.is_empty() {
+        return;
+    }
+    let worst = view
+        .checks
+        .iter()
+        .map(|c| c.position_error_mm)
+        .fold(0.0_f64, f64::max);
+    ui.label(format!(
+        "Flange poses: {} checked, {} flagged, largest position mismatch {worst:.3} mm",
+        view.checks.len(),
+        flagged.len()
+    ));
+    if flagged.is_empty() {
+        return;
+    }
+    egui::Grid::new("import_flagged")
+        .striped(true)
+        .num_columns(4)
+        .show(ui, |ui| {
+            for h in ["pose", "position (mm)", "rotation (deg)", "likely cause"] {
+                ui.label(RichText::new(h).strong());
+            }
+            ui.end_row();
+            for c in flagged {
+                ui.label(RichText::new(&c.id).color(WARN));
+                ui.label(format!("{:.3}", c.position_error_mm));
+                ui.label(format!("{:.3}", c.rotation_error_deg));
+                ui.label(&c.hint);
+                ui.end_row();
+            }
+        });
+}

@@ -1,0 +1,805 @@
+//! The Measure view: a scan measured with the calibrated cell. The
+//! inputs (the result on show, the scan: the open session, a session
+//! file or a raw scan's pose log and profiles; `use`, a workpiece frame,
+//! the sensor's noise, σ or not), Measure and Cancel with the job's
+//! progress; the cloud in three projections (XY, XZ, YZ) coloured by σ
+//! with a colour bar in mm or µm, drawn from the job's decimated copy
+//! (never more than [`DRAWN_MAX`] points whatever the cloud's size); the
+//! counts; the self-validation on the sphere stations before and after
+//! calibration; and the export to PLY, E57 or CSV, refused while the
+//! cloud is stale. Also the Measure step of the step bar.
+
+use egui::{Color32, RichText};
+use egui_plot::{Plot, PlotPoint};
+
+use crate::app::AppState;
+use crate::app::Forms;
+use crate::app::command::{Command, MeasureCommand};
+use crate::app::dialog::Purpose;
+use crate::app::import::form::CONVENTIONS;
+use crate::app::job::Slot;
+use crate::app::ledger::Artefact;
+use crate::app::measure::job::MeasuredCloud;
+use crate::app::measure::job::{DRAWN_MAX, group, has_covariance};
+use crate::app::measure::{MAX_SENSOR_NOISE_MM, RawLog, ScanChoice};
+use crate::app::widgets::{
+    AFTER, BAD, GOOD, MUTED, WARN, labelled_field, number_field, stale_banner_ui,
+};
+use crate::engine::base::session::Use;
+use crate::engine::files::import::{AngleUnit, LengthUnit};
+use crate::engine::uses::measure::selfcheck::ModelCheck;
+
+/// Side of a drawn point, screen points: one or two pixels, so that
+/// 50,000 points show the part's shape rather than a blot.
+const POINT_SIZE: f32 = 2.0;
+
+/// Width of the colour bar beside the projections, points.
+const BAR_WIDTH: f32 = 86.0;
+
+/// Tallest projection, points: three of them and the inputs above fit a
+/// 1366×768 screen with the self-validation one scroll below.
+const MAX_PLOT_HEIGHT: f32 = 270.0;
+
+/// Below this largest σ (mm) the colour bar and figures are in µm: a
+/// well calibrated cell's points are tens of micrometres.
+const MICROMETRE_BELOW_MM: f64 = 0.1;
+
+/// The colour scale (viridis at five stops): low σ dark blue, high σ
+/// yellow; tells values apart in grey print and for the colour-blind.
+const SCALE: [[u8; 3]; 5] = [
+    [68, 1, 84],
+    [59, 82, 139],
+    [33, 145, 140],
+    [94, 201, 98],
+    [253, 231, 37],
+];
+
+/// The colour of `t` ∈ [0, 1] on [`SCALE`].
+#[must_use]
+pub fn scale_colour(t: f64) -> Color32 {
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = t * (SCALE.len() - 1) as f64;
+    let k = (x.floor() as usize).min(SCALE.len() - 2);
+    let f = x - k as f64;
+    let mix = |i: usize| {
+        let (a, b) = (f64::from(SCALE[k][i]), f64::from(SCALE[k + 1][i]));
+        (a + (b - a) * f).round() as u8
+    };
+    Color32::from_rgb(mix(0), mix(1), mix(2))
+}
+
+/// The unit σ is shown in, and millimetres to it: µm when the largest σ
+/// is below [`MICROMETRE_BELOW_MM`], else mm.
+#[must_use]
+pub fn sigma_unit(max_mm: f64) -> (&'static str, f64) {
+    if max_mm < MICROMETRE_BELOW_MM {
+        ("µm", 1000.0)
+    } else {
+        ("mm", 1.0)
+    }
+}
+
+/// The Measure view.
+pub fn measure_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    egui::ScrollArea::vertical()
+        .id_salt("measure_scroll")
+        .auto_shrink(false)
+        .show(ui, |ui| {
+            inputs_ui(ui, state, forms, commands);
+            let Some(cloud) = &state.measure.shown else {
+                ui.label(
+                    RichText::new(
+                        "No cloud yet: choose the scan above and press ▶ Measure. The cloud is drawn in three projections coloured by each point's σ; the counts, the export and the self-validation come with it.",
+                    )
+                    .color(MUTED),
+                );
+                return;
+            };
+            ui.separator();
+            if let Some(s) = state.ledger.stale(Artefact::Cloud) {
+                stale_banner_ui(ui, &s, "Press ▶ Measure again; its export is refused until then.");
+            }
+            summary_ui(ui, cloud);
+            export_ui(ui, state, forms, commands);
+            projections_ui(ui, cloud);
+            ui.separator();
+            self_check_ui(ui, cloud);
+        });
+}
+
+/// A path field with its Browse… button and the note when the dialog
+/// chose nothing.
+fn path_row(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    label: &str,
+    text: &mut String,
+    hint: &str,
+    purpose: Purpose,
+    commands: &mut Vec<Command>,
+) {
+    ui.horizontal(|ui| {
+        labelled_field(ui, label, text, hint, 420.0);
+        if ui
+            .add_enabled(
+                !state.jobs.runs(&Slot::Dialog),
+                egui::Button::new("Browse…"),
+            )
+            .clicked()
+        {
+            commands.push(Command::Browse(purpose));
+        }
+        if state.dialog_empty == Some(purpose) {
+            ui.label(
+                RichText::new(crate::app::dialog::NO_DIALOG)
+                    .small()
+                    .color(WARN),
+            );
+        }
+    });
+}
+
+/// The result, the scan and the options, Measure and Cancel.
+fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mut Vec<Command>) {
+    let form = &mut forms.measure;
+    ui.horizontal_wrapped(|ui| {
+        ui.label(RichText::new("Result:").strong());
+        match &state.result {
+            Some(v) => {
+                let origin = match &v.origin {
+                    crate::app::results::ResultOrigin::Review(p) => p.display().to_string(),
+                    crate::app::results::ResultOrigin::Run { .. } => "this window's run".to_string(),
+                };
+                ui.label(format!(
+                    "the result on show: {origin} (method {}, session \"{}\")",
+                    v.method, v.file.session
+                ));
+                if !has_covariance(&v.file) {
+                    ui.label(
+                        RichText::new(format!(
+                            "σ is unavailable: method {} gives no parameter covariance; tick \"no σ\" to measure without it",
+                            v.file.solver.method()
+                        ))
+                        .color(WARN),
+                    );
+                }
+                if let Some(s) = state.ledger.stale(Artefact::Result) {
+                    ui.label(RichText::new(format!("{s}")).color(WARN));
+                }
+            }
+            None => {
+                ui.label(
+                    RichText::new("none: run the calibration (or open a result file) first")
+                        .color(WARN),
+                );
+            }
+        }
+    });
+    let summary = match form.choice {
+        ScanChoice::OpenSession => "the open session".to_string(),
+        ScanChoice::SessionFile => form.session_file.trim().to_string(),
+        ScanChoice::RawScan => form.log.trim().to_string(),
+    };
+    egui::CollapsingHeader::new(RichText::new(format!("Scan and options: {summary}")).strong())
+        .id_salt("measure_inputs")
+        .default_open(true)
+        .show(ui, |ui| scan_ui(ui, state, form, commands));
+    ui.horizontal_wrapped(|ui| {
+        if let Some(v) = number_field(
+            ui,
+            "measure_noise",
+            "Sensor noise (1σ in-plane)",
+            form.sensor_noise_mm,
+            0.0..=MAX_SENSOR_NOISE_MM,
+            "mm",
+        ) {
+            form.sensor_noise_mm = v;
+        }
+        ui.checkbox(&mut form.no_sigma, "no σ (as --no-sigma)")
+            .on_hover_text("measure without σ: for a result without covariance (method paper)");
+        ui.add_space(12.0);
+        let running = state.jobs.runs(&Slot::Measure);
+        if ui
+            .add_enabled(
+                !running && state.result.is_some(),
+                egui::Button::new(RichText::new("▶ Measure").size(16.0)),
+            )
+            .on_hover_text("measure the scan with the result on show, on a background thread")
+            .on_disabled_hover_text("a result is needed (and no measuring under way)")
+            .clicked()
+        {
+            commands.push(Command::Measure(MeasureCommand::Start));
+        }
+        if ui
+            .add_enabled(running, egui::Button::new("Cancel measuring"))
+            .on_hover_text("stop the measuring job; the cloud on show stays")
+            .clicked()
+        {
+            commands.push(Command::Measure(MeasureCommand::Cancel));
+        }
+        if let Some(job) = state.jobs.get(&Slot::Measure) {
+            crate::app::widgets::job_ui(ui, job);
+        }
+    });
+    if let Some(why) = &state.measure.failure {
+        ui.label(RichText::new(why).color(BAD));
+    }
+}
+
+/// What is measured and how: the scan (the open session, a session
+/// file, a raw scan's files and their options), the workpiece frame.
+fn scan_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    form: &mut crate::app::measure::MeasureForm,
+    commands: &mut Vec<Command>,
+) {
+    ui.horizontal_wrapped(|ui| {
+        ui.label(RichText::new("Scan:").strong());
+        for choice in ScanChoice::ALL {
+            ui.radio_value(&mut form.choice, choice, choice.label());
+        }
+        if form.choice != ScanChoice::RawScan {
+            let l = ui.label("  use");
+            egui::ComboBox::from_id_salt("measure_use")
+                .selected_text(form.usage.map_or("all", Use::as_str))
+                .show_ui(ui, |ui| {
+                    ui.selectable_value(&mut form.usage, None, "all");
+                    for u in Use::ALL {
+                        ui.selectable_value(&mut form.usage, Some(u), u.as_str());
+                    }
+                })
+                .response
+                .labelled_by(l.id)
+                .on_hover_text("which measurements of the session are measured (as --use)");
+        }
+    });
+    match form.choice {
+        ScanChoice::OpenSession => {
+            let what = state.loaded.as_ref().map_or_else(
+                || "no session open".to_string(),
+                |l| {
+                    format!(
+                        "\"{}\": every stripe point of its measurements, as they are",
+                        l.session.name
+                    )
+                },
+            );
+            ui.label(RichText::new(what).small().color(MUTED));
+        }
+        ScanChoice::SessionFile => path_row(
+            ui,
+            state,
+            "Session file",
+            &mut form.session_file,
+            "a session .json",
+            Purpose::MeasureSession,
+            commands,
+        ),
+        ScanChoice::RawScan => {
+            ui.horizontal_wrapped(|ui| {
+                ui.radio_value(&mut form.raw_log, RawLog::Joints, "joint log CSV")
+                    .on_hover_text("columns id, j1..jn (optional station, use)");
+                ui.radio_value(&mut form.raw_log, RawLog::Poses, "pose file")
+                    .on_hover_text("a table, a JSON list or a robot program (layout detected); only the hand-eye applies to flange poses");
+            });
+            path_row(
+                ui,
+                state,
+                "Pose log",
+                &mut form.log,
+                "joint log CSV or pose file",
+                Purpose::MeasureLog,
+                commands,
+            );
+            path_row(
+                ui,
+                state,
+                "Profiles",
+                &mut form.profiles,
+                "a folder of <id>.csv…, or one CSV with a pose column",
+                Purpose::MeasureProfiles,
+                commands,
+            );
+            raw_units_ui(ui, form);
+            path_row(
+                ui,
+                state,
+                "References",
+                &mut form.references,
+                "optional: the artefact's distances CSV (from,to,distance mm)",
+                Purpose::MeasureReferences,
+                commands,
+            );
+        }
+    }
+    path_row(
+        ui,
+        state,
+        "Workpiece frame",
+        &mut form.frame,
+        "optional: a JSON 4×4 base_from_workpiece (mm); empty: robot base frame",
+        Purpose::MeasureFrame,
+        commands,
+    );
+}
+
+/// The raw scan's units and readings: joint unit or pose convention,
+/// profile unit, axes, no-return value, the artefact's diameter.
+fn raw_units_ui(ui: &mut egui::Ui, form: &mut crate::app::measure::MeasureForm) {
+    ui.horizontal_wrapped(|ui| {
+        match form.raw_log {
+            RawLog::Joints => {
+                let l = ui.label("joints in");
+                egui::ComboBox::from_id_salt("measure_joint_unit")
+                    .selected_text(form.joint_unit.as_str())
+                    .show_ui(ui, |ui| {
+                        for u in [AngleUnit::Deg, AngleUnit::Rad] {
+                            ui.selectable_value(&mut form.joint_unit, u, u.as_str());
+                        }
+                    })
+                    .response
+                    .labelled_by(l.id);
+            }
+            RawLog::Poses => {
+                let l = ui.label("pose convention");
+                let shown = CONVENTIONS
+                    .iter()
+                    .find(|(c, _)| Some(*c) == form.pose_convention)
+                    .map_or("as the file says", |(_, t)| t);
+                egui::ComboBox::from_id_salt("measure_convention")
+                    .selected_text(shown)
+                    .show_ui(ui, |ui| {
+                        ui.selectable_value(
+                            &mut form.pose_convention,
+                            None,
+                            "as the file says",
+                        );
+                        for (c, t) in CONVENTIONS {
+                            ui.selectable_value(&mut form.pose_convention, Some(c), t);
+                        }
+                    })
+                    .response
+                    .labelled_by(l.id);
+            }
+        }
+        let l = ui.label("profiles in");
+        egui::ComboBox::from_id_salt("measure_profile_unit")
+            .selected_text(form.profile_unit.as_str())
+            .show_ui(ui, |ui| {
+                for u in [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M] {
+                    ui.selectable_value(&mut form.profile_unit, u, u.as_str());
+                }
+            })
+            .response
+            .labelled_by(l.id);
+        labelled_field(ui, "axes", &mut form.axes, "auto or -y,x,z", 70.0);
+        labelled_field(ui, "no-return value", &mut form.no_return, "none", 60.0);
+        labelled_field(
+            ui,
+            "sphere artefact Ø (mm)",
+            &mut form.sphere_diameter,
+            "none",
+            60.0,
+        )
+        .on_hover_text("a scan of a sphere artefact: its spheres' diameter, for the self-validation of the log's stations");
+    });
+}
+
+/// The counts, the σ figures, the warnings.
+fn summary_ui(ui: &mut egui::Ui, c: &MeasuredCloud) {
+    ui.label(
+        RichText::new(format!(
+            "{} points kept of {} poses ({} model, {}); dropped {} NaN and {} no-return points",
+            group(c.points),
+            group(c.poses),
+            c.model,
+            c.frame,
+            group(c.dropped.non_finite),
+            group(c.dropped.no_return)
+        ))
+        .strong(),
+    );
+    ui.label(
+        RichText::new(format!(
+            "scan {} · result {} · {:.2} s",
+            c.scan, c.result, c.seconds
+        ))
+        .small()
+        .color(MUTED),
+    );
+    let shown = c.drawn.len();
+    let decimation = if shown < c.points {
+        format!(
+            "showing {} of {} points (spread evenly; at most {} are drawn)",
+            group(shown),
+            group(c.points),
+            group(DRAWN_MAX)
+        )
+    } else {
+        format!("showing all {} points", group(c.points))
+    };
+    ui.horizontal_wrapped(|ui| {
+        ui.label(decimation);
+        match (&c.sigma, &c.no_sigma) {
+            (Some(s), _) => {
+                let (unit, k) = sigma_unit(s.max);
+                ui.label(format!(
+                    "· σ of a point: median {:.3} {unit}, rms {:.3} {unit}, max {:.3} {unit} (3-D, after the cloud's best rigid alignment; {})",
+                    s.median * k,
+                    s.rms * k,
+                    s.max * k,
+                    c.sigma_basis
+                ));
+            }
+            (None, Some(why)) => {
+                ui.label(RichText::new(format!("· {why}")).color(WARN));
+            }
+            (None, None) => {}
+        }
+    });
+    if c.skipped > 0 {
+        ui.label(
+            RichText::new(format!(
+                "{} measurement(s) give a sphere centre, no profile: not in the cloud",
+                c.skipped
+            ))
+            .small(),
+        );
+    }
+    for note in &c.notes {
+        ui.label(RichText::new(note).small());
+    }
+    for w in &c.warnings {
+        ui.label(RichText::new(format!("warning: {w}")).color(WARN));
+    }
+    if !c.out_of_range.is_empty() {
+        ui.collapsing(
+            RichText::new(format!(
+                "warning: {} pose(s) outside the joint range the calibration saw (the model was not checked there)",
+                c.out_of_range_count
+            ))
+            .color(WARN),
+            |ui| {
+                for o in &c.out_of_range {
+                    ui.label(RichText::new(o).small());
+                }
+            },
+        );
+    }
+}
+
+/// The three projections and the colour bar.
+fn projections_ui(ui: &mut egui::Ui, c: &MeasuredCloud) {
+    let Some((lo, hi)) = c.bounds else {
+        ui.label("the cloud has no points");
+        return;
+    };
+    let spacing = ui.spacing().item_spacing.x;
+    let width = ((ui.available_width() - BAR_WIDTH - 4.0 * spacing) / 3.0).max(160.0);
+    let height = (width * 0.9).min(MAX_PLOT_HEIGHT);
+    let axes = ["x", "y", "z"];
+    ui.horizontal_top(|ui| {
+        for (name, a, b) in [
+            ("XY (from above)", 0, 1),
+            ("XZ (from the front)", 0, 2),
+            ("YZ (from the side)", 1, 2),
+        ] {
+            ui.vertical(|ui| {
+                ui.label(RichText::new(name).strong());
+                let response = Plot::new(("measure_projection", a, b))
+                    .width(width)
+                    .height(height)
+                    .data_aspect(1.0)
+                    .include_x(lo[a])
+                    .include_x(hi[a])
+                    .include_y(lo[b])
+                    .include_y(hi[b])
+                    .x_axis_label(format!("{} (mm)", axes[a]))
+                    .y_axis_label(format!("{} (mm)", axes[b]))
+                    .allow_scroll(false)
+                    .show(ui, |_| {});
+                paint_points(ui, c, a, b, &response.transform);
+            });
+        }
+        colour_bar_ui(ui, c, height);
+    });
+}
+
+/// The drawn points of `c` on axes `a`, `b` as small squares in one
+/// mesh (a shape per point would cost the frame far more).
+fn paint_points(
+    ui: &egui::Ui,
+    c: &MeasuredCloud,
+    a: usize,
+    b: usize,
+    transform: &egui_plot::PlotTransform,
+) {
+    let frame = *transform.frame();
+    let mut mesh = egui::Mesh::default();
+    mesh.reserve_vertices(4 * c.drawn.len());
+    mesh.reserve_triangles(2 * c.drawn.len());
+    let colour = |s: f64| match c.sigma_range {
+        Some((lo, hi)) if s.is_finite() => {
+            scale_colour(if hi > lo { (s - lo) / (hi - lo) } else { 0.5 })
+        }
+        _ => AFTER,
+    };
+    let size = egui::vec2(POINT_SIZE, POINT_SIZE);
+    for p in &c.drawn {
+        let at = transform.position_from_point(&PlotPoint::new(p.position[a], p.position[b]));
+        if frame.contains(at) {
+            mesh.add_colored_rect(egui::Rect::from_center_size(at, size), colour(p.sigma_mm));
+        }
+    }
+    ui.painter_at(frame).add(egui::Shape::mesh(mesh));
+}
+
+/// The colour bar: σ from the smallest (bottom) to the largest (top)
+/// drawn, in mm or µm; or why there is no σ.
+fn colour_bar_ui(ui: &mut egui::Ui, c: &MeasuredCloud, height: f32) {
+    ui.vertical(|ui| {
+        ui.set_width(BAR_WIDTH);
+        let Some((lo, hi)) = c.sigma_range else {
+            ui.label(RichText::new("σ").strong());
+            ui.label(
+                RichText::new(c.no_sigma.as_deref().unwrap_or("no σ"))
+                    .small()
+                    .color(WARN),
+            );
+            return;
+        };
+        let (unit, k) = sigma_unit(hi);
+        ui.label(RichText::new(format!("σ ({unit})")).strong())
+            .on_hover_text(
+                "1σ of each point's 3-D position, after the cloud's best rigid alignment",
+            );
+        ui.label(format!("{:.3}", hi * k));
+        let bar_height = (height - 70.0).max(60.0);
+        let (rect, _) = ui.allocate_exact_size(egui::vec2(24.0, bar_height), egui::Sense::hover());
+        let mut mesh = egui::Mesh::default();
+        const STRIPS: usize = 32;
+        for i in 0..STRIPS {
+            let t0 = i as f32 / STRIPS as f32;
+            let t1 = (i + 1) as f32 / STRIPS as f32;
+            let strip = egui::Rect::from_x_y_ranges(
+                rect.x_range(),
+                egui::Rangef::new(
+                    rect.bottom() - t1 * rect.height(),
+                    rect.bottom() - t0 * rect.height(),
+                ),
+            );
+            mesh.add_colored_rect(strip, scale_colour(f64::from(t0 + t1) / 2.0));
+        }
+        ui.painter().add(egui::Shape::mesh(mesh));
+        ui.label(format!("{:.3}", lo * k));
+        ui.label(
+            RichText::new(format!("mid {:.3}", f64::midpoint(lo, hi) * k))
+                .small()
+                .color(MUTED),
+        );
+    });
+}
+
+/// A figure's rms and largest value, mm.
+type RmsMax = (f64, f64);
+
+/// `rms / max` of a figure in `unit`.
+fn pair(v: (f64, f64), k: f64, unit: &str) -> String {
+    format!("{:.4} / {:.4} {unit}", v.0 * k, v.1 * k)
+}
+
+/// The self-validation table: the ISO 10360-8-style figures before and
+/// after calibration, with units.
+fn self_check_ui(ui: &mut egui::Ui, c: &MeasuredCloud) {
+    ui.label(RichText::new("Self-validation with the cell's own scanner").strong());
+    let Some(v) = &c.check else {
+        ui.label(
+            RichText::new(
+                "no sphere station in the scan (a session's validate stations, or a raw scan with a station column): nothing to check",
+            )
+            .small()
+            .color(MUTED),
+        );
+        return;
+    };
+    ui.label(
+        RichText::new(format!(
+            "the {} mm sphere at {} station(s), fitted in the base frame (ISO 10360-8-style; rms / max over stations)",
+            v.diameter,
+            v.after.stations.len()
+        ))
+        .small(),
+    );
+    let rows: Vec<(String, RmsMax, RmsMax)> = {
+        let mut rows = vec![
+            (
+                "size error (fitted − calibrated diameter)".to_string(),
+                v.before.size(),
+                v.after.size(),
+            ),
+            (
+                "form error (range of radial residuals)".to_string(),
+                v.before.form(),
+                v.after.form(),
+            ),
+            (
+                "position spread (each pose's centre)".to_string(),
+                v.before.spread(),
+                v.after.spread(),
+            ),
+        ];
+        if let (Some(b), Some(a)) = (v.before.spacing_error(), v.after.spacing_error()) {
+            rows.push((
+                format!(
+                    "spacing error ({} reference distances)",
+                    v.after
+                        .spacings
+                        .iter()
+                        .filter(|s| s.reference.is_some())
+                        .count()
+                ),
+                b,
+                a,
+            ));
+        }
+        rows
+    };
+    egui::Grid::new("measure_selfcheck")
+        .striped(true)
+        .num_columns(4)
+        .show(ui, |ui| {
+            ui.label(RichText::new("figure").strong());
+            ui.label(RichText::new("before (nominal)").strong());
+            ui.label(RichText::new("after (calibrated)").strong());
+            ui.label(RichText::new("").strong());
+            ui.end_row();
+            for (name, b, a) in &rows {
+                ui.label(name);
+                ui.label(pair(*b, 1.0, "mm"));
+                ui.label(RichText::new(pair(*a, 1.0, "mm")).color(if a.0 <= b.0 {
+                    GOOD
+                } else {
+                    WARN
+                }));
+                ui.label(RichText::new(crate::app::widgets::ratio_text(b.0, a.0)).small());
+                ui.end_row();
+            }
+        });
+    distances_ui(ui, &v.before, &v.after);
+}
+
+/// The distances between the spheres, before and after (with the
+/// reference where there is one).
+fn distances_ui(ui: &mut egui::Ui, before: &ModelCheck, after: &ModelCheck) {
+    if after.spacings.is_empty() {
+        return;
+    }
+    ui.collapsing(
+        format!("distances between spheres ({})", after.spacings.len()),
+        |ui| {
+            egui::Grid::new("measure_spacings")
+                .striped(true)
+                .num_columns(4)
+                .show(ui, |ui| {
+                    for h in ["spheres", "before", "after", "reference"] {
+                        ui.label(RichText::new(h).strong());
+                    }
+                    ui.end_row();
+                    for s in &after.spacings {
+                        let b = before
+                            .spacings
+                            .iter()
+                            .find(|x| x.from == s.from && x.to == s.to)
+                            .map_or_else(|| "–".to_string(), |x| format!("{:.4} mm", x.measured));
+                        ui.label(format!("{}–{}", s.from, s.to));
+                        ui.label(b);
+                        ui.label(format!("{:.4} mm", s.measured));
+                        ui.label(
+                            s.reference
+                                .map_or_else(|| "–".to_string(), |r| format!("{r:.4} mm")),
+                        );
+                        ui.end_row();
+                    }
+                });
+        },
+    );
+}
+
+/// The export on one line: a path (format by its extension), Write
+/// and Save as… (a dialog); refused with the reason while the cloud is
+/// stale; the files written of it below.
+fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mut Vec<Command>) {
+    let stale = state.ledger.stale(Artefact::Cloud);
+    ui.horizontal_wrapped(|ui| {
+        ui.label(RichText::new("Export:").strong());
+        labelled_field(ui, "Export to", &mut forms.measure.out, "cloud.ply", 260.0)
+            .on_hover_text(
+                "PLY (binary: x y z double mm, sigma_mm float, pose), E57 (a scan per pose with its sensor pose) or CSV (id,x,y,z,sigma_mm), by the extension; written whole or not at all",
+            );
+        let busy = state.jobs.writing() || state.jobs.runs(&Slot::Dialog);
+        let why = stale.as_ref().map_or_else(
+            || "write the cloud on show to the typed file".to_string(),
+            |s| format!("refused: {s}; measure again first"),
+        );
+        if ui
+            .add_enabled(!busy, egui::Button::new("Write cloud"))
+            .on_hover_text(&why)
+            .clicked()
+        {
+            commands.push(Command::Measure(MeasureCommand::Export));
+        }
+        if ui
+            .add_enabled(!busy, egui::Button::new("Save as…"))
+            .on_hover_text("choose the file (.ply, .e57, .csv) in a dialog, then write it")
+            .clicked()
+        {
+            commands.push(Command::Browse(Purpose::MeasureExport));
+        }
+        ui.label(RichText::new(".ply · .e57 · .csv").small().color(MUTED));
+        if state.dialog_empty == Some(Purpose::MeasureExport) {
+            ui.label(
+                RichText::new(crate::app::dialog::NO_DIALOG)
+                    .small()
+                    .color(WARN),
+            );
+        }
+    });
+    if let Some(s) = &stale {
+        ui.label(
+            RichText::new(format!("export refused: {s}"))
+                .small()
+                .color(WARN),
+        );
+    }
+    for w in state
+        .ledger
+        .written
+        .iter()
+        .rev()
+        .filter(|w| w.from == Artefact::Cloud)
+        .take(2)
+    {
+        let mark = if state.ledger.written_stale(w).is_some() {
+            RichText::new(format!(
+                "! wrote {} {} (now stale)",
+                w.what,
+                w.path.display()
+            ))
+            .color(WARN)
+        } else {
+            RichText::new(format!("● wrote {} {}", w.what, w.path.display())).color(GOOD)
+        };
+        ui.label(mark.small());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_scale_runs_from_dark_blue_to_yellow() {
+        assert_eq!(scale_colour(0.0), Color32::from_rgb(68, 1, 84));
+        assert_eq!(scale_colour(1.0), Color32::from_rgb(253, 231, 37));
+        assert_eq!(scale_colour(0.5), Color32::from_rgb(33, 145, 140));
+        assert_eq!(scale_colour(f64::NAN), scale_colour(0.0));
+        assert_eq!(scale_colour(7.0), scale_colour(1.0));
+    }
+
+    #[test]
+    fn small_sigmas_are_shown_in_micrometres() {
+        assert_eq!(sigma_unit(0.05), ("µm", 1000.0));
+        assert_eq!(sigma_unit(0.1), ("mm", 1.0));
+        assert_eq!(sigma_unit(2.0), ("mm", 1.0));
+    }
+}

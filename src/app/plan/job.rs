@@ -1,0 +1,116 @@
+//! The Plan view's job work: the engine's pose planner
+//! ([`crate::engine::tools::plan::plan`]) and its predicted accuracy
+//! ([`crate::engine::tools::plan::predict`]) as `spherecal plan` runs
+//! them, with progress and cancel; and a simulated session of a plan, to
+//! try the whole workflow without a robot.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::engine::base::robot::RobotChoice;
+use crate::engine::base::session::Session;
+use crate::engine::calibrate::solve::Control;
+use crate::engine::tools::plan::{
+    self, Plan, PlanConfig, PlanError, PlanStage, PredictConfig, RequestError,
+};
+use crate::engine::tools::simulate::{self, PlanExecution, SimConfig};
+
+use super::PlanOutcome;
+use crate::app::error::JobError;
+
+/// Plans and predicts, reporting each stage in words; `cancel` stops at
+/// the next stage or prediction run.
+///
+/// # Errors
+/// The planner's error ([`PlanError::Cancelled`] after a cancel, also
+/// during the prediction). A failed prediction is not an error: the plan
+/// comes with the reason.
+pub fn make_plan(
+    config: &PlanConfig,
+    runs: usize,
+    cancel: &AtomicBool,
+    report: &mut dyn FnMut(String, Option<f64>),
+) -> Result<PlanOutcome, PlanError> {
+    let control = || {
+        if cancel.load(Ordering::Relaxed) {
+            Control::Cancel
+        } else {
+            Control::Continue
+        }
+    };
+    // The candidates take most of the planning; a prediction, when
+    // asked for, the second half of the bar.
+    let share = if runs > 0 { 0.5 } else { 1.0 };
+    let plan = plan::plan(config, &mut |stage| {
+        let done = match stage {
+            PlanStage::Candidates { done, of } => 0.8 * done as f64 / of.max(1) as f64,
+            _ => 0.9,
+        };
+        report(stage_text(stage), Some(share * done));
+        control()
+    })?;
+    let prediction = (runs > 0).then(|| {
+        let predict = PredictConfig {
+            runs,
+            ..PredictConfig::default()
+        };
+        plan::predict(&plan, &predict, &mut |done, of| {
+            report(
+                format!("predicting the accuracy: {done} of {of} simulated calibrations"),
+                Some(0.5 + 0.5 * done as f64 / of.max(1) as f64),
+            );
+            control()
+        })
+    });
+    if let Some(Err(e)) = &prediction
+        && cancel.load(Ordering::Relaxed)
+    {
+        return Err(e.clone());
+    }
+    Ok(PlanOutcome {
+        plan: Box::new(plan),
+        prediction,
+    })
+}
+
+/// A planner stage in words.
+#[must_use]
+pub fn stage_text(stage: PlanStage) -> String {
+    match stage {
+        PlanStage::Candidates { done, of } => {
+            format!("solving candidate poses: station {done} of {of}")
+        }
+        PlanStage::Analysis => "identifiability of the candidate pool…".to_string(),
+        PlanStage::Selection => "D-optimal selection…".to_string(),
+        PlanStage::Ordering => "ordering for short moves…".to_string(),
+        PlanStage::Comparison => "the plan without the spread, for comparison…".to_string(),
+    }
+}
+
+/// A simulated session of `plan` (the simulator's default kinematic errors,
+/// the true hand-eye of the prediction), each pose touched up on the true
+/// robot as in the paper's teach mode, to try the workflow without a
+/// robot.
+///
+/// # Errors
+/// An unknown preset, or the simulator's error (a pose that would not see
+/// the sphere on the true robot).
+pub fn simulate_plan(plan: &Plan, robot: &str, seed: u64) -> Result<Session, JobError> {
+    let robot_choice = RobotChoice::from_key(robot)
+        .ok_or_else(|| RequestError::UnknownPreset(robot.to_owned()))?;
+    let config = SimConfig {
+        robot: robot_choice,
+        seed,
+        name: Some(format!("simulated from a plan ({robot}, seed {seed})")),
+        range: plan.range,
+        ..SimConfig::default()
+    };
+    let truth_hand_eye = plan::simulated_true_hand_eye(&plan.flange_from_sensor);
+    let (session, _truth) = simulate::simulate_plan(
+        &config,
+        &plan.robot,
+        &truth_hand_eye,
+        &plan.simulation_poses(),
+        PlanExecution::TouchUp,
+    )?;
+    Ok(session)
+}

@@ -1,0 +1,301 @@
+//! The Results view's tables: the hand-eye before and after with ± 1σ,
+//! the joint errors in the layout of the paper's Table 1 (or, for a
+//! pose-only result, what was calibrated), the SVD's dropped directions,
+//! `ml`'s diagnostics (outliers, leave-one-station-out, correlations) and
+//! the solver block as written.
+
+use egui::RichText;
+
+use crate::app::results::{HandEyeView, ResultView};
+use crate::app::widgets::{MUTED, WARN};
+use crate::engine::base::geometry::{rows_from_isometry, wrap_deg};
+use crate::engine::base::robot::{PARAM_NAMES, PARAMS_PER_JOINT};
+use crate::engine::calibrate::solve::estimate::HAND_EYE_LABELS;
+
+/// Longest solver-block value shown in full (longer ones are cut, the
+/// whole value is in the tooltip and the exported JSON).
+const SOLVER_ENTRY_CHARS: usize = 300;
+
+pub(super) fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
+    // One above the other: with ± 1σ the joint table needs the width.
+    hand_eye_ui(ui, view);
+    ui.add_space(8.0);
+    match &view.hand_eye_only {
+        Some(lines) => hand_eye_only_ui(ui, lines),
+        None => joint_errors_ui(ui, view),
+    }
+    if !view.dropped.is_empty() {
+        ui.add_space(6.0);
+        egui::CollapsingHeader::new(format!(
+            "Directions the SVD dropped ({})",
+            view.dropped.len()
+        ))
+        .show(ui, |ui| {
+            for d in &view.dropped {
+                ui.monospace(d);
+            }
+        });
+    }
+    ml_tables_ui(ui, view);
+    egui::CollapsingHeader::new("Details: the solver block as written in the result file").show(
+        ui,
+        |ui| {
+            egui::Grid::new("solver_entries")
+                .striped(true)
+                .num_columns(2)
+                .show(ui, |ui| {
+                    for (k, v) in &view.solver_entries {
+                        ui.monospace(k);
+                        let short: String = v.chars().take(SOLVER_ENTRY_CHARS).collect();
+                        let shown = if short.len() < v.len() {
+                            format!("{short}…")
+                        } else {
+                            short
+                        };
+                        ui.add(egui::Label::new(shown).wrap()).on_hover_text(v);
+                        ui.end_row();
+                    }
+                });
+        },
+    );
+}
+
+fn marked_cell(ui: &mut egui::Ui, view: &ResultView, label: &str, text: String) {
+    if let Some(why) = view.shown.marked.get(label) {
+        ui.label(RichText::new(format!("{text} †")).color(MUTED))
+            .on_hover_text(format!("{label} is not identifiable from this data: {why}"));
+    } else {
+        ui.label(text);
+    }
+}
+
+fn hand_eye_ui(ui: &mut egui::Ui, view: &ResultView) {
+    ui.label(RichText::new("Hand-eye eT_s (sensor to flange)").strong());
+    let (b, a): (&HandEyeView, &HandEyeView) =
+        (&view.shown.hand_eye_before, &view.shown.hand_eye_after);
+    let sigma = view.shown.hand_eye_sigma;
+    egui::Grid::new("hand_eye")
+        .striped(true)
+        .num_columns(5)
+        .show(ui, |ui| {
+            for t in ["", "initial", "calibrated", "± 1σ", "change"] {
+                ui.strong(t);
+            }
+            ui.end_row();
+            let rows: [(&str, f64, f64, &str); 6] = [
+                (
+                    "x (mm)",
+                    b.translation[0],
+                    a.translation[0],
+                    HAND_EYE_LABELS[0],
+                ),
+                (
+                    "y (mm)",
+                    b.translation[1],
+                    a.translation[1],
+                    HAND_EYE_LABELS[1],
+                ),
+                (
+                    "z (mm)",
+                    b.translation[2],
+                    a.translation[2],
+                    HAND_EYE_LABELS[2],
+                ),
+                ("roll (deg)", b.rpy_deg[0], a.rpy_deg[0], HAND_EYE_LABELS[3]),
+                (
+                    "pitch (deg)",
+                    b.rpy_deg[1],
+                    a.rpy_deg[1],
+                    HAND_EYE_LABELS[4],
+                ),
+                ("yaw (deg)", b.rpy_deg[2], a.rpy_deg[2], HAND_EYE_LABELS[5]),
+            ];
+            for (k, (name, before, after, label)) in rows.into_iter().enumerate() {
+                ui.label(name);
+                ui.label(format!("{before:.4}"));
+                marked_cell(ui, view, label, format!("{after:.4}"));
+                match sigma {
+                    Some(s) if !view.shown.marked.contains_key(label) => {
+                        ui.label(RichText::new(format!("± {:.4}", s[k])).color(MUTED))
+                    }
+                    _ => ui.label(RichText::new("–").color(MUTED)),
+                }
+                .on_hover_text(
+                    "1σ from ml's covariance, in the row's frame and unit (flange-frame x, y, z; roll, pitch, yaw)",
+                );
+                let change = if k < 3 {
+                    after - before
+                } else {
+                    wrap_deg(after - before)
+                };
+                ui.label(format!("{change:+.4}"));
+                ui.end_row();
+            }
+        });
+    ui.label(
+        RichText::new(format!(
+            "rotation changed by {:.4}°",
+            view.shown.hand_eye_rotation_change_deg
+        ))
+        .small(),
+    );
+    egui::CollapsingHeader::new("matrices").show(ui, |ui| {
+        for (title, m) in [
+            ("initial", &view.file.hand_eye_initial),
+            ("calibrated", &view.file.hand_eye),
+        ] {
+            ui.label(title);
+            for r in rows_from_isometry(m) {
+                ui.monospace(format!(
+                    "{:>10.5} {:>10.5} {:>10.5} {:>10.3}",
+                    r[0], r[1], r[2], r[3]
+                ));
+            }
+        }
+    });
+}
+
+/// A pose-only result: no joint table; what was calibrated and how well.
+fn hand_eye_only_ui(ui: &mut egui::Ui, lines: &[String]) {
+    ui.label(RichText::new("Hand-eye only: no kinematic model").strong());
+    for (k, line) in lines.iter().enumerate() {
+        let text = RichText::new(line);
+        ui.label(if line.starts_with("weakly") {
+            text.color(WARN)
+        } else if k == 0 {
+            text
+        } else {
+            text.color(MUTED)
+        });
+    }
+}
+
+fn joint_errors_ui(ui: &mut egui::Ui, view: &ResultView) {
+    ui.label(RichText::new("Joint errors, calibrated − nominal (cf. paper Table 1)").strong());
+    const HEADER: [&str; PARAMS_PER_JOINT + 1] = [
+        "joint",
+        "Δα (deg)",
+        "Δa (mm)",
+        "Δβ (deg)",
+        "Δθ (deg)",
+        "Δd (mm)",
+    ];
+    egui::Grid::new("joint_errors")
+        .striped(true)
+        .num_columns(HEADER.len())
+        .show(ui, |ui| {
+            for h in HEADER {
+                ui.strong(h);
+            }
+            ui.end_row();
+            for (j, e) in view.file.joint_errors.iter().enumerate() {
+                ui.label(format!("{}", j + 1));
+                for (p, name) in PARAM_NAMES.iter().enumerate() {
+                    let label = format!("{name}{}", j + 1);
+                    let text = match view.shown.sigma.get(&label) {
+                        Some(s) => format!("{:+.4} ± {:.4}", e.get(p), s.std),
+                        None => format!("{:+.4}", e.get(p)),
+                    };
+                    marked_cell(ui, view, &label, text);
+                }
+                ui.end_row();
+            }
+        });
+    if !view.shown.marked.is_empty() {
+        ui.label(
+            RichText::new(format!(
+                "± 1σ from ml's covariance. † not identifiable from this data ({} parameter(s)): they lie in a direction the SVD dropped (or the method held them fixed), so the value is not a measurement of the robot. Hover a value for the direction.",
+                view.shown.marked.len()
+            ))
+            .small()
+            .color(MUTED),
+        );
+    }
+}
+
+/// `ml`'s diagnostics as tables: outliers, leave-one-station-out and the
+/// strong correlations (each collapsible, open when it has something to
+/// say).
+fn ml_tables_ui(ui: &mut egui::Ui, view: &ResultView) {
+    let Some(ml) = view.file.solver.ml() else {
+        return;
+    };
+    ui.add_space(6.0);
+    if let Some(r) = &ml.range_error {
+        ui.label(r.summary()).on_hover_text(format!(
+            "1σ of points of the laser plane on a {} × {} grid at {} working poses, from ml's covariance, after the best rigid alignment",
+            r.grid, r.grid, r.poses
+        ));
+        if let Some(w) = &r.warning {
+            ui.label(RichText::new(format!("warning: {w}")).color(WARN));
+        }
+        super::range_map::range_map_ui(ui, r);
+    }
+    egui::CollapsingHeader::new(format!(
+        "Outliers ({}; limit {:.1} σ)",
+        ml.outliers.len(),
+        ml.outlier_limit_sigma
+    ))
+    .default_open(!ml.outliers.is_empty())
+    .show(ui, |ui| {
+        if ml.outliers.is_empty() {
+            ui.label("No identify measurement's standardised residual exceeds the limit.");
+            return;
+        }
+        egui::Grid::new("outliers").striped(true).show(ui, |ui| {
+            for h in ["measurement", "station", "residual (mm)", "σ", "reason"] {
+                ui.strong(h);
+            }
+            ui.end_row();
+            for o in &ml.outliers {
+                ui.label(&o.measurement);
+                ui.label(&o.station);
+                ui.label(format!("{:.4}", o.residual_mm));
+                ui.label(format!("{:.1}", o.sigma));
+                ui.label(&o.reason);
+                ui.end_row();
+            }
+        });
+    });
+    if let Some(cv) = &ml.cross_validation {
+        egui::CollapsingHeader::new(format!(
+            "Leave-one-station-out: rms {:.4} mm over {} stations",
+            cv.rms,
+            cv.stations.len()
+        ))
+        .show(ui, |ui| {
+            ui.label(
+                RichText::new(
+                    "Each station's within-station centre distances predicted by the model fitted without it: an accuracy estimate without a tracker.",
+                )
+                .color(MUTED),
+            );
+            let mut rows: Vec<_> = cv.stations.iter().collect();
+            rows.sort_by(|a, b| b.rms.total_cmp(&a.rms));
+            egui::Grid::new("loso").striped(true).show(ui, |ui| {
+                for h in ["station", "pairs", "rms (mm)"] {
+                    ui.strong(h);
+                }
+                ui.end_row();
+                for s in rows {
+                    ui.label(&s.station);
+                    ui.label(s.pairs.to_string());
+                    ui.label(format!("{:.4}", s.rms));
+                    ui.end_row();
+                }
+            });
+        });
+    }
+    egui::CollapsingHeader::new(format!(
+        "Strong correlations ({}, |r| ≥ 0.95)",
+        ml.strong_correlations.len()
+    ))
+    .show(ui, |ui| {
+        if ml.strong_correlations.is_empty() {
+            ui.label("No two estimated parameters correlate by 0.95 or more.");
+        }
+        for c in &ml.strong_correlations {
+            ui.label(c);
+        }
+    });
+}

@@ -1,0 +1,363 @@
+//! The Results view: the headline figures in large type, the paper's
+//! Fig. 5 (within-station centre distances, before and after, per pair)
+//! and Fig. 6 (reference-distance errors, before and after, per distance),
+//! ε per iteration, the singular values with the truncation line, the
+//! hand-eye before and after, the Table 1 view of the joint errors with
+//! the non-identifiable ones marked, and the export buttons. A stale
+//! result is marked over everything and its exports are refused with
+//! what changed.
+//!
+//! Split by idea: [`figures`] (the four plots), [`sets`] (calibration
+//! set against validation set, with the error histogram), [`fail`] (the
+//! way forward after a FAIL), [`tables`] (hand-eye, joints, `ml`'s
+//! diagnostics), [`range_map`](super::range_map) (the predicted error over the range).
+
+use super::{fail, figures, sets, tables};
+use egui::RichText;
+
+use crate::app::AppState;
+use crate::app::Forms;
+use crate::app::command::ExportKind;
+use crate::app::command::{Command, ViewCommand};
+use crate::app::dialog::Purpose;
+use crate::app::ledger::{Artefact, Stale};
+use crate::app::results::{ResultOrigin, ResultView};
+use crate::app::widgets::{
+    AFTER, BAD, GOOD, MUTED, WARN, labelled_field, number_field, ratio_text,
+};
+use crate::engine::tools::result_view::Verdict;
+
+/// Height of each of the four plots, points.
+pub(super) const PLOT_HEIGHT: f32 = 230.0;
+
+/// The Results view.
+pub fn results_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    let Some(view) = &state.result else {
+        ui.add_space(20.0);
+        ui.label(RichText::new("No result yet.").size(18.0));
+        ui.label("Press ▶ Run in the solver panel on the left, or open a result file (path field or Open…) to review it beside its session.");
+        return;
+    };
+    let stale = state.ledger.stale(Artefact::Result);
+    egui::ScrollArea::vertical()
+        .auto_shrink([false, false])
+        .show(ui, |ui| {
+            if let Some(s) = &stale {
+                crate::app::widgets::stale_banner_ui(
+                    ui,
+                    s,
+                    "What is shown below no longer matches the inputs: its verdict does not hold and its exports are refused until you run again.",
+                );
+            }
+            origin_ui(ui, view);
+            export_ui(ui, state, forms, stale.as_ref(), commands);
+            headline_ui(ui, view, forms, commands);
+            fail::after_fail_ui(ui, state, forms, commands);
+            ui.add_space(4.0);
+            sets::sets_ui(ui, view);
+            ui.add_space(4.0);
+            figures::plots_ui(ui, view);
+            ui.add_space(8.0);
+            tables::tables_ui(ui, view);
+        });
+}
+
+fn origin_ui(ui: &mut egui::Ui, view: &ResultView) {
+    let text = match &view.origin {
+        ResultOrigin::Run { seconds, excluded } => {
+            let left_out = if *excluded > 0 {
+                format!(", {excluded} measurement(s) left out")
+            } else {
+                String::new()
+            };
+            format!(
+                "Run of session \"{}\" in this window ({seconds:.2} s{left_out}), method {}.",
+                view.file.session, view.method
+            )
+        }
+        ResultOrigin::Review(path) => format!(
+            "Reviewing {} (session \"{}\", method {}): shown as it was computed, the solver was not run.",
+            path.display(),
+            view.file.session,
+            view.method
+        ),
+    };
+    ui.label(RichText::new(text).weak());
+    if let Some(stop) = &view.stop_reason {
+        ui.label(RichText::new(stop).small());
+    }
+    for w in &view.shown.warnings {
+        ui.label(RichText::new(format!("warning: {w}")).color(WARN));
+    }
+    for n in &view.notes {
+        ui.label(RichText::new(format!("note: {n}")).color(WARN));
+    }
+}
+
+/// Validation std and max before → after in large type, with the ratio,
+/// and the verdict against the acceptance tolerance (editable here).
+fn headline_ui(ui: &mut egui::Ui, view: &ResultView, forms: &Forms, commands: &mut Vec<Command>) {
+    egui::Frame::group(ui.style()).show(ui, |ui| {
+        ui.set_width(ui.available_width());
+        match &view.shown.headline {
+            Some(h) => {
+                ui.label(RichText::new(&h.what).strong());
+                let (b, a) = (h.stats.before, h.stats.after);
+                ui.horizontal_wrapped(|ui| {
+                    big(ui, format!("std {:.3} → {:.3} mm", b.std, a.std));
+                    ui.label(RichText::new(ratio_text(b.std, a.std)).size(16.0).color(AFTER));
+                    ui.add_space(24.0);
+                    big(ui, format!("max {:.3} → {:.3} mm", b.max, a.max));
+                    ui.label(RichText::new(ratio_text(b.max, a.max)).size(16.0).color(AFTER));
+                });
+            }
+            None => {
+                ui.label(
+                    RichText::new(
+                        "Validation skipped: no validate data (the session has no validate measurements), so accuracy is not checked; the report says so.",
+                    )
+                    .color(WARN),
+                );
+            }
+        }
+        verdict_ui(ui, view, forms, commands);
+        let w = &view.shown.within_stats;
+        ui.label(format!(
+            "{} stations, centre distances (true value 0): std {:.3} → {:.3} mm, max {:.3} → {:.3} mm · ε {:.4} → {:.4} mm",
+            view.shown.within_of.as_str(),
+            w.before.std,
+            w.after.std,
+            w.before.max,
+            w.after.max,
+            view.file.epsilon_before,
+            view.file.epsilon_after
+        ));
+        let (b, a) = view.shown.identify_scatter;
+        ui.label(format!(
+            "identify centres about their station's mean (3-D rms): {b:.3} → {a:.3} mm"
+        ));
+        held_out_ui(ui, view);
+    });
+}
+
+/// The held-out figure beside the fit's own scatter: each identify centre
+/// predicted by a calibration made without it.
+fn held_out_ui(ui: &mut egui::Ui, view: &ResultView) {
+    let Some(h) = &view.shown.held_out else {
+        ui.label(
+            RichText::new("held out: not in this result (written before spherecal computed it, or with --no-held-out)")
+                .color(MUTED),
+        );
+        return;
+    };
+    ui.horizontal_wrapped(|ui| {
+        ui.label(RichText::new(format!("held out ({})", h.label())).strong());
+        ui.label(
+            RichText::new(format!("rms {:.3} mm, max {:.3} mm", h.rms, h.max))
+                .size(16.0)
+                .strong(),
+        )
+        .on_hover_text(format!(
+            "each identify centre predicted by a calibration made without it, against its station's centre from the other measurements; largest: {}. Refit: {}",
+            h.max_measurement, h.refit
+        ));
+        ui.label(format!(
+            "· fit's own scatter rms {:.3} mm, max {:.3} mm ({:.2}× the fit's own)",
+            h.fit_rms,
+            h.fit_max,
+            h.ratio()
+        ));
+    });
+    if !h.undetermined.is_empty() {
+        ui.label(
+            RichText::new(format!(
+                "not predictable without themselves: {}",
+                h.undetermined.join(", ")
+            ))
+            .color(WARN),
+        );
+    }
+}
+
+/// PASS / FAIL in large type against the tolerance, which is edited
+/// beside it (remembered for the session's robot).
+fn verdict_ui(ui: &mut egui::Ui, view: &ResultView, forms: &Forms, commands: &mut Vec<Command>) {
+    let tolerance = forms.tolerance;
+    let verdict = Verdict::of(view.shown.headline.as_ref(), &tolerance);
+    ui.horizontal_wrapped(|ui| {
+        let colour = match verdict {
+            Verdict::Pass => GOOD,
+            Verdict::Fail(_) => BAD,
+            Verdict::NotChecked => MUTED,
+        };
+        ui.label(
+            RichText::new(verdict.word())
+                .size(28.0)
+                .strong()
+                .color(colour),
+        )
+        .on_hover_text(verdict.describe(&tolerance));
+        ui.add_space(12.0);
+        // Typed, never dragged: a sideways drag must not turn a PASS
+        // into a FAIL. A value takes effect on Enter or leaving the field.
+        let mut edited = tolerance;
+        if let Some(v) = number_field(
+            ui,
+            "tolerance_std",
+            "tolerance: std ≤",
+            tolerance.std_mm,
+            TOLERANCE_MM,
+            "mm",
+        ) {
+            edited.std_mm = v;
+        }
+        if let Some(v) = number_field(
+            ui,
+            "tolerance_max",
+            "max ≤",
+            tolerance.max_mm,
+            TOLERANCE_MM,
+            "mm",
+        ) {
+            edited.max_mm = v;
+        }
+        if edited != tolerance {
+            commands.push(Command::View(ViewCommand::SetTolerance(edited)));
+        }
+        if let Verdict::Fail(reasons) = &verdict {
+            ui.label(RichText::new(reasons.join(", ")).color(BAD));
+        }
+    });
+}
+
+/// The tolerances one may type, mm.
+const TOLERANCE_MM: std::ops::RangeInclusive<f64> = 0.001..=100.0;
+
+fn big(ui: &mut egui::Ui, text: String) {
+    ui.label(RichText::new(text).size(28.0).strong());
+}
+
+fn export_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    stale: Option<&Stale>,
+    commands: &mut Vec<Command>,
+) {
+    ui.horizontal_wrapped(|ui| {
+        labelled_field(
+            ui,
+            "Export to folder",
+            &mut forms.export_dir,
+            "/path/to/folder",
+            220.0,
+        );
+        if ui
+            .button("Browse…")
+            .on_hover_text("choose the folder with the desktop's dialog")
+            .clicked()
+        {
+            commands.push(Command::Browse(Purpose::ExportFolder));
+        }
+        ui.separator();
+        let hand_eye_only = state
+            .result
+            .as_ref()
+            .is_some_and(|v| v.hand_eye_only.is_some());
+        for kind in ExportKind::ALL {
+            let model = matches!(
+                kind,
+                ExportKind::ModelJson | ExportKind::ModelCsv | ExportKind::ModelUrdf
+            );
+            let enabled = !(model && hand_eye_only) && stale.is_none();
+            let why = match stale {
+                Some(s) => format!("refused: {s}; run again, then export"),
+                None => "a pose-only result calibrated the hand-eye only: there is no kinematic model to export".to_string(),
+            };
+            if ui
+                .add_enabled(enabled, egui::Button::new(kind.label()))
+                .on_hover_text(export_hint(kind))
+                .on_disabled_hover_text(why)
+                .clicked()
+            {
+                commands.push(Command::Export(kind));
+            }
+        }
+    });
+    crate::app::widgets::dialog_note_ui(ui, state, &[Purpose::ExportFolder]);
+    written_ui(ui, state);
+}
+
+/// The files written of the result on show this session, each marked
+/// stale when an input of it has changed since.
+fn written_ui(ui: &mut egui::Ui, state: &AppState) {
+    let prov = &state.ledger;
+    let mine: Vec<_> = prov
+        .written
+        .iter()
+        .filter(|w| matches!(w.from, Artefact::Result | Artefact::Report))
+        .rev()
+        .take(WRITTEN_SHOWN)
+        .collect();
+    if mine.is_empty() {
+        return;
+    }
+    ui.horizontal_wrapped(|ui| {
+        ui.label(RichText::new("written:").small().weak());
+        for w in mine {
+            let name = w.path.file_name().map_or_else(
+                || w.path.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            );
+            match prov.written_stale(w) {
+                Some(s) => ui
+                    .label(
+                        RichText::new(format!("! {name} (stale)"))
+                            .small()
+                            .color(WARN),
+                    )
+                    .on_hover_text(format!("{}: {s}", w.path.display())),
+                None => ui
+                    .label(RichText::new(format!("● {name}")).small().color(GOOD))
+                    .on_hover_text(format!("{} ({}), current", w.path.display(), w.what)),
+            };
+        }
+    });
+}
+
+/// Files listed under the export buttons, newest first.
+const WRITTEN_SHOWN: usize = 4;
+
+fn export_hint(kind: ExportKind) -> &'static str {
+    match kind {
+        ExportKind::ResultJson => {
+            "the result file of FORMAT.md (what `spherecal calibrate` writes)"
+        }
+        ExportKind::CentresCsv => {
+            "every sphere centre: sensor frame, base frame before and after (mm)"
+        }
+        ExportKind::DistancesCsv => {
+            "reference-distance errors and within-station distances, before and after (mm)"
+        }
+        ExportKind::PlotsPng => {
+            "Fig. 5, Fig. 6, ε and the singular values on one white sheet, whole, for print (2 pixels per point)"
+        }
+        ExportKind::ReportHtml => {
+            "one self-contained HTML file: provenance (SHA-256), settings, stripe quality, figures, hand-eye, joint errors, validation"
+        }
+        ExportKind::ModelJson => {
+            "the calibrated robot as the FORMAT.md robot block (deg, mm), pasteable into a session"
+        }
+        ExportKind::ModelCsv => {
+            "the calibrated MDH table with the deltas, then base, flange and hand-eye matrices (deg, mm)"
+        }
+        ExportKind::ModelUrdf => {
+            "a URDF fragment with the calibrated joint origins and the sensor link (m, rad), for ROS"
+        }
+    }
+}

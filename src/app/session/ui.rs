@@ -1,0 +1,682 @@
+//! The Session view: the table of measurements (id, station, use, side,
+//! points, fit RMS, cut angle, warnings), filters and grouping, include or
+//! leave out, and "Save as" of the session without the left-out ones; and
+//! the left panel's loading part (the session open, the path field, the
+//! demo, recent files, the error notice).
+
+use egui::{Color32, RichText};
+use egui_extras::{Column, TableBuilder};
+
+use super::{Fit, Grouping, LoadedSession};
+use crate::app::command::{Command, FilesCommand, ViewCommand};
+use crate::app::dialog::{NO_DIALOG, Purpose};
+use crate::app::job::Slot;
+use crate::app::widgets::{
+    BAD, DEFAULT_RANGE, MUTED, WARN, labelled_field, range_fields, range_of, range_values,
+};
+use crate::app::{AppState, Forms};
+use crate::engine::base::session::Use;
+
+/// A row of the table: a group header or a measurement.
+enum Row {
+    /// Group title; `Some(station)` for a station group (with a checkbox).
+    Header(String, Option<String>),
+    /// Index into the session's measurements.
+    Item(usize),
+}
+
+/// The Session view.
+pub fn session_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    let Some(loaded) = &state.loaded else {
+        crate::app::widgets::no_session_ui(ui, state);
+        return;
+    };
+    filters_ui(ui, loaded, forms, commands);
+    let n = loaded.session.measurements.len();
+    let excluded = state.excluded_count();
+    ui.horizontal_wrapped(|ui| {
+        let stations = loaded.station_ids().len();
+        ui.label(format!(
+            "{n} measurements in {stations} station{}.",
+            if stations == 1 { "" } else { "s" }
+        ));
+        if excluded > 0 {
+            ui.label(
+                RichText::new(format!(
+                    "{excluded} left out: the solver skips them; the opened file is unchanged until you save a copy."
+                ))
+                .color(WARN),
+            );
+        } else {
+            ui.label(RichText::new("Untick a measurement to leave it out of the solver.").weak());
+        }
+    });
+    range_ui(ui, loaded, forms, commands);
+    save_ui(ui, state, forms, commands);
+    crate::app::widgets::dialog_note_ui(ui, state, &[Purpose::SaveSession]);
+    ui.separator();
+    table_ui(ui, state, loaded, forms, commands);
+}
+
+/// The measuring range (`sensor.range`): where the calibrated sensor will
+/// be used, so that `ml` predicts the error over it (Results) and the
+/// planner spreads the sphere over it.
+fn range_ui(
+    ui: &mut egui::Ui,
+    loaded: &LoadedSession,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    let current = loaded.session.sensor_range;
+    ui.horizontal_wrapped(|ui| {
+        ui.label(RichText::new("Measuring range").strong())
+            .on_hover_text("sensor.range: the part of the laser plane the sensor measures in (sensor frame); the next run predicts the error over it");
+        let mut edit = forms
+            .range_edit
+            .unwrap_or_else(|| current.as_ref().map_or(DEFAULT_RANGE, range_values));
+        if range_fields(ui, "session_range", &mut edit, false) {
+            forms.range_edit = Some(edit);
+        }
+        let parsed = range_of(&edit);
+        let differs = parsed.ok() != current;
+        if ui
+            .add_enabled(parsed.is_ok() && differs, egui::Button::new("Set range"))
+            .on_hover_text("keep this range with the session (saved with it); run again to predict the error over it")
+            .clicked()
+            && let Ok(r) = parsed
+        {
+            commands.push(Command::View(ViewCommand::SetSensorRange(Some(r))));
+        }
+        if current.is_some()
+            && ui
+                .button("Clear")
+                .on_hover_text("forget the range: the error is then predicted where the sphere was seen")
+                .clicked()
+        {
+            commands.push(Command::View(ViewCommand::SetSensorRange(None)));
+        }
+        match (&parsed, current) {
+            (Err(why), _) => {
+                ui.label(RichText::new(*why).color(BAD));
+            }
+            (_, Some(r)) => {
+                ui.label(
+                    RichText::new(format!(
+                        "set: y {:.0}…{:.0}, z {:.0}…{:.0} mm",
+                        r.y[0], r.y[1], r.z[0], r.z[1]
+                    ))
+                    .color(MUTED),
+                );
+            }
+            (_, None) => {
+                ui.label(
+                    RichText::new("not set: the error is predicted only where the sphere was seen")
+                        .color(WARN),
+                );
+            }
+        }
+    });
+}
+
+fn filters_ui(
+    ui: &mut egui::Ui,
+    loaded: &LoadedSession,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Station");
+        egui::ComboBox::from_id_salt("filter_station")
+            .selected_text(forms.filter_station.clone().unwrap_or_else(|| "all".into()))
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut forms.filter_station, None, "all");
+                for s in loaded.station_ids() {
+                    let text = s.clone();
+                    ui.selectable_value(&mut forms.filter_station, Some(s), text);
+                }
+            })
+            .response
+            .on_hover_text("show one station only");
+        ui.label("Use");
+        egui::ComboBox::from_id_salt("filter_use")
+            .selected_text(forms.filter_use.map_or("all", Use::as_str))
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut forms.filter_use, None, "all");
+                for u in Use::ALL {
+                    ui.selectable_value(&mut forms.filter_use, Some(u), u.as_str());
+                }
+            })
+            .response
+            .on_hover_text("show one use only");
+        ui.label("Group by");
+        egui::ComboBox::from_id_salt("group")
+            .selected_text(forms.group.label())
+            .show_ui(ui, |ui| {
+                for g in Grouping::ALL {
+                    ui.selectable_value(&mut forms.group, g, g.label());
+                }
+            })
+            .response
+            .on_hover_text("group the rows");
+        let problems = loaded.analysis.failures().count() + loaded.analysis.warnings.len();
+        ui.checkbox(
+            &mut forms.filter_problems,
+            format!("only warnings and failures ({problems})"),
+        )
+        .on_hover_text("show only the measurements whose stripe fit warned or failed");
+        let search = ui.label("Find");
+        ui.add(
+            egui::TextEdit::singleline(&mut forms.search)
+                .hint_text("id or station")
+                .desired_width(110.0),
+        )
+        .labelled_by(search.id)
+        .on_hover_text("show only measurements whose id or station contains this text");
+        if ui
+            .button("Use all")
+            .on_hover_text("include every measurement again")
+            .clicked()
+        {
+            commands.push(Command::View(ViewCommand::IncludeAll));
+        }
+    });
+}
+
+fn save_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mut Vec<Command>) {
+    ui.horizontal(|ui| {
+        let width = (ui.available_width() - 230.0).max(160.0);
+        let field = labelled_field(
+            ui,
+            "Save as",
+            &mut forms.save_path,
+            "/path/to/edited-session.json",
+            width,
+        );
+        if ui
+            .button("Browse…")
+            .on_hover_text("choose the file with the desktop's dialog")
+            .clicked()
+        {
+            commands.push(Command::Browse(Purpose::SaveSession));
+        }
+        let save = ui
+            .add_enabled(!state.jobs.writing(), egui::Button::new("Save"))
+            .on_hover_text("write the session without the left-out measurements (atomic write)");
+        let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+        if save.clicked() || entered {
+            commands.push(Command::Files(FilesCommand::SaveSession));
+        }
+    });
+}
+
+fn rows(state: &AppState, loaded: &LoadedSession, forms: &Forms) -> Vec<Row> {
+    let ms = &loaded.session.measurements;
+    let mut out = Vec::new();
+    let mut current: Option<String> = None;
+    for i in state.visible_rows(forms) {
+        let key = match forms.group {
+            Grouping::None => None,
+            Grouping::Station => Some(ms[i].station.clone()),
+            Grouping::Use => Some(ms[i].usage.as_str().to_string()),
+        };
+        if key.is_some() && key != current {
+            let k = key.clone().unwrap_or_default();
+            let members: Vec<&crate::engine::base::session::Measurement> = ms
+                .iter()
+                .filter(|m| match forms.group {
+                    Grouping::Station => m.station == k,
+                    _ => m.usage.as_str() == k,
+                })
+                .collect();
+            let used = members
+                .iter()
+                .filter(|m| !state.excluded.contains(&m.id))
+                .count();
+            let (title, station) = match forms.group {
+                Grouping::Station => (
+                    format!("station {k}: {} measurements, {used} used", members.len()),
+                    Some(k),
+                ),
+                _ => (
+                    format!("{k}: {} measurements, {used} used", members.len()),
+                    None,
+                ),
+            };
+            out.push(Row::Header(title, station));
+            current = key;
+        }
+        out.push(Row::Item(i));
+    }
+    out
+}
+
+fn table_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    loaded: &LoadedSession,
+    forms: &Forms,
+    commands: &mut Vec<Command>,
+) {
+    let rows = rows(state, loaded, forms);
+    let selected_row = state.selected.and_then(|s| {
+        rows.iter()
+            .position(|r| matches!(r, Row::Item(i) if *i == s))
+    });
+    let ms = &loaded.session.measurements;
+    // Scroll to the selection once each time it changes (arrow keys).
+    let moved_id = egui::Id::unique("session_table_scrolled_to");
+    let last: Option<Option<usize>> = ui.data(|d| d.get_temp(moved_id));
+    let scroll = selected_row.filter(|_| last != Some(state.selected));
+    ui.data_mut(|d| d.insert_temp(moved_id, state.selected));
+    let mut table = TableBuilder::new(ui)
+        .striped(true)
+        .sense(egui::Sense::click())
+        .cell_layout(egui::Layout::left_to_right(egui::Align::Center))
+        .column(Column::initial(90.0).at_least(70.0))
+        .column(Column::initial(60.0))
+        .column(Column::initial(80.0))
+        .column(Column::initial(40.0))
+        .column(Column::initial(55.0))
+        .column(Column::initial(95.0))
+        .column(Column::initial(95.0))
+        .column(Column::remainder().at_least(120.0).clip(true))
+        .min_scrolled_height(0.0);
+    if let Some(row) = scroll {
+        table = table.scroll_to_row(row, None);
+    }
+    table
+        .header(22.0, |mut h| {
+            for title in [
+                "use · id",
+                "station",
+                "use",
+                "side",
+                "points",
+                "fit RMS (mm)",
+                "cut angle (°)",
+                "warnings",
+            ] {
+                h.col(|ui| {
+                    ui.strong(title);
+                });
+            }
+        })
+        .body(|body| {
+            body.rows(22.0, rows.len(), |mut row| match &rows[row.index()] {
+                Row::Header(title, station) => {
+                    row.col(|ui| {
+                        if let Some(s) = station {
+                            let all = ms
+                                .iter()
+                                .filter(|m| m.station == *s)
+                                .all(|m| !state.excluded.contains(&m.id));
+                            let mut v = all;
+                            if ui
+                                .checkbox(&mut v, "all")
+                                .on_hover_text(format!("use every measurement of station {s}"))
+                                .changed()
+                            {
+                                commands.push(Command::View(ViewCommand::SetStationIncluded {
+                                    station: s.clone(),
+                                    included: v,
+                                }));
+                            }
+                        }
+                    });
+                    row.col(|ui| {
+                        ui.add(egui::Label::new(RichText::new(title).strong()).extend());
+                    });
+                    for _ in 0..6 {
+                        row.col(|_| {});
+                    }
+                }
+                Row::Item(i) => {
+                    let i = *i;
+                    row.set_selected(state.selected == Some(i));
+                    item_row(&mut row, state, loaded, i, commands);
+                    let r = row.response();
+                    if r.double_clicked() {
+                        commands.push(Command::View(ViewCommand::Inspect(i)));
+                    } else if r.clicked() {
+                        commands.push(Command::View(ViewCommand::Select(i)));
+                    }
+                }
+            });
+        });
+}
+
+fn item_row(
+    row: &mut egui_extras::TableRow<'_, '_>,
+    state: &AppState,
+    loaded: &LoadedSession,
+    i: usize,
+    commands: &mut Vec<Command>,
+) {
+    let m = &loaded.session.measurements[i];
+    let used = !state.excluded.contains(&m.id);
+    let dim = |t: String| {
+        if used {
+            RichText::new(t)
+        } else {
+            RichText::new(t).color(MUTED).strikethrough()
+        }
+    };
+    row.col(|ui| {
+        let mut v = used;
+        if ui
+            .checkbox(&mut v, dim(m.id.clone()))
+            .on_hover_text(format!("use measurement {} in the solver", m.id))
+            .changed()
+        {
+            commands.push(Command::View(ViewCommand::SetIncluded {
+                id: m.id.clone(),
+                included: v,
+            }));
+        }
+    });
+    row.col(|ui| {
+        ui.label(dim(m.station.clone()));
+    });
+    row.col(|ui| {
+        ui.label(dim(m.usage.as_str().to_string()));
+    });
+    row.col(|ui| {
+        ui.label(dim(format!("{:+}", m.side)));
+    });
+    row.col(|ui| {
+        ui.label(dim(loaded
+            .points(i)
+            .map_or_else(|| "—".into(), |n| n.to_string())));
+    });
+    let fit = loaded.fit(i);
+    match fit {
+        Fit::GivenCentre => {
+            row.col(|ui| {
+                ui.label(dim("given centre".into()));
+            });
+            row.col(|ui| {
+                ui.label(dim("—".into()));
+            });
+            row.col(|_| {});
+        }
+        Fit::Failed(e) => {
+            row.col(|ui| {
+                ui.label(RichText::new("fit failed").color(BAD))
+                    .on_hover_text(e.to_string());
+            });
+            row.col(|ui| {
+                ui.label("—");
+            });
+            row.col(|ui| {
+                ui.label(RichText::new(e.to_string()).color(BAD))
+                    .on_hover_text(e.to_string());
+            });
+        }
+        Fit::Stripe(s) => {
+            row.col(|ui| {
+                ui.label(dim(format!("{:.4}", s.fit.rms)));
+            });
+            row.col(|ui| {
+                ui.label(dim(format!("{:+.1}", s.sphere.cut_angle_deg)));
+            });
+            row.col(|ui| {
+                if s.warnings.is_empty() {
+                    ui.label(RichText::new("ok").color(Color32::from_rgb(90, 170, 90)));
+                } else {
+                    // Every warning named, in a few words each (the whole
+                    // text on hover and in the Stripe view).
+                    ui.add(
+                        egui::Label::new(RichText::new(warnings_cell(&s.warnings)).color(WARN))
+                            .extend(),
+                    )
+                    .on_hover_text(s.warnings.join("\n"));
+                }
+            });
+        }
+    }
+}
+
+/// Longest tag of a warning without a recognised opening, characters.
+const TAG_CHARS: usize = 32;
+
+/// A stripe warning in a few words, for the table: what it is about
+/// ("raw profile", "3 points rejected", "short arc", "high fit RMS",
+/// "centre on the laser plane", "cut angle 72.3° is above 60°").
+#[must_use]
+pub fn warning_tag(warning: &str) -> String {
+    let before_colon = warning.split(':').next().unwrap_or(warning).trim();
+    if warning.starts_with("raw profile") {
+        "raw profile".to_string()
+    } else if let Some(n) = warning
+        .find(" stripe points rejected")
+        .and_then(|at| warning[..at].split(" of ").next())
+    {
+        format!("{n} points rejected")
+    } else if warning.starts_with("short arc") {
+        "short arc".to_string()
+    } else if warning.starts_with("high circle-fit RMS") {
+        "high fit RMS".to_string()
+    } else if warning.starts_with("stripe radius") {
+        "centre on the laser plane".to_string()
+    } else if warning.starts_with("cut angle") {
+        before_colon.to_string()
+    } else {
+        let mut tag: String = before_colon.chars().take(TAG_CHARS).collect();
+        if before_colon.chars().count() > TAG_CHARS {
+            tag.push('…');
+        }
+        tag
+    }
+}
+
+/// Every warning of a measurement, tagged, in one line.
+#[must_use]
+pub fn warnings_cell(warnings: &[String]) -> String {
+    warnings
+        .iter()
+        .map(|w| warning_tag(w))
+        .collect::<Vec<_>>()
+        .join(" · ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The issue: "(2) raw profile, …" hid the cut-angle warning behind
+    /// the count and cut the rest with "…". Every warning is named.
+    #[test]
+    fn every_warning_is_named_in_a_few_words() {
+        let ws = vec![
+            "raw profile, the sphere's arc: 412 of 800 points, 38.1° to 141.9°".to_string(),
+            "cut angle 66.2° is above 60°: the laser plane is near the sphere's pole and the stripe circle is small (r = 16.2 mm); about ±40° is best".to_string(),
+        ];
+        assert_eq!(
+            warnings_cell(&ws),
+            "raw profile · cut angle 66.2° is above 60°"
+        );
+        assert_eq!(
+            warning_tag("3 of 120 stripe points rejected as outliers (largest residual 0.300 mm)"),
+            "3 points rejected"
+        );
+        assert_eq!(
+            warning_tag("short arc: the stripe spans 12.0° of its circle"),
+            "short arc"
+        );
+        assert_eq!(
+            warning_tag("high circle-fit RMS: 0.2 mm over 9 points"),
+            "high fit RMS"
+        );
+        assert_eq!(
+            warning_tag("stripe radius r = 19.1 mm exceeds the sphere radius"),
+            "centre on the laser plane"
+        );
+        assert!(warning_tag(&"x".repeat(80)).ends_with('…'));
+    }
+}
+
+/// Loading: the current session (three lines whatever it is, so that
+/// nothing below moves), the path field with Open… and the demo.
+pub fn load_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    ui.heading("Session");
+    let line = |ui: &mut egui::Ui, text: RichText| ui.add(egui::Label::new(text).truncate());
+    // Whole, wrapped: a cut path or count hides what is open.
+    let whole = |ui: &mut egui::Ui, text: RichText| ui.add(egui::Label::new(text).wrap());
+    if let Some(l) = &state.loaded {
+        name_ui(ui, &l.session.name);
+        whole(ui, RichText::new(l.source.label()).small().weak());
+        let n = l.session.measurements.len();
+        let stations = l.station_ids().len();
+        let text = format!(
+            "{n} measurements, {stations} station{}, sphere Ø {} mm{}",
+            if stations == 1 { "" } else { "s" },
+            l.session.sphere_diameter,
+            if l.session.pose_only() {
+                " · pose-only (flange poses)"
+            } else {
+                ""
+            }
+        );
+        whole(ui, RichText::new(text).small());
+    } else {
+        match state.jobs.get(&Slot::Load) {
+            Some(job) => name_ui(ui, &job.phase),
+            None => name_ui(ui, "no session open"),
+        }
+        line(ui, RichText::new(" ").small());
+        line(ui, RichText::new(" ").small());
+    }
+    ui.add_space(4.0);
+    let width = ui.available_width();
+    let field = ui
+        .vertical(|ui| {
+            labelled_field(
+                ui,
+                "Session or result file",
+                &mut forms.open_path,
+                "/path/to/session.json",
+                width,
+            )
+        })
+        .inner;
+    let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+    ui.horizontal(|ui| {
+        if ui
+            .button("Open path")
+            .on_hover_text("open the file typed above")
+            .clicked()
+            || entered
+        {
+            commands.push(Command::Files(FilesCommand::OpenPath(
+                forms.open_path.trim().into(),
+            )));
+        }
+        let dialog = ui
+            .add_enabled(!state.jobs.runs(&Slot::Dialog), egui::Button::new("Open…"))
+            .on_hover_text("choose a file with the desktop's file dialog");
+        if dialog.clicked() {
+            commands.push(Command::Browse(Purpose::Open));
+        }
+        if ui
+            .button("Demo")
+            .on_hover_text("the demo session built into the program")
+            .clicked()
+        {
+            commands.push(Command::Files(FilesCommand::OpenDemo));
+        }
+    });
+    // One line either way: the dialog's note replaces the drop hint.
+    let hint = if state.dialog_empty == Some(Purpose::Open) {
+        NO_DIALOG
+    } else {
+        "or drop a file onto the window"
+    };
+    line(ui, RichText::new(hint).small().weak()).on_hover_text(hint);
+}
+
+/// The session's name in two lines of room whatever its length (wrapped,
+/// cut with … beyond two lines, whole on hover).
+fn name_ui(ui: &mut egui::Ui, name: &str) {
+    let style = egui::TextStyle::Body;
+    let width = ui.available_width();
+    let height = 2.0 * ui.text_style_height(&style);
+    let mut job = egui::text::LayoutJob::single_section(
+        name.to_string(),
+        egui::TextFormat {
+            font_id: style.resolve(ui.style()),
+            color: ui.visuals().strong_text_color(),
+            ..Default::default()
+        },
+    );
+    job.wrap = egui::text::TextWrapping {
+        max_width: width,
+        max_rows: 2,
+        break_anywhere: false,
+        overflow_character: Some('…'),
+    };
+    let rect = egui::Rect::from_min_size(ui.cursor().min, egui::vec2(width, height));
+    let used = ui
+        .scope_builder(egui::UiBuilder::new().max_rect(rect), |ui| {
+            ui.add(egui::Label::new(job)).on_hover_text(name);
+        })
+        .response
+        .rect
+        .height();
+    if used < height {
+        ui.add_space(height - used);
+    }
+}
+
+/// The error of the last thing that failed (a file that did not open, an
+/// export not written), until dismissed.
+pub fn notice_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
+    if let Some(notice) = &state.notice {
+        ui.add_space(6.0);
+        egui::Frame::group(ui.style())
+            .stroke(egui::Stroke::new(1.5, BAD))
+            .show(ui, |ui| {
+                ui.label(RichText::new(&notice.title).strong().color(BAD));
+                ui.label(&notice.body);
+                if ui.button("Dismiss").clicked() {
+                    commands.push(Command::View(ViewCommand::DismissNotice));
+                }
+            });
+    }
+}
+
+/// The recent files, newest first.
+pub fn recent_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
+    if !state.prefs.recent.is_empty() {
+        ui.add_space(4.0);
+        egui::CollapsingHeader::new("Recent files")
+            .default_open(true)
+            .show(ui, |ui| {
+                for p in &state.prefs.recent {
+                    let name = p.file_name().map_or_else(
+                        || p.display().to_string(),
+                        |n| n.to_string_lossy().into_owned(),
+                    );
+                    if ui
+                        .add(egui::Button::new(name).truncate())
+                        .on_hover_text(p.display().to_string())
+                        .clicked()
+                    {
+                        commands.push(Command::Files(FilesCommand::OpenPath(p.clone())));
+                    }
+                }
+                if ui.small_button("Clear list").clicked() {
+                    commands.push(Command::Files(FilesCommand::ClearRecent));
+                }
+            });
+    }
+}

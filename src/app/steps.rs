@@ -1,0 +1,495 @@
+//! The step bar: the operator's job in order (plan → data in → stripes
+//! checked → calibrated → validated → reported, then measured: scans
+//! through the calibrated cell), where the open session
+//! stands, and the next action as one button, with an action in every
+//! state: a stale step is done again, a FAIL leads to the outliers and
+//! then to the planner, a session without validate measurements skips
+//! the validation and goes on to the report. Whether a step is stale
+//! comes from the one [`ledger`](crate::app::ledger) of the
+//! state, never from a flag of its own.
+
+use egui::RichText;
+
+use crate::app::AppState;
+use crate::app::command::ExportKind;
+use crate::app::command::{Command, PlanCommand, RunCommand, ViewCommand};
+use crate::app::job::Slot;
+use crate::app::ledger::Artefact;
+use crate::app::widgets::{AFTER, BAD, GOOD, MUTED, WARN};
+use crate::app::{Forms, command::Tab};
+use crate::engine::tools::result_view::Verdict;
+
+/// Where one step stands.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum StepState {
+    /// Done, and made from the inputs as they are.
+    Done,
+    /// Done, with something to look at (stripe warnings, a FAIL).
+    Attention,
+    /// Done, but an input it was made from has changed since: what
+    /// changed, in words.
+    Stale(String),
+    /// Not needed for this session (no validate measurements).
+    Skipped,
+    /// Under way (a run, a file being opened).
+    Running,
+    /// Not done yet.
+    Todo,
+}
+
+impl StepState {
+    /// The mark on the bar: ● done, ! attention or stale, – skipped,
+    /// … under way, ○ to do.
+    #[must_use]
+    pub fn mark(&self) -> &'static str {
+        match self {
+            Self::Done => "●",
+            Self::Attention | Self::Stale(_) => "!",
+            Self::Skipped => "–",
+            Self::Running => "…",
+            Self::Todo => "○",
+        }
+    }
+}
+
+/// One step of the job.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Step {
+    /// Its name on the bar.
+    pub name: &'static str,
+    /// Where it stands.
+    pub state: StepState,
+    /// A few words on its state (hover text).
+    pub detail: String,
+    /// The button that does or shows it, and its command.
+    pub action: (String, Command),
+}
+
+fn show(tab: Tab) -> Command {
+    Command::View(ViewCommand::ShowTab(tab))
+}
+
+/// The verdict of the result on show against the form's tolerance.
+#[must_use]
+pub fn verdict(state: &AppState, forms: &Forms) -> Option<Verdict> {
+    state
+        .result
+        .as_ref()
+        .map(|r| Verdict::of(r.shown.headline.as_ref(), &forms.tolerance))
+}
+
+/// Measurements `ml` listed as outliers in the result on show.
+fn outliers(state: &AppState) -> usize {
+    state
+        .result
+        .as_ref()
+        .and_then(|r| r.file.solver.ml())
+        .map_or(0, |m| m.outliers.len())
+}
+
+/// Where the step of `artefact` stands, from the ledger and the job
+/// table alone: under way (its phase), stale (what changed), done (what
+/// it is), or not made.
+#[must_use]
+pub fn standing(state: &AppState, artefact: Artefact) -> (StepState, String) {
+    let ledger = &state.ledger;
+    if let Some(job) = Slot::of(artefact).and_then(|s| state.jobs.get(&s)) {
+        return (StepState::Running, job.phase.clone());
+    }
+    match (ledger.made(artefact), ledger.stale(artefact)) {
+        (Some(_), Some(s)) => (StepState::Stale(s.what_changed()), s.to_string()),
+        (Some(m), None) => (StepState::Done, m.what.clone()),
+        (None, _) => (StepState::Todo, String::new()),
+    }
+}
+
+/// A step of `artefact` ([`standing`]) with its words for each state:
+/// `todo` before it is made, `again` added to what makes it stale.
+fn step(
+    state: &AppState,
+    artefact: Artefact,
+    name: &'static str,
+    (todo, again): (&str, &str),
+    action: (String, Command),
+) -> Step {
+    let (state, words) = standing(state, artefact);
+    let detail = match &state {
+        StepState::Todo => todo.to_string(),
+        StepState::Stale(_) => format!("{words}: {again}"),
+        _ => words,
+    };
+    Step {
+        name,
+        state,
+        detail,
+        action,
+    }
+}
+
+/// The steps of the job for the current state (the Measure step, the
+/// cell's use once calibrated, last). Whether an artefact's step is done,
+/// under way or stale comes from the ledger and the job table only.
+#[must_use]
+pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
+    let loaded = state.loaded.as_ref();
+    let failed = loaded.map_or(0, |l| l.analysis.failures().count());
+    let warned = loaded.map_or(0, |l| l.analysis.warnings.len());
+    let calibrated = standing(state, Artefact::Result).0;
+    let again = |label: &str, state: &StepState, first: &str| match state {
+        StepState::Stale(_) => label.to_string(),
+        _ => first.to_string(),
+    };
+    let mut plan = step(
+        state,
+        Artefact::Plan,
+        "Plan",
+        (
+            "plan the poses for the robot and the sphere",
+            "make it again before writing its program",
+        ),
+        (String::new(), show(Tab::Plan)),
+    );
+    plan.action.0 = again("Make the plan again", &plan.state, "Plan the poses");
+    if plan.state == StepState::Todo && loaded.is_some() {
+        plan.state = StepState::Done;
+        plan.detail = "a session is open (its poses were planned elsewhere)".into();
+    }
+    let mut calibrate = step(
+        state,
+        Artefact::Result,
+        "Calibrated",
+        ("run the calibration", "run again"),
+        (String::new(), Command::Run(RunCommand::Start)),
+    );
+    if calibrate.state == StepState::Running {
+        calibrate.detail = format!("calibrating: {}", calibrate.detail);
+    }
+    calibrate.action.0 = again("▶ Run again", &calibrate.state, "▶ Run the calibration");
+    let mut report = step(
+        state,
+        Artefact::Report,
+        "Reported",
+        (
+            "write the HTML report",
+            "it no longer says what is on show; write it again",
+        ),
+        (String::new(), Command::Export(ExportKind::ReportHtml)),
+    );
+    report.action.0 = again("Write the report again", &report.state, "Write the report");
+    vec![
+        plan,
+        Step {
+            name: "Data in",
+            state: if state.jobs.runs(&Slot::Load) {
+                StepState::Running
+            } else if loaded.is_some() {
+                StepState::Done
+            } else {
+                StepState::Todo
+            },
+            detail: if let Some(job) = state.jobs.get(&Slot::Load) {
+                job.phase.clone()
+            } else {
+                loaded.map_or_else(
+                    || "import the robot's log and the sensor's profiles, or open a session".into(),
+                    |l| {
+                        format!(
+                            "{} measurements in \"{}\"",
+                            l.session.measurements.len(),
+                            l.session.name
+                        )
+                    },
+                )
+            },
+            action: ("Import data".into(), show(Tab::Import)),
+        },
+        Step {
+            name: "Stripes checked",
+            state: match loaded {
+                None => StepState::Todo,
+                Some(_) if failed + warned > 0 => StepState::Attention,
+                Some(_) => StepState::Done,
+            },
+            detail: match loaded {
+                None => "no session yet".into(),
+                Some(_) if failed + warned > 0 => format!(
+                    "{failed} stripe(s) cannot be fitted, {warned} with warnings: look at them in Stripe (Session: only warnings and failures), leave out what is wrong"
+                ),
+                Some(_) => "every stripe fits a circle, no warnings".into(),
+            },
+            action: ("Check the stripes".into(), show(Tab::Stripe)),
+        },
+        calibrate,
+        validated(state, forms, calibrated),
+        report,
+        measure_step(state),
+    ]
+}
+
+/// The Validated step: the verdict of the result on show against the
+/// tolerance, stale with the result.
+fn validated(state: &AppState, forms: &Forms, calibrated: StepState) -> Step {
+    let verdict = verdict(state, forms);
+    let (state, detail) = match (calibrated, &verdict) {
+        (StepState::Running | StepState::Todo, _) | (_, None) => {
+            (StepState::Todo, "calibrate first".to_string())
+        }
+        (StepState::Stale(s), Some(_)) => (
+            StepState::Stale(s.clone()),
+            format!("the result is stale: {s}; its verdict no longer holds"),
+        ),
+        (_, Some(Verdict::Pass)) => (StepState::Done, Verdict::Pass.describe(&forms.tolerance)),
+        (_, Some(v @ Verdict::Fail(_))) => (StepState::Attention, v.describe(&forms.tolerance)),
+        (_, Some(Verdict::NotChecked)) => (
+            StepState::Skipped,
+            "skipped: no validate data (the session has no validate measurements)".to_string(),
+        ),
+    };
+    Step {
+        name: "Validated",
+        state,
+        detail,
+        action: ("See the verdict".into(), show(Tab::Results)),
+    }
+}
+
+/// What the Next button offers: its text, its command (`None`: shown
+/// disabled, e.g. while a run is under way), why, and other ways on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NextAction {
+    /// The button text after "Next: ".
+    pub label: String,
+    /// Its command; `None` while something is under way.
+    pub command: Option<Command>,
+    /// Why this is next (hover text).
+    pub why: String,
+    /// Other ways on, as smaller buttons ("or: write the report").
+    pub others: Vec<(String, Command)>,
+}
+
+/// The next action in the current state; `None` when every step is done
+/// (and nothing failed).
+#[must_use]
+pub fn next_action(state: &AppState, forms: &Forms, all: &[Step]) -> Option<NextAction> {
+    let simple = |k: usize| {
+        let step: &Step = &all[k];
+        Some(NextAction {
+            label: step.action.0.clone(),
+            command: Some(step.action.1.clone()),
+            why: step.detail.clone(),
+            others: Vec::new(),
+        })
+    };
+    if let Some(run) = state.jobs.get(&Slot::Run) {
+        return Some(NextAction {
+            label: format!(
+                "calibrating… {:.0} %",
+                run.fraction.unwrap_or_default() * 100.0
+            ),
+            command: None,
+            why: format!(
+                "{}: wait for the run, or press Cancel in the solver panel (the result on show stays)",
+                run.phase
+            ),
+            others: Vec::new(),
+        });
+    }
+    if state.jobs.runs(&Slot::Load) {
+        return Some(NextAction {
+            label: "opening…".into(),
+            command: None,
+            why: all[1].detail.clone(),
+            others: Vec::new(),
+        });
+    }
+    if state.loaded.is_none() {
+        // Plan (again) or bring the data in.
+        let k = usize::from(!matches!(
+            all[0].state,
+            StepState::Todo | StepState::Stale(_)
+        ));
+        return simple(k);
+    }
+    // A missing or stale result: run (again).
+    if matches!(all[3].state, StepState::Todo | StepState::Stale(_)) {
+        return simple(3);
+    }
+    let report = &all[5];
+    let report_todo = !matches!(report.state, StepState::Done);
+    if let Some(Verdict::Fail(reasons)) = verdict(state, forms) {
+        let n = outliers(state);
+        let mut others = Vec::new();
+        if report_todo {
+            others.push((
+                "write the report (FAIL)".to_string(),
+                report.action.1.clone(),
+            ));
+        }
+        let why = format!("FAIL: {}", reasons.join(", "));
+        if n > 0 && !state.outliers_seen {
+            others.insert(
+                0,
+                (
+                    "plan more stations".to_string(),
+                    Command::Plan(PlanCommand::MoreStations),
+                ),
+            );
+            return Some(NextAction {
+                label: format!("Look at the {n} outlier(s)"),
+                command: Some(Command::View(ViewCommand::ShowOutliers)),
+                why: format!(
+                    "{why}: see which measurements the solver flagged, leave out what is wrong, run again"
+                ),
+                others,
+            });
+        }
+        return Some(NextAction {
+            label: "Plan more stations".into(),
+            command: Some(Command::Plan(PlanCommand::MoreStations)),
+            why: format!(
+                "{why}: more identify stations determine the parameters better; the planner opens with more of them"
+            ),
+            others,
+        });
+    }
+    report_todo.then(|| simple(5)).flatten()
+}
+
+/// The first-start "what to do", on the demo until dismissed.
+fn intro_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
+    let on_demo = state
+        .loaded
+        .as_ref()
+        .is_some_and(|l| l.source == crate::app::session::Source::Demo);
+    if !on_demo || state.prefs.intro_dismissed {
+        return;
+    }
+    egui::Frame::group(ui.style()).show(ui, |ui| {
+        ui.horizontal_wrapped(|ui| {
+            ui.label(RichText::new("What to do").strong());
+            ui.label(
+                "This is the demo: a simulated paper-like cell. The bar below is the job in order. \
+                 Press Next to run the calibration, then see the verdict in Results and write the report. \
+                 For your own cell: Plan the poses, Import the robot's log and the sensor's profiles \
+                 (or open a session file on the left), check the stripes, then run.",
+            );
+            if ui.button("Got it").clicked() {
+                commands.push(Command::View(ViewCommand::DismissIntro));
+            }
+        });
+    });
+}
+
+/// The colour of a step's mark and name.
+fn colour(step: &Step) -> egui::Color32 {
+    match step.state {
+        StepState::Done => GOOD,
+        StepState::Attention if step.name == "Validated" => BAD,
+        StepState::Attention | StepState::Stale(_) => WARN,
+        StepState::Running => AFTER,
+        StepState::Skipped | StepState::Todo => MUTED,
+    }
+}
+
+/// The bar: each step with its mark, then the next action's button and
+/// the other ways on.
+pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mut Vec<Command>) {
+    intro_ui(ui, state, commands);
+    let all = steps(state, forms);
+    let next = next_action(state, forms, &all);
+    ui.horizontal_wrapped(|ui| {
+        for (k, step) in all.iter().enumerate() {
+            if k > 0 {
+                ui.label(RichText::new("›").color(MUTED));
+            }
+            let text = RichText::new(format!("{} {}. {}", step.state.mark(), k + 1, step.name))
+                .size(14.0)
+                .color(colour(step));
+            // A step is a link to its view (or does its action).
+            let busy = state.jobs.runs(&Slot::Run) && matches!(step.action.1, Command::Run(_));
+            let hover = match &step.state {
+                StepState::Stale(_) => format!("stale: {} ({})", step.detail, step.action.0),
+                _ => format!("{} ({})", step.detail, step.action.0),
+            };
+            if ui
+                .add_enabled(!busy, egui::Button::new(text).frame(false))
+                .on_hover_text(hover)
+                .clicked()
+            {
+                commands.push(step.action.1.clone());
+            }
+        }
+        match &next {
+            Some(n) => {
+                ui.add_space(12.0);
+                let button =
+                    egui::Button::new(RichText::new(format!("Next: {}", n.label)).color(AFTER));
+                if ui
+                    .add_enabled(n.command.is_some(), button)
+                    .on_hover_text(&n.why)
+                    .on_disabled_hover_text(&n.why)
+                    .clicked()
+                    && let Some(c) = &n.command
+                {
+                    commands.push(c.clone());
+                }
+                for (label, command) in &n.others {
+                    if ui
+                        .small_button(format!("or: {label}"))
+                        .on_hover_text(&n.why)
+                        .clicked()
+                    {
+                        commands.push(command.clone());
+                    }
+                }
+            }
+            None if state.loaded.is_some() => {
+                ui.add_space(12.0);
+                ui.label(RichText::new("● every step is done").color(GOOD));
+            }
+            None => {}
+        }
+    });
+    // What changed, in words, under the bar: the stale steps, by cause.
+    let mut causes: Vec<(&str, Vec<String>)> = Vec::new();
+    for (k, step) in all.iter().enumerate() {
+        if let StepState::Stale(what) = &step.state {
+            let name = format!("{}. {}", k + 1, step.name);
+            match causes.iter_mut().find(|(w, _)| *w == what.as_str()) {
+                Some((_, names)) => names.push(name),
+                None => causes.push((what, vec![name])),
+            }
+        }
+    }
+    for (what, names) in causes {
+        ui.label(
+            RichText::new(format!("! stale: {} — {what}", names.join(", ")))
+                .small()
+                .color(WARN),
+        );
+    }
+}
+
+/// The Measure step of the step bar: to do, under way, done or stale
+/// (the cloud's standing in the ledger).
+#[must_use]
+pub fn measure_step(state: &AppState) -> Step {
+    let mut m = step(
+        state,
+        Artefact::Cloud,
+        "Measured",
+        (
+            "measure a scan with the calibrated cell (optional)",
+            "measure again before exporting",
+        ),
+        (
+            "Measure a scan".to_string(),
+            Command::View(ViewCommand::ShowTab(Tab::Measure)),
+        ),
+    );
+    if let (StepState::Running, Some(job)) = (&m.state, state.jobs.get(&Slot::Measure)) {
+        let percent = job.fraction.unwrap_or_default() * 100.0;
+        m.detail = format!("measuring: {} ({percent:.0} %)", job.phase);
+    }
+    m
+}
