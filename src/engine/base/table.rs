@@ -37,6 +37,25 @@ pub fn csv_field(text: &str) -> String {
     }
 }
 
+/// A side cell that is not one.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("side `{}` is not +1, -1 or blank", excerpt(.0))]
+pub struct SideCellError(pub String);
+
+/// A `side` cell of a table (joint logs, pose tables, plans): `+1`, `1`,
+/// `-1` (also `1.0`, `+1.0`, `-1.0`), or blank (`None`: not given).
+///
+/// # Errors
+/// [`SideCellError`] for anything else.
+pub fn side_cell(cell: &str) -> Result<Option<i8>, SideCellError> {
+    match cell.trim() {
+        "" => Ok(None),
+        "1" | "+1" | "1.0" | "+1.0" => Ok(Some(1)),
+        "-1" | "-1.0" => Ok(Some(-1)),
+        other => Err(SideCellError(other.to_string())),
+    }
+}
+
 /// `text` cut to at most `max` characters for a message: the start, then
 /// `…` and how many characters were left out.
 #[must_use]

@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
-use crate::engine::base::geometry::{isometry_from_rows, rows_from_isometry};
+use crate::engine::base::geometry::{MatrixError, isometry_from_rows, rows_from_isometry};
 
 /// Largest accepted deviation of an ABB quaternion's norm from 1.
 const QUATERNION_NORM_TOLERANCE: f64 = 1e-3;
@@ -187,6 +187,28 @@ impl Controller {
     }
 }
 
+/// Why a controller's values are no pose.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PoseValuesError {
+    /// Another count of values than the convention has.
+    #[error("{given} values given, the convention needs {needed}")]
+    Count {
+        /// Values given.
+        given: usize,
+        /// Values of the convention.
+        needed: usize,
+    },
+    /// An ABB quaternion that is not of unit norm.
+    #[error("quaternion norm {0:.6} is not 1")]
+    QuaternionNorm(f64),
+    /// NaN or infinite.
+    #[error("a value is not a finite number")]
+    NotFinite,
+    /// A matrix that is not a rigid transform.
+    #[error(transparent)]
+    Matrix(#[from] MatrixError),
+}
+
 /// How a controller writes the flange pose.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FlangeConvention {
@@ -283,20 +305,20 @@ impl FlangeConvention {
     /// is wrong with them.
     ///
     /// # Errors
-    /// A message when the count is wrong or an ABB quaternion is not unit.
-    pub fn pose_from_values(self, v: &[f64]) -> Result<Isometry3<f64>, String> {
+    /// [`PoseValuesError`]: the count is wrong, an ABB quaternion is not
+    /// unit, a value is not finite, a matrix is not rigid.
+    pub fn pose_from_values(self, v: &[f64]) -> Result<Isometry3<f64>, PoseValuesError> {
         if v.len() != self.n_columns() {
-            return Err(format!(
-                "{} values given, the convention needs {}",
-                v.len(),
-                self.n_columns()
-            ));
+            return Err(PoseValuesError::Count {
+                given: v.len(),
+                needed: self.n_columns(),
+            });
         }
         let (t, r) = match self {
             Self::AbbQuaternion => {
                 let q = Quaternion::new(v[3], v[4], v[5], v[6]);
                 if (q.norm() - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
-                    return Err(format!("quaternion norm {:.6} is not 1", q.norm()));
+                    return Err(PoseValuesError::QuaternionNorm(q.norm()));
                 }
                 (
                     Vector3::new(v[0], v[1], v[2]),
@@ -328,11 +350,11 @@ impl FlangeConvention {
                 for (k, x) in v.iter().enumerate() {
                     rows[k / 4][k % 4] = *x;
                 }
-                return isometry_from_rows(&rows).map_err(|e| e.to_string());
+                return Ok(isometry_from_rows(&rows)?);
             }
         };
         if v.iter().any(|x| !x.is_finite()) {
-            return Err("a value is not a finite number".to_string());
+            return Err(PoseValuesError::NotFinite);
         }
         Ok(Isometry3::from_parts(Translation3::from(t), r))
     }
@@ -453,14 +475,16 @@ mod tests {
     fn bad_values_are_named() {
         let e = FlangeConvention::FanucWpr
             .pose_from_values(&[1.0, 2.0, 3.0, 4.0, 5.0])
-            .unwrap_err();
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("5 values"), "{e}");
         let mut m = vec![0.0; 16];
         m[0] = 2.0;
         assert!(FlangeConvention::Matrix.pose_from_values(&m).is_err());
         let nan = FlangeConvention::KukaAbc
             .pose_from_values(&[1.0, 2.0, f64::NAN, 0.0, 0.0, 0.0])
-            .unwrap_err();
+            .unwrap_err()
+            .to_string();
         assert!(nan.contains("finite"), "{nan}");
     }
 }

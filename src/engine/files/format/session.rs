@@ -325,7 +325,12 @@ impl<'a> Ctx<'a> {
     }
 
     /// A broken rule ([`rules`]) of the value `raw`, with its position.
-    fn rule(&self, m: Option<&str>, message: String, raw: &'a RawValue) -> FileError {
+    fn rule(
+        &self,
+        m: Option<&str>,
+        message: impl std::fmt::Display,
+        raw: &'a RawValue,
+    ) -> FileError {
         self.invalid(m, format!("{message}{}", self.at(raw)))
     }
 

@@ -16,7 +16,7 @@ use serde_json::Value;
 
 use super::read::{Cap, read_text};
 use crate::engine::base::geometry::{MatrixError, isometry_from_rows};
-use crate::engine::base::session::rules;
+use crate::engine::base::session::rules::{self, RuleViolation};
 
 /// Why a transform file gives no transform. The messages name no file:
 /// the caller names the file and what it is.
@@ -40,9 +40,9 @@ pub enum TransformError {
     /// Not a rigid transform.
     #[error("not a rigid transform: {0}")]
     NotRigid(#[from] MatrixError),
-    /// Beyond the session rules' plausibility caps (message names the key).
-    #[error("{0}")]
-    Implausible(String),
+    /// Beyond the session rules' plausibility caps (names the key).
+    #[error(transparent)]
+    Implausible(#[from] RuleViolation),
 }
 
 /// The transform in `path`: a 4×4 matrix (JSON rows), an object with the
@@ -70,6 +70,6 @@ pub fn read_transform(path: &Path, key: &str) -> Result<Isometry3<f64>, Transfor
     let rows: [[f64; 4]; 4] =
         serde_json::from_value(matrix).map_err(|e| TransformError::NotMatrix(e.to_string()))?;
     let transform = isometry_from_rows(&rows)?;
-    rules::transform(key, &transform).map_err(TransformError::Implausible)?;
+    rules::transform(key, &transform)?;
     Ok(transform)
 }

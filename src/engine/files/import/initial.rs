@@ -58,24 +58,35 @@ fn translation_group(poses: &[Isometry3<f64>]) -> Vec<usize> {
     best
 }
 
+/// No group of one orientation for eq. 6-9: the sizes found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "no group of one orientation for eq. 6-9: the largest set of poses with one orientation (within {SAME_ORIENTATION_DEG}°) has {translations} poses and {others} others change orientation; eq. 6-9 need at least {MIN_TRANSLATIONS} of the one and {MIN_ROTATIONS} of the other"
+)]
+pub struct Eq69Error {
+    /// Poses of the largest group of one orientation.
+    pub translations: usize,
+    /// The other poses.
+    pub others: usize,
+}
+
 /// The poses (flange poses `bT_e`, mm) of the group of one orientation
 /// the paper's eq. 6-9 start from, when there is one: at least
 /// [`MIN_TRANSLATIONS`] poses of one orientation (within
 /// [`SAME_ORIENTATION_DEG`]) and [`MIN_ROTATIONS`] others.
 ///
 /// # Errors
-/// No such group: the sentence that says why (the sizes found and what
-/// eq. 6-9 need).
-pub fn eq69_group(poses: &[Isometry3<f64>]) -> Result<Vec<usize>, String> {
+/// [`Eq69Error`]: no such group (the sizes found).
+pub fn eq69_group(poses: &[Isometry3<f64>]) -> Result<Vec<usize>, Eq69Error> {
     let group = translation_group(poses);
     let others = poses.len() - group.len();
     if group.len() >= MIN_TRANSLATIONS && others >= MIN_ROTATIONS {
         Ok(group)
     } else {
-        Err(format!(
-            "no group of one orientation for eq. 6-9: the largest set of poses with one orientation (within {SAME_ORIENTATION_DEG}°) has {} poses and {others} others change orientation; eq. 6-9 need at least {MIN_TRANSLATIONS} of the one and {MIN_ROTATIONS} of the other",
-            group.len()
-        ))
+        Err(Eq69Error {
+            translations: group.len(),
+            others,
+        })
     }
 }
 
@@ -303,40 +314,42 @@ fn paper_hand_eye(
     ids: &[&str],
 ) -> Result<(Isometry3<f64>, String), String> {
     let robot = &session.robot;
-    eq69_group(poses).and_then(|group| {
-        let sight = |i: usize| -> Option<Sighting> {
-            let m = &session.measurements[i];
-            centres[i].map(|c| Sighting {
-                id: m.id.clone(),
-                joints: m.joints.clone(),
-                flange: m.flange,
-                centre_in_sensor: c,
-            })
-        };
-        let in_group: Vec<bool> = (0..poses.len()).map(|i| group.contains(&i)).collect();
-        let translations: Vec<Sighting> = group.iter().filter_map(|&i| sight(i)).collect();
-        let rotations: Vec<Sighting> = (0..poses.len())
-            .filter(|&i| !in_group[i] && stations[i] == stations[group[0]])
-            .filter_map(sight)
-            .collect();
-        let t_ids: Vec<&str> = group.iter().map(|&i| ids[i]).collect();
-        let r_ids: Vec<&str> = (0..poses.len())
-            .filter(|&i| !in_group[i])
-            .map(|i| ids[i])
-            .collect();
-        initial_hand_eye(robot, &translations, &rotations)
-            .map(|h| {
-                (
-                    h.flange_from_sensor,
-                    format!(
-                        "translation group {} (one orientation), rotation {}",
-                        names(&t_ids),
-                        names(&r_ids)
-                    ),
-                )
-            })
-            .map_err(|e| e.to_string())
-    })
+    eq69_group(poses)
+        .map_err(|e| e.to_string())
+        .and_then(|group| {
+            let sight = |i: usize| -> Option<Sighting> {
+                let m = &session.measurements[i];
+                centres[i].map(|c| Sighting {
+                    id: m.id.clone(),
+                    joints: m.joints.clone(),
+                    flange: m.flange,
+                    centre_in_sensor: c,
+                })
+            };
+            let in_group: Vec<bool> = (0..poses.len()).map(|i| group.contains(&i)).collect();
+            let translations: Vec<Sighting> = group.iter().filter_map(|&i| sight(i)).collect();
+            let rotations: Vec<Sighting> = (0..poses.len())
+                .filter(|&i| !in_group[i] && stations[i] == stations[group[0]])
+                .filter_map(sight)
+                .collect();
+            let t_ids: Vec<&str> = group.iter().map(|&i| ids[i]).collect();
+            let r_ids: Vec<&str> = (0..poses.len())
+                .filter(|&i| !in_group[i])
+                .map(|i| ids[i])
+                .collect();
+            initial_hand_eye(robot, &translations, &rotations)
+                .map(|h| {
+                    (
+                        h.flange_from_sensor,
+                        format!(
+                            "translation group {} (one orientation), rotation {}",
+                            names(&t_ids),
+                            names(&r_ids)
+                        ),
+                    )
+                })
+                .map_err(|e| e.to_string())
+        })
 }
 
 /// The general solution from `n` poses in words: its orientation span,

@@ -14,6 +14,7 @@ use super::csv_file::CsvFile;
 use super::units::{self, AngleUnit};
 use super::{ImportError, ImportSpec, load_robot};
 use crate::engine::base::session::Use;
+use crate::engine::base::table::side_cell;
 
 /// The side column read when the mapping names none.
 pub const DEFAULT_SIDE_COLUMN: &str = "side";
@@ -360,20 +361,4 @@ pub fn preview(spec: &ImportSpec, rows: usize) -> Result<String, ImportError> {
         let _ = writeln!(out);
     }
     Ok(out)
-}
-
-/// A side cell: `+1`, `1`, `-1`, or blank (not given).
-///
-/// # Errors
-/// Anything else, in words.
-pub(crate) fn side_cell(cell: &str) -> Result<Option<i8>, String> {
-    match cell.trim() {
-        "" => Ok(None),
-        "1" | "+1" | "1.0" | "+1.0" => Ok(Some(1)),
-        "-1" | "-1.0" => Ok(Some(-1)),
-        other => Err(format!(
-            "side `{}` is not +1, -1 or blank",
-            crate::engine::base::table::excerpt(other)
-        )),
-    }
 }

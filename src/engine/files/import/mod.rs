@@ -56,7 +56,7 @@ pub use self::preview::{PairingPreview, PosePreview, preview_pose_import};
 pub use self::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource, RawProfile};
 pub use self::progress::{ImportProgress, ImportStage};
 pub use self::references::{read_references, reference_rows};
-pub use self::robot_source::{RobotSource, load_dh_csv, load_robot, load_urdf};
+pub use self::robot_source::{RobotSource, RobotSourceError, load_dh_csv, load_robot, load_urdf};
 pub use self::side::{decide_side, import_poses, import_poses_with};
 pub use self::units::{AngleUnit, LengthUnit};
 pub use crate::engine::base::robot::controller::FlangeConvention;
@@ -283,7 +283,7 @@ pub(crate) fn planar(
                 },
                 None => ImportError::File {
                     path: raws.first().map_or_else(PathBuf::new, |r| r.source.clone()),
-                    message,
+                    message: message.to_string(),
                 },
             }
         })?;
@@ -364,12 +364,12 @@ pub(crate) fn check_profile_size(
     sphere_diameter: f64,
 ) -> Result<(), ImportError> {
     let extents: Vec<f64> = planes.iter().map(PlaneProfile::extent).collect();
-    units::check_profile_unit(format.unit, sphere_diameter, &extents).map_err(|message| {
+    units::check_profile_unit(format.unit, sphere_diameter, &extents).map_err(|e| {
         ImportError::File {
             path: planes
                 .first()
                 .map_or_else(PathBuf::new, |p| p.source.clone()),
-            message,
+            message: e.to_string(),
         }
     })
 }

@@ -280,7 +280,7 @@ pub fn records_of(file: &PoseFile) -> Result<Vec<PoseRecord>, ImportError> {
                 }
                 for (k, v) in deg.iter().enumerate() {
                     rules::plausible(*v, limits::ANGLE_DEG, &format!("joint {}", k + 1), "deg")
-                        .map_err(fail)?;
+                        .map_err(|m| fail(m.to_string()))?;
                 }
                 PoseValue::Joints(deg.clone())
             }
@@ -456,10 +456,10 @@ fn read_centres(
     let rows = centre_rows(path)?;
     for row in &rows {
         let c = Vector3::new(row.values[0], row.values[1], row.values[2]);
-        rules::centre("the centre (x, y, z)", &c).map_err(|message| ImportError::Csv {
+        rules::centre("the centre (x, y, z)", &c).map_err(|e| ImportError::Csv {
             path: path.to_path_buf(),
             line: row.line,
-            message,
+            message: e.to_string(),
         })?;
     }
     let record_ids: Vec<Option<&String>> = records.iter().map(|r| r.id.as_ref()).collect();

@@ -129,7 +129,8 @@ pub fn preview_pose_import(spec: &PoseImportSpec) -> Result<PosePreview, ImportE
         .iter()
         .any(|r| matches!(r.value, PoseValue::Joints(_)));
     let pairing = pairing(spec, &records).map_err(|e| e.to_string());
-    let translation_group = flange_poses(spec, &records).map(|poses| eq69_group(&poses));
+    let translation_group =
+        flange_poses(spec, &records).map(|poses| eq69_group(&poses).map_err(|e| e.to_string()));
     Ok(PosePreview {
         path: spec.poses.clone(),
         format: file.format,

@@ -10,6 +10,24 @@ use crate::engine::base::robot::{
 };
 use crate::engine::files::format::{Cap, parse_result, parse_session, read_text};
 
+/// A command-line or form value that names no robot source.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum RobotSourceError {
+    /// A DH table without its convention.
+    #[error(
+        "{0} is a DH table: say whether it is the standard or the modified convention (--dh standard|modified)"
+    )]
+    DhConvention(String),
+}
+
+/// The message, for the edges that show errors as text (the command
+/// line's and the workbench's forms).
+impl From<RobotSourceError> for String {
+    fn from(e: RobotSourceError) -> Self {
+        e.to_string()
+    }
+}
+
 /// Where the nominal robot model comes from.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum RobotSource {
@@ -42,12 +60,13 @@ impl RobotSource {
     /// which a DH table needs), else a preset key.
     ///
     /// # Errors
-    /// A `.csv` without a DH convention.
+    /// [`RobotSourceError::DhConvention`]: a `.csv` without a DH
+    /// convention.
     pub fn from_text(
         text: &str,
         tip: Option<String>,
         convention: Option<DhConvention>,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, RobotSourceError> {
         let path = Path::new(text);
         let ext = path
             .extension()
@@ -61,11 +80,8 @@ impl RobotSource {
             },
             "csv" | "txt" => Self::DhTable {
                 path: path.to_path_buf(),
-                convention: convention.ok_or_else(|| {
-                    format!(
-                        "{text} is a DH table: say whether it is the standard or the modified convention (--dh standard|modified)"
-                    )
-                })?,
+                convention: convention
+                    .ok_or_else(|| RobotSourceError::DhConvention(text.to_string()))?,
             },
             _ => Self::Preset(text.to_string()),
         })

@@ -1,6 +1,8 @@
 //! Units of the imported files: joint readings (deg or rad) and profile
 //! coordinates (mm, µm or m); the session holds deg and mm.
 
+use crate::engine::base::numeric::approx;
+
 /// Unit of the joint readings in the log.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AngleUnit {
@@ -195,6 +197,43 @@ const MIN_PROFILE_EXTENT: f64 = 1.0 / 20.0;
 /// sensor's whole field, background included, around a small sphere).
 const MAX_PROFILE_EXTENT: f64 = 200.0;
 
+/// Profiles whose size does not fit the sphere: their median size, the
+/// poses it is over, the sphere, the unit they were read in and the unit
+/// that would fit, if one does.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "the profiles span {} mm (median over {poses} poses) against a sphere of {} mm diameter, read as {}: not plausible{}",
+    approx(*median_mm),
+    approx(*diameter_mm),
+    unit.symbol(),
+    hint(*suggestion)
+)]
+pub struct ProfileUnitError {
+    /// The median profile size, mm as read.
+    pub median_mm: f64,
+    /// Profiles it is over.
+    pub poses: usize,
+    /// The sphere's diameter, mm.
+    pub diameter_mm: f64,
+    /// The unit the profiles were read in.
+    pub unit: LengthUnit,
+    /// A unit that makes the size plausible, and the size then (mm).
+    pub suggestion: Option<(LengthUnit, f64)>,
+}
+
+/// The suggestion of a [`ProfileUnitError`] in words.
+fn hint(suggestion: Option<(LengthUnit, f64)>) -> String {
+    match suggestion {
+        Some((u, e)) => format!(
+            "; read as {} they would span {} mm: import with --profile-unit {}",
+            u.symbol(),
+            approx(e),
+            u.as_str()
+        ),
+        None => "; check --profile-unit and --sphere-diameter".to_string(),
+    }
+}
+
 /// Catches profile coordinates in the wrong unit: the profiles' typical
 /// size (the median over poses of each profile's bounding-box diagonal,
 /// mm) against the sphere's diameter. A stripe across a sphere spans
@@ -204,12 +243,12 @@ const MAX_PROFILE_EXTENT: f64 = 200.0;
 /// that makes the size plausible, if one does.
 ///
 /// # Errors
-/// The median size, the sphere and the suggestion.
+/// [`ProfileUnitError`]: the median size, the sphere and the suggestion.
 pub fn check_profile_unit(
     unit: LengthUnit,
     diameter_mm: f64,
     extents_mm: &[f64],
-) -> Result<(), String> {
+) -> Result<(), ProfileUnitError> {
     let Some(median) = crate::engine::base::numeric::median(extents_mm) else {
         return Ok(());
     };
@@ -218,28 +257,18 @@ pub fn check_profile_unit(
     if plausible(median) {
         return Ok(());
     }
-    let show = crate::engine::base::numeric::approx;
     let suggestion = [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M]
         .into_iter()
         .filter(|&u| u != unit)
         .map(|u| (u, median / unit.to_mm(1.0) * u.to_mm(1.0)))
         .find(|&(_, e)| plausible(e));
-    let hint = match suggestion {
-        Some((u, e)) => format!(
-            "; read as {} they would span {} mm: import with --profile-unit {}",
-            u.symbol(),
-            show(e),
-            u.as_str()
-        ),
-        None => "; check --profile-unit and --sphere-diameter".to_string(),
-    };
-    Err(format!(
-        "the profiles span {} mm (median over {} poses) against a sphere of {} mm diameter, read as {}: not plausible{hint}",
-        show(median),
-        extents_mm.len(),
-        show(diameter_mm),
-        unit.symbol()
-    ))
+    Err(ProfileUnitError {
+        median_mm: median,
+        poses: extents_mm.len(),
+        diameter_mm,
+        unit,
+        suggestion,
+    })
 }
 
 #[cfg(test)]

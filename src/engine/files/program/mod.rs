@@ -289,7 +289,7 @@ impl PoseFile {
     /// # Errors
     /// A target index out of range or a count of numbers that does not
     /// match the target's spans.
-    pub fn rewritten(&self, edits: &[(usize, Vec<String>)]) -> Result<String, String> {
+    pub fn rewritten(&self, edits: &[(usize, Vec<String>)]) -> Result<String, RewriteError> {
         self.rewritten_with_config(edits, &[])
     }
 
@@ -304,20 +304,19 @@ impl PoseFile {
         &self,
         edits: &[(usize, Vec<String>)],
         configs: &[(usize, String)],
-    ) -> Result<String, String> {
+    ) -> Result<String, RewriteError> {
         let mut replacements: Vec<(Range<usize>, &str)> = Vec::new();
         for (index, numbers) in edits {
             let target = self
                 .targets
                 .get(*index)
-                .ok_or_else(|| format!("no target {index}"))?;
+                .ok_or(RewriteError::NoTarget(*index))?;
             if numbers.len() != target.spans.len() {
-                return Err(format!(
-                    "{}: {} numbers for {} places",
-                    target.name,
-                    numbers.len(),
-                    target.spans.len()
-                ));
+                return Err(RewriteError::Count {
+                    target: target.name.clone(),
+                    numbers: numbers.len(),
+                    places: target.spans.len(),
+                });
             }
             for (span, n) in target.spans.iter().zip(numbers) {
                 replacements.push((span.clone(), n.as_str()));
@@ -328,11 +327,33 @@ impl PoseFile {
                 .targets
                 .get(*index)
                 .and_then(|t| t.config.as_ref())
-                .ok_or_else(|| format!("target {index} has no configuration"))?;
+                .ok_or(RewriteError::NoConfiguration(*index))?;
             replacements.push((range.clone(), text.as_str()));
         }
         Ok(scan::replace_ranges(&self.text, replacements))
     }
+}
+
+/// Edits that do not fit the file's targets (an internal error of the
+/// caller).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum RewriteError {
+    /// A target index out of range.
+    #[error("no target {0}")]
+    NoTarget(usize),
+    /// Another count of numbers than the target has places.
+    #[error("{target}: {numbers} numbers for {places} places")]
+    Count {
+        /// The target's name.
+        target: String,
+        /// Numbers given.
+        numbers: usize,
+        /// Its places.
+        places: usize,
+    },
+    /// A configuration edit of a target without one.
+    #[error("target {0} has no configuration")]
+    NoConfiguration(usize),
 }
 
 /// A pose file could not be read: the line and what is wrong.

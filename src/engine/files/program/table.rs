@@ -26,7 +26,9 @@ use super::scan::shown;
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::base::session::Use;
-use crate::engine::base::table::{decimal_comma, parse_number, spaced_with_decimal_commas};
+use crate::engine::base::table::{
+    decimal_comma, parse_number, side_cell, spaced_with_decimal_commas,
+};
 
 /// How the fields of a row are separated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -463,16 +465,6 @@ fn pose_fits(convention: FlangeConvention, v: &[f64]) -> bool {
             v[3..6].iter().map(|a| a * a).sum::<f64>().sqrt() <= std::f64::consts::TAU
         }
         FlangeConvention::AbbQuaternion | FlangeConvention::Matrix => true,
-    }
-}
-
-/// A `side` cell: `+1`/`1`, `-1`, or blank for the session default.
-fn side_cell(s: &str) -> Result<Option<i8>, String> {
-    match s.trim() {
-        "" => Ok(None),
-        "1" | "+1" | "1.0" | "+1.0" => Ok(Some(1)),
-        "-1" | "-1.0" => Ok(Some(-1)),
-        other => Err(format!("`{}` is not +1 or -1", shown(other))),
     }
 }
 

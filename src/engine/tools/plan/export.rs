@@ -10,7 +10,7 @@ use super::{Plan, PlanError};
 use crate::engine::base::cell::joint_log;
 use crate::engine::base::robot::controller::Controller;
 use crate::engine::base::session::Use;
-use crate::engine::base::table::Table;
+use crate::engine::base::table::{Table, side_cell};
 use crate::engine::tools::simulate::PlanPose;
 
 /// The plan as a joint log CSV that `spherecal import` reads: header
@@ -124,10 +124,12 @@ pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPose>, PlanError> {
                 fields[usage]
             ))
         })?;
-        let side = match fields[side].as_str() {
-            "1" | "+1" => 1,
-            "-1" => -1,
-            other => return Err(fail(format!("side `{other}` is not +1 or -1"))),
+        // A plan gives every pose its side: blank is no side.
+        let side = match side_cell(&fields[side]) {
+            Ok(Some(side)) => side,
+            _ => {
+                return Err(fail(format!("side `{}` is not +1 or -1", fields[side])));
+            }
         };
         out.push(PlanPose {
             id: fields[id].clone(),

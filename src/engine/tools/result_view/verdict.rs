@@ -26,21 +26,41 @@ impl Default for Tolerance {
     }
 }
 
+/// A tolerance that cannot be read.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ToleranceError {
+    /// Not two parts.
+    #[error("`{0}`: give STD,MAX in mm, e.g. 0.2,0.5")]
+    NotTwo(String),
+    /// A part that is not a positive number.
+    #[error("`{0}` is not a positive number of mm")]
+    NotPositive(String),
+}
+
+/// The message, for the edges that show errors as text (the command
+/// line's value parser).
+impl From<ToleranceError> for String {
+    fn from(e: ToleranceError) -> Self {
+        e.to_string()
+    }
+}
+
 impl Tolerance {
     /// Parses `STD,MAX` (mm), e.g. `0.2,0.5`.
     ///
     /// # Errors
-    /// Not two positive finite numbers separated by a comma.
-    pub fn parse(s: &str) -> Result<Self, String> {
+    /// [`ToleranceError`]: not two positive finite numbers separated by a
+    /// comma.
+    pub fn parse(s: &str) -> Result<Self, ToleranceError> {
         let parts: Vec<&str> = s.split(',').map(str::trim).collect();
         let [std, max] = parts.as_slice() else {
-            return Err(format!("`{s}`: give STD,MAX in mm, e.g. 0.2,0.5"));
+            return Err(ToleranceError::NotTwo(s.to_string()));
         };
-        let value = |t: &str| -> Result<f64, String> {
+        let value = |t: &str| -> Result<f64, ToleranceError> {
             t.parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite() && *v > 0.0)
-                .ok_or_else(|| format!("`{t}` is not a positive number of mm"))
+                .ok_or_else(|| ToleranceError::NotPositive(t.to_string()))
         };
         Ok(Self {
             std_mm: value(std)?,

@@ -622,18 +622,34 @@ fn profile(
     text
 }
 
+/// A text that is not a scan truth.
+#[derive(Debug, thiserror::Error)]
+pub enum ScanTruthError {
+    /// Not JSON, or not the truth's shape.
+    #[error("not a scan truth file: {0}")]
+    Json(#[from] serde_json::Error),
+    /// Another format or version.
+    #[error("\"format\" {format:?} version {version}, expected \"{SCAN_TRUTH_FORMAT}\" version 1")]
+    Format {
+        /// The `format` found.
+        format: String,
+        /// The `version` found.
+        version: u32,
+    },
+}
+
 /// Reads a scan truth file's text.
 ///
 /// # Errors
-/// Not JSON, not the truth's shape, or another format or version.
-pub fn parse_scan_truth(text: &str) -> Result<ScanTruth, String> {
-    let t: ScanTruth =
-        serde_json::from_str(text).map_err(|e| format!("not a scan truth file: {e}"))?;
+/// [`ScanTruthError`]: not JSON, not the truth's shape, or another format
+/// or version.
+pub fn parse_scan_truth(text: &str) -> Result<ScanTruth, ScanTruthError> {
+    let t: ScanTruth = serde_json::from_str(text)?;
     if t.format != SCAN_TRUTH_FORMAT || t.version != 1 {
-        return Err(format!(
-            "\"format\" {:?} version {}, expected \"{SCAN_TRUTH_FORMAT}\" version 1",
-            t.format, t.version
-        ));
+        return Err(ScanTruthError::Format {
+            format: t.format,
+            version: t.version,
+        });
     }
     Ok(t)
 }

@@ -77,7 +77,7 @@ use crate::engine::base::session::{Session, Use};
 use crate::engine::calibrate::solve::Control;
 use crate::engine::calibrate::solve::ml::covariance::ParameterCovariance;
 use crate::engine::files::format::ResultFile;
-use crate::engine::files::program::PoseFile;
+use crate::engine::files::program::{PoseFile, RewriteError};
 
 pub use self::report::Summary;
 
@@ -227,7 +227,7 @@ pub enum CompensateError {
     Targets(Vec<TargetFailure>),
     /// The file could not be rewritten (an internal error).
     #[error("the targets could not be rewritten: {0}")]
-    Rewrite(String),
+    Rewrite(#[from] RewriteError),
     /// The caller cancelled.
     #[error("cancelled")]
     Cancelled,

@@ -79,7 +79,9 @@ pub(super) fn compensate_target(
     let mut config_update = None;
     let (joints_target, written, qn, qc, branch, wanted, values) = match &t.value {
         TargetValue::Pose { values, convention } => {
-            let wanted = convention.pose_from_values(values).map_err(fail)?;
+            let wanted = convention
+                .pose_from_values(values)
+                .map_err(|e| fail(e.to_string()))?;
             let flange = wanted * tool.inverse();
             let range = t.config.as_ref().map(|(_, r)| r.clone());
             let written_text = range.map(|r| file.text[r].to_string());

@@ -293,9 +293,9 @@ pub fn scan_from_files(spec: &ScanFiles) -> Result<Scan, ImportError> {
     let (axes, guessed) = match spec.profile_format.axes {
         Some(m) => (m, false),
         None => (
-            AxisMap::guess(&raws).map_err(|message| ImportError::File {
+            AxisMap::guess(&raws).map_err(|e| ImportError::File {
                 path: raws.first().map_or_else(PathBuf::new, |r| r.source.clone()),
-                message,
+                message: e.to_string(),
             })?,
             true,
         ),

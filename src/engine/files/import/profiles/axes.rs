@@ -16,6 +16,73 @@ pub(super) struct SignedAxis {
     negative: bool,
 }
 
+/// Why an axis map cannot be read or guessed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AxisMapError {
+    /// Not three axes.
+    #[error("axis map `{0}`: give three sensor axes for spherecal x, y, z, e.g. `-y,x,z`")]
+    NotThree(String),
+    /// A part that is not an axis.
+    #[error("axis map `{text}`: `{part}` is not x, y or z (with an optional sign)")]
+    NotAnAxis {
+        /// The map as given.
+        text: String,
+        /// The part at fault.
+        part: String,
+    },
+    /// A sensor axis used twice.
+    #[error("axis map `{text}`: sensor axis {axis} is used twice")]
+    Twice {
+        /// The map as given.
+        text: String,
+        /// The axis.
+        axis: &'static str,
+    },
+    /// A left-handed map.
+    #[error(
+        "axis map `{text}` mirrors the frame (a left-handed map): the hand-eye would be a reflection; change one sign, e.g. `{fixed}`"
+    )]
+    Mirror {
+        /// The map as given.
+        text: String,
+        /// The map with spherecal's `x` negated.
+        fixed: AxisMap,
+    },
+    /// No point to guess from.
+    #[error("no profile points to guess the laser plane from")]
+    NoPoints,
+    /// No coordinate is constant over the profiles.
+    #[error(
+        "cannot guess the laser plane: no coordinate is constant (spreads x {}, y {}, z {} mm); give the axis map, e.g. `--axes -y,x,z`",
+        approx(spreads[0]),
+        approx(spreads[1]),
+        approx(spreads[2])
+    )]
+    NoConstant {
+        /// Each sensor coordinate's spread, mm.
+        spreads: [f64; 3],
+    },
+    /// The constant coordinate is not 0.
+    #[error(
+        "every point has {axis} = {} mm: the laser plane does not pass through the sensor's origin; FORMAT.md needs the plane at 0",
+        crate::engine::base::numeric::show(*value)
+    )]
+    OffOrigin {
+        /// The sensor axis.
+        axis: &'static str,
+        /// Its value, mm.
+        value: f64,
+    },
+}
+
+/// The message, for the edges that show errors as text (the command
+/// line's and the workbench's forms).
+impl From<AxisMapError> for String {
+    fn from(e: AxisMapError) -> Self {
+        e.to_string()
+    }
+}
+
 /// Maps the sensor's axes onto FORMAT.md's frame: spherecal's `x`, `y`,
 /// `z` each the sensor axis named, with its sign. Always a rotation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -47,12 +114,10 @@ impl AxisMap {
     ///
     /// # Errors
     /// Not three axes, an axis used twice, or a map that mirrors the frame.
-    pub fn parse(text: &str) -> Result<Self, String> {
+    pub fn parse(text: &str) -> Result<Self, AxisMapError> {
         let parts: Vec<&str> = text.split(',').map(str::trim).collect();
         if parts.len() != 3 {
-            return Err(format!(
-                "axis map `{text}`: give three sensor axes for spherecal x, y, z, e.g. `-y,x,z`"
-            ));
+            return Err(AxisMapError::NotThree(text.to_string()));
         }
         let mut axes = [SignedAxis {
             axis: 0,
@@ -66,8 +131,9 @@ impl AxisMap {
             let axis = AXIS_NAMES
                 .iter()
                 .position(|n| n.eq_ignore_ascii_case(name))
-                .ok_or_else(|| {
-                    format!("axis map `{text}`: `{part}` is not x, y or z (with an optional sign)")
+                .ok_or_else(|| AxisMapError::NotAnAxis {
+                    text: text.to_string(),
+                    part: (*part).to_string(),
                 })?;
             *slot = SignedAxis { axis, negative };
         }
@@ -75,17 +141,17 @@ impl AxisMap {
         let mut used = [false; 3];
         for a in &map.axes {
             if std::mem::replace(&mut used[a.axis], true) {
-                return Err(format!(
-                    "axis map `{text}`: sensor axis {} is used twice",
-                    AXIS_NAMES[a.axis]
-                ));
+                return Err(AxisMapError::Twice {
+                    text: text.to_string(),
+                    axis: AXIS_NAMES[a.axis],
+                });
             }
         }
         if map.rotation().determinant() < 0.0 {
-            return Err(format!(
-                "axis map `{text}` mirrors the frame (a left-handed map): the hand-eye would be a reflection; change one sign, e.g. `{}`",
-                map.flipped_x()
-            ));
+            return Err(AxisMapError::Mirror {
+                text: text.to_string(),
+                fixed: map.flipped_x(),
+            });
         }
         Ok(map)
     }
@@ -144,7 +210,7 @@ impl AxisMap {
     /// # Errors
     /// No coordinate is constant, or the constant one is not 0 (the plane
     /// does not pass through the sensor's origin).
-    pub fn guess(profiles: &[RawProfile]) -> Result<Self, String> {
+    pub fn guess(profiles: &[RawProfile]) -> Result<Self, AxisMapError> {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         for p in profiles.iter().flat_map(|p| &p.points) {
@@ -154,23 +220,17 @@ impl AxisMap {
             }
         }
         if lo.iter().any(|v| !v.is_finite()) {
-            return Err("no profile points to guess the laser plane from".to_string());
+            return Err(AxisMapError::NoPoints);
         }
-        let spread: Vec<f64> = (0..3).map(|k| hi[k] - lo[k]).collect();
+        let spread: [f64; 3] = std::array::from_fn(|k| hi[k] - lo[k]);
         let Some(normal) = (0..3).find(|&k| spread[k] <= PLANE_TOLERANCE_MM) else {
-            return Err(format!(
-                "cannot guess the laser plane: no coordinate is constant (spreads x {}, y {}, z {} mm); give the axis map, e.g. `--axes -y,x,z`",
-                approx(spread[0]),
-                approx(spread[1]),
-                approx(spread[2])
-            ));
+            return Err(AxisMapError::NoConstant { spreads: spread });
         };
         if lo[normal].abs() > PLANE_TOLERANCE_MM {
-            return Err(format!(
-                "every point has {} = {} mm: the laser plane does not pass through the sensor's origin; FORMAT.md needs the plane at 0",
-                AXIS_NAMES[normal],
-                crate::engine::base::numeric::show(lo[normal])
-            ));
+            return Err(AxisMapError::OffOrigin {
+                axis: AXIS_NAMES[normal],
+                value: lo[normal],
+            });
         }
         let rest: Vec<usize> = (0..3).filter(|&k| k != normal).collect();
         let map = Self {
