@@ -484,42 +484,6 @@ pub fn warnings_cell(warnings: &[String]) -> String {
         .join(" · ")
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The issue: "(2) raw profile, …" hid the cut-angle warning behind
-    /// the count and cut the rest with "…". Every warning is named.
-    #[test]
-    fn every_warning_is_named_in_a_few_words() {
-        let ws = vec![
-            "raw profile, the sphere's arc: 412 of 800 points, 38.1° to 141.9°".to_string(),
-            "cut angle 66.2° is above 60°: the laser plane is near the sphere's pole and the stripe circle is small (r = 16.2 mm); about ±40° is best".to_string(),
-        ];
-        assert_eq!(
-            warnings_cell(&ws),
-            "raw profile · cut angle 66.2° is above 60°"
-        );
-        assert_eq!(
-            warning_tag("3 of 120 stripe points rejected as outliers (largest residual 0.300 mm)"),
-            "3 points rejected"
-        );
-        assert_eq!(
-            warning_tag("short arc: the stripe spans 12.0° of its circle"),
-            "short arc"
-        );
-        assert_eq!(
-            warning_tag("high circle-fit RMS: 0.2 mm over 9 points"),
-            "high fit RMS"
-        );
-        assert_eq!(
-            warning_tag("stripe radius r = 19.1 mm exceeds the sphere radius"),
-            "centre on the laser plane"
-        );
-        assert!(warning_tag(&"x".repeat(80)).ends_with('…'));
-    }
-}
-
 /// Loading: the current session (three lines whatever it is, so that
 /// nothing below moves), the path field with Open… and the demo.
 pub fn load_ui(
@@ -678,5 +642,41 @@ pub fn recent_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command
                     commands.push(Command::Files(FilesCommand::ClearRecent));
                 }
             });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The issue: "(2) raw profile, …" hid the cut-angle warning behind
+    /// the count and cut the rest with "…". Every warning is named.
+    #[test]
+    fn every_warning_is_named_in_a_few_words() {
+        let ws = vec![
+            "raw profile, the sphere's arc: 412 of 800 points, 38.1° to 141.9°".to_string(),
+            "cut angle 66.2° is above 60°: the laser plane is near the sphere's pole and the stripe circle is small (r = 16.2 mm); about ±40° is best".to_string(),
+        ];
+        assert_eq!(
+            warnings_cell(&ws),
+            "raw profile · cut angle 66.2° is above 60°"
+        );
+        assert_eq!(
+            warning_tag("3 of 120 stripe points rejected as outliers (largest residual 0.300 mm)"),
+            "3 points rejected"
+        );
+        assert_eq!(
+            warning_tag("short arc: the stripe spans 12.0° of its circle"),
+            "short arc"
+        );
+        assert_eq!(
+            warning_tag("high circle-fit RMS: 0.2 mm over 9 points"),
+            "high fit RMS"
+        );
+        assert_eq!(
+            warning_tag("stripe radius r = 19.1 mm exceeds the sphere radius"),
+            "centre on the laser plane"
+        );
+        assert!(warning_tag(&"x".repeat(80)).ends_with('…'));
     }
 }
