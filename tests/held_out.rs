@@ -16,7 +16,7 @@ use spherecal::engine::calibrate::solve::{
 use spherecal::engine::files::format::{self, ResultFile};
 use spherecal::engine::tools::report::html::{self, ReportInput, ReportMeta};
 use spherecal::engine::tools::report::summary::summary;
-use spherecal::engine::tools::result_view::ResultView;
+use spherecal::engine::tools::result_view::ResultFigures;
 use spherecal::engine::tools::simulate::{self, SimConfig};
 
 mod one_station;
@@ -280,7 +280,7 @@ fn the_paper_method_warns_when_its_loop_made_epsilon_worse() {
     // the last ε), and every reader shows the warning.
     let file = ResultFile::from_calibration(&session, &cal);
     assert_eq!(file.epsilon_after, *cal.iterations.last().unwrap());
-    let view = ResultView::new(&file);
+    let view = ResultFigures::new(&file);
     assert_eq!(view.warnings.len(), 1);
     assert!(view.warnings[0].starts_with("ε rose from"));
     let meta = ReportMeta::new("s.json", UNIX_EPOCH);
@@ -316,12 +316,12 @@ fn the_fixture_with_a_held_out_figure_loads() {
     // Five identify measurements for 36 unknowns: the fit's own scatter
     // says 0.017 mm, a pose it has not seen lands 67 mm off.
     assert!(h.fit_rms < 0.02 && h.rms > 60.0, "{h}");
-    let view = ResultView::new(&r);
+    let view = ResultFigures::new(&r);
     assert_eq!(view.held_out.as_ref(), Some(h));
     // The fixture without its held-out key is the result of before.
     let old = format::load_result(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/v1/result.json"),
     )
     .unwrap();
-    assert!(old.held_out.is_none() && ResultView::new(&old).held_out.is_none());
+    assert!(old.held_out.is_none() && ResultFigures::new(&old).held_out.is_none());
 }

@@ -128,7 +128,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     format::write_atomic(&args.out, html.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
     if !args.quiet {
         if let Some(t) = &args.tolerance {
-            let view = result_view::ResultView::new(&result);
+            let view = result_view::ResultFigures::new(&result);
             sayln!(
                 "{}",
                 result_view::Verdict::of(view.headline.as_ref(), t).describe(t)

@@ -31,7 +31,7 @@ use crate::engine::tools::result_view::{Tolerance, within_pairs};
 
 use super::AppState;
 use super::ledger::Reading;
-pub use crate::engine::tools::result_view::{HandEyeView, ResultView as Shown};
+pub use crate::engine::tools::result_view::{HandEyeView, ResultFigures as Shown};
 
 /// Where a result on show came from.
 #[derive(Debug, Clone, PartialEq)]

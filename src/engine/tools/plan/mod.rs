@@ -132,7 +132,7 @@ use select::{
 
 /// What failed in one simulated calibration of a prediction.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum RunFailure {
+pub enum PredictionFailure {
     /// The plan's poses could not be simulated on the true robot.
     #[error(transparent)]
     Simulate(#[from] SimError),
@@ -187,7 +187,7 @@ pub enum PlanError {
         seed: u64,
         /// What failed: the simulation or the calibration.
         #[source]
-        failure: RunFailure,
+        failure: PredictionFailure,
     },
     /// The `ml` analysis of the candidates or the plan failed.
     #[error("identifiability analysis failed: {0}")]

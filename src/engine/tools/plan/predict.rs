@@ -148,7 +148,7 @@ pub fn predict(
     let mut runs = Vec::with_capacity(config.runs);
     for k in 0..config.runs {
         let seed = config.seed + k as u64;
-        let fail = |failure: RunFailure| PlanError::Prediction {
+        let fail = |failure: PredictionFailure| PlanError::Prediction {
             run: k + 1,
             seed,
             failure,

@@ -259,7 +259,7 @@ pub struct Sigma {
 
 /// What every reader shows of a result.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ResultView {
+pub struct ResultFigures {
     /// The headline figures, when the result has validation.
     pub headline: Option<Headline>,
     /// Within-station distances of the validate stations (or, without any,
@@ -301,7 +301,7 @@ pub struct ResultView {
     pub warnings: Vec<String>,
 }
 
-impl ResultView {
+impl ResultFigures {
     /// The view of `result`.
     #[must_use]
     pub fn new(result: &ResultFile) -> Self {

@@ -48,7 +48,7 @@ use crate::engine::calibrate::validate::BeforeAfter;
 use crate::engine::files::format::result::ResultFile;
 use crate::engine::tools::report::svg::escape;
 use crate::engine::tools::result_view::{
-    PairDistance, ResultView, Sigma, Tolerance, Verdict, check_result, excluded_measurements,
+    PairDistance, ResultFigures, Sigma, Tolerance, Verdict, check_result, excluded_measurements,
 };
 use css::CSS;
 use figures::figures;
@@ -222,7 +222,7 @@ struct Ctx<'a> {
 impl<'a> Ctx<'a> {
     fn new(input: &'a ReportInput<'a>, prepared: Result<&'a Prepared, String>) -> Self {
         let result = input.result;
-        let view = ResultView::new(result);
+        let view = ResultFigures::new(result);
         Self {
             input,
             prepared,

@@ -186,7 +186,7 @@ pub(super) fn marked_cell(ctx: &Ctx<'_>, label: &str, text: String) -> String {
 }
 
 /// A calibrated hand-eye cell (row `k`: x, y, z, roll, pitch, yaw) with
-/// its σ in the same frame and unit ([`ResultView::hand_eye_sigma`]), and
+/// its σ in the same frame and unit ([`ResultFigures::hand_eye_sigma`]), and
 /// the † mark.
 pub(super) fn hand_eye_cell(ctx: &Ctx<'_>, k: usize, text: String) -> String {
     let label = HAND_EYE_LABELS[k];
