@@ -125,11 +125,8 @@ pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPose>, PlanError> {
             ))
         })?;
         // A plan gives every pose its side: blank is no side.
-        let side = match side_cell(&fields[side]) {
-            Ok(Some(side)) => side,
-            _ => {
-                return Err(fail(format!("side `{}` is not +1 or -1", fields[side])));
-            }
+        let Ok(Some(side)) = side_cell(&fields[side]) else {
+            return Err(fail(format!("side `{}` is not +1 or -1", fields[side])));
         };
         out.push(PlanPose {
             id: fields[id].clone(),
