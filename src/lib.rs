@@ -46,6 +46,9 @@ pub mod engine;
 #[cfg(feature = "gui")]
 pub mod app;
 
+#[cfg(feature = "gui")]
+pub mod screenshots;
+
 /// The demo session embedded in the binary (`sessions/demo-irb2400.json`):
 /// what the workbench opens when started without a file.
 pub const DEMO_SESSION_JSON: &str = include_str!("../sessions/demo-irb2400.json");

@@ -51,6 +51,9 @@ fn gui(
     result: Option<std::path::PathBuf>,
 ) -> Result<(), CliError> {
     cli::check_display()?;
+    if let Some(shot) = spherecal::screenshots::Request::from_env().map_err(CliError::input)? {
+        return spherecal::screenshots::run(shot, session, result).map_err(CliError::input);
+    }
     spherecal::app::run(session, result).map_err(CliError::input)
 }
 

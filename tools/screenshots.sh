@@ -10,7 +10,7 @@
 # folder (SPHERECAL_SHOTS_DIR, default /tmp/spherecal-screenshots, emptied
 # first), then starts `spherecal gui` once per scenario with
 # SPHERECAL_SCREENSHOT=<scenario>:<file>: the window drives itself through
-# the scenario (src/app/screenshot.rs says what each does), saves its own
+# the scenario (src/screenshots/scenarios.rs says what each does), saves its own
 # picture and closes. report.png is the HTML report's first screen in
 # headless Chromium, taken when Chromium is installed.
 #

@@ -45,7 +45,6 @@ pub mod measure;
 pub mod plan;
 pub mod results;
 pub mod run;
-pub mod screenshot;
 pub mod session;
 pub mod state;
 pub mod steps;
@@ -72,25 +71,11 @@ pub use workbench::WorkbenchApp;
 pub const NO_DISPLAY_HINT: &str =
     "to calibrate without a display run `spherecal calibrate SESSION --out RESULT`";
 
-/// Opens the workbench window on `session` (default: the embedded demo
-/// session) and, when given, `result` for review beside it. Blocks until
-/// the window closes.
-///
-/// # Errors
-/// No display (neither `DISPLAY` nor `WAYLAND_DISPLAY` set) or a window
-/// that could not be created: one line pointing to `spherecal calibrate`.
-pub fn run(session: Option<PathBuf>, result: Option<PathBuf>) -> Result<(), String> {
-    let shot = screenshot::Request::from_env()?;
-    if shot == Some(screenshot::Request::List) {
-        print!("{}", screenshot::listing());
-        return Ok(());
-    }
-    if std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none() {
-        return Err(format!(
-            "no display (DISPLAY and WAYLAND_DISPLAY are unset); {NO_DISPLAY_HINT}"
-        ));
-    }
-    let mut options = eframe::NativeOptions {
+/// The window's options: titled, 1366×768 (at least 960×600), files may
+/// be dropped on it.
+#[must_use]
+pub fn native_options() -> eframe::NativeOptions {
+    eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("spherecal workbench")
             .with_app_id("spherecal")
@@ -98,37 +83,27 @@ pub fn run(session: Option<PathBuf>, result: Option<PathBuf>) -> Result<(), Stri
             .with_min_inner_size([960.0, 600.0])
             .with_drag_and_drop(true),
         ..Default::default()
-    };
-    // A screenshot scenario: default preferences, none stored.
-    let director = match shot {
-        Some(screenshot::Request::Take(spec)) => {
-            let d = screenshot::Director::new(spec, &mut options);
-            d.check_inputs()?;
-            Some(d)
-        }
-        _ => None,
-    };
-    let outcome = director.as_ref().map(screenshot::Director::outcome);
-    let opened = eframe::run_native(
+    }
+}
+
+/// Opens the workbench window on `session` (default: the embedded demo
+/// session) and, when given, `result` for review beside it, with the
+/// preferences kept in eframe's storage. Blocks until the window closes.
+///
+/// # Errors
+/// A window that could not be created: one line pointing to `spherecal
+/// calibrate`.
+pub fn run(session: Option<PathBuf>, result: Option<PathBuf>) -> Result<(), String> {
+    eframe::run_native(
         "spherecal",
-        options,
+        native_options(),
         Box::new(move |cc| {
-            Ok(Box::new(match director {
-                Some(d) => {
-                    WorkbenchApp::new(state::Prefs::default(), session, result).with_screenshot(d)
-                }
-                None => WorkbenchApp::from_storage(cc.storage, session, result),
-            }))
+            Ok(Box::new(WorkbenchApp::from_storage(
+                cc.storage, session, result,
+            )))
         }),
     )
-    .map_err(|e| format!("could not open the workbench window ({e}); {NO_DISPLAY_HINT}"));
-    let Some(outcome) = outcome else {
-        return opened;
-    };
-    screenshot::remove_storage();
-    opened?;
-    println!("{}", outcome.result()?);
-    Ok(())
+    .map_err(|e| format!("could not open the workbench window ({e}); {NO_DISPLAY_HINT}"))
 }
 
 /// Everything the workbench shows. Changed only by commands and job

@@ -19,6 +19,16 @@ use super::{measure, plan, results, run, session, widgets};
 /// Key of the preferences in eframe's storage (JSON text).
 pub const PREFS_KEY: &str = "spherecal.prefs";
 
+/// What drives the window instead of an operator (a screenshot
+/// scenario): it sees each frame's input first and the core after each
+/// frame.
+pub trait Driver {
+    /// Adds to the input of the next frame (the pointer, the wheel).
+    fn raw_input(&mut self, raw: &mut egui::RawInput);
+    /// Acts after the frame: commands, form edits, checks, a picture.
+    fn frame(&mut self, ctx: &egui::Context, core: &mut Core);
+}
+
 /// The workbench application (also driven directly by the UI tests).
 pub struct WorkbenchApp {
     core: Core,
@@ -26,8 +36,9 @@ pub struct WorkbenchApp {
     startup: Vec<Command>,
     /// Whether [`install_fonts`] has run.
     fonts_installed: bool,
-    /// A screenshot scenario driving the window ([`super::screenshot`]).
-    screenshot: Option<Box<super::screenshot::Director>>,
+    /// What drives the window instead of an operator (a screenshot
+    /// scenario), if anything.
+    driver: Option<Box<dyn Driver>>,
 }
 
 /// Adds the default monospace font (Hack) as a fallback of the
@@ -87,14 +98,14 @@ impl WorkbenchApp {
             core: Core::new(state, forms),
             startup: vec![Command::Files(open)],
             fonts_installed: false,
-            screenshot: None,
+            driver: None,
         }
     }
 
-    /// The workbench driven by a screenshot scenario (nothing stored).
+    /// The workbench driven by `driver` (nothing stored).
     #[must_use]
-    pub fn with_screenshot(mut self, director: super::screenshot::Director) -> Self {
-        self.screenshot = Some(Box::new(director));
+    pub fn with_driver(mut self, driver: impl Driver + 'static) -> Self {
+        self.driver = Some(Box::new(driver));
         self
     }
 
@@ -202,7 +213,7 @@ impl WorkbenchApp {
         self.core.finish(&ctx);
         // Fields edited this frame mark what they feed stale at once.
         self.core.observe(&ctx);
-        if let Some(director) = &mut self.screenshot {
+        if let Some(director) = &mut self.driver {
             director.frame(&ctx, &mut self.core);
         }
     }
@@ -248,13 +259,13 @@ impl eframe::App for WorkbenchApp {
     }
 
     fn raw_input_hook(&mut self, _ctx: &egui::Context, raw_input: &mut egui::RawInput) {
-        if let Some(director) = &mut self.screenshot {
+        if let Some(director) = &mut self.driver {
             director.raw_input(raw_input);
         }
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        if self.screenshot.is_some() {
+        if self.driver.is_some() {
             return;
         }
         if let Ok(text) = serde_json::to_string(&self.core.state.prefs) {
