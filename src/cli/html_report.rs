@@ -71,7 +71,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     inputs.extend(args.result.as_deref());
     CliError::guard_output(&args.out, &inputs)?;
     let started = Instant::now();
-    let bytes = std::fs::read(&args.session).map_err(|source| {
+    let bytes = format::read_bytes(&args.session, format::Cap::SESSION).map_err(|source| {
         CliError::from_file(
             &FileError::Io {
                 action: "reading",

@@ -390,7 +390,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let (mut session, truth) = match &args.plan {
         None => simulate::simulate(&config).map_err(|e| sim_error(&e))?,
         Some(path) => {
-            let text = std::fs::read_to_string(path).map_err(|e| {
+            let text = format::read_text(path, format::Cap::TABLE).map_err(|e| {
                 CliError::input(format!("reading failed ({}): {e}", path.display()))
             })?;
             let poses = plan::read_plan_csv(&text)
