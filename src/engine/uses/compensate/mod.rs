@@ -305,9 +305,9 @@ pub struct TargetReport {
     pub notes: Vec<String>,
 }
 
-/// Progress of [`compensate`], after each target.
+/// How far [`compensate`] is: told after each target.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Progress {
+pub struct CompensateProgress {
     /// Targets done.
     pub done: usize,
     /// Targets in all.
@@ -591,7 +591,7 @@ pub fn compensate(
     model: &Model,
     file: &PoseFile,
     options: &Options,
-    progress: &mut dyn FnMut(&Progress) -> Control,
+    progress: &mut dyn FnMut(&CompensateProgress) -> Control,
 ) -> Result<Compensation, CompensateError> {
     let total = file.order.len();
     let mut targets = Vec::with_capacity(total);
@@ -609,7 +609,7 @@ pub fn compensate(
                 name
             }
         };
-        if progress(&Progress {
+        if progress(&CompensateProgress {
             done: done + 1,
             total,
             target: name,
