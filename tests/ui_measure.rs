@@ -20,12 +20,11 @@ use spherecal::app::command::Tab;
 use spherecal::app::command::{Command, MeasureCommand, ViewCommand};
 use spherecal::app::job::Slot;
 use spherecal::app::measure::ScanChoice;
-use spherecal::app::measure::job::MeasureFailure;
-use spherecal::app::measure::job::{DRAWN_MAX, MeasureRequest, ScanInput, group, measure_scan};
+use spherecal::app::measure::job::{DRAWN_MAX, MeasureFailure, group, measure_cloud};
 use spherecal::engine::base::session::Observation;
 use spherecal::engine::calibrate::solve::Method;
 use spherecal::engine::tools::simulate::SimConfig;
-use spherecal::engine::uses::measure::{MeasureOptions, ModelChoice};
+use spherecal::engine::uses::measure::{MeasureOptions, MeasureRequest, ModelChoice, ScanSource};
 
 mod ui_support;
 use ui_support::{harness, settle, simulated, status, step_label};
@@ -229,9 +228,8 @@ fn cancel_stops_the_job_and_keeps_the_previous_cloud() {
     let view = h.state().state().result.clone().unwrap();
     let session = h.state().state().loaded.as_ref().unwrap().session.clone();
     let request = MeasureRequest {
-        scan: ScanInput::Session(Box::new(session), Vec::new(), "s".into()),
+        scan: ScanSource::Session(Box::new(session), Vec::new(), "s".into()),
         result: view.file,
-        result_label: "r".into(),
         joint_range: None,
         frame: None,
         options: MeasureOptions {
@@ -241,7 +239,7 @@ fn cancel_stops_the_job_and_keeps_the_previous_cloud() {
         },
     };
     let cancelled = AtomicBool::new(true);
-    let outcome = measure_scan(request, &cancelled, &mut |_, _| true);
+    let outcome = measure_cloud(request, "r".into(), &cancelled, &mut |_, _| true);
     assert!(matches!(outcome, Err(MeasureFailure::Cancelled)));
 }
 

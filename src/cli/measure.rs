@@ -12,18 +12,15 @@ use clap::Args;
 use super::scan_flags::ScanFlags;
 use super::values::{Keywords, Range, number};
 use super::{CliError, QUIET_HELP};
+use crate::engine::base::robot::kinematics::Robot;
 use crate::engine::base::session::Use;
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
 use crate::engine::files::import::{self, ProfileSource};
 use crate::engine::uses::measure::{
-    self, CellModel, CloudFormat, JointRange, MeasureError, MeasureOptions, ModelChoice,
-    Provenance, Scan, ScanColumns, ScanFiles, ScanLog, ScanPose, selfcheck,
+    self, CloudFormat, JointRange, LISTED_POSES, MeasureError, MeasureOptions, MeasureRequest,
+    ModelChoice, Outcome, Provenance, ScanColumns, ScanFiles, ScanLog, ScanSource,
 };
-
-/// Poses outside the calibrated joint range listed by name at most (a
-/// scan of thousands of poses would bury the summary).
-const LISTED_POSES: usize = 20;
 
 /// `spherecal measure`.
 #[derive(Debug, Args)]
@@ -294,127 +291,6 @@ fn output_format(args: &MeasureArgs) -> Result<CloudFormat, CliError> {
     Ok(format)
 }
 
-/// The scan to measure (a session's stripes or a raw scan's files) and
-/// the joint range the calibration saw (from `--calibration`, else the
-/// measured session's own; none for a raw scan without it). Refuses a
-/// scan with no pose to measure.
-fn load_scan(
-    args: &MeasureArgs,
-    result: &format::ResultFile,
-) -> Result<(Scan, Option<JointRange>), CliError> {
-    let mut joint_range = match &args.calibration {
-        Some(path) => {
-            let s = format::load_session(path).map_err(|e| CliError::from_file(&e, true))?;
-            JointRange::of_session(&s)
-        }
-        None => None,
-    };
-    let scan = if let Some(path) = &args.session {
-        let session = format::load_session(path).map_err(|e| CliError::from_file(&e, true))?;
-        if args.calibration.is_none() {
-            joint_range = JointRange::of_session(&session);
-        }
-        Scan::from_session(session, &uses(args))
-    } else {
-        let dof = result
-            .robot
-            .as_ref()
-            .map_or(0, super::super::engine::base::robot::kinematics::Robot::dof);
-        measure::scan_from_files(&scan_files(args, dof)?)
-            .map_err(|e| CliError::input(e.to_string()))?
-    };
-    if scan.poses.is_empty() {
-        return Err(CliError::input(format!(
-            "nothing to measure: no pose with a profile{} ({})",
-            if scan.skipped.is_empty() {
-                String::new()
-            } else {
-                format!(
-                    " (the {} measurements give sphere centres)",
-                    scan.skipped.len()
-                )
-            },
-            args.session
-                .as_ref()
-                .map_or_else(|| scan.name.clone(), |p| p.display().to_string())
-        )));
-    }
-    Ok((scan, joint_range))
-}
-
-/// The cloud measured and written, the self-validation beside it, and
-/// how long each took (s).
-struct Done {
-    measured: measure::Measured,
-    check: Option<selfcheck::SelfValidation>,
-    checked_secs: f64,
-    placed_secs: f64,
-    written_secs: f64,
-}
-
-/// Measures the scan and writes the cloud while the sphere
-/// self-validation (when the scan gives a sphere diameter) runs on its
-/// own thread beside them, on a copy of the poses it looks at.
-fn measure_and_write(
-    args: &MeasureArgs,
-    scan: Scan,
-    result: &format::ResultFile,
-    options: &MeasureOptions,
-    joint_range: Option<&JointRange>,
-    format: CloudFormat,
-    provenance: &Provenance,
-) -> Result<Done, CliError> {
-    let sphere = scan.sphere_diameter;
-    let references = scan.reference_distances.clone();
-    let checked: Vec<ScanPose> = match sphere {
-        Some(_) => scan
-            .poses
-            .iter()
-            .filter(|p| selfcheck::checks(*p))
-            .cloned()
-            .collect(),
-        None => Vec::new(),
-    };
-    let (nominal, calibrated) = (
-        CellModel::of_result(result, ModelChoice::Nominal),
-        CellModel::of_result(result, ModelChoice::Calibrated),
-    );
-    let self_validation = || {
-        let t = Instant::now();
-        let check = sphere
-            .and_then(|d| measure::self_validate(&checked, &nominal, &calibrated, d, &references));
-        (check, t.elapsed().as_secs_f64())
-    };
-    std::thread::scope(|s| {
-        let worker = std::thread::Builder::new()
-            .name("self-validation".into())
-            .spawn_scoped(s, self_validation);
-        let t0 = Instant::now();
-        let measured = measure::measure(scan, result, options, joint_range, &mut |_| {
-            Control::Continue
-        })
-        .map_err(|e| from_measure(&e))?;
-        let placed_secs = t0.elapsed().as_secs_f64();
-        let t1 = Instant::now();
-        measure::write_cloud(&measured.cloud, &args.out, format, provenance)
-            .map_err(|e| CliError::from_file(&e, false))?;
-        let written_secs = t1.elapsed().as_secs_f64();
-        let (check, checked_secs) = match worker {
-            Ok(handle) => handle
-                .join()
-                .map_err(|_| CliError::internal("the self-validation thread failed"))?,
-            Err(_) => self_validation(),
-        };
-        Ok(Done {
-            measured,
-            check,
-            checked_secs,
-            placed_secs,
-            written_secs,
-        })
-    })
-}
-
 /// The measurement's warnings on stderr, the poses outside the calibrated
 /// joint range listed up to [`LISTED_POSES`].
 fn print_warnings(measured: &measure::Measured) {
@@ -426,29 +302,24 @@ fn print_warnings(measured: &measure::Measured) {
             "warning: {} pose(s) outside the joint range the calibration saw (the model was not checked there):",
             measured.out_of_range.len()
         );
-        for o in measured.out_of_range.iter().take(LISTED_POSES) {
-            eprintln!("  {o}");
-        }
-        if measured.out_of_range.len() > LISTED_POSES {
-            eprintln!(
-                "  … and {} more",
-                measured.out_of_range.len() - LISTED_POSES
-            );
+        for line in measure::listed(&measured.out_of_range) {
+            eprintln!("  {line}");
         }
     }
 }
 
 /// The summary on stdout: the scan's notes, the points measured and
 /// dropped, the measurements left out, σ, the joint-range check, the
-/// self-validation and the timing line (`loaded`: seconds to load).
+/// self-validation and the timing line (`loaded`: seconds to load,
+/// `written`: to write).
 fn print_summary(
     args: &MeasureArgs,
     result: &format::ResultFile,
     format: CloudFormat,
-    (notes, skipped): (&[String], &[String]),
-    done: &Done,
-    (started, loaded): (Instant, f64),
+    done: &Outcome,
+    (started, loaded, written): (Instant, f64, f64),
 ) {
+    let (notes, skipped) = (&done.notes, &done.skipped);
     let cloud = &done.measured.cloud;
     let n = cloud.len();
     let dropped = cloud.dropped();
@@ -521,12 +392,14 @@ fn print_summary(
         started.elapsed().as_secs_f64() * 1e3,
         loaded,
         rate(n, done.placed_secs),
-        rate(n, done.written_secs),
+        rate(n, written),
         done.checked_secs
     );
 }
 
-/// Runs `spherecal measure`.
+/// Runs `spherecal measure`: the scan measured by the one engine entry
+/// ([`measure::measure_scan`], which the workbench calls too), then the
+/// cloud written and the summary printed.
 ///
 /// # Errors
 /// [`CliError`] with status 2 for bad input (nothing written), 1 when the
@@ -535,52 +408,48 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
     let started = Instant::now();
     let format = output_format(args)?;
     let result = format::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;
-    let frame = args
-        .frame
-        .as_ref()
-        .map(|path| {
-            measure::load_frame(path)
-                .map(|w| (w, path.display().to_string()))
-                .map_err(|e| from_measure(&e))
-        })
-        .transpose()?;
-    let (scan, joint_range) = load_scan(args, &result)?;
-    let loaded = started.elapsed().as_secs_f64();
-    let options = MeasureOptions {
-        model: args.model,
-        frame,
-        sigma: !args.no_sigma && args.model == ModelChoice::Calibrated,
-        sensor_noise_mm: args.sensor_noise,
-        covariance_as_written: args.covariance_as_written,
+    let joint_range = match &args.calibration {
+        Some(path) => {
+            let s = format::load_session(path).map_err(|e| CliError::from_file(&e, true))?;
+            JointRange::of_session(&s)
+        }
+        None => None,
     };
-    let (notes, skipped) = (scan.notes.clone(), scan.skipped.clone());
+    let scan = if let Some(path) = &args.session {
+        ScanSource::SessionFile(path.clone(), uses(args))
+    } else {
+        let dof = result.robot.as_ref().map_or(0, Robot::dof);
+        ScanSource::Files(Box::new(scan_files(args, dof)?))
+    };
+    let loaded = started.elapsed().as_secs_f64();
+    let request = MeasureRequest {
+        scan,
+        result: result.clone(),
+        joint_range,
+        frame: args.frame.clone(),
+        options: MeasureOptions {
+            model: args.model,
+            frame: None,
+            sigma: !args.no_sigma && args.model == ModelChoice::Calibrated,
+            sensor_noise_mm: args.sensor_noise,
+            covariance_as_written: args.covariance_as_written,
+        },
+    };
+    let done =
+        measure::measure_scan(request, &mut |_| Control::Continue).map_err(|e| from_measure(&e))?;
     let provenance = Provenance {
         result: args.result.display().to_string(),
-        scan: args
-            .session
-            .as_ref()
-            .map_or_else(|| scan.name.clone(), |p| p.display().to_string()),
+        scan: done.scan.clone(),
     };
-    let done = measure_and_write(
-        args,
-        scan,
-        &result,
-        &options,
-        joint_range.as_ref(),
-        format,
-        &provenance,
-    )?;
+    let t = Instant::now();
+    measure::write_cloud(&done.measured.cloud, &args.out, format, &provenance)
+        .map_err(|e| CliError::from_file(&e, false))?;
+    let written = t.elapsed().as_secs_f64();
     if args.quiet {
         return Ok(());
     }
     print_warnings(&done.measured);
-    print_summary(
-        args,
-        &result,
-        format,
-        (&notes, &skipped),
-        &done,
-        (started, loaded),
-    );
+    let timing = (started, loaded + done.read_secs, written);
+    print_summary(args, &result, format, &done, timing);
     Ok(())
 }

@@ -1,24 +1,23 @@
 //! The Measure view's job work: a scan (the open session, a session
 //! file, or a raw scan's pose log and profiles) into a point cloud
-//! through the result on show, by the same engine functions `spherecal
-//! measure` calls, with the self-validation on its sphere stations; and
-//! what the view draws of it, made on the job thread: a decimated copy
+//! through the result on show, by the one engine entry `spherecal
+//! measure` calls too ([`measure::measure_scan`], with the
+//! self-validation on its sphere stations); and what the view draws of
+//! it, made on the job thread: a decimated copy
 //! ([`DRAWN_MAX`] points at most) sorted by σ, the bounds and the σ
 //! figures, so that a cloud of millions costs the frame only the points
 //! drawn.
 
-use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use crate::engine::base::session::{Session, Use};
 use crate::engine::calibrate::solve::{Control, SolverReport};
 pub use crate::engine::calibrate::stripe::segment::grouped as group;
-use crate::engine::files::format::{self, ResultFile};
+use crate::engine::files::format::ResultFile;
 use crate::engine::uses::measure::{
-    self, CellModel, Cloud, CloudFormat, CloudPoint, Dropped, JointRange, MeasureError,
-    MeasureOptions, ModelChoice, Scan, ScanFiles, SelfValidation, SigmaStats, Stage,
+    self, Cloud, CloudFormat, CloudPoint, Dropped, MeasureError, MeasureOptions, MeasureRequest,
+    Outcome, SelfValidation, SigmaStats,
 };
 
 use crate::app::error::JobError;
@@ -30,102 +29,15 @@ use crate::app::error::JobError;
 /// whatever the cloud's size (10 M points stay responsive).
 pub const DRAWN_MAX: usize = 50_000;
 
-/// Poses outside the calibrated joint range listed by name at most (as
-/// the command lists them).
-const LISTED_POSES: usize = 20;
-
 /// The smallest step of the progress bar that is reported (1 %): a
 /// scan of 10,000 poses sends 100 messages, not 20,000.
 const PROGRESS_STEP: f64 = 0.01;
-
-/// What is measured.
-#[derive(Debug, Clone)]
-pub enum ScanInput {
-    /// A session's stripes (the open one), with the uses to keep (empty:
-    /// all) and its name for people.
-    Session(Box<Session>, Vec<Use>, String),
-    /// A session file, with the uses to keep.
-    SessionFile(PathBuf, Vec<Use>),
-    /// A raw scan's files.
-    Files(Box<ScanFiles>),
-}
-
-/// Everything a measuring job needs.
-#[derive(Debug, Clone)]
-pub struct MeasureRequest {
-    /// The scan.
-    pub scan: ScanInput,
-    /// The result on show.
-    pub result: ResultFile,
-    /// The result for people and the file header (its file, or "a
-    /// workbench run of …").
-    pub result_label: String,
-    /// The joint range the calibration saw (the open session's).
-    pub joint_range: Option<JointRange>,
-    /// The workpiece frame file, if any.
-    pub frame: Option<PathBuf>,
-    /// σ or not, sensor noise (the frame is read by the job).
-    pub options: MeasureOptions,
-}
 
 /// Whether `result` carries the parameter covariance σ needs (an `ml`
 /// result that reached its diagnostics).
 #[must_use]
 pub fn has_covariance(result: &ResultFile) -> bool {
     matches!(&result.solver, SolverReport::Ml(r) if !r.covariance.labels.is_empty())
-}
-
-/// The fraction of the whole job at `stage`'s step `done` of `of`:
-/// reading the scan takes the first tenth, placing the poses the next
-/// four, σ the next three and a half, the self-validation and the view
-/// the rest.
-fn fraction(stage: Stage, done: usize, of: usize) -> f64 {
-    let f = done as f64 / of.max(1) as f64;
-    match stage {
-        Stage::Poses => 0.1 + 0.4 * f,
-        Stage::Sigma => 0.5 + 0.35 * f,
-    }
-}
-
-/// The scan a request names, read (a session as it is, a session file,
-/// or a raw scan's files), with the label it is shown under.
-fn read_scan(scan: ScanInput) -> Result<(Scan, String), MeasureFailure> {
-    Ok(match scan {
-        ScanInput::Session(session, uses, name) => (Scan::from_session(*session, &uses), name),
-        ScanInput::SessionFile(path, uses) => {
-            let session = format::load_session(&path)
-                .map_err(|e| MeasureFailure::Failed(JobError::from(e)))?;
-            (
-                Scan::from_session(session, &uses),
-                path.display().to_string(),
-            )
-        }
-        ScanInput::Files(files) => {
-            let scan = measure::scan_from_files(&files)
-                .map_err(|e| MeasureFailure::Failed(JobError::from(e)))?;
-            let label = files.log.path().display().to_string();
-            (scan, label)
-        }
-    })
-}
-
-/// Refuses a scan with no pose to measure (saying when its measurements
-/// give sphere centres instead of profiles).
-fn refuse_empty(scan: &Scan, scan_label: &str) -> Result<(), MeasureFailure> {
-    if scan.poses.is_empty() {
-        return Err(MeasureFailure::Failed(JobError::Missing(format!(
-            "nothing to measure: no pose with a profile in {scan_label}{}",
-            if scan.skipped.is_empty() {
-                String::new()
-            } else {
-                format!(
-                    " (its {} measurements give sphere centres)",
-                    scan.skipped.len()
-                )
-            }
-        ))));
-    }
-    Ok(())
 }
 
 /// The points drawn (at most [`DRAWN_MAX`], the largest σ last so that
@@ -176,120 +88,77 @@ fn sigma_words(
     (no_sigma, sigma_basis)
 }
 
-/// The poses outside the calibrated joint range, in words, at most
-/// [`LISTED_POSES`] and a line for the rest.
-fn listed_out_of_range(out_of_range: &[measure::OutOfRange]) -> Vec<String> {
-    let mut listed: Vec<String> = out_of_range
-        .iter()
-        .take(LISTED_POSES)
-        .map(ToString::to_string)
-        .collect();
-    if out_of_range.len() > LISTED_POSES {
-        listed.push(format!("… and {} more", out_of_range.len() - LISTED_POSES));
-    }
-    listed
-}
-
-/// Measures `request` (module doc): reads the scan, measures it, runs
-/// the self-validation on its sphere stations, and makes the view of the
-/// cloud. `progress` gets each phase in words and the fraction done
-/// (false: the workbench is gone); `cancel` is looked at after every
-/// pose and between the phases.
+/// Measures `request` by the engine's [`measure::measure_scan`] (what
+/// `spherecal measure` calls) and makes the view of the cloud;
+/// `result_label` names the result for people and the file header.
+/// `progress` gets each phase in words and the fraction done (false: the
+/// workbench is gone); `cancel` is looked at after every pose and
+/// between the phases.
 ///
 /// # Errors
 /// [`MeasureFailure::Cancelled`] after a cancel, [`MeasureFailure::Failed`]
 /// with the engine's error (naming the file, pose or parameter) otherwise.
-pub fn measure_scan(
+pub fn measure_cloud(
     request: MeasureRequest,
+    result_label: String,
     cancel: &AtomicBool,
     progress: &mut dyn FnMut(&str, f64) -> bool,
 ) -> Result<MeasuredCloud, MeasureFailure> {
     let started = Instant::now();
-    let failed = |e: MeasureError| match e {
-        MeasureError::Cancelled => MeasureFailure::Cancelled,
-        e => MeasureFailure::Failed(JobError::from(e)),
-    };
-    let stopped = |cancel: &AtomicBool| {
-        if cancel.load(Ordering::Relaxed) {
-            Err(MeasureFailure::Cancelled)
-        } else {
-            Ok(())
-        }
-    };
-    progress("reading the scan", 0.0);
-    let MeasureRequest {
-        scan,
-        result,
-        result_label,
-        joint_range,
-        frame,
-        mut options,
-    } = request;
-    let (scan, scan_label) = read_scan(scan)?;
-    stopped(cancel)?;
-    refuse_empty(&scan, &scan_label)?;
-    if let Some(path) = &frame {
-        let w = measure::load_frame(path).map_err(failed)?;
-        options.frame = Some((w, path.display().to_string()));
-    }
-    let sphere = scan.sphere_diameter;
-    let references = scan.reference_distances.clone();
-    let (notes, skipped) = (scan.notes.clone(), scan.skipped.len());
-    let mut last = 0.0;
-    let measured = measure::measure(scan, &result, &options, joint_range.as_ref(), &mut |p| {
-        let f = fraction(p.stage, p.done, p.of);
+    let cancelled = || cancel.load(Ordering::Relaxed);
+    let (result, options) = (request.result.clone(), request.options.clone());
+    let mut last = -1.0;
+    let done = measure::measure_scan(request, &mut |p| {
+        let f = p.fraction();
         let mut alive = true;
         if f - last >= PROGRESS_STEP || p.done == p.of {
             last = f;
-            let what = match p.stage {
-                Stage::Poses => "placing the sensor at each pose",
-                Stage::Sigma => "the σ of each pose",
-            };
-            alive = progress(&format!("{what} ({} of {})", p.done, p.of), f);
+            alive = progress(&p.describe(), f);
         }
-        if cancel.load(Ordering::Relaxed) || !alive {
+        if cancelled() || !alive {
             Control::Cancel
         } else {
             Control::Continue
         }
     })
-    .map_err(failed)?;
-    stopped(cancel)?;
-    progress("the self-validation on the sphere stations", 0.85);
-    let check = sphere.and_then(|d| {
-        measure::self_validate(
-            &measured.cloud.poses,
-            &CellModel::of_result(&result, ModelChoice::Nominal),
-            &CellModel::of_result(&result, ModelChoice::Calibrated),
-            d,
-            &references,
-        )
-    });
-    stopped(cancel)?;
+    .map_err(|e| match e {
+        MeasureError::Cancelled => MeasureFailure::Cancelled,
+        e => MeasureFailure::Failed(JobError::from(e)),
+    })?;
+    if cancelled() {
+        return Err(MeasureFailure::Cancelled);
+    }
     progress("the view of the cloud (decimated, σ colours)", 0.95);
+    let Outcome {
+        measured,
+        check,
+        scan,
+        notes,
+        skipped,
+        ..
+    } = done;
     let cloud = measured.cloud;
     let (drawn, sigma_range) = drawn_points(&cloud);
-    let sigma = cloud.sigma_stats();
     let (no_sigma, sigma_basis) = sigma_words(&cloud, &result, &options);
-    let out_of_range = listed_out_of_range(&measured.out_of_range);
-    let out_of_range_count = measured.out_of_range.len();
-    stopped(cancel)?;
+    if cancelled() {
+        return Err(MeasureFailure::Cancelled);
+    }
     Ok(MeasuredCloud {
-        out_of_range_count,
+        out_of_range_count: measured.out_of_range.len(),
+        out_of_range: measure::listed(&measured.out_of_range),
         points: cloud.len(),
         poses: cloud.poses.len(),
         dropped: cloud.dropped(),
         bounds: cloud.bounds(),
-        sigma,
+        sigma: cloud.sigma_stats(),
         sigma_range,
         no_sigma,
         sigma_basis,
         check,
         warnings: measured.warnings,
-        out_of_range,
-        skipped,
+        skipped: skipped.len(),
         notes,
-        scan: scan_label,
+        scan,
         result: result_label,
         frame: cloud.frame.to_string(),
         model: cloud.model,
@@ -367,18 +236,4 @@ pub enum MeasureFailure {
     Cancelled,
     /// The inputs or the engine failed.
     Failed(JobError),
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The progress bar only moves forward through the phases.
-    #[test]
-    fn the_fraction_grows_through_the_stages() {
-        assert!((fraction(Stage::Poses, 0, 10) - 0.1).abs() < 1e-12);
-        assert!((fraction(Stage::Poses, 10, 10) - 0.5).abs() < 1e-12);
-        assert!((fraction(Stage::Sigma, 10, 10) - 0.85).abs() < 1e-12);
-        assert!(fraction(Stage::Sigma, 0, 0) >= 0.5);
-    }
 }

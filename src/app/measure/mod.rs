@@ -19,7 +19,8 @@ use crate::engine::files::import::{
     AngleUnit, AxisMap, FlangeConvention, LengthUnit, ProfileFormat, ProfileSource,
 };
 use crate::engine::uses::measure::{
-    self, CloudFormat, JointRange, MeasureOptions, ModelChoice, ScanColumns, ScanFiles, ScanLog,
+    self, CloudFormat, JointRange, MeasureOptions, MeasureRequest, ModelChoice, ScanColumns,
+    ScanFiles, ScanLog, ScanSource,
 };
 
 use super::command::{Command, MeasureCommand};
@@ -29,10 +30,7 @@ use super::ledger::{Artefact, Reading};
 use super::results::ResultOrigin;
 use super::state::{Level, Notice};
 use super::{Core, Write};
-use job::{
-    MeasureFailure, MeasureRequest, MeasuredCloud, ScanInput, format_label, group, has_covariance,
-    measure_scan,
-};
+use job::{MeasureFailure, MeasuredCloud, format_label, group, has_covariance, measure_cloud};
 
 /// The Measure view's state.
 #[derive(Debug, Default)]
@@ -260,7 +258,7 @@ impl Core {
 
     /// The job's request from the form and the result on show, or why
     /// there is none.
-    fn measure_request(&self) -> Result<MeasureRequest, String> {
+    fn measure_request(&self) -> Result<(MeasureRequest, String), String> {
         let Some(view) = &self.state.result else {
             return Err("no result on show: run the calibration or open a result first".into());
         };
@@ -285,7 +283,7 @@ impl Core {
                 let Some(l) = loaded else {
                     return Err("no session open to measure".into());
                 };
-                ScanInput::Session(
+                ScanSource::Session(
                     Box::new(l.session.clone()),
                     form.uses(),
                     format!("\"{}\" ({})", l.session.name, l.source.label()),
@@ -296,7 +294,7 @@ impl Core {
                 if path.is_empty() {
                     return Err("type or choose the session file to measure".into());
                 }
-                ScanInput::SessionFile(PathBuf::from(path), form.uses())
+                ScanSource::SessionFile(PathBuf::from(path), form.uses())
             }
             ScanChoice::RawScan => {
                 let dof = view
@@ -304,7 +302,7 @@ impl Core {
                     .robot
                     .as_ref()
                     .map_or(0, crate::engine::base::robot::kinematics::Robot::dof);
-                ScanInput::Files(Box::new(form.scan_files(dof)?))
+                ScanSource::Files(Box::new(form.scan_files(dof)?))
             }
         };
         let result_label = match &view.origin {
@@ -314,10 +312,9 @@ impl Core {
                 view.method, view.file.session
             ),
         };
-        Ok(MeasureRequest {
+        let request = MeasureRequest {
             scan,
             result: view.file.clone(),
-            result_label,
             joint_range: loaded.and_then(|l| JointRange::of_session(&l.session)),
             frame: form.frame_path(),
             options: MeasureOptions {
@@ -327,14 +324,15 @@ impl Core {
                 sensor_noise_mm: form.sensor_noise_mm,
                 covariance_as_written: false,
             },
-        })
+        };
+        Ok((request, result_label))
     }
 
     fn start_measure(&mut self, ctx: &egui::Context) {
         if self.state.jobs.runs(&Slot::Measure) {
             return;
         }
-        let request = match self.measure_request() {
+        let (request, result_label) = match self.measure_request() {
             Ok(r) => r,
             Err(why) => {
                 self.state.say(Level::Warning, "nothing measured");
@@ -344,7 +342,7 @@ impl Core {
         };
         let stamp = self.state.ledger.stamp(Artefact::Cloud);
         if self.start(ctx, Slot::Measure, stamp, move |w| {
-            measure_scan(request, w.flag(), &mut |phase, fraction| {
+            measure_cloud(request, result_label, w.flag(), &mut |phase, fraction| {
                 w.progress(phase, Some(fraction))
             })
             .map(Box::new)

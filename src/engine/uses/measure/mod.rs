@@ -52,9 +52,11 @@
 //! that a scan belongs to it), [`sigma`], [`cloud`] (the measured cloud,
 //! its decimated view), [`sphere`] (least-squares sphere fits),
 //! [`selfcheck`] (ISO 10360-8-style figures before and after
-//! calibration), [`write`] (PLY, E57, CSV).
+//! calibration), [`write`] (PLY, E57, CSV); [`entry`] the one entry the
+//! command line and the workbench call ([`measure_scan`]).
 
 pub mod cloud;
+pub mod entry;
 pub mod model;
 pub mod scan;
 pub mod selfcheck;
@@ -67,6 +69,7 @@ use std::path::Path;
 use nalgebra::Isometry3;
 
 pub use cloud::{Cloud, CloudPoint, CloudPose, FrameLabel, SigmaStats};
+pub use entry::{LISTED_POSES, MeasureRequest, Outcome, ScanSource, listed, measure_scan};
 pub use model::{CellModel, JointRange, ModelChoice, OutOfRange, covariance_of};
 pub use scan::{
     Dropped, Placement, Scan, ScanColumns, ScanFiles, ScanLog, ScanPose, scan_from_files,
@@ -120,10 +123,14 @@ pub struct MeasureOptions {
 /// What a measurement is doing, for a progress display.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stage {
+    /// Reading the scan ([`measure_scan`]).
+    Reading,
     /// Placing the sensor at each pose.
     Poses,
     /// The σ of each pose (two passes over the poses).
     Sigma,
+    /// Waiting for the self-validation ([`measure_scan`]).
+    SelfCheck,
 }
 
 /// Progress of a measurement: `done` of `of` steps of `stage`.
