@@ -62,7 +62,7 @@ fn bench(c: &mut Criterion) {
     let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("sessions/history");
     group.bench_function("history: scan sessions/history and drift", |b| {
         b.iter(|| {
-            let library = history::scan(&folder).expect("scan");
+            let library = history::read_library(&folder).expect("scan");
             let robot = library.robots()[0].0.clone();
             history::drift(&library, &robot, &DriftOptions::default()).expect("drift")
         });

@@ -212,7 +212,7 @@ fn read_everywhere(session: &Session, result: &ResultFile, dir: &Path, must_load
     let written = format::save_result(result, &path);
     if must_load {
         written.unwrap();
-        let library = history::scan(dir).unwrap();
+        let library = history::read_library(dir).unwrap();
         assert!(library.problems.is_empty(), "{:?}", library.problems);
         assert_eq!(library.entries.len(), 1);
         assert_eq!(&format::load_result(&path).unwrap(), result);

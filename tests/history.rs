@@ -189,7 +189,7 @@ fn write_library(dir: &Path) {
 fn library() -> (tempfile::TempDir, Library) {
     let dir = tempfile::tempdir().unwrap();
     write_library(dir.path());
-    let library = history::scan(dir.path()).unwrap();
+    let library = history::read_library(dir.path()).unwrap();
     (dir, library)
 }
 
@@ -472,11 +472,11 @@ fn bad_files_are_reported_and_the_scan_goes_on() {
     assert!(library.entries.windows(2).all(|w| w[0].date <= w[1].date));
     // A folder that cannot be scanned is an error, not an empty library.
     assert!(matches!(
-        history::scan(&dir.path().join("missing")),
+        history::read_library(&dir.path().join("missing")),
         Err(history::HistoryError::Folder { .. })
     ));
     assert!(matches!(
-        history::scan(&dir.path().join("readme.txt")),
+        history::read_library(&dir.path().join("readme.txt")),
         Err(history::HistoryError::NotAFolder { .. })
     ));
 }
@@ -501,7 +501,7 @@ fn linked_folders_are_followed_without_loops_and_a_bom_is_accepted() {
     );
     fs::write(lib.join("bom.result.json"), bom).unwrap();
 
-    let library = history::scan(&lib).unwrap();
+    let library = history::read_library(&lib).unwrap();
     let found: Vec<&Path> = library.entries.iter().map(|e| e.path.as_path()).collect();
     assert_eq!(found.len(), 2, "{found:?} {:?}", library.problems);
     assert!(
@@ -648,7 +648,7 @@ fn dates_come_from_names_then_file_names_then_file_times() {
     fs::remove_file(s).unwrap();
     set_mtime(&r, sep);
 
-    let library = history::scan(dir.path()).unwrap();
+    let library = history::read_library(dir.path()).unwrap();
     let found = |session: &str| {
         let e = library
             .entries
@@ -810,7 +810,7 @@ fn the_example_library_shows_its_two_events() {
     // sessions/history (make.sh): three repeats, a sensor remount on
     // 2026-04-13, a joint-3 zero change on 2026-05-11.
     let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("sessions/history");
-    let library = history::scan(&folder).unwrap();
+    let library = history::read_library(&folder).unwrap();
     assert!(library.problems.is_empty(), "{:?}", library.problems);
     assert_eq!(library.entries.len(), 5);
     assert!(library.entries.iter().all(|e| {
@@ -897,7 +897,7 @@ fn variance_factor_prior_and_fixed_sets_are_respected() {
             });
         }),
     );
-    let library = history::scan(dir.path()).unwrap();
+    let library = history::read_library(dir.path()).unwrap();
     let e = &library.entries;
     assert_eq!(
         e[0].sigma_scale,

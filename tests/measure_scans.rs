@@ -183,7 +183,7 @@ fn simulate_writes_a_raw_scan_and_its_truth() {
         truth.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let t = simulate::scan::parse_scan_truth(&std::fs::read_to_string(&truth).unwrap()).unwrap();
+    let t = simulate::parts::parse_scan_truth(&std::fs::read_to_string(&truth).unwrap()).unwrap();
     assert_eq!(t.poses.len(), 9, "3 poses at each of 3 spheres");
     assert!(matches!(t.part, simulate::Part::Spheres { .. }));
     for id in ["s1", "s9"] {

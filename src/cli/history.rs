@@ -68,7 +68,8 @@ pub fn run(args: &HistoryArgs) -> Result<(), CliError> {
     if let Some(path) = &args.csv {
         super::check_outputs(&[path], format::Folders::Existing)?;
     }
-    let library = history::scan(&args.folder).map_err(|e| CliError::input(e.to_string()))?;
+    let library =
+        history::read_library(&args.folder).map_err(|e| CliError::input(e.to_string()))?;
     let robots: Vec<String> = match &args.robot {
         Some(query) => vec![
             library

@@ -84,7 +84,9 @@ impl Core {
         self.state
             .say(Level::Info, format!("scanning {}…", folder.display()));
         self.start(ctx, Slot::Library, Stamp::default(), move |_| {
-            let outcome = history::scan(&folder).map(Box::new).map_err(JobError::from);
+            let outcome = history::read_library(&folder)
+                .map(Box::new)
+                .map_err(JobError::from);
             (folder, outcome)
         });
     }

@@ -1,5 +1,5 @@
 //! The History view: the library of a folder of sessions and results
-//! ([`crate::engine::tools::history::scan`]) as a table, and for one robot the
+//! ([`crate::engine::tools::history::read_library`]) as a table, and for one robot the
 //! drift of the hand-eye and of its main kinematic deviations over the
 //! ticked results, with every change beyond `k` combined σ flagged
 //! ([`crate::engine::tools::history::drift`]). Nothing is computed here.

@@ -25,7 +25,7 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
-use super::scan::{Lines, number_at, shown, skip_blanks};
+use super::lex::{Lines, number_at, shown, skip_blanks};
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 

@@ -7,7 +7,7 @@
 
 use std::ops::Range;
 
-use super::scan::{Lines, number_at, skip_space};
+use super::lex::{Lines, number_at, skip_space};
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 

@@ -23,7 +23,7 @@ mod fanuc;
 mod json;
 mod krl;
 mod rapid;
-mod scan;
+mod lex;
 pub mod style;
 mod table;
 mod urscript;
@@ -36,7 +36,7 @@ use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::base::session::Use;
 use crate::engine::files::format::{Cap, read_bytes, read_text};
 
-pub use self::scan::MAX_SHOWN_CHARS;
+pub use self::lex::MAX_SHOWN_CHARS;
 pub use self::table::Row;
 
 /// The layout of a pose file.
@@ -159,7 +159,7 @@ pub fn detect(text: &str, path: &Path) -> PoseFormat {
     }
     // URScript by its pose literals or move calls (before KRL, whose
     // programs have neither).
-    if scan::contains_ur_pose(text)
+    if lex::contains_ur_pose(text)
         || text.contains("movej(")
         || text.contains("movel(")
         || ext == "script"
@@ -183,7 +183,7 @@ pub fn detect(text: &str, path: &Path) -> PoseFormat {
 /// The last number in a target's name (`P[3]` → 3, `XP12` → 12).
 #[must_use]
 pub fn number_in(name: &str) -> Option<u64> {
-    scan::last_number(name)
+    lex::last_number(name)
 }
 
 /// A target's value as written.
@@ -237,7 +237,7 @@ pub struct Target {
 
 impl Target {
     fn new(name: String, line: usize, value: TargetValue, spans: Vec<Range<usize>>) -> Self {
-        let number = scan::last_number(&name);
+        let number = lex::last_number(&name);
         Self {
             name,
             number,
@@ -330,7 +330,7 @@ impl PoseFile {
                 .ok_or(RewriteError::NoConfiguration(*index))?;
             replacements.push((range.clone(), text.as_str()));
         }
-        Ok(scan::replace_ranges(&self.text, replacements))
+        Ok(lex::replace_ranges(&self.text, replacements))
     }
 }
 
@@ -485,7 +485,7 @@ pub fn parse_pose_text(
             ),
         ));
     }
-    let (order, order_note, mut warnings) = scan::motion_order(&parsed.targets, &parsed.visits);
+    let (order, order_note, mut warnings) = lex::motion_order(&parsed.targets, &parsed.visits);
     warnings.splice(0..0, parsed.warnings);
     Ok(PoseFile {
         path: path.to_path_buf(),

@@ -11,7 +11,7 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
-use super::scan::{
+use super::lex::{
     Lines, MotionArguments, computed_motion, inside, line_comments, number_at, shown, skip_space,
 };
 use super::{ParseError, Parsed, Target, TargetValue};

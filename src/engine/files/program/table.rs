@@ -22,7 +22,7 @@
 
 use std::ops::Range;
 
-use super::scan::shown;
+use super::lex::shown;
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::base::session::Use;

@@ -7,7 +7,7 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
-use super::scan::{
+use super::lex::{
     Lines, computed_motion, inside, line_comments, number_at, skip_space, ur_pose_starts,
 };
 use super::{ParseError, Parsed, Target, TargetValue};

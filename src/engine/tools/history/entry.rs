@@ -136,7 +136,7 @@ fn model_joints(result: &ResultFile) -> (Vec<Joint>, Vec<Joint>) {
 
 #[allow(
     clippy::unnecessary_wraps,
-    reason = "the same shape as the scan's other readers, which can fail"
+    reason = "the same shape as the walk's other readers, which can fail"
 )]
 pub(super) fn build_entry(
     path: PathBuf,

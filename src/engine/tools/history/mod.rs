@@ -1,12 +1,12 @@
 //! The history of a cell: a library over a folder of session and result
-//! files ([`scan`]), and for one robot the drift of the hand-eye and of
+//! files ([`read_library`]), and for one robot the drift of the hand-eye and of
 //! its main kinematic deviations over time, with every change between
 //! consecutive results that exceeds `k` times their combined 1σ flagged
 //! ([`drift`]).
 //!
 //! # The library
 //!
-//! [`scan`] walks a folder (subfolders to [`MAX_DEPTH`] levels; hidden
+//! [`read_library`] walks a folder (subfolders to [`MAX_DEPTH`] levels; hidden
 //! entries such as `.git` or the temporary files of
 //! [`write_atomic`](crate::engine::files::format::write_atomic) and symbolic links to
 //! folders are skipped). Every `*.json` file is classified by its
@@ -15,8 +15,8 @@
 //! [`session`](crate::engine::files::format); JSON files of other formats (truth files,
 //! anything else) are listed as ignored. A file that cannot be read, is
 //! not JSON, or breaks a rule of its format is a [`Problem`] with its path
-//! and message, and the scan goes on. Only a folder that cannot be read at
-//! all fails the scan ([`HistoryError`]).
+//! and message, and the walk goes on. Only a folder that cannot be read at
+//! all fails the walk ([`HistoryError`]).
 //!
 //! **One [`Entry`] per result file.** Its session file is found, in order:
 //! by name, `X.result.json` (the `--out` name of the README) or
@@ -103,12 +103,12 @@ mod csv;
 mod date;
 mod drift;
 mod entry;
-mod scan;
+mod walk;
 
 pub use csv::drift_csv;
 pub use date::{DateSource, Timestamp, date_in_name};
 pub use drift::{Drift, DriftOptions, JumpCheck, Point, Series, SeriesKind, Verdict, drift};
-pub use scan::scan;
+pub use walk::read_library;
 
 use std::fmt;
 use std::io;
@@ -121,7 +121,7 @@ use crate::engine::base::robot::Joint;
 use crate::engine::calibrate::validate::Stats;
 use crate::engine::tools::result_view::HandEyeView;
 
-/// Deepest subfolder level [`scan`] enters (the folder itself is level 0).
+/// Deepest subfolder level [`read_library`] enters (the folder itself is level 0).
 /// A library is a folder of cells, robots or dates; 8 levels is far beyond
 /// any such layout and still stops a walk into an unrelated tree.
 pub const MAX_DEPTH: usize = 8;
@@ -230,7 +230,7 @@ fn list_or_none(names: &[String]) -> String {
     }
 }
 
-/// A file the scan could not use, and why.
+/// A file the walk could not use, and why.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Problem {
     /// The file (or folder).
@@ -464,7 +464,7 @@ pub struct SessionInfo {
     pub results: Vec<usize>,
 }
 
-/// What [`scan`] found.
+/// What [`read_library`] found.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Library {
     /// The folder scanned.
@@ -550,7 +550,7 @@ mod tests {
     use nalgebra::{Matrix3, Vector3};
 
     use super::entry::{hand_eye_jacobians, roll_pitch_yaw_deg};
-    use super::scan::result_stem;
+    use super::walk::result_stem;
     use super::*;
     use crate::engine::base::geometry::wrap_deg;
 

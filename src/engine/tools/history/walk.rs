@@ -25,7 +25,7 @@ use crate::engine::files::format::{self, RESULT_FORMAT, ResultFile, SESSION_FORM
 /// [`HistoryError::Folder`] when the folder cannot be read,
 /// [`HistoryError::NotAFolder`] when it is a file. Bad files are
 /// [`Library::problems`], never an error.
-pub fn scan(folder: &Path) -> Result<Library, HistoryError> {
+pub fn read_library(folder: &Path) -> Result<Library, HistoryError> {
     let meta = fs::metadata(folder).map_err(|source| HistoryError::Folder {
         path: folder.to_path_buf(),
         source,

@@ -44,14 +44,14 @@ pub mod config;
 pub mod from_plan;
 pub mod import_files;
 mod poses;
-pub mod scan;
+pub mod parts;
 mod stripe;
 pub mod truth;
 
 pub use config::{ErrorModel, InitialHandEye, SideChoice, SimConfig, SimError};
 pub use from_plan::{PlanExecution, PlanPose, simulate_plan};
 pub use import_files::{ImportFiles, import_files};
-pub use scan::{Part, PartKind, ScanConfig, ScanTruth, SimulatedScan, simulate_scan};
+pub use parts::{Part, PartKind, ScanConfig, ScanTruth, SimulatedScan, simulate_scan};
 pub use truth::{Truth, TruthError, load_truth, parse_truth, truth_to_json};
 
 use nalgebra::Vector3;
