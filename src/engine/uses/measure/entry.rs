@@ -9,8 +9,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use super::{
-    CellModel, JointRange, MeasureError, MeasureOptions, Measured, ModelChoice, Progress, Scan,
-    ScanFiles, ScanPose, SelfValidation, Stage, load_frame, measure, scan_from_files, selfcheck,
+    CellModel, JointRange, MeasureError, MeasureOptions, MeasureProgress, Measured, ModelChoice,
+    Scan, ScanFiles, ScanPose, SelfValidation, Stage, load_frame, measure, scan_from_files,
+    selfcheck,
 };
 use crate::engine::base::session::{Session, Use};
 use crate::engine::calibrate::solve::Control;
@@ -84,7 +85,7 @@ pub struct Outcome {
     pub checked_secs: f64,
 }
 
-impl Progress {
+impl MeasureProgress {
     /// What the measurement is doing, in words: "the σ of each pose (3 of
     /// 40)".
     #[must_use]
@@ -153,7 +154,7 @@ fn read_scan(
 /// a result without covariance ([`MeasureError`]); cancelled.
 pub fn measure_scan(
     request: MeasureRequest,
-    progress: &mut dyn FnMut(&Progress) -> Control,
+    progress: &mut dyn FnMut(&MeasureProgress) -> Control,
 ) -> Result<Outcome, MeasureError> {
     let started = Instant::now();
     let MeasureRequest {
@@ -163,7 +164,7 @@ pub fn measure_scan(
         frame,
         mut options,
     } = request;
-    let step = |stage| Progress {
+    let step = |stage| MeasureProgress {
         stage,
         done: 0,
         of: 1,
@@ -245,7 +246,7 @@ mod tests {
     /// The progress bar only moves forward through the phases.
     #[test]
     fn the_fraction_grows_through_the_stages() {
-        let at = |stage, done, of| Progress { stage, done, of }.fraction();
+        let at = |stage, done, of| MeasureProgress { stage, done, of }.fraction();
         assert!(at(Stage::Reading, 0, 1).abs() < 1e-12);
         assert!((at(Stage::Poses, 0, 10) - 0.1).abs() < 1e-12);
         assert!((at(Stage::Poses, 10, 10) - 0.5).abs() < 1e-12);

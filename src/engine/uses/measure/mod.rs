@@ -133,9 +133,9 @@ pub enum Stage {
     SelfCheck,
 }
 
-/// Progress of a measurement: `done` of `of` steps of `stage`.
+/// How far a measurement is: `done` of `of` steps of `stage`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Progress {
+pub struct MeasureProgress {
     /// The stage.
     pub stage: Stage,
     /// Steps done.
@@ -199,7 +199,7 @@ pub fn measure(
     result: &ResultFile,
     options: &MeasureOptions,
     joint_range: Option<&JointRange>,
-    progress: &mut dyn FnMut(&Progress) -> Control,
+    progress: &mut dyn FnMut(&MeasureProgress) -> Control,
 ) -> Result<Measured, MeasureError> {
     let warnings = model::check_scan(&scan, result)?;
     let out_of_range = joint_range.map(|r| r.outside(&scan)).unwrap_or_default();
@@ -238,7 +238,7 @@ pub fn measure(
             ))
         })?;
         base_from_sensor.push(t);
-        let step = Progress {
+        let step = MeasureProgress {
             stage: Stage::Poses,
             done: i + 1,
             of: n,
@@ -269,7 +269,7 @@ pub fn measure(
                 .collect();
             let mut cancelled = false;
             let forms = sigma::sigma_forms(&est, cov, &inputs, &mut |done, of| {
-                let c = progress(&Progress {
+                let c = progress(&MeasureProgress {
                     stage: Stage::Sigma,
                     done,
                     of,
