@@ -207,15 +207,13 @@ pub fn rotation_from_rpy_deg(rpy_deg: [f64; 3]) -> UnitQuaternion<f64> {
     UnitQuaternion::from_euler_angles(r, p, y)
 }
 
-/// The proper rotation `R` minimising `Σ |R·a_k − b_k|²` given the
-/// cross-covariance `m = Σ a_k·b_kᵀ` (Kabsch; the paper's eq. 7 with the
-/// determinant forced to +1): `R = V·diag(1, 1, det(V·Uᵀ))·Uᵀ` from the
-/// SVD `m = U·S·Vᵀ`, taken to the nearest rotation (Müller et al.'s
-/// iteration, bounded as in [`nearest_rotation`]) so that rounding leaves
-/// no scale. `None` for a failed SVD or a matrix that is not finite. The one Kabsch of the crate: the
-/// initial hand-eye (eq. 7) and [`kabsch`] call it.
+/// The rotation nearest `m` by its SVD `m = U·S·Vᵀ` (the polar
+/// decomposition, determinant forced to +1): `U·diag(1, 1, ±1)·Vᵀ`. The
+/// one SVD of Kabsch's problem in the crate: [`kabsch_rotation`] and the
+/// general hand-eye's start use it. `None` for a matrix that is not
+/// finite or a failed SVD.
 #[must_use]
-pub fn kabsch_rotation(m: &Matrix3<f64>) -> Option<Rotation3<f64>> {
+pub fn polar_rotation(m: &Matrix3<f64>) -> Option<Matrix3<f64>> {
     if m.iter().any(|v| !v.is_finite()) {
         return None;
     }
@@ -227,11 +225,24 @@ pub fn kabsch_rotation(m: &Matrix3<f64>) -> Option<Rotation3<f64>> {
         crate::engine::base::numeric::MAX_DECOMPOSITION_SWEEPS,
     )?;
     let (u, v_t) = (svd.u?, svd.v_t?);
-    let v = v_t.transpose();
-    let d = (v * u.transpose()).determinant().signum();
+    let d = (u * v_t).determinant().signum();
     let fix = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, d));
+    Some(u * fix * v_t)
+}
+
+/// The proper rotation `R` minimising `Σ |R·a_k − b_k|²` given the
+/// cross-covariance `m = Σ a_k·b_kᵀ` (Kabsch; the paper's eq. 7 with the
+/// determinant forced to +1): `R = V·diag(1, 1, det(V·Uᵀ))·Uᵀ` from the
+/// SVD `m = U·S·Vᵀ`, the transpose of [`polar_rotation`]`(m)`, taken to
+/// the nearest rotation (Müller et al.'s iteration, bounded as in
+/// [`nearest_rotation`]) so that rounding leaves no scale. `None` for a
+/// failed SVD or a matrix that is not finite. The one Kabsch of the
+/// crate: the initial hand-eye (eq. 7) and [`kabsch`] call it.
+#[must_use]
+pub fn kabsch_rotation(m: &Matrix3<f64>) -> Option<Rotation3<f64>> {
+    let r = polar_rotation(m)?.transpose();
     Some(Rotation3::from_matrix_eps(
-        &(v * fix * u.transpose()),
+        &r,
         f64::EPSILON,
         crate::engine::base::numeric::MAX_DECOMPOSITION_SWEEPS,
         Rotation3::identity(),

@@ -32,7 +32,7 @@ use nalgebra::{
 };
 
 use super::HandEyeError;
-use crate::engine::base::geometry::skew;
+use crate::engine::base::geometry::{polar_rotation, skew};
 use crate::engine::base::numeric::MAX_DECOMPOSITION_SWEEPS;
 
 /// Centre noise (mm, per coordinate) under which the conditioning is
@@ -187,17 +187,6 @@ fn linear(sightings: &[GeneralSighting], stations: usize) -> Option<(Matrix3<f64
     Some((m, Vector3::new(v[9], v[10], v[11])))
 }
 
-/// The rotation nearest `m` (polar decomposition, determinant +1).
-fn nearest_rotation(m: &Matrix3<f64>) -> Option<Matrix3<f64>> {
-    let svd = SVD::try_new(*m, true, true, f64::EPSILON, MAX_DECOMPOSITION_SWEEPS)?;
-    let (u, vt) = (svd.u?, svd.v_t?);
-    let mut d = Matrix3::identity();
-    if (u * vt).determinant() < 0.0 {
-        d[(2, 2)] = -1.0;
-    }
-    Some(u * d * vt)
-}
-
 /// The rotation whose y and z columns are nearest those of `m`, its x
 /// column their cross product: for a set whose centres barely move off
 /// the laser plane the x column of `m` is the weakly seen one.
@@ -208,7 +197,7 @@ fn rotation_from_plane_columns(m: &Matrix3<f64>) -> Option<Matrix3<f64>> {
     if x.norm() < 1e-12 {
         return None;
     }
-    nearest_rotation(&Matrix3::from_columns(&[
+    polar_rotation(&Matrix3::from_columns(&[
         x.normalize() * (0.5 * (y.norm() + z.norm())),
         y,
         z,
@@ -337,7 +326,7 @@ pub fn general_hand_eye(
     let (m, t) = linear(sightings, stations)
         .ok_or_else(|| degenerate("the least-squares system could not be solved".to_string()))?;
     let mut best: Option<(Matrix3<f64>, Vector3<f64>, f64)> = None;
-    for start in [nearest_rotation(&m), rotation_from_plane_columns(&m)]
+    for start in [polar_rotation(&m), rotation_from_plane_columns(&m)]
         .into_iter()
         .flatten()
     {
