@@ -245,7 +245,7 @@ impl Table {
     pub fn parse(text: &str) -> Result<Self, TableError> {
         let mut header: Option<(usize, Vec<String>)> = None;
         let mut rows = Vec::new();
-        Self::scan(text, |line, record| {
+        Self::for_each_record(text, |line, record| {
             let fields: Vec<String> = record.iter().map(str::to_string).collect();
             if header.is_none() {
                 header = Some((line, fields));
@@ -277,7 +277,7 @@ impl Table {
     /// a data row whose field count differs from the header's; or the
     /// first error `each` returns. No header row
     /// is not an error here (`each` is then never called).
-    pub fn scan<E: From<TableError>>(
+    pub fn for_each_record<E: From<TableError>>(
         text: &str,
         mut each: impl FnMut(usize, &csv::StringRecord) -> Result<(), E>,
     ) -> Result<(), E> {

@@ -70,7 +70,7 @@ impl CsvFile {
             }
         }
         let mut file: Option<Self> = None;
-        let scanned = Table::scan(text, |line, record| {
+        let scanned = Table::for_each_record(text, |line, record| {
             match &file {
                 None => {
                     file = Some(Self {
