@@ -1,6 +1,7 @@
 //! `spherecal compensate`: the targets of a pose table or a robot program
 //! compensated through a calibration, written in the same layout with
-//! every other byte kept. A thin caller of [`crate::engine::uses::compensate`].
+//! every other byte kept. A thin caller of the one engine entry
+//! [`crate::engine::uses::compensate::compensate_file`].
 
 use std::path::PathBuf;
 
@@ -11,9 +12,10 @@ use super::values::{Range, number};
 use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
-use crate::engine::files::program::{self, PoseFormat, ReadSpec};
+use crate::engine::files::program::{PoseFormat, ReadSpec};
 use crate::engine::uses::compensate::{
-    self, CompensateError, JointTargets, Model, Options, Tcp, report, tool,
+    self, CompensateError, CompensateFileError, CompensateRequest, JointTargets, Options, Outcome,
+    Tcp, TcpSource, report,
 };
 
 /// Rows of the target table printed without `--all`.
@@ -100,39 +102,49 @@ pub fn run(args: &CompensateArgs) -> Result<(), CliError> {
         None => None,
     };
     let tcp = match args.tcp.as_str() {
-        "sensor" => Tcp::Sensor,
-        "flange" => Tcp::Flange,
-        path => Tcp::Tool(tool::read_tool(std::path::Path::new(path)).map_err(CliError::input)?),
+        "sensor" => TcpSource::Sensor,
+        "flange" => TcpSource::Flange,
+        path => TcpSource::ToolFile(PathBuf::from(path)),
     };
-    let spec = ReadSpec {
-        format: args.pose_format,
-        convention: args.pose_convention,
-        columns: (!args.pose_columns.is_empty()).then(|| args.pose_columns.clone()),
+    let request = CompensateRequest {
+        result,
+        session,
+        session_if_it_fits: false,
+        targets: args.targets.clone(),
+        read: ReadSpec {
+            format: args.pose_format,
+            convention: args.pose_convention,
+            columns: (!args.pose_columns.is_empty()).then(|| args.pose_columns.clone()),
+        },
+        tcp,
+        options: Options {
+            joint_targets: match args.joint_targets {
+                JointTargetsArg::Compensate => JointTargets::Compensate,
+                JointTargetsArg::Keep => JointTargets::Keep,
+            },
+            sigma_tolerance_mm: args.sigma_tolerance,
+            far_joints_deg: args.far_joints,
+            region_margin_mm: args.region_margin,
+        },
     };
-    let file = program::read_pose_file(&args.targets, &spec)
-        .map_err(|e| CliError::input(e.to_string()))?;
-    let model = Model::new(&result, session.as_ref(), tcp).map_err(|e| {
-        CliError::input(format!(
+    let targets = args.targets.display();
+    let Outcome {
+        file,
+        model,
+        compensation: done,
+        ..
+    } = compensate::compensate_file(request, &mut |_| Control::Continue).map_err(|e| match e {
+        CompensateFileError::Tool(e) => CliError::input(e),
+        CompensateFileError::Targets(e) => CliError::input(e.to_string()),
+        CompensateFileError::Model(e) => CliError::input(format!(
             "{e} ({})",
             args.session.as_ref().unwrap_or(&args.result).display()
-        ))
+        )),
+        CompensateFileError::Compensate(
+            e @ (CompensateError::Rewrite(_) | CompensateError::Cancelled),
+        ) => CliError::internal(format!("{e} ({targets})")),
+        CompensateFileError::Compensate(e) => CliError::input(format!("{e} ({targets})")),
     })?;
-    let options = Options {
-        joint_targets: match args.joint_targets {
-            JointTargetsArg::Compensate => JointTargets::Compensate,
-            JointTargetsArg::Keep => JointTargets::Keep,
-        },
-        sigma_tolerance_mm: args.sigma_tolerance,
-        far_joints_deg: args.far_joints,
-        region_margin_mm: args.region_margin,
-    };
-    let done = compensate::compensate(&model, &file, &options, &mut |_| Control::Continue)
-        .map_err(|e| match e {
-            CompensateError::Rewrite(_) | CompensateError::Cancelled => {
-                CliError::internal(format!("{e} ({})", args.targets.display()))
-            }
-            _ => CliError::input(format!("{e} ({})", args.targets.display())),
-        })?;
     if args.strict && done.summary.flagged > 0 {
         return Err(CliError::input(format!(
             "{} target(s) lie outside what the calibration saw (--strict), nothing written: {} ({})",

@@ -1,8 +1,8 @@
 //! The Compensate view's job work: the targets read, the model of the
-//! result on show built and every target compensated by the engine's
-//! [`compensate`](crate::engine::uses::compensate::compensate), as
-//! `spherecal compensate` runs it (same reading, model and default
-//! options); the view of it (one row per target, largest correction
+//! result on show built and every target compensated by the one engine
+//! entry `spherecal compensate` calls too
+//! ([`compensate_file`](crate::engine::uses::compensate::compensate_file));
+//! the view of it (one row per target, largest correction
 //! first, the flags in words, the summary line and the tool data the
 //! command line prints) with the compensated text; the file written
 //! atomically, never over an input.
@@ -11,75 +11,34 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::engine::base::robot::controller::FlangeConvention;
-use crate::engine::base::session::Session;
 use crate::engine::calibrate::solve::Control;
-use crate::engine::files::format::{ResultFile, refuse_inputs, write_atomic};
-use crate::engine::files::program::{self, PoseFile, ReadSpec};
+use crate::engine::files::format::{refuse_inputs, write_atomic};
+use crate::engine::files::program::PoseFile;
 use crate::engine::uses::compensate::{
-    self, CompensateError, Compensation, Model, Options, TargetFailure, Tcp, report, tool,
+    self, CompensateError, CompensateFileError, CompensateRequest, Compensation, Model,
+    TargetFailure, Tcp, report,
 };
 
-use super::form::TcpChoice;
-
-/// Everything a compensation job needs, taken when it starts.
-#[derive(Debug, Clone)]
-pub struct CompensateRequest {
-    /// The result on show.
-    pub result: ResultFile,
-    /// The open session, for a result that does not record the joints of
-    /// its poses (`pose_joints`, older results): as `--session`.
-    pub session: Option<Session>,
-    /// The targets file.
-    pub targets: PathBuf,
-    /// A table's pose convention (`--pose-convention`).
-    pub convention: Option<FlangeConvention>,
-    /// The TCP (`--tcp`).
-    pub tcp: TcpChoice,
-    /// The tool file, for [`TcpChoice::ToolFile`].
-    pub tool: PathBuf,
-    /// Joint targets and the flag limits.
-    pub options: Options,
-}
-
-/// Reads the targets, builds the model of the result and compensates
-/// every target, as `spherecal compensate` with the request's options; `progress` hears of each target,
-/// `cancel` stops at the next one.
+/// Compensates the request's targets by the one engine entry `spherecal
+/// compensate` calls too ([`compensate::compensate_file`]) and makes the
+/// view of it; `progress` hears of each target, `cancel` stops at the
+/// next one.
 ///
 /// # Errors
 /// The message, naming the file (and the target and line): a file that
 /// cannot be read, a result without a 6-axis robot, an unreachable
 /// target, "cancelled".
 pub fn compensate_targets(
-    request: &CompensateRequest,
+    request: CompensateRequest,
     cancel: &AtomicBool,
     progress: &mut dyn FnMut(String, f64),
 ) -> Result<CompensationView, String> {
-    let tcp = match request.tcp {
-        TcpChoice::Sensor => Tcp::Sensor,
-        TcpChoice::Flange => Tcp::Flange,
-        TcpChoice::ToolFile => Tcp::Tool(tool::read_tool(&request.tool)?),
-    };
-    let spec = ReadSpec {
-        format: None,
-        convention: request.convention,
-        columns: None,
-    };
-    let file = program::read_pose_file(&request.targets, &spec).map_err(|e| e.to_string())?;
-    let mut notes = Vec::new();
-    let model = match Model::new(&request.result, request.session.as_ref(), tcp.clone()) {
-        // The open session is not the result's: go on without it, as the
-        // command line without `--session`.
-        Err(CompensateError::Session(why)) => {
-            notes.push(format!("the open session is not used: {why}"));
-            Model::new(&request.result, None, tcp)
-        }
-        other => other,
-    }
-    .map_err(|e| format!("{e} (the result on show)"))?;
-    let done = compensate::compensate(&model, &file, &request.options, &mut |p| {
+    let (targets, convention) = (request.targets.clone(), request.read.convention);
+    let done = compensate::compensate_file(request, &mut |p| {
+        let fraction = p.done as f64 / p.total.max(1) as f64;
         progress(
             format!("target {}: {} of {}", p.target, p.done, p.total),
-            p.done as f64 / p.total.max(1) as f64,
+            fraction,
         );
         if cancel.load(Ordering::Relaxed) {
             Control::Cancel
@@ -88,13 +47,15 @@ pub fn compensate_targets(
         }
     })
     .map_err(|e| match e {
-        CompensateError::Targets(failed) if failed.len() > 1 => {
-            failures_text(&failed, &request.targets)
+        CompensateFileError::Model(e) => format!("{e} (the result on show)"),
+        CompensateFileError::Compensate(CompensateError::Targets(failed)) if failed.len() > 1 => {
+            failures_text(&failed, &targets)
         }
-        e => format!("{e} ({})", request.targets.display()),
+        CompensateFileError::Compensate(e) => format!("{e} ({})", targets.display()),
+        e => e.to_string(),
     })?;
-    let mut view = CompensationView::new(done, &file, &model, request.convention);
-    view.notes.extend(notes);
+    let mut view = CompensationView::new(done.compensation, &done.file, &done.model, convention);
+    view.notes.extend(done.notes);
     Ok(view)
 }
 

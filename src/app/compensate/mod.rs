@@ -16,9 +16,11 @@ use super::job::{Job, Slot};
 use super::ledger::{Artefact, Reading};
 use super::state::{Level, Notice};
 use super::{Core, Write};
+use crate::engine::files::program::ReadSpec;
 use crate::engine::uses::compensate::JointTargets;
+use crate::engine::uses::compensate::{CompensateRequest, TcpSource};
 use form::{CompensateForm, TcpChoice};
-use job::{CompensateRequest, CompensationView, compensate_targets, write_compensated};
+use job::{CompensationView, compensate_targets, write_compensated};
 
 /// What "Write compensated program" calls the file it writes (status
 /// line, list of files written).
@@ -91,15 +93,24 @@ impl Core {
         let request = CompensateRequest {
             result,
             session,
+            // The open session may not be the result's: then it is left
+            // out, as the command line without `--session`.
+            session_if_it_fits: true,
             targets: PathBuf::from(form.targets.trim()),
-            convention: form.convention,
-            tcp: form.tcp,
-            tool: PathBuf::from(form.tool.trim()),
+            read: ReadSpec {
+                convention: form.convention,
+                ..ReadSpec::default()
+            },
+            tcp: match form.tcp {
+                TcpChoice::Sensor => TcpSource::Sensor,
+                TcpChoice::Flange => TcpSource::Flange,
+                TcpChoice::ToolFile => TcpSource::ToolFile(PathBuf::from(form.tool.trim())),
+            },
             options: form.options.clone(),
         };
         let stamp = self.state.ledger.stamp(Artefact::Compensation);
         if self.start(ctx, Slot::Compensate, stamp, move |w| {
-            compensate_targets(&request, w.flag(), &mut |text, fraction| {
+            compensate_targets(request, w.flag(), &mut |text, fraction| {
                 w.progress(text, Some(fraction));
             })
             .map(Box::new)

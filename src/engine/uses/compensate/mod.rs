@@ -54,11 +54,14 @@
 //! cell teaches, σ is not aligned and the joint-space flag is not raised.
 //!
 //! [`compensate`] runs over every target with a progress callback that
-//! may cancel (a workbench job); [`study`] is the validation in
-//! simulation of the README.
+//! may cancel (a workbench job); [`compensate_file`] ([`entry`]) is the
+//! one entry the command line and the workbench call (the TCP, the
+//! targets read, the model, the compensation); [`study`] is the
+//! validation in simulation of the README.
 
 pub mod arms;
 pub mod config;
+pub mod entry;
 mod region;
 pub mod report;
 pub mod study;
@@ -79,6 +82,9 @@ use crate::engine::calibrate::solve::ml::covariance::ParameterCovariance;
 use crate::engine::files::format::ResultFile;
 use crate::engine::files::program::{PoseFile, RewriteError};
 
+pub use self::entry::{
+    CompensateFileError, CompensateRequest, Outcome, TcpSource, compensate_file,
+};
 pub use self::report::Summary;
 
 /// Default tolerance of the predicted σ (mm): a target whose predicted
