@@ -382,14 +382,7 @@ fn write_ui(
         }
     });
     dialog_note_ui(ui, state, &[Purpose::CompensateOut]);
-    let mut written = state.ledger.written.iter().rev();
-    if let Some(w) = written.find(|w| w.from == Artefact::Compensation) {
-        let text = match state.ledger.written_stale(w) {
-            Some(_) => format!("last written: {} (stale now)", w.path.display()),
-            None => format!("last written: {}", w.path.display()),
-        };
-        ui.label(RichText::new(text).small().color(MUTED));
-    }
+    crate::app::widgets::written_ui(ui, state, &[Artefact::Compensation]);
 }
 
 /// One row per target, largest correction first.

@@ -117,34 +117,19 @@ pub fn measure_ui(
 }
 
 /// A path field with its Browse… button and the note when the dialog
-/// chose nothing.
+/// A path field with its Browse… button (the note when a dialog chose
+/// nothing is under the scan's fields).
 fn path_row(
     ui: &mut egui::Ui,
     state: &AppState,
-    label: &str,
+    (label, hint): (&str, &str),
     text: &mut String,
-    hint: &str,
     purpose: Purpose,
     commands: &mut Vec<Command>,
 ) {
+    let busy = state.jobs.runs(&Slot::Dialog);
     ui.horizontal(|ui| {
-        labelled_field(ui, label, text, hint, 420.0);
-        if ui
-            .add_enabled(
-                !state.jobs.runs(&Slot::Dialog),
-                egui::Button::new("Browse…"),
-            )
-            .clicked()
-        {
-            commands.push(Command::Browse(purpose));
-        }
-        if state.dialog_empty == Some(purpose) {
-            ui.label(
-                RichText::new(crate::app::dialog::NO_DIALOG)
-                    .small()
-                    .color(WARN),
-            );
-        }
+        crate::app::widgets::path_row(ui, label, text, hint, busy, purpose, commands);
     });
 }
 
@@ -279,9 +264,8 @@ fn scan_ui(
         ScanChoice::SessionFile => path_row(
             ui,
             state,
-            "Session file",
+            ("Session file", "a session .json"),
             &mut form.session_file,
-            "a session .json",
             Purpose::MeasureSession,
             commands,
         ),
@@ -295,18 +279,19 @@ fn scan_ui(
             path_row(
                 ui,
                 state,
-                "Pose log",
+                ("Pose log", "joint log CSV or pose file"),
                 &mut form.log,
-                "joint log CSV or pose file",
                 Purpose::MeasureLog,
                 commands,
             );
             path_row(
                 ui,
                 state,
-                "Profiles",
+                (
+                    "Profiles",
+                    "a folder of <id>.csv…, or one CSV with a pose column",
+                ),
                 &mut form.profiles,
-                "a folder of <id>.csv…, or one CSV with a pose column",
                 Purpose::MeasureProfiles,
                 commands,
             );
@@ -314,9 +299,11 @@ fn scan_ui(
             path_row(
                 ui,
                 state,
-                "References",
+                (
+                    "References",
+                    "optional: the artefact's distances CSV (from,to,distance mm)",
+                ),
                 &mut form.references,
-                "optional: the artefact's distances CSV (from,to,distance mm)",
                 Purpose::MeasureReferences,
                 commands,
             );
@@ -325,12 +312,22 @@ fn scan_ui(
     path_row(
         ui,
         state,
-        "Workpiece frame",
+        (
+            "Workpiece frame",
+            "optional: a JSON 4×4 base_from_workpiece (mm); empty: robot base frame",
+        ),
         &mut form.frame,
-        "optional: a JSON 4×4 base_from_workpiece (mm); empty: robot base frame",
         Purpose::MeasureFrame,
         commands,
     );
+    let purposes = [
+        Purpose::MeasureSession,
+        Purpose::MeasureLog,
+        Purpose::MeasureProfiles,
+        Purpose::MeasureReferences,
+        Purpose::MeasureFrame,
+    ];
+    crate::app::widgets::dialog_note_ui(ui, state, &purposes);
 }
 
 /// The raw scan's units and readings: joint unit or pose convention,
@@ -746,13 +743,7 @@ fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
             commands.push(Command::Browse(Purpose::MeasureExport));
         }
         ui.label(RichText::new(".ply · .e57 · .csv").small().color(MUTED));
-        if state.dialog_empty == Some(Purpose::MeasureExport) {
-            ui.label(
-                RichText::new(crate::app::dialog::NO_DIALOG)
-                    .small()
-                    .color(WARN),
-            );
-        }
+        crate::app::widgets::dialog_note_ui(ui, state, &[Purpose::MeasureExport]);
     });
     if let Some(s) = &stale {
         ui.label(
@@ -761,26 +752,7 @@ fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
                 .color(WARN),
         );
     }
-    for w in state
-        .ledger
-        .written
-        .iter()
-        .rev()
-        .filter(|w| w.from == Artefact::Cloud)
-        .take(2)
-    {
-        let mark = if state.ledger.written_stale(w).is_some() {
-            RichText::new(format!(
-                "! wrote {} {} (now stale)",
-                w.what,
-                w.path.display()
-            ))
-            .color(WARN)
-        } else {
-            RichText::new(format!("● wrote {} {}", w.what, w.path.display())).color(GOOD)
-        };
-        ui.label(mark.small());
-    }
+    crate::app::widgets::written_ui(ui, state, &[Artefact::Cloud]);
 }
 
 #[cfg(test)]

@@ -290,48 +290,8 @@ fn export_ui(
         }
     });
     crate::app::widgets::dialog_note_ui(ui, state, &[Purpose::ExportFolder]);
-    written_ui(ui, state);
+    crate::app::widgets::written_ui(ui, state, &[Artefact::Result, Artefact::Report]);
 }
-
-/// The files written of the result on show this session, each marked
-/// stale when an input of it has changed since.
-fn written_ui(ui: &mut egui::Ui, state: &AppState) {
-    let prov = &state.ledger;
-    let mine: Vec<_> = prov
-        .written
-        .iter()
-        .filter(|w| matches!(w.from, Artefact::Result | Artefact::Report))
-        .rev()
-        .take(WRITTEN_SHOWN)
-        .collect();
-    if mine.is_empty() {
-        return;
-    }
-    ui.horizontal_wrapped(|ui| {
-        ui.label(RichText::new("written:").small().weak());
-        for w in mine {
-            let name = w.path.file_name().map_or_else(
-                || w.path.display().to_string(),
-                |n| n.to_string_lossy().into_owned(),
-            );
-            match prov.written_stale(w) {
-                Some(s) => ui
-                    .label(
-                        RichText::new(format!("! {name} (stale)"))
-                            .small()
-                            .color(WARN),
-                    )
-                    .on_hover_text(format!("{}: {s}", w.path.display())),
-                None => ui
-                    .label(RichText::new(format!("● {name}")).small().color(GOOD))
-                    .on_hover_text(format!("{} ({}), current", w.path.display(), w.what)),
-            };
-        }
-    });
-}
-
-/// Files listed under the export buttons, newest first.
-const WRITTEN_SHOWN: usize = 4;
 
 fn export_hint(kind: ExportKind) -> &'static str {
     match kind {

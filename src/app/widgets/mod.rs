@@ -14,6 +14,7 @@ use super::command::Tab;
 use super::command::{Command, ViewCommand};
 use super::dialog::{NO_DIALOG, Purpose};
 use super::job::{Job, Slot};
+use super::ledger::Artefact;
 use super::state::Level;
 
 /// Colour of "before calibration" series (nominal model, initial hand-eye).
@@ -362,6 +363,47 @@ pub fn confirm_ui(ctx: &egui::Context, state: &AppState, commands: &mut Vec<Comm
         });
     });
 }
+
+/// The files written this session of the `of` artefacts, newest first
+/// (the last [`WRITTEN_SHOWN`]), each marked stale when an input of it
+/// has changed since (what changed on hover).
+pub fn written_ui(ui: &mut egui::Ui, state: &AppState, of: &[Artefact]) {
+    let ledger = &state.ledger;
+    let written = ledger.written.iter().rev();
+    let mine: Vec<_> = written
+        .filter(|w| of.contains(&w.from))
+        .take(WRITTEN_SHOWN)
+        .collect();
+    if mine.is_empty() {
+        return;
+    }
+    ui.horizontal_wrapped(|ui| {
+        ui.label(RichText::new("written:").small().weak());
+        for w in mine {
+            let name = w.path.file_name().map_or_else(
+                || w.path.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            );
+            let (text, colour, hover) = match ledger.written_stale(w) {
+                Some(s) => (
+                    format!("! {name} (stale)"),
+                    WARN,
+                    format!("{}: {s}", w.path.display()),
+                ),
+                None => (
+                    format!("● {name}"),
+                    GOOD,
+                    format!("{} ({}), current", w.path.display(), w.what),
+                ),
+            };
+            ui.label(RichText::new(text).small().color(colour))
+                .on_hover_text(hover);
+        }
+    });
+}
+
+/// Files listed by [`written_ui`], newest first.
+const WRITTEN_SHOWN: usize = 4;
 
 /// A dimmed overlay while files are dragged over the window.
 pub fn drop_overlay_ui(ctx: &egui::Context) {
