@@ -357,3 +357,94 @@ impl Jobs {
         self.started
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Waits until every job's thread has answered (or been dropped).
+    fn settle(jobs: &mut Jobs) -> Vec<Finished> {
+        let mut out = Vec::new();
+        for _ in 0..1000 {
+            jobs.drain();
+            out.extend(jobs.finish());
+            if !jobs.is_busy() {
+                return out;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(2));
+        }
+        panic!("the jobs did not end");
+    }
+
+    /// An answer comes back with its job (phase, fraction, series); a
+    /// job replaced in its slot, or cancelled, is forgotten at once and
+    /// its late answer dropped.
+    #[test]
+    fn a_late_answer_is_dropped_and_the_latest_job_answers() {
+        let ctx = egui::Context::default();
+        let mut jobs = Jobs::default();
+        let (go, wait) = std::sync::mpsc::channel::<()>();
+        jobs.start(Slot::Plan, Stamp::default(), &ctx, move |w| {
+            wait.recv().ok();
+            w.point(0, 2.5);
+            w.progress("second half", Some(0.5));
+            1_u32
+        })
+        .unwrap();
+        // Replaced before it answers: its answer is dropped.
+        jobs.start(Slot::Plan, Stamp::default(), &ctx, |_| 2_u32)
+            .unwrap();
+        go.send(()).unwrap();
+        let done = settle(&mut jobs);
+        assert_eq!(done.len(), 1);
+        let (slot, job, answer) = &done[0];
+        assert_eq!(*slot, Slot::Plan);
+        assert_eq!(job.id, 2);
+        let answer = answer.as_ref().and_then(|a| a.downcast_ref::<u32>());
+        assert_eq!(answer, Some(&2));
+        // Cancelled: nothing comes back, and the job saw the flag.
+        let (go, wait) = std::sync::mpsc::channel::<()>();
+        jobs.start(Slot::Run, Stamp::default(), &ctx, move |w| {
+            wait.recv().ok();
+            w.progress("after the cancel", Some(1.0))
+        })
+        .unwrap();
+        let cancelled = jobs.cancel(&Slot::Run).expect("running");
+        assert!(cancelled.cancel.load(Ordering::Relaxed));
+        assert!(jobs.is_busy(), "until its thread ends");
+        go.send(()).unwrap();
+        assert!(settle(&mut jobs).is_empty());
+        assert!(jobs.get(&Slot::Run).is_none());
+    }
+
+    /// Progress reaches the job in its slot and never goes back; a series
+    /// point replaces what followed it.
+    #[test]
+    fn progress_reaches_the_job_and_never_goes_back() {
+        let ctx = egui::Context::default();
+        let mut jobs = Jobs::default();
+        let (go, wait) = std::sync::mpsc::channel::<()>();
+        jobs.start(Slot::Measure, Stamp::default(), &ctx, move |w| {
+            w.progress("a", Some(0.6));
+            w.progress("b", Some(0.4));
+            w.point(0, 1.0);
+            w.point(1, 0.5);
+            w.point(1, 0.25);
+            wait.recv().ok();
+        })
+        .unwrap();
+        let job = loop {
+            jobs.drain();
+            let job = jobs.get(&Slot::Measure).expect("running");
+            if job.series.len() == 2 && job.series[1] == 0.25 {
+                break job.clone();
+            }
+            std::thread::sleep(std::time::Duration::from_millis(2));
+        };
+        assert_eq!(job.phase, "b");
+        assert_eq!(job.fraction, Some(0.6));
+        assert_eq!(job.series, [1.0, 0.25]);
+        go.send(()).unwrap();
+        assert_eq!(settle(&mut jobs).len(), 1);
+    }
+}
