@@ -409,12 +409,6 @@ impl ResultView {
             file,
         }
     }
-
-    /// Whether parameter `label` (e.g. `theta2`) is marked not identifiable.
-    #[must_use]
-    pub fn is_marked(&self, label: &str) -> bool {
-        self.shown.marked.contains_key(label)
-    }
 }
 
 /// The camera of the 3D centres view (orthographic, orbiting the centres).

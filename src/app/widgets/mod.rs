@@ -87,12 +87,6 @@ pub fn station_style(k: usize) -> StationStyle {
     }
 }
 
-/// The colour of station number `k` ([`station_style`]).
-#[must_use]
-pub fn station_colour(k: usize) -> Color32 {
-    station_style(k).colour
-}
-
 /// A one-line text field with a visible label tied to it (screen readers
 /// and the UI tests find it by that label).
 pub fn labelled_field(
