@@ -427,7 +427,7 @@ pub fn save_result(result: &ResultFile, path: &Path) -> Result<(), FileError> {
 /// (microseconds); only a result that has one is walked key by key to
 /// tell a legal `null` from a number that is not finite. That every
 /// result written this way loads in `report`, `export-model` and
-/// `history` is a property test (`tests/fuzz.rs`).
+/// `history` is a property test (`tests/engine/fuzz.rs`).
 ///
 /// # Errors
 /// [`FileError::Invalid`] naming the first non-finite number by its key

@@ -1,0 +1,20 @@
+//! The command line's tests, on the real binary: its contract, every
+//! subcommand, hostile input, the report in a browser, and the user guide
+//! whose every command runs here.
+
+#[path = "../support/mod.rs"]
+mod support;
+
+mod cli_help;
+mod compensate;
+mod contract;
+mod guide;
+mod history;
+mod hostile;
+mod layout;
+mod measure;
+mod measure_scans;
+mod model_export;
+mod plan;
+mod report;
+mod report_browser;

@@ -1,0 +1,22 @@
+//! The engine's tests: the paper's method and `ml` on seeded simulated
+//! sessions against their truth, the stripe fits and segmentation, the
+//! simulator, every file format and import, the real data set.
+
+#[path = "../support/mod.rs"]
+mod support;
+
+mod formats;
+mod fuzz;
+mod held_out;
+mod import;
+mod ml;
+mod paper;
+mod pose_files;
+mod pose_only;
+mod range;
+mod range_spread;
+mod realdata;
+mod robot_import;
+mod segment;
+mod simulate;
+mod stripe;

@@ -1,0 +1,15 @@
+//! The workbench's tests: egui_kittest drives the real app (no display,
+//! no GPU), finds widgets by their labels, clicks, and checks state.
+#![cfg(feature = "gui")]
+
+#[path = "../support/mod.rs"]
+mod support;
+
+mod compensate;
+mod guided;
+mod held_out;
+mod import_poses;
+mod measure;
+mod range;
+mod trust;
+mod workbench;
