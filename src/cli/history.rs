@@ -6,6 +6,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use crate::engine::base::numeric::plural;
 use crate::engine::files::format;
 use crate::engine::tools::history::{
     self, DEFAULT_K, DEFAULT_TOP, Drift, DriftOptions, Entry, Library, Series, SeriesKind, Verdict,
@@ -115,10 +116,6 @@ pub fn run(args: &HistoryArgs) -> Result<(), CliError> {
         }
     }
     Ok(())
-}
-
-fn plural(n: usize, one: &str, many: &str) -> String {
-    format!("{n} {}", if n == 1 { one } else { many })
 }
 
 fn cut(s: &str, width: usize) -> String {

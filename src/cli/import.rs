@@ -231,8 +231,7 @@ pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
     })
 }
 
-/// The `--out` path, required unless only previewing.
-/// The `--out` path, refused when it is one of the import's inputs (the
+/// The `--out` path, required unless only previewing, refused when it is one of the import's inputs (the
 /// pose log, a profile, the references or the robot file).
 fn out_path(args: &ImportArgs) -> Result<PathBuf, CliError> {
     let out = args.out.clone().ok_or_else(|| {
@@ -251,8 +250,19 @@ fn out_path(args: &ImportArgs) -> Result<PathBuf, CliError> {
     inputs.extend(args.centres.iter().chain(&args.hand_eye).cloned());
     if let Some(profiles) = &args.profiles {
         if profiles.is_dir() {
-            if let Ok(files) = crate::engine::files::import::profiles::profile_files(profiles) {
-                inputs.extend(files);
+            // The files the import reads: the profiles named alike, not
+            // what the folder's listing skips (an earlier output, the
+            // pose file, a README).
+            let exclude: Vec<&std::path::Path> = args
+                .joints
+                .iter()
+                .chain(&args.poses)
+                .map(PathBuf::as_path)
+                .collect();
+            if let Ok(listing) =
+                crate::engine::files::import::pairing::list_profiles(profiles, &exclude, None)
+            {
+                inputs.extend(listing.profiles);
             }
         } else {
             inputs.push(profiles.clone());

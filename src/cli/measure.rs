@@ -12,6 +12,7 @@ use clap::Args;
 use super::scan_flags::ScanFlags;
 use super::values::{Keywords, Range, number};
 use super::{CliError, QUIET_HELP};
+use crate::engine::base::numeric::plural;
 use crate::engine::base::robot::kinematics::Robot;
 use crate::engine::base::session::Use;
 use crate::engine::calibrate::solve::Control;
@@ -236,6 +237,7 @@ fn scan_files(args: &MeasureArgs, dof: usize) -> Result<ScanFiles, CliError> {
         robot,
         sphere_diameter: args.sphere_diameter,
         references: args.references.clone(),
+        uses: uses(args),
     })
 }
 
@@ -327,9 +329,9 @@ fn print_summary(
         sayln!("{note}");
     }
     sayln!(
-        "measured {} points of {} poses ({} model of {}, {}); dropped {} non-finite and {} no-return points",
+        "measured {} points of {} ({} model of {}, {}); dropped {} non-finite and {} no-return points",
         n,
-        cloud.poses.len(),
+        plural(cloud.poses.len(), "pose", "poses"),
         cloud.model,
         args.result.display(),
         cloud.frame,

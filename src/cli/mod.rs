@@ -269,9 +269,24 @@ pub fn stdout_result() -> Result<(), CliError> {
     note_stdout(std::io::stdout().lock().flush());
     let first = STDOUT_ERROR.lock().ok().and_then(|mut e| e.take());
     match first {
-        Some(e) => Err(CliError::input(format!(
-            "writing to standard output failed: {e}; the command's text is lost"
-        ))),
+        Some(e) => {
+            let files = format::written();
+            let files = if files.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    ", but the files it wrote are whole and kept: {}",
+                    files
+                        .iter()
+                        .map(|p| p.display().to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            };
+            Err(CliError::input(format!(
+                "writing to standard output failed: {e}; the command's text is lost{files}"
+            )))
+        }
         None => Ok(()),
     }
 }
@@ -302,10 +317,22 @@ pub fn bounded_message(message: &str) -> String {
 
 /// The one line printed after `error: `: numbers written out in full by
 /// an engine message shown as people write them ([`readable_numbers`]),
-/// then cut to [`MAX_MESSAGE_CHARS`] ([`bounded_message`]).
+/// control characters (a line feed in a file name) written as escapes so
+/// the message stays one line, then cut to [`MAX_MESSAGE_CHARS`]
+/// ([`bounded_message`]).
 #[must_use]
 pub fn error_line(message: &str) -> String {
-    bounded_message(&readable_numbers(message))
+    let one_line: String = message
+        .chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect();
+    bounded_message(&readable_numbers(&one_line))
 }
 
 /// Digits a number may have before it is rewritten in scientific
@@ -590,13 +617,19 @@ impl MlArgs {
 /// Status 2: the file cannot be read, or its transform is not plausible.
 pub fn hand_eye_file(path: &Path) -> Result<nalgebra::Isometry3<f64>, CliError> {
     use crate::engine::tools::plan::RequestError;
-    crate::engine::tools::plan::read_hand_eye(path).map_err(|e| match e {
-        RequestError::File { message, .. } => {
-            let message = message.strip_prefix("hand_eye: ").unwrap_or(&message);
-            CliError::input(format!("--hand-eye: {message} ({})", path.display()))
-        }
-        other => CliError::input(other.to_string()),
-    })
+    let (hand_eye, note) =
+        crate::engine::tools::plan::read_hand_eye(path).map_err(|e| match e {
+            RequestError::File { message, .. } => {
+                let message = message.strip_prefix("hand_eye: ").unwrap_or(&message);
+                CliError::input(format!("--hand-eye: {message} ({})", path.display()))
+            }
+            other => CliError::input(other.to_string()),
+        })?;
+    if let Some(note) = note {
+        let note = note.strip_prefix("hand_eye: ").unwrap_or(&note);
+        sayln!("note: --hand-eye: {note} ({})", path.display());
+    }
+    Ok(hand_eye)
 }
 
 /// The robot presets' keys, for the help of every `--robot`:

@@ -8,6 +8,7 @@ mod support;
 mod cli_help;
 mod compensate;
 mod contract;
+mod doors;
 mod guide;
 mod history;
 mod hostile;

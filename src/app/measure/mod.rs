@@ -231,6 +231,7 @@ impl MeasureForm {
             robot: None,
             sphere_diameter,
             references: (!references.is_empty()).then(|| PathBuf::from(references)),
+            uses: self.uses(),
         })
     }
 }

@@ -26,8 +26,8 @@ pub enum MatrixError {
     #[error("last row must be [0, 0, 0, 1], found [{0}, {1}, {2}, {3}]")]
     LastRow(f64, f64, f64, f64),
     /// The 3×3 block is not orthonormal.
-    #[error("3x3 block is not orthonormal (|RᵀR − I| = {0:.3e}, tolerance {ROTATION_TOLERANCE:e})")]
-    NotOrthonormal(f64),
+    #[error("3x3 block is not orthonormal (|RᵀR − I| = {0:.3e}, tolerance {1:e})")]
+    NotOrthonormal(f64, f64),
     /// The 3×3 block is a reflection.
     #[error("3x3 block has determinant {0:.6}, not +1 (a reflection)")]
     Reflection(f64),
@@ -40,6 +40,24 @@ pub enum MatrixError {
 /// # Errors
 /// [`MatrixError`] naming the broken property.
 pub fn isometry_from_rows(rows: &[[f64; 4]; 4]) -> Result<Isometry3<f64>, MatrixError> {
+    isometry_from_rows_within(rows, ROTATION_TOLERANCE).map(|(iso, _)| iso)
+}
+
+/// Largest |RᵀR − I| of a 4×4 typed by a person (a hand-eye guess, a
+/// workpiece frame, a tool) that is re-orthonormalised rather than
+/// refused: a rotation written to 4 decimals is off by up to ~1e-4.
+pub const TYPED_ROTATION_TOLERANCE: f64 = 1e-3;
+
+/// [`isometry_from_rows`] with the rotation checked to `tolerance`; also
+/// returns how far from orthonormal the 3×3 block was (|RᵀR − I|), which
+/// the re-orthonormalisation removed.
+///
+/// # Errors
+/// [`MatrixError`] naming the broken property.
+pub fn isometry_from_rows_within(
+    rows: &[[f64; 4]; 4],
+    tolerance: f64,
+) -> Result<(Isometry3<f64>, f64), MatrixError> {
     if rows.iter().flatten().any(|v| !v.is_finite()) {
         return Err(MatrixError::NotFinite);
     }
@@ -53,17 +71,20 @@ pub fn isometry_from_rows(rows: &[[f64; 4]; 4]) -> Result<Isometry3<f64>, Matrix
     }
     let r = Matrix3::from_fn(|i, j| rows[i][j]);
     let off = (r.transpose() * r - Matrix3::identity()).abs().max();
-    if off > ROTATION_TOLERANCE {
-        return Err(MatrixError::NotOrthonormal(off));
+    if off > tolerance {
+        return Err(MatrixError::NotOrthonormal(off, tolerance));
     }
     let det = r.determinant();
-    if (det - 1.0).abs() > ROTATION_TOLERANCE {
+    if (det - 1.0).abs() > tolerance {
         return Err(MatrixError::Reflection(det));
     }
     let rotation = nearest_rotation(&r);
-    Ok(Isometry3::from_parts(
-        Translation3::new(rows[0][3], rows[1][3], rows[2][3]),
-        rotation,
+    Ok((
+        Isometry3::from_parts(
+            Translation3::new(rows[0][3], rows[1][3], rows[2][3]),
+            rotation,
+        ),
+        off,
     ))
 }
 
@@ -341,7 +362,7 @@ mod tests {
         rows[0][1] = 0.01;
         assert!(matches!(
             isometry_from_rows(&rows),
-            Err(MatrixError::NotOrthonormal(_))
+            Err(MatrixError::NotOrthonormal(..))
         ));
         let mut rows = rows_from_isometry(&Isometry3::identity());
         rows[3][0] = 1.0;

@@ -128,6 +128,13 @@ pub fn step_125_at_most(most: f64) -> f64 {
         .unwrap_or(decade)
 }
 
+/// `n` and the noun that fits it: "1 pose", "2 poses" (`many` is the
+/// plural, for nouns that do not just add an s).
+#[must_use]
+pub fn plural(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -140,6 +147,13 @@ mod tests {
         assert_eq!(approx(-45.0), "-45");
         assert_eq!(approx(1.5e160), "1.500e160");
         assert_eq!(approx(0.0), "0");
+    }
+
+    #[test]
+    fn plurals() {
+        assert_eq!(plural(1, "pose", "poses"), "1 pose");
+        assert_eq!(plural(0, "pose", "poses"), "0 poses");
+        assert_eq!(plural(2, "station", "stations"), "2 stations");
     }
 
     #[test]

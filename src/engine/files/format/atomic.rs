@@ -55,6 +55,18 @@ static PENDING: Mutex<Pending> = Mutex::new(Pending {
     folders: Vec::new(),
 });
 
+/// Every file this process has written whole, in order (what a command
+/// that fails after writing says it leaves behind).
+static WRITTEN: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// The files this process has written whole so far, in order.
+#[must_use]
+pub fn written() -> Vec<PathBuf> {
+    WRITTEN
+        .lock()
+        .map_or_else(|e| e.into_inner().clone(), |w| w.clone())
+}
+
 /// Set by [`remove_pending`]: the process is being interrupted, no write
 /// may rename its files any more.
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
@@ -417,6 +429,12 @@ fn commit(
                 break;
             }
         }
+    }
+    if outcome.is_ok() {
+        let mut written = WRITTEN
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        written.extend(done.iter().map(|(target, _)| target.to_path_buf()));
     }
     for (target, backup) in done.into_iter().rev() {
         match (&outcome, backup) {

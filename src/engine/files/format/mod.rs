@@ -15,14 +15,14 @@ pub mod transform;
 
 pub use atomic::{
     Folders, check_outputs, interrupted, refuse_inputs, remove_pending, same_file,
-    write_all_atomic, write_atomic, write_atomic_with,
+    write_all_atomic, write_atomic, write_atomic_with, written,
 };
 pub use read::{Cap, read_bytes, read_text};
 pub use result::{
     ResultFile, load_result, parse_result, result_text_checked, result_to_json, save_result,
 };
 pub use session::{load_session, parse_session, save_session, session_to_json};
-pub use transform::{TransformError, read_transform};
+pub use transform::{TransformError, read_transform, read_typed_transform};
 
 /// The `format` of a session file.
 pub const SESSION_FORMAT: &str = "spherecal-session";

@@ -15,7 +15,9 @@ use nalgebra::Isometry3;
 use serde_json::Value;
 
 use super::read::{Cap, read_text};
-use crate::engine::base::geometry::{MatrixError, isometry_from_rows};
+use crate::engine::base::geometry::{
+    MatrixError, ROTATION_TOLERANCE, TYPED_ROTATION_TOLERANCE, isometry_from_rows_within,
+};
 use crate::engine::base::session::rules::{self, RuleViolation};
 
 /// Why a transform file gives no transform. The messages name no file:
@@ -54,8 +56,24 @@ pub enum TransformError {
 /// [`TransformError`]: unreadable, not JSON, no matrix, not a rigid
 /// transform, not plausible.
 pub fn read_transform(path: &Path, key: &str) -> Result<Isometry3<f64>, TransformError> {
+    read_typed_transform(path, key).map(|(transform, _)| transform)
+}
+
+/// [`read_transform`], and a note when the rotation was re-orthonormalised:
+/// a 4×4 typed by a person (rotation written to a few decimals) is
+/// accepted up to [`TYPED_ROTATION_TOLERANCE`] from orthonormal and made
+/// exactly rigid, the note saying by how much.
+///
+/// # Errors
+/// As [`read_transform`].
+pub fn read_typed_transform(
+    path: &Path,
+    key: &str,
+) -> Result<(Isometry3<f64>, Option<String>), TransformError> {
     let text = read_text(path, Cap::SESSION).map_err(TransformError::Read)?;
-    let value: Value = serde_json::from_str(text.trim_start_matches('\u{feff}'))
+    // A key given twice is refused: which of the two is meant? (The
+    // JSON map keeps the last one silently.)
+    let super::json::UniqueValue(value) = serde_json::from_str(text.trim_start_matches('\u{feff}'))
         .map_err(|e| TransformError::Json(e.to_string()))?;
     let matrix = match value {
         Value::Object(mut map) => map
@@ -69,7 +87,12 @@ pub fn read_transform(path: &Path, key: &str) -> Result<Isometry3<f64>, Transfor
     }
     let rows: [[f64; 4]; 4] =
         serde_json::from_value(matrix).map_err(|e| TransformError::NotMatrix(e.to_string()))?;
-    let transform = isometry_from_rows(&rows)?;
+    let (transform, off) = isometry_from_rows_within(&rows, TYPED_ROTATION_TOLERANCE)?;
     rules::transform(key, &transform)?;
-    Ok(transform)
+    let note = (off > ROTATION_TOLERANCE).then(|| {
+        format!(
+            "{key}: the rotation is {off:.1e} from orthonormal (|RᵀR − I|, numbers rounded as written): taken as the nearest rotation"
+        )
+    });
+    Ok((transform, note))
 }

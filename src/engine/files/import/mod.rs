@@ -63,6 +63,7 @@ pub use crate::engine::base::robot::controller::FlangeConvention;
 pub use crate::engine::files::program::PoseFormat;
 
 use self::log::JointLog;
+use crate::engine::base::numeric::plural;
 use crate::engine::base::robot::Robot;
 use crate::engine::base::session::{MIN_STRIPE_POINTS, Measurement, Observation, Session};
 use crate::engine::files::format::FileError;
@@ -208,8 +209,8 @@ impl ProfileReport {
         let no_return: usize = self.poses.iter().map(|p| p.no_return).sum();
         let points: usize = self.poses.iter().map(|p| p.points).sum();
         format!(
-            "profiles: {} poses, {points} points; axis map {} ({}{}); dropped {non_finite} non-finite and {no_return} no-return points",
-            self.poses.len(),
+            "profiles: {}, {points} points; axis map {} ({}{}); dropped {non_finite} non-finite and {no_return} no-return points",
+            plural(self.poses.len(), "pose", "poses"),
             self.axes,
             self.axes.describe(),
             if self.axes_guessed {

@@ -7,7 +7,7 @@
 
 use std::ops::Range;
 
-use super::lex::{Lines, number_at, skip_space};
+use super::lex::{Lines, number_at, shown, skip_space};
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 
@@ -60,6 +60,15 @@ fn value(text: &str, at: usize, depth: usize, lines: &Lines) -> Result<(Node, us
             loop {
                 let (key, after) =
                     string(text, j).ok_or_else(|| (lines.line(j), "malformed key".to_string()))?;
+                if members.iter().any(|(k, _)| *k == key) {
+                    return Err((
+                        lines.line(j),
+                        format!(
+                            "the key `{}` is given twice in one object: which is meant?",
+                            shown(&key)
+                        ),
+                    ));
+                }
                 let colon = skip_space(text, after);
                 let (v, next) = value(text, colon + 1, depth + 1, lines)?;
                 members.push((key, v));

@@ -72,6 +72,12 @@ fn aggregate(text: &str, at: usize, lines: &Lines) -> Result<(Vec<Field>, usize)
             ));
         }
         let key = text[i..key_end].to_ascii_uppercase();
+        if fields.iter().any(|f: &Field| f.key == key) {
+            return Err((
+                lines.line(i),
+                format!("the field `{key}` is given twice in one aggregate: which is meant?"),
+            ));
+        }
         let value_at = skip_space(text, key_end);
         // The value runs to the next `,` or `}` at this level.
         let mut depth = 0_usize;

@@ -6,6 +6,7 @@ use std::collections::HashMap;
 use std::ops::Range;
 
 use super::{ParseError, Target};
+use crate::engine::base::numeric::plural;
 
 /// Longest piece of a file quoted in a message, characters: a message
 /// names what is wrong, it does not echo a megabyte line.
@@ -170,7 +171,10 @@ pub(super) fn motion_order(
     if visits.is_empty() {
         return (
             written,
-            format!("{} poses in the order written", targets.len()),
+            format!(
+                "{} in the order written",
+                plural(targets.len(), "pose", "poses")
+            ),
             Vec::new(),
         );
     }
@@ -215,13 +219,13 @@ pub(super) fn motion_order(
     }
     let note = if order == written {
         format!(
-            "{} poses in the order written, which is the order the motion instructions move through them",
-            order.len()
+            "{} in the order written, which is the order the motion instructions move through them",
+            plural(order.len(), "pose", "poses")
         )
     } else {
         format!(
-            "{} poses in the order the motion instructions first move to them (it differs from the order written: {})",
-            order.len(),
+            "{} in the order the motion instructions first move to them (it differs from the order written: {})",
+            plural(order.len(), "pose", "poses"),
             list(
                 &order
                     .iter()

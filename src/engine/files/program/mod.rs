@@ -436,7 +436,12 @@ pub fn parse_pose_text(
         return Err(fail(
             0,
             format!(
-                "a {} writes its poses as {}, but --pose-convention says {}: leave it out or give `{}`",
+                "{} {} writes its poses as {}, but --pose-convention says {}: leave it out or give `{}`",
+                if format == PoseFormat::Rapid {
+                    "an"
+                } else {
+                    "a"
+                },
                 format.describe(),
                 fixed.describe(),
                 given.key(),

@@ -20,6 +20,7 @@
 //! without ids has number `k` (1-based), for pairing with numbered
 //! profiles.
 
+use std::collections::HashMap;
 use std::ops::Range;
 
 use super::lex::shown;
@@ -376,6 +377,21 @@ pub(super) fn read(
         &|v| pose_fits(convention, v),
         &hint,
     )?;
+    // An id given twice: which pose is meant?
+    let mut lines_of: HashMap<&str, usize> = HashMap::new();
+    for row in &rows {
+        if let Some(id) = row.id.as_deref()
+            && let Some(first) = lines_of.insert(id, row.line)
+        {
+            return Err((
+                row.line,
+                format!(
+                    "the id `{}` is given twice (also at line {first})",
+                    shown(id)
+                ),
+            ));
+        }
+    }
     let targets = rows
         .into_iter()
         .map(|row| {
@@ -524,6 +540,22 @@ impl Layout {
     }
 
     fn named(header: &[String], names: &[String], what: &str) -> Result<Self, String> {
+        // A column named twice: which one is meant?
+        for (k, h) in header.iter().enumerate() {
+            let h = h.trim();
+            if !h.is_empty()
+                && let Some(j) = header[..k]
+                    .iter()
+                    .position(|o| o.trim().eq_ignore_ascii_case(h))
+            {
+                return Err(format!(
+                    "the header names `{}` twice (columns {} and {}): rename one, or skip it with --pose-columns",
+                    shown(h),
+                    j + 1,
+                    k + 1
+                ));
+            }
+        }
         let find = |n: &str| header.iter().position(|h| h.trim().eq_ignore_ascii_case(n));
         let numbers = names
             .iter()

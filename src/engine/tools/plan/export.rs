@@ -173,8 +173,18 @@ pub fn program_controller(robot_name: &str) -> Option<Controller> {
 /// The plan as `controller`'s program.
 ///
 /// # Errors
-/// [`PlanError::NoProgram`] for a controller not in [`PROGRAMS`].
+/// [`PlanError::NoProgram`] for a controller not in [`PROGRAMS`];
+/// [`PlanError::OtherMaker`] when the robot's name says another maker.
 pub fn render_program(controller: Controller, plan: &Plan) -> Result<String, PlanError> {
+    if let Some(own) = Controller::for_robot(&plan.robot.name)
+        && own != controller
+    {
+        return Err(PlanError::OtherMaker {
+            robot: plan.robot.name.clone(),
+            controller,
+            own: super::PROGRAMS.contains(&own).then_some(own),
+        });
+    }
     match controller {
         Controller::Abb => Ok(rapid_module(plan)),
         Controller::Ur => Ok(ur_script(plan)),

@@ -172,15 +172,21 @@ impl PlanRequest {
 }
 
 /// A hand-eye `flange_from_sensor` from a JSON file: a bare 4×4 array of
-/// rows, or an object with a `hand_eye` 4×4 (a session or result file).
+/// rows, or an object with a `hand_eye` 4×4 (a session or result file);
+/// with a note when its rotation, typed to a few decimals, was made
+/// orthonormal ([`read_typed_transform`]).
+///
+/// [`read_typed_transform`]: crate::engine::files::format::read_typed_transform
 ///
 /// # Errors
 /// [`RequestError::File`] naming the file and what is wrong.
-pub fn read_hand_eye(path: &Path) -> Result<Isometry3<f64>, RequestError> {
-    crate::engine::files::format::read_transform(path, "hand_eye").map_err(|e| RequestError::File {
-        what: "hand-eye",
-        message: e.to_string(),
-        path: path.to_path_buf(),
+pub fn read_hand_eye(path: &Path) -> Result<(Isometry3<f64>, Option<String>), RequestError> {
+    crate::engine::files::format::read_typed_transform(path, "hand_eye").map_err(|e| {
+        RequestError::File {
+            what: "hand-eye",
+            message: e.to_string(),
+            path: path.to_path_buf(),
+        }
     })
 }
 

@@ -141,6 +141,15 @@ pub fn escape(s: &str) -> String {
             '>' => out.push_str("&gt;"),
             '"' => out.push_str("&quot;"),
             '\'' => out.push_str("&#39;"),
+            // Control characters (NUL, a line feed inside a name) and the
+            // bidirectional overrides (U+202A-U+202E, U+2066-U+2069: text
+            // that reads backwards) are shown as their code, not obeyed.
+            c if (c.is_control() && c != '\n' && c != '\t')
+                || ('\u{202a}'..='\u{202e}').contains(&c)
+                || ('\u{2066}'..='\u{2069}').contains(&c) =>
+            {
+                out.push_str(&format!("[U+{:04X}]", u32::from(c)));
+            }
             c => out.push(c),
         }
     }
@@ -573,6 +582,15 @@ fn write_legend(s: &mut String, plot: &Plot, f: &Frame) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_session_name_with_nul_or_a_bidi_override_is_shown_not_obeyed() {
+        assert_eq!(escape("a<b>&\"'"), "a&lt;b&gt;&amp;&quot;&#39;");
+        assert_eq!(escape("cell\u{0}1"), "cell[U+0000]1");
+        assert_eq!(escape("abc\u{202e}fed"), "abc[U+202E]fed");
+        assert_eq!(escape("x\u{2066}y"), "x[U+2066]y");
+        assert_eq!(escape("two\nlines\tkept"), "two\nlines\tkept");
+    }
 
     #[test]
     fn ticks_are_nice_and_cover_the_range() {

@@ -143,12 +143,22 @@ pub(super) fn compensate_target(
             })?;
             let flange = arms.nominal.base_from_flange(&qw);
             let wanted = flange * tool;
-            let keep = options.joint_targets == JointTargets::Keep;
+            let mut keep = options.joint_targets == JointTargets::Keep;
             let qc = if keep {
                 qw
             } else {
-                arms.calibrated_solution(&flange, &qw)
-                    .map_err(|e| fail(e.describe()))?
+                // A joint target with no calibrated solution on its branch
+                // (a home position at a wrist singularity, all joints 0) is
+                // a place to park, not a pose to measure at: kept as
+                // written, with a note, rather than refusing the program.
+                match arms.calibrated_solution(&flange, &qw) {
+                    Ok(q) => q,
+                    Err(e) => {
+                        keep = true;
+                        notes.push(format!("a joint target kept as written: {}", e.describe()));
+                        qw
+                    }
+                }
             };
             let new: Vec<f64> = qc
                 .iter()
@@ -177,7 +187,7 @@ pub(super) fn compensate_target(
     let nearest_identify_deg = model.region.nearest_identify(&qc);
     let outside_mm = model.region.outside(&wanted);
     let flags = flags_of(options, nearest_identify_deg, outside_mm, sigma_mm);
-    if joints_target && !written {
+    if joints_target && !written && options.joint_targets == JointTargets::Keep {
         notes.push("a joint target, kept as written (--joint-targets keep)".to_string());
     }
     Ok(TargetReport {

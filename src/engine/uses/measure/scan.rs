@@ -19,14 +19,17 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::Isometry3;
 
+use crate::engine::base::limits;
+use crate::engine::base::numeric::approx;
 use crate::engine::base::robot::Robot;
 use crate::engine::base::session::{Observation, ReferenceDistance, Session, Use};
 use crate::engine::files::import::log::JointLog;
 use crate::engine::files::import::pairing;
 use crate::engine::files::import::poses::PoseValue;
-use crate::engine::files::import::profiles::RawProfile;
+use crate::engine::files::import::profiles::{PlaneProfile, RawProfile};
 use crate::engine::files::import::progress;
 use crate::engine::files::import::units::AngleUnit;
+use crate::engine::files::import::units::LengthUnit;
 use crate::engine::files::import::{
     AxisMap, FlangeConvention, ImportError, PoseFormat, ProfileFormat, ProfileSource,
     read_references,
@@ -235,6 +238,9 @@ pub struct ScanFiles {
     /// Reference distances between the artefact's stations (`from,to,distance`
     /// CSV, mm), optional.
     pub references: Option<PathBuf>,
+    /// The poses measured: those whose `use` (the log's use column) is
+    /// one of these; empty: every pose.
+    pub uses: Vec<Use>,
 }
 
 /// One pose of a log before its profile: id, station, use, placement.
@@ -303,6 +309,7 @@ pub fn scan_from_files(spec: &ScanFiles) -> Result<Scan, ImportError> {
     let mut poses = Vec::with_capacity(log.len());
     for ((pose, id), raw) in log.into_iter().zip(ids).zip(raws) {
         let plane = raw.to_plane(&axes)?;
+        within_sensor_field(&plane, spec.profile_format.unit)?;
         drop(raw);
         poses.push(ScanPose {
             id,
@@ -315,6 +322,31 @@ pub fn scan_from_files(spec: &ScanFiles) -> Result<Scan, ImportError> {
                 no_return: plane.no_return,
             },
         });
+    }
+    if !spec.uses.is_empty() {
+        if let Some(p) = poses.iter().find(|p| p.usage.is_none()) {
+            return Err(ImportError::File {
+                path: spec.log.path().to_path_buf(),
+                message: format!(
+                    "pose {} has no use: choosing poses by their use needs a use column in the log (or measure every pose)",
+                    p.id
+                ),
+            });
+        }
+        poses.retain(|p| p.usage.is_some_and(|u| spec.uses.contains(&u)));
+        if poses.is_empty() {
+            return Err(ImportError::File {
+                path: spec.log.path().to_path_buf(),
+                message: format!(
+                    "no pose of the log is of use {}",
+                    spec.uses
+                        .iter()
+                        .map(|u| u.as_str())
+                        .collect::<Vec<_>>()
+                        .join(" or ")
+                ),
+            });
+        }
     }
     let name = spec
         .log
@@ -344,6 +376,32 @@ pub fn scan_from_files(spec: &ScanFiles) -> Result<Scan, ImportError> {
             notes
         },
     })
+}
+
+/// Refuses a profile with a point beyond any sensor's field
+/// ([`limits::SENSOR_COORDINATE_MM`], the session's rule for stripe
+/// points): a unit read wrong (millimetres as metres puts a part tens of
+/// metres off), naming the file, the point and the unit it was read in.
+fn within_sensor_field(plane: &PlaneProfile, unit: LengthUnit) -> Result<(), ImportError> {
+    let limit = limits::SENSOR_COORDINATE_MM;
+    match plane
+        .points
+        .iter()
+        .position(|p| p[0].abs() > limit || p[1].abs() > limit)
+    {
+        None => Ok(()),
+        Some(i) => Err(ImportError::File {
+            path: plane.source.clone(),
+            message: format!(
+                "point {}: (y, z) = ({}, {}) mm, read in {}, lies beyond any sensor's field (at most {} mm from the sensor): check --profile-unit",
+                i + 1,
+                approx(plane.points[i][0]),
+                approx(plane.points[i][1]),
+                unit.symbol(),
+                approx(limit)
+            ),
+        }),
+    }
 }
 
 /// The poses of a raw scan's joint log, read by the import's joint-log
