@@ -63,7 +63,7 @@ pub enum ModelFormat {
 pub enum ExportError {
     /// The result calibrated no kinematic model (a pose-only session).
     #[error(
-        "the result has no calibrated kinematic model: it is of a pose-only session (flange poses, no joints), so only the hand-eye was calibrated; export the hand-eye from the result file instead"
+        "the result has no calibrated kinematic model: it is of a pose-only session (flange poses, no joints), so only the hand-eye was calibrated; export it as tool data instead (--format tool --controller abb|kuka|fanuc|ur|ros)"
     )]
     HandEyeOnly,
     /// `joint_errors` does not have one entry per joint.
