@@ -227,6 +227,20 @@ pub fn urdf_origin(iso: &Isometry3<f64>) -> ([f64; 3], [f64; 3]) {
     ([t.x, t.y, t.z], [roll, pitch, yaw])
 }
 
+/// A length (m) or angle (rad) as the URDF and YAML exports write it:
+/// Rust's shortest text that reads back to the same `f64`, in plain
+/// decimals (no exponent, which YAML 1.1 readers such as xacro's take for
+/// a string); below 1e-15 (1e-12 mm, rounding of a composed transform)
+/// it is `0`, never `-0`.
+#[must_use]
+pub fn urdf_number(v: f64) -> String {
+    if v.abs() < 1e-15 {
+        "0".to_string()
+    } else {
+        format!("{v}")
+    }
+}
+
 /// The fixed part of joint `joint`'s link transform before its rotation,
 /// `Rx(alpha) · Tx(a) · Ry(beta) · Rz(theta)` (mm).
 fn mdh_origin(joint: &Joint) -> Isometry3<f64> {

@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 
 use nalgebra::{Isometry3, Matrix6, Translation3, UnitQuaternion, Vector3};
 
-use super::model::urdf_origin;
+use super::model::{urdf_number, urdf_origin};
 use crate::engine::base::robot::controller::{Controller, ToolDigits};
 use crate::engine::calibrate::solve::estimate::HAND_EYE_LABELS;
 use crate::engine::calibrate::solve::ml::report::LabelledMatrix;
@@ -243,7 +243,7 @@ pub fn tool_export(result: &ResultFile, target: ToolTarget, source: &str) -> Str
             s.push_str(&ctrl.tool_data_with(&tool, TOOL_NAME, ToolDigits::Full));
         }
         ToolTarget::Ros => {
-            let v = target.values(&tool);
+            let v: Vec<String> = target.values(&tool).into_iter().map(urdf_number).collect();
             let _ = writeln!(
                 s,
                 "# ROS 2: the sensor frame as a static transform from the flange frame ({ROS_FLANGE_FRAME}, the frame the calibration's flange poses are of):"
@@ -264,7 +264,9 @@ pub fn tool_export(result: &ResultFile, target: ToolTarget, source: &str) -> Str
 /// at the hand-eye, each line led by `indent`.
 #[must_use]
 pub fn sensor_urdf(hand_eye: &Isometry3<f64>, parent: &str, indent: &str) -> String {
-    let ([x, y, z], [roll, pitch, yaw]) = urdf_origin(hand_eye);
+    let (t, r) = urdf_origin(hand_eye);
+    let [x, y, z] = t.map(urdf_number);
+    let [roll, pitch, yaw] = r.map(urdf_number);
     let mut s = String::new();
     let _ = writeln!(s, "{indent}<link name=\"{ROS_SENSOR_FRAME}\"/>");
     let _ = writeln!(

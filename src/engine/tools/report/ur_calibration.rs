@@ -25,7 +25,7 @@ use std::fmt::Write as _;
 use nalgebra::{Isometry3, Vector3};
 use sha2::{Digest, Sha256};
 
-use super::model::urdf_origin;
+use super::model::{urdf_number, urdf_origin};
 use crate::engine::base::geometry::{rot_x, rot_y, rot_z};
 use crate::engine::base::robot::Robot;
 use crate::engine::base::robot::chain_origins::{ChainFitError, ChainStep, calibrated_origins};
@@ -173,7 +173,7 @@ pub fn ur_calibration(
             ("pitch", pitch),
             ("yaw", yaw),
         ] {
-            let _ = writeln!(body, "    {name}: {}", yaml_number(v));
+            let _ = writeln!(body, "    {name}: {}", urdf_number(v));
         }
     }
     let digest = Sha256::digest(body.as_bytes());
@@ -198,15 +198,4 @@ pub fn ur_calibration(
     out.push_str(&body);
     let _ = writeln!(out, "  hash: spherecal_{hash}");
     Ok(out)
-}
-
-/// A float as YAML reads it back to the same `f64`: plain decimals (no
-/// exponent, which YAML 1.1 readers such as xacro's take for a string),
-/// never `-0`.
-fn yaml_number(v: f64) -> String {
-    if v == 0.0 {
-        "0".to_string()
-    } else {
-        format!("{v}")
-    }
 }

@@ -13,7 +13,7 @@ use std::path::Path;
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
-use super::model::urdf_origin;
+use super::model::{urdf_number, urdf_origin};
 use super::tool_data::{ROS_SENSOR_FRAME, sensor_urdf};
 use crate::engine::base::robot::RobotImportError;
 use crate::engine::base::robot::chain_origins::{ChainFitError, ChainStep, calibrated_origins};
@@ -145,8 +145,8 @@ pub fn calibrated_urdf(
         }
         changed.push(step.name.clone());
         let ([x, y, z], [roll, pitch, yaw]) = urdf_origin(origin);
-        let xyz = format!("{x} {y} {z}");
-        let rpy = format!("{roll} {pitch} {yaw}");
+        let xyz = [x, y, z].map(urdf_number).join(" ");
+        let rpy = [roll, pitch, yaw].map(urdf_number).join(" ");
         if let Some(o) = node.children().find(|n| n.has_tag_name("origin")) {
             for (name, value) in [("xyz", xyz), ("rpy", rpy)] {
                 if let Some(a) = o.attribute_node(name) {
