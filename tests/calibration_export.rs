@@ -802,3 +802,62 @@ fn ur_calibration_file_builds_the_calibrated_ur5e() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("not a Universal Robots arm"), "{err}");
 }
+
+#[test]
+fn a_joint_without_origin_or_rpy_gets_them_written() {
+    let dir = tempfile::tempdir().unwrap();
+    // URDF defaults: no <origin> is the identity, no rpy is 0 0 0.
+    let source = std::fs::read_to_string(ABB_URDF)
+        .unwrap()
+        .replacen(
+            "<joint name=\"joint_1\" type=\"revolute\">\n    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>",
+            "<joint name=\"joint_1\" type=\"revolute\">",
+            1,
+        )
+        .replacen(
+            "<origin xyz=\"0 0 0.705\" rpy=\"0 0 0\"/>",
+            "<origin xyz=\"0 0 0.705\"/>",
+            1,
+        );
+    assert!(!source.contains("0.705\" rpy"));
+    let urdf_path = dir.path().join("bare.urdf");
+    std::fs::write(&urdf_path, &source).unwrap();
+    let nominal = robot_from_urdf(&source, &urdf_path).unwrap().robot;
+    let calibrated = perturbed(&nominal, 8, 1.0);
+    let result = result_of(&nominal, &calibrated, dir.path(), "bare.result.json");
+    ok(
+        &[
+            "export-model",
+            result.to_str().unwrap(),
+            "--format",
+            "urdf",
+            "--robot",
+            urdf_path.to_str().unwrap(),
+            "-o",
+            "bare.calibrated.urdf",
+            "-q",
+        ],
+        dir.path(),
+    );
+    let written = std::fs::read_to_string(dir.path().join("bare.calibrated.urdf")).unwrap();
+    let urdf = urdf_rs::read_from_string(&written).unwrap();
+    for name in ["joint_1", "joint_3"] {
+        let j = urdf.joints.iter().find(|j| j.name == name).unwrap();
+        assert!(
+            j.origin.rpy.0 != [0.0; 3],
+            "{name} has its calibrated rotation"
+        );
+    }
+    let tip = robot_from_urdf(&source, &urdf_path).unwrap().tip_link;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+    for _ in 0..20 {
+        let q: Vec<f64> = (0..6).map(|_| rng.random_range(-170.0..170.0)).collect();
+        assert_same(
+            &urdf_fk(&urdf, &tip, &q),
+            &calibrated.base_from_flange(&q),
+            1e-6,
+            1e-9,
+            "tip",
+        );
+    }
+}
