@@ -9,10 +9,10 @@ use clap::{Args, ValueEnum};
 
 use super::CliError;
 use super::values::{Range, number};
-use crate::engine::base::robot::controller::FlangeConvention;
+use crate::engine::base::robot::controller::{Controller, FlangeConvention, ToolDigits};
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
-use crate::engine::files::program::{PoseFormat, ReadSpec};
+use crate::engine::files::program::{self, PoseFormat, ReadSpec};
 use crate::engine::uses::compensate::{
     self, CompensateError, CompensateFileError, CompensateRequest, JointTargets, Options, Outcome,
     Tcp, TcpSource, report,
@@ -54,6 +54,9 @@ pub struct CompensateArgs {
     /// The TCP the targets are poses of: `sensor` (the calibrated hand-eye, printed as tool data to set on the controller), `flange`, or a JSON file with a 4x4 matrix `flange_from_tcp` (rows, mm).
     #[arg(long, default_value = "sensor")]
     pub tcp: String,
+    /// For a pose-only result (hand-eye calibrated, kinematics not): the tool data the controller holds now, with which the program was taught (a JSON file with a 4x4 matrix `flange_from_tcp`, rows, mm; or one line of the tool's values in the targets' convention, e.g. x,y,z,w,p,r for FANUC). Each target is rewritten so that the controller, still using this tool, puts the calibrated sensor where the target says.
+    #[arg(long, value_name = "FILE")]
+    pub current_tool: Option<PathBuf>,
     /// The result's session, for results that do not record the joints of their poses (`pose_joints`: older results): the poses choose the branch of a target without a configuration (the nearest pose's) and flag targets far in joint space from every identify pose.
     #[arg(long)]
     pub session: Option<PathBuf>,
@@ -95,8 +98,27 @@ pub fn run(args: &CompensateArgs) -> Result<(), CliError> {
     if !matches!(args.tcp.as_str(), "sensor" | "flange") {
         inputs.push(std::path::Path::new(&args.tcp));
     }
+    if let Some(t) = &args.current_tool {
+        inputs.push(t.as_path());
+    }
     CliError::guard_output(&args.out, &inputs)?;
     let result = format::load_result(&args.result).map_err(|e| CliError::from_file(&e, true))?;
+    if let Some(current) = &args.current_tool {
+        return run_tool_only(args, &result, current);
+    }
+    if result.hand_eye_only() {
+        let mut message = format!("{} ({})", CompensateError::PoseOnly, args.result.display());
+        let file = program::read_pose_file(&args.targets, &read_spec(args)).ok();
+        let controllers = file.as_ref().map_or_else(
+            || Controller::ALL.to_vec(),
+            |f| report::tool_controllers(f, args.pose_convention),
+        );
+        for c in controllers {
+            message.push_str(&format!("\n{}:\n", c.tool_data_kind()));
+            message.push_str(&c.tool_data_with(&result.hand_eye, "tSpherecal", ToolDigits::Full));
+        }
+        return Err(CliError::input(message.trim_end().to_string()));
+    }
     let session = match &args.session {
         Some(p) => Some(format::load_session(p).map_err(|e| CliError::from_file(&e, true))?),
         None => None,
@@ -111,11 +133,7 @@ pub fn run(args: &CompensateArgs) -> Result<(), CliError> {
         session,
         session_if_it_fits: false,
         targets: args.targets.clone(),
-        read: ReadSpec {
-            format: args.pose_format,
-            convention: args.pose_convention,
-            columns: (!args.pose_columns.is_empty()).then(|| args.pose_columns.clone()),
-        },
+        read: read_spec(args),
         tcp,
         options: Options {
             joint_targets: match args.joint_targets {
@@ -135,6 +153,7 @@ pub fn run(args: &CompensateArgs) -> Result<(), CliError> {
         ..
     } = compensate::compensate_file(request, &mut |_| Control::Continue).map_err(|e| match e {
         CompensateFileError::Tool(e) => CliError::input(e),
+        CompensateFileError::CurrentTool(e) => CliError::input(e.to_string()),
         CompensateFileError::Targets(e) => CliError::input(e.to_string()),
         CompensateFileError::Model(e) => CliError::input(format!(
             "{e} ({})",
@@ -192,6 +211,75 @@ pub fn run(args: &CompensateArgs) -> Result<(), CliError> {
         sayln!("note: {n}");
     }
     sayln!("{}", done.summary.line());
+    sayln!("wrote {}", args.out.display());
+    Ok(())
+}
+
+/// How the targets are read.
+fn read_spec(args: &CompensateArgs) -> ReadSpec {
+    ReadSpec {
+        format: args.pose_format,
+        convention: args.pose_convention,
+        columns: (!args.pose_columns.is_empty()).then(|| args.pose_columns.clone()),
+    }
+}
+
+/// `--current-tool`: a pose-only result's targets rewritten for the tool
+/// the controller holds now.
+fn run_tool_only(
+    args: &CompensateArgs,
+    result: &format::ResultFile,
+    current: &std::path::Path,
+) -> Result<(), CliError> {
+    let targets = args.targets.display();
+    let done = compensate::compensate_file_tool_only(
+        result,
+        &args.targets,
+        &read_spec(args),
+        current,
+        &mut |_| Control::Continue,
+    )
+    .map_err(|e| match e {
+        CompensateFileError::Compensate(
+            e @ (CompensateError::Rewrite(_) | CompensateError::Cancelled),
+        ) => CliError::internal(format!("{e} ({targets})")),
+        CompensateFileError::Targets(e) => CliError::input(e.to_string()),
+        e => CliError::input(format!("{e} ({targets})")),
+    })?;
+    format::write_atomic(&args.out, done.compensation.text.as_bytes())
+        .map_err(|e| CliError::from_file(&e, false))?;
+    if args.quiet {
+        return Ok(());
+    }
+    sayln!("{}", report::file_line(&done.file));
+    for w in &done.file.warnings {
+        sayln!("  warning: {w}");
+    }
+    sayln!(
+        "TCP: the calibrated sensor, reached through the current tool of {}",
+        current.display()
+    );
+    say!(
+        "{}",
+        report::table(
+            &done.compensation.targets,
+            (!args.all).then_some(TABLE_ROWS)
+        )
+    );
+    for t in done
+        .compensation
+        .targets
+        .iter()
+        .filter(|t| !t.notes.is_empty())
+    {
+        for n in &t.notes {
+            sayln!("  note: {} (line {}): {n}", t.name, t.line);
+        }
+    }
+    for n in &done.compensation.notes {
+        sayln!("note: {n}");
+    }
+    sayln!("{}", done.compensation.summary.line());
     sayln!("wrote {}", args.out.display());
     Ok(())
 }

@@ -178,7 +178,7 @@ pub enum Command {
     /// evidence chapters; --planned-range and --compensation run the other
     /// two studies instead. Writes no file; the progress goes to stderr.
     Evaluate(evaluate::EvaluateArgs),
-    /// Write the calibrated model of a result file as JSON (a session's `robot` block), CSV (MDH table) or URDF
+    /// Write a result's calibration for other software: model JSON, MDH CSV, URDF (yours), UR YAML or tool data
     ExportModel(export_model::ExportModelArgs),
     /// Build a session file from a pose log and what the sensor saw: stripe profiles or sphere centres
     ///

@@ -133,10 +133,31 @@ impl Controller {
 
     /// The tool `flange_from_tcp` (mm) as this controller's tool data,
     /// named `name` where the syntax has a name (RAPID), tool number 1
-    /// where it has a number; a few lines with the controller's comments.
+    /// where it has a number; a few lines with the controller's comments,
+    /// with the decimals a pendant shows ([`ToolDigits::Display`]).
     #[must_use]
     pub fn tool_data(self, flange_from_tcp: &Isometry3<f64>, name: &str) -> String {
+        self.tool_data_with(flange_from_tcp, name, ToolDigits::Display)
+    }
+
+    /// [`Self::tool_data`] with the decimals `digits` asks for:
+    /// [`ToolDigits::Full`] reads back to the tool within 1e-7 mm and
+    /// 1e-11 rad (the export of `export-model --format tool`).
+    #[must_use]
+    pub fn tool_data_with(
+        self,
+        flange_from_tcp: &Isometry3<f64>,
+        name: &str,
+        digits: ToolDigits,
+    ) -> String {
         let v = self.convention().values_from_pose(flange_from_tcp);
+        let full = digits == ToolDigits::Full;
+        // Decimals of mm, deg, a quaternion, m and rad.
+        let (mm, deg, quat, m, rad) = if full {
+            (7, 9, 12, 10, 12)
+        } else {
+            (4, 5, 9, 7, 7)
+        };
         let mut s = String::new();
         match self {
             Self::Abb => {
@@ -146,7 +167,7 @@ impl Controller {
                 );
                 let _ = writeln!(
                     s,
-                    "PERS tooldata {name} := [TRUE,[[{:.4},{:.4},{:.4}],[{:.9},{:.9},{:.9},{:.9}]],[1,[0,0,1],[1,0,0,0],0,0,0]];",
+                    "PERS tooldata {name} := [TRUE,[[{:.mm$},{:.mm$},{:.mm$}],[{:.quat$},{:.quat$},{:.quat$},{:.quat$}]],[1,[0,0,1],[1,0,0,0],0,0,0]];",
                     v[0], v[1], v[2], v[3], v[4], v[5], v[6]
                 );
             }
@@ -157,17 +178,36 @@ impl Controller {
                 );
                 let _ = writeln!(
                     s,
-                    "TOOL_DATA[1]={{X {:.4},Y {:.4},Z {:.4},A {:.5},B {:.5},C {:.5}}}",
+                    "TOOL_DATA[1]={{X {:.mm$},Y {:.mm$},Z {:.mm$},A {:.deg$},B {:.deg$},C {:.deg$}}}",
                     v[0], v[1], v[2], v[3], v[4], v[5]
                 );
             }
             Self::Fanuc => {
-                let _ = writeln!(
-                    s,
-                    "! TCP of {name}: SETUP > Frames > Tool Frame > Direct Entry, or in a TP program (mm; W, P, R deg):"
-                );
+                if full {
+                    let _ = writeln!(
+                        s,
+                        "! UTOOL of {name}, as entered on SETUP > Frames > Tool Frame > Direct Entry (mm; W, P, R deg):"
+                    );
+                    for (k, label) in ["X", "Y", "Z", "W", "P", "R"].iter().enumerate() {
+                        let d = if k < 3 { mm } else { deg };
+                        let _ = writeln!(s, "!   {label}: {:.d$}", v[k]);
+                    }
+                    let _ = writeln!(s, "! or in a TP program, through position register 1:");
+                } else {
+                    let _ = writeln!(
+                        s,
+                        "! TCP of {name}: SETUP > Frames > Tool Frame > Direct Entry, or in a TP program (mm; W, P, R deg):"
+                    );
+                }
                 for (k, label) in ["X", "Y", "Z", "W", "P", "R"].iter().enumerate() {
-                    let _ = writeln!(s, "PR[1,{}]={:.4} ; ! {label}", k + 1, v[k]);
+                    let d = if k < 3 {
+                        mm
+                    } else if full {
+                        deg
+                    } else {
+                        4
+                    };
+                    let _ = writeln!(s, "PR[1,{}]={:.d$} ; ! {label}", k + 1, v[k]);
                 }
                 let _ = writeln!(s, "UTOOL[1]=PR[1] ;");
             }
@@ -178,13 +218,22 @@ impl Controller {
                 );
                 let _ = writeln!(
                     s,
-                    "set_tcp(p[{:.7}, {:.7}, {:.7}, {:.7}, {:.7}, {:.7}])",
+                    "set_tcp(p[{:.m$}, {:.m$}, {:.m$}, {:.rad$}, {:.rad$}, {:.rad$}])",
                     v[0], v[1], v[2], v[3], v[4], v[5]
                 );
             }
         }
         s
     }
+}
+
+/// How many decimals tool data is written with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ToolDigits {
+    /// What a pendant shows: 4 decimals of mm (0.1 µm), 5 of deg.
+    Display,
+    /// Enough to read back to the tool within 1e-7 mm and 1e-11 rad.
+    Full,
 }
 
 /// Why a controller's values are no pose.

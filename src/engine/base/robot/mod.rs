@@ -5,6 +5,7 @@
 //! standard or modified DH table in CSV ([`dh_table`]), and the pose
 //! conventions of robot controllers ([`controller`]).
 
+pub mod chain_origins;
 pub mod controller;
 pub mod dh_table;
 pub mod ik;

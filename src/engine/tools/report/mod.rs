@@ -8,3 +8,6 @@ pub mod model;
 pub mod sheet;
 pub mod summary;
 pub mod svg;
+pub mod tool_data;
+pub mod ur_calibration;
+pub mod urdf_back;

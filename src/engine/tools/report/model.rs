@@ -63,7 +63,7 @@ pub enum ModelFormat {
 pub enum ExportError {
     /// The result calibrated no kinematic model (a pose-only session).
     #[error(
-        "the result has no calibrated kinematic model: it is of a pose-only session (flange poses, no joints), so only the hand-eye was calibrated; export the hand-eye from the result file instead"
+        "the result has no calibrated kinematic model: it is of a pose-only session (flange poses, no joints), so only the hand-eye was calibrated; export it as tool data instead (--format tool --controller abb|kuka|fanuc|ur|ros)"
     )]
     HandEyeOnly,
     /// `joint_errors` does not have one entry per joint.
@@ -225,6 +225,20 @@ pub fn urdf_origin(iso: &Isometry3<f64>) -> ([f64; 3], [f64; 3]) {
     let rm = rest.matrix();
     let yaw = rm[(1, 0)].atan2(rm[(0, 0)]);
     ([t.x, t.y, t.z], [roll, pitch, yaw])
+}
+
+/// A length (m) or angle (rad) as the URDF and YAML exports write it:
+/// Rust's shortest text that reads back to the same `f64`, in plain
+/// decimals (no exponent, which YAML 1.1 readers such as xacro's take for
+/// a string); below 1e-15 (1e-12 mm, rounding of a composed transform)
+/// it is `0`, never `-0`.
+#[must_use]
+pub fn urdf_number(v: f64) -> String {
+    if v.abs() < 1e-15 {
+        "0".to_string()
+    } else {
+        format!("{v}")
+    }
 }
 
 /// The fixed part of joint `joint`'s link transform before its rotation,

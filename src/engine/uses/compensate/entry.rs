@@ -8,6 +8,7 @@
 use std::path::PathBuf;
 
 use super::tool::{self, ToolError};
+use super::tool_only::{self, CurrentToolError};
 use super::{CompensateError, CompensateProgress, Compensation, Model, Options, Tcp};
 use crate::engine::base::session::Session;
 use crate::engine::calibrate::solve::Control;
@@ -65,6 +66,9 @@ pub enum CompensateFileError {
     /// The tool file cannot be read.
     #[error(transparent)]
     Tool(#[from] ToolError),
+    /// The current-tool file cannot be read.
+    #[error(transparent)]
+    CurrentTool(#[from] CurrentToolError),
     /// The targets file cannot be read (naming it and the line).
     #[error(transparent)]
     Targets(#[from] ProgramError),
@@ -108,5 +112,49 @@ pub fn compensate_file(
         model,
         compensation,
         notes,
+    })
+}
+
+/// A targets file rewritten for the controller's current tool with a
+/// pose-only result ([`tool_only`]).
+#[derive(Debug, Clone)]
+pub struct ToolOnlyOutcome {
+    /// The targets as read.
+    pub file: PoseFile,
+    /// The tool the controller holds now, `flange_from_tcp` (mm).
+    pub current_tool: nalgebra::Isometry3<f64>,
+    /// Every target and the rewritten text.
+    pub compensation: Compensation,
+}
+
+/// The targets of `targets` rewritten so that the controller, still with
+/// the tool of `current_tool` (a file), puts the result's calibrated
+/// sensor where each target says ([`tool_only`]); for a pose-only result.
+///
+/// # Errors
+/// [`CompensateFileError`]: a result that calibrated the kinematics (its
+/// targets are compensated through the model instead), a file that
+/// cannot be read, a target that is no pose, or cancelled.
+pub fn compensate_file_tool_only(
+    result: &ResultFile,
+    targets: &std::path::Path,
+    read: &ReadSpec,
+    current_tool: &std::path::Path,
+    progress: &mut dyn FnMut(&CompensateProgress) -> Control,
+) -> Result<ToolOnlyOutcome, CompensateFileError> {
+    if !result.hand_eye_only() {
+        return Err(CompensateFileError::Model(CompensateError::Session(
+            "--current-tool is for a pose-only result; this result calibrated the robot's kinematics: compensate through its model (--tcp sensor) and set its tool data".to_string(),
+        )));
+    }
+    let file = program::read_pose_file(targets, read)?;
+    let convention = file.format.convention().or(read.convention);
+    let tool = tool_only::read_current_tool(current_tool, convention)?;
+    let compensation = tool_only::compensate_tool_only(&file, &result.hand_eye, &tool, progress)
+        .map_err(CompensateFileError::Compensate)?;
+    Ok(ToolOnlyOutcome {
+        file,
+        current_tool: tool,
+        compensation,
     })
 }

@@ -67,6 +67,7 @@ pub mod report;
 pub mod study;
 mod target;
 pub mod tool;
+pub mod tool_only;
 pub mod uncertainty;
 
 use nalgebra::{Isometry3, Vector3};
@@ -83,7 +84,8 @@ use crate::engine::files::format::ResultFile;
 use crate::engine::files::program::{PoseFile, RewriteError};
 
 pub use self::entry::{
-    CompensateFileError, CompensateRequest, Outcome, TcpSource, compensate_file,
+    CompensateFileError, CompensateRequest, Outcome, TcpSource, ToolOnlyOutcome, compensate_file,
+    compensate_file_tool_only,
 };
 pub use self::report::Summary;
 
@@ -215,11 +217,11 @@ fn failures_text(failures: &[TargetFailure]) -> String {
 /// Why compensation failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CompensateError {
-    /// The result calibrated no kinematic model.
+    /// The result calibrated no kinematic model (pose-only).
     #[error(
-        "the result has no robot model (a pose-only calibration without a robot): there is no kinematics to compensate targets with"
+        "the result is pose-only: the sensor (hand-eye) was calibrated, the robot's kinematics were not, so there is no model to compensate targets with; install the calibrated sensor as the controller's tool data instead (`spherecal export-model RESULT --format tool --controller …`), or give --current-tool FILE (the tool the program was taught with) to rewrite the targets for the tool the controller holds now"
     )]
-    NoRobot,
+    PoseOnly,
     /// Not a 6-axis arm.
     #[error("the robot has {0} joints; target compensation solves 6-axis arms")]
     NotSixAxis(usize),
@@ -367,17 +369,15 @@ impl Model {
         tcp: Tcp,
     ) -> Result<Self, CompensateError> {
         let (Some(calibrated), Some(nominal)) = (result.robot.clone(), result.nominal()) else {
-            return Err(CompensateError::NoRobot);
+            return Err(CompensateError::PoseOnly);
         };
+        if result.hand_eye_only() {
+            return Err(CompensateError::PoseOnly);
+        }
         if calibrated.dof() != DOF {
             return Err(CompensateError::NotSixAxis(calibrated.dof()));
         }
         let mut notes = Vec::new();
-        if result.hand_eye_only() {
-            notes.push(
-                "the result identified no kinematic parameter (pose-only): the calibrated model is the nominal one, so targets keep their positions".to_string(),
-            );
-        }
         // Where the calibration saw the robot: the result's own record of
         // the joints, else the session's.
         let mut joints: Vec<(String, [f64; DOF])> = result

@@ -219,7 +219,7 @@ pub(super) fn compensate_target(
 /// that a rewritten target changes by its correction only: the
 /// quaternion's sign as the target had it, Euler angles by whole turns, a
 /// rotation vector to its equivalent on the other side of π.
-fn nearest(convention: FlangeConvention, new: &[f64], old: &[f64]) -> Vec<f64> {
+pub(super) fn nearest(convention: FlangeConvention, new: &[f64], old: &[f64]) -> Vec<f64> {
     let mut v = new.to_vec();
     match convention {
         FlangeConvention::AbbQuaternion => {

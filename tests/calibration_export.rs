@@ -1,0 +1,863 @@
+//! The calibration where it is used (issue 33), on the real binary: tool
+//! data of a pose-only result in each controller's syntax, read back by
+//! readers written here from the vendors' grammars; `compensate
+//! --current-tool`; the user's URDF written back (read by `urdf-rs`,
+//! diffed as XML trees against the source); UR's calibration YAML (read
+//! by `serde_norway`, its chain built as ur_description builds it).
+
+// Test helpers may panic: a panic is a test failure with its message.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use rand::{Rng, SeedableRng};
+use spherecal::engine::base::robot::{Joint, Robot, robot_from_urdf, ur5e};
+use spherecal::engine::files::format::{self, ResultFile};
+
+const REAL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/data/robcalibrator-sphere");
+const RESULT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/v1/result.json");
+const ABB_URDF: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/data/robots/abb_irb2400.urdf"
+);
+
+fn spherecal(args: &[&str], dir: &Path) -> (i32, String, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_spherecal"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn ok(args: &[&str], dir: &Path) -> String {
+    let (code, out, err) = spherecal(args, dir);
+    assert_eq!(code, 0, "spherecal {args:?}: {err}");
+    out
+}
+
+/// The real set's pose-only result (ml, with the hand-eye's covariance).
+fn real_result(dir: &Path) -> (PathBuf, ResultFile) {
+    ok(
+        &[
+            "import",
+            "--poses",
+            &format!("{REAL}/RobPoses.rob"),
+            "--pose-convention",
+            "fanuc",
+            "--profiles",
+            REAL,
+            "--sphere-diameter",
+            "80",
+            "--out",
+            "real.json",
+            "-q",
+        ],
+        dir,
+    );
+    ok(
+        &["calibrate", "real.json", "--out", "real.result.json", "-q"],
+        dir,
+    );
+    let path = dir.join("real.result.json");
+    let result = format::load_result(&path).unwrap();
+    assert!(result.hand_eye_only(), "the real set is pose-only");
+    (path, result)
+}
+
+// Rotations from elementary matrices, as the vendors define them.
+fn rx(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.sin_cos();
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
+}
+fn ry(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.sin_cos();
+    Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
+}
+fn rz(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.sin_cos();
+    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
+}
+fn pose(t: [f64; 3], r: Matrix3<f64>) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(t[0], t[1], t[2]),
+        UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r)),
+    )
+}
+/// Unit quaternion (w, x, y, z) → matrix, the textbook formula.
+fn quat_matrix(w: f64, x: f64, y: f64, z: f64) -> Matrix3<f64> {
+    Matrix3::new(
+        1.0 - 2.0 * (y * y + z * z),
+        2.0 * (x * y - w * z),
+        2.0 * (x * z + w * y),
+        2.0 * (x * y + w * z),
+        1.0 - 2.0 * (x * x + z * z),
+        2.0 * (y * z - w * x),
+        2.0 * (x * z - w * y),
+        2.0 * (y * z + w * x),
+        1.0 - 2.0 * (x * x + y * y),
+    )
+}
+/// Rotation vector → matrix (Rodrigues).
+fn rotvec_matrix(v: Vector3<f64>) -> Matrix3<f64> {
+    let angle = v.norm();
+    if angle == 0.0 {
+        return Matrix3::identity();
+    }
+    let k = v / angle;
+    let kx = Matrix3::new(0.0, -k.z, k.y, k.z, 0.0, -k.x, -k.y, k.x, 0.0);
+    Matrix3::identity() + kx * angle.sin() + kx * kx * (1.0 - angle.cos())
+}
+/// URDF / ROS rpy: fixed-axis roll, pitch, yaw, `Rz(y)·Ry(p)·Rx(r)`.
+fn rpy_matrix(r: f64, p: f64, y: f64) -> Matrix3<f64> {
+    rz(y) * ry(p) * rx(r)
+}
+
+fn assert_same(a: &Isometry3<f64>, b: &Isometry3<f64>, mm: f64, rad: f64, what: &str) {
+    let dt = (a.translation.vector - b.translation.vector).norm();
+    let dr = a.rotation.angle_to(&b.rotation);
+    assert!(dt <= mm && dr <= rad, "{what}: {dt:e} mm, {dr:e} rad");
+}
+
+/// RAPID: `PERS tooldata name := [robhold,[[x,y,z],[q1,q2,q3,q4]],[load]];`
+/// (Technical reference manual, RAPID Instructions, Functions and Data
+/// types: tooldata = robhold, tframe (pose: trans pos, rot orient),
+/// tload), read as a bracketed aggregate.
+fn read_rapid_tooldata(text: &str) -> Isometry3<f64> {
+    let line = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("PERS tooldata"))
+        .unwrap();
+    let value = line
+        .split(":=")
+        .nth(1)
+        .unwrap()
+        .trim()
+        .trim_end_matches(';');
+    // Parse nested [ , ] into a tree.
+    #[derive(Debug)]
+    enum Agg {
+        Leaf(String),
+        List(Vec<Agg>),
+    }
+    fn parse(s: &[u8], i: &mut usize) -> Agg {
+        if s[*i] == b'[' {
+            *i += 1;
+            let mut items = Vec::new();
+            loop {
+                items.push(parse(s, i));
+                match s[*i] {
+                    b',' => *i += 1,
+                    b']' => {
+                        *i += 1;
+                        return Agg::List(items);
+                    }
+                    c => panic!("unexpected {}", c as char),
+                }
+            }
+        }
+        let start = *i;
+        while s[*i] != b',' && s[*i] != b']' {
+            *i += 1;
+        }
+        Agg::Leaf(String::from_utf8(s[start..*i].to_vec()).unwrap())
+    }
+    let mut i = 0;
+    let Agg::List(top) = parse(value.as_bytes(), &mut i) else {
+        panic!()
+    };
+    assert!(matches!(&top[0], Agg::Leaf(s) if s == "TRUE"), "robhold");
+    let Agg::List(tframe) = &top[1] else { panic!() };
+    let nums = |a: &Agg| -> Vec<f64> {
+        let Agg::List(v) = a else { panic!() };
+        v.iter()
+            .map(|x| match x {
+                Agg::Leaf(s) => s.parse().unwrap(),
+                Agg::List(_) => panic!(),
+            })
+            .collect()
+    };
+    let t = nums(&tframe[0]);
+    let q = nums(&tframe[1]);
+    assert!(q[0] >= 0.0, "ABB writes q1 ≥ 0");
+    pose([t[0], t[1], t[2]], quat_matrix(q[0], q[1], q[2], q[3]))
+}
+
+/// KRL: `TOOL_DATA[1]={X x,Y y,Z z,A a,B b,C c}` (FRAME structure, KUKA
+/// System Software: components by name in any order; A about z, B about
+/// the new y, C about the new x: `Rz(A)·Ry(B)·Rx(C)`).
+fn read_krl_tool(text: &str) -> Isometry3<f64> {
+    let line = text.lines().find(|l| l.starts_with("TOOL_DATA[")).unwrap();
+    let body = &line[line.find('{').unwrap() + 1..line.rfind('}').unwrap()];
+    let mut f = BTreeMap::new();
+    for part in body.split(',') {
+        let mut it = part.split_whitespace();
+        let (k, v) = (it.next().unwrap(), it.next().unwrap());
+        f.insert(k.to_string(), v.parse::<f64>().unwrap());
+    }
+    let g = |k: &str| f[k];
+    pose(
+        [g("X"), g("Y"), g("Z")],
+        rz(g("A").to_radians()) * ry(g("B").to_radians()) * rx(g("C").to_radians()),
+    )
+}
+
+/// FANUC TP: `PR[1,i]=v ;` for i = 1..6 (X Y Z W P R) then
+/// `UTOOL[1]=PR[1] ;`; W P R fixed-axis about x, y, z: `Rz(R)·Ry(P)·Rx(W)`.
+/// The screen values (`!   X: v`) must be the same numbers.
+fn read_fanuc_utool(text: &str) -> Isometry3<f64> {
+    let mut pr = [f64::NAN; 6];
+    let mut screen = BTreeMap::new();
+    for l in text.lines() {
+        if let Some(rest) = l.strip_prefix("PR[1,") {
+            let k: usize = rest[..rest.find(']').unwrap()].parse().unwrap();
+            let v = rest[rest.find('=').unwrap() + 1..rest.find(';').unwrap()].trim();
+            pr[k - 1] = v.parse().unwrap();
+        } else if let Some(rest) = l.strip_prefix("!   ") {
+            let (k, v) = rest.split_once(':').unwrap();
+            screen.insert(k.to_string(), v.trim().parse::<f64>().unwrap());
+        }
+    }
+    assert!(text.lines().any(|l| l.trim() == "UTOOL[1]=PR[1] ;"));
+    for (k, name) in ["X", "Y", "Z", "W", "P", "R"].iter().enumerate() {
+        assert_eq!(screen[*name], pr[k], "screen value {name}");
+    }
+    pose(
+        [pr[0], pr[1], pr[2]],
+        rz(pr[5].to_radians()) * ry(pr[4].to_radians()) * rx(pr[3].to_radians()),
+    )
+}
+
+/// URScript: `set_tcp(p[x, y, z, rx, ry, rz])`, m and a rotation vector.
+fn read_ur_tcp(text: &str) -> Isometry3<f64> {
+    let line = text.lines().find(|l| l.starts_with("set_tcp(p[")).unwrap();
+    let v: Vec<f64> = line["set_tcp(p[".len()..line.find("])").unwrap()]
+        .split(',')
+        .map(|s| s.trim().parse().unwrap())
+        .collect();
+    pose(
+        [v[0] * 1000.0, v[1] * 1000.0, v[2] * 1000.0],
+        rotvec_matrix(Vector3::new(v[3], v[4], v[5])),
+    )
+}
+
+/// ROS 2 `static_transform_publisher --x … --roll … --frame-id tool0
+/// --child-frame-id sensor` and the URDF joint, read by `urdf-rs`; both
+/// must give the same pose.
+fn read_ros(text: &str) -> Isometry3<f64> {
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("ros2 run tf2_ros static_transform_publisher"))
+        .unwrap();
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let arg = |k: &str| words[words.iter().position(|w| *w == k).unwrap() + 1];
+    let num = |k: &str| arg(k).parse::<f64>().unwrap();
+    assert_eq!(arg("--frame-id"), "tool0");
+    assert_eq!(arg("--child-frame-id"), "sensor");
+    let tf = pose(
+        [num("--x") * 1e3, num("--y") * 1e3, num("--z") * 1e3],
+        rpy_matrix(num("--roll"), num("--pitch"), num("--yaw")),
+    );
+    let xml: String = text
+        .lines()
+        .filter(|l| l.trim_start().starts_with('<'))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let robot = urdf_rs::read_from_string(&format!(
+        "<robot name=\"t\"><link name=\"tool0\"/>{xml}</robot>"
+    ))
+    .unwrap();
+    let j = robot
+        .joints
+        .iter()
+        .find(|j| j.name == "sensor_joint")
+        .unwrap();
+    assert_eq!(j.parent.link, "tool0");
+    assert_eq!(j.child.link, "sensor");
+    let [x, y, z] = j.origin.xyz.0;
+    let [r, p, yw] = j.origin.rpy.0;
+    let urdf = pose([x * 1e3, y * 1e3, z * 1e3], rpy_matrix(r, p, yw));
+    assert_same(&tf, &urdf, 1e-9, 1e-12, "ROS line and URDF joint");
+    tf
+}
+
+/// A reader of one syntax.
+type Reader = fn(&str) -> Isometry3<f64>;
+
+#[test]
+fn tool_data_of_a_pose_only_result_reads_back_in_every_syntax() {
+    let dir = tempfile::tempdir().unwrap();
+    let (path, result) = real_result(dir.path());
+    let path = path.to_str().unwrap();
+    let readers: [(&str, Reader); 5] = [
+        ("abb", read_rapid_tooldata),
+        ("kuka", read_krl_tool),
+        ("fanuc", read_fanuc_utool),
+        ("ur", read_ur_tcp),
+        ("ros", read_ros),
+    ];
+    for (controller, read) in readers {
+        let out = format!("tool.{controller}");
+        let printed = ok(
+            &[
+                "export-model",
+                path,
+                "--format",
+                "tool",
+                "--controller",
+                controller,
+                "-o",
+                &out,
+            ],
+            dir.path(),
+        );
+        let text = std::fs::read_to_string(dir.path().join(&out)).unwrap();
+        assert!(printed.contains(&text), "the tool data is printed too");
+        assert!(text.contains("kinematics were not"), "{text}");
+        let sigma = text.lines().find(|l| l.contains("1σ:")).unwrap();
+        assert_eq!(
+            sigma.matches('±').count(),
+            if controller == "abb" { 7 } else { 6 },
+            "{sigma}"
+        );
+        let back = read(&text);
+        assert_same(&back, &result.hand_eye, 1e-6, 1e-9, controller);
+    }
+}
+
+#[test]
+fn current_tool_rewrites_targets_so_the_calibrated_sensor_reaches_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let (path, result) = real_result(dir.path());
+    let path = path.to_str().unwrap();
+    std::fs::write(
+        dir.path().join("t.csv"),
+        "id,x,y,z,w,p,r\nt1,800,100,400,180,0,90\nt2,850,-50,420,175,5,80\nt3,700,0,380,-170,-3,100\n",
+    )
+    .unwrap();
+    // Without --current-tool: refused, with the tool data to install.
+    let (code, _, err) = spherecal(
+        &[
+            "compensate",
+            "--result",
+            path,
+            "--targets",
+            "t.csv",
+            "--pose-convention",
+            "fanuc",
+            "--tcp",
+            "sensor",
+            "-o",
+            "out.csv",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("pose-only") && err.contains("UTOOL[1]=PR[1]"),
+        "{err}"
+    );
+    assert!(!dir.path().join("out.csv").exists());
+    // The tool the program was taught with, as FANUC values.
+    let current = [2.0, -1.5, 250.0, 179.0, 0.5, -90.0];
+    std::fs::write(
+        dir.path().join("current.txt"),
+        format!(
+            "! taught with UTOOL 1\n{}\n",
+            current.map(|v| v.to_string()).join(",")
+        ),
+    )
+    .unwrap();
+    let out = ok(
+        &[
+            "compensate",
+            "--result",
+            path,
+            "--targets",
+            "t.csv",
+            "--pose-convention",
+            "fanuc",
+            "--current-tool",
+            "current.txt",
+            "-o",
+            "out.csv",
+        ],
+        dir.path(),
+    );
+    assert!(out.contains("kinematics were not calibrated"), "{out}");
+    let c = pose(
+        [current[0], current[1], current[2]],
+        rz(current[5].to_radians()) * ry(current[4].to_radians()) * rx(current[3].to_radians()),
+    );
+    let read = |name: &str| -> Vec<Isometry3<f64>> {
+        std::fs::read_to_string(dir.path().join(name))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let v: Vec<f64> = l.split(',').skip(1).map(|s| s.parse().unwrap()).collect();
+                pose(
+                    [v[0], v[1], v[2]],
+                    rz(v[5].to_radians()) * ry(v[4].to_radians()) * rx(v[3].to_radians()),
+                )
+            })
+            .collect()
+    };
+    let (wanted, commanded) = (read("t.csv"), read("out.csv"));
+    assert_eq!(wanted.len(), 3);
+    for (t, p) in wanted.iter().zip(&commanded) {
+        // The controller puts the flange at P·C⁻¹, the real sensor at P·C⁻¹·H.
+        let sensor = p * c.inverse() * result.hand_eye;
+        assert_same(&sensor, t, 1e-6, 1e-9, "sensor on the target");
+    }
+}
+
+/// A result of `robot` (calibrated) over `nominal`, saved in `dir`.
+fn result_of(nominal: &Robot, calibrated: &Robot, dir: &Path, name: &str) -> PathBuf {
+    let mut r = format::load_result(Path::new(RESULT)).unwrap();
+    r.robot = Some(calibrated.clone());
+    r.joint_errors = calibrated.joint_errors(nominal);
+    let path = dir.join(name);
+    format::save_result(&r, &path).unwrap();
+    path
+}
+
+fn perturbed(nominal: &Robot, seed: u64, scale: f64) -> Robot {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut r = nominal.clone();
+    r.joints = nominal
+        .joints
+        .iter()
+        .map(|j| Joint {
+            alpha: j.alpha + scale * rng.random_range(-0.2..0.2),
+            a: j.a + scale * rng.random_range(-1.0..1.0),
+            beta: j.beta + scale * rng.random_range(-0.2..0.2),
+            theta: j.theta + scale * rng.random_range(-0.2..0.2),
+            d: j.d + scale * rng.random_range(-1.0..1.0),
+        })
+        .collect();
+    r
+}
+
+/// Root → `tip` of a URDF at `q` (deg, moving joints in chain order), as
+/// a plain product of `urdf-rs`' joints: origin, then the rotation about
+/// the axis.
+fn urdf_fk(robot: &urdf_rs::Robot, tip: &str, q: &[f64]) -> Isometry3<f64> {
+    let mut chain = Vec::new();
+    let mut link = tip.to_string();
+    while let Some(j) = robot.joints.iter().find(|j| j.child.link == link) {
+        chain.push(j);
+        link = j.parent.link.clone();
+    }
+    chain.reverse();
+    let mut t = Isometry3::identity();
+    let mut k = 0;
+    for j in chain {
+        let [x, y, z] = j.origin.xyz.0;
+        let [r, p, yw] = j.origin.rpy.0;
+        t *= pose([x * 1e3, y * 1e3, z * 1e3], rpy_matrix(r, p, yw));
+        if matches!(
+            j.joint_type,
+            urdf_rs::JointType::Revolute | urdf_rs::JointType::Continuous
+        ) {
+            let a = Vector3::from(j.axis.xyz.0).normalize();
+            t *= pose([0.0; 3], rotvec_matrix(a * q[k].to_radians()));
+            k += 1;
+        }
+    }
+    t
+}
+
+/// Every node of an XML tree as (path, attributes, text), for a diff.
+/// A node of [`tree`]: path, attributes, text.
+type XmlNode = (String, Vec<(String, String)>, String);
+
+fn tree(text: &str) -> Vec<XmlNode> {
+    let doc = roxmltree::Document::parse(text).unwrap();
+    let mut out = Vec::new();
+    for n in doc.descendants() {
+        let path: Vec<String> = n
+            .ancestors()
+            .filter(roxmltree::Node::is_element)
+            .map(|a| {
+                format!(
+                    "{}[{}]",
+                    a.tag_name().name(),
+                    a.attribute("name").unwrap_or("")
+                )
+            })
+            .collect();
+        let kind = match n.node_type() {
+            roxmltree::NodeType::Comment => "#comment",
+            roxmltree::NodeType::Text => "#text",
+            _ => "",
+        };
+        out.push((
+            format!("{}{kind}", path.join("<")),
+            n.attributes()
+                .map(|a| (a.name().to_string(), a.value().to_string()))
+                .collect(),
+            n.text().unwrap_or("").to_string(),
+        ));
+    }
+    out
+}
+
+#[test]
+fn the_users_urdf_comes_back_with_only_the_joint_origins_changed() {
+    let dir = tempfile::tempdir().unwrap();
+    // ROS-I's IRB 2400 with meshes, given inertials and a comment here.
+    let mut source = std::fs::read_to_string(ABB_URDF).unwrap();
+    for k in 1..=6 {
+        let tag = format!("<link name=\"link_{k}\">");
+        source = source.replace(
+            &tag,
+            &format!(
+                "{tag}\n    <!-- link {k}'s mass -->\n    <inertial>\n      <origin xyz=\"0.01 0 0.1\" rpy=\"0 0 0\"/>\n      <mass value=\"{}\"/>\n      <inertia ixx=\"0.1\" ixy=\"0\" ixz=\"0\" iyy=\"0.1\" iyz=\"0\" izz=\"0.05\"/>\n    </inertial>",
+                30 - 4 * k
+            ),
+        );
+    }
+    assert!(source.contains("<mesh") && source.matches("<inertial>").count() == 6);
+    let urdf_path = dir.path().join("irb2400.urdf");
+    std::fs::write(&urdf_path, &source).unwrap();
+    let urdf_arg = urdf_path.to_str().unwrap();
+    let nominal = robot_from_urdf(&source, &urdf_path).unwrap().robot;
+    let calibrated = perturbed(&nominal, 33, 1.0);
+    let result = result_of(&nominal, &calibrated, dir.path(), "abb.result.json");
+    let hand_eye = format::load_result(&result).unwrap().hand_eye;
+    let out = ok(
+        &[
+            "export-model",
+            result.to_str().unwrap(),
+            "--format",
+            "urdf",
+            "--robot",
+            urdf_arg,
+            "-o",
+            "calibrated.urdf",
+        ],
+        dir.path(),
+    );
+    assert!(out.contains("joint origins calibrated"), "{out}");
+    let written = std::fs::read_to_string(dir.path().join("calibrated.urdf")).unwrap();
+    // The XML trees differ only in the revolute joints' origins and the
+    // added comment, sensor link and joint.
+    let moving: Vec<String> = urdf_rs::read_from_string(&source)
+        .unwrap()
+        .joints
+        .iter()
+        .filter(|j| matches!(j.joint_type, urdf_rs::JointType::Revolute))
+        .map(|j| j.name.clone())
+        .collect();
+    assert_eq!(moving.len(), 6);
+    let is_origin_of_moving = |path: &str| {
+        moving
+            .iter()
+            .any(|m| path.starts_with(&format!("origin[]<joint[{m}]<")))
+    };
+    let (a, b) = (tree(&source), tree(&written));
+    let a_kept: Vec<_> = a.iter().filter(|n| !is_origin_of_moving(&n.0)).collect();
+    let b_kept: Vec<_> = b
+        .iter()
+        .filter(|n| !is_origin_of_moving(&n.0))
+        .filter(|n| !n.0.contains("[sensor]") && !n.0.contains("[sensor_joint]"))
+        .filter(|n| !n.2.contains("Added by spherecal"))
+        .collect();
+    // Whitespace text nodes around the insertion may differ in count only.
+    let strip = |v: Vec<&XmlNode>| {
+        v.into_iter()
+            .filter(|n| !(n.0.ends_with("#text") && n.2.trim().is_empty()))
+            .cloned()
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        strip(a_kept),
+        strip(b_kept),
+        "only the origins and the sensor differ"
+    );
+    let changed = a
+        .iter()
+        .filter(|n| is_origin_of_moving(&n.0))
+        .zip(b.iter().filter(|n| is_origin_of_moving(&n.0)))
+        .filter(|(x, y)| x != y)
+        .count();
+    assert_eq!(changed, 6, "every revolute joint's origin is calibrated");
+    // Outside the origins' numbers and the insertion, the bytes are the source's.
+    let prefix = source
+        .bytes()
+        .zip(written.bytes())
+        .take_while(|(x, y)| x == y)
+        .count();
+    assert!(
+        source[..prefix].contains("<robot"),
+        "the head is kept byte for byte"
+    );
+    assert!(written.ends_with(&source[source.rfind("</robot>").unwrap()..]));
+    // Forward kinematics of the written file (urdf-rs + a chain product)
+    // is the calibrated model at 100 random joint vectors.
+    let urdf = urdf_rs::read_from_string(&written).unwrap();
+    let tip = robot_from_urdf(&source, &urdf_path).unwrap().tip_link;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    for _ in 0..100 {
+        let q: Vec<f64> = (0..6).map(|_| rng.random_range(-170.0..170.0)).collect();
+        let want = calibrated.base_from_flange(&q);
+        assert_same(&urdf_fk(&urdf, &tip, &q), &want, 1e-6, 1e-9, "tip");
+        assert_same(
+            &urdf_fk(&urdf, "sensor", &q),
+            &(want * hand_eye),
+            1e-6,
+            1e-9,
+            "sensor",
+        );
+    }
+}
+
+#[test]
+fn a_urdf_of_another_robot_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let nominal = ur5e().robot;
+    let result = result_of(
+        &nominal,
+        &perturbed(&nominal, 1, 1.0),
+        dir.path(),
+        "ur.json",
+    );
+    let (code, _, err) = spherecal(
+        &[
+            "export-model",
+            result.to_str().unwrap(),
+            "--format",
+            "urdf",
+            "--robot",
+            ABB_URDF,
+            "-o",
+            "x.urdf",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("not the result's nominal robot"), "{err}");
+    assert!(!dir.path().join("x.urdf").exists());
+}
+
+#[derive(serde::Deserialize)]
+struct UrFile {
+    kinematics: UrKinematics,
+}
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct UrKinematics {
+    shoulder: UrJoint,
+    upper_arm: UrJoint,
+    forearm: UrJoint,
+    wrist_1: UrJoint,
+    wrist_2: UrJoint,
+    wrist_3: UrJoint,
+    hash: String,
+}
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct UrJoint {
+    x: f64,
+    y: f64,
+    z: f64,
+    roll: f64,
+    pitch: f64,
+    yaw: f64,
+}
+
+/// base_link_inertia (UR's `base`) → tool0 as ur_description's
+/// ur_macro.xacro builds it from the kinematics file.
+fn ur_fk(k: &UrKinematics, q: &[f64]) -> Isometry3<f64> {
+    let half = std::f64::consts::FRAC_PI_2;
+    let mut t = Isometry3::identity();
+    for (j, q) in [
+        &k.shoulder,
+        &k.upper_arm,
+        &k.forearm,
+        &k.wrist_1,
+        &k.wrist_2,
+        &k.wrist_3,
+    ]
+    .iter()
+    .zip(q)
+    {
+        t *= pose(
+            [j.x * 1e3, j.y * 1e3, j.z * 1e3],
+            rpy_matrix(j.roll, j.pitch, j.yaw) * rz(q.to_radians()),
+        );
+    }
+    // wrist_3_link → flange (rpy 0 -pi/2 -pi/2) → tool0 (rpy pi/2 0 pi/2).
+    t * pose([0.0; 3], rpy_matrix(0.0, -half, -half)) * pose([0.0; 3], rpy_matrix(half, 0.0, half))
+}
+
+#[test]
+fn ur_calibration_file_builds_the_calibrated_ur5e() {
+    let dir = tempfile::tempdir().unwrap();
+    let nominal = ur5e().robot;
+    // The nominal file is UR's own default_kinematics.yaml for the UR5e
+    // (Universal_Robots_ROS2_Description, config/ur5e), to its 2e-11 m.
+    let path = result_of(&nominal, &nominal, dir.path(), "nominal.json");
+    ok(
+        &[
+            "export-model",
+            path.to_str().unwrap(),
+            "--format",
+            "ur-calibration",
+            "-o",
+            "nominal.yaml",
+        ],
+        dir.path(),
+    );
+    let text = std::fs::read_to_string(dir.path().join("nominal.yaml")).unwrap();
+    let file: UrFile = serde_norway::from_str(&text).unwrap();
+    let published = "kinematics:
+  shoulder: {x: 0, y: 0, z: 0.1625, roll: 0, pitch: 0, yaw: 0}
+  upper_arm: {x: 0, y: 0, z: 0, roll: 1.570796327, pitch: 0, yaw: 0}
+  forearm: {x: -0.425, y: 0, z: 0, roll: 0, pitch: 0, yaw: 0}
+  wrist_1: {x: -0.3922, y: 0, z: 0.1333, roll: 0, pitch: 0, yaw: 0}
+  wrist_2: {x: 0, y: -0.0997, z: -2.044881182297852e-11, roll: 1.570796327, pitch: 0, yaw: 0}
+  wrist_3: {x: 0, y: 0.09959999999999999, z: -2.042830148012698e-11, roll: 1.570796326589793, pitch: 3.141592653589793, yaw: 3.141592653589793}
+  hash: calib_12788084448423163542
+";
+    let ur: UrFile = serde_norway::from_str(published).unwrap();
+    let joints = |k: &UrKinematics| {
+        [
+            &k.shoulder,
+            &k.upper_arm,
+            &k.forearm,
+            &k.wrist_1,
+            &k.wrist_2,
+            &k.wrist_3,
+        ]
+        .map(|j| {
+            pose(
+                [j.x * 1e3, j.y * 1e3, j.z * 1e3],
+                rpy_matrix(j.roll, j.pitch, j.yaw),
+            )
+        })
+    };
+    for (a, b) in joints(&file.kinematics)
+        .iter()
+        .zip(joints(&ur.kinematics).iter())
+    {
+        assert_same(a, b, 1e-6, 1e-9, "nominal origin vs UR's file");
+    }
+    assert!(file.kinematics.hash.starts_with("spherecal_"));
+    // A calibrated UR5e: its file's chain is the calibrated model.
+    let calibrated = perturbed(&nominal, 5, 0.5);
+    let path = result_of(&nominal, &calibrated, dir.path(), "cal.json");
+    ok(
+        &[
+            "export-model",
+            path.to_str().unwrap(),
+            "--format",
+            "ur-calibration",
+            "-o",
+            "cal.yaml",
+        ],
+        dir.path(),
+    );
+    let text = std::fs::read_to_string(dir.path().join("cal.yaml")).unwrap();
+    let file: UrFile = serde_norway::from_str(&text).unwrap();
+    assert_ne!(file.kinematics.hash, ur.kinematics.hash);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    for _ in 0..100 {
+        let q: Vec<f64> = (0..6).map(|_| rng.random_range(-360.0..360.0)).collect();
+        assert_same(
+            &ur_fk(&file.kinematics, &q),
+            &calibrated.base_from_flange(&q),
+            1e-6,
+            1e-9,
+            "UR chain vs calibrated model",
+        );
+    }
+    // Not a UR: refused unless named one.
+    let abb = robot_from_urdf(
+        &std::fs::read_to_string(ABB_URDF).unwrap(),
+        Path::new(ABB_URDF),
+    )
+    .unwrap()
+    .robot;
+    let path = result_of(&abb, &abb, dir.path(), "abb.json");
+    let (code, _, err) = spherecal(
+        &[
+            "export-model",
+            path.to_str().unwrap(),
+            "--format",
+            "ur-calibration",
+            "-o",
+            "abb.yaml",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("not a Universal Robots arm"), "{err}");
+}
+
+#[test]
+fn a_joint_without_origin_or_rpy_gets_them_written() {
+    let dir = tempfile::tempdir().unwrap();
+    // URDF defaults: no <origin> is the identity, no rpy is 0 0 0.
+    let source = std::fs::read_to_string(ABB_URDF)
+        .unwrap()
+        .replacen(
+            "<joint name=\"joint_1\" type=\"revolute\">\n    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>",
+            "<joint name=\"joint_1\" type=\"revolute\">",
+            1,
+        )
+        .replacen(
+            "<origin xyz=\"0 0 0.705\" rpy=\"0 0 0\"/>",
+            "<origin xyz=\"0 0 0.705\"/>",
+            1,
+        );
+    assert!(!source.contains("0.705\" rpy"));
+    let urdf_path = dir.path().join("bare.urdf");
+    std::fs::write(&urdf_path, &source).unwrap();
+    let nominal = robot_from_urdf(&source, &urdf_path).unwrap().robot;
+    let calibrated = perturbed(&nominal, 8, 1.0);
+    let result = result_of(&nominal, &calibrated, dir.path(), "bare.result.json");
+    ok(
+        &[
+            "export-model",
+            result.to_str().unwrap(),
+            "--format",
+            "urdf",
+            "--robot",
+            urdf_path.to_str().unwrap(),
+            "-o",
+            "bare.calibrated.urdf",
+            "-q",
+        ],
+        dir.path(),
+    );
+    let written = std::fs::read_to_string(dir.path().join("bare.calibrated.urdf")).unwrap();
+    let urdf = urdf_rs::read_from_string(&written).unwrap();
+    for name in ["joint_1", "joint_3"] {
+        let j = urdf.joints.iter().find(|j| j.name == name).unwrap();
+        assert!(
+            j.origin.rpy.0 != [0.0; 3],
+            "{name} has its calibrated rotation"
+        );
+    }
+    let tip = robot_from_urdf(&source, &urdf_path).unwrap().tip_link;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+    for _ in 0..20 {
+        let q: Vec<f64> = (0..6).map(|_| rng.random_range(-170.0..170.0)).collect();
+        assert_same(
+            &urdf_fk(&urdf, &tip, &q),
+            &calibrated.base_from_flange(&q),
+            1e-6,
+            1e-9,
+            "tip",
+        );
+    }
+}
