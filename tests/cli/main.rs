@@ -5,6 +5,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod calibration_export;
 mod cli_help;
 mod compensate;
 mod contract;
