@@ -13,13 +13,12 @@ use crate::app::command::{Command, PlanCommand};
 use crate::app::dialog::Purpose;
 use crate::app::job::Slot;
 use crate::app::ledger::{Artefact, Stale};
-use crate::app::plan::PlanOutcome;
 use crate::app::widgets::{
     AFTER, BAD, BEFORE, DEFAULT_RANGE, MUTED, labelled_field, range_fields, range_of, range_values,
 };
 use crate::app::{Forms, plan::form::default_sphere};
 use crate::engine::base::robot;
-use crate::engine::tools::plan::{Plan, PlanStats, StationRole};
+use crate::engine::tools::plan::{Plan, PlanStats, Planned, StationRole};
 
 /// Width of the settings column, points.
 const FORM_WIDTH: f32 = 330.0;
@@ -196,7 +195,7 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
 
 /// The predicted validation std after calibration (simulated
 /// calibrations of the plan), or why there is none.
-fn prediction_ui(ui: &mut egui::Ui, o: &PlanOutcome) {
+fn prediction_ui(ui: &mut egui::Ui, o: &Planned) {
     match &o.prediction {
         Some(Ok(p)) => {
             ui.label(
@@ -390,7 +389,7 @@ fn outcome_ui(
     ui: &mut egui::Ui,
     state: &AppState,
     forms: &mut Forms,
-    o: &PlanOutcome,
+    o: &Planned,
     commands: &mut Vec<Command>,
 ) {
     let plan = &o.plan;
