@@ -18,7 +18,8 @@ use crate::app::dialog::Purpose;
 use crate::app::import::form::{CONVENTIONS, ImportForm, LogKind, ObservationKind, ProfilesKind};
 use crate::app::job::Slot;
 use crate::app::widgets::{
-    BAD, DEFAULT_RANGE, GOOD, PATH_WIDTH, WARN, labelled_field, path_row, range_fields, range_of,
+    BAD, DEFAULT_RANGE, GOOD, PATH_WIDTH, WARN, boxed, labelled_field, path_row, range_fields,
+    range_of, scrolled_text,
 };
 use crate::engine::base::robot::{self, DhConvention};
 use crate::engine::files::import::{AngleUnit, LengthUnit, SideChoice};
@@ -29,20 +30,11 @@ const ERROR_HEIGHT: f32 = 90.0;
 /// Width of a column-name field, points.
 const COLUMN_WIDTH: f32 = 90.0;
 
-/// The whole Import view.
+/// The whole Import view. An edit makes the preview, the last outcome
+/// and the checks stale (the ledger clears them); a pose file that reads
+/// otherwise than at the last scan is read and paired again (the ledger
+/// asks for it).
 pub fn import_ui(
-    ui: &mut egui::Ui,
-    state: &AppState,
-    forms: &mut Forms,
-    commands: &mut Vec<Command>,
-) {
-    // An edit makes the preview, the last outcome and the checks stale
-    // (the ledger clears them); a pose file that reads otherwise than at
-    // the last scan is read and paired again (the ledger asks for it).
-    import_form_ui(ui, state, forms, commands);
-}
-
-fn import_form_ui(
     ui: &mut egui::Ui,
     state: &AppState,
     forms: &mut Forms,
@@ -154,26 +146,17 @@ fn actions_ui(
         }
     });
     if let Some(Err(e)) = &state.import.outcome {
-        egui::Frame::group(ui.style())
-            .stroke(egui::Stroke::new(1.5, BAD))
-            .show(ui, |ui| {
-                ui.set_width(ui.available_width());
-                ui.label(RichText::new("The import failed").strong().color(BAD));
-                if state.import.guess_needed.is_some() {
-                    ui.label(
-                        RichText::new(
-                            "A hand-eye guess is needed: give one under \"Initial hand-eye\" below (numbers or a file).",
-                        )
-                        .strong(),
-                    );
-                }
-                egui::ScrollArea::vertical()
-                    .id_salt("import_error")
-                    .max_height(ERROR_HEIGHT)
-                    .show(ui, |ui| {
-                        ui.label(e);
-                    });
-            });
+        boxed(ui, BAD, "The import failed", |ui| {
+            if state.import.guess_needed.is_some() {
+                ui.label(
+                    RichText::new(
+                        "A hand-eye guess is needed: give one under \"Initial hand-eye\" below (numbers or a file).",
+                    )
+                    .strong(),
+                );
+            }
+            scrolled_text(ui, "import_error", ERROR_HEIGHT, e);
+        });
     }
 }
 

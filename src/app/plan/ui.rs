@@ -14,7 +14,8 @@ use crate::app::dialog::Purpose;
 use crate::app::job::Slot;
 use crate::app::ledger::{Artefact, Stale};
 use crate::app::widgets::{
-    AFTER, BAD, BEFORE, DEFAULT_RANGE, MUTED, labelled_field, range_fields, range_of, range_values,
+    AFTER, BAD, BEFORE, DEFAULT_RANGE, MUTED, export_folder_ui, range_fields, range_of,
+    range_values,
 };
 use crate::app::{Forms, plan::form::default_sphere};
 use crate::engine::base::robot;
@@ -329,16 +330,7 @@ fn export_ui(
     );
     let busy = state.jobs.writing() || state.jobs.runs(&Slot::Simulate);
     ui.horizontal_wrapped(|ui| {
-        labelled_field(
-            ui,
-            "Write to folder",
-            &mut forms.export_dir,
-            "/path/to/folder",
-            240.0,
-        );
-        if ui.button("Browse…").clicked() {
-            commands.push(Command::Browse(Purpose::ExportFolder));
-        }
+        export_folder_ui(ui, "Write to folder", &mut forms.export_dir, 240.0, commands);
         let robot_name = crate::engine::base::robot::presets::preset(&forms.plan.robot)
             .map(|p| p.robot.name)
             .unwrap_or_default();

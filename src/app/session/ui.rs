@@ -606,15 +606,12 @@ fn name_ui(ui: &mut egui::Ui, name: &str) {
 pub fn notice_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
     if let Some(notice) = &state.notice {
         ui.add_space(6.0);
-        egui::Frame::group(ui.style())
-            .stroke(egui::Stroke::new(1.5, BAD))
-            .show(ui, |ui| {
-                ui.label(RichText::new(&notice.title).strong().color(BAD));
-                ui.label(&notice.body);
-                if ui.button("Dismiss").clicked() {
-                    commands.push(Command::View(ViewCommand::DismissNotice));
-                }
-            });
+        crate::app::widgets::boxed(ui, BAD, &notice.title, |ui| {
+            ui.label(&notice.body);
+            if ui.button("Dismiss").clicked() {
+                commands.push(Command::View(ViewCommand::DismissNotice));
+            }
+        });
     }
 }
 

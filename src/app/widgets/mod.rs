@@ -232,6 +232,57 @@ pub fn stale_banner_ui(ui: &mut egui::Ui, stale: &crate::app::ledger::Stale, tod
         });
 }
 
+/// A box framed in `colour` with its `title` in that colour (a failure,
+/// a notice, what to do next) above what `add` draws.
+pub fn boxed<R>(
+    ui: &mut egui::Ui,
+    colour: Color32,
+    title: &str,
+    add: impl FnOnce(&mut egui::Ui) -> R,
+) -> egui::InnerResponse<R> {
+    egui::Frame::group(ui.style())
+        .stroke(egui::Stroke::new(1.5, colour))
+        .show(ui, |ui| {
+            ui.set_width(ui.available_width());
+            ui.label(RichText::new(title).strong().color(colour));
+            add(ui)
+        })
+}
+
+/// A long text (an error, a why) that scrolls past `max_height` points
+/// rather than push what follows off the screen.
+pub fn scrolled_text(
+    ui: &mut egui::Ui,
+    id: &str,
+    max_height: f32,
+    text: impl Into<egui::WidgetText>,
+) {
+    egui::ScrollArea::vertical()
+        .id_salt(id)
+        .max_height(max_height)
+        .show(ui, |ui| {
+            ui.label(text);
+        });
+}
+
+/// The folder field the exports are written to, with its Browse… button.
+pub fn export_folder_ui(
+    ui: &mut egui::Ui,
+    label: &str,
+    folder: &mut String,
+    width: f32,
+    commands: &mut Vec<Command>,
+) {
+    labelled_field(ui, label, folder, "/path/to/folder", width);
+    if ui
+        .button("Browse…")
+        .on_hover_text("choose the folder with the desktop's dialog")
+        .clicked()
+    {
+        commands.push(Command::Browse(Purpose::ExportFolder));
+    }
+}
+
 /// A plot's key on one line above it, each entry in its series' colour
 /// (a legend inside the plot would cover data).
 pub fn plot_key(ui: &mut egui::Ui, entries: &[(&str, egui::Color32)]) {
