@@ -14,11 +14,10 @@ use crate::app::dialog::Purpose;
 use crate::app::job::Slot;
 use crate::app::ledger::{Artefact, Stale};
 use crate::app::widgets::{
-    AFTER, BAD, BEFORE, DEFAULT_RANGE, MUTED, export_folder_ui, range_fields, range_of,
+    AFTER, BAD, BEFORE, DEFAULT_RANGE, MUTED, export_folder_ui, preset_ui, range_fields, range_of,
     range_values,
 };
 use crate::app::{Forms, plan::form::default_sphere};
-use crate::engine::base::robot;
 use crate::engine::tools::plan::{Plan, PlanStats, Planned, StationRole};
 
 /// Width of the settings column, points.
@@ -80,19 +79,7 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
         .show(ui, |ui| {
             let l = ui.label("Robot");
             let before = f.robot.clone();
-            egui::ComboBox::from_id_salt("plan_robot")
-                .selected_text(&f.robot)
-                .show_ui(ui, |ui| {
-                    for p in robot::presets() {
-                        ui.selectable_value(
-                            &mut f.robot,
-                            p.key.to_string(),
-                            format!("{} ({})", p.key, p.robot.name),
-                        );
-                    }
-                })
-                .response
-                .labelled_by(l.id);
+            preset_ui(ui, "plan_robot", &mut f.robot).labelled_by(l.id);
             if f.robot != before {
                 f.request.design.sphere = default_sphere(&f.robot);
             }

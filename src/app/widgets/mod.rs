@@ -105,6 +105,51 @@ pub fn labelled_field(
     .labelled_by(l.id)
 }
 
+/// A drop-down that sets `value` to one of `options` (each with its
+/// text, the chosen one's shown), after the label `label` tied to it
+/// (screen readers and the UI tests find it by that label; none when
+/// empty).
+pub fn choice<T: PartialEq>(
+    ui: &mut egui::Ui,
+    label: &str,
+    id_salt: &str,
+    value: &mut T,
+    options: impl IntoIterator<Item = (T, String)>,
+) -> egui::Response {
+    let l = (!label.is_empty()).then(|| ui.label(label));
+    let options: Vec<(T, String)> = options.into_iter().collect();
+    let shown = options
+        .iter()
+        .find(|(v, _)| v == value)
+        .map_or_else(String::new, |(_, t)| t.clone());
+    let response = egui::ComboBox::from_id_salt(id_salt)
+        .selected_text(shown)
+        .show_ui(ui, |ui| {
+            for (v, t) in options {
+                ui.selectable_value(value, v, t);
+            }
+        })
+        .response;
+    match l {
+        Some(l) => response.labelled_by(l.id),
+        None => response,
+    }
+}
+
+/// The robot presets to choose from, each as `key (name)`, the key
+/// shown: returns the drop-down's response (to tie a label to it).
+pub fn preset_ui(ui: &mut egui::Ui, id_salt: &str, key: &mut String) -> egui::Response {
+    egui::ComboBox::from_id_salt(id_salt)
+        .selected_text(key.as_str())
+        .show_ui(ui, |ui| {
+            for p in crate::engine::base::robot::presets() {
+                let text = format!("{} ({})", p.key, p.robot.name);
+                ui.selectable_value(key, p.key.to_string(), text);
+            }
+        })
+        .response
+}
+
 /// A number that is typed, never dragged (a sideways drag over it
 /// changes nothing): a text field labelled `label`, showing `value` with
 /// `unit` beside it, that takes what is typed on Enter or when it loses
