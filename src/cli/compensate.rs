@@ -164,12 +164,9 @@ pub fn run(args: &CompensateArgs) -> Result<(), CliError> {
     }
     sayln!("TCP: {}", model.tcp.describe());
     if model.tcp == Tcp::Sensor {
-        for c in report::tool_controllers(&file, args.pose_convention) {
-            sayln!(
-                "tool data to set on the controller ({}):",
-                c.tool_data_kind()
-            );
-            for line in c.tool_data(&model.tool, "tSpherecal").lines() {
+        for (kind, text) in report::tool_data(&file, args.pose_convention, &model.tool) {
+            sayln!("tool data to set on the controller ({kind}):");
+            for line in text.lines() {
                 sayln!("  {line}");
             }
         }
