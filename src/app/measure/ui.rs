@@ -116,7 +116,6 @@ pub fn measure_ui(
         });
 }
 
-/// A path field with its Browse… button and the note when the dialog
 /// A path field with its Browse… button (the note when a dialog chose
 /// nothing is under the scan's fields).
 fn path_row(
