@@ -1,8 +1,10 @@
 //! The widgets every view shares: colours and station markers, labelled
-//! text and number fields, path rows with their Browse… button and the
-//! note when a dialog chose nothing, a job's phase and fraction, the
-//! STALE banner, the Replace / Keep question, the tabs, the status bar,
-//! measuring-range fields; plot helpers in [`plots`].
+//! text and number fields, labelled drop-downs and the robot presets',
+//! path rows with their Browse… button and the note when a dialog chose
+//! nothing, the export folder, a job's phase and fraction, the STALE
+//! banner, framed boxes (a failure, a notice), the Replace / Keep
+//! question, the tabs, the status bar, measuring-range fields; plot
+//! helpers in [`plots`].
 
 pub mod plots;
 
