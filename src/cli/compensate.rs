@@ -115,7 +115,11 @@ pub fn run(args: &CompensateArgs) -> Result<(), CliError> {
         );
         for c in controllers {
             message.push_str(&format!("\n{}:\n", c.tool_data_kind()));
-            message.push_str(&c.tool_data_with(&result.hand_eye, "tSpherecal", ToolDigits::Full));
+            message.push_str(&c.tool_data_with(
+                &result.hand_eye,
+                report::TOOL_NAME,
+                ToolDigits::Full,
+            ));
         }
         return Err(CliError::input(message.trim_end().to_string()));
     }
@@ -183,12 +187,9 @@ pub fn run(args: &CompensateArgs) -> Result<(), CliError> {
     }
     sayln!("TCP: {}", model.tcp.describe());
     if model.tcp == Tcp::Sensor {
-        for c in report::tool_controllers(&file, args.pose_convention) {
-            sayln!(
-                "tool data to set on the controller ({}):",
-                c.tool_data_kind()
-            );
-            for line in c.tool_data(&model.tool, "tSpherecal").lines() {
+        for (kind, text) in report::tool_data(&file, args.pose_convention, &model.tool) {
+            sayln!("tool data to set on the controller ({kind}):");
+            for line in text.lines() {
                 sayln!("  {line}");
             }
         }

@@ -14,8 +14,8 @@ use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
 use crate::engine::files::import::{
     self, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
-    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportError, ImportSpec, ImportStage,
-    Imported, Observations, PoseImportSpec, ProfileSource, SideChoice,
+    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportError, ImportRequest, ImportSpec,
+    ImportStage, Imported, Observations, PoseImportSpec, PoseLog, ProfileSource, SideChoice,
 };
 
 use super::scan_flags::ScanFlags;
@@ -315,58 +315,41 @@ fn progress_line(
 /// [`CliError`] with status 2 for bad input, 1 when the session cannot be
 /// written.
 pub fn run(args: &ImportArgs) -> Result<(), CliError> {
-    let imported = if let Some(poses) = &args.poses {
-        if args.preview.is_some() {
+    match (&args.poses, args.preview) {
+        (Some(_), Some(_)) => {
             return Err(CliError::input("--preview reads a joint log (--joints)"));
         }
-        // Every input refused as the output before any is read.
-        let out = out_path(args)?;
-        let spec = pose_spec(args, poses)?;
-        // Read and pair every input once; then the side, given or decided
-        // from the data (a step of its own, which calibrates both sides).
-        let mut progress = progress_lines(args.quiet, Instant::now());
-        let inputs = import::read_pose_inputs_with(&spec, &mut progress).map_err(|e| input(&e))?;
-        let imported = match spec.side {
-            SideChoice::Auto if !inputs.all_sides_given() && !inputs.centres() => {
-                if !args.quiet {
-                    sayln!("deciding the side of the laser plane from the data (both calibrated)…");
-                }
-                import::decide_side(&spec, &inputs)
-            }
-            choice => import::build_pose_session(
-                &spec,
-                &inputs,
-                if choice == SideChoice::Minus { -1 } else { 1 },
-            ),
-        }
-        .map_err(|e| input(&e))?;
-        (imported, out)
-    } else {
-        if let Some(n) = args.preview {
+        (None, Some(n)) => {
             let spec = spec(args)?;
             say!("{}", import::preview(&spec, n).map_err(|e| input(&e))?);
             return Ok(());
         }
-        let out = out_path(args)?;
-        let spec = spec(args)?;
-        let mut progress = progress_lines(args.quiet, Instant::now());
-        (
-            import::import_with(&spec, &mut progress).map_err(|e| input(&e))?,
-            out,
-        )
-    };
-    let (
-        Imported {
-            mut session,
-            checks,
-            notes,
-            ..
-        },
-        out,
-    ) = imported;
-    if args.range.is_some() {
-        session.sensor_range = args.range;
+        _ => {}
     }
+    // Every input refused as the output before any is read.
+    let out = out_path(args)?;
+    let log = match &args.poses {
+        Some(poses) => PoseLog::Poses(pose_spec(args, poses)?),
+        None => PoseLog::Joints(spec(args)?),
+    };
+    let request = ImportRequest {
+        log,
+        range: args.range,
+    };
+    let mut lines = progress_lines(args.quiet, Instant::now());
+    let Imported {
+        session,
+        checks,
+        notes,
+        ..
+    } = import::import_session(&request, &mut |stage| {
+        // The side decision calibrates both sides: said at once.
+        if stage == ImportStage::Side && !args.quiet {
+            sayln!("deciding the side of the laser plane from the data (both calibrated)…");
+        }
+        lines(stage)
+    })
+    .map_err(|e| input(&e))?;
     let out = &out;
     let text = format::session_to_json(&session);
     format::write_atomic(out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;

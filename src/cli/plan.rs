@@ -16,8 +16,8 @@ use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
 use crate::engine::files::import::RobotSource;
 use crate::engine::tools::plan::{
-    self, Controller, PlanConfig, PlanDesign, PlanError, PlanRequest, PlanStage, PredictConfig,
-    RequestError, Selection, defaults, read_stations,
+    self, Controller, PlanConfig, PlanDesign, PlanError, PlanProgress, PlanRequest, PlanStage,
+    PredictConfig, RequestError, Selection, defaults, read_stations,
 };
 use crate::engine::tools::simulate;
 
@@ -335,6 +335,36 @@ impl Ticker {
     }
 }
 
+/// The name of the timing line's part that `stage` begins, if any.
+fn stage_mark(stage: PlanStage) -> Option<&'static str> {
+    match stage {
+        PlanStage::Candidates { .. } => None,
+        PlanStage::Analysis => Some("identifiability"),
+        PlanStage::Selection => Some("selection"),
+        PlanStage::Ordering => Some("ordering and report"),
+        PlanStage::Comparison => Some("plan without the spread"),
+    }
+}
+
+/// `planned in … ms (candidates …, identifiability …, …)`: the time
+/// since `started` and of each part, from when each began (`marks`)
+/// to `end`.
+fn timing_line(started: Instant, marks: &[(&str, Instant)], end: Instant) -> String {
+    let stages: Vec<String> = marks
+        .iter()
+        .enumerate()
+        .map(|(k, (name, at))| {
+            let next = marks.get(k + 1).map_or(end, |m| m.1);
+            format!("{name} {:.0}", (next - *at).as_secs_f64() * 1e3)
+        })
+        .collect();
+    format!(
+        "  planned in {:.0} ms ({} ms)",
+        (end - started).as_secs_f64() * 1e3,
+        stages.join(", ")
+    )
+}
+
 /// Runs `spherecal plan`.
 ///
 /// # Errors
@@ -380,60 +410,48 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     super::check_outputs(&outputs, format::Folders::Existing)?;
     let config = config(args)?;
     let quiet = args.quiet;
+    let predict = (args.predict > 0).then(|| PredictConfig {
+        runs: args.predict,
+        seed: args.seed,
+        ..PredictConfig::default()
+    });
     // When each stage began, for the timing line.
     let mut marks: Vec<(&str, Instant)> = vec![("candidates", Instant::now())];
     let mut ticker = Ticker::new(Instant::now());
-    let made = plan::plan(&config, &mut |stage| {
-        if !quiet && let Some(line) = ticker.tick(&stage, Instant::now()) {
-            eprintln!("{line}");
-        }
-        let name = match stage {
-            PlanStage::Candidates { .. } => None,
-            PlanStage::Analysis => Some("identifiability"),
-            PlanStage::Selection => Some("selection"),
-            PlanStage::Ordering => Some("ordering and report"),
-            PlanStage::Comparison => Some("plan without the spread"),
-        };
-        if let Some(name) = name
-            && marks.last().is_none_or(|(last, _)| *last != name)
-        {
-            marks.push((name, Instant::now()));
+    // When the prediction began.
+    let mut predicting = Instant::now();
+    let planned = plan::plan_and_predict(&config, predict.as_ref(), &mut |progress| {
+        match progress {
+            PlanProgress::Stage(stage) => {
+                if !quiet && let Some(line) = ticker.tick(&stage, Instant::now()) {
+                    eprintln!("{line}");
+                }
+                if let Some(name) = stage_mark(stage)
+                    && marks.last().is_none_or(|(last, _)| *last != name)
+                {
+                    marks.push((name, Instant::now()));
+                }
+            }
+            PlanProgress::Planned(made) => {
+                if !quiet {
+                    say!("{}", plan::summary(made));
+                    sayln!("{}", timing_line(started, &marks, Instant::now()));
+                }
+                predicting = Instant::now();
+                ticker = Ticker::new(predicting);
+            }
+            PlanProgress::Predicting { done, of } => {
+                if !quiet && let Some(line) = ticker.runs(done, of, Instant::now()) {
+                    eprintln!("{line}");
+                }
+            }
         }
         Control::Continue
     })
     .map_err(|e| plan_error(&e))?;
-    let end = Instant::now();
-    if !quiet {
-        say!("{}", plan::summary(&made));
-        let stages: Vec<String> = marks
-            .iter()
-            .enumerate()
-            .map(|(k, (name, at))| {
-                let next = marks.get(k + 1).map_or(end, |m| m.1);
-                format!("{name} {:.0}", (next - *at).as_secs_f64() * 1e3)
-            })
-            .collect();
-        sayln!(
-            "  planned in {:.0} ms ({} ms)",
-            (end - started).as_secs_f64() * 1e3,
-            stages.join(", ")
-        );
-    }
-    if args.predict > 0 {
-        let predict = PredictConfig {
-            runs: args.predict,
-            seed: args.seed,
-            ..PredictConfig::default()
-        };
-        let t = Instant::now();
-        let mut ticker = Ticker::new(t);
-        let p = plan::predict(&made, &predict, &mut |done, of| {
-            if !quiet && let Some(line) = ticker.runs(done, of, Instant::now()) {
-                eprintln!("{line}");
-            }
-            Control::Continue
-        })
-        .map_err(|e| plan_error(&e))?;
+    let made = &planned.plan;
+    if let (Some(prediction), Some(predict)) = (planned.prediction, &predict) {
+        let p = prediction.map_err(|e| plan_error(&e))?;
         if !quiet {
             sayln!(
                 "  predicted validation std after calibration (ml, {} simulated robots with random errors σ {}°/{} mm, joint noise {}°, stripe noise {} mm): {:.4} ± {:.4} mm",
@@ -450,7 +468,7 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
                 p.before_mean,
                 p.floor_mean,
                 p.ratio_mean,
-                t.elapsed().as_secs_f64() * 1e3
+                predicting.elapsed().as_secs_f64() * 1e3
             );
             if let Some(r) = &p.range {
                 sayln!(
@@ -466,12 +484,12 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     // Every file or none.
     let mut files: Vec<(&Path, String, String)> = Vec::new();
     if let Some(path) = &args.csv {
-        files.push((path, plan::plan_csv(&made), "joint log CSV".to_owned()));
+        files.push((path, plan::plan_csv(made), "joint log CSV".to_owned()));
     }
     for (controller, path) in &programs {
         let what = format!("{} program", controller.key());
         let text =
-            plan::render_program(*controller, &made).map_err(|e| CliError::input(e.to_string()))?;
+            plan::render_program(*controller, made).map_err(|e| CliError::input(e.to_string()))?;
         files.push((path, text, what));
     }
     let bytes: Vec<(&Path, &[u8])> = files.iter().map(|(p, t, _)| (*p, t.as_bytes())).collect();

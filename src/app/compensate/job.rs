@@ -98,9 +98,6 @@ pub fn write_compensated(
     Ok(write_atomic(path, text.as_bytes())?)
 }
 
-/// Name of the tool in the tool data shown (RAPID's `tooldata` name).
-pub const TOOL_NAME: &str = "tSpherecal";
-
 /// One target of the table.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TargetRow {
@@ -171,21 +168,16 @@ impl CompensationView {
     ) -> Self {
         let file_line = report::file_line(file);
         let tool_data = if model.tcp == Tcp::Sensor {
-            report::tool_controllers(file, convention)
+            report::tool_data(file, convention, &model.tool)
                 .into_iter()
-                .map(|c| {
-                    (
-                        c.tool_data_kind().to_string(),
-                        c.tool_data(&model.tool, TOOL_NAME),
-                    )
-                })
+                .map(|(kind, text)| (kind.to_string(), text))
                 .collect()
         } else {
             Vec::new()
         };
-        let mut rows: Vec<TargetRow> = done
-            .targets
-            .iter()
+        // Largest first, as the command line's table.
+        let rows = report::largest_first(&done.targets)
+            .into_iter()
             .map(|t| TargetRow {
                 name: t.name.clone(),
                 line: t.line,
@@ -203,8 +195,6 @@ impl CompensationView {
                 notes: t.notes.clone(),
             })
             .collect();
-        // Largest first, as the command line's table.
-        rows.sort_by(|a, b| b.correction_mm.total_cmp(&a.correction_mm));
         Self {
             targets: file.path.clone(),
             file_line,

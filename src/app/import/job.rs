@@ -3,12 +3,12 @@
 //! engine's [`import::import_with`] or [`import::import_poses_with`], as
 //! `spherecal import`), analysed like an opened file.
 
-use std::path::Path;
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use crate::engine::calibrate::solve::Control;
-use crate::engine::files::import::{self, ImportError, ImportStage};
+use crate::engine::files::import::{self, ImportError, ImportRequest, ImportStage, PoseLog};
 
 use super::form::{ImportForm, LogKind, PREVIEW_ROWS};
 use crate::app::error::JobError;
@@ -40,25 +40,16 @@ pub struct Imported {
 /// the first rows mapped.
 pub fn import_preview(mut form: ImportForm, guess: bool) -> Previewed {
     if form.joints.trim().is_empty() {
-        return (
-            Vec::new(),
-            None,
-            Err(JobError::ImportForm(
-                "choose the joint log CSV first".into(),
-            )),
-        );
+        let why = JobError::ImportForm("choose the joint log CSV first".into());
+        return (Vec::new(), None, Err(why));
     }
-    let header = match import::header(Path::new(form.joints.trim())) {
-        Ok(h) => h,
-        Err(e) => return (Vec::new(), None, Err(e.into())),
-    };
-    if guess {
-        form.guess_mapping(&header);
-    }
-    let preview = form
-        .spec()
-        .map_err(JobError::ImportForm)
-        .and_then(|spec| Ok(import::preview(&spec, PREVIEW_ROWS)?));
+    let joint_log = PathBuf::from(form.joints.trim());
+    let (header, preview) = import::preview_joint_log(&joint_log, PREVIEW_ROWS, |header| {
+        if guess {
+            form.guess_mapping(header);
+        }
+        form.spec().map_err(JobError::ImportForm)
+    });
     (header, guess.then(|| Box::new(form)), preview)
 }
 
@@ -95,24 +86,32 @@ pub fn import_session(
         }
         Control::Continue
     };
-    let (imported, log) = match form.log_kind {
+    let (log, path) = match form.log_kind {
         LogKind::Joints => {
             let spec = form.spec().map_err(JobError::ImportForm)?;
-            (import::import_with(&spec, &mut stage)?, spec.joint_log)
+            let path = spec.joint_log.clone();
+            (PoseLog::Joints(spec), path)
         }
         LogKind::FlangePoses => {
             let mut spec = form.pose_spec().map_err(JobError::ImportForm)?;
             if spec.hand_eye.is_none() {
                 spec.hand_eye = form.hand_eye_guess().map_err(JobError::ImportForm)?;
             }
-            (import::import_poses_with(&spec, &mut stage)?, spec.poses)
+            let path = spec.poses.clone();
+            (PoseLog::Poses(spec), path)
         }
     };
+    let range = form
+        .range
+        .map(|v| crate::app::widgets::range_of(&v))
+        .transpose()
+        .map_err(|why| JobError::ImportForm(format!("measuring range: {why}")))?;
+    let imported = import::import_session(&ImportRequest { log, range }, &mut stage)?;
     if cancel.load(Ordering::Relaxed) {
         return Err(ImportError::Cancelled.into());
     }
     progress("fitting the stripes".to_string(), None);
-    let mut session = imported.session;
+    let session = imported.session;
     let mut notes = imported.notes;
     if form.log_kind == LogKind::FlangePoses
         && let Some(he) = &session.hand_eye
@@ -124,14 +123,8 @@ pub fn import_session(
             t.x, t.y, t.z
         ));
     }
-    if let Some(v) = form.range {
-        session.sensor_range = Some(
-            crate::app::widgets::range_of(&v)
-                .map_err(|why| JobError::ImportForm(format!("measuring range: {why}")))?,
-        );
-    }
     Ok(Imported {
-        loaded: Box::new(analyse(session, Source::Imported(log))),
+        loaded: Box::new(analyse(session, Source::Imported(path))),
         checks: imported.checks,
         notes,
     })

@@ -15,8 +15,7 @@ use crate::app::command::{Command, ImportCommand};
 use crate::app::dialog::Purpose;
 use crate::app::import::form::{HandEyeChoice, ImportForm, ObservationKind};
 use crate::app::job::Slot;
-use crate::app::widgets::path_row;
-use crate::app::widgets::{BAD, GOOD, MUTED, WARN};
+use crate::app::widgets::{BAD, GOOD, MUTED, WARN, boxed, path_row, scrolled_text};
 use crate::engine::files::import::{FlangeConvention, PairingPreview, PoseFormat, PosePreview};
 
 /// Height of the pairing list, points: a dozen rows, the rest scrolled
@@ -348,27 +347,17 @@ pub fn hand_eye_ui(
         } else {
             MUTED
         };
-        egui::Frame::group(ui.style())
-            .stroke(egui::Stroke::new(1.5, colour))
-            .show(ui, |ui| {
-                ui.label(
-                    RichText::new("A hand-eye guess is needed: these poses give none")
-                        .strong()
-                        .color(colour),
-                );
-                ui.label(
-                    RichText::new(
-                        "Give x y z (mm) and roll pitch yaw (deg) of the sensor on the flange, or a file, below; the calibration refines it.",
-                    )
-                    .strong(),
-                );
-                egui::ScrollArea::vertical()
-                    .id_salt("import_guess_why")
-                    .max_height(WHY_HEIGHT)
-                    .show(ui, |ui| {
-                        ui.label(RichText::new(why).weak());
-                    });
-            });
+        let title = "A hand-eye guess is needed: these poses give none";
+        boxed(ui, colour, title, |ui| {
+            let what = "Give x y z (mm) and roll pitch yaw (deg) of the sensor on the flange, or a file, below; the calibration refines it.";
+            ui.label(RichText::new(what).strong());
+            scrolled_text(
+                ui,
+                "import_guess_why",
+                WHY_HEIGHT,
+                RichText::new(why).weak(),
+            );
+        });
     }
     ui.horizontal_wrapped(|ui| {
         ui.radio_value(

@@ -18,9 +18,10 @@ use crate::app::dialog::Purpose;
 use crate::app::import::form::{CONVENTIONS, ImportForm, LogKind, ObservationKind, ProfilesKind};
 use crate::app::job::Slot;
 use crate::app::widgets::{
-    BAD, DEFAULT_RANGE, GOOD, PATH_WIDTH, WARN, labelled_field, path_row, range_fields, range_of,
+    BAD, DEFAULT_RANGE, GOOD, PATH_WIDTH, WARN, boxed, choice, labelled_field, path_row, preset_ui,
+    range_fields, range_of, scrolled_text,
 };
-use crate::engine::base::robot::{self, DhConvention};
+use crate::engine::base::robot::DhConvention;
 use crate::engine::files::import::{AngleUnit, LengthUnit, SideChoice};
 
 /// Largest height of the import's error above the form, points: a long
@@ -29,20 +30,11 @@ const ERROR_HEIGHT: f32 = 90.0;
 /// Width of a column-name field, points.
 const COLUMN_WIDTH: f32 = 90.0;
 
-/// The whole Import view.
+/// The whole Import view. An edit makes the preview, the last outcome
+/// and the checks stale (the ledger clears them); a pose file that reads
+/// otherwise than at the last scan is read and paired again (the ledger
+/// asks for it).
 pub fn import_ui(
-    ui: &mut egui::Ui,
-    state: &AppState,
-    forms: &mut Forms,
-    commands: &mut Vec<Command>,
-) {
-    // An edit makes the preview, the last outcome and the checks stale
-    // (the ledger clears them); a pose file that reads otherwise than at
-    // the last scan is read and paired again (the ledger asks for it).
-    import_form_ui(ui, state, forms, commands);
-}
-
-fn import_form_ui(
     ui: &mut egui::Ui,
     state: &AppState,
     forms: &mut Forms,
@@ -154,26 +146,17 @@ fn actions_ui(
         }
     });
     if let Some(Err(e)) = &state.import.outcome {
-        egui::Frame::group(ui.style())
-            .stroke(egui::Stroke::new(1.5, BAD))
-            .show(ui, |ui| {
-                ui.set_width(ui.available_width());
-                ui.label(RichText::new("The import failed").strong().color(BAD));
-                if state.import.guess_needed.is_some() {
-                    ui.label(
-                        RichText::new(
-                            "A hand-eye guess is needed: give one under \"Initial hand-eye\" below (numbers or a file).",
-                        )
-                        .strong(),
-                    );
-                }
-                egui::ScrollArea::vertical()
-                    .id_salt("import_error")
-                    .max_height(ERROR_HEIGHT)
-                    .show(ui, |ui| {
-                        ui.label(e);
-                    });
-            });
+        boxed(ui, BAD, "The import failed", |ui| {
+            if state.import.guess_needed.is_some() {
+                ui.label(
+                    RichText::new(
+                        "A hand-eye guess is needed: give one under \"Initial hand-eye\" below (numbers or a file).",
+                    )
+                    .strong(),
+                );
+            }
+            scrolled_text(ui, "import_error", ERROR_HEIGHT, e);
+        });
     }
 }
 
@@ -285,19 +268,7 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
             ui.horizontal(|ui| {
                 let from_file = !f.robot_file.trim().is_empty();
                 ui.add_enabled_ui(!from_file, |ui| {
-                    egui::ComboBox::from_id_salt("import_robot_preset")
-                        .selected_text(&f.robot_preset)
-                        .show_ui(ui, |ui| {
-                            for p in robot::presets() {
-                                ui.selectable_value(
-                                    &mut f.robot_preset,
-                                    p.key.to_string(),
-                                    format!("{} ({})", p.key, p.robot.name),
-                                );
-                            }
-                        })
-                        .response
-                        .labelled_by(l.id);
+                    preset_ui(ui, "import_robot_preset", &mut f.robot_preset).labelled_by(l.id);
                 });
                 labelled_field(
                     ui,
@@ -457,22 +428,11 @@ fn column_field(ui: &mut egui::Ui, label: &str, value: &mut String, header: &[St
 fn flange_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
     ui.label(RichText::new("4 · Flange poses from the controller (optional)").strong());
     ui.horizontal(|ui| {
-        let text = f
-            .flange
-            .and_then(|c| CONVENTIONS.iter().find(|(k, _)| *k == c))
-            .map_or("no check", |(_, l)| l);
-        egui::ComboBox::from_id_salt("import_flange")
-            .selected_text(text)
-            .show_ui(ui, |ui| {
-                ui.selectable_value(&mut f.flange, None, "no check");
-                for (c, l) in CONVENTIONS {
-                    ui.selectable_value(&mut f.flange, Some(c), l);
-                }
-            })
-            .response
-            .on_hover_text(
-                "compare the controller's flange poses with the nominal model's forward kinematics",
-            );
+        let conventions = CONVENTIONS.map(|(c, l)| (Some(c), l.to_string()));
+        let options = std::iter::once((None, "no check".to_string())).chain(conventions);
+        choice(ui, "", "import_flange", &mut f.flange, options).on_hover_text(
+            "compare the controller's flange poses with the nominal model's forward kinematics",
+        );
         if let Some(c) = f.flange {
             labelled_field(
                 ui,

@@ -23,7 +23,7 @@ use crate::app::measure::job::MeasuredCloud;
 use crate::app::measure::job::{DRAWN_MAX, group, has_covariance};
 use crate::app::measure::{MAX_SENSOR_NOISE_MM, RawLog, ScanChoice};
 use crate::app::widgets::{
-    AFTER, BAD, GOOD, MUTED, WARN, labelled_field, number_field, stale_banner_ui,
+    AFTER, BAD, GOOD, MUTED, WARN, choice, labelled_field, number_field, stale_banner_ui,
 };
 use crate::engine::base::session::Use;
 use crate::engine::files::import::{AngleUnit, LengthUnit};
@@ -116,7 +116,6 @@ pub fn measure_ui(
         });
 }
 
-/// A path field with its Browse… button and the note when the dialog
 /// A path field with its Browse… button (the note when a dialog chose
 /// nothing is under the scan's fields).
 fn path_row(
@@ -234,17 +233,9 @@ fn scan_ui(
             ui.radio_value(&mut form.choice, choice, choice.label());
         }
         if form.choice != ScanChoice::RawScan {
-            let l = ui.label("  use");
-            egui::ComboBox::from_id_salt("measure_use")
-                .selected_text(form.usage.map_or("all", Use::as_str))
-                .show_ui(ui, |ui| {
-                    ui.selectable_value(&mut form.usage, None, "all");
-                    for u in Use::ALL {
-                        ui.selectable_value(&mut form.usage, Some(u), u.as_str());
-                    }
-                })
-                .response
-                .labelled_by(l.id)
+            let uses = Use::ALL.map(|u| (Some(u), u.as_str().to_string()));
+            let options = std::iter::once((None, "all".to_string())).chain(uses);
+            choice(ui, "  use", "measure_use", &mut form.usage, options)
                 .on_hover_text("which measurements of the session are measured (as --use)");
         }
     });
@@ -336,49 +327,18 @@ fn raw_units_ui(ui: &mut egui::Ui, form: &mut crate::app::measure::MeasureForm) 
     ui.horizontal_wrapped(|ui| {
         match form.raw_log {
             RawLog::Joints => {
-                let l = ui.label("joints in");
-                egui::ComboBox::from_id_salt("measure_joint_unit")
-                    .selected_text(form.joint_unit.as_str())
-                    .show_ui(ui, |ui| {
-                        for u in [AngleUnit::Deg, AngleUnit::Rad] {
-                            ui.selectable_value(&mut form.joint_unit, u, u.as_str());
-                        }
-                    })
-                    .response
-                    .labelled_by(l.id);
+                let units = [AngleUnit::Deg, AngleUnit::Rad].map(|u| (u, u.as_str().to_string()));
+                choice(ui, "joints in", "measure_joint_unit", &mut form.joint_unit, units);
             }
             RawLog::Poses => {
-                let l = ui.label("pose convention");
-                let shown = CONVENTIONS
-                    .iter()
-                    .find(|(c, _)| Some(*c) == form.pose_convention)
-                    .map_or("as the file says", |(_, t)| t);
-                egui::ComboBox::from_id_salt("measure_convention")
-                    .selected_text(shown)
-                    .show_ui(ui, |ui| {
-                        ui.selectable_value(
-                            &mut form.pose_convention,
-                            None,
-                            "as the file says",
-                        );
-                        for (c, t) in CONVENTIONS {
-                            ui.selectable_value(&mut form.pose_convention, Some(c), t);
-                        }
-                    })
-                    .response
-                    .labelled_by(l.id);
+                let conventions = CONVENTIONS.map(|(c, t)| (Some(c), t.to_string()));
+                let options = std::iter::once((None, "as the file says".to_string()));
+                let (value, id) = (&mut form.pose_convention, "measure_convention");
+                choice(ui, "pose convention", id, value, options.chain(conventions));
             }
         }
-        let l = ui.label("profiles in");
-        egui::ComboBox::from_id_salt("measure_profile_unit")
-            .selected_text(form.profile_unit.as_str())
-            .show_ui(ui, |ui| {
-                for u in [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M] {
-                    ui.selectable_value(&mut form.profile_unit, u, u.as_str());
-                }
-            })
-            .response
-            .labelled_by(l.id);
+        let units = [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M].map(|u| (u, u.as_str().to_string()));
+        choice(ui, "profiles in", "measure_profile_unit", &mut form.profile_unit, units);
         labelled_field(ui, "axes", &mut form.axes, "auto or -y,x,z", 70.0);
         labelled_field(ui, "no-return value", &mut form.no_return, "none", 60.0);
         labelled_field(

@@ -10,15 +10,16 @@ use crate::engine::base::robot::RobotChoice;
 use crate::engine::base::session::Session;
 use crate::engine::calibrate::solve::Control;
 use crate::engine::tools::plan::{
-    self, Plan, PlanConfig, PlanError, PlanStage, PredictConfig, RequestError,
+    self, Plan, PlanConfig, PlanError, PlanProgress, PlanStage, Planned, PredictConfig,
+    RequestError,
 };
 use crate::engine::tools::simulate::{self, PlanExecution, SimConfig};
 
-use super::PlanOutcome;
 use crate::app::error::JobError;
 
-/// Plans and predicts, reporting each stage in words; `cancel` stops at
-/// the next stage or prediction run.
+/// Plans and predicts ([`plan::plan_and_predict`], as `spherecal plan`),
+/// reporting each stage in words; `cancel` stops at the next stage or
+/// prediction run.
 ///
 /// # Errors
 /// The planner's error ([`PlanError::Cancelled`] after a cancel, also
@@ -29,46 +30,34 @@ pub fn make_plan(
     runs: usize,
     cancel: &AtomicBool,
     report: &mut dyn FnMut(String, Option<f64>),
-) -> Result<PlanOutcome, PlanError> {
-    let control = || {
+) -> Result<Planned, PlanError> {
+    // The candidates take most of the planning; a prediction, when
+    // asked for, the second half of the bar.
+    let share = if runs > 0 { 0.5 } else { 1.0 };
+    let predict = (runs > 0).then(|| PredictConfig {
+        runs,
+        ..PredictConfig::default()
+    });
+    plan::plan_and_predict(config, predict.as_ref(), &mut |progress| {
+        match progress {
+            PlanProgress::Stage(stage) => {
+                let done = match stage {
+                    PlanStage::Candidates { done, of } => 0.8 * done as f64 / of.max(1) as f64,
+                    _ => 0.9,
+                };
+                report(stage_text(stage), Some(share * done));
+            }
+            PlanProgress::Planned(_) => {}
+            PlanProgress::Predicting { done, of } => report(
+                format!("predicting the accuracy: {done} of {of} simulated calibrations"),
+                Some(0.5 + 0.5 * done as f64 / of.max(1) as f64),
+            ),
+        }
         if cancel.load(Ordering::Relaxed) {
             Control::Cancel
         } else {
             Control::Continue
         }
-    };
-    // The candidates take most of the planning; a prediction, when
-    // asked for, the second half of the bar.
-    let share = if runs > 0 { 0.5 } else { 1.0 };
-    let plan = plan::plan(config, &mut |stage| {
-        let done = match stage {
-            PlanStage::Candidates { done, of } => 0.8 * done as f64 / of.max(1) as f64,
-            _ => 0.9,
-        };
-        report(stage_text(stage), Some(share * done));
-        control()
-    })?;
-    let prediction = (runs > 0).then(|| {
-        let predict = PredictConfig {
-            runs,
-            ..PredictConfig::default()
-        };
-        plan::predict(&plan, &predict, &mut |done, of| {
-            report(
-                format!("predicting the accuracy: {done} of {of} simulated calibrations"),
-                Some(0.5 + 0.5 * done as f64 / of.max(1) as f64),
-            );
-            control()
-        })
-    });
-    if let Some(Err(e)) = &prediction
-        && cancel.load(Ordering::Relaxed)
-    {
-        return Err(e.clone());
-    }
-    Ok(PlanOutcome {
-        plan: Box::new(plan),
-        prediction,
     })
 }
 

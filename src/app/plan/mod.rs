@@ -13,7 +13,7 @@ use nalgebra::Isometry3;
 
 use crate::engine::base::session::Use;
 use crate::engine::files::format::write_atomic;
-use crate::engine::tools::plan::{self, Plan, PlanError, Prediction};
+use crate::engine::tools::plan::{self, Plan, PlanError, Planned};
 
 use super::command::{Command, PlanCommand, PlanExport, Tab};
 use super::error::JobError;
@@ -26,20 +26,11 @@ use super::{AppState, Core, Write};
 use form::PlanForm;
 use job::{make_plan, simulate_plan};
 
-/// A finished plan.
-#[derive(Debug, Clone)]
-pub struct PlanOutcome {
-    /// The plan.
-    pub plan: Box<Plan>,
-    /// The predicted accuracy, when asked for, or why it failed.
-    pub prediction: Option<Result<Prediction, PlanError>>,
-}
-
 /// What the Plan view shows.
 #[derive(Debug, Default)]
 pub struct PlanView {
     /// The last plan, or why planning failed (the message).
-    pub outcome: Option<Result<PlanOutcome, String>>,
+    pub outcome: Option<Result<Planned, String>>,
 }
 
 /// The planner's error in the Plan view's words.
@@ -175,7 +166,7 @@ impl Core {
 
     /// The planner's answer: the plan on show (recorded with the inputs
     /// it started from), or why there is none.
-    pub(super) fn on_plan(&mut self, job: &Job, outcome: Result<PlanOutcome, JobError>) {
+    pub(super) fn on_plan(&mut self, job: &Job, outcome: Result<Planned, JobError>) {
         match &outcome {
             Ok(o) => {
                 let what = format!(

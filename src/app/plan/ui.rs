@@ -13,13 +13,12 @@ use crate::app::command::{Command, PlanCommand};
 use crate::app::dialog::Purpose;
 use crate::app::job::Slot;
 use crate::app::ledger::{Artefact, Stale};
-use crate::app::plan::PlanOutcome;
 use crate::app::widgets::{
-    AFTER, BAD, BEFORE, DEFAULT_RANGE, MUTED, labelled_field, range_fields, range_of, range_values,
+    AFTER, BAD, BEFORE, DEFAULT_RANGE, MUTED, export_folder_ui, preset_ui, range_fields, range_of,
+    range_values,
 };
 use crate::app::{Forms, plan::form::default_sphere};
-use crate::engine::base::robot;
-use crate::engine::tools::plan::{Plan, PlanStats, StationRole};
+use crate::engine::tools::plan::{Plan, PlanStats, Planned, StationRole};
 
 /// Width of the settings column, points.
 const FORM_WIDTH: f32 = 330.0;
@@ -80,19 +79,7 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
         .show(ui, |ui| {
             let l = ui.label("Robot");
             let before = f.robot.clone();
-            egui::ComboBox::from_id_salt("plan_robot")
-                .selected_text(&f.robot)
-                .show_ui(ui, |ui| {
-                    for p in robot::presets() {
-                        ui.selectable_value(
-                            &mut f.robot,
-                            p.key.to_string(),
-                            format!("{} ({})", p.key, p.robot.name),
-                        );
-                    }
-                })
-                .response
-                .labelled_by(l.id);
+            preset_ui(ui, "plan_robot", &mut f.robot).labelled_by(l.id);
             if f.robot != before {
                 f.request.design.sphere = default_sphere(&f.robot);
             }
@@ -196,7 +183,7 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
 
 /// The predicted validation std after calibration (simulated
 /// calibrations of the plan), or why there is none.
-fn prediction_ui(ui: &mut egui::Ui, o: &PlanOutcome) {
+fn prediction_ui(ui: &mut egui::Ui, o: &Planned) {
     match &o.prediction {
         Some(Ok(p)) => {
             ui.label(
@@ -330,16 +317,7 @@ fn export_ui(
     );
     let busy = state.jobs.writing() || state.jobs.runs(&Slot::Simulate);
     ui.horizontal_wrapped(|ui| {
-        labelled_field(
-            ui,
-            "Write to folder",
-            &mut forms.export_dir,
-            "/path/to/folder",
-            240.0,
-        );
-        if ui.button("Browse…").clicked() {
-            commands.push(Command::Browse(Purpose::ExportFolder));
-        }
+        export_folder_ui(ui, "Write to folder", &mut forms.export_dir, 240.0, commands);
         let robot_name = crate::engine::base::robot::presets::preset(&forms.plan.robot)
             .map(|p| p.robot.name)
             .unwrap_or_default();
@@ -390,7 +368,7 @@ fn outcome_ui(
     ui: &mut egui::Ui,
     state: &AppState,
     forms: &mut Forms,
-    o: &PlanOutcome,
+    o: &Planned,
     commands: &mut Vec<Command>,
 ) {
     let plan = &o.plan;

@@ -6,18 +6,17 @@
 //! export-model`). Every file is written atomically by the engine's
 //! [`write_atomic`], on a job thread.
 
-use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::SystemTime;
 
 use crate::engine::base::session::Session;
-use crate::engine::base::table::csv_field;
 use crate::engine::calibrate::solve::Analysis;
 use crate::engine::files::format::{result_text_checked, write_atomic};
 use crate::engine::tools::report::html::{self, ReportInput, ReportMeta};
 use crate::engine::tools::report::model::{self, ModelFormat};
 use crate::engine::tools::report::sheet::{self, SheetInput};
+use crate::engine::tools::report::tables;
 use crate::engine::tools::result_view::{self, Tolerance};
 
 use crate::app::command::Command;
@@ -28,69 +27,6 @@ use crate::app::results::{ResultOrigin, ResultView};
 use crate::app::state::Level;
 use crate::app::{Core, Write};
 
-/// CSV of every sphere centre: sensor frame and base frame before and
-/// after, mm.
-#[must_use]
-pub fn centres_csv(view: &ResultView) -> String {
-    let mut s = String::from(
-        "measurement,station,use,sensor_x_mm,sensor_y_mm,sensor_z_mm,before_x_mm,before_y_mm,before_z_mm,after_x_mm,after_y_mm,after_z_mm\n",
-    );
-    for c in &view.file.centres {
-        let _ = write!(
-            s,
-            "{},{},{}",
-            csv_field(&c.measurement),
-            csv_field(&c.station),
-            c.usage.as_str()
-        );
-        for v in c.sensor.iter().chain(&c.before).chain(&c.after) {
-            let _ = write!(s, ",{v}");
-        }
-        s.push('\n');
-    }
-    s
-}
-
-/// CSV of the distance errors: the reference distances (paper Fig. 6,
-/// `kind` = `reference`, error = measured − reference) and the
-/// within-station centre distances (Fig. 5, `kind` = `within_station`,
-/// reference 0), mm.
-#[must_use]
-pub fn distances_csv(view: &ResultView) -> String {
-    let mut s = String::from(
-        "kind,from,to,pose,reference_mm,before_mm,after_mm,error_before_mm,error_after_mm\n",
-    );
-    for d in &view.shown.distances {
-        let _ = writeln!(
-            s,
-            "reference,{},{},{},{},{},{},{},{}",
-            csv_field(&d.from),
-            csv_field(&d.to),
-            d.pose,
-            d.reference,
-            d.before,
-            d.after,
-            d.error_before(),
-            d.error_after()
-        );
-    }
-    for p in &view.shown.within {
-        let _ = writeln!(
-            s,
-            "within_station,{},{},{}/{},0,{},{},{},{}",
-            csv_field(&p.station),
-            csv_field(&p.station),
-            csv_field(&p.ids.0),
-            csv_field(&p.ids.1),
-            p.before,
-            p.after,
-            p.before,
-            p.after
-        );
-    }
-    s
-}
-
 /// Writes a text export of `view` to `path` atomically.
 ///
 /// # Errors
@@ -99,8 +35,8 @@ pub fn distances_csv(view: &ResultView) -> String {
 pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<(), JobError> {
     let text = match kind {
         ExportKind::ResultJson => result_text_checked(&view.file, path)?,
-        ExportKind::CentresCsv => centres_csv(view),
-        ExportKind::DistancesCsv => distances_csv(view),
+        ExportKind::CentresCsv => tables::centres_csv(&view.file),
+        ExportKind::DistancesCsv => tables::distances_csv(&view.shown),
         ExportKind::PlotsPng => return write_plots_png(view, path),
         ExportKind::ReportHtml => {
             return Err(JobError::Missing("a report needs its session".to_string()));

@@ -39,11 +39,7 @@ pub(super) fn after_fail_ui(
         .map(|m| m.outliers.as_slice())
         .unwrap_or_default();
     let running = state.jobs.runs(&crate::app::job::Slot::Run);
-    let response = egui::Frame::group(ui.style())
-        .stroke(egui::Stroke::new(1.5, BAD))
-        .show(ui, |ui| {
-            ui.set_width(ui.available_width());
-            ui.label(RichText::new(AFTER_FAIL_TITLE).strong().color(BAD));
+    let response = crate::app::widgets::boxed(ui, BAD, AFTER_FAIL_TITLE, |ui| {
             ui.label(format!(
                 "The validation is beyond the tolerance ({}).",
                 reasons.join(", ")

@@ -23,7 +23,7 @@ use crate::app::dialog::Purpose;
 use crate::app::ledger::{Artefact, Stale};
 use crate::app::results::{ResultOrigin, ResultView};
 use crate::app::widgets::{
-    AFTER, BAD, GOOD, MUTED, WARN, labelled_field, number_field, ratio_text,
+    AFTER, BAD, GOOD, MUTED, WARN, export_folder_ui, number_field, ratio_text,
 };
 use crate::engine::tools::result_view::Verdict;
 
@@ -250,20 +250,7 @@ fn export_ui(
     commands: &mut Vec<Command>,
 ) {
     ui.horizontal_wrapped(|ui| {
-        labelled_field(
-            ui,
-            "Export to folder",
-            &mut forms.export_dir,
-            "/path/to/folder",
-            220.0,
-        );
-        if ui
-            .button("Browse…")
-            .on_hover_text("choose the folder with the desktop's dialog")
-            .clicked()
-        {
-            commands.push(Command::Browse(Purpose::ExportFolder));
-        }
+        export_folder_ui(ui, "Export to folder", &mut forms.export_dir, 220.0, commands);
         ui.separator();
         let hand_eye_only = state
             .result

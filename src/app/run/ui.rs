@@ -7,7 +7,7 @@ use egui::{RichText, Vec2};
 use crate::app::command::{Command, RunCommand};
 use crate::app::job::Slot;
 use crate::app::ledger::Artefact;
-use crate::app::widgets::{BAD, plots::epsilon_plot_ui};
+use crate::app::widgets::{BAD, choice, plots::epsilon_plot_ui};
 use crate::app::{AppState, Forms};
 use crate::engine::calibrate::solve::Method;
 use crate::engine::calibrate::solve::paper::Pairing;
@@ -124,15 +124,8 @@ fn settings_ui(ui: &mut egui::Ui, forms: &mut Forms) {
         .num_columns(2)
         .spacing([8.0, 6.0])
         .show(ui, |ui| {
-            ui.label("Method");
-            egui::ComboBox::from_id_salt("method")
-                .selected_text(s.method.as_str())
-                .show_ui(ui, |ui| {
-                    for m in Method::ALL {
-                        ui.selectable_value(&mut s.method, m, m.as_str());
-                    }
-                })
-                .response
+            let methods = Method::ALL.map(|m| (m, m.as_str().to_string()));
+            choice(ui, "Method", "method", &mut s.method, methods)
                 .on_hover_text("identification method");
             ui.end_row();
             let paper = s.method == Method::Paper;

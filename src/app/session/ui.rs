@@ -12,7 +12,7 @@ use crate::app::command::{Command, FilesCommand, ViewCommand};
 use crate::app::dialog::{NO_DIALOG, Purpose};
 use crate::app::job::Slot;
 use crate::app::widgets::{
-    BAD, DEFAULT_RANGE, MUTED, WARN, labelled_field, range_fields, range_of, range_values,
+    BAD, DEFAULT_RANGE, MUTED, WARN, choice, labelled_field, range_fields, range_of, range_values,
 };
 use crate::app::{AppState, Forms};
 use crate::engine::base::session::Use;
@@ -130,38 +130,21 @@ fn filters_ui(
     commands: &mut Vec<Command>,
 ) {
     ui.horizontal_wrapped(|ui| {
-        ui.label("Station");
-        egui::ComboBox::from_id_salt("filter_station")
-            .selected_text(forms.filter_station.clone().unwrap_or_else(|| "all".into()))
-            .show_ui(ui, |ui| {
-                ui.selectable_value(&mut forms.filter_station, None, "all");
-                for s in loaded.station_ids() {
-                    let text = s.clone();
-                    ui.selectable_value(&mut forms.filter_station, Some(s), text);
-                }
-            })
-            .response
-            .on_hover_text("show one station only");
-        ui.label("Use");
-        egui::ComboBox::from_id_salt("filter_use")
-            .selected_text(forms.filter_use.map_or("all", Use::as_str))
-            .show_ui(ui, |ui| {
-                ui.selectable_value(&mut forms.filter_use, None, "all");
-                for u in Use::ALL {
-                    ui.selectable_value(&mut forms.filter_use, Some(u), u.as_str());
-                }
-            })
-            .response
+        // Each filter offers "all" first.
+        let all = "all".to_string();
+        let stations = loaded
+            .station_ids()
+            .into_iter()
+            .map(|s| (Some(s.clone()), s));
+        let options = std::iter::once((None, all.clone())).chain(stations);
+        let (value, id) = (&mut forms.filter_station, "filter_station");
+        choice(ui, "Station", id, value, options).on_hover_text("show one station only");
+        let uses = Use::ALL.map(|u| (Some(u), u.as_str().to_string()));
+        let options = std::iter::once((None, all)).chain(uses);
+        choice(ui, "Use", "filter_use", &mut forms.filter_use, options)
             .on_hover_text("show one use only");
-        ui.label("Group by");
-        egui::ComboBox::from_id_salt("group")
-            .selected_text(forms.group.label())
-            .show_ui(ui, |ui| {
-                for g in Grouping::ALL {
-                    ui.selectable_value(&mut forms.group, g, g.label());
-                }
-            })
-            .response
+        let groupings = Grouping::ALL.map(|g| (g, g.label().to_string()));
+        choice(ui, "Group by", "group", &mut forms.group, groupings)
             .on_hover_text("group the rows");
         let problems = loaded.analysis.failures().count() + loaded.analysis.warnings.len();
         ui.checkbox(
@@ -606,15 +589,12 @@ fn name_ui(ui: &mut egui::Ui, name: &str) {
 pub fn notice_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
     if let Some(notice) = &state.notice {
         ui.add_space(6.0);
-        egui::Frame::group(ui.style())
-            .stroke(egui::Stroke::new(1.5, BAD))
-            .show(ui, |ui| {
-                ui.label(RichText::new(&notice.title).strong().color(BAD));
-                ui.label(&notice.body);
-                if ui.button("Dismiss").clicked() {
-                    commands.push(Command::View(ViewCommand::DismissNotice));
-                }
-            });
+        crate::app::widgets::boxed(ui, BAD, &notice.title, |ui| {
+            ui.label(&notice.body);
+            if ui.button("Dismiss").clicked() {
+                commands.push(Command::View(ViewCommand::DismissNotice));
+            }
+        });
     }
 }
 

@@ -1,8 +1,10 @@
 //! The widgets every view shares: colours and station markers, labelled
-//! text and number fields, path rows with their Browse… button and the
-//! note when a dialog chose nothing, a job's phase and fraction, the
-//! STALE banner, the Replace / Keep question, the tabs, the status bar,
-//! measuring-range fields; plot helpers in [`plots`].
+//! text and number fields, labelled drop-downs and the robot presets',
+//! path rows with their Browse… button and the note when a dialog chose
+//! nothing, the export folder, a job's phase and fraction, the STALE
+//! banner, framed boxes (a failure, a notice), the Replace / Keep
+//! question, the tabs, the status bar, measuring-range fields; plot
+//! helpers in [`plots`].
 
 pub mod plots;
 
@@ -103,6 +105,51 @@ pub fn labelled_field(
             .desired_width(width),
     )
     .labelled_by(l.id)
+}
+
+/// A drop-down that sets `value` to one of `options` (each with its
+/// text, the chosen one's shown), after the label `label` tied to it
+/// (screen readers and the UI tests find it by that label; none when
+/// empty).
+pub fn choice<T: PartialEq>(
+    ui: &mut egui::Ui,
+    label: &str,
+    id_salt: &str,
+    value: &mut T,
+    options: impl IntoIterator<Item = (T, String)>,
+) -> egui::Response {
+    let l = (!label.is_empty()).then(|| ui.label(label));
+    let options: Vec<(T, String)> = options.into_iter().collect();
+    let shown = options
+        .iter()
+        .find(|(v, _)| v == value)
+        .map_or_else(String::new, |(_, t)| t.clone());
+    let response = egui::ComboBox::from_id_salt(id_salt)
+        .selected_text(shown)
+        .show_ui(ui, |ui| {
+            for (v, t) in options {
+                ui.selectable_value(value, v, t);
+            }
+        })
+        .response;
+    match l {
+        Some(l) => response.labelled_by(l.id),
+        None => response,
+    }
+}
+
+/// The robot presets to choose from, each as `key (name)`, the key
+/// shown: returns the drop-down's response (to tie a label to it).
+pub fn preset_ui(ui: &mut egui::Ui, id_salt: &str, key: &mut String) -> egui::Response {
+    egui::ComboBox::from_id_salt(id_salt)
+        .selected_text(key.as_str())
+        .show_ui(ui, |ui| {
+            for p in crate::engine::base::robot::presets() {
+                let text = format!("{} ({})", p.key, p.robot.name);
+                ui.selectable_value(key, p.key.to_string(), text);
+            }
+        })
+        .response
 }
 
 /// A number that is typed, never dragged (a sideways drag over it
@@ -230,6 +277,57 @@ pub fn stale_banner_ui(ui: &mut egui::Ui, stale: &crate::app::ledger::Stale, tod
                 );
             });
         });
+}
+
+/// A box framed in `colour` with its `title` in that colour (a failure,
+/// a notice, what to do next) above what `add` draws.
+pub fn boxed<R>(
+    ui: &mut egui::Ui,
+    colour: Color32,
+    title: &str,
+    add: impl FnOnce(&mut egui::Ui) -> R,
+) -> egui::InnerResponse<R> {
+    egui::Frame::group(ui.style())
+        .stroke(egui::Stroke::new(1.5, colour))
+        .show(ui, |ui| {
+            ui.set_width(ui.available_width());
+            ui.label(RichText::new(title).strong().color(colour));
+            add(ui)
+        })
+}
+
+/// A long text (an error, a why) that scrolls past `max_height` points
+/// rather than push what follows off the screen.
+pub fn scrolled_text(
+    ui: &mut egui::Ui,
+    id: &str,
+    max_height: f32,
+    text: impl Into<egui::WidgetText>,
+) {
+    egui::ScrollArea::vertical()
+        .id_salt(id)
+        .max_height(max_height)
+        .show(ui, |ui| {
+            ui.label(text);
+        });
+}
+
+/// The folder field the exports are written to, with its Browse… button.
+pub fn export_folder_ui(
+    ui: &mut egui::Ui,
+    label: &str,
+    folder: &mut String,
+    width: f32,
+    commands: &mut Vec<Command>,
+) {
+    labelled_field(ui, label, folder, "/path/to/folder", width);
+    if ui
+        .button("Browse…")
+        .on_hover_text("choose the folder with the desktop's dialog")
+        .clicked()
+    {
+        commands.push(Command::Browse(Purpose::ExportFolder));
+    }
 }
 
 /// A plot's key on one line above it, each entry in its series' colour

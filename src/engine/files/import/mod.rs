@@ -19,7 +19,8 @@
 //!
 //! A long import tells its stage ([`progress`]: each profile read, the side
 //! decision, the check) through [`import_with`] and [`import_poses_with`],
-//! and stops when the callback cancels.
+//! and stops when the callback cancels. [`entry`] is the one entry the
+//! command line and the workbench both call.
 //!
 //! CSV files are read with the `csv` crate
 //! ([`Table`](crate::engine::base::table::Table)): a UTF-8 byte-order
@@ -28,6 +29,7 @@
 //! the file.
 
 pub mod check;
+pub mod entry;
 mod csv_file;
 pub mod initial;
 pub mod log;
@@ -47,6 +49,7 @@ use std::path::{Path, PathBuf};
 pub use self::check::{
     DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG, FlangeCheck, PoseCheck,
 };
+pub use self::entry::{ImportRequest, PoseLog, import_session, preview_joint_log};
 pub use self::log::{ColumnMap, DEFAULT_SIDE_COLUMN, header, preview};
 pub use self::poses::{
     Observations, PoseImportSpec, PoseInputs, SideChoice, build_pose_session, read_pose_inputs,

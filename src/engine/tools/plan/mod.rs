@@ -70,7 +70,8 @@
 //!    covariance), the condition number of the whitened Jacobian, the
 //!    criterion against a random selection of the same size from the same
 //!    candidates, and the path length. [`predict`] simulates the plan on
-//!    randomly perturbed robots and calibrates each run.
+//!    randomly perturbed robots and calibrates each run; [`entry`] is the
+//!    one entry of both that the command line and the workbench call.
 //!
 //! # Exports
 //!
@@ -97,6 +98,7 @@ use crate::engine::tools::simulate::{PlanPose, SimError};
 
 mod candidates;
 mod config;
+pub mod entry;
 mod export;
 mod order;
 mod predict;
@@ -116,6 +118,7 @@ pub use config::{
     DEFAULT_ROTATION_MIN_DEG, DEFAULT_TRANSLATION_STEP_MM, MAX_CANDIDATES, MAX_GROUP_POSES,
     MAX_ORIENTATIONS, MAX_STATIONS, PlanConfig, PlanDesign, Selection, StationLayout, defaults,
 };
+pub use entry::{PlanProgress, Planned, plan_and_predict};
 pub use export::{
     PROGRAMS, RAPID_MODULE, parse_program, plan_csv, program_controller, rapid_module,
     read_plan_csv, render_program, ur_script,

@@ -7,8 +7,10 @@
 //! planner read these; none of them looks into the solver block itself.
 //! Also here: whether a result belongs to a session, and how well a
 //! hand-eye-only result determined the hand-eye ([`strength`]), and the
-//! PASS/FAIL verdict against an acceptance tolerance ([`verdict`]).
+//! PASS/FAIL verdict against an acceptance tolerance ([`verdict`]); the
+//! centres by station and the sets of errors before and after ([`sets`]).
 
+pub mod sets;
 pub mod strength;
 pub mod verdict;
 
@@ -23,6 +25,7 @@ use crate::engine::calibrate::validate::{
     BeforeAfter, DistanceRecord, Stats, scatter_rms, within_station_distances,
 };
 use crate::engine::files::format::result::{CentreRecord, ResultFile};
+pub use sets::{CALIBRATION_SET, CentrePoint, CentreSet, ErrorSet, Summary, VALIDATION_SET};
 pub use strength::{HAND_EYE_ONLY, HandEyeStrength, flange_poses, hand_eye_only_lines};
 pub use verdict::{Tolerance, Verdict};
 

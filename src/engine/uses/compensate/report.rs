@@ -4,6 +4,8 @@
 
 use std::fmt::Write as _;
 
+use nalgebra::Isometry3;
+
 use super::TargetReport;
 use crate::engine::base::robot::controller::Controller;
 use crate::engine::base::robot::controller::FlangeConvention;
@@ -109,8 +111,7 @@ impl Summary {
 /// identify pose, flags. At most `limit` rows (all with `None`).
 #[must_use]
 pub fn table(targets: &[TargetReport], limit: Option<usize>) -> String {
-    let mut rows: Vec<&TargetReport> = targets.iter().collect();
-    rows.sort_by(|a, b| b.correction_mm.total_cmp(&a.correction_mm));
+    let rows = largest_first(targets);
     let shown = limit.unwrap_or(rows.len()).min(rows.len());
     let mut s = String::new();
     let _ = writeln!(
@@ -192,6 +193,33 @@ pub fn tool_controllers(file: &PoseFile, convention: Option<FlangeConvention>) -
         Some(Some(c)) => vec![c],
         _ => Controller::ALL.to_vec(),
     }
+}
+
+/// The targets, largest position correction first (the order of the
+/// command line's table and the workbench's).
+#[must_use]
+pub fn largest_first(targets: &[TargetReport]) -> Vec<&TargetReport> {
+    let mut rows: Vec<&TargetReport> = targets.iter().collect();
+    rows.sort_by(|a, b| b.correction_mm.total_cmp(&a.correction_mm));
+    rows
+}
+
+/// Name of the tool in the tool data (RAPID's `tooldata` name).
+pub const TOOL_NAME: &str = "tSpherecal";
+
+/// The tool data to set on the controller for the TCP `flange_from_tcp`
+/// ([`TOOL_NAME`]), for each controller of [`tool_controllers`]: the kind
+/// of data and its text.
+#[must_use]
+pub fn tool_data(
+    file: &PoseFile,
+    convention: Option<FlangeConvention>,
+    flange_from_tcp: &Isometry3<f64>,
+) -> Vec<(&'static str, String)> {
+    tool_controllers(file, convention)
+        .into_iter()
+        .map(|c| (c.tool_data_kind(), c.tool_data(flange_from_tcp, TOOL_NAME)))
+        .collect()
 }
 
 /// `name` cut to `n` characters with `…`.
