@@ -107,21 +107,26 @@ pub fn run(args: &CompensateArgs) -> Result<(), CliError> {
         return run_tool_only(args, &result, current);
     }
     if result.hand_eye_only() {
-        let mut message = format!("{} ({})", CompensateError::PoseOnly, args.result.display());
+        // The tool data to install goes to standard output (what the user
+        // copies), the refusal to standard error on one line.
         let file = program::read_pose_file(&args.targets, &read_spec(args)).ok();
         let controllers = file.as_ref().map_or_else(
             || Controller::ALL.to_vec(),
             |f| report::tool_controllers(f, args.pose_convention),
         );
         for c in controllers {
-            message.push_str(&format!("\n{}:\n", c.tool_data_kind()));
-            message.push_str(&c.tool_data_with(
-                &result.hand_eye,
-                report::TOOL_NAME,
-                ToolDigits::Full,
-            ));
+            sayln!("{}:", c.tool_data_kind());
+            sayln!(
+                "{}",
+                c.tool_data_with(&result.hand_eye, report::TOOL_NAME, ToolDigits::Full)
+                    .trim_end()
+            );
         }
-        return Err(CliError::input(message.trim_end().to_string()));
+        return Err(CliError::input(format!(
+            "{} ({})",
+            CompensateError::PoseOnly,
+            args.result.display()
+        )));
     }
     let session = match &args.session {
         Some(p) => Some(format::load_session(p).map_err(|e| CliError::from_file(&e, true))?),

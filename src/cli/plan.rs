@@ -488,6 +488,11 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     }
     for (controller, path) in &programs {
         let what = format!("{} program", controller.key());
+        if let Some(warning) = plan::other_maker_warning(*controller, made)
+            && !quiet
+        {
+            sayln!("{warning}");
+        }
         let text =
             plan::render_program(*controller, made).map_err(|e| CliError::input(e.to_string()))?;
         files.push((path, text, what));

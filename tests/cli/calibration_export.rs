@@ -339,8 +339,9 @@ fn current_tool_rewrites_targets_so_the_calibrated_sensor_reaches_them() {
         "id,x,y,z,w,p,r\nt1,800,100,400,180,0,90\nt2,850,-50,420,175,5,80\nt3,700,0,380,-170,-3,100\n",
     )
     .unwrap();
-    // Without --current-tool: refused, with the tool data to install.
-    let (code, _, err) = spherecal(
+    // Without --current-tool: refused (one line on stderr), with the tool
+    // data to install (stdout).
+    let (code, out, err) = spherecal(
         &[
             "compensate",
             "--result",
@@ -357,10 +358,9 @@ fn current_tool_rewrites_targets_so_the_calibrated_sensor_reaches_them() {
         dir.path(),
     );
     assert_eq!(code, 2, "{err}");
-    assert!(
-        err.contains("pose-only") && err.contains("UTOOL[1]=PR[1]"),
-        "{err}"
-    );
+    assert!(err.contains("pose-only"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(out.contains("UTOOL[1]=PR[1]"), "{out}");
     assert!(!dir.path().join("out.csv").exists());
     // The tool the program was taught with, as FANUC values.
     let current = [2.0, -1.5, 250.0, 179.0, 0.5, -90.0];

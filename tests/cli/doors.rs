@@ -278,10 +278,10 @@ fn an_output_onto_an_old_output_inside_the_profiles_folder_is_written() {
 }
 
 #[test]
-fn plan_rapid_for_a_ur5e_or_urscript_for_an_irb_2400_is_refused() {
+fn plan_rapid_for_a_ur5e_or_urscript_for_an_irb_2400_is_not_written_silently() {
     let dir = tempfile::tempdir().unwrap();
     let module = dir.path().join("plan.mod");
-    let (code, _, err) = run(&[
+    let (code, out, err) = run(&[
         "plan",
         "--robot",
         "ur5e",
@@ -292,15 +292,17 @@ fn plan_rapid_for_a_ur5e_or_urscript_for_an_irb_2400_is_refused() {
         "--rapid",
         p(&module),
     ]);
-    assert_eq!(code, 2, "{err}");
+    assert_eq!(code, 0, "{err}");
     assert!(
-        err.contains("the robot is Universal Robots UR5e, not a robot of ABB"),
-        "{err}"
+        out.contains("warning: the robot is Universal Robots UR5e, not a robot of ABB"),
+        "{out}"
     );
-    assert!(err.contains("write a URScript program for it"), "{err}");
-    assert!(!module.exists());
+    assert!(
+        out.contains("(a URScript program is what it runs)"),
+        "{out}"
+    );
     let script = dir.path().join("plan.script");
-    let (code, _, err) = run(&[
+    let (code, out, err) = run(&[
         "plan",
         "--sphere",
         "1050,0,475",
@@ -309,9 +311,20 @@ fn plan_rapid_for_a_ur5e_or_urscript_for_an_irb_2400_is_refused() {
         "--program",
         &format!("urscript={}", p(&script)),
     ]);
-    assert_eq!(code, 2, "{err}");
-    assert!(err.contains("not a robot of Universal Robots"), "{err}");
-    assert!(!script.exists());
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("not a robot of Universal Robots"), "{out}");
+    // The robot's own program: no warning.
+    let (code, out, err) = run(&[
+        "plan",
+        "--sphere",
+        "1050,0,475",
+        "--predict",
+        "0",
+        "--rapid",
+        p(&module),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!out.contains("warning"), "{out}");
 }
 
 #[test]
@@ -481,4 +494,42 @@ fn wording_an_abb_rapid_module_and_one_pose() {
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(stdout.contains("points of 1 pose ("), "{stdout}");
+}
+
+#[test]
+fn skipped_files_in_a_joint_log_profile_folder_are_listed() {
+    let dir = tempfile::tempdir().unwrap();
+    let profiles = dir.path().join("profiles");
+    fs::create_dir(&profiles).unwrap();
+    for e in fs::read_dir(root().join("examples/log/profiles")).unwrap() {
+        let e = e.unwrap();
+        fs::copy(e.path(), profiles.join(e.file_name())).unwrap();
+    }
+    fs::write(profiles.join("c999.csv"), "1,2\n").unwrap();
+    fs::write(profiles.join("README.txt"), "notes\n").unwrap();
+    fs::create_dir(profiles.join("old.csv")).unwrap();
+    let (code, out, err) = run(&[
+        "import",
+        "--joints",
+        p(&root().join("examples/log/log.csv")),
+        "--profiles",
+        p(&profiles),
+        "--robot",
+        "irb2400",
+        "--map",
+        "id=Pose,station=Sphere,use=Use,side=Side,j1=A1,j2=A2,j3=A3,j4=A4,j5=A5,j6=A6",
+        "--joint-unit",
+        "rad",
+        "--profile-unit",
+        "um",
+        "--out",
+        p(&dir.path().join("s.json")),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains(
+            "skipped 3 entries that name no pose: README.txt, c999.csv, old.csv (a folder)"
+        ),
+        "{out}"
+    );
 }

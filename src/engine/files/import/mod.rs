@@ -187,6 +187,9 @@ pub struct ProfileReport {
     pub axes_guessed: bool,
     /// One per pose, session order.
     pub poses: Vec<ProfileCount>,
+    /// Files of a profile folder paired by pose id that name no pose (a
+    /// README, an old profile), listed rather than passed over.
+    pub skipped: Vec<PathBuf>,
 }
 
 /// One pose's profile as read.
@@ -221,7 +224,7 @@ impl ProfileReport {
             } else {
                 ""
             }
-        )
+        ) + &pairing::skipped_summary(&self.skipped)
     }
 }
 
@@ -254,6 +257,7 @@ pub fn read_profiles(
                 axes,
                 axes_guessed: false,
                 poses,
+                skipped: pairing::naming_no_pose(source, ids),
             },
         ));
     }
@@ -262,7 +266,9 @@ pub fn read_profiles(
         raws.push(raw);
         Ok(())
     })?;
-    planar(raws, format, ids)
+    let (planes, mut report) = planar(raws, format, ids)?;
+    report.skipped = pairing::naming_no_pose(source, ids);
+    Ok((planes, report))
 }
 
 /// Raw profiles in the laser plane, with their report. Each raw profile
@@ -307,6 +313,7 @@ pub(crate) fn planar(
             axes,
             axes_guessed,
             poses,
+            skipped: Vec::new(),
         },
     ))
 }

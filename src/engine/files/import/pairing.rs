@@ -24,6 +24,7 @@ use std::path::{Path, PathBuf};
 use super::ImportError;
 use super::profiles::{self, PROFILE_EXTENSIONS, ProfileFormat, ProfileSource, RawProfile};
 use super::progress::{self, ImportProgress, ImportStage};
+use crate::engine::base::numeric::plural;
 use crate::engine::files::format::same_file;
 
 /// The profile files of a folder and what was left out.
@@ -84,6 +85,69 @@ pub fn ids_naming_profiles<'a>(
         ProfileSource::File { .. } => true,
     };
     named.then_some(ids)
+}
+
+/// Most skipped files a summary names (the rest are counted).
+const MAX_SKIPPED_NAMED: usize = 5;
+
+/// The entries of a profile folder paired by pose id that are not the
+/// profile of one of `ids` (`<id>.<ext>` of a profile extension): a
+/// README, an old profile, a folder or a link named like a profile.
+/// Nothing for a profile table.
+#[must_use]
+pub fn naming_no_pose(source: &ProfileSource, ids: &[String]) -> Vec<PathBuf> {
+    let ProfileSource::Folder(dir) = source else {
+        return Vec::new();
+    };
+    let read: HashSet<PathBuf> = ids
+        .iter()
+        .filter_map(|id| profiles::file_of(dir, id))
+        .collect();
+    let Ok(entries) = fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut others: Vec<PathBuf> = entries
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| !read.contains(p))
+        .collect();
+    others.sort();
+    others
+}
+
+/// `; skipped N files that name no pose: a, b, …` for a summary line, or
+/// nothing.
+#[must_use]
+pub fn skipped_summary(skipped: &[PathBuf]) -> String {
+    if skipped.is_empty() {
+        return String::new();
+    }
+    let mut names: Vec<String> = skipped
+        .iter()
+        .take(MAX_SKIPPED_NAMED)
+        .map(|p| {
+            let name = p
+                .file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+            if p.is_file() {
+                name
+            } else if p.is_dir() {
+                format!("{name} (a folder)")
+            } else if fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_symlink()) {
+                format!("{name} (a link to nothing)")
+            } else {
+                format!("{name} (not a file)")
+            }
+        })
+        .collect();
+    if skipped.len() > MAX_SKIPPED_NAMED {
+        names.push(format!("{} more", skipped.len() - MAX_SKIPPED_NAMED));
+    }
+    format!(
+        "; skipped {} that name no pose: {}",
+        plural(skipped.len(), "entry", "entries"),
+        names.join(", ")
+    )
 }
 
 /// Reads the profiles of the poses `ids` from `source` in that order (a

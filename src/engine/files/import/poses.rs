@@ -401,6 +401,7 @@ pub fn read_pose_inputs_with(
                     axes: AxisMap::IDENTITY,
                     axes_guessed: false,
                     poses: Vec::new(),
+                    skipped: Vec::new(),
                 },
             )
         }

@@ -173,23 +173,34 @@ pub fn program_controller(robot_name: &str) -> Option<Controller> {
 /// The plan as `controller`'s program.
 ///
 /// # Errors
-/// [`PlanError::NoProgram`] for a controller not in [`PROGRAMS`];
-/// [`PlanError::OtherMaker`] when the robot's name says another maker.
+/// [`PlanError::NoProgram`] for a controller not in [`PROGRAMS`].
 pub fn render_program(controller: Controller, plan: &Plan) -> Result<String, PlanError> {
-    if let Some(own) = Controller::for_robot(&plan.robot.name)
-        && own != controller
-    {
-        return Err(PlanError::OtherMaker {
-            robot: plan.robot.name.clone(),
-            controller,
-            own: super::PROGRAMS.contains(&own).then_some(own),
-        });
-    }
     match controller {
         Controller::Abb => Ok(rapid_module(plan)),
         Controller::Ur => Ok(ur_script(plan)),
         other @ (Controller::Kuka | Controller::Fanuc) => Err(PlanError::NoProgram(other)),
     }
+}
+
+/// A warning when the plan's robot, by its name, is another maker's than
+/// `controller`'s: its controller does not run that program (a RAPID
+/// module for a UR5e). `None` when they match or the name names no maker.
+#[must_use]
+pub fn other_maker_warning(controller: Controller, plan: &Plan) -> Option<String> {
+    let own = Controller::for_robot(&plan.robot.name)?;
+    (own != controller).then(|| {
+        format!(
+            "warning: the robot is {}, not a robot of {}: its controller does not run a {}{}",
+            plan.robot.name,
+            controller.name(),
+            controller.label(),
+            if super::PROGRAMS.contains(&own) {
+                format!(" (a {} is what it runs)", own.label())
+            } else {
+                String::new()
+            }
+        )
+    })
 }
 
 /// The comment lines every controller program starts with (robot, poses,

@@ -120,8 +120,8 @@ pub use config::{
 };
 pub use entry::{PlanProgress, Planned, plan_and_predict};
 pub use export::{
-    PROGRAMS, RAPID_MODULE, parse_program, plan_csv, program_controller, rapid_module,
-    read_plan_csv, render_program, ur_script,
+    PROGRAMS, RAPID_MODULE, other_maker_warning, parse_program, plan_csv, program_controller,
+    rapid_module, read_plan_csv, render_program, ur_script,
 };
 use order::{Metric, order_groups};
 pub use predict::{
@@ -210,21 +210,6 @@ pub enum PlanError {
         .0.label()
     )]
     NoProgram(Controller),
-    /// A program for another maker's controller than the robot's.
-    #[error(
-        "the robot is {robot}, not a robot of {}: its controller does not run a {}{}",
-        .controller.name(),
-        .controller.label(),
-        .own.map_or_else(String::new, |c| format!(" (write a {} for it, or plan for the robot the program is for)", c.label()))
-    )]
-    OtherMaker {
-        /// The plan's robot, by name.
-        robot: String,
-        /// The controller asked for.
-        controller: Controller,
-        /// The robot's own maker's controller.
-        own: Option<Controller>,
-    },
 }
 
 /// What a station is for.
