@@ -151,6 +151,40 @@ impl AlignedGrid {
         }
     }
 
+    /// The aligned grid of single sensor points, one at each pose:
+    /// `points[i] = (pose, sensor-frame point)` (the planner's working
+    /// volume: a sphere centre seen at each sampled pose). The rigid
+    /// motion fitted to all of them is taken out, as over a range.
+    pub(crate) fn at_points(
+        est: &Estimate,
+        points: &[(PoseSensitivity, Vector3<f64>)],
+        estimated: &[usize],
+        scale: &[f64],
+    ) -> Self {
+        let points: Vec<([f64; 2], DMatrix<f64>, Vector3<f64>)> = points
+            .iter()
+            .map(|(pose, x)| {
+                let (g, p) = point_rows(est, pose, estimated, scale, *x);
+                ([x.y, x.z], g, p)
+            })
+            .collect();
+        let fit = RigidFit::new(points.iter().map(|(_, g, p)| (p, g)), estimated.len());
+        Self {
+            points,
+            poses: 1,
+            fit,
+        }
+    }
+
+    /// The aligned 1σ (mm) of every point under the covariance `cov` of
+    /// the (scaled) estimated parameters.
+    pub(crate) fn sigmas(&self, cov: &DMatrix<f64>) -> Vec<f64> {
+        self.points
+            .iter()
+            .map(|(_, g, p)| aligned_sigma(&self.aligned(g, p), cov))
+            .collect()
+    }
+
     /// `H` of a point with sensitivity `g` at base position `p`.
     fn aligned(&self, g: &DMatrix<f64>, p: &Vector3<f64>) -> DMatrix<f64> {
         self.fit.aligned(g, p)
