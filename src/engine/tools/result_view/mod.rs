@@ -298,6 +298,9 @@ pub struct ResultFigures {
     pub hand_eye_sigma: Option<[f64; 6]>,
     /// The same from the covariance as written (a priori).
     pub hand_eye_sigma_a_priori: Option<[f64; 6]>,
+    /// `ml`'s predicted measuring error over the session's volume (a
+    /// posteriori), when the result has it.
+    pub volume_error: Option<crate::engine::calibrate::solve::ml::range::VolumeError>,
     /// The a posteriori variance factor every σ shown is scaled by
     /// ([`variance_factor`](crate::engine::calibrate::solve::ml::covariance::variance_factor):
     /// 1 without one); σ a posteriori = σ a priori × √factor.
@@ -387,6 +390,7 @@ impl ResultFigures {
             hand_eye_sigma: hand_eye_sigma_a_priori.map(|s| s.map(|v| v * root)),
             hand_eye_sigma_a_priori,
             variance_factor,
+            volume_error: result.solver.ml().and_then(|m| m.volume_error.clone()),
             held_out: result.held_out.clone(),
             warnings: result
                 .solver

@@ -88,11 +88,16 @@ pub fn unknown_of_label(label: &str, joints: usize) -> Option<(usize, bool)> {
 #[must_use]
 pub fn variance_factor(report: &SolverReport) -> f64 {
     match report {
-        SolverReport::Ml(r) if r.variance_factor.is_finite() && r.variance_factor > 0.0 => {
-            r.variance_factor
-        }
+        SolverReport::Ml(r) => a_posteriori_factor(r.variance_factor),
         _ => 1.0,
     }
+}
+
+/// The factor a covariance is scaled by for a variance factor `v`: `v`
+/// itself when it is a positive number, else 1.
+#[must_use]
+pub fn a_posteriori_factor(v: f64) -> f64 {
+    if v.is_finite() && v > 0.0 { v } else { 1.0 }
 }
 
 impl ParameterCovariance {

@@ -79,6 +79,9 @@ pub(super) fn identifiability(h: &mut String, ctx: &Ctx<'_>) {
                     .unwrap_or_default()
             );
         }
+        if let Some(v) = &ml.volume_error {
+            let _ = writeln!(h, "<li id=\"volume-error\">{}</li>", escape(&v.summary()));
+        }
         let p = &ml.predicted_distance_std_identify;
         let _ = writeln!(
             h,
