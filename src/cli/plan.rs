@@ -90,9 +90,9 @@ pub struct PlanArgs {
     /// Half-range of the spin about the viewing axis in the working volume the plan is made for, deg (the flange turned about its approach from the roll with its x axis toward the station).
     #[arg(long, value_name = "DEG", default_value_t = plan::DEFAULT_SPIN_DEG)]
     pub spin: f64,
-    /// Choose identify poses D-optimally (ln det, the parameters as a whole) instead of for the smallest predicted measuring error over the working volume.
+    /// Choose identify poses for the smallest predicted measuring error over the working volume (I-optimal: station box × approach cone × spin) instead of D-optimally (ln det, the parameters as a whole).
     #[arg(long, conflicts_with = "random")]
-    pub d_optimal: bool,
+    pub volume: bool,
     /// Flange orientations drawn per station (each with every IK branch and both sides).
     #[arg(long, default_value_t = plan::DEFAULT_CANDIDATES)]
     pub candidates: usize,
@@ -242,10 +242,10 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
             candidates: args.candidates,
             selection: if args.random {
                 Selection::Random
-            } else if args.d_optimal {
-                Selection::DOptimal
-            } else {
+            } else if args.volume {
                 Selection::Volume
+            } else {
+                Selection::DOptimal
             },
             seed: args.seed,
         },
