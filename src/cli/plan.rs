@@ -429,79 +429,7 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         );
     }
     if args.predict > 0 {
-        let predict = PredictConfig {
-            runs: args.predict,
-            seed: args.seed,
-            ..PredictConfig::default()
-        };
-        let t = Instant::now();
-        let mut ticker = Ticker::new(t);
-        let p = plan::predict(&made, &predict, &mut |done, of| {
-            if !quiet && let Some(line) = ticker.runs(done, of, Instant::now()) {
-                eprintln!("{line}");
-            }
-            Control::Continue
-        })
-        .map_err(|e| plan_error(&e))?;
-        if !quiet {
-            sayln!(
-                "  predicted validation std after calibration (ml, {} simulated robots with random errors σ {}°/{} mm, joint noise {}°, stripe noise {} mm): {:.4} ± {:.4} mm",
-                p.runs.len(),
-                simulate::config::RANDOM_ANGLE_SIGMA_DEG,
-                simulate::config::RANDOM_LENGTH_SIGMA_MM,
-                predict.joint_noise,
-                predict.stripe_noise,
-                p.after_mean,
-                p.after_spread
-            );
-            sayln!(
-                "    before {:.3} mm; noise floor {:.4} mm; after / floor {:.2} ({:.0} ms)",
-                p.before_mean,
-                p.floor_mean,
-                p.ratio_mean,
-                t.elapsed().as_secs_f64() * 1e3
-            );
-            if let Some(r) = &p.range {
-                sayln!(
-                    "    error over the range (9 × 9 grid at the validate poses, against the truth): rms {:.4} mm (max {:.4} mm); floor {:.4} mm; after / floor {:.2}",
-                    r.after_rms,
-                    r.after_max,
-                    r.floor_rms,
-                    r.ratio_mean
-                );
-            }
-            if let Some(v) = &p.volume {
-                sayln!(
-                    "    error over the volume (validate spheres in the base frame, aligned rigidly to the truth): rms {:.4} mm; floor {:.4} mm; after / floor {:.2} (worst run {:.2})",
-                    v.after_rms,
-                    v.floor_rms,
-                    v.ratio_mean,
-                    v.ratio_max
-                );
-            }
-        }
-        if config.design.selection != Selection::Random {
-            // The same stations with poses at random, scored alike.
-            let baseline = plan::PlanConfig {
-                design: PlanDesign {
-                    selection: Selection::Random,
-                    ..config.design
-                },
-                ..config.clone()
-            };
-            let other = plan::plan(&baseline, &mut |_| Control::Continue)
-                .and_then(|b| plan::predict(&b, &predict, &mut |_, _| Control::Continue))
-                .map_err(|e| plan_error(&e))?;
-            if !quiet && let Some(v) = &other.volume {
-                sayln!(
-                    "    poses at random at the same stations (the paper's practice): error over the volume rms {:.4} mm; floor {:.4} mm; after / floor {:.2} (worst run {:.2})",
-                    v.after_rms,
-                    v.floor_rms,
-                    v.ratio_mean,
-                    v.ratio_max
-                );
-            }
-        }
+        predicted(&made, &config, args)?;
     }
     // Every file or none.
     let mut files: Vec<(&Path, String, String)> = Vec::new();
@@ -519,6 +447,86 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     if !quiet {
         for (path, _, what) in &files {
             sayln!("wrote {} ({what})", path.display());
+        }
+    }
+    Ok(())
+}
+
+/// `--predict`: the plan's simulated calibrations, and those of random
+/// poses at the same stations (scored over the volume alike).
+fn predicted(made: &plan::Plan, config: &PlanConfig, args: &PlanArgs) -> Result<(), CliError> {
+    let quiet = args.quiet;
+    let predict = PredictConfig {
+        runs: args.predict,
+        seed: args.seed,
+        ..PredictConfig::default()
+    };
+    let t = Instant::now();
+    let mut ticker = Ticker::new(t);
+    let p = plan::predict(made, &predict, &mut |done, of| {
+        if !quiet && let Some(line) = ticker.runs(done, of, Instant::now()) {
+            eprintln!("{line}");
+        }
+        Control::Continue
+    })
+    .map_err(|e| plan_error(&e))?;
+    if !quiet {
+        sayln!(
+            "  predicted validation std after calibration (ml, {} simulated robots with random errors σ {}°/{} mm, joint noise {}°, stripe noise {} mm): {:.4} ± {:.4} mm",
+            p.runs.len(),
+            simulate::config::RANDOM_ANGLE_SIGMA_DEG,
+            simulate::config::RANDOM_LENGTH_SIGMA_MM,
+            predict.joint_noise,
+            predict.stripe_noise,
+            p.after_mean,
+            p.after_spread
+        );
+        sayln!(
+            "    before {:.3} mm; noise floor {:.4} mm; after / floor {:.2} ({:.0} ms)",
+            p.before_mean,
+            p.floor_mean,
+            p.ratio_mean,
+            t.elapsed().as_secs_f64() * 1e3
+        );
+        if let Some(r) = &p.range {
+            sayln!(
+                "    error over the range (9 × 9 grid at the validate poses, against the truth): rms {:.4} mm (max {:.4} mm); floor {:.4} mm; after / floor {:.2}",
+                r.after_rms,
+                r.after_max,
+                r.floor_rms,
+                r.ratio_mean
+            );
+        }
+        if let Some(v) = &p.volume {
+            sayln!(
+                "    error over the volume (validate spheres in the base frame, aligned rigidly to the truth): rms {:.4} mm; floor {:.4} mm; after / floor {:.2} (worst run {:.2})",
+                v.after_rms,
+                v.floor_rms,
+                v.ratio_mean,
+                v.ratio_max
+            );
+        }
+    }
+    if config.design.selection != Selection::Random {
+        // The same stations with poses at random, scored alike.
+        let baseline = plan::PlanConfig {
+            design: PlanDesign {
+                selection: Selection::Random,
+                ..config.design
+            },
+            ..config.clone()
+        };
+        let other = plan::plan(&baseline, &mut |_| Control::Continue)
+            .and_then(|b| plan::predict(&b, &predict, &mut |_, _| Control::Continue))
+            .map_err(|e| plan_error(&e))?;
+        if !quiet && let Some(v) = &other.volume {
+            sayln!(
+                "    poses at random at the same stations (the paper's practice): error over the volume rms {:.4} mm; floor {:.4} mm; after / floor {:.2} (worst run {:.2})",
+                v.after_rms,
+                v.floor_rms,
+                v.ratio_mean,
+                v.ratio_max
+            );
         }
     }
     Ok(())
