@@ -178,3 +178,56 @@ fn volume_study() {
         }
     }
 }
+
+/// `calibrate`'s predicted measuring error over the session's volume: at
+/// every identify and validate pose, a posteriori, beside the realised
+/// volume error of the same calibration against the truth; a result
+/// written before it loads without it.
+#[test]
+fn calibrate_predicts_the_error_over_the_session_volume() {
+    use spherecal::engine::base::session::Use;
+    use spherecal::engine::calibrate::solve::{self, Options};
+    use spherecal::engine::tools::evaluate;
+    use spherecal::engine::tools::simulate::{self, SimConfig};
+
+    let (session, truth) = simulate::simulate(&SimConfig::default()).unwrap();
+    let prepared = solve::prepare(&session).unwrap();
+    let mut options = Options::from_session(&session);
+    options.held_out = false;
+    let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue).unwrap();
+    let ml = cal.report.ml().unwrap();
+    let v = ml.volume_error.as_ref().unwrap();
+    let working = session
+        .measurements
+        .iter()
+        .filter(|m| matches!(m.usage, Use::Identify | Use::Validate))
+        .count();
+    assert_eq!(v.poses, working);
+    assert_eq!(v.stations, 19);
+    assert!(v.rms_mm > 0.0 && v.rms_mm <= v.max_mm, "{v:?}");
+    assert!(
+        (0..3).all(|k| v.box_mm[k][1] - v.box_mm[k][0] > 100.0),
+        "{v:?}"
+    );
+    assert!(
+        ml.summary()
+            .contains("predicted measuring error over the session's volume")
+    );
+    // The realised model part of the validate spheres (station means of
+    // 6 sightings, where much of a single sighting's parameter error
+    // averages out) stays below the predicted σ of a single sighting.
+    let s = evaluate::volume_score(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye)
+        .unwrap();
+    let model = (s.after.rms.powi(2) - s.floor.rms.powi(2)).max(0.0).sqrt();
+    assert!(
+        model < v.rms_mm && s.after.rms > s.floor.rms,
+        "realised {model:.4} mm, predicted {:.4} mm",
+        v.rms_mm
+    );
+    // A result written before 2026-11-28 has none and still loads.
+    let old = spherecal::engine::files::format::load_result(std::path::Path::new(
+        "tests/data/v1/result.json",
+    ))
+    .unwrap();
+    assert!(old.solver.ml().is_none_or(|m| m.volume_error.is_none()));
+}
