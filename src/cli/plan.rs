@@ -87,6 +87,12 @@ pub struct PlanArgs {
     /// Half-angle of the cone of approach directions, deg.
     #[arg(long, value_name = "DEG", default_value_t = plan::DEFAULT_CONE_DEG)]
     pub cone: f64,
+    /// Half-range of the spin about the viewing axis in the working volume the plan is made for, deg (the flange turned about its approach from the roll with its x axis toward the station).
+    #[arg(long, value_name = "DEG", default_value_t = plan::DEFAULT_SPIN_DEG)]
+    pub spin: f64,
+    /// Choose identify poses for the smallest predicted measuring error over the working volume (I-optimal: station box × approach cone × spin) instead of D-optimally (ln det, the parameters as a whole).
+    #[arg(long, conflicts_with = "random")]
+    pub volume: bool,
     /// Flange orientations drawn per station (each with every IK branch and both sides).
     #[arg(long, default_value_t = plan::DEFAULT_CANDIDATES)]
     pub candidates: usize,
@@ -96,7 +102,7 @@ pub struct PlanArgs {
     /// With --range: keep the sphere at the paper's one spot (±2, ±3 mm) and choose by ln det; the range is only predicted.
     #[arg(long, requires = "range")]
     pub no_spread: bool,
-    /// Choose identify poses at random instead of D-optimally (the baseline).
+    /// Choose identify poses at random (the baseline).
     #[arg(long)]
     pub random: bool,
     /// Seed of every random choice; the same arguments give the same plan.
@@ -236,6 +242,8 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
             candidates: args.candidates,
             selection: if args.random {
                 Selection::Random
+            } else if args.volume {
+                Selection::Volume
             } else {
                 Selection::DOptimal
             },
@@ -259,6 +267,7 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
             .transpose()
             .map_err(input)?,
         cone_angle: args.cone,
+        spin_deg: args.spin,
         predict_runs: args.predict,
         range: args.range,
         spread: args.range.is_some() && !args.no_spread,
@@ -479,6 +488,18 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
                     r.ratio_mean
                 );
             }
+            if let Some(v) = &p.volume {
+                sayln!(
+                    "    error over the volume (validate spheres in the base frame, aligned rigidly to the truth): rms {:.4} mm; floor {:.4} mm; after / floor {:.2} (worst run {:.2})",
+                    v.after_rms,
+                    v.floor_rms,
+                    v.ratio_mean,
+                    v.ratio_max
+                );
+            }
+        }
+        if config.design.selection != Selection::Random {
+            random_baseline(&config, predict, quiet)?;
         }
     }
     // Every file or none.
@@ -503,6 +524,35 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         for (path, _, what) in &files {
             sayln!("wrote {} ({what})", path.display());
         }
+    }
+    Ok(())
+}
+
+/// `--predict`'s comparison: the same stations with poses at random (the
+/// paper's practice), planned and scored over the volume alike.
+fn random_baseline(
+    config: &PlanConfig,
+    predict: &PredictConfig,
+    quiet: bool,
+) -> Result<(), CliError> {
+    let baseline = plan::PlanConfig {
+        design: PlanDesign {
+            selection: Selection::Random,
+            ..config.design
+        },
+        ..config.clone()
+    };
+    let other = plan::plan(&baseline, &mut |_| Control::Continue)
+        .and_then(|b| plan::predict(&b, predict, &mut |_, _| Control::Continue))
+        .map_err(|e| plan_error(&e))?;
+    if !quiet && let Some(v) = &other.volume {
+        sayln!(
+            "    poses at random at the same stations (the paper's practice): error over the volume rms {:.4} mm; floor {:.4} mm; after / floor {:.2} (worst run {:.2})",
+            v.after_rms,
+            v.floor_rms,
+            v.ratio_mean,
+            v.ratio_max
+        );
     }
     Ok(())
 }

@@ -5,6 +5,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod a_posteriori;
 mod formats;
 mod fuzz;
 mod held_out;
@@ -20,3 +21,4 @@ mod robot_import;
 mod segment;
 mod simulate;
 mod stripe;
+mod volume_plan;

@@ -120,9 +120,13 @@ fn hand_eye_ui(ui: &mut egui::Ui, view: &ResultView) {
                     }
                     _ => ui.label(RichText::new("–").color(MUTED)),
                 }
-                .on_hover_text(
-                    "1σ from ml's covariance, in the row's frame and unit (flange-frame x, y, z; roll, pitch, yaw)",
-                );
+                .on_hover_text(format!(
+                    "1σ a posteriori (ml's covariance × variance factor {:.3}), in the row's frame and unit (flange-frame x, y, z; roll, pitch, yaw); a priori (the covariance as written): ± {}",
+                    view.shown.variance_factor,
+                    view.shown
+                        .hand_eye_sigma_a_priori
+                        .map_or_else(|| "–".to_owned(), |p| format!("{:.4}", p[k]))
+                ));
                 let change = if k < 3 {
                     after - before
                 } else {
@@ -204,7 +208,8 @@ fn joint_errors_ui(ui: &mut egui::Ui, view: &ResultView) {
     if !view.shown.marked.is_empty() {
         ui.label(
             RichText::new(format!(
-                "± 1σ from ml's covariance. † not identifiable from this data ({} parameter(s)): they lie in a direction the SVD dropped (or the method held them fixed), so the value is not a measurement of the robot. Hover a value for the direction.",
+                "± 1σ a posteriori: ml's covariance × variance factor {:.3}. † not identifiable from this data ({} parameter(s)): they lie in a direction the SVD dropped (or the method held them fixed), so the value is not a measurement of the robot. Hover a value for the direction.",
+                view.shown.variance_factor,
                 view.shown.marked.len()
             ))
             .small()

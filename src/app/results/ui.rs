@@ -141,6 +141,13 @@ fn headline_ui(ui: &mut egui::Ui, view: &ResultView, forms: &Forms, commands: &m
         ui.label(format!(
             "identify centres about their station's mean (3-D rms): {b:.3} → {a:.3} mm"
         ));
+        if let Some(v) = &view.shown.volume_error {
+            ui.label(format!(
+                "predicted measuring error over the session's volume: rms {:.3} mm, max {:.3} mm",
+                v.rms_mm, v.max_mm
+            ))
+            .on_hover_text(v.summary());
+        }
         held_out_ui(ui, view);
     });
 }

@@ -100,3 +100,74 @@ pub fn score(
         floor: stats(&truth.true_robot(), &truth.true_hand_eye()),
     }
 }
+
+/// The realised measuring error over the working volume: each validate
+/// station's sphere measured in the base frame (the mean of its sightings'
+/// centres through the model and hand-eye), all of them aligned rigidly to
+/// the true station centres (sphere data do not see the base frame), mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VolumeScore {
+    /// Calibrated model and hand-eye.
+    pub after: range::RangeStats,
+    /// True model and hand-eye on the same readings: the repeatability
+    /// floor.
+    pub floor: range::RangeStats,
+    /// Validate stations scored.
+    pub stations: usize,
+}
+
+impl VolumeScore {
+    /// `after.rms / floor.rms`: 1 is as good as the readings allow.
+    #[must_use]
+    pub fn ratio_to_floor(&self) -> f64 {
+        self.after.rms / self.floor.rms
+    }
+}
+
+/// Scores a calibration over the volume its validate stations span
+/// ([`VolumeScore`]); `None` with fewer than 3 validate stations in the
+/// truth.
+#[must_use]
+pub fn volume_score(
+    session: &Session,
+    prepared: &Prepared,
+    truth: &Truth,
+    calibrated: &Robot,
+    hand_eye: &Isometry3<f64>,
+) -> Option<VolumeScore> {
+    let stations: Vec<(String, Vec<usize>)> = session
+        .stations(Use::Validate)
+        .into_iter()
+        .filter(|(id, idx)| truth.station(id).is_some() && !idx.is_empty())
+        .collect();
+    if stations.len() < 3 {
+        return None;
+    }
+    let measured = |robot: &Robot, he: &Isometry3<f64>| -> Vec<Vector3<f64>> {
+        stations
+            .iter()
+            .map(|(_, idx)| {
+                idx.iter()
+                    .map(|&i| {
+                        let m = &session.measurements[i];
+                        let t = robot.base_from_flange(&m.joints) * he;
+                        (t * Point3::from(prepared.measurements[i].centre_in_sensor)).coords
+                    })
+                    .sum::<Vector3<f64>>()
+                    / idx.len() as f64
+            })
+            .collect()
+    };
+    let exact: Vec<Vector3<f64>> = stations
+        .iter()
+        .filter_map(|(id, _)| truth.station(id))
+        .collect();
+    Some(VolumeScore {
+        after: range::aligned_stats(&measured(calibrated, hand_eye), &exact),
+        floor: range::aligned_stats(
+            &measured(&truth.true_robot(), &truth.true_hand_eye()),
+            &exact,
+        ),
+        stations: stations.len(),
+    })
+}

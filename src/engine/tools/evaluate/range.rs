@@ -65,7 +65,7 @@ fn grid(range: &SensorRange) -> Vec<Point3<f64>> {
 
 /// The aligned 3-D errors of `model` (points of a model, one per grid point
 /// and pose) against `truth` (the same points, truly), mm.
-fn aligned_stats(model: &[Vector3<f64>], truth: &[Vector3<f64>]) -> RangeStats {
+pub(crate) fn aligned_stats(model: &[Vector3<f64>], truth: &[Vector3<f64>]) -> RangeStats {
     let Some(fit) = kabsch(model, truth) else {
         return RangeStats::default();
     };

@@ -26,7 +26,7 @@ use std::fmt::Write as _;
 use std::time::Instant;
 
 use super::range::range_score;
-use super::score;
+use super::{score, volume_score};
 use crate::engine::base::session::SensorRange;
 use crate::engine::calibrate::solve::{self, Control, Method, Options, SolveError};
 use crate::engine::tools::simulate::{self, ErrorModel, SimConfig, SimError};
@@ -208,6 +208,14 @@ pub struct MethodRuns {
     pub range_rms: Vec<f64>,
     /// `range_rms / range floor`, per seed.
     pub range_ratio: Vec<f64>,
+    /// Realised error over the volume of the validate stations (rms after
+    /// the rigid alignment, [`volume_score`]), mm, per seed.
+    pub volume_rms: Vec<f64>,
+    /// `volume_rms / volume floor`, per seed.
+    pub volume_ratio: Vec<f64>,
+    /// The method's own prediction of it (`ml`'s `volume_error` rms), mm,
+    /// per seed; empty for the paper's method.
+    pub volume_predicted: Vec<f64>,
 }
 
 /// One scenario's results.
@@ -222,6 +230,8 @@ pub struct ScenarioResult {
     /// Floor of the error over the range (rms, mm) per seed; empty
     /// without a range.
     pub range_floor: Vec<f64>,
+    /// Floor of the error over the volume (rms, mm) per seed.
+    pub volume_floor: Vec<f64>,
     /// The paper's method.
     pub paper: MethodRuns,
     /// The `ml` method.
@@ -263,6 +273,7 @@ pub fn run_scenario(scenario: &Scenario, seeds: u64) -> Result<ScenarioResult, S
         title: scenario.title,
         floor: Vec::new(),
         range_floor: Vec::new(),
+        volume_floor: Vec::new(),
         paper: MethodRuns::default(),
         ml: MethodRuns::default(),
     };
@@ -298,6 +309,18 @@ pub fn run_scenario(scenario: &Scenario, seeds: u64) -> Result<ScenarioResult, S
             runs.ratio.push(score.ratio_to_floor());
             if method == Method::Paper {
                 out.floor.push(score.floor.std);
+            }
+            if let Some(v) =
+                volume_score(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye)
+            {
+                runs.volume_rms.push(v.after.rms);
+                runs.volume_ratio.push(v.ratio_to_floor());
+                if method == Method::Paper {
+                    out.volume_floor.push(v.floor.rms);
+                }
+            }
+            if let Some(v) = cal.report.ml().and_then(|m| m.volume_error.as_ref()) {
+                runs.volume_predicted.push(v.rms_mm);
             }
             let initial = &prepared.hand_eye_initial;
             if let Some(range) = range_score(
@@ -371,6 +394,33 @@ pub fn text(results: &[ScenarioResult], seeds: u64) -> String {
             r.ml_worse_seeds(),
             r.ml.std.len()
         );
+        if !r.volume_floor.is_empty() {
+            let _ = writeln!(
+                s,
+                "  error over the volume (validate spheres aligned rigidly to the truth, rms, mm): floor {:.4} / {:.4}",
+                mean(&r.volume_floor),
+                max(&r.volume_floor)
+            );
+            for (name, m) in [("paper", &r.paper), ("ml", &r.ml)] {
+                let predicted = if m.volume_predicted.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "   predicted σ of a sighting {:.4} / {:.4}",
+                        mean(&m.volume_predicted),
+                        max(&m.volume_predicted)
+                    )
+                };
+                let _ = writeln!(
+                    s,
+                    "  {name:<6} rms {:.4} / {:.4}   ratio {:.2} / {:.2}{predicted}",
+                    mean(&m.volume_rms),
+                    max(&m.volume_rms),
+                    mean(&m.volume_ratio),
+                    max(&m.volume_ratio)
+                );
+            }
+        }
         if !r.range_floor.is_empty() {
             let _ = writeln!(
                 s,

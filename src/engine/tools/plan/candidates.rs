@@ -26,7 +26,7 @@ use crate::engine::calibrate::solve::{self, HandEyeSource, Method, Options, Prep
 use crate::engine::tools::simulate::SimConfig;
 
 use super::select::{Info, StationInfo, rotation_criterion};
-use super::{Plan, PlanConfig, PlanError, PlannedPose, StationLayout, StationRole};
+use super::{Plan, PlanConfig, PlanError, PlannedPose, StationLayout, StationRole, VOLUME_SAMPLES};
 use crate::engine::calibrate::solve::estimate::unknown_scale;
 
 /// Reference FK must put the planned centre on the station to this, mm
@@ -51,6 +51,13 @@ pub(super) const STREAM_GEOMETRY: u64 = 10;
 
 /// See [`STREAM_GEOMETRY`].
 pub(super) const STREAM_BASELINE: u64 = 11;
+
+/// See [`STREAM_GEOMETRY`]: the sampled poses of the working volume.
+pub(super) const STREAM_VOLUME: u64 = 12;
+
+/// Orientation draws tried per sampled place of the working volume before
+/// the place is dropped (out of reach in the whole cone and spin).
+const VOLUME_TRIES: usize = 8;
 
 /// One candidate pose.
 #[derive(Debug, Clone)]
@@ -654,6 +661,105 @@ impl Planner<'_> {
             .collect();
         let scale: Vec<f64> = estimated.iter().map(|&k| unknown_scale(k)).collect();
         AlignedGrid::new(&est, &poses, estimated, &scale, range).weight()
+    }
+
+    /// The box of the working volume (base frame, mm): the station box
+    /// about the sphere, or the box the explicit stations span.
+    pub(super) fn volume_box(&self) -> (Vector3<f64>, Vector3<f64>) {
+        let c = self.config;
+        match &c.stations {
+            StationLayout::Box { size } => {
+                let centre = Vector3::from(c.design.sphere);
+                let half = Vector3::from(*size) / 2.0;
+                (centre - half, centre + half)
+            }
+            StationLayout::Explicit { identify, validate } => identify.iter().chain(validate).fold(
+                (
+                    Vector3::from(c.design.sphere),
+                    Vector3::from(c.design.sphere),
+                ),
+                |(lo, hi), p| {
+                    let p = Vector3::from(*p);
+                    (lo.inf(&p), hi.sup(&p))
+                },
+            ),
+        }
+    }
+
+    /// Poses sampled over the working volume: [`VOLUME_SAMPLES`] places
+    /// uniform in [`Self::volume_box`], at each an approach in the cone
+    /// about the look from the eye point and a spin within `±spin_deg`
+    /// about it from the reference roll (the flange x axis toward the
+    /// station, horizontally away from the robot), the sphere at the
+    /// planned centre on alternating sides; the first reachable IK branch
+    /// (up to [`VOLUME_TRIES`] draws per place; a place out of reach is
+    /// dropped).
+    pub(super) fn volume_samples(&self, rng: &mut ChaCha8Rng) -> Vec<Candidate> {
+        let c = self.config;
+        let (lo, hi) = self.volume_box();
+        let cone = c.cone_angle.to_radians();
+        let spin = c.spin_deg.to_radians();
+        let base = self.config.robot.base.translation.vector;
+        let mut out = Vec::with_capacity(VOLUME_SAMPLES);
+        for k in 0..VOLUME_SAMPLES {
+            let place = Vector3::from_fn(|i, _| random::uniform(rng, lo[i], hi[i]));
+            let side: i8 = if k % 2 == 0 { 1 } else { -1 };
+            let mean = self.mean_approach(&place);
+            let outward = {
+                let d = place - base;
+                let h = Vector3::new(d.x, d.y, 0.0);
+                if h.norm() > 1e-9 {
+                    h.normalize()
+                } else {
+                    Vector3::x()
+                }
+            };
+            for _ in 0..VOLUME_TRIES {
+                let approach_dir = approach::direction_in_cone(rng, &mean, cone);
+                let turn = random::uniform(rng, -spin, spin);
+                let reference = outward - approach_dir * outward.dot(&approach_dir);
+                let x0 = if reference.norm() > 1e-9 {
+                    reference.normalize()
+                } else {
+                    approach_dir.cross(&Vector3::y()).normalize()
+                };
+                let x = UnitQuaternion::from_axis_angle(
+                    &nalgebra::Unit::new_normalize(approach_dir),
+                    turn,
+                ) * x0;
+                let y = approach_dir.cross(&x);
+                let rotation = UnitQuaternion::from_rotation_matrix(
+                    &nalgebra::Rotation3::from_basis_unchecked(&[x, y, approach_dir]),
+                );
+                let offset = self.offset(rng);
+                if let Some(found) = self
+                    .candidates_at(&place, &rotation, &(c.centre(side) + offset), side)
+                    .into_iter()
+                    .next()
+                {
+                    out.push(found);
+                    break;
+                }
+            }
+        }
+        out
+    }
+
+    /// The working volume's aligned grid over `estimated`: the sphere
+    /// centre seen at each of `samples` (see [`AlignedGrid::at_points`]).
+    pub(super) fn volume_grid(&self, samples: &[Candidate], estimated: &[usize]) -> AlignedGrid {
+        let est = self.estimate();
+        let points: Vec<(PoseSensitivity, Vector3<f64>)> = samples
+            .iter()
+            .map(|c| {
+                (
+                    PoseSensitivity::new(&est, &Self::sighting("volume", c)),
+                    c.centre,
+                )
+            })
+            .collect();
+        let scale: Vec<f64> = estimated.iter().map(|&k| unknown_scale(k)).collect();
+        AlignedGrid::at_points(&est, &points, estimated, &scale)
     }
 
     /// Condition number of the whitened, scaled Jacobian of `estimated`

@@ -109,14 +109,15 @@ mod select;
 pub use crate::engine::base::robot::controller::Controller;
 pub use candidates::stripe_centre_covariance;
 use candidates::{
-    Candidate, Group, Planner, STREAM_BASELINE, STREAM_GEOMETRY, Site, joint_gap, provisional_id,
-    side_quota, unknown_indices,
+    Candidate, Group, Planner, STREAM_BASELINE, STREAM_GEOMETRY, STREAM_VOLUME, Site, joint_gap,
+    provisional_id, side_quota, unknown_indices,
 };
 pub use config::{
     DEFAULT_BOX_MM, DEFAULT_CANDIDATES, DEFAULT_CENTRE_SPREAD_MM, DEFAULT_CONE_DEG,
     DEFAULT_CUT_ANGLE_DEG, DEFAULT_MIN_WRIST_DEG, DEFAULT_ROTATION_MAX_DEG,
-    DEFAULT_ROTATION_MIN_DEG, DEFAULT_TRANSLATION_STEP_MM, MAX_CANDIDATES, MAX_GROUP_POSES,
-    MAX_ORIENTATIONS, MAX_STATIONS, PlanConfig, PlanDesign, Selection, StationLayout, defaults,
+    DEFAULT_ROTATION_MIN_DEG, DEFAULT_SPIN_DEG, DEFAULT_TRANSLATION_STEP_MM, MAX_CANDIDATES,
+    MAX_GROUP_POSES, MAX_ORIENTATIONS, MAX_STATIONS, PlanConfig, PlanDesign, Selection,
+    StationLayout, VOLUME_SAMPLES, defaults,
 };
 pub use entry::{PlanProgress, Planned, plan_and_predict};
 pub use export::{
@@ -125,12 +126,14 @@ pub use export::{
 };
 use order::{Metric, order_groups};
 pub use predict::{
-    PredictConfig, Prediction, RangePrediction, RunScore, predict, simulated_true_hand_eye,
+    PredictConfig, Prediction, RangePrediction, RunScore, VolumePrediction, predict,
+    simulated_true_hand_eye,
 };
 pub use request::{PlanRequest, RequestError, read_hand_eye, read_stations};
+pub use select::VolumeError;
 use select::{
     Info, Objective, criterion, greedy_selection, prior_information, random_selection,
-    spread_selection,
+    selection_covariance, spread_selection,
 };
 
 /// What failed in one simulated calibration of a prediction.
@@ -292,6 +295,12 @@ pub struct PlanStats {
     /// sphere at the paper's spot, `ln det`), when this one spreads: what
     /// the spread gains.
     pub range_error_unspread: Option<RangeError>,
+    /// The predicted measuring error over the working volume of the chosen
+    /// identify poses ([`VolumeError`]).
+    pub volume_error: Option<VolumeError>,
+    /// The same for the random selection of the same size at the same
+    /// stations (the paper's practice: poses not chosen for a criterion).
+    pub volume_error_random: Option<VolumeError>,
 }
 
 /// A measurement plan.
@@ -393,11 +402,13 @@ pub fn plan(
         }
     };
     let groups = gather_candidates(&planner, &mut rng, &mut sites, &mut cancel)?;
-    let (log_det, log_det_random) = choose_poses(&planner, &mut sites, &mut cancel)?;
+    let chosen = choose_poses(&planner, &mut sites, &mut cancel)?;
     cancel(PlanStage::Ordering)?;
     let mut plan = ordered_plan(config, &sites, groups);
-    plan.stats.log_det = log_det;
-    plan.stats.log_det_random = log_det_random;
+    plan.stats.log_det = chosen.log_det;
+    plan.stats.log_det_random = chosen.log_det_random;
+    plan.stats.volume_error = chosen.volume;
+    plan.stats.volume_error_random = chosen.volume_random;
     analyse_plan(&planner, &mut plan)?;
     if config.spread {
         // The comparison: the same cell planned without the spread.
@@ -515,15 +526,24 @@ fn gather_candidates(
     Ok(groups)
 }
 
+/// What [`choose_poses`] found: `ln det` and the predicted volume error
+/// of the chosen identify poses and of the random baseline of the same
+/// size.
+struct Chosen {
+    log_det: f64,
+    log_det_random: f64,
+    volume: Option<VolumeError>,
+    volume_random: Option<VolumeError>,
+}
+
 /// The analysis of the candidate pool (the identifiable parameters, by
 /// ml) and the selection: the validate poses spread, the identify poses
-/// D-optimal (or random). Returns `ln det` of the chosen identify poses
-/// and of the random baseline of the same size.
+/// for the working volume (I-optimal), D-optimal or random.
 fn choose_poses(
     planner: &Planner<'_>,
     sites: &mut [Site],
     cancel: &mut dyn FnMut(PlanStage) -> Result<(), PlanError>,
-) -> Result<(f64, f64), PlanError> {
+) -> Result<Chosen, PlanError> {
     let config = planner.config;
     cancel(PlanStage::Analysis)?;
     let pool = planner.pool_report(sites)?;
@@ -562,12 +582,25 @@ fn choose_poses(
             site.chosen = spread_selection(planner, site, config.design.validate_poses);
         }
     }
-    let objective = match (config.spread, config.range) {
-        (true, Some(range)) => Objective::Range(planner.range_weight(sites, &estimated, &range)),
+    // The working volume: sampled poses and their aligned grid.
+    let mut volume_rng = random::stream(config.design.seed, STREAM_VOLUME);
+    let samples = planner.volume_samples(&mut volume_rng);
+    let volume = (!samples.is_empty()).then(|| planner.volume_grid(&samples, &estimated));
+    let volume_error = |selection: &[(usize, Vec<usize>)]| {
+        let grid = volume.as_ref()?;
+        let cov = selection_covariance(&prior, &infos, selection)?;
+        VolumeError::of(&grid.sigmas(&cov))
+    };
+    let volume_random = volume_error(&random);
+    let objective = match (config.spread, config.range, &volume) {
+        (true, Some(range), _) => Objective::Range(planner.range_weight(sites, &estimated, &range)),
+        (_, _, Some(grid)) if config.design.selection == Selection::Volume => {
+            Objective::Range(grid.weight())
+        }
         _ => Objective::LogDet,
     };
     let chosen = match config.design.selection {
-        Selection::DOptimal => {
+        Selection::Volume | Selection::DOptimal => {
             greedy_selection(planner, sites, &identify_sites, &infos, &prior, &objective)
         }
         Selection::Random => random,
@@ -575,18 +608,19 @@ fn choose_poses(
     for (k, c) in chosen {
         sites[k].chosen = c;
     }
-    let log_det = criterion(
-        &prior,
-        &infos,
-        &sites
-            .iter()
-            .enumerate()
-            .filter(|(_, s)| s.role == StationRole::Identify)
-            .map(|(k, s)| (k, s.chosen.clone()))
-            .collect::<Vec<_>>(),
-    )
-    .unwrap_or(f64::NEG_INFINITY);
-    Ok((log_det, log_det_random))
+    let selection: Vec<(usize, Vec<usize>)> = sites
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.role == StationRole::Identify)
+        .map(|(k, s)| (k, s.chosen.clone()))
+        .collect();
+    let log_det = criterion(&prior, &infos, &selection).unwrap_or(f64::NEG_INFINITY);
+    Ok(Chosen {
+        log_det,
+        log_det_random,
+        volume: volume_error(&selection),
+        volume_random,
+    })
 }
 
 /// The chosen poses in visit order: the groups (the hand-eye ones, then
@@ -648,6 +682,8 @@ fn ordered_plan(config: &PlanConfig, sites: &[Site], mut groups: Vec<Group>) -> 
             path_deg,
             range_error: None,
             range_error_unspread: None,
+            volume_error: None,
+            volume_error_random: None,
         },
     }
 }
@@ -845,6 +881,22 @@ pub fn summary(plan: &Plan) -> String {
                     r.coverage * 100.0
                 );
             }
+        }
+    }
+    if let Some(v) = &st.volume_error {
+        let _ = writeln!(
+            s,
+            "  predicted measuring error over the working volume (σ of a sphere centre after the rigid alignment, {} sampled poses: station box × approach cone × spin): rms {:.4} mm, max {:.4} mm",
+            v.samples, v.rms_mm, v.max_mm
+        );
+        if let Some(r) = &st.volume_error_random {
+            let _ = writeln!(
+                s,
+                "    the same stations with poses at random (the paper's practice), same number of measurements: rms {:.4} mm, max {:.4} mm ({:.2}× the rms)",
+                r.rms_mm,
+                r.max_mm,
+                r.rms_mm / v.rms_mm
+            );
         }
     }
     let _ = writeln!(

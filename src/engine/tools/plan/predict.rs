@@ -68,6 +68,22 @@ pub struct RunScore {
     /// The error over the plan's range (before, after, floor), when the
     /// plan has one.
     pub range: Option<RangeScore>,
+    /// The realised error over the volume of the validate stations
+    /// (after, floor), with 3 or more of them.
+    pub volume: Option<evaluate::VolumeScore>,
+}
+
+/// The realised measuring error over the volume, over the runs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VolumePrediction {
+    /// Mean rms error after calibration, mm.
+    pub after_rms: f64,
+    /// Mean rms floor, mm.
+    pub floor_rms: f64,
+    /// Mean of `after / floor`.
+    pub ratio_mean: f64,
+    /// Largest `after / floor` of any run.
+    pub ratio_max: f64,
 }
 
 /// The realised error over the plan's range, mean over the runs, mm.
@@ -103,6 +119,8 @@ pub struct Prediction {
     pub before_mean: f64,
     /// The error over the plan's range, when it has one.
     pub range: Option<RangePrediction>,
+    /// The error over the volume of the validate stations.
+    pub volume: Option<VolumePrediction>,
 }
 
 /// The true hand-eye of a simulated run: the plan's guess moved by the
@@ -190,7 +208,10 @@ pub fn predict(
             &cal.hand_eye,
             None,
         );
+        let volume =
+            evaluate::volume_score(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
         runs.push(RunScore {
+            volume,
             seed,
             before_std: score.before.std,
             after_std: score.after.std,
@@ -226,7 +247,23 @@ pub fn predict(
             model_rms: avg(&|r| r.model.rms),
         }
     });
+    let volumes: Vec<evaluate::VolumeScore> = runs.iter().filter_map(|r| r.volume).collect();
+    let volume = (!volumes.is_empty()).then(|| {
+        let m = volumes.len() as f64;
+        let avg =
+            |f: &dyn Fn(&evaluate::VolumeScore) -> f64| volumes.iter().map(f).sum::<f64>() / m;
+        VolumePrediction {
+            after_rms: avg(&|v| v.after.rms),
+            floor_rms: avg(&|v| v.floor.rms),
+            ratio_mean: avg(&evaluate::VolumeScore::ratio_to_floor),
+            ratio_max: volumes
+                .iter()
+                .map(evaluate::VolumeScore::ratio_to_floor)
+                .fold(0.0, f64::max),
+        }
+    });
     Ok(Prediction {
+        volume,
         range,
         after_mean,
         after_spread,

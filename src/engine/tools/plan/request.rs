@@ -70,6 +70,9 @@ pub struct PlanRequest {
     pub stations: Option<StationLayout>,
     /// Half-angle of the cone of approach directions, deg.
     pub cone_angle: f64,
+    /// Half-range of the spin about the viewing axis in the working
+    /// volume, deg.
+    pub spin_deg: f64,
     /// Simulated calibrations for the predicted accuracy (0: none).
     pub predict_runs: usize,
     /// The sensor's measuring range (`sensor.range`): the plan predicts
@@ -92,6 +95,7 @@ impl PlanRequest {
             box_size: None,
             stations: None,
             cone_angle: DEFAULT_CONE_DEG,
+            spin_deg: super::config::DEFAULT_SPIN_DEG,
             predict_runs: PredictConfig::default().runs,
             range: None,
             spread: false,
@@ -165,6 +169,7 @@ impl PlanRequest {
             config.stations = stations.clone();
         }
         config.cone_angle = self.cone_angle;
+        config.spin_deg = self.spin_deg;
         config.range = self.range;
         config.spread = self.spread && self.range.is_some();
         Ok(config)

@@ -209,6 +209,54 @@ pub(super) fn criterion(
     m.cholesky().map(|c| log_det(&c))
 }
 
+/// The covariance `(prior + Σ_s M_s)⁻¹` (scaled units) of a selection
+/// `(site, chosen)`; `None` when singular.
+pub(super) fn selection_covariance(
+    prior: &DMatrix<f64>,
+    infos: &[Vec<Info>],
+    selection: &[(usize, Vec<usize>)],
+) -> Option<DMatrix<f64>> {
+    let k = prior.nrows();
+    let mut m = prior.clone();
+    for (site, chosen) in selection {
+        m += StationInfo::of(&infos[*site], chosen, k).schur();
+    }
+    m.cholesky().map(|c| c.inverse())
+}
+
+/// The predicted measuring error over the working volume: the per-point
+/// 1σ (3-D, after the best rigid alignment of the whole volume, as
+/// `measure` reports it) of the sphere centre at each sampled pose of the
+/// volume, from the planner's covariance of the identify poses (the `ml`
+/// model and prior, see the module docs), mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VolumeError {
+    /// RMS over the sampled poses.
+    pub rms_mm: f64,
+    /// Mean.
+    pub mean_mm: f64,
+    /// Largest.
+    pub max_mm: f64,
+    /// Sampled poses (reachable places of the volume).
+    pub samples: usize,
+}
+
+impl VolumeError {
+    /// The figures of per-point σ (mm); `None` without any.
+    pub(super) fn of(sigmas: &[f64]) -> Option<Self> {
+        if sigmas.is_empty() {
+            return None;
+        }
+        let n = sigmas.len() as f64;
+        Some(Self {
+            rms_mm: (sigmas.iter().map(|s| s * s).sum::<f64>() / n).sqrt(),
+            mean_mm: sigmas.iter().sum::<f64>() / n,
+            max_mm: sigmas.iter().copied().fold(0.0, f64::max),
+            samples: sigmas.len(),
+        })
+    }
+}
+
 /// A seeded random selection of `n` poses per identify station, sides
 /// balanced as in the greedy selection.
 pub(super) fn random_selection(

@@ -254,8 +254,11 @@ pub struct Headline {
 /// A parameter's standard deviation as the method reports it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sigma {
-    /// 1σ, file units.
+    /// 1σ a posteriori (the covariance as written times the variance
+    /// factor, [`ResultFigures::variance_factor`]), file units.
     pub std: f64,
+    /// 1σ a priori (the covariance as written, from the noise model).
+    pub a_priori: f64,
     /// `mm` or `deg`.
     pub unit: String,
 }
@@ -293,8 +296,18 @@ pub struct ResultFigures {
     /// 1σ of the calibrated hand-eye as the tables show it: x, y, z (mm,
     /// flange frame) and roll, pitch, yaw (deg), propagated from `ml`'s
     /// covariance of the sensor-frame perturbation (`None` without one,
-    /// or when a hand-eye direction was held fixed).
+    /// or when a hand-eye direction was held fixed). A posteriori: the
+    /// covariance times [`Self::variance_factor`].
     pub hand_eye_sigma: Option<[f64; 6]>,
+    /// The same from the covariance as written (a priori).
+    pub hand_eye_sigma_a_priori: Option<[f64; 6]>,
+    /// `ml`'s predicted measuring error over the session's volume (a
+    /// posteriori), when the result has it.
+    pub volume_error: Option<crate::engine::calibrate::solve::ml::range::VolumeError>,
+    /// The a posteriori variance factor every σ shown is scaled by
+    /// ([`variance_factor`](crate::engine::calibrate::solve::ml::covariance::variance_factor):
+    /// 1 without one); σ a posteriori = σ a priori × √factor.
+    pub variance_factor: f64,
     /// Each identify measurement predicted by a calibration made without
     /// it, beside the fit's own scatter (`None` for a result written
     /// without it).
@@ -333,6 +346,9 @@ impl ResultFigures {
             }),
             None => None,
         };
+        let variance_factor =
+            crate::engine::calibrate::solve::ml::covariance::variance_factor(&result.solver);
+        let root = variance_factor.sqrt();
         let sigma = result
             .solver
             .ml()
@@ -342,12 +358,17 @@ impl ResultFigures {
                 (
                     p.parameter.clone(),
                     Sigma {
-                        std: p.std,
+                        std: p.std * root,
+                        a_priori: p.std,
                         unit: p.unit.clone(),
                     },
                 )
             })
             .collect();
+        let hand_eye_sigma_a_priori = result
+            .solver
+            .ml()
+            .and_then(|ml| hand_eye_sigma(&result.hand_eye, &ml.covariance));
         Self {
             headline,
             within_stats: pair_stats(&within),
@@ -369,10 +390,10 @@ impl ResultFigures {
             marked: identifiability_marks(&result.solver),
             sigma,
             identify_scatter: identify_scatter(&result.centres),
-            hand_eye_sigma: result
-                .solver
-                .ml()
-                .and_then(|ml| hand_eye_sigma(&result.hand_eye, &ml.covariance)),
+            hand_eye_sigma: hand_eye_sigma_a_priori.map(|s| s.map(|v| v * root)),
+            hand_eye_sigma_a_priori,
+            variance_factor,
+            volume_error: result.solver.ml().and_then(|m| m.volume_error.clone()),
             held_out: result.held_out.clone(),
             warnings: result
                 .solver

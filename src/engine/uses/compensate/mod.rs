@@ -415,8 +415,10 @@ impl Model {
             Tcp::Flange => Isometry3::identity(),
             Tcp::Tool(t) => *t,
         };
-        // A malformed covariance is as none: no σ, said below.
-        let covariance = ParameterCovariance::read(&result.solver, DOF)
+        // A malformed covariance is as none: no σ, said below. A
+        // posteriori: scaled by the result's variance factor, as
+        // measuring's per-point σ.
+        let covariance = ParameterCovariance::read_a_posteriori(&result.solver, DOF)
             .ok()
             .flatten();
         let predictor = covariance.as_ref().map(|c| {
@@ -460,6 +462,14 @@ impl Model {
             region,
             notes,
         })
+    }
+
+    /// The predicted 1σ (mm) of the TCP position at joints `q` after
+    /// compensation, a posteriori (the result's covariance times its
+    /// variance factor); `None` without a covariance.
+    #[must_use]
+    pub fn predicted_sigma(&self, q: &[f64; DOF]) -> Option<f64> {
+        self.predictor.as_ref().map(|p| p.sigma(q))
     }
 
     /// Whether the joints of the identify poses are known (recorded in the

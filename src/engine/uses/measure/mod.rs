@@ -160,14 +160,7 @@ pub struct Measured {
 /// noise model fits), 1 when it has none or it is not a positive number.
 #[must_use]
 pub fn variance_factor(result: &ResultFile) -> f64 {
-    match &result.solver {
-        crate::engine::calibrate::solve::SolverReport::Ml(r)
-            if r.variance_factor.is_finite() && r.variance_factor > 0.0 =>
-        {
-            r.variance_factor
-        }
-        _ => 1.0,
-    }
+    crate::engine::calibrate::solve::ml::covariance::variance_factor(&result.solver)
 }
 
 /// Reads a workpiece frame: a JSON 4×4 matrix (four rows of four numbers,

@@ -78,7 +78,45 @@ pub fn unknown_of_label(label: &str, joints: usize) -> Option<(usize, bool)> {
         .map(|u| (u, unknown_is_angle(u)))
 }
 
+/// The a posteriori variance factor of `report` (`ml`'s
+/// `solver.variance_factor`, Σ r² / (residuals − unknowns) of the whitened
+/// residuals: 1 when the noise model fits), 1 when it has none or it is
+/// not a positive number. Every σ a user sees is the covariance as written
+/// (a priori, from the noise model) times this factor (a posteriori): the
+/// one home of that rule (measuring's per-point σ, compensation's
+/// predicted σ, the result view's hand-eye σ, the history's jump test).
+#[must_use]
+pub fn variance_factor(report: &SolverReport) -> f64 {
+    match report {
+        SolverReport::Ml(r) => a_posteriori_factor(r.variance_factor),
+        _ => 1.0,
+    }
+}
+
+/// The factor a covariance is scaled by for a variance factor `v`: `v`
+/// itself when it is a positive number, else 1.
+#[must_use]
+pub fn a_posteriori_factor(v: f64) -> f64 {
+    if v.is_finite() && v > 0.0 { v } else { 1.0 }
+}
+
 impl ParameterCovariance {
+    /// [`Self::read`] scaled by [`variance_factor`]: the a posteriori
+    /// covariance every σ downstream uses.
+    ///
+    /// # Errors
+    /// As [`Self::read`].
+    pub fn read_a_posteriori(
+        report: &SolverReport,
+        joints: usize,
+    ) -> Result<Option<Self>, CovarianceError> {
+        let factor = variance_factor(report);
+        Ok(Self::read(report, joints)?.map(|mut c| {
+            c.matrix *= factor;
+            c
+        }))
+    }
+
     /// The covariance of `report` for a model of `joints` joints:
     /// `Ok(None)` when it has none (the paper's method, or an `ml` run
     /// that stopped before its diagnostics).

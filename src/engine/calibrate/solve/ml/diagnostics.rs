@@ -207,6 +207,15 @@ pub(super) fn report(
     }
     let range_error =
         super::range::range_error(session, prepared, problem, &state.est, &cov_scaled);
+    // A posteriori, as `measure` reports a point's σ.
+    let factor = super::covariance::a_posteriori_factor(variance_factor);
+    let volume_error = super::range::volume_error(
+        session,
+        prepared,
+        problem,
+        &state.est,
+        &(&cov_scaled * factor),
+    );
     // Leave-one-station-out.
     let cross_validation = if mo.cross_validation && problem.stations.len() >= 2 {
         match problem.cross_validate(state, phase) {
@@ -234,6 +243,7 @@ pub(super) fn report(
         predicted_distance_std_identify: predicted_identify,
         cross_validation,
         range_error,
+        volume_error,
         outlier_limit_sigma: limit,
         outliers,
         ..base

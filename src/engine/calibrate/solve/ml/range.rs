@@ -151,6 +151,40 @@ impl AlignedGrid {
         }
     }
 
+    /// The aligned grid of single sensor points, one at each pose:
+    /// `points[i] = (pose, sensor-frame point)` (the planner's working
+    /// volume: a sphere centre seen at each sampled pose). The rigid
+    /// motion fitted to all of them is taken out, as over a range.
+    pub(crate) fn at_points(
+        est: &Estimate,
+        points: &[(PoseSensitivity, Vector3<f64>)],
+        estimated: &[usize],
+        scale: &[f64],
+    ) -> Self {
+        let points: Vec<([f64; 2], DMatrix<f64>, Vector3<f64>)> = points
+            .iter()
+            .map(|(pose, x)| {
+                let (g, p) = point_rows(est, pose, estimated, scale, *x);
+                ([x.y, x.z], g, p)
+            })
+            .collect();
+        let fit = RigidFit::new(points.iter().map(|(_, g, p)| (p, g)), estimated.len());
+        Self {
+            points,
+            poses: 1,
+            fit,
+        }
+    }
+
+    /// The aligned 1σ (mm) of every point under the covariance `cov` of
+    /// the (scaled) estimated parameters.
+    pub(crate) fn sigmas(&self, cov: &DMatrix<f64>) -> Vec<f64> {
+        self.points
+            .iter()
+            .map(|(_, g, p)| aligned_sigma(&self.aligned(g, p), cov))
+            .collect()
+    }
+
     /// `H` of a point with sensitivity `g` at base position `p`.
     fn aligned(&self, g: &DMatrix<f64>, p: &Vector3<f64>) -> DMatrix<f64> {
         self.fit.aligned(g, p)
@@ -287,5 +321,98 @@ pub(super) fn range_error(
         coverage,
         map,
         warning,
+    })
+}
+
+/// Most poses the volume error is taken over (an even sample beyond).
+pub const VOLUME_POSES: usize = 400;
+
+/// The predicted measuring error over the session's volume (result file:
+/// `solver.volume_error`): the 1σ a measured sphere centre gets
+/// (`measure`'s per-point σ: 3-D, after the best rigid alignment of all
+/// of them, the covariance times the variance factor) at every identify
+/// and validate pose of the session, i.e. over the box its stations span
+/// and the orientations it used.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct VolumeError {
+    /// Poses the figures are over.
+    pub poses: usize,
+    /// Stations they are at.
+    pub stations: usize,
+    /// RMS of the 1σ, mm.
+    pub rms_mm: f64,
+    /// Largest 1σ, mm.
+    pub max_mm: f64,
+    /// The box the stations span (base frame, mm): `[min, max]` of x, y, z
+    /// of the measured centres.
+    pub box_mm: [[f64; 2]; 3],
+}
+
+impl VolumeError {
+    /// One line for people.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let e = |k: usize| self.box_mm[k][1] - self.box_mm[k][0];
+        format!(
+            "predicted measuring error over the session's volume (a sphere centre's σ after the rigid alignment, a posteriori, at its {} poses at {} stations, a {:.0} × {:.0} × {:.0} mm box): rms {:.4} mm, max {:.4} mm",
+            self.poses,
+            self.stations,
+            e(0),
+            e(1),
+            e(2),
+            self.rms_mm,
+            self.max_mm
+        )
+    }
+}
+
+/// The prediction over the session's volume ([`VolumeError`]) with the
+/// covariance `cov` (scaled units, a posteriori); `None` with fewer than
+/// 2 stations (one station's volume is the sensor's range there:
+/// [`range_error`]).
+pub(super) fn volume_error(
+    session: &Session,
+    prepared: &Prepared,
+    problem: &Problem,
+    est: &Estimate,
+    cov: &DMatrix<f64>,
+) -> Option<VolumeError> {
+    let working: Vec<usize> = (0..session.measurements.len())
+        .filter(|&i| matches!(session.measurements[i].usage, Use::Identify | Use::Validate))
+        .collect();
+    let stations: std::collections::HashSet<&str> = working
+        .iter()
+        .map(|&i| session.measurements[i].station.as_str())
+        .collect();
+    if stations.len() < 2 {
+        return None;
+    }
+    let stride = working.len().div_ceil(VOLUME_POSES).max(1);
+    let points: Vec<(PoseSensitivity, Vector3<f64>)> = working
+        .iter()
+        .step_by(stride)
+        .map(|&i| {
+            (
+                PoseSensitivity::new(est, &prepared.sighting(session, i)),
+                prepared.measurements[i].centre_in_sensor,
+            )
+        })
+        .collect();
+    let grid = AlignedGrid::at_points(est, &points, &problem.estimated, &problem.scale);
+    let sigmas = grid.sigmas(cov);
+    let n = sigmas.len().max(1) as f64;
+    let mut box_mm = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
+    for (_, _, p) in &grid.points {
+        for k in 0..3 {
+            box_mm[k] = [box_mm[k][0].min(p[k]), box_mm[k][1].max(p[k])];
+        }
+    }
+    Some(VolumeError {
+        poses: sigmas.len(),
+        stations: stations.len(),
+        rms_mm: (sigmas.iter().map(|s| s * s).sum::<f64>() / n).sqrt(),
+        max_mm: sigmas.iter().copied().fold(0.0, f64::max),
+        box_mm,
     })
 }

@@ -238,6 +238,11 @@ pub struct MlReport {
     /// covered), from the covariance ([`super::range`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub range_error: Option<super::range::RangeError>,
+    /// Predicted measuring error over the session's volume (a posteriori),
+    /// with 2 or more stations ([`super::range::VolumeError`]); absent in
+    /// results written before 2026-11-28.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub volume_error: Option<super::range::VolumeError>,
     /// Outlier limit, σ of the standardised residual norm.
     pub outlier_limit_sigma: f64,
     /// Measurements beyond the limit.
@@ -372,6 +377,9 @@ impl MlReport {
                     .map(|w| format!(" (worst {} {:.4} mm)", w.station, w.rms))
                     .unwrap_or_default()
             );
+        }
+        if let Some(v) = &self.volume_error {
+            let _ = writeln!(s, "  {}", v.summary());
         }
         if let Some(r) = &self.range_error {
             let _ = writeln!(s, "  {}", r.summary());

@@ -213,6 +213,8 @@ struct Ctx<'a> {
     verdict: Option<(Verdict, Tolerance)>,
     /// 1σ of the hand-eye as tabled (flange-frame x, y, z; roll, pitch, yaw).
     hand_eye_sigma: Option<[f64; 6]>,
+    /// The same a priori (the covariance as written).
+    hand_eye_sigma_a_priori: Option<[f64; 6]>,
     /// The held-out figure, when the result has one.
     held_out: Option<HeldOut>,
     /// Warnings about the run (the paper's loop making ε worse).
@@ -237,6 +239,7 @@ impl<'a> Ctx<'a> {
             identify_scatter: view.identify_scatter,
             excluded: excluded_measurements(input.session, result),
             hand_eye_sigma: view.hand_eye_sigma,
+            hand_eye_sigma_a_priori: view.hand_eye_sigma_a_priori,
             held_out: view.held_out,
             warnings: view.warnings,
             verdict: input

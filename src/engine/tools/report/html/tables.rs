@@ -60,8 +60,9 @@ pub(super) fn identifiability(h: &mut String, ctx: &Ctx<'_>) {
         h.push_str("<h3>Uncertainty</h3>\n<ul>\n");
         let _ = writeln!(
             h,
-            "<li>variance factor {} (≈ 1 when the noise model fits; the covariance is not rescaled by it)</li>",
-            num(ml.variance_factor, 3)
+            "<li>variance factor {} (≈ 1 when the noise model fits). The ± 1σ of the tables are a posteriori: the covariance as written (a priori, from the noise model) times the variance factor, σ × {}; hover a value for its a priori σ. The file's covariance is as written.</li>",
+            num(ml.variance_factor, 3),
+            num(ml.variance_factor.max(0.0).sqrt(), 3)
         );
         if let Some(v) = &ml.predicted_distance_std_validate {
             let _ = writeln!(
@@ -77,6 +78,9 @@ pub(super) fn identifiability(h: &mut String, ctx: &Ctx<'_>) {
                     .map(|x| format!(" (measured: {} mm)", num(x.after.std, 4)))
                     .unwrap_or_default()
             );
+        }
+        if let Some(v) = &ml.volume_error {
+            let _ = writeln!(h, "<li id=\"volume-error\">{}</li>", escape(&v.summary()));
         }
         let p = &ml.predicted_distance_std_identify;
         let _ = writeln!(
@@ -173,7 +177,13 @@ pub(super) fn marked_cell(ctx: &Ctx<'_>, label: &str, text: String) -> String {
     let sigma = ctx
         .sigma
         .get(label)
-        .map(|s| format!(" <span class=\"muted\">± {}</span>", num(s.std, 4)))
+        .map(|s| {
+            format!(
+                " <span class=\"muted\" title=\"a priori ± {}\">± {}</span>",
+                num(s.a_priori, 4),
+                num(s.std, 4)
+            )
+        })
         .unwrap_or_default();
     match ctx.marks.get(label) {
         Some(why) => format!(
@@ -199,7 +209,13 @@ pub(super) fn hand_eye_cell(ctx: &Ctx<'_>, k: usize, text: String) -> String {
     } else {
         let sigma = ctx
             .hand_eye_sigma
-            .map(|s| format!(" <span class=\"muted\">± {}</span>", num(s[k], 4)))
+            .map(|s| {
+                let prior = ctx
+                    .hand_eye_sigma_a_priori
+                    .map(|p| format!(" title=\"a priori ± {}\"", num(p[k], 4)))
+                    .unwrap_or_default();
+                format!(" <span class=\"muted\"{prior}>± {}</span>", num(s[k], 4))
+            })
             .unwrap_or_default();
         format!("<td class=\"n\">{}{sigma}</td>", escape(&text))
     }
