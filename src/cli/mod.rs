@@ -793,6 +793,10 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
                 h.rotation_residual,
                 h.translation_residual
             ),
+            HandEyeSource::Linear(g) => sayln!(
+                "initial base-from-sensor (linear, from every identify measurement): points scatter {:.4} mm rms",
+                g.rms_mm
+            ),
         }
         sayln!(
             "identification: method {}, threshold {} mm, at most {} update(s)",
