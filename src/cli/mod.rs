@@ -33,10 +33,12 @@ pub mod export_model;
 pub mod history;
 pub mod html_report;
 pub mod import;
+pub mod import_fixed;
 pub mod measure;
 pub mod plan;
 pub mod scan_flags;
 pub mod simulate;
+pub mod simulate_fixed;
 pub mod values;
 
 use std::path::{Path, PathBuf};

@@ -186,6 +186,15 @@ pub struct SimulateArgs {
     /// A pose-only session: every measurement reports its flange pose (the true flange position plus Gaussian error of this σ, mm, each base-frame coordinate) instead of joints, and the session has no robot (as a cell whose controller reports poses).
     #[arg(long, value_name = "MM", conflicts_with_all = ["plan", "scan", "csv_out"], value_parser = number(Range::non_negative("mm").at_most(MAX_SENSOR_NOISE_MM)))]
     pub pose_only: Option<f64>,
+    /// Where the sensor stands: `flange` (the paper's cell) or `fixed` (a sensor fixed in the cell measuring targets on the tool; see --fixed-sensor).
+    #[arg(long, value_enum, default_value_t = super::import::MountArg::Flange)]
+    pub mount: super::import::MountArg,
+    /// With --mount fixed: a laser tracker and three SMRs on the tool, or a fixed scanner and one sphere.
+    #[arg(long, value_enum, default_value_t = super::simulate_fixed::FixedSensorArg::Tracker)]
+    pub fixed_sensor: super::simulate_fixed::FixedSensorArg,
+    /// With --mount fixed: the sensor's noise, mm (1σ a coordinate; the scanner's depth three times it).
+    #[arg(long, value_name = "MM", default_value_t = 0.01, value_parser = number(Range::non_negative("mm").at_most(MAX_SENSOR_NOISE_MM)))]
+    pub sensor_noise: f64,
 }
 
 /// Most poses of a simulated scan (per sphere for `spheres`): a scan of
@@ -369,6 +378,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             "the session and the truth would both be written to {}; give --truth another path",
             args.out.display()
         )));
+    }
+    if args.mount == super::import::MountArg::Fixed {
+        return super::simulate_fixed::run(args, &truth_path);
     }
     CliError::guard_output(&args.out, &inputs)?;
     CliError::guard_output(&truth_path, &inputs)?;

@@ -205,8 +205,10 @@ pub(super) fn report(
     if phase(Phase::RangeError) == Control::Cancel {
         return cancelled(solver);
     }
-    let range_error =
-        super::range::range_error(session, prepared, problem, &state.est, &cov_scaled);
+    // The range is a laser plane on the flange; a fixed sensor has none.
+    let range_error = (session.mount == crate::engine::base::session::Mount::Flange)
+        .then(|| super::range::range_error(session, prepared, problem, &state.est, &cov_scaled))
+        .flatten();
     // Leave-one-station-out.
     let cross_validation = if mo.cross_validation && problem.stations.len() >= 2 {
         match problem.cross_validate(state, phase) {
