@@ -11,6 +11,8 @@ use spherecal::engine::base::session::{Mount, Session, Use};
 use spherecal::engine::calibrate::solve::{self, Method, Options};
 use spherecal::engine::files::format::stations::prediction_errors;
 use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::files::import::tracker::{TrackerSpec, import_tracker};
+use spherecal::engine::files::import::{AngleUnit, LengthUnit};
 use spherecal::engine::tools::simulate::{FixedCell, FixedTruth, SimConfig, simulate_fixed};
 
 fn rms(v: &[f64]) -> f64 {
@@ -152,4 +154,66 @@ fn the_first_joint_is_fixed_for_the_sensor_pose_and_the_last_for_the_targets() {
     for p in ["he_x", "he_rz", "a2", "theta3"] {
         assert!(!fixed.iter().any(|f| f == p), "{p} fixed: {fixed:?}");
     }
+}
+
+fn tracker_spec(points: &Path, unit: LengthUnit) -> TrackerSpec {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    TrackerSpec {
+        points: points.to_path_buf(),
+        joint_log: root.join("examples/tracker/joints.csv"),
+        id_column: "id".into(),
+        joint_columns: (1..=6).map(|k| format!("j{k}")).collect(),
+        angle_unit: AngleUnit::Deg,
+        length_unit: unit,
+        robot: spherecal::engine::base::robot::irb2400().robot,
+        diameter: 38.1,
+        name: "tracker".into(),
+    }
+}
+
+#[test]
+fn a_trackers_table_in_metres_with_named_columns_and_repeats_imports_averaged() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let named = root.join("examples/tracker/points-m.csv");
+    let (session, notes) = import_tracker(&tracker_spec(&named, LengthUnit::M)).unwrap();
+    assert_eq!(session.mount, Mount::Fixed);
+    assert_eq!(session.measurements.len(), 24);
+    assert_eq!(session.with_use(Use::Validate).count(), 6);
+    assert!(
+        notes.iter().any(|n| n.contains("averaged at 24")),
+        "{notes:?}"
+    );
+    // The same points one a row, in mm, in another order: the same session.
+    let dir = tempfile::tempdir().unwrap();
+    let rows = dir.path().join("rows.csv");
+    let mut text = String::from("pose,target,x,y,z\n");
+    for m in session.measurements.iter().rev() {
+        let spherecal::engine::base::session::Observation::Centre(c) = &m.observation else {
+            panic!("a centre")
+        };
+        let pose = m.id.split('-').next().unwrap();
+        text += &format!("{pose},{},{},{},{}\n", m.station, c.x, c.y, c.z);
+    }
+    std::fs::write(&rows, text).unwrap();
+    let (again, _) = import_tracker(&tracker_spec(&rows, LengthUnit::Mm)).unwrap();
+    assert_eq!(again.measurements.len(), 24);
+    // Poses in the log's order, targets in the table's order within one.
+    let key = |s: &Session| {
+        let mut v: Vec<(String, String, Vec<f64>)> = s
+            .measurements
+            .iter()
+            .map(|m| (m.id.clone(), m.station.clone(), m.joints.clone()))
+            .collect();
+        v.sort_by(|a, b| a.0.cmp(&b.0));
+        v
+    };
+    assert_eq!(key(&again), key(&session));
+    assert_eq!(again.measurements[0].id, "P1-SMR3");
+    // A pose the joint log does not have is named with its line.
+    std::fs::write(&rows, "pose,x,y,z\nP1,1,2,3\nP99,1,2,3\n").unwrap();
+    let e = import_tracker(&tracker_spec(&rows, LengthUnit::Mm)).unwrap_err();
+    assert!(
+        e.to_string().contains("line 3") && e.to_string().contains("P99"),
+        "{e}"
+    );
 }

@@ -333,9 +333,6 @@ fn progress_line(
 /// [`CliError`] with status 2 for bad input, 1 when the session cannot be
 /// written.
 pub fn run(args: &ImportArgs) -> Result<(), CliError> {
-    if args.mount == MountArg::Fixed {
-        return super::import_fixed::run(args);
-    }
     if args.centres.is_some() && args.poses.is_none() {
         return Err(CliError::input(
             "--centres reads beside a pose file (--poses), or beside a joint log with --mount fixed",

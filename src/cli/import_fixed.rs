@@ -4,17 +4,30 @@
 //! ([`import_tracker`](crate::engine::files::import::tracker::import_tracker)).
 
 use crate::cli::CliError;
-use crate::cli::import::{ImportArgs, joint_log_columns};
+use crate::cli::import::{ImportArgs, MountArg, joint_log_columns};
 use crate::engine::files::format;
 use crate::engine::files::import::tracker::{TrackerSpec, import_tracker};
 use crate::engine::files::import::{self, LengthUnit};
+
+/// `spherecal import`: a fixed sensor's points here, anything else by
+/// [`crate::cli::import::run`].
+///
+/// # Errors
+/// As the import that runs.
+pub fn dispatch(args: &ImportArgs) -> Result<(), CliError> {
+    if args.mount == MountArg::Fixed {
+        run(args)
+    } else {
+        crate::cli::import::run(args)
+    }
+}
 
 /// Imports, writes the session and prints what was read.
 ///
 /// # Errors
 /// [`CliError`] (status 2) for a missing flag or a bad input, naming the
 /// file, line and column.
-pub fn run(args: &ImportArgs) -> Result<(), CliError> {
+fn run(args: &ImportArgs) -> Result<(), CliError> {
     if args.poses.is_some() {
         return Err(CliError::input(
             "--mount fixed reads a joint log (--joints) beside --centres; a pose file is not read for a fixed sensor yet",

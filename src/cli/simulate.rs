@@ -89,6 +89,15 @@ impl From<SideArg> for SideChoice {
     }
 }
 
+/// The fixed sensor simulated (`--fixed-sensor`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FixedSensorArg {
+    /// A laser tracker 2.6 m from the base, three SMRs on the tool.
+    Tracker,
+    /// A fixed 3-D scanner, one sphere on the tool.
+    Scanner,
+}
+
 /// `spherecal simulate`: a simulated session with a known truth, for tests,
 /// demos and what-if studies. Defaults give the paper-like demo.
 #[derive(Debug, Clone, clap::Args)]
@@ -190,8 +199,8 @@ pub struct SimulateArgs {
     #[arg(long, value_enum, default_value_t = super::import::MountArg::Flange)]
     pub mount: super::import::MountArg,
     /// With --mount fixed: a laser tracker and three SMRs on the tool, or a fixed scanner and one sphere.
-    #[arg(long, value_enum, default_value_t = super::simulate_fixed::FixedSensorArg::Tracker)]
-    pub fixed_sensor: super::simulate_fixed::FixedSensorArg,
+    #[arg(long, value_enum, default_value_t = FixedSensorArg::Tracker)]
+    pub fixed_sensor: FixedSensorArg,
     /// With --mount fixed: the sensor's noise, mm (1σ a coordinate; the scanner's depth three times it).
     #[arg(long, value_name = "MM", default_value_t = 0.01, value_parser = number(Range::non_negative("mm").at_most(MAX_SENSOR_NOISE_MM)))]
     pub sensor_noise: f64,
@@ -378,9 +387,6 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             "the session and the truth would both be written to {}; give --truth another path",
             args.out.display()
         )));
-    }
-    if args.mount == super::import::MountArg::Fixed {
-        return super::simulate_fixed::run(args, &truth_path);
     }
     CliError::guard_output(&args.out, &inputs)?;
     CliError::guard_output(&truth_path, &inputs)?;

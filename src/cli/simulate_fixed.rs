@@ -7,20 +7,11 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::cli::CliError;
-use crate::cli::simulate::SimulateArgs;
+use crate::cli::simulate::{FixedSensorArg, SimulateArgs};
 use crate::engine::base::geometry::rows_from_isometry;
 use crate::engine::base::session::{Observation, Session, Use};
 use crate::engine::files::format;
 use crate::engine::tools::simulate::{FixedCell, FixedTruth, simulate_fixed};
-
-/// The fixed sensor simulated (`--fixed-sensor`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum FixedSensorArg {
-    /// A laser tracker 2.6 m from the base, three SMRs on the tool.
-    Tracker,
-    /// A fixed 3-D scanner, one sphere on the tool.
-    Scanner,
-}
 
 /// The truth of a fixed cell as JSON: the true robot's joints, `bT_s` and
 /// the targets on the flange.
@@ -70,12 +61,31 @@ fn tables(session: &Session) -> (String, String) {
     (points, joints)
 }
 
+/// `spherecal simulate`: a fixed sensor's cell here, anything else by
+/// [`crate::cli::simulate::run`].
+///
+/// # Errors
+/// As the simulation that runs.
+pub fn dispatch(args: &SimulateArgs) -> Result<(), CliError> {
+    if args.mount != crate::cli::import::MountArg::Fixed {
+        return crate::cli::simulate::run(args);
+    }
+    let truth_path = args.truth_path();
+    if truth_path == args.out {
+        return Err(CliError::input(format!(
+            "the session and the truth would both be written to {}; give --truth another path",
+            args.out.display()
+        )));
+    }
+    run(args, &truth_path)
+}
+
 /// Simulates, writes the session, the truth and the tables, and prints.
 ///
 /// # Errors
 /// [`CliError`] for flags that do not apply to a fixed sensor, a bad
 /// setting or an output that cannot be written.
-pub fn run(args: &SimulateArgs, truth_path: &Path) -> Result<(), CliError> {
+fn run(args: &SimulateArgs, truth_path: &Path) -> Result<(), CliError> {
     if args.plan.is_some() || args.scan.is_some() || args.pose_only.is_some() {
         return Err(CliError::input(
             "--mount fixed simulates its own poses: --plan, --scan and --pose-only do not apply",
