@@ -21,7 +21,7 @@ fn main() -> ExitCode {
         Some(Command::ExportModel(args)) => cli::export_model::run(&args),
         Some(Command::Import(args)) => cli::import_fixed::dispatch(&args),
         Some(Command::Measure(args)) => cli::measure::run(&args),
-        Some(Command::Plan(args)) => cli::plan::run(&args),
+        Some(Command::Plan(args)) => cli::plan_fixed::dispatch(&args),
         Some(Command::Report(args)) => cli::html_report::run(&args),
         Some(Command::History(args)) => cli::history::run(&args),
         Some(Command::Compensate(args)) => cli::compensate::run(&args),

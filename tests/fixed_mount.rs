@@ -217,3 +217,45 @@ fn a_trackers_table_in_metres_with_named_columns_and_repeats_imports_averaged() 
         "{e}"
     );
 }
+
+#[test]
+fn a_fixed_plan_puts_the_target_in_the_box_facing_the_sensor() {
+    use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+    use spherecal::engine::tools::plan::fixed::{FixedPlanRequest, fixed_plan_csv, plan_fixed};
+    let position = Vector3::new(2600.0, 300.0, 900.0);
+    let centre = Vector3::new(1100.0, 0.0, 700.0);
+    let req = FixedPlanRequest {
+        preset: spherecal::engine::base::robot::irb2400(),
+        base_from_sensor: Isometry3::from_parts(
+            Translation3::from(position),
+            UnitQuaternion::face_towards(&(centre - position), &Vector3::z()),
+        ),
+        target: Vector3::new(0.0, 0.0, 100.0),
+        target_normal: Vector3::z(),
+        cone_deg: 45.0,
+        reach_mm: 5000.0,
+        box_min: [800.0, -300.0, 400.0],
+        box_max: [1400.0, 300.0, 1000.0],
+        n_identify: 30,
+        n_validate: 8,
+        candidates: 600,
+        seed: 3,
+    };
+    let poses = plan_fixed(&req).unwrap();
+    assert_eq!(poses.len(), 38);
+    assert_eq!(poses.iter().filter(|p| p.usage == Use::Validate).count(), 8);
+    for p in &poses {
+        let flange = req.preset.robot.base_from_flange(&p.joints);
+        let x = (flange * Point3::from(req.target)).coords;
+        assert!((0..3).all(|k| x[k] >= req.box_min[k] - 1e-3 && x[k] <= req.box_max[k] + 1e-3));
+        let to_sensor = (position - x).normalize();
+        let facing = (flange.rotation * Vector3::z()).dot(&to_sensor);
+        assert!(facing >= 45f64.to_radians().cos() - 1e-6, "{}", p.id);
+    }
+    assert_eq!(plan_fixed(&req).unwrap(), poses, "seeded");
+    let csv = fixed_plan_csv(&poses);
+    assert!(
+        csv.starts_with("id,use,j1,j2,j3,j4,j5,j6\nP1,identify,"),
+        "{csv}"
+    );
+}

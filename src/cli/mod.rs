@@ -36,6 +36,7 @@ pub mod import;
 pub mod import_fixed;
 pub mod measure;
 pub mod plan;
+pub mod plan_fixed;
 pub mod scan_flags;
 pub mod simulate;
 pub mod simulate_fixed;

@@ -98,6 +98,7 @@ use crate::engine::tools::simulate::{PlanPose, SimError};
 mod candidates;
 mod config;
 mod export;
+pub mod fixed;
 mod order;
 mod predict;
 pub mod range_study;
