@@ -27,12 +27,15 @@ pub struct StationRecord {
     pub frame: String,
 }
 
+/// Per station: the sum and count of its identify points, then of the others.
+type Sums = ([f64; 3], usize, [f64; 3], usize);
+
 /// The `stations` block of a run's `centres` on a session with `mount`,
 /// stations in order of first appearance.
 #[must_use]
 pub fn stations_of(centres: &[CentreRecord], mount: Mount) -> Vec<StationRecord> {
     let mut order: Vec<&str> = Vec::new();
-    let mut sums: HashMap<&str, ([f64; 3], usize, [f64; 3], usize)> = HashMap::new();
+    let mut sums: HashMap<&str, Sums> = HashMap::new();
     for c in centres {
         let entry = sums.entry(c.station.as_str()).or_insert_with(|| {
             order.push(c.station.as_str());
@@ -43,8 +46,8 @@ pub fn stations_of(centres: &[CentreRecord], mount: Mount) -> Vec<StationRecord>
         } else {
             (&mut entry.2, &mut entry.3)
         };
-        for k in 0..3 {
-            sum[k] += c.after[k];
+        for (s, a) in sum.iter_mut().zip(c.after) {
+            *s += a;
         }
         *n += 1;
     }
