@@ -259,3 +259,17 @@ fn a_fixed_plan_puts_the_target_in_the_box_facing_the_sensor() {
         "{csv}"
     );
 }
+
+#[test]
+fn compensation_takes_a_fixed_sensors_model_but_not_its_sensor_as_a_tool() {
+    use spherecal::engine::uses::compensate::{CompensateError, Model, Tcp};
+    let (session, _) = simulate_fixed(&config(3), &FixedCell::tracker(0.01)).unwrap();
+    let (_, cal) = solve::calibrate(&session, &Options::from_session(&session)).unwrap();
+    let result = ResultFile::from_calibration(&session, &cal);
+    assert!(matches!(
+        Model::new(&result, Some(&session), Tcp::Sensor),
+        Err(CompensateError::FixedSensor)
+    ));
+    let flange = Model::new(&result, Some(&session), Tcp::Flange);
+    assert!(flange.is_ok(), "{:?}", flange.err());
+}
