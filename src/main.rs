@@ -15,13 +15,13 @@ fn main() -> ExitCode {
     let parsed = Cli::parse_args();
     let outcome = match parsed.command {
         Some(Command::Calibrate(args)) => cli::calibrate_command(&args),
-        Some(Command::Simulate(args)) => cli::simulate::run(&args),
+        Some(Command::Simulate(args)) => cli::simulate_fixed::dispatch(&args),
         Some(Command::Gui(args)) => gui(args.session, args.result),
         Some(Command::Evaluate(args)) => cli::evaluate::run(&args),
         Some(Command::ExportModel(args)) => cli::export_model::run(&args),
-        Some(Command::Import(args)) => cli::import::run(&args),
+        Some(Command::Import(args)) => cli::import_fixed::dispatch(&args),
         Some(Command::Measure(args)) => cli::measure::run(&args),
-        Some(Command::Plan(args)) => cli::plan::run(&args),
+        Some(Command::Plan(args)) => cli::plan_fixed::dispatch(&args),
         Some(Command::Report(args)) => cli::html_report::run(&args),
         Some(Command::History(args)) => cli::history::run(&args),
         Some(Command::Compensate(args)) => cli::compensate::run(&args),

@@ -39,9 +39,15 @@ pub struct ImportArgs {
     /// A folder of stripe profiles (`<id>.csv|txt|yml|yaml|json`; for a pose log without ids the files named alike, in the order of the number in their names: p7.yml, 7_3C_line.yml, scan_007.csv; other files, the pose file among them, are skipped and listed) or one CSV with a pose column.
     #[arg(long, required_unless_present = "centres", conflicts_with = "centres")]
     pub profiles: Option<PathBuf>,
-    /// With --poses: the sphere centres the sensor reported, instead of profiles: a table with one `x y z` a pose (sensor frame, mm; any separator, header optional, an `id` column optional), paired with the poses in order.
-    #[arg(long, requires = "poses", conflicts_with = "joints")]
+    /// With --poses: the sphere centres the sensor reported, instead of profiles: a table with one `x y z` a pose (sensor frame, mm; any separator, header optional, an `id` column optional), paired with the poses in order. With --mount fixed and --joints: the fixed sensor's points (a tracker's table; see the guide's "A fixed sensor").
+    #[arg(long)]
     pub centres: Option<PathBuf>,
+    /// Where the sensor stands: `flange` (the sensor on the robot, the sphere in the cell) or `fixed` (a laser tracker, fixed camera or scanner in the cell measuring targets on the tool; reads --centres beside --joints).
+    #[arg(long, value_enum, default_value_t = MountArg::Flange)]
+    pub mount: MountArg,
+    /// With --mount fixed: the unit of the points in --centres.
+    #[arg(long, value_name = "UNIT", default_value = "mm", value_parser = ["mm", "m", "um"])]
+    pub centre_unit: String,
     /// A hand-eye guess to start from instead of computing one: a JSON 4x4 matrix (rows, mm), or a session or result file (its `hand_eye`).
     #[arg(long)]
     pub hand_eye: Option<PathBuf>,
@@ -88,6 +94,15 @@ pub struct ImportArgs {
     /// `-q`: [`QUIET_HELP`](super::QUIET_HELP).
     #[arg(long, short, help = QUIET_HELP)]
     pub quiet: bool,
+}
+
+/// `--mount`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MountArg {
+    /// The sensor on the flange, the sphere fixed in the cell (the paper's).
+    Flange,
+    /// The sensor fixed in the cell, the targets on the flange.
+    Fixed,
 }
 
 /// `--side`.
@@ -163,6 +178,40 @@ fn input(e: &ImportError) -> CliError {
 /// # Errors
 /// [`CliError`] (status 2) for a bad `--map` entry or an unknown robot.
 pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
+    let (joint_log, robot, columns) = joint_log_columns(args)?;
+    let profiles = profile_source(args)?;
+    let flange = args.flange_poses.map(|convention| {
+        let mut check = FlangeCheck::new(convention);
+        if !args.flange_columns.is_empty() {
+            check.columns.clone_from(&args.flange_columns);
+        }
+        check.tolerance_mm = args.position_tolerance;
+        check.tolerance_deg = args.rotation_tolerance;
+        check
+    });
+    Ok(ImportSpec {
+        joint_log,
+        columns,
+        joint_unit: args.scan.joint_unit,
+        profiles,
+        profile_format: args.scan.profile_format()?,
+        robot,
+        sphere_diameter: args.sphere_diameter,
+        name: args.name.clone(),
+        flange,
+        references: args.references.clone(),
+    })
+}
+
+/// The joint log, the robot and the log's columns (`--map` over the
+/// defaults `id`, `station`, `use`, `j1..jn`).
+///
+/// # Errors
+/// [`CliError`] (status 2): no `--joints` or `--robot`, a robot that does
+/// not load, a bad `--map` entry.
+pub fn joint_log_columns(
+    args: &ImportArgs,
+) -> Result<(PathBuf, import::RobotSource, ColumnMap), CliError> {
     let Some(joint_log) = &args.joints else {
         return Err(CliError::input("a joint log (--joints) is needed here"));
     };
@@ -207,28 +256,7 @@ pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
             }
         }
     }
-    let profiles = profile_source(args)?;
-    let flange = args.flange_poses.map(|convention| {
-        let mut check = FlangeCheck::new(convention);
-        if !args.flange_columns.is_empty() {
-            check.columns.clone_from(&args.flange_columns);
-        }
-        check.tolerance_mm = args.position_tolerance;
-        check.tolerance_deg = args.rotation_tolerance;
-        check
-    });
-    Ok(ImportSpec {
-        joint_log: joint_log.clone(),
-        columns,
-        joint_unit: args.scan.joint_unit,
-        profiles,
-        profile_format: args.scan.profile_format()?,
-        robot,
-        sphere_diameter: args.sphere_diameter,
-        name: args.name.clone(),
-        flange,
-        references: args.references.clone(),
-    })
+    Ok((joint_log.clone(), robot, columns))
 }
 
 /// The `--out` path, required unless only previewing, refused when it is one of the import's inputs (the
@@ -315,6 +343,11 @@ fn progress_line(
 /// [`CliError`] with status 2 for bad input, 1 when the session cannot be
 /// written.
 pub fn run(args: &ImportArgs) -> Result<(), CliError> {
+    if args.centres.is_some() && args.poses.is_none() {
+        return Err(CliError::input(
+            "--centres reads beside a pose file (--poses), or beside a joint log with --mount fixed",
+        ));
+    }
     match (&args.poses, args.preview) {
         (Some(_), Some(_)) => {
             return Err(CliError::input("--preview reads a joint log (--joints)"));

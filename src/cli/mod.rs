@@ -33,10 +33,13 @@ pub mod export_model;
 pub mod history;
 pub mod html_report;
 pub mod import;
+pub mod import_fixed;
 pub mod measure;
 pub mod plan;
+pub mod plan_fixed;
 pub mod scan_flags;
 pub mod simulate;
+pub mod simulate_fixed;
 pub mod values;
 
 use std::path::{Path, PathBuf};
@@ -825,6 +828,10 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
                 "initial hand-eye (eq. 6-9): rotation residual {:.4} mm, translation residual {:.4} mm",
                 h.rotation_residual,
                 h.translation_residual
+            ),
+            HandEyeSource::Linear(g) => sayln!(
+                "initial base-from-sensor (linear, from every identify measurement): points scatter {:.4} mm rms",
+                g.rms_mm
             ),
         }
         sayln!(

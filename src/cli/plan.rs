@@ -49,8 +49,20 @@ pub struct PlanArgs {
     )]
     pub limits: Vec<String>,
     /// Rough sphere position `x,y,z` (mm, base frame): station P0 and the middle of the station box.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_triple, allow_hyphen_values = true, required_unless_present = "sensor_at")]
+    pub sphere: Option<[f64; 3]>,
+    /// Where the sensor stands: `flange` (the paper's cell) or `fixed` (a laser tracker, fixed camera or scanner measuring a target on the tool; needs --sensor-at; writes the joint log with --csv).
+    #[arg(long, value_enum, default_value_t = super::import::MountArg::Flange)]
+    pub mount: super::import::MountArg,
+    /// With --mount fixed: the sensor's position `x,y,z` (mm, base frame); it looks at the middle of the workspace box.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_triple, allow_hyphen_values = true)]
-    pub sphere: [f64; 3],
+    pub sensor_at: Option<[f64; 3]>,
+    /// With --mount fixed: the target on the tool `x,y,z` (mm, flange frame); it faces along the flange's z.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_triple, allow_hyphen_values = true, default_value = "0,0,100")]
+    pub target: [f64; 3],
+    /// With --mount fixed: the sensor's reach, mm.
+    #[arg(long, value_name = "MM", default_value_t = 5000.0, value_parser = number(Range::positive("mm")))]
+    pub reach: f64,
     /// Hand-eye guess: a JSON file with a 4x4 matrix (rows, mm) or a session/result file with `hand_eye` [default: the paper's initial hand-eye]
     #[arg(long)]
     pub hand_eye: Option<PathBuf>,
@@ -186,7 +198,7 @@ fn setting_error(message: &str) -> CliError {
     }
 }
 
-fn parse_triple(s: &str) -> Result<[f64; 3], String> {
+pub(crate) fn parse_triple(s: &str) -> Result<[f64; 3], String> {
     let v: Vec<f64> = s
         .split(',')
         .map(|p| p.trim().parse::<f64>())
@@ -228,9 +240,12 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
         RobotSource::from_text(&args.robot, args.urdf_tip.clone(), args.dh)
             .map_err(CliError::input)?
     };
+    let sphere = args.sphere.ok_or_else(|| {
+        CliError::input("--sphere X,Y,Z is needed (or --mount fixed with --sensor-at)")
+    })?;
     Ok(PlanRequest {
         design: PlanDesign {
-            sphere: args.sphere,
+            sphere,
             diameter: args.diameter,
             n_translation: args.translations,
             n_rotation: args.rotations,
@@ -271,7 +286,7 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
         predict_runs: args.predict,
         range: args.range,
         spread: args.range.is_some() && !args.no_spread,
-        ..PlanRequest::new(robot, args.sphere)
+        ..PlanRequest::new(robot, sphere)
     })
 }
 

@@ -89,6 +89,15 @@ impl From<SideArg> for SideChoice {
     }
 }
 
+/// The fixed sensor simulated (`--fixed-sensor`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FixedSensorArg {
+    /// A laser tracker 2.6 m from the base, three SMRs on the tool.
+    Tracker,
+    /// A fixed 3-D scanner, one sphere on the tool.
+    Scanner,
+}
+
 /// `spherecal simulate`: a simulated session with a known truth, for tests,
 /// demos and what-if studies. Defaults give the paper-like demo.
 #[derive(Debug, Clone, clap::Args)]
@@ -186,6 +195,15 @@ pub struct SimulateArgs {
     /// A pose-only session: every measurement reports its flange pose (the true flange position plus Gaussian error of this σ, mm, each base-frame coordinate) instead of joints, and the session has no robot (as a cell whose controller reports poses).
     #[arg(long, value_name = "MM", conflicts_with_all = ["plan", "scan", "csv_out"], value_parser = number(Range::non_negative("mm").at_most(MAX_SENSOR_NOISE_MM)))]
     pub pose_only: Option<f64>,
+    /// Where the sensor stands: `flange` (the paper's cell) or `fixed` (a sensor fixed in the cell measuring targets on the tool; see --fixed-sensor).
+    #[arg(long, value_enum, default_value_t = super::import::MountArg::Flange)]
+    pub mount: super::import::MountArg,
+    /// With --mount fixed: a laser tracker and three SMRs on the tool, or a fixed scanner and one sphere.
+    #[arg(long, value_enum, default_value_t = FixedSensorArg::Tracker)]
+    pub fixed_sensor: FixedSensorArg,
+    /// With --mount fixed: the sensor's noise, mm (1σ a coordinate; the scanner's depth three times it).
+    #[arg(long, value_name = "MM", default_value_t = 0.01, value_parser = number(Range::non_negative("mm").at_most(MAX_SENSOR_NOISE_MM)))]
+    pub sensor_noise: f64,
 }
 
 /// Most poses of a simulated scan (per sphere for `spheres`): a scan of

@@ -118,6 +118,7 @@ fn paper_without(session: &Session, options: &Options, id: &str) -> f64 {
     let refit = solve::estimate::Estimate {
         robot: cal.calibrated.clone(),
         flange_from_sensor: cal.hand_eye,
+        mount: session.mount,
     };
     let sighting = solve::prepare(session).unwrap().sighting(session, i);
     (refit.centre_in_base(&sighting) - mean).norm()

@@ -437,6 +437,7 @@ fn reference_fit(session: &Session, prepared: &Prepared, truth: &Truth) -> Truth
     let start = Estimate {
         robot: truth.true_robot(),
         flange_from_sensor: truth.true_hand_eye(),
+        mount: session.mount,
     };
     let mut options = ml_options(session);
     options.ml.prior = false;

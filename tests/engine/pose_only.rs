@@ -149,6 +149,7 @@ fn with_noise_the_hand_eye_error_is_at_the_noise_floor() {
     let floor_est = spherecal::engine::calibrate::solve::estimate::Estimate {
         robot: session.solver_robot(),
         flange_from_sensor: truth.true_hand_eye(),
+        mount: session.mount,
     };
     let (prepared, _) = solve::calibrate(&session, &Options::from_session(&session)).unwrap();
     let stations = prepared.stations(&session, spherecal::engine::base::session::Use::Identify);

@@ -88,6 +88,7 @@ fn robcalibrator_data_calibrates_below_the_reference_scatter() {
         &solve::estimate::Estimate {
             robot: session.solver_robot(),
             flange_from_sensor: cal.hand_eye,
+            mount: session.mount,
         }
         .station_centres(&stations),
     );
@@ -102,6 +103,7 @@ fn robcalibrator_data_calibrates_below_the_reference_scatter() {
         &solve::estimate::Estimate {
             robot: session.solver_robot(),
             flange_from_sensor: reference,
+            mount: session.mount,
         }
         .station_centres(&stations),
     );

@@ -11,6 +11,7 @@ pub mod centres;
 pub mod export;
 mod fail;
 mod figures;
+mod fixed;
 pub mod range_map;
 mod sets;
 mod tables;

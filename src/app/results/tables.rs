@@ -19,6 +19,7 @@ const SOLVER_ENTRY_CHARS: usize = 300;
 pub(super) fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
     // One above the other: with ± 1σ the joint table needs the width.
     hand_eye_ui(ui, view);
+    super::fixed::fixed_ui(ui, view);
     ui.add_space(8.0);
     match &view.hand_eye_only {
         Some(lines) => hand_eye_only_ui(ui, lines),
@@ -70,7 +71,7 @@ fn marked_cell(ui: &mut egui::Ui, view: &ResultView, label: &str, text: String) 
 }
 
 fn hand_eye_ui(ui: &mut egui::Ui, view: &ResultView) {
-    ui.label(RichText::new("Hand-eye eT_s (sensor to flange)").strong());
+    ui.label(RichText::new(super::fixed::hand_eye_title(view)).strong());
     let (b, a): (&HandEyeView, &HandEyeView) =
         (&view.shown.hand_eye_before, &view.shown.hand_eye_after);
     let sigma = view.shown.hand_eye_sigma;

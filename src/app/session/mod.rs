@@ -252,6 +252,7 @@ pub fn analyse(session: Session, source: Source) -> LoadedSession {
         let start = Estimate {
             robot: session.robot.clone(),
             flange_from_sensor: prepared.hand_eye_initial,
+            mount: session.mount,
         };
         let points = session
             .measurements

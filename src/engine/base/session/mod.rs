@@ -74,6 +74,62 @@ impl PartialEq<&str> for Use {
     }
 }
 
+/// Where the sensor stands (FORMAT.md `sensor.mount`, added 2026-11-27).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Mount {
+    /// The paper's set-up: the sensor on the flange, the sphere fixed in
+    /// the cell; the hand-eye is `eT_s` and a station is a point fixed in
+    /// the base frame.
+    #[default]
+    Flange,
+    /// The sensor fixed in the cell (a laser tracker, a 3-D camera, a
+    /// line scanner), the target on the flange; the hand-eye is `bT_s`
+    /// (`base_from_sensor`) and a station is a point fixed in the flange
+    /// frame.
+    Fixed,
+}
+
+impl Mount {
+    /// The file spelling.
+    #[must_use]
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Flange => "flange",
+            Self::Fixed => "fixed",
+        }
+    }
+
+    /// Parses the file spelling.
+    #[must_use]
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "flange" => Some(Self::Flange),
+            "fixed" => Some(Self::Fixed),
+            _ => None,
+        }
+    }
+
+    /// The frame a station's point is fixed in: `"base"` for a sensor on
+    /// the flange, `"flange"` for a fixed sensor (the result's
+    /// `stations[].frame`).
+    #[must_use]
+    pub fn station_frame(self) -> &'static str {
+        match self {
+            Self::Flange => "base",
+            Self::Fixed => "flange",
+        }
+    }
+
+    /// What the hand-eye transform is, in words.
+    #[must_use]
+    pub fn hand_eye_name(self) -> &'static str {
+        match self {
+            Self::Flange => "hand-eye (flange from sensor)",
+            Self::Fixed => "base from sensor",
+        }
+    }
+}
+
 /// What the sensor reported for one measurement.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Observation {
@@ -237,7 +293,10 @@ pub struct Session {
     /// `sensor.range`: where in the laser plane the calibrated sensor will
     /// measure (FORMAT.md "Additions to version 1"); `None` when not given.
     pub sensor_range: Option<SensorRange>,
-    /// Initial hand-eye `eT_s` from the file, if given.
+    /// `sensor.mount`: on the flange (default) or fixed in the cell.
+    pub mount: Mount,
+    /// Initial hand-eye from the file, if given: `eT_s`, or `bT_s` for a
+    /// fixed mount.
     pub hand_eye: Option<Isometry3<f64>>,
     /// Solver settings (defaults when absent).
     pub solver: SolverSettings,
@@ -273,6 +332,7 @@ impl Session {
             default_side: 1,
             sensor_given: false,
             sensor_range: None,
+            mount: Mount::Flange,
             hand_eye: None,
             solver: SolverSettings::default(),
             solver_given: false,
@@ -375,7 +435,9 @@ impl Session {
                 ));
             }
         }
-        if session.hand_eye.is_none() {
+        // A fixed sensor's initial `bT_s` follows from the identify
+        // measurements (FORMAT.md 2026-11-27): no translation or rotation group.
+        if session.hand_eye.is_none() && session.mount == Mount::Flange {
             for (usage, needed, purpose) in [
                 (Use::Translation, 3, "the initial rotation (paper eq. 6-7)"),
                 (Use::Rotation, 2, "the initial translation (paper eq. 8-9)"),

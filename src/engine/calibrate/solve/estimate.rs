@@ -13,11 +13,25 @@
 //!
 //! The paper's update ([`paper`](super::paper)) and `ml` ([`ml`](super::ml))
 //! both linearise with these.
+//!
+//! One constraint serves both mounts (FORMAT.md `sensor.mount`): a point
+//! fixed in one frame, seen from another, the kinematic chain between.
+//! With the sensor on the flange the point is the sphere centre in the
+//! base frame, `X = bT_e(q)·eT_s·X_s`; with a fixed sensor it is the
+//! target on the flange, `X = bT_e(q)⁻¹·bT_s·X_s`, and the transform
+//! estimated beside the model is `bT_s`. With `T = bT_e`, `H = bT_s`,
+//! `Y = H·X_s` (base frame) and a base-frame twist `ξ = J_i·ΔP` of the
+//! flange, the fixed mount's sensitivity is
+//!
+//! ```text
+//! ΔX_i = R(T⁻¹·H) · P_i · ΔX − R(T)ᵀ · [I | −[Y]×] · J_i · ΔP
+//! ```
 
 use nalgebra::{DMatrix, Isometry3, Matrix3, Point3, Vector3};
 
 use crate::engine::base::geometry::{isometry_from_twist, skew, twist_rows};
 use crate::engine::base::robot::{PARAM_IS_ANGLE, PARAMS_PER_JOINT, Robot};
+use crate::engine::base::session::Mount;
 use crate::engine::calibrate::handeye::Sighting;
 
 /// Lever (mm per rad) applied to angle unknowns before the SVD: the arm's
@@ -41,16 +55,34 @@ pub struct Station {
 pub struct Estimate {
     /// Kinematic model.
     pub robot: Robot,
-    /// `eT_s`.
+    /// The hand-eye: `eT_s` for a sensor on the flange; for a fixed
+    /// sensor ([`Mount::Fixed`]) `bT_s`, the sensor's pose in the base
+    /// frame.
     pub flange_from_sensor: Isometry3<f64>,
+    /// Where the sensor stands; says what the hand-eye and the stations are.
+    pub mount: Mount,
 }
 
 impl Estimate {
-    /// The base-frame sphere centre of one sighting (eq. 10), mm.
+    /// The transform from the sensor frame to the frame a station's point
+    /// is fixed in, at the flange pose `base_from_flange`: `bT_e·eT_s`
+    /// (base frame) for a sensor on the flange, `bT_e⁻¹·bT_s` (flange
+    /// frame) for a fixed sensor.
+    #[must_use]
+    pub fn station_from_sensor(&self, base_from_flange: &Isometry3<f64>) -> Isometry3<f64> {
+        match self.mount {
+            Mount::Flange => base_from_flange * self.flange_from_sensor,
+            Mount::Fixed => base_from_flange.inverse() * self.flange_from_sensor,
+        }
+    }
+
+    /// One sighting's point in its station's frame (eq. 10), mm: the
+    /// sphere centre in the base frame for a sensor on the flange, the
+    /// target in the flange frame for a fixed sensor.
     #[must_use]
     pub fn centre_in_base(&self, s: &Sighting) -> Vector3<f64> {
-        let base_from_sensor = s.base_from_flange(&self.robot) * self.flange_from_sensor;
-        (base_from_sensor * Point3::from(s.centre_in_sensor)).coords
+        let station_from_sensor = self.station_from_sensor(&s.base_from_flange(&self.robot));
+        (station_from_sensor * Point3::from(s.centre_in_sensor)).coords
     }
 
     /// Base-frame centres of every station, grouped as `stations`.
@@ -74,6 +106,7 @@ impl Estimate {
         Self {
             robot: self.robot.perturbed(&delta[6..]),
             flange_from_sensor: self.flange_from_sensor * isometry_from_twist(&twist),
+            mount: self.mount,
         }
     }
 }
@@ -149,22 +182,41 @@ impl PoseSensitivity {
         }
     }
 
-    /// `A_i` and the base-frame position of sensor point `x_s` at this pose.
+    /// `A_i` and the position of sensor point `x_s` at this pose in the
+    /// station frame (the base frame for a sensor on the flange, the
+    /// flange frame for a fixed sensor).
     #[must_use]
     pub fn at(&self, est: &Estimate, x_s: &Vector3<f64>) -> (Vector3<f64>, DMatrix<f64>) {
-        let base_from_sensor = self.base_from_flange * est.flange_from_sensor;
-        let x_b = (base_from_sensor * Point3::from(*x_s)).coords;
-        let r_bs: Matrix3<f64> = base_from_sensor.rotation.to_rotation_matrix().into_inner();
+        let station_from_sensor = est.station_from_sensor(&self.base_from_flange);
+        let x = (station_from_sensor * Point3::from(*x_s)).coords;
+        let r: Matrix3<f64> = station_from_sensor
+            .rotation
+            .to_rotation_matrix()
+            .into_inner();
         let n = 6 + self.jac.ncols();
         let mut a = DMatrix::zeros(3, n);
-        // Hand-eye block: R_bs · [I | −[X_s]×]   (eq. 13-14)
-        a.fixed_view_mut::<3, 3>(0, 0).copy_from(&r_bs);
+        // Hand-eye block: R · [I | −[X_s]×]   (eq. 13-14)
+        a.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
         a.fixed_view_mut::<3, 3>(0, 3)
-            .copy_from(&(-(r_bs * skew(x_s))));
-        // Kinematic block: Q_i · J_i = [I | −[X_b]×] · J_i   (eq. 15-16)
-        let qj = twist_rows(&x_b) * &self.jac;
+            .copy_from(&(-(r * skew(x_s))));
+        let qj = match est.mount {
+            // Kinematic block: Q_i · J_i = [I | −[X_b]×] · J_i   (eq. 15-16)
+            Mount::Flange => twist_rows(&x) * &self.jac,
+            // The flange moves by the base-frame twist J_i·ΔP; the point
+            // seen in the base frame, Y, moves the other way in the
+            // flange frame: −R(bT_e)ᵀ · [I | −[Y]×] · J_i.
+            Mount::Fixed => {
+                let y = (est.flange_from_sensor * Point3::from(*x_s)).coords;
+                let r_be: Matrix3<f64> = self
+                    .base_from_flange
+                    .rotation
+                    .to_rotation_matrix()
+                    .into_inner();
+                -(r_be.transpose() * twist_rows(&y)) * &self.jac
+            }
+        };
         a.view_mut((0, 6), (3, n - 6)).copy_from(&qj);
-        (x_b, a)
+        (x, a)
     }
 }
 
@@ -174,10 +226,17 @@ mod tests {
 
     #[test]
     fn sensitivity_matches_finite_differences() {
+        for mount in [Mount::Flange, Mount::Fixed] {
+            check_sensitivity(mount);
+        }
+    }
+
+    fn check_sensitivity(mount: Mount) {
         let robot = crate::engine::base::robot::irb2400().robot;
         let est = Estimate {
             robot,
             flange_from_sensor: isometry_from_twist(&[-7.4, -1.0, 287.8, 3.1, 0.02, 0.5]),
+            mount,
         };
         let s = Sighting {
             id: "x".into(),

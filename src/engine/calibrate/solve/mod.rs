@@ -513,6 +513,7 @@ pub fn run(
     let start = Estimate {
         robot: session.solver_robot(),
         flange_from_sensor: prepared.hand_eye_initial,
+        mount: session.mount,
     };
     let report = |updates: usize, epsilon: f64, phase: Phase| Progress {
         updates,
@@ -777,8 +778,8 @@ fn finish(
     report: SolverReport,
 ) -> Calibration {
     let centre = |e: &Estimate, i: usize| -> Vector3<f64> {
-        let base_from_sensor = session.base_from_flange(&e.robot, i) * e.flange_from_sensor;
-        (base_from_sensor * Point3::from(prepared.measurements[i].centre_in_sensor)).coords
+        let station_from_sensor = e.station_from_sensor(&session.base_from_flange(&e.robot, i));
+        (station_from_sensor * Point3::from(prepared.measurements[i].centre_in_sensor)).coords
     };
     let centres: Vec<CentreRow> = (0..session.measurements.len())
         .map(|i| CentreRow {

@@ -13,7 +13,11 @@ use nalgebra::{Isometry3, Matrix3, Vector3};
 
 use super::SolveError;
 use super::estimate::Station;
+use crate::engine::base::session::Mount;
 use crate::engine::base::session::{Observation, Session, Use};
+use crate::engine::calibrate::handeye::general::{
+    GeneralHandEye, GeneralSighting, general_hand_eye,
+};
 use crate::engine::calibrate::handeye::{InitialHandEye, Sighting, initial_hand_eye};
 use crate::engine::calibrate::stripe::{StripeError, StripeResult, centre_from_stripe};
 
@@ -37,6 +41,10 @@ pub enum HandEyeSource {
     File,
     /// Computed by eq. 6-9, with its diagnostics.
     Computed(InitialHandEye),
+    /// A fixed sensor's `bT_s`, with the targets on the flange, linear in
+    /// the unknowns from all identify measurements at once (FORMAT.md
+    /// 2026-11-27; [`general_hand_eye`] on the inverted flange poses).
+    Linear(GeneralHandEye),
 }
 
 /// What [`analyse`] made of a session: every measurement's outcome, in
@@ -161,10 +169,45 @@ fn hand_eye(
             })
             .collect()
     };
+    if session.mount == Mount::Fixed {
+        return fixed_initial(session, measurements);
+    }
     let translations = sightings(Use::Translation)?;
     let rotations = sightings(Use::Rotation)?;
     let initial = initial_hand_eye(&session.robot, &translations, &rotations)?;
     Ok((initial.flange_from_sensor, HandEyeSource::Computed(initial)))
+}
+
+/// A fixed sensor's initial `bT_s` (FORMAT.md 2026-11-27): the constraint
+/// `bT_s·X_s = bT_e(q)·X_e` is `bT_e(q)⁻¹·(R_s·X_s + t_s) = X_e`, the
+/// general hand-eye's `R_i·(R_s·x_i + t_s) + p_i = c_s` with the inverted
+/// nominal flange pose in place of the flange pose: linear in `R_s`, `t_s`
+/// and the station points, from every identify measurement at once.
+fn fixed_initial(
+    session: &Session,
+    measurements: &[Result<PreparedMeasurement, StripeError>],
+) -> Result<(Isometry3<f64>, HandEyeSource), SolveError> {
+    let stations = session.stations(Use::Identify);
+    let mut sightings = Vec::new();
+    for (k, (_, indices)) in stations.iter().enumerate() {
+        for &i in indices {
+            let m = &session.measurements[i];
+            let p = measurements[i]
+                .as_ref()
+                .map_err(|source| SolveError::Stripe {
+                    id: m.id.clone(),
+                    source: source.clone(),
+                })?;
+            sightings.push(GeneralSighting {
+                id: m.id.clone(),
+                station: k,
+                base_from_flange: session.base_from_flange(&session.robot, i).inverse(),
+                centre_in_sensor: p.centre_in_sensor,
+            });
+        }
+    }
+    let initial = general_hand_eye(&sightings, stations.len())?;
+    Ok((initial.flange_from_sensor, HandEyeSource::Linear(initial)))
 }
 
 /// Fits every stripe of `session` once (eq. 21) and computes the initial

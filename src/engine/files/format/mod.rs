@@ -10,7 +10,9 @@ mod json;
 mod layout;
 pub mod read;
 pub mod result;
+mod result_check;
 pub mod session;
+pub mod stations;
 pub mod transform;
 
 pub use atomic::{
@@ -20,6 +22,7 @@ pub use atomic::{
 pub use read::{Cap, read_bytes, read_text};
 pub use result::{
     ResultFile, load_result, parse_result, result_text_checked, result_to_json, save_result,
+    solver_block,
 };
 pub use session::{load_session, parse_session, save_session, session_to_json};
 pub use transform::{TransformError, read_transform, read_typed_transform};

@@ -11,11 +11,13 @@ use serde_json::{Map, Value};
 use nalgebra::Isometry3;
 
 use super::json::{Ctx, UniqueValue, join, read_text, render, render_lossy, settle, some};
+pub use super::result_check::implausible_number;
+use super::result_check::{first_non_finite, has_bare_null};
+use super::stations::{StationRecord, mount_of, stations_of};
 use super::{FORMAT_VERSION, FileError, RESULT_FORMAT, write_atomic};
 use crate::engine::base::geometry::{isometry_from_rows, rigid_from_rows, rows_from_isometry};
-use crate::engine::base::numeric::show;
 use crate::engine::base::robot::{Joint, Robot};
-use crate::engine::base::session::{Session, Use, limits};
+use crate::engine::base::session::{Mount, Session, Use};
 use crate::engine::calibrate::solve::ml::MlReport;
 use crate::engine::calibrate::solve::report::{Direction, PaperReport, SolverReport};
 use crate::engine::calibrate::solve::{Calibration, HeldOut};
@@ -34,9 +36,11 @@ use crate::engine::calibrate::validate::Validation;
 pub struct ResultFile {
     /// Name of the session the result was computed from.
     pub session: String,
-    /// Initial hand-eye `flange_from_sensor` (`eT_s`), before identification.
+    /// Initial hand-eye, before identification: `eT_s`
+    /// (`flange_from_sensor`), or `bT_s` (`base_from_sensor`) for a fixed
+    /// sensor ([`ResultFile::mount`]).
     pub hand_eye_initial: Isometry3<f64>,
-    /// Calibrated hand-eye `flange_from_sensor` (`eT_s`).
+    /// Calibrated hand-eye, as `hand_eye_initial`.
     pub hand_eye: Isometry3<f64>,
     /// The calibrated robot model; `None` for a pose-only session without
     /// a robot (FORMAT.md "Additions to version 1": `robot: null`). A
@@ -68,6 +72,9 @@ pub struct ResultFile {
     /// compensation takes the branch and the calibrated region from it).
     /// Empty for a pose-only session and for results written before it.
     pub pose_joints: Vec<(String, Vec<f64>)>,
+    /// Every station's calibrated point and its frame (FORMAT.md
+    /// 2026-11-27); empty in results written before it.
+    pub stations: Vec<StationRecord>,
 }
 
 impl PartialEq for ResultFile {
@@ -94,6 +101,7 @@ impl PartialEq for ResultFile {
             && self.validation == other.validation
             && self.held_out == other.held_out
             && self.pose_joints == other.pose_joints
+            && self.stations == other.stations
     }
 }
 
@@ -101,7 +109,7 @@ impl ResultFile {
     /// The result of a run on `session`.
     #[must_use]
     pub fn from_calibration(session: &Session, cal: &Calibration) -> Self {
-        Self {
+        let mut result = Self {
             session: session.name.clone(),
             hand_eye_initial: cal.hand_eye_initial,
             hand_eye: cal.hand_eye,
@@ -149,7 +157,17 @@ impl ResultFile {
                 })
                 .map(|m| (m.id.clone(), m.joints.clone()))
                 .collect(),
-        }
+            stations: Vec::new(),
+        };
+        result.stations = stations_of(&result.centres, session.mount);
+        result
+    }
+
+    /// Where the sensor stood: fixed when the stations are points on the
+    /// flange (FORMAT.md 2026-11-27), else on the flange.
+    #[must_use]
+    pub fn mount(&self) -> Mount {
+        mount_of(&self.stations)
     }
 
     /// The session's nominal model: the calibrated one minus the joint
@@ -459,182 +477,6 @@ pub fn result_text_checked(result: &ResultFile, path: &Path) -> Result<String, F
     Ok(text)
 }
 
-/// The first finite number of `r` beyond the session file's plausibility
-/// limits ([`limits`]), as its key path, value and limit: a hand-eye of
-/// 1e308 mm or a length of 1e300 mm is not a calibration, and would flow
-/// into every report, export and history table. Checked on reading and
-/// before writing, so that every result spherecal writes loads.
-/// (Numbers that are not finite are [`result_text_checked`]'s.)
-#[must_use]
-pub fn implausible_number(r: &ResultFile) -> Option<String> {
-    let mut f = Finder(None);
-    for (key, t) in [
-        ("hand_eye_initial", &r.hand_eye_initial),
-        ("hand_eye", &r.hand_eye),
-    ] {
-        f.transform(key, t);
-    }
-    if let Some(robot) = &r.robot {
-        f.joints("robot.joints", &robot.joints);
-        f.transform("robot.base", &robot.base);
-        f.transform("robot.flange", &robot.flange);
-    }
-    f.joints("joint_errors", &r.joint_errors);
-    for (i, it) in r.iterations.iter().enumerate() {
-        f.check(
-            || format!("iterations[{i}].epsilon"),
-            it.epsilon,
-            limits::DISTANCE_MM,
-            "mm",
-        );
-    }
-    for (i, c) in r.centres.iter().enumerate() {
-        for k in 0..3 {
-            let limit = limits::SENSOR_COORDINATE_MM;
-            f.check(
-                || format!("centres[{i}].sensor[{k}]"),
-                c.sensor[k],
-                limit,
-                "mm",
-            );
-            let limit = limits::LENGTH_MM;
-            f.check(
-                || format!("centres[{i}].before[{k}]"),
-                c.before[k],
-                limit,
-                "mm",
-            );
-            f.check(
-                || format!("centres[{i}].after[{k}]"),
-                c.after[k],
-                limit,
-                "mm",
-            );
-        }
-    }
-    if let Some(v) = &r.validation {
-        let limit = limits::DISTANCE_MM;
-        for (i, d) in v.distances.iter().enumerate() {
-            for (name, x) in [
-                ("reference", d.reference),
-                ("before", d.before),
-                ("after", d.after),
-            ] {
-                f.check(
-                    || format!("validation.distances[{i}].{name}"),
-                    x,
-                    limit,
-                    "mm",
-                );
-            }
-        }
-        for (key, st) in [
-            ("validation.before", &v.before),
-            ("validation.after", &v.after),
-            ("validation.within_station.before", &v.within_station.before),
-            ("validation.within_station.after", &v.within_station.after),
-        ] {
-            for (name, x) in [("max", st.max), ("std", st.std), ("rms", st.rms)] {
-                f.check(|| format!("{key}.{name}"), x, limit, "mm");
-            }
-        }
-    }
-    if let (None, SolverReport::Ml(ml)) = (&f.0, &r.solver) {
-        f.0 = ml.implausible();
-    }
-    f.0
-}
-
-/// The first implausible number found ([`implausible_number`]).
-struct Finder(Option<String>);
-
-impl Finder {
-    /// Notes `v` under `key` when it is finite and beyond `limit`.
-    fn check(&mut self, key: impl FnOnce() -> String, v: f64, limit: f64, unit: &str) {
-        if self.0.is_none() && v.is_finite() && v.abs() > limit {
-            self.0 = Some(format!(
-                "`{}` = {} {unit} is not plausible (at most {limit} {unit})",
-                key(),
-                show(v)
-            ));
-        }
-    }
-
-    /// The translation of a 4×4 matrix written under `key`.
-    fn transform(&mut self, key: &str, t: &Isometry3<f64>) {
-        for (k, v) in t.translation.vector.iter().enumerate() {
-            self.check(|| format!("{key}[{k}][3]"), *v, limits::LENGTH_MM, "mm");
-        }
-    }
-
-    /// MDH joints (or their errors) under `key`.
-    fn joints(&mut self, key: &str, joints: &[Joint]) {
-        for (i, j) in joints.iter().enumerate() {
-            for (name, v, limit, unit) in [
-                ("alpha", j.alpha, limits::ANGLE_DEG, "deg"),
-                ("a", j.a, limits::LENGTH_MM, "mm"),
-                ("beta", j.beta, limits::ANGLE_DEG, "deg"),
-                ("theta", j.theta, limits::ANGLE_DEG, "deg"),
-                ("d", j.d, limits::LENGTH_MM, "mm"),
-            ] {
-                self.check(|| format!("{key}[{i}].{name}"), v, limit, unit);
-            }
-        }
-    }
-}
-
-/// Whether JSON `text` has a `null` outside its strings.
-fn has_bare_null(text: &str) -> bool {
-    let b = text.as_bytes();
-    let (mut in_string, mut escaped) = (false, false);
-    for (i, &c) in b.iter().enumerate() {
-        if in_string {
-            match c {
-                _ if escaped => escaped = false,
-                b'\\' => escaped = true,
-                b'"' => in_string = false,
-                _ => {}
-            }
-        } else if c == b'"' {
-            in_string = true;
-        } else if c == b'n' && b[i..].starts_with(b"null") {
-            return true;
-        }
-    }
-    false
-}
-
-/// Keys whose `null` is a legal value: a pose-only result's robot, and
-/// the optional parts of ml's report (no validate pairs, no
-/// cross-validation).
-fn null_allowed(key: &str) -> bool {
-    let last = key.rsplit('.').next().unwrap_or(key);
-    key == "robot"
-        || (key.starts_with("solver.")
-            && matches!(last, "predicted_distance_std_validate" | "cross_validation"))
-}
-
-/// The key path of the first `null` that stands for a number (serde_json
-/// writes NaN and ±infinity as `null`).
-fn first_non_finite(v: &Value, key: &str) -> Option<String> {
-    match v {
-        Value::Null if !null_allowed(key) => Some(key.to_string()),
-        Value::Array(items) => items
-            .iter()
-            .enumerate()
-            .find_map(|(i, x)| first_non_finite(x, &format!("{key}[{i}]"))),
-        Value::Object(map) => map.iter().find_map(|(k, x)| {
-            let sub = if key.is_empty() {
-                k.clone()
-            } else {
-                format!("{key}.{k}")
-            };
-            first_non_finite(x, &sub)
-        }),
-        _ => None,
-    }
-}
-
 /// Where the result file holds objects (`[]`: every element of an array).
 const RESULT_OBJECTS: &[&str] = &[
     "robot",
@@ -652,6 +494,7 @@ const RESULT_OBJECTS: &[&str] = &[
     "validation.within_station.after",
     "held_out",
     "held_out.measurements[]",
+    "stations[]",
 ];
 
 /// The result file as read: [`ResultFile`] plus `format` and `version`
@@ -684,6 +527,8 @@ struct ResultKeys {
     held_out: Option<HeldOut>,
     #[serde(default)]
     pose_joints: Option<Map<String, Value>>,
+    #[serde(default)]
+    stations: Vec<StationRecord>,
 }
 
 /// The transform of checked file rows, settled so that it survives its
@@ -755,6 +600,7 @@ impl ResultKeys {
             validation: self.validation,
             held_out: self.held_out,
             pose_joints: pose_joints(self.pose_joints.as_ref(), &ids),
+            stations: self.stations,
         }
     }
 }
@@ -886,6 +732,17 @@ impl Ctx<'_> {
                 ),
             ));
         }
+        for (i, st) in r.stations.iter().enumerate() {
+            if st.frame != "base" && st.frame != "flange" {
+                return Err(self.invalid(
+                    None,
+                    format!(
+                        "stations[{i}].frame must be \"base\" or \"flange\"; found \"{}\"",
+                        st.frame
+                    ),
+                ));
+            }
+        }
         for (i, c) in r.centres.iter().enumerate() {
             if Use::parse(&c.usage).is_none() {
                 return Err(self.invalid(
@@ -924,6 +781,8 @@ struct ResultOut<'a> {
     held_out: Option<&'a HeldOut>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pose_joints: Option<Map<String, Value>>,
+    #[serde(skip_serializing_if = "<[StationRecord]>::is_empty")]
+    stations: &'a [StationRecord],
 }
 
 /// Serialises the `solver` block with `method` first, then the other keys.
@@ -976,22 +835,7 @@ impl<'a> ResultOut<'a> {
                     .map(|(id, q)| (id.clone(), Value::from(q.clone())))
                     .collect()
             }),
+            stations: &r.stations,
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_bare_null_is_told_from_one_in_a_string() {
-        assert!(has_bare_null(r#"{"a": null}"#));
-        assert!(has_bare_null("[1,\n  null]"));
-        assert!(!has_bare_null(
-            r#"{"session": "null \"null\" null", "b": 1}"#
-        ));
-        assert!(!has_bare_null(r#"{"a\\": "nullable"}"#));
-        assert!(has_bare_null(r#"{"a\\": 1, "b": null}"#));
     }
 }

@@ -59,7 +59,7 @@ use super::{FileError, SESSION_FORMAT, write_atomic};
 use crate::engine::base::geometry::rows_from_isometry;
 use crate::engine::base::robot::{Joint, Robot};
 use crate::engine::base::session::{
-    DEFAULT_MAX_ITERATIONS, DEFAULT_THRESHOLD, Measurement, Observation, ReferenceDistance,
+    DEFAULT_MAX_ITERATIONS, DEFAULT_THRESHOLD, Measurement, Mount, Observation, ReferenceDistance,
     SensorRange, Session, SolverSettings, Use, rules,
 };
 use nalgebra::Vector3;
@@ -128,7 +128,7 @@ keys_struct!(RobotKeys, "an object with name, joints and optionally base and fla
     name, joints, base, flange,
 });
 keys_struct!(SphereKeys, "an object with diameter" { diameter });
-keys_struct!(SensorKeys, "an object with side and/or range" { side, range });
+keys_struct!(SensorKeys, "an object with side, range and/or mount" { side, range, mount });
 keys_struct!(SolverKeys, "an object with threshold and max_iterations" {
     threshold, max_iterations,
 });
@@ -165,9 +165,13 @@ impl<'a> Ctx<'a> {
         let sphere_diameter =
             self.sphere(self.required(keys.sphere, top, "", "sphere", None)?)?;
         let sensor_given = keys.sensor.is_some();
-        let (default_side, sensor_range) = match keys.sensor {
+        let (default_side, sensor_range, mount) = match keys.sensor {
             Some(raw) => {
                 let sensor: SensorKeys = self.object(raw, "sensor", None)?;
+                let mount = match sensor.mount {
+                    Some(raw) => self.mount(raw)?,
+                    None => Mount::Flange,
+                };
                 let side = match sensor.side {
                     Some(side) => self.side(side, "sensor.side", None)?,
                     None => 1,
@@ -176,9 +180,9 @@ impl<'a> Ctx<'a> {
                     Some(r) => Some(self.range(r)?),
                     None => None,
                 };
-                (side, range)
+                (side, range, mount)
             }
-            None => (1, None),
+            None => (1, None, Mount::Flange),
         };
         let hand_eye = match keys.hand_eye {
             Some(raw) => Some(self.matrix(raw, "hand_eye")?),
@@ -225,6 +229,7 @@ impl<'a> Ctx<'a> {
             default_side,
             sensor_given,
             sensor_range,
+            mount,
             hand_eye,
             solver,
             solver_given,
@@ -282,6 +287,20 @@ impl<'a> Ctx<'a> {
             flange: flange.unwrap_or_else(Isometry3::identity),
         };
         Ok((robot, base.is_some(), flange.is_some()))
+    }
+
+    /// `sensor.mount`: `"flange"` or `"fixed"` (FORMAT.md, added 2026-11-27).
+    fn mount(&self, raw: &'a RawValue) -> Result<Mount, FileError> {
+        let text: String = self.parse(raw, "sensor.mount", None)?;
+        Mount::parse(&text).ok_or_else(|| {
+            self.invalid(
+                None,
+                format!(
+                    "sensor.mount must be \"flange\" or \"fixed\"; found \"{text}\"{}",
+                    self.at(raw)
+                ),
+            )
+        })
     }
 
     /// `sensor.range`: `{"y": [min, max], "z": [min, max]}` in mm, each
@@ -654,6 +673,8 @@ struct SensorOut {
     side: i8,
     #[serde(skip_serializing_if = "Option::is_none")]
     range: Option<RangeOut>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mount: Option<&'static str>,
 }
 
 #[derive(Serialize)]
@@ -718,12 +739,15 @@ impl<'a> SessionOut<'a> {
             sphere: SphereOut {
                 diameter: s.sphere_diameter,
             },
-            sensor: (s.sensor_given || s.default_side != 1 || s.sensor_range.is_some()).then_some(
-                SensorOut {
+            sensor: (s.sensor_given
+                || s.default_side != 1
+                || s.sensor_range.is_some()
+                || s.mount != Mount::Flange)
+                .then_some(SensorOut {
                     side: s.default_side,
                     range: s.sensor_range.map(|r| RangeOut { y: r.y, z: r.z }),
-                },
-            ),
+                    mount: (s.mount != Mount::Flange).then_some(s.mount.as_str()),
+                }),
             hand_eye: s.hand_eye.as_ref().map(rows_from_isometry),
             solver: (s.solver_given
                 || s.solver.threshold != DEFAULT_THRESHOLD

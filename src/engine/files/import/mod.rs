@@ -41,6 +41,7 @@ pub mod progress;
 pub mod references;
 pub mod robot_source;
 pub mod side;
+pub mod tracker;
 pub mod units;
 
 use std::collections::HashMap;

@@ -476,6 +476,7 @@ impl Planner<'_> {
         Estimate {
             robot: self.config.robot.clone(),
             flange_from_sensor: self.config.flange_from_sensor,
+            mount: crate::engine::base::session::Mount::Flange,
         }
     }
 

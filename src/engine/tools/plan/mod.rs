@@ -100,6 +100,7 @@ mod candidates;
 mod config;
 pub mod entry;
 mod export;
+pub mod fixed;
 mod order;
 mod predict;
 pub mod range_study;

@@ -4,9 +4,12 @@ use std::fmt::Write as _;
 
 use crate::engine::tools::result_view::{HAND_EYE_ONLY, HandEyeStrength, flange_poses};
 
-use crate::engine::base::session::Session;
+use crate::engine::base::session::{Mount, Session};
 use crate::engine::calibrate::solve::Calibration;
 use crate::engine::calibrate::solve::plausible::identify_scatter;
+use crate::engine::calibrate::validate::Stats;
+use crate::engine::files::format::ResultFile;
+use crate::engine::files::format::stations::prediction_errors;
 
 /// A few lines for people: why the loop stopped (and a warning when the
 /// paper's loop made ε worse), what the SVD kept, how the hand-eye moved,
@@ -52,9 +55,13 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
         .to_degrees();
     let dt = (cal.hand_eye.translation.vector - cal.hand_eye_initial.translation.vector).norm();
     let t = cal.hand_eye.translation.vector;
+    let what = match session.mount {
+        Mount::Flange => "hand-eye",
+        Mount::Fixed => "base from sensor",
+    };
     let _ = writeln!(
         s,
-        "hand-eye: translation ({:.3}, {:.3}, {:.3}) mm; moved {dt:.3} mm and {dr:.4}° from the initial estimate",
+        "{what}: translation ({:.3}, {:.3}, {:.3}) mm; moved {dt:.3} mm and {dr:.4}° from the initial estimate",
         t.x, t.y, t.z
     );
     let within = &cal.identify_within;
@@ -111,6 +118,9 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
             );
         }
     }
+    if session.mount == Mount::Fixed {
+        fixed_lines(&mut s, session, cal);
+    }
     if let Some(r) = cal.report.ml() {
         s.push_str(&r.summary());
     }
@@ -128,4 +138,49 @@ pub fn summary(session: &Session, cal: &Calibration) -> String {
         }
     }
     s
+}
+
+/// A fixed sensor's lines (FORMAT.md 2026-11-27): each target's point on
+/// the flange, and the held-out check, each validate pose's predicted
+/// point against the measured one.
+fn fixed_lines(s: &mut String, session: &Session, cal: &Calibration) {
+    let result = ResultFile::from_calibration(session, cal);
+    for st in &result.stations {
+        let _ = writeln!(
+            s,
+            "target {} on the flange: ({:.3}, {:.3}, {:.3}) mm",
+            st.id, st.point[0], st.point[1], st.point[2]
+        );
+    }
+    let after: Vec<f64> = prediction_errors(&result.centres, &result.stations)
+        .iter()
+        .map(|p| p.error)
+        .collect();
+    if after.is_empty() {
+        return;
+    }
+    let before_records: Vec<_> = result
+        .centres
+        .iter()
+        .map(|c| crate::engine::files::format::result::CentreRecord {
+            after: c.before,
+            ..c.clone()
+        })
+        .collect();
+    let before_stations =
+        crate::engine::files::format::stations::stations_of(&before_records, session.mount);
+    let before: Vec<f64> = prediction_errors(&before_records, &before_stations)
+        .iter()
+        .map(|p| p.error)
+        .collect();
+    let (b, a) = (Stats::of(&before), Stats::of(&after));
+    let _ = writeln!(
+        s,
+        "validation, {} validate poses, predicted point against the measured one (sensor frame): rms {:.4} → {:.4} mm, max {:.4} → {:.4} mm",
+        after.len(),
+        b.rms,
+        a.rms,
+        b.max,
+        a.max
+    );
 }

@@ -41,6 +41,7 @@
 //! gives byte-identical files.
 
 pub mod config;
+pub mod fixed;
 pub mod from_plan;
 pub mod import_files;
 mod poses;
@@ -49,6 +50,7 @@ mod stripe;
 pub mod truth;
 
 pub use config::{ErrorModel, InitialHandEye, SideChoice, SimConfig, SimError};
+pub use fixed::{FixedCell, FixedTruth, simulate_fixed};
 pub use from_plan::{PlanExecution, PlanPose, simulate_plan};
 pub use import_files::{ImportFiles, import_files};
 pub use parts::{Part, PartKind, ScanConfig, ScanTruth, SimulatedScan, simulate_scan};

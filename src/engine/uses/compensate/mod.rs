@@ -225,6 +225,12 @@ pub enum CompensateError {
     /// Not a 6-axis arm.
     #[error("the robot has {0} joints; target compensation solves 6-axis arms")]
     NotSixAxis(usize),
+    /// The sensor of a fixed-sensor result asked for as the tool: it
+    /// stands in the cell, not on the flange.
+    #[error(
+        "the result is of a fixed sensor (its hand_eye is base_from_sensor, the sensor's pose in the cell, not a tool on the flange): compensate for the flange or a tool file instead of the sensor"
+    )]
+    FixedSensor,
     /// The session given is not the result's.
     #[error("{0}")]
     Session(String),
@@ -377,6 +383,9 @@ impl Model {
         if calibrated.dof() != DOF {
             return Err(CompensateError::NotSixAxis(calibrated.dof()));
         }
+        if result.mount() == crate::engine::base::session::Mount::Fixed && tcp == Tcp::Sensor {
+            return Err(CompensateError::FixedSensor);
+        }
         let mut notes = Vec::new();
         // Where the calibration saw the robot: the result's own record of
         // the joints, else the session's.
@@ -503,13 +512,18 @@ fn session_joints(
         })
         .collect();
     // The session's joints, the calibrated model and hand-eye must
-    // give back the result's own base-frame centres.
+    // give back the result's own centres (base frame; the flange frame for
+    // a fixed sensor).
+    let est = crate::engine::calibrate::solve::estimate::Estimate {
+        robot: calibrated.clone(),
+        flange_from_sensor: result.hand_eye,
+        mount: result.mount(),
+    };
     let worst = from_session
         .iter()
         .filter_map(|(id, q)| {
             let c = result.centres.iter().find(|c| c.measurement == *id)?;
-            let seen = calibrated.base_from_flange(q)
-                * result.hand_eye
+            let seen = est.station_from_sensor(&calibrated.base_from_flange(q))
                 * nalgebra::Point3::from(Vector3::from(c.sensor));
             Some((seen.coords - Vector3::from(c.after)).norm())
         })

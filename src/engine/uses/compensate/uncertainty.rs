@@ -24,6 +24,7 @@ use nalgebra::{DMatrix, Isometry3, Vector3};
 
 use crate::engine::base::robot::Robot;
 use crate::engine::base::robot::ik::DOF;
+use crate::engine::base::session::Mount;
 use crate::engine::calibrate::solve::estimate::{Estimate, PoseSensitivity};
 use crate::engine::calibrate::solve::ml::covariance::{
     ParameterCovariance, RigidFit, aligned_sigma,
@@ -82,6 +83,7 @@ impl Predictor {
         let est = Estimate {
             robot: self.calibrated.clone(),
             flange_from_sensor: self.tool,
+            mount: Mount::Flange,
         };
         let (p, a) = PoseSensitivity::at_pose(&est, q, None).at(&est, &Vector3::zeros());
         let cols = DMatrix::from_fn(3, self.unknowns.len(), |r, c| {

@@ -164,6 +164,11 @@ pub fn measure_scan(
         frame,
         mut options,
     } = request;
+    if result.mount() == crate::engine::base::session::Mount::Fixed {
+        return Err(MeasureError::Input(
+            "the result is of a fixed sensor (sensor.mount \"fixed\"): measuring parts needs a sensor on the flange, whose hand-eye places each profile".into(),
+        ));
+    }
     let step = |stage| MeasureProgress {
         stage,
         done: 0,

@@ -249,6 +249,7 @@ pub fn measure(
                     .clone()
                     .unwrap_or_else(|| Robot::new(result.robot_name(), Vec::new())),
                 flange_from_sensor: cell.flange_from_sensor,
+                mount: crate::engine::base::session::Mount::Flange,
             };
             let inputs: Vec<sigma::SigmaPose> = scan
                 .poses

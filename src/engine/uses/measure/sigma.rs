@@ -246,6 +246,7 @@ mod tests {
         let est = Estimate {
             robot,
             flange_from_sensor: isometry_from_twist(&[-7.4, -1.0, 287.8, 3.1, 0.02, 0.5]),
+            mount: crate::engine::base::session::Mount::Flange,
         };
         // A covariance on the hand-eye and a few kinematic parameters.
         let unknowns = vec![0, 1, 2, 3, 4, 5, 6 + 7, 6 + 13, 6 + 18, 6 + 24];

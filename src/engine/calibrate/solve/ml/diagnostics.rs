@@ -205,17 +205,25 @@ pub(super) fn report(
     if phase(Phase::RangeError) == Control::Cancel {
         return cancelled(solver);
     }
-    let range_error =
-        super::range::range_error(session, prepared, problem, &state.est, &cov_scaled);
+    // The range is a laser plane on the flange, and the volume error a
+    // sphere seen by it; a fixed sensor has neither.
+    let flange = session.mount == crate::engine::base::session::Mount::Flange;
+    let range_error = flange
+        .then(|| super::range::range_error(session, prepared, problem, &state.est, &cov_scaled))
+        .flatten();
     // A posteriori, as `measure` reports a point's σ.
     let factor = super::covariance::a_posteriori_factor(variance_factor);
-    let volume_error = super::range::volume_error(
-        session,
-        prepared,
-        problem,
-        &state.est,
-        &(&cov_scaled * factor),
-    );
+    let volume_error = flange
+        .then(|| {
+            super::range::volume_error(
+                session,
+                prepared,
+                problem,
+                &state.est,
+                &(&cov_scaled * factor),
+            )
+        })
+        .flatten();
     // Leave-one-station-out.
     let cross_validation = if mo.cross_validation && problem.stations.len() >= 2 {
         match problem.cross_validate(state, phase) {

@@ -69,12 +69,12 @@ pub(super) struct Identifiability {
 /// exactly null, as it is for distances, and every exact redundancy of
 /// the model (`theta6` with the hand-eye, say) stays exact.
 pub(super) fn sensitivity_at(est: &Estimate, s: &Sighting, point: &Vector3<f64>) -> DMatrix<f64> {
-    let base_from_sensor = s.base_from_flange(&est.robot) * est.flange_from_sensor;
+    let station_from_sensor = est.station_from_sensor(&s.base_from_flange(&est.robot));
     let moved = Sighting {
         id: s.id.clone(),
         joints: s.joints.clone(),
         flange: s.flange,
-        centre_in_sensor: base_from_sensor
+        centre_in_sensor: station_from_sensor
             .inverse_transform_point(&nalgebra::Point3::from(*point))
             .coords,
     };
@@ -113,6 +113,20 @@ pub(super) fn pivot_preference(robot: &crate::engine::base::robot::Robot, u: usi
         _ => false,
     };
     if redundant { REDUNDANT_WEIGHT } else { 1.0 }
+}
+
+/// [`pivot_preference`] for the estimate's mount. With a fixed sensor the
+/// first joint's five parameters (the frame before the first moving axis)
+/// are exactly what `bT_s` already holds (a sensor standing in the cell
+/// cannot tell a shifted base from a shifted sensor), so they are the
+/// members fixed and `base_from_sensor` is estimated.
+pub(super) fn pivot_weight(est: &Estimate, u: usize) -> f64 {
+    let first_joint = (6..6 + crate::engine::base::robot::PARAMS_PER_JOINT).contains(&u);
+    if est.mount == crate::engine::base::session::Mount::Fixed && first_joint {
+        REDUNDANT_WEIGHT
+    } else {
+        pivot_preference(&est.robot, u)
+    }
 }
 
 /// Stations between two looks at the cancel while the projected Jacobian
@@ -181,7 +195,7 @@ pub(super) fn identifiability(
     }
     // Pivoted modified Gram-Schmidt on the preference-weighted columns.
     let mut work: Vec<DVector<f64>> = (0..n_unknowns)
-        .map(|u| j.column(u) * pivot_preference(&est.robot, u))
+        .map(|u| j.column(u) * pivot_weight(est, u))
         .collect();
     let mut remaining: Vec<usize> = (0..n_unknowns).collect();
     let mut pivots = Vec::with_capacity(n_unknowns);
@@ -201,7 +215,7 @@ pub(super) fn identifiability(
         let u = remaining.remove(pos);
         let r = work[u].norm();
         // The unweighted pivot decides the rank.
-        let r_plain = r / pivot_preference(&est.robot, u);
+        let r_plain = r / pivot_weight(est, u);
         if pivots.is_empty() {
             r11 = r_plain;
         }

@@ -560,6 +560,7 @@ pub fn analyse(
     let start = Estimate {
         robot: session.robot.clone(),
         flange_from_sensor: prepared.hand_eye_initial,
+        mount: session.mount,
     };
     let stations = prepared.stations(session, Use::Identify);
     let update = MlUpdate::new(
@@ -599,6 +600,7 @@ pub fn exact_held_out(
     let start = Estimate {
         robot: session.solver_robot(),
         flange_from_sensor: prepared.hand_eye_initial,
+        mount: session.mount,
     };
     let stations = prepared.stations(session, Use::Identify);
     let mut update = MlUpdate::new(

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::MlOptions;
 use crate::engine::base::geometry::twist_rows;
+use crate::engine::base::session::Mount;
 use crate::engine::calibrate::handeye::Sighting;
 use crate::engine::calibrate::solve::estimate::Estimate;
 use crate::engine::calibrate::solve::prepare::PreparedMeasurement;
@@ -167,15 +168,34 @@ pub fn base_covariance(
     pose_sigma_mm: f64,
 ) -> Matrix3<f64> {
     if let Some(base_from_flange) = sighting.flange {
-        let base_from_sensor = base_from_flange * est.flange_from_sensor;
-        let r: Matrix3<f64> = base_from_sensor.rotation.to_rotation_matrix().into_inner();
+        let station_from_sensor = est.station_from_sensor(&base_from_flange);
+        let r: Matrix3<f64> = station_from_sensor
+            .rotation
+            .to_rotation_matrix()
+            .into_inner();
         return r * sensor_cov * r.transpose() + Matrix3::identity() * pose_sigma_mm.powi(2);
     }
     let (base_from_flange, jq) = est.robot.joint_jacobian(&sighting.joints);
-    let base_from_sensor = base_from_flange * est.flange_from_sensor;
-    let x_b = (base_from_sensor * nalgebra::Point3::from(sighting.centre_in_sensor)).coords;
-    let r: Matrix3<f64> = base_from_sensor.rotation.to_rotation_matrix().into_inner();
-    let g = twist_rows(&x_b) * jq;
+    let station_from_sensor = est.station_from_sensor(&base_from_flange);
+    let r: Matrix3<f64> = station_from_sensor
+        .rotation
+        .to_rotation_matrix()
+        .into_inner();
+    let g = match est.mount {
+        Mount::Flange => {
+            let x_b =
+                (station_from_sensor * nalgebra::Point3::from(sighting.centre_in_sensor)).coords;
+            twist_rows(&x_b) * jq
+        }
+        // A fixed sensor: the target in the flange frame moves against the
+        // flange's base-frame twist (see `estimate`).
+        Mount::Fixed => {
+            let y =
+                (est.flange_from_sensor * nalgebra::Point3::from(sighting.centre_in_sensor)).coords;
+            let r_be: Matrix3<f64> = base_from_flange.rotation.to_rotation_matrix().into_inner();
+            -(r_be.transpose() * twist_rows(&y)) * jq
+        }
+    };
     let sq = joint_sigma_deg.to_radians().powi(2);
     r * sensor_cov * r.transpose() + &g * g.transpose() * sq
 }

@@ -11,6 +11,9 @@
 //!   stations' within-station distances, ε, the stop reason (and a warning
 //!   when the paper's loop made ε worse), the held-out figure beside the
 //!   fit's own scatter;
+//! - for a fixed sensor (FORMAT.md `sensor.mount: "fixed"`), the sensor's
+//!   pose in the base frame, the targets on the flange and each validate
+//!   pose's prediction error;
 //! - settings: every scalar of the result's `solver` block and where the
 //!   initial hand-eye came from;
 //! - stripe quality: fitted radii, arc spans, cut angles, fit RMS
@@ -31,6 +34,7 @@
 
 mod css;
 pub mod figures;
+mod fixed;
 mod tables;
 mod text;
 
@@ -172,6 +176,7 @@ pub fn render(input: &ReportInput<'_>) -> String {
     header(&mut h, &ctx);
     notes(&mut h, &ctx);
     summary(&mut h, &ctx);
+    fixed::fixed_sensor(&mut h, &ctx);
     settings(&mut h, &ctx);
     stripes(&mut h, &ctx);
     figures(&mut h, &ctx);

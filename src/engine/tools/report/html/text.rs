@@ -402,6 +402,13 @@ pub(super) fn settings(h: &mut String, ctx: &Ctx<'_>) {
                     num(i.translation_residual, 4)
                 );
             }
+            HandEyeSource::Linear(g) => {
+                let _ = writeln!(
+                    h,
+                    "<p>Initial base-from-sensor (a fixed sensor): linear in the unknowns from every identify measurement; the targets scatter {} mm rms about their points.</p>",
+                    num(g.rms_mm, 4)
+                );
+            }
         },
         Err(_) => {
             h.push_str("<p>Initial hand-eye: unknown (the session could not be prepared).</p>\n");
