@@ -115,6 +115,17 @@ pub fn naming_no_pose(source: &ProfileSource, ids: &[String]) -> Vec<PathBuf> {
     others
 }
 
+/// Why an entry of a profile folder is not a file, in words.
+fn not_a_file(path: &Path) -> &'static str {
+    if path.is_dir() {
+        "a folder"
+    } else if fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
+        "a link to nothing"
+    } else {
+        "not a file (a FIFO or a device)"
+    }
+}
+
 /// `; skipped N files that name no pose: a, b, …` for a summary line, or
 /// nothing.
 #[must_use]
@@ -131,12 +142,8 @@ pub fn skipped_summary(skipped: &[PathBuf]) -> String {
                 .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
             if p.is_file() {
                 name
-            } else if p.is_dir() {
-                format!("{name} (a folder)")
-            } else if fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_symlink()) {
-                format!("{name} (a link to nothing)")
             } else {
-                format!("{name} (not a file)")
+                format!("{name} ({})", not_a_file(p))
             }
         })
         .collect();
@@ -338,16 +345,19 @@ pub fn list_profiles(
     })?;
     let mut skipped = Vec::new();
     let mut groups: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
-    let mut files: Vec<PathBuf> = entries
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .filter(|p| p.is_file())
-        .collect();
+    let mut files: Vec<PathBuf> = entries.filter_map(Result::ok).map(|e| e.path()).collect();
     files.sort();
     for path in files {
         let name = path
             .file_name()
             .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+        // A folder, a FIFO or a link to nothing named like a profile is
+        // listed as skipped, not passed over (a count that then differs
+        // names it).
+        if !path.is_file() {
+            skipped.push((path.clone(), not_a_file(&path).to_string()));
+            continue;
+        }
         if exclude.iter().any(|e| same_file(e, &path)) {
             skipped.push((path, "the pose file".to_string()));
             continue;
