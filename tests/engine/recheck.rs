@@ -17,7 +17,8 @@ use spherecal::engine::tools::simulate::{
     self, ErrorModel, InitialHandEye, PlanExecution, SimConfig, Truth, simulate_plan,
 };
 use spherecal::engine::uses::check::{
-    Checked, DEFAULT_ALPHA, DEFAULT_CHECK_POSES, check_design, check_session, plan_check,
+    CHECK_ROTATIONS, CHECK_TRANSLATIONS, Checked, DEFAULT_ALPHA, DEFAULT_CHECK_POSES, check_design,
+    check_session, plan_check,
 };
 
 /// Where the check's sphere is (the IRB 2400's quick-start spot).
@@ -37,7 +38,11 @@ fn cell(seed: u64) -> (Session, Truth, ResultFile) {
     options.method = Method::Ml;
     options.ml.cross_validation = false;
     let (_, cal) = solve::calibrate(&session, &options).unwrap();
-    (session.clone(), truth, ResultFile::from_calibration(&session, &cal))
+    (
+        session.clone(),
+        truth,
+        ResultFile::from_calibration(&session, &cal),
+    )
 }
 
 /// `plan --check`'s plan for `result` on the IRB 2400.
@@ -126,15 +131,21 @@ fn param_index(robot: &Robot, label: &str) -> usize {
 fn an_unchanged_cell_holds_and_a_knocked_one_names_what_moved() {
     let (_, truth, result) = cell(1);
     let plan = check_plan(&result);
-    assert_eq!(plan.poses.len(), DEFAULT_CHECK_POSES);
+    let n = DEFAULT_CHECK_POSES + CHECK_TRANSLATIONS + CHECK_ROTATIONS;
+    assert_eq!(plan.poses.len(), n);
     let robot = truth.nominal.to_robot();
     let elsewhere = check_plan_at(&result, MOVED);
     for seed in 10..13 {
         let c = check(&truth, &result, &plan, Knock::None, seed);
         assert!(c.test.holds, "seed {seed}: {:?}", c.test);
-        assert_eq!(c.test.dof, 3 * DEFAULT_CHECK_POSES - 3);
+        // Two stations at the one sphere: P0 (translations, rotations), P1.
+        assert_eq!(c.test.dof, 3 * n - 6);
         let moved = check(&truth, &result, &elsewhere, Knock::None, seed);
-        assert!(moved.test.holds, "moved sphere, seed {seed}: {:?}", moved.test);
+        assert!(
+            moved.test.holds,
+            "moved sphere, seed {seed}: {:?}",
+            moved.test
+        );
         // The fitted sphere is where the plan put it, to the robot's
         // absolute error (a few mm of base-like error are not calibrated).
         let found = moved.test.centres[0].1;
@@ -149,7 +160,10 @@ fn an_unchanged_cell_holds_and_a_knocked_one_names_what_moved() {
     // Its size, in the flange frame: the twist is in the sensor frame.
     let r = result.hand_eye.rotation;
     let found = r * Vector3::new(best.change[0], best.change[1], best.change[2]);
-    assert!((found - Vector3::new(0.0, 0.5, 0.0)).norm() < 0.15, "{found}");
+    assert!(
+        (found - Vector3::new(0.0, 0.5, 0.0)).norm() < 0.15,
+        "{found}"
+    );
     // The sensor turned 0.2°.
     let c = check(&truth, &result, &plan, Knock::Turn([0.2, 0.0, 0.0]), 21);
     assert!(!c.test.holds, "{:?}", c.test);
@@ -159,8 +173,16 @@ fn an_unchanged_cell_holds_and_a_knocked_one_names_what_moved() {
     let c = check(&truth, &result, &plan, Knock::Parameter(k, 0.15), 22);
     assert!(!c.test.holds, "{:?}", c.test);
     let best = &c.test.explanations[0];
-    assert_eq!(best.moved, Moved::Parameter("theta3".into()), "{:?}", c.test.explanations);
-    assert!((best.change[0] - 0.15).abs() < 3.0 * best.sigma[0] + 0.005, "{best:?}");
+    assert_eq!(
+        best.moved,
+        Moved::Parameter("theta3".into()),
+        "{:?}",
+        c.test.explanations
+    );
+    assert!(
+        (best.change[0] - 0.15).abs() < 3.0 * best.sigma[0] + 0.005,
+        "{best:?}"
+    );
 }
 
 /// `plan --check`'s smallest detectable changes are finite and below the
@@ -169,7 +191,13 @@ fn an_unchanged_cell_holds_and_a_knocked_one_names_what_moved() {
 fn the_planned_check_detects_a_fraction_of_a_millimetre() {
     let (_, _, result) = cell(1);
     let plan = check_plan(&result);
-    let d = plan_check(&plan, &result, SimConfig::default().stripe_noise, DEFAULT_ALPHA).unwrap();
+    let d = plan_check(
+        &plan,
+        &result,
+        SimConfig::default().stripe_noise,
+        DEFAULT_ALPHA,
+    )
+    .unwrap();
     assert!(d.translation_mm > 0.0 && d.translation_mm < 0.5, "{d:?}");
     assert!(d.rotation_deg > 0.0 && d.rotation_deg < 1.0, "{d:?}");
     // The power the figure promises is there: d4 at its smallest
@@ -178,7 +206,11 @@ fn the_planned_check_detects_a_fraction_of_a_millimetre() {
     let (_, d4, _) = d.parameters.iter().find(|(l, _, _)| l == "d4").unwrap();
     let k = param_index(&truth.nominal.to_robot(), "d4");
     let detected = (0..50)
-        .filter(|&s| !check(&truth, &result, &plan, Knock::Parameter(k, *d4), 500 + s).test.holds)
+        .filter(|&s| {
+            !check(&truth, &result, &plan, Knock::Parameter(k, *d4), 500 + s)
+                .test
+                .holds
+        })
         .count();
     assert!(detected >= 40, "{detected} of 50");
 }
@@ -215,19 +247,27 @@ fn study(cells: u64, trials: u64) -> Vec<(String, f64)> {
             let seed = 1000 * c + t;
             count(
                 "sphere moved",
-                !check(&truth, &result, &elsewhere, Knock::None, seed).test.holds,
+                !check(&truth, &result, &elsewhere, Knock::None, seed)
+                    .test
+                    .holds,
             );
             let mut run = |name: &str, knock: Knock| {
                 let failed = !check(&truth, &result, &plan, knock, seed).test.holds;
                 count(name, failed);
             };
             run("unchanged", Knock::None);
-            for (axis, v) in [("x", [0.3, 0.0, 0.0]), ("y", [0.0, 0.3, 0.0]), ("z", [0.0, 0.0, 0.3])]
-            {
+            for (axis, v) in [
+                ("x", [0.3, 0.0, 0.0]),
+                ("y", [0.0, 0.3, 0.0]),
+                ("z", [0.0, 0.0, 0.3]),
+            ] {
                 run(&format!("hand-eye 0.3 mm along {axis}"), Knock::Shift(v));
             }
-            for (axis, v) in [("x", [0.1, 0.0, 0.0]), ("y", [0.0, 0.1, 0.0]), ("z", [0.0, 0.0, 0.1])]
-            {
+            for (axis, v) in [
+                ("x", [0.1, 0.0, 0.0]),
+                ("y", [0.0, 0.1, 0.0]),
+                ("z", [0.0, 0.0, 0.1]),
+            ] {
                 run(&format!("hand-eye 0.1° about {axis}"), Knock::Turn(v));
             }
             for label in ["theta2", "theta3", "d4"] {

@@ -52,6 +52,12 @@ pub const DETECTION_POWER: f64 = 0.95;
 /// a few minutes at the robot.
 pub const DEFAULT_CHECK_POSES: usize = 10;
 
+/// Translation poses of a planned check: the fewest eq. 6-7 takes.
+pub const CHECK_TRANSLATIONS: usize = 3;
+
+/// Rotation poses of a planned check: the fewest eq. 8-9 takes.
+pub const CHECK_ROTATIONS: usize = 2;
+
 /// A check could not be made.
 #[derive(Debug, thiserror::Error)]
 pub enum CheckError {
@@ -147,14 +153,11 @@ fn belongs(session: &Session, result: &ResultFile) -> Result<(bool, Vec<String>)
     let flange = session.measurements.iter().all(|m| m.flange.is_some());
     let joints = session.measurements.iter().find(|m| m.flange.is_none());
     if let Some(m) = joints {
-        let robot = match (&result.robot, result.hand_eye_only()) {
-            (Some(r), false) => r,
-            _ => {
-                return Err(CheckError::Input(format!(
-                    "measurement {}: the check gives joint readings, but the result calibrated only the hand-eye from flange poses: check it from a pose list (import --poses)",
-                    m.id
-                )));
-            }
+        let Some(robot) = result.robot.as_ref().filter(|_| !result.hand_eye_only()) else {
+            return Err(CheckError::Input(format!(
+                "measurement {}: the check gives joint readings, but the result calibrated only the hand-eye from flange poses: check it from a pose list (import --poses)",
+                m.id
+            )));
         };
         if session.robot.dof() != robot.dof() || session.robot.name != robot.name {
             return Err(CheckError::Input(format!(
@@ -304,12 +307,9 @@ pub fn plan_check(
         .poses
         .iter()
         .map(|p| {
-            let cov = stripe_centre_covariance(
-                0.5 * plan.diameter,
-                plan.cut_angle,
-                p.side,
-                stripe_sigma,
-            ) + nalgebra::Matrix3::identity() * floor;
+            let cov =
+                stripe_centre_covariance(0.5 * plan.diameter, plan.cut_angle, p.side, stripe_sigma)
+                    + nalgebra::Matrix3::identity() * floor;
             let flange_pose: Option<Isometry3<f64>> = flange.then_some(p.base_from_flange);
             CheckPoint {
                 station: p.station.clone(),
@@ -327,13 +327,17 @@ pub fn plan_check(
 }
 
 /// Turns a plan's configuration into a check's: `poses` poses at the one
-/// sphere position (no translation, rotation or validate group), planned
+/// sphere position, after the fewest translation and rotation poses an
+/// import needs there (no validate group), planned
 /// about the result's calibrated model and hand-eye, chosen D-optimally (the most
 /// information, so the most power, for the parameters the check sees).
 pub fn check_design(config: &mut PlanConfig, result: &ResultFile, poses: usize) {
     let d = &mut config.design;
-    d.n_translation = 0;
-    d.n_rotation = 0;
+    // The smallest translation and rotation groups at the sphere: the
+    // check imports like any session, its initial hand-eye from them
+    // (eq. 6-9); they are sightings of the sphere like the others.
+    d.n_translation = CHECK_TRANSLATIONS;
+    d.n_rotation = CHECK_ROTATIONS;
     d.n_identify = 1;
     d.identify_poses = poses;
     d.n_validate = 0;

@@ -149,9 +149,7 @@ pub enum RecheckError {
         stations: usize,
     },
     /// The covariance of the centres is not positive definite.
-    #[error(
-        "the noise model gives the check's centres a covariance that is not positive definite"
-    )]
+    #[error("the noise model gives the check's centres a covariance that is not positive definite")]
     NotDefinite,
 }
 
@@ -210,7 +208,10 @@ fn rows(model: &CheckModel, points: &[CheckPoint]) -> Result<Rows, RecheckError>
         });
         x.fixed_rows_mut::<3>(3 * i).copy_from(&xi);
         a.view_mut((3 * i, 0), (3, n_unknowns)).copy_from(&ai);
-        let k = stations.iter().position(|st| *st == pt.station).unwrap_or(0);
+        let k = stations
+            .iter()
+            .position(|st| *st == pt.station)
+            .unwrap_or(0);
         p.view_mut((3 * i, 3 * k), (3, 3))
             .copy_from(&Matrix3::identity());
         let sigma = base_covariance(
@@ -660,6 +661,9 @@ mod tests {
     fn noncentral_reduces_and_matches_the_normal_case() {
         assert!((noncentral_chi2_sf(5.0, 3.0, 0.0) - chi2_sf(5.0, 3.0)).abs() < 1e-12);
         let lambda = required_noncentrality(3.841_458_8, 1.0, 0.95);
-        assert!((lambda - (1.959_964 + 1.644_854_f64).powi(2)).abs() < 0.01, "{lambda}");
+        assert!(
+            (lambda - (1.959_964 + 1.644_854_f64).powi(2)).abs() < 0.01,
+            "{lambda}"
+        );
     }
 }
