@@ -25,6 +25,7 @@ fn main() -> ExitCode {
         Some(Command::Report(args)) => cli::html_report::run(&args),
         Some(Command::History(args)) => cli::history::run(&args),
         Some(Command::Compensate(args)) => cli::compensate::run(&args),
+        Some(Command::Check(args)) => cli::check::run(&args),
         None => gui(None, None),
     };
     // The text a command printed must have reached its reader.

@@ -27,6 +27,7 @@ macro_rules! say {
     };
 }
 
+pub mod check;
 pub mod compensate;
 pub mod evaluate;
 pub mod export_model;
@@ -69,7 +70,7 @@ use crate::engine::tools::report::summary;
     about = "Calibrate a robot-mounted laser-stripe sensor against a reference sphere (hand-eye and kinematic errors); plan the poses, measure parts and compensate programs with the calibration, follow a cell's drift",
     long_about = None,
     after_help = "Without a command the workbench opens on the demo session (spherecal gui).\n\
-        Exit status: 0 done, 2 bad input or a refused output (one `error:` line), 1 internal failure, 130 interrupted."
+        Exit status: 0 done, 3 a check that fails, 2 bad input or a refused output (one `error:` line), 1 internal failure, 130 interrupted."
 )]
 pub struct Cli {
     /// What to do; without a command the workbench opens on the demo session.
@@ -231,6 +232,13 @@ pub enum Command {
     /// kept; prints the calibrated hand-eye as the controller's tool data
     /// and flags targets outside what the calibration saw.
     Compensate(compensate::CompensateArgs),
+    /// Re-check a calibrated cell in five minutes: a short scan of the sphere against the result
+    ///
+    /// The poses of `plan --check`, run at the robot and imported, predicted
+    /// through the result and tested against its covariance and noise model
+    /// at the false-alarm rate --alpha: exit 0 when the cell holds its
+    /// calibration, 3 when it does not (with what moved).
+    Check(check::CheckArgs),
 }
 
 /// The first error writing to stdout other than a closed pipe (a full

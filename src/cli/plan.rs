@@ -20,6 +20,7 @@ use crate::engine::tools::plan::{
     PredictConfig, RequestError, Selection, defaults, read_stations,
 };
 use crate::engine::tools::simulate;
+use crate::engine::uses::check;
 
 /// `spherecal plan`.
 #[derive(Debug, Args)]
@@ -143,6 +144,12 @@ pub struct PlanArgs {
     /// Predict the calibrated accuracy from N simulated calibrations (random kinematic errors, default noise, ml); 0 skips.
     #[arg(long, value_name = "N", default_value_t = PredictConfig::default().runs, value_parser = count(0, MAX_PREDICT_RUNS))]
     pub predict: usize,
+    /// Plan a re-check of the cell calibrated in --result instead of a calibration: --identify-poses poses (10 unless given) at the one sphere position --sphere, solved on the calibrated model about the calibrated hand-eye; prints the smallest knock the check detects. Run them, import them, then `spherecal check`.
+    #[arg(long, requires = "result")]
+    pub check: bool,
+    /// The result a re-check (--check) is planned for (an `ml` result).
+    #[arg(long, requires = "check")]
+    pub result: Option<PathBuf>,
     /// `-q`: [`QUIET_HELP`](super::QUIET_HELP).
     #[arg(long, short, help = QUIET_HELP)]
     pub quiet: bool,
@@ -296,11 +303,78 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
 /// [`CliError`] (status 2) for an unknown robot, bad limits, an unreadable
 /// hand-eye or stations file.
 pub fn config(args: &PlanArgs) -> Result<PlanConfig, CliError> {
-    let config = request(args)?
+    let mut config = request(args)?
         .config()
         .map_err(|e| CliError::input(e.to_string()))?;
+    if let Some(result) = check_result(args)? {
+        let poses = if args.identify_poses == defaults::IDENTIFY_POSES {
+            check::DEFAULT_CHECK_POSES
+        } else {
+            args.identify_poses
+        };
+        check::check_design(&mut config, &result, poses);
+    }
     config.validate().map_err(|e| plan_error(&e))?;
     Ok(config)
+}
+
+/// The result of `--check`, read.
+fn check_result(args: &PlanArgs) -> Result<Option<format::ResultFile>, CliError> {
+    match (&args.result, args.check) {
+        (Some(path), true) => format::load_result(path)
+            .map(Some)
+            .map_err(|e| CliError::input(e.to_string())),
+        _ => Ok(None),
+    }
+}
+
+/// The smallest knocks a planned re-check detects, in words.
+fn detectable_text(
+    made: &plan::Plan,
+    args: &PlanArgs,
+    config: &PlanConfig,
+) -> Result<String, CliError> {
+    let Some(result) = check_result(args)? else {
+        return Ok(String::new());
+    };
+    let d = check::plan_check(made, &result, config.stripe_sigma, check::DEFAULT_ALPHA)
+        .map_err(|e| CliError::input(e.to_string()))?;
+    let mut text = format!(
+        "  re-check: detects with {:.0} % power at a false-alarm rate of {} % ({} degrees of freedom): the sensor knocked {:.3} mm in its worst direction, or turned {:.3}° about its mount's worst axis",
+        100.0 * check::DETECTION_POWER,
+        100.0 * check::DEFAULT_ALPHA,
+        d.dof,
+        d.translation_mm,
+        d.rotation_deg
+    );
+    let mut seen: Vec<(String, f64, f64)> = d
+        .parameters
+        .iter()
+        .filter_map(|(l, v, s)| s.map(|s| (l.clone(), *v, s)))
+        .collect();
+    seen.sort_by(|a, b| a.2.total_cmp(&b.2));
+    let listed: Vec<String> = seen
+        .iter()
+        .take(4)
+        .map(|(l, v, s)| {
+            let unit = if l.starts_with('a') && !l.starts_with("alpha") || l.starts_with('d') {
+                "mm"
+            } else {
+                "°"
+            };
+            format!("{l} {v:.3} {unit} ({s:.1}σ)")
+        })
+        .collect();
+    if !listed.is_empty() {
+        text.push_str(&format!(
+            "\n  robot parameters best seen from here (change detected, in σ of the calibration): {}",
+            listed.join(", ")
+        ));
+    }
+    text.push_str(
+        "\n  a drift of the robot's base cannot be told from a moved sphere at one station",
+    );
+    Ok(text)
 }
 
 fn plan_error(e: &PlanError) -> CliError {
@@ -434,7 +508,8 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     super::check_outputs(&outputs, format::Folders::Existing)?;
     let config = config(args)?;
     let quiet = args.quiet;
-    let predict = (args.predict > 0).then(|| PredictConfig {
+    // A re-check has no validate stations to score: no prediction.
+    let predict = (args.predict > 0 && !args.check).then(|| PredictConfig {
         runs: args.predict,
         seed: args.seed,
         ..PredictConfig::default()
@@ -474,6 +549,9 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     })
     .map_err(|e| plan_error(&e))?;
     let made = &planned.plan;
+    if args.check && !quiet {
+        sayln!("{}", detectable_text(made, args, &config)?);
+    }
     if let (Some(prediction), Some(predict)) = (planned.prediction, &predict) {
         let p = prediction.map_err(|e| plan_error(&e))?;
         if !quiet {

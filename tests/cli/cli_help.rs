@@ -45,7 +45,7 @@ fn subcommands() -> Vec<clap::Command> {
 const OUTPUT_OPTIONS: [&str; 6] = ["out", "truth", "csv", "csv-out", "rapid", "program"];
 
 /// Commands that write no file (they print, or open a window).
-const WRITE_NO_FILE: [&str; 2] = ["gui", "evaluate"];
+const WRITE_NO_FILE: [&str; 3] = ["gui", "evaluate", "check"];
 
 /// A run of every command that writes files, on the repository's
 /// examples, its outputs in `dir`; `calibrate` first (the others read its
@@ -649,7 +649,7 @@ fn rendered_help() -> Vec<(String, String)> {
 }
 
 /// The chapter of the guide that shows each command at work.
-const CHAPTERS: [(&str, &str, &str); 11] = [
+const CHAPTERS: [(&str, &str, &str); 12] = [
     ("calibrate", "Calibrating", "../workflows/calibrating.md"),
     ("simulate", "A quick tour", "../getting-started/tour.md"),
     ("gui", "The workbench", "../workflows/workbench.md"),
@@ -677,6 +677,7 @@ const CHAPTERS: [(&str, &str, &str); 11] = [
         "Compensating programs",
         "../workflows/compensating.md",
     ),
+    ("check", "A five-minute re-check", "../workflows/recheck.md"),
 ];
 
 /// The reference chapter: an intro with a table of the commands (their

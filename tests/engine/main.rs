@@ -17,6 +17,7 @@ mod pose_files;
 mod pose_only;
 mod range;
 mod range_spread;
+mod recheck;
 mod realdata;
 mod robot_import;
 mod segment;

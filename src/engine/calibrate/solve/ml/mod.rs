@@ -104,6 +104,7 @@ pub mod noise;
 mod prior;
 mod problem;
 pub mod range;
+pub mod recheck;
 pub mod report;
 pub mod variance;
 

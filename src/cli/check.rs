@@ -1,0 +1,125 @@
+//! `spherecal check`: the five-minute re-check. A short scan of the
+//! sphere (planned by `plan --check`, imported like any session) tested
+//! against a result's covariance and noise model: the verdict at the
+//! false-alarm rate α, exit 0 when the cell still holds its calibration
+//! and 3 when it does not, with what moved. A thin caller of
+//! [`crate::engine::uses::check`].
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::values::{Range, number};
+use super::{CliError, QUIET_HELP};
+use crate::engine::files::format;
+use crate::engine::uses::check::{
+    self, CheckError, CheckRequest, CheckSource, Checked, DEFAULT_ALPHA,
+};
+
+/// The exit status of a check that fails: the cell no longer holds its
+/// calibration (not an error of the input).
+pub const CHECK_FAILED_STATUS: i32 = 3;
+
+/// `spherecal check`.
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// The check's session: the poses of `plan --check` run at the robot, imported like any session.
+    pub session: PathBuf,
+    /// The result the cell was calibrated to (an `ml` result: its covariance and noise model).
+    #[arg(long)]
+    pub result: PathBuf,
+    /// The false-alarm rate: the share of checks of an unchanged cell that fail.
+    #[arg(long, default_value_t = DEFAULT_ALPHA, value_parser = number(Range::positive("").at_most(0.2)))]
+    pub alpha: f64,
+    /// `-q`: [`QUIET_HELP`](super::QUIET_HELP).
+    #[arg(long, short, help = QUIET_HELP)]
+    pub quiet: bool,
+}
+
+fn error(e: &CheckError) -> CliError {
+    CliError::input(e.to_string())
+}
+
+/// The verdict's lines.
+fn verdict_text(checked: &Checked, alpha: f64) -> Vec<String> {
+    let t = &checked.test;
+    let mut out = Vec::new();
+    let what = if checked.hand_eye_only {
+        "the hand-eye (flange poses)"
+    } else {
+        "the calibrated model and hand-eye"
+    };
+    out.push(format!(
+        "{} sightings at {} station(s) predicted through {what}: {:.4} mm rms about the fitted sphere",
+        checked.sightings,
+        t.centres.len(),
+        t.rms_mm
+    ));
+    for (id, c) in &t.centres {
+        out.push(format!(
+            "  sphere at {id}: {:.3}, {:.3}, {:.3} mm (fitted: it may have been moved)",
+            c.x, c.y, c.z
+        ));
+    }
+    out.push(format!(
+        "test: T = {:.2} on {} degrees of freedom, threshold {:.2} at a false-alarm rate α = {} ({:.2} %); p = {:.3e}",
+        t.statistic,
+        t.dof,
+        t.threshold,
+        alpha,
+        100.0 * alpha,
+        t.p_value
+    ));
+    out.push(
+        "  a drift of the whole robot's base moves every centre alike: at one station it cannot be told from a moved sphere, and is not tested".into(),
+    );
+    out
+}
+
+/// Runs `spherecal check`.
+///
+/// # Errors
+/// [`CliError`] with status 2 for a file that cannot be read or a check
+/// of another cell, and status [`CHECK_FAILED_STATUS`] when the cell no
+/// longer holds its calibration.
+pub fn run(args: &CheckArgs) -> Result<(), CliError> {
+    let result = format::load_result(&args.result).map_err(|e| CliError::input(e.to_string()))?;
+    let (_, checked) = check::check_file(CheckRequest {
+        scan: CheckSource::SessionFile(args.session.clone()),
+        result,
+        alpha: args.alpha,
+    })
+    .map_err(|e| error(&e))?;
+    if !args.quiet {
+        for note in &checked.notes {
+            sayln!("note: {note}");
+        }
+        for s in &checked.skipped {
+            sayln!("warning: left out: {s}");
+        }
+        for line in verdict_text(&checked, args.alpha) {
+            sayln!("{line}");
+        }
+    }
+    if checked.test.holds {
+        if !args.quiet {
+            sayln!("HOLDS: the cell still holds its calibration");
+        }
+        return Ok(());
+    }
+    let moved = check::moved_words(&checked);
+    if !args.quiet {
+        for line in &moved {
+            sayln!("  {line}");
+        }
+    }
+    Err(CliError {
+        status: CHECK_FAILED_STATUS,
+        message: format!(
+            "the cell no longer holds its calibration (T {:.2} > {:.2}); {}: re-calibrate",
+            checked.test.statistic,
+            checked.test.threshold,
+            moved.first().map_or("", String::as_str)
+        ),
+    })
+}
