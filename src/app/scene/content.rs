@@ -186,9 +186,12 @@ pub fn cloud_scene(c: &MeasuredCloud) -> Scene {
         .iter()
         .map(|p| (p.position, colour(p.sigma_mm)))
         .collect();
-    let radius = scene.bounds().map_or(100.0, |b| b.1);
+    // Framed on the cloud; the base frame's axes and the sensor's path
+    // are a zoom out away.
+    scene.focus = scene.bounds();
+    let radius = scene.focus.map_or(100.0, |b| b.1);
     axes_lines(
-        &frame_axes(&Isometry3::identity(), (0.3 * radius).clamp(20.0, 300.0)),
+        &frame_axes(&Isometry3::identity(), (0.5 * radius).clamp(20.0, 300.0)),
         2.0,
         &mut scene.lines,
     );
@@ -211,4 +214,81 @@ pub fn cloud_scene(c: &MeasuredCloud) -> Scene {
         });
     }
     scene
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::app::session::{Source, analyse, open_demo};
+
+    /// Lines as wide as the robot's links.
+    fn links(scene: &Scene) -> Vec<&Line3> {
+        scene
+            .lines
+            .iter()
+            .filter(|l| l.stroke.width == 5.0)
+            .collect()
+    }
+
+    #[test]
+    fn the_session_scene_has_every_pose_and_the_selected_robot() {
+        let loaded = open_demo().expect("demo");
+        let n = loaded.session.measurements.len();
+        let scene = session_scene(&loaded, Some(7), &BTreeSet::new());
+        assert_eq!(scene.marks.len(), n);
+        assert_eq!(scene.marks.iter().filter(|m| m.selected).count(), 1);
+        assert!(scene.marks[7].selected);
+        // The robot at pose 7 reaches that pose's flange mark.
+        let robot = links(&scene);
+        assert_eq!(robot.len(), 1);
+        assert_eq!(robot[0].points.last(), Some(&scene.marks[7].at));
+        // A sphere a station, the stripe's points among the points.
+        let stations = loaded.station_ids().len();
+        assert_eq!(scene.spheres.len(), stations);
+        let stripe = match &loaded.session.measurements[7].observation {
+            Observation::Stripe(p) => p.len(),
+            Observation::Centre(_) => 1,
+        };
+        assert_eq!(scene.points.len(), stripe);
+        assert_eq!(scene.triangles.len(), 1, "the laser fan");
+        // The stripe lies on its station's sphere (nominal model): within
+        // a few mm of the sphere's surface.
+        let m = &loaded.session.measurements[7];
+        let k = loaded
+            .before
+            .as_ref()
+            .expect("centres")
+            .station_index(&m.station);
+        let c = scene.spheres[k].centre;
+        let r = loaded.session.sphere_radius();
+        for (p, _) in &scene.points {
+            let d = ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2)).sqrt();
+            assert!((d - r).abs() < 5.0, "{d} vs {r}");
+        }
+        // A left-out pose is muted.
+        let left = BTreeSet::from([loaded.session.measurements[3].id.clone()]);
+        let scene = session_scene(&loaded, None, &left);
+        assert_eq!(scene.marks[3].colour, MUTED);
+        assert!(scene.marks[3].label.ends_with("(left out)"));
+    }
+
+    #[test]
+    fn a_pose_only_session_shows_frames_and_no_robot() {
+        let demo = open_demo().expect("demo");
+        let mut session = demo.session.clone();
+        for m in &mut session.measurements {
+            m.flange = Some(session.robot.base_from_flange(&m.joints));
+        }
+        assert!(session.pose_only());
+        let loaded = analyse(session, Source::Demo);
+        let scene = session_scene(&loaded, Some(2), &BTreeSet::new());
+        assert!(links(&scene).is_empty(), "no robot drawn without a model");
+        let n = loaded.session.measurements.len();
+        assert_eq!(scene.marks.len(), n);
+        // Three axes a pose, the base's, the flange's and the sensor's.
+        let axes = scene.lines.iter().filter(|l| l.points.len() == 2).count();
+        assert!(axes >= 3 * n + 9, "{axes} axes for {n} poses");
+        assert_eq!(scene.spheres.len(), loaded.station_ids().len());
+        assert_eq!(scene.triangles.len(), 1);
+    }
 }

@@ -72,6 +72,9 @@ pub struct Scene {
     pub lines: Vec<Line3>,
     /// The pickable marks, drawn last.
     pub marks: Vec<Mark>,
+    /// What Fit and the standard views frame (centre, radius, mm): `None`
+    /// frames everything.
+    pub focus: Option<([f64; 3], f64)>,
 }
 
 impl Scene {
@@ -273,7 +276,7 @@ const MARK_RADIUS: f32 = 4.0;
 /// `rect` is left out.
 #[must_use]
 pub fn shapes(scene: &Scene, camera: &Camera, rect: Rect) -> (Vec<Shape>, Vec<(usize, Pos2)>) {
-    let Some(bounds) = scene.bounds() else {
+    let Some(bounds) = scene.focus.or_else(|| scene.bounds()) else {
         return (Vec::new(), Vec::new());
     };
     let proj = camera.projection(rect, bounds);

@@ -14,8 +14,9 @@ const ZOOM_PER_POINT: f64 = 1.0 / 200.0;
 /// The canvas's background.
 const BACKGROUND: Color32 = Color32::from_rgb(24, 26, 30);
 
-/// The scene `scene` in a canvas `height` points tall, as `camera` looks
-/// at it, with `caption` under it; the index of the mark a click picked.
+/// The scene `scene` in a canvas `height` points tall (0: the height
+/// left, less three small lines for the caption), as `camera` looks at
+/// it, with `caption` under it; the index of the mark a click picked.
 pub fn scene_ui(
     ui: &mut egui::Ui,
     id: &str,
@@ -24,7 +25,7 @@ pub fn scene_ui(
     caption: &str,
     height: f32,
 ) -> Option<usize> {
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label(RichText::new("3-D").strong());
         for v in StandardView::ALL {
             if ui
@@ -57,6 +58,12 @@ pub fn scene_ui(
                 .color(MUTED),
         );
     });
+    let height = if height > 0.0 {
+        height
+    } else {
+        let line = ui.text_style_height(&egui::TextStyle::Small) + ui.spacing().item_spacing.y;
+        (ui.available_height() - 3.0 * line).max(120.0)
+    };
     let size = egui::vec2(ui.available_width().max(120.0), height);
     let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
     let response = response.on_hover_cursor(egui::CursorIcon::Grab);

@@ -65,7 +65,7 @@ pub fn session_ui(
 }
 
 /// Width the 3-D scene starts at beside the table, points.
-const SCENE_WIDTH: f32 = 430.0;
+const SCENE_WIDTH: f32 = 380.0;
 
 /// The 3-D scene beside the table: every pose, and the robot, frames,
 /// laser fan and stripe of the selected one; a pose picked there is
@@ -99,14 +99,13 @@ fn scene_panel_ui(
                     m.id, m.station
                 )
             });
-            let height = (ui.available_height() - 60.0).max(160.0);
             if let Some(i) = crate::app::scene::ui::scene_ui(
                 ui,
                 "session",
                 &mut forms.scene.session,
                 &scene,
                 &caption,
-                height,
+                0.0,
             ) {
                 commands.push(Command::View(ViewCommand::Select(i)));
             }
@@ -317,7 +316,7 @@ fn table_ui(
         .column(Column::initial(55.0))
         .column(Column::initial(95.0))
         .column(Column::initial(95.0))
-        .column(Column::remainder().at_least(120.0).clip(true))
+        .column(Column::remainder().at_least(60.0).clip(true))
         .min_scrolled_height(0.0);
     if let Some(row) = scroll {
         table = table.scroll_to_row(row, None);
