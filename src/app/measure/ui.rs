@@ -442,7 +442,7 @@ const SCENE_HEIGHT: f32 = 330.0;
 /// The cloud in the cell, in 3-D: its drawn points coloured by σ, the
 /// frame's axes and the sensor's path, with the budget said.
 fn scene_ui(ui: &mut egui::Ui, c: &MeasuredCloud, forms: &mut Forms) {
-    let scene = crate::app::scene::content::cloud_scene(c);
+    let scene = crate::app::measure::scene::cloud_scene(c);
     let caption = format!(
         "3-D: {} of {} points drawn (budget {}, spread evenly), coloured by σ as the bar below; axes of the {} (x red, y green, z blue); the sensor's path in red",
         group(c.drawn.len()),

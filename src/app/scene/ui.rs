@@ -94,17 +94,17 @@ pub fn scene_ui(
     painter.rect_filled(rect, 4.0, BACKGROUND);
     painter.extend(shapes);
     let mut picked = None;
-    if let Some(at) = response.interact_pointer_pos().or(response.hover_pos()) {
-        if let Some(k) = nearest_mark(&drawn, at, PICK_RADIUS) {
-            if response.clicked() {
-                picked = Some(k);
-            }
-            if let (Some(m), Some((_, p))) = (
-                scene.marks.iter().find(|m| m.index == k),
-                drawn.iter().find(|d| d.0 == k),
-            ) {
-                name_at(&painter, rect, *p, &m.label);
-            }
+    if let Some(at) = response.interact_pointer_pos().or(response.hover_pos())
+        && let Some(k) = nearest_mark(&drawn, at, PICK_RADIUS)
+    {
+        if response.clicked() {
+            picked = Some(k);
+        }
+        if let (Some(m), Some((_, p))) = (
+            scene.marks.iter().find(|m| m.index == k),
+            drawn.iter().find(|d| d.0 == k),
+        ) {
+            name_at(&painter, rect, *p, &m.label);
         }
     }
     if scene.marks.is_empty() && scene.points.is_empty() && scene.lines.is_empty() {

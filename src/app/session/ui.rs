@@ -82,7 +82,7 @@ fn scene_panel_ui(
         .default_size(SCENE_WIDTH)
         .size_range(260.0..=900.0)
         .show(ui, |ui| {
-            let scene = crate::app::scene::content::session_scene(
+            let scene = super::scene::session_scene(
                 loaded,
                 state.selected,
                 &state.excluded,
