@@ -20,7 +20,7 @@
 //! from, stale at once when an input changes, and whether a file may be
 //! replaced without asking), [`command`] (what the views ask for),
 //! [`dialog`] (the native file dialogs), [`widgets`] (colours, fields,
-//! plots), [`steps`] (the step bar, read from the ledger), [`state`]
+//! plots), [`scene`] (the 3-D scene of the cell, one widget), [`steps`] (the step bar, read from the ledger), [`state`]
 //! (status, notices, preferences), [`error`]. This module ties them:
 //! [`AppState`] (what the workbench knows), [`Forms`] (what the widgets
 //! edit), and [`Core`], which hands each command and each job's answer to
@@ -45,6 +45,7 @@ pub mod measure;
 pub mod plan;
 pub mod results;
 pub mod run;
+pub mod scene;
 pub mod session;
 pub mod state;
 pub mod steps;
@@ -293,6 +294,8 @@ pub struct Forms {
     pub compensate: compensate::form::CompensateForm,
     /// The Measure view's fields.
     pub measure: measure::MeasureForm,
+    /// How the 3-D scenes are looked at, one camera a view.
+    pub scene: scene::SceneCameras,
 }
 
 impl Default for Forms {
@@ -317,6 +320,7 @@ impl Default for Forms {
             focus_after_fail: false,
             compensate: compensate::form::CompensateForm::default(),
             measure: measure::MeasureForm::default(),
+            scene: scene::SceneCameras::default(),
         }
     }
 }

@@ -78,6 +78,14 @@ pub enum Scenario {
     Sets,
     /// The demo's Stripe view (its first measurement).
     Stripe,
+    /// The demo's Session view with the 3-D scene: the robot at a
+    /// selected pose, its frames, the laser fan, the spheres.
+    SceneSession,
+    /// A pose-only real set (RobCalibrator's, imported) in the Session
+    /// view's 3-D scene: the flange poses as frames.
+    ScenePoses,
+    /// The example artefact measured: the cloud in the 3-D scene.
+    SceneMeasure,
     /// The demo calibrated: the Centres view, before hollow, after filled.
     Centres,
     /// The Import view on a simulated joint log (`sim/joints.csv`,
@@ -135,7 +143,7 @@ pub enum Scenario {
 
 impl Scenario {
     /// Every scenario, in the order the script takes them.
-    pub const ALL: [Self; 23] = [
+    pub const ALL: [Self; 26] = [
         Self::Steps,
         Self::Results,
         Self::ResultsTables,
@@ -159,6 +167,9 @@ impl Scenario {
         Self::Compensate,
         Self::Measure,
         Self::PlotsExport,
+        Self::SceneSession,
+        Self::ScenePoses,
+        Self::SceneMeasure,
     ];
 
     /// The name given in [`ENV`].
@@ -187,6 +198,9 @@ impl Scenario {
             Self::RealdataStripe => "realdata-stripe",
             Self::Compensate => "compensate",
             Self::Measure => "measure",
+            Self::SceneSession => "scene-session",
+            Self::ScenePoses => "scene-poses",
+            Self::SceneMeasure => "scene-measure",
             Self::PlotsExport => "plots-export",
         }
     }
@@ -294,6 +308,14 @@ impl Scenario {
             Self::RealdataStripe => realdata_stripe(),
             Self::Compensate => compensate(),
             Self::Measure => measure(),
+            Self::SceneSession => vec![
+                Act::Settle,
+                dismiss(),
+                show(Tab::Session),
+                Act::Find(|s| measurement(s, "c13").map(|i| Command::View(ViewCommand::Select(i)))),
+            ],
+            Self::ScenePoses => [realdata_stripe(), vec![show(Tab::Session)]].concat(),
+            Self::SceneMeasure => [measure(), vec![Act::Scroll(-330.0)]].concat(),
             Self::PlotsExport => {
                 let mut acts = demo_run();
                 acts.extend([
@@ -331,7 +353,8 @@ impl Scenario {
             Self::Fail => &["fail.json"],
             Self::RealdataStripe => &["data/robcalibrator-sphere/RobPoses.rob"],
             Self::Compensate => &["seed7.json", "examples/path.mod"],
-            Self::Measure => &["seed7.json", "examples/artefact/joints.csv"],
+            Self::Measure | Self::SceneMeasure => &["seed7.json", "examples/artefact/joints.csv"],
+            Self::ScenePoses => &["data/robcalibrator-sphere/RobPoses.rob"],
             _ => &[],
         }
     }

@@ -533,3 +533,27 @@ fn skipped_files_in_a_joint_log_profile_folder_are_listed() {
         "{out}"
     );
 }
+
+#[test]
+fn a_cr_only_ls_says_its_line_ends_not_no_pos_section() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = fs::read_to_string(root().join("examples/poses/calib_sph.ls"))
+        .unwrap()
+        .replace('\n', "\r");
+    let ls = dir.path().join("cr.ls");
+    fs::write(&ls, text).unwrap();
+    let (code, _, err) = run(&[
+        "import",
+        "--poses",
+        p(&ls),
+        "--profiles",
+        p(&root().join("data/robcalibrator-sphere")),
+        "--sphere-diameter",
+        "80",
+        "--out",
+        p(&dir.path().join("s.json")),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("its lines end with CR alone"), "{err}");
+    assert!(!err.contains("/POS"), "{err}");
+}

@@ -11,5 +11,6 @@ mod held_out;
 mod import_poses;
 mod measure;
 mod range;
+mod scene;
 mod trust;
 mod workbench;

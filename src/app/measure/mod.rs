@@ -8,6 +8,7 @@
 //! [`ui`].
 
 pub mod job;
+pub mod scene;
 pub mod ui;
 
 use std::path::{Path, PathBuf};

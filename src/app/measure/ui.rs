@@ -110,6 +110,7 @@ pub fn measure_ui(
             }
             summary_ui(ui, cloud);
             export_ui(ui, state, forms, commands);
+            scene_ui(ui, cloud, forms);
             projections_ui(ui, cloud);
             ui.separator();
             self_check_ui(ui, cloud);
@@ -433,6 +434,30 @@ fn summary_ui(ui: &mut egui::Ui, c: &MeasuredCloud) {
             },
         );
     }
+}
+
+/// Height of the 3-D scene of the cloud, points.
+const SCENE_HEIGHT: f32 = 330.0;
+
+/// The cloud in the cell, in 3-D: its drawn points coloured by σ, the
+/// frame's axes and the sensor's path, with the budget said.
+fn scene_ui(ui: &mut egui::Ui, c: &MeasuredCloud, forms: &mut Forms) {
+    let scene = crate::app::measure::scene::cloud_scene(c);
+    let caption = format!(
+        "3-D: {} of {} points drawn (budget {}, spread evenly), coloured by σ as the bar below; axes of the {} (x red, y green, z blue); the sensor's path in red",
+        group(c.drawn.len()),
+        group(c.points),
+        group(DRAWN_MAX),
+        c.frame
+    );
+    crate::app::scene::ui::scene_ui(
+        ui,
+        "measure",
+        &mut forms.scene.measure,
+        &scene,
+        &caption,
+        SCENE_HEIGHT,
+    );
 }
 
 /// The three projections and the colour bar.

@@ -6,6 +6,7 @@
 //! every stripe once ([`analyse`]): what the tables, the stripe view and
 //! every later run use.
 
+pub mod scene;
 pub mod stripe;
 pub mod ui;
 

@@ -36,6 +36,7 @@ pub fn session_ui(
         crate::app::widgets::no_session_ui(ui, state);
         return;
     };
+    scene_panel_ui(ui, state, loaded, forms, commands);
     filters_ui(ui, loaded, forms, commands);
     let n = loaded.session.measurements.len();
     let excluded = state.excluded_count();
@@ -61,6 +62,54 @@ pub fn session_ui(
     crate::app::widgets::dialog_note_ui(ui, state, &[Purpose::SaveSession]);
     ui.separator();
     table_ui(ui, state, loaded, forms, commands);
+}
+
+/// Width the 3-D scene starts at beside the table, points.
+const SCENE_WIDTH: f32 = 380.0;
+
+/// The 3-D scene beside the table: every pose, and the robot, frames,
+/// laser fan and stripe of the selected one; a pose picked there is
+/// selected in the table.
+fn scene_panel_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    loaded: &LoadedSession,
+    forms: &mut Forms,
+    commands: &mut Vec<Command>,
+) {
+    egui::Panel::right("session_scene")
+        .resizable(true)
+        .default_size(SCENE_WIDTH)
+        .size_range(260.0..=900.0)
+        .show(ui, |ui| {
+            let scene = super::scene::session_scene(
+                loaded,
+                state.selected,
+                &state.excluded,
+            );
+            let shown = state.selected.unwrap_or(0);
+            let caption = loaded.session.measurements.get(shown).map_or_else(String::new, |m| {
+                let what = if loaded.session.pose_only() {
+                    "pose-only: the flange poses as frames"
+                } else {
+                    "the robot from the nominal model"
+                };
+                format!(
+                    "{} (station {}): {what}, flange and sensor frames (x red, y green, z blue), the laser fan and stripe; the sphere at every station where the nominal model puts it",
+                    m.id, m.station
+                )
+            });
+            if let Some(i) = crate::app::scene::ui::scene_ui(
+                ui,
+                "session",
+                &mut forms.scene.session,
+                &scene,
+                &caption,
+                0.0,
+            ) {
+                commands.push(Command::View(ViewCommand::Select(i)));
+            }
+        });
 }
 
 /// The measuring range (`sensor.range`): where the calibrated sensor will
@@ -267,7 +316,7 @@ fn table_ui(
         .column(Column::initial(55.0))
         .column(Column::initial(95.0))
         .column(Column::initial(95.0))
-        .column(Column::remainder().at_least(120.0).clip(true))
+        .column(Column::remainder().at_least(60.0).clip(true))
         .min_scrolled_height(0.0);
     if let Some(row) = scroll {
         table = table.scroll_to_row(row, None);

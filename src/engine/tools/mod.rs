@@ -10,6 +10,7 @@
 //! | [`simulate`] | simulated sessions and scans with their truth |
 //! | [`evaluate`] | scoring against the truth; the method comparison study |
 //! | [`plan`] | pose plans and their predicted accuracy, programs to teach them |
+//! | [`scene`] | the cell's geometry for the 3-D scene: links, frames, laser fan, stripes |
 
 pub mod result_view;
 pub mod report;
@@ -17,3 +18,4 @@ pub mod history;
 pub mod simulate;
 pub mod evaluate;
 pub mod plan;
+pub mod scene;

@@ -421,14 +421,22 @@ pub fn parse_pose_text(
     path: &Path,
     spec: &ReadSpec,
 ) -> Result<PoseFile, ProgramError> {
-    let (format, detected) = match spec.format {
-        Some(f) => (f, false),
-        None => (detect(&text, path), true),
-    };
     let fail = |line: usize, message: String| ProgramError {
         path: path.to_path_buf(),
         line,
         message,
+    };
+    // Lines ended by CR alone (an old Mac editor) read as one line: every
+    // reader would then miss what it looks for and say something else.
+    if text.contains('\r') && !text.contains('\n') && text.trim_end().contains('\r') {
+        return Err(fail(
+            0,
+            "its lines end with CR alone (no line feed): save it with LF or CRLF line ends".to_string(),
+        ));
+    }
+    let (format, detected) = match spec.format {
+        Some(f) => (f, false),
+        None => (detect(&text, path), true),
     };
     if let (Some(fixed), Some(given)) = (format.convention(), spec.convention)
         && fixed != given
