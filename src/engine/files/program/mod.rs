@@ -431,7 +431,8 @@ pub fn parse_pose_text(
     if text.contains('\r') && !text.contains('\n') && text.trim_end().contains('\r') {
         return Err(fail(
             0,
-            "its lines end with CR alone (no line feed): save it with LF or CRLF line ends".to_string(),
+            "its lines end with CR alone (no line feed): save it with LF or CRLF line ends"
+                .to_string(),
         ));
     }
     let (format, detected) = match spec.format {
