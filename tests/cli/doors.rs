@@ -54,6 +54,25 @@ fn scan(args: &[&str]) -> (i32, String, String) {
     run(&all)
 }
 
+/// `spherecal import` of the pose file `poses` beside the profiles of
+/// the real set (or a copy, `profiles`), its 80 mm sphere, into `out`,
+/// with `extra` flags.
+fn import_real(poses: &Path, profiles: &Path, out: &Path, extra: &[&str]) -> (i32, String, String) {
+    let mut args = vec![
+        "import",
+        "--poses",
+        p(poses),
+        "--profiles",
+        p(profiles),
+        "--sphere-diameter",
+        "80",
+        "--out",
+        p(out),
+    ];
+    args.extend_from_slice(extra);
+    run(&args)
+}
+
 #[test]
 fn measure_profile_unit_m_putting_points_40_m_from_the_sensor_is_refused() {
     let dir = tempfile::tempdir().unwrap();
@@ -144,21 +163,8 @@ fn the_frame_key_twice_is_refused_not_the_last_one_taken() {
 fn duplicate_keys_or_columns_are_refused_naming_the_line() {
     let dir = tempfile::tempdir().unwrap();
     let data = root().join("data/robcalibrator-sphere");
-    let import = |poses: &Path| {
-        run(&[
-            "import",
-            "--poses",
-            p(poses),
-            "--pose-convention",
-            "fanuc",
-            "--profiles",
-            p(&data),
-            "--sphere-diameter",
-            "80",
-            "--out",
-            p(&dir.path().join("s.json")),
-        ])
-    };
+    let out = dir.path().join("s.json");
+    let import = |poses: &Path| import_real(poses, &data, &out, &["--pose-convention", "fanuc"]);
     let rob = fs::read_to_string(data.join("RobPoses.rob")).unwrap();
     let rob = format!(
         "{}, \"RobPoses\": [[1, 2, 3, 0, 0, 0]]}}",
@@ -175,17 +181,7 @@ fn duplicate_keys_or_columns_are_refused_naming_the_line() {
         .replacen("{X ", "{X 5,X ", 1);
     let dat = dir.path().join("poses.dat");
     fs::write(&dat, krl).unwrap();
-    let (code, _, err) = run(&[
-        "import",
-        "--poses",
-        p(&dat),
-        "--profiles",
-        p(&data),
-        "--sphere-diameter",
-        "80",
-        "--out",
-        p(&dir.path().join("s.json")),
-    ]);
+    let (code, _, err) = import_real(&dat, &data, &out, &[]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("the field `X` is given twice"), "{err}");
     assert!(err.contains("line 3"), "{err}");
@@ -237,22 +233,8 @@ fn an_output_onto_an_old_output_inside_the_profiles_folder_is_written() {
         fs::copy(e.path(), data.join(e.file_name())).unwrap();
     }
     let out = data.join("session.json");
-    let import = || {
-        run(&[
-            "import",
-            "--poses",
-            p(&data.join("RobPoses.rob")),
-            "--pose-convention",
-            "fanuc",
-            "--profiles",
-            p(&data),
-            "--sphere-diameter",
-            "80",
-            "--out",
-            p(&out),
-            "-q",
-        ])
-    };
+    let rob = data.join("RobPoses.rob");
+    let import = || import_real(&rob, &data, &out, &["--pose-convention", "fanuc", "-q"]);
     let (code, _, err) = import();
     assert_eq!(code, 0, "{err}");
     // Again, onto the old output that now lies among the profiles (the
@@ -260,19 +242,12 @@ fn an_output_onto_an_old_output_inside_the_profiles_folder_is_written() {
     let (code, _, err) = import();
     assert_eq!(code, 0, "{err}");
     // A profile itself is still refused as an output.
-    let (code, _, err) = run(&[
-        "import",
-        "--poses",
-        p(&data.join("RobPoses.rob")),
-        "--pose-convention",
-        "fanuc",
-        "--profiles",
-        p(&data),
-        "--sphere-diameter",
-        "80",
-        "--out",
-        p(&data.join("p3.yml")),
-    ]);
+    let (code, _, err) = import_real(
+        &rob,
+        &data,
+        &data.join("p3.yml"),
+        &["--pose-convention", "fanuc"],
+    );
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("the output is the input"), "{err}");
 }
@@ -417,21 +392,12 @@ fn a_hand_eye_guess_rounded_to_4_decimals_is_taken_with_a_note() {
     )
     .unwrap();
     let data = root().join("data/robcalibrator-sphere");
-    let (code, stdout, err) = run(&[
-        "import",
-        "--poses",
-        p(&data.join("RobPoses.rob")),
-        "--pose-convention",
-        "fanuc",
-        "--profiles",
-        p(&data),
-        "--sphere-diameter",
-        "80",
-        "--hand-eye",
-        p(&guess),
-        "--out",
-        p(&dir.path().join("s.json")),
-    ]);
+    let (code, stdout, err) = import_real(
+        &data.join("RobPoses.rob"),
+        &data,
+        &dir.path().join("s.json"),
+        &["--pose-convention", "fanuc", "--hand-eye", p(&guess)],
+    );
     assert_eq!(code, 0, "{err}");
     assert!(
         stdout.contains("note: --hand-eye: the rotation is 8.2e-5 from orthonormal"),
@@ -460,17 +426,12 @@ fn a_hand_eye_guess_rounded_to_4_decimals_is_taken_with_a_note() {
 fn wording_an_abb_rapid_module_and_one_pose() {
     let dir = tempfile::tempdir().unwrap();
     let data = root().join("data/robcalibrator-sphere");
-    let (code, _, err) = run(&[
-        "import",
-        "--poses",
-        p(&root().join("examples/poses/robposes.mod")),
-        "--pose-convention",
-        "fanuc",
-        "--profiles",
-        p(&data),
-        "--out",
-        p(&dir.path().join("s.json")),
-    ]);
+    let (code, _, err) = import_real(
+        &root().join("examples/poses/robposes.mod"),
+        &data,
+        &dir.path().join("s.json"),
+        &["--pose-convention", "fanuc"],
+    );
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("error: an ABB RAPID module writes"), "{err}");
     // A raw scan of one pose: "1 pose".
@@ -542,17 +503,12 @@ fn a_cr_only_ls_says_its_line_ends_not_no_pos_section() {
         .replace('\n', "\r");
     let ls = dir.path().join("cr.ls");
     fs::write(&ls, text).unwrap();
-    let (code, _, err) = run(&[
-        "import",
-        "--poses",
-        p(&ls),
-        "--profiles",
-        p(&root().join("data/robcalibrator-sphere")),
-        "--sphere-diameter",
-        "80",
-        "--out",
-        p(&dir.path().join("s.json")),
-    ]);
+    let (code, _, err) = import_real(
+        &ls,
+        &root().join("data/robcalibrator-sphere"),
+        &dir.path().join("s.json"),
+        &[],
+    );
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("its lines end with CR alone"), "{err}");
     assert!(!err.contains("/POS"), "{err}");
