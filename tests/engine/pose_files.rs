@@ -865,6 +865,21 @@ fn an_import_whose_centres_scatter_beyond_any_sensor_is_warned() {
             && notes.contains("robot.txt"),
         "{notes}"
     );
+    // The import's one entry (the command line's and the workbench's)
+    // refuses the pose-only session: its start is its verdict.
+    let request = import::entry::ImportRequest {
+        log: import::entry::PoseLog::Poses(s),
+        range: None,
+    };
+    let e = import::entry::import_session(&request, &mut import::progress::quiet)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("robot.txt")
+            && e.contains("nothing is written")
+            && e.contains("--pose-convention"),
+        "{e}"
+    );
 }
 
 /// Issue 31, medium: a profile folder with `p1..p15.yml` and

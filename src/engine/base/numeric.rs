@@ -135,9 +135,27 @@ pub fn plural(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
 }
 
+/// The square root of a variance, `0` for a variance that rounding made
+/// negative or `-0.0` (`f64::max(-0.0, 0.0)` may keep the sign, and
+/// `sqrt(-0.0)` is `-0.0`, printed "-0.000").
+#[must_use]
+pub fn sigma_of_variance(variance: f64) -> f64 {
+    if variance > 0.0 { variance.sqrt() } else { 0.0 }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_sigma_is_never_negative_zero() {
+        for v in [-0.0, 0.0, -1e-30, f64::NAN] {
+            let s = sigma_of_variance(v);
+            assert!(s == 0.0 && s.is_sign_positive(), "{v}: {s}");
+        }
+        assert_eq!(format!("{:.3}", sigma_of_variance(-0.0)), "0.000");
+        assert_eq!(sigma_of_variance(4.0), 2.0);
+    }
 
     #[test]
     fn approx_keeps_four_significant_digits() {

@@ -350,7 +350,7 @@ pub fn general_hand_eye(
     let eig_t = SymmetricEigen::try_new(c_tt, f64::EPSILON, MAX_DECOMPOSITION_SWEEPS)
         .ok_or(HandEyeError::NonFinite)?;
     let k = eig_t.eigenvalues.imax();
-    let sigma_t = eig_t.eigenvalues[k].max(0.0).sqrt();
+    let sigma_t = crate::engine::base::numeric::sigma_of_variance(eig_t.eigenvalues[k]);
     let direction_base = eig_t.eigenvectors.column(k).into_owned();
     let sigma_w = SymmetricEigen::try_new(c_ww, f64::EPSILON, MAX_DECOMPOSITION_SWEEPS)
         .ok_or(HandEyeError::NonFinite)?

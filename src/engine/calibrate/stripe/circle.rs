@@ -124,7 +124,7 @@ impl CircleFit {
     /// Standard deviation of the radius, mm (from [`CircleFit::covariance`]).
     #[must_use]
     pub fn radius_std(&self) -> f64 {
-        self.covariance[(2, 2)].max(0.0).sqrt()
+        crate::engine::base::numeric::sigma_of_variance(self.covariance[(2, 2)])
     }
 }
 

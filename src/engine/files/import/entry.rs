@@ -52,6 +52,26 @@ pub fn import_session(
     if request.range.is_some() {
         imported.session.sensor_range = request.range;
     }
+    // Calibrate's verdict on the start, the import's last step: a
+    // pose-only session whose centres no hand-eye brings together is a
+    // misread file (another convention, unit or session), refused here
+    // rather than written for `calibrate` to refuse. A session with joints
+    // only warns (the nominal model's own scatter can exceed the bound and
+    // still calibrate).
+    if let PoseLog::Poses(spec) = &request.log
+        && imported.session.pose_only()
+        && let Some(why) = super::initial::implausible_start(&imported.session)
+    {
+        return Err(ImportError::File {
+            path: spec.poses.clone(),
+            message: format!(
+                "with the initial hand-eye the sphere centres scatter by {} mm (3-D rms about each station's mean), beyond what any sensor and robot give (at most {} mm); nothing is written; likely causes: {}, or poses and centres that do not belong together (another unit, another session)",
+                crate::engine::base::numeric::approx(why.scatter_mm),
+                crate::engine::calibrate::solve::plausible::MAX_PLAUSIBLE_SCATTER_MM,
+                why.causes
+            ),
+        });
+    }
     Ok(imported)
 }
 

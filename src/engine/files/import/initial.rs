@@ -121,6 +121,41 @@ fn scatter(
     if n > 0.0 { (ss / n).sqrt() } else { f64::NAN }
 }
 
+/// The centres' scatter (3-D rms about each station's mean, mm) under
+/// the session's initial hand-eye, when calibrate's verdict refuses it
+/// ([`check_scatter`]): the finished import's last check, a refusal for a
+/// pose-only session (its start is its verdict: no kinematic error can
+/// bring the centres together). `None` when plausible or without a
+/// hand-eye.
+pub(crate) fn implausible_start(
+    session: &Session,
+) -> Option<crate::engine::calibrate::solve::plausible::ImplausibleScatter> {
+    let he = session.hand_eye?;
+    let robot = session.robot.clone();
+    let poses: Vec<Isometry3<f64>> = (0..session.measurements.len())
+        .map(|i| session.base_from_flange(&robot, i))
+        .collect();
+    let centres: Vec<Option<Vector3<f64>>> = analyse(session)
+        .measurements
+        .iter()
+        .map(|m| m.as_ref().ok().map(|p| p.centre_in_sensor))
+        .collect();
+    let mut station_index: HashMap<&str, usize> = HashMap::new();
+    let stations: Vec<usize> = session
+        .measurements
+        .iter()
+        .map(|m| {
+            let next = station_index.len();
+            *station_index.entry(m.station.as_str()).or_insert(next)
+        })
+        .collect();
+    check_scatter(
+        scatter(&poses, &centres, &stations, &he),
+        session.pose_only(),
+    )
+    .err()
+}
+
 /// Names, shortened: "p1, p2, …, p15 (15)".
 fn names(ids: &[&str]) -> String {
     if ids.len() <= 8 {

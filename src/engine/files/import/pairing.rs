@@ -264,7 +264,7 @@ pub fn read_in_order(
                 return Err(ImportError::File {
                     path: path.clone(),
                     message: format!(
-                        "{} profiles for {poses} poses of {}: a log without ids pairs pose k with the k-th profile, so the counts must match",
+                        "{} profiles for {poses} poses of {}: without pose ids that name the table's profiles, pose k pairs with the k-th profile, so the counts must match",
                         order.len(),
                         log.display()
                     ),

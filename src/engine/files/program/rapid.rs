@@ -194,13 +194,28 @@ pub(super) fn read(text: &str) -> Result<Parsed, ParseError> {
                 inline_at.insert(i, targets.len());
             }
             targets.push(t);
-        } else if let (Some(base), Node::List(items, _)) = (&declared, &node) {
+        } else if let Some(base) = &declared {
             // An array of targets: `robtarget pts{3} := [[…], […], […]]`.
-            for (k, item) in items.iter().enumerate() {
-                if let Some(t) = target_of(item, format!("{base}{{{}}}", k + 1), line) {
-                    targets.push(t);
-                }
-            }
+            let array: Option<Vec<Target>> = match &node {
+                Node::List(items, _) if !items.is_empty() => items
+                    .iter()
+                    .enumerate()
+                    .map(|(k, item)| target_of(item, format!("{base}{{{}}}", k + 1), line))
+                    .collect(),
+                _ => None,
+            };
+            // A declared target the reader cannot take is named, never
+            // skipped (a skipped one shifts every later pairing).
+            let Some(array) = array else {
+                return Err((
+                    line,
+                    format!(
+                        "`{}` is declared as a target but its value is not [[x,y,z],[q1,q2,q3,q4],[cf1,cf4,cf6,cfx],[eax_a,…,eax_f]] (robtarget) or [[j1,…,j6],[eax_a,…,eax_f]] (jointtarget) of numbers",
+                        shown(base)
+                    ),
+                ));
+            };
+            targets.extend(array);
         }
         i = next;
     }
@@ -387,6 +402,16 @@ mod tests {
         let (line, m) = read("MODULE m\nCONST robtarget p := [[1,2,3],[1,0,0,0];\n").unwrap_err();
         assert_eq!(line, 2);
         assert!(m.contains("without"), "{m}");
+        // A declared target with a value the reader cannot take is named,
+        // not skipped.
+        let (line, m) = read(
+            "MODULE m\n\nCONST robtarget p2 := [[zz,1,2],[1,0,0,0],[0,0,0,0],[0,0,0,0,0,0]];\n",
+        )
+        .unwrap_err();
+        assert_eq!(line, 3);
+        assert!(m.contains("`p2` is declared as a target"), "{m}");
+        let (_, m) = read("VAR robtarget pts{2} := [[[1,2,3],[1,0,0,0],[0,0,0,0],[0,0,0,0,0,0]],[[4,5],[1,0,0,0],[0,0,0,0],[0,0,0,0,0,0]]];").unwrap_err();
+        assert!(m.contains("`pts`"), "{m}");
         let deep = format!("x := {}{};", "[".repeat(50), "]".repeat(50));
         assert!(read(&deep).unwrap_err().1.contains("nested"));
     }

@@ -174,7 +174,9 @@ pub(super) fn build_entry(
         info.stds
             .get(label)
             .copied()
-            .or_else(|| cov(label, label).map(|v| v.max(0.0).sqrt()))
+            .or_else(|| {
+                cov(label, label).map(|v| crate::engine::base::numeric::sigma_of_variance(v))
+            })
             .filter(|s| s.is_finite())
     };
 
@@ -204,7 +206,7 @@ pub(super) fn build_entry(
                     var += jac[(row, a)] * jac[(row, b)] * cov(block[a], block[b]).unwrap_or(0.0);
                 }
             }
-            var.max(0.0).sqrt() * sigma_scale
+            crate::engine::base::numeric::sigma_of_variance(var) * sigma_scale
         });
         let value = if i < 3 {
             hand_eye.translation[i]

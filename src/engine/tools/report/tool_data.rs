@@ -186,7 +186,9 @@ pub fn value_sigmas(
     }
     let c = nalgebra::DMatrix::from_iterator(6, 6, c.iter().copied());
     let f = &jac * c * jac.transpose();
-    let out: Vec<f64> = (0..n).map(|i| f[(i, i)].max(0.0).sqrt()).collect();
+    let out: Vec<f64> = (0..n)
+        .map(|i| crate::engine::base::numeric::sigma_of_variance(f[(i, i)]))
+        .collect();
     out.iter().all(|v| v.is_finite()).then_some(out)
 }
 

@@ -444,7 +444,8 @@ pub fn hand_eye_sigma(
         }
     }
     let f = jac * c * jac.transpose();
-    let out: [f64; 6] = std::array::from_fn(|i| f[(i, i)].max(0.0).sqrt());
+    let out: [f64; 6] =
+        std::array::from_fn(|i| crate::engine::base::numeric::sigma_of_variance(f[(i, i)]));
     out.iter().all(|v| v.is_finite()).then_some(out)
 }
 

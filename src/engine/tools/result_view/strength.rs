@@ -87,7 +87,7 @@ impl HandEyeStrength {
         };
         let mut sigma = [0.0; 6];
         for (k, s) in sigma.iter_mut().enumerate() {
-            *s = entry(k, k)?.max(0.0).sqrt();
+            *s = crate::engine::base::numeric::sigma_of_variance(entry(k, k)?);
         }
         let mut t = Matrix3::zeros();
         for i in 0..3 {
@@ -126,8 +126,11 @@ impl HandEyeStrength {
         });
         Some(Self {
             sigma,
-            weakest_translation: (dir.into(), eig.eigenvalues[hi].max(0.0).sqrt()),
-            best_translation: eig.eigenvalues[lo].max(0.0).sqrt(),
+            weakest_translation: (
+                dir.into(),
+                crate::engine::base::numeric::sigma_of_variance(eig.eigenvalues[hi]),
+            ),
+            best_translation: crate::engine::base::numeric::sigma_of_variance(eig.eigenvalues[lo]),
             orientation_span_deg: span,
         })
     }

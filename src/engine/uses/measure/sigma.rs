@@ -55,7 +55,7 @@ impl SigmaForm {
     /// `σ` (mm) of the point `(0, y, z)`.
     #[must_use]
     pub fn sigma(&self, y: f64, z: f64) -> f64 {
-        self.variance(y, z).sqrt()
+        crate::engine::base::numeric::sigma_of_variance(self.variance(y, z))
     }
 
     /// The same form with `v` (mm²) added to every point.
@@ -146,7 +146,8 @@ fn square_root(c: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     let eig = SymmetricEigen::try_new(c.clone(), f64::EPSILON, MAX_DECOMPOSITION_SWEEPS)?;
     let mut l = eig.eigenvectors;
     for (j, value) in eig.eigenvalues.iter().enumerate() {
-        l.column_mut(j).scale_mut(value.max(0.0).sqrt());
+        l.column_mut(j)
+            .scale_mut(crate::engine::base::numeric::sigma_of_variance(*value));
     }
     Some(l)
 }

@@ -250,7 +250,7 @@ impl RigidFit {
 /// `cov` of the parameters `h`'s columns are in (never below 0).
 #[must_use]
 pub fn aligned_sigma(h: &DMatrix<f64>, cov: &DMatrix<f64>) -> f64 {
-    (h * cov * h.transpose()).trace().max(0.0).sqrt()
+    crate::engine::base::numeric::sigma_of_variance((h * cov * h.transpose()).trace())
 }
 
 #[cfg(test)]

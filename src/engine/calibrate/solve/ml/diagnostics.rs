@@ -316,7 +316,9 @@ fn file_covariance(problem: &Problem, cov_scaled: &DMatrix<f64>) -> FileCovarian
                 .collect()
         })
         .collect();
-    let std: Vec<f64> = (0..k).map(|i| cov_file[i][i].max(0.0).sqrt()).collect();
+    let std: Vec<f64> = (0..k)
+        .map(|i| crate::engine::base::numeric::sigma_of_variance(cov_file[i][i]))
+        .collect();
     let corr: Vec<Vec<f64>> = (0..k)
         .map(|i| {
             (0..k)

@@ -361,7 +361,10 @@ pub fn recheck(
             sigma: cols
                 .iter()
                 .enumerate()
-                .map(|(j, &u)| f.cov[(off + j, off + j)].max(0.0).sqrt() * file_unit(u))
+                .map(|(j, &u)| {
+                    crate::engine::base::numeric::sigma_of_variance(f.cov[(off + j, off + j)])
+                        * file_unit(u)
+                })
                 .collect(),
             p_drop: chi2_sf(drop, added as f64),
             remaining: f.rss,
@@ -459,7 +462,7 @@ pub fn detectable(
             .unknowns
             .iter()
             .position(|&k| k == u)
-            .map(|i| model.covariance[(i, i)].max(0.0).sqrt())
+            .map(|i| crate::engine::base::numeric::sigma_of_variance(model.covariance[(i, i)]))
     };
     let parameters = model
         .unknowns

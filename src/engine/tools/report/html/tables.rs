@@ -62,7 +62,10 @@ pub(super) fn identifiability(h: &mut String, ctx: &Ctx<'_>) {
             h,
             "<li>variance factor {} (≈ 1 when the noise model fits). The ± 1σ of the tables are a posteriori: the covariance as written (a priori, from the noise model) times the variance factor, σ × {}; hover a value for its a priori σ. The file's covariance is as written.</li>",
             num(ml.variance_factor, 3),
-            num(ml.variance_factor.max(0.0).sqrt(), 3)
+            num(
+                crate::engine::base::numeric::sigma_of_variance(ml.variance_factor),
+                3
+            )
         );
         if let Some(v) = &ml.predicted_distance_std_validate {
             let _ = writeln!(
