@@ -5,6 +5,7 @@
 //! | unit | holds |
 //! |---|---|
 //! | [`numeric`] | rounding, medians, shared numeric helpers |
+//! | [`control`] | what a long job's progress callback answers (go on, cancel) |
 //! | [`geometry`] | rigid transforms, twists, roll/pitch/yaw |
 //! | [`table`] | CSV tables as the engine reads them (line numbers for messages) |
 //! | [`limits`] | physical plausibility limits of a session's numbers |
@@ -13,6 +14,7 @@
 //! | [`cell`] | what the simulator, the planner and compensation share about a cell: sensor, workspace, approach cones, joint logs, configuration branches, seeded streams |
 
 pub mod numeric;
+pub mod control;
 pub mod geometry;
 pub mod table;
 pub mod limits;

@@ -208,15 +208,10 @@ impl Progress {
     }
 }
 
-/// What the progress callback asks for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Control {
-    /// Go on.
-    Continue,
-    /// Stop now: the run ends with
-    /// [`StopReason::Cancelled`](super::StopReason::Cancelled).
-    Cancel,
-}
+/// What the progress callback asks for (one type for every job, in
+/// `base`): [`Control::Cancel`] ends the run with
+/// [`StopReason::Cancelled`](super::StopReason::Cancelled).
+pub use crate::engine::base::control::Control;
 
 #[cfg(test)]
 mod tests {

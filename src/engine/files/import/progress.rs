@@ -3,7 +3,7 @@
 //! decided by calibrating both, the session checked by the file rules.
 
 use super::ImportError;
-use crate::engine::calibrate::solve::Control;
+use crate::engine::base::control::Control;
 
 /// A stage of an import.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
