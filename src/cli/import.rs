@@ -39,10 +39,10 @@ pub struct ImportArgs {
     /// A folder of stripe profiles (`<id>.csv|txt|yml|yaml|json`; for a pose log without ids the files named alike, in the order of the number in their names: p7.yml, 7_3C_line.yml, scan_007.csv; other files, the pose file among them, are skipped and listed) or one CSV with a pose column.
     #[arg(long, required_unless_present = "centres", conflicts_with = "centres")]
     pub profiles: Option<PathBuf>,
-    /// With --poses: the sphere centres the sensor reported, instead of profiles: a table with one `x y z` a pose (sensor frame, mm; any separator, header optional, an `id` column optional), paired with the poses in order. With --mount fixed and --joints: the fixed sensor's points (a tracker's table; see the guide's "A fixed sensor").
+    /// With --poses: the sphere centres the sensor reported, instead of profiles: a table with one `x y z` a pose (sensor frame, mm; any separator, header optional, an `id` column optional), paired with the poses in order. With --mount fixed (beside --joints or --poses): the fixed sensor's points (a tracker's table; see the guide's "A fixed sensor").
     #[arg(long)]
     pub centres: Option<PathBuf>,
-    /// Where the sensor stands: `flange` (the sensor on the robot, the sphere in the cell) or `fixed` (a laser tracker, fixed camera or scanner in the cell measuring targets on the tool; reads --centres beside --joints).
+    /// Where the sensor stands: `flange` (the sensor on the robot, the sphere in the cell) or `fixed` (a laser tracker, fixed camera or scanner in the cell measuring targets on the tool; reads --centres, or a fixed line scanner's --profiles, beside --joints or --poses).
     #[arg(long, value_enum, default_value_t = MountArg::Flange)]
     pub mount: MountArg,
     /// With --mount fixed: the unit of the points in --centres.

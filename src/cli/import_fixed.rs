@@ -1,13 +1,17 @@
 //! `spherecal import --mount fixed`: a fixed sensor's points (a laser
-//! tracker's table, a fixed camera's or scanner's) beside a joint log
-//! become a session with `sensor.mount: "fixed"`
-//! ([`import_tracker`](crate::engine::files::import::tracker::import_tracker)).
+//! tracker's table, a fixed camera's) or a fixed line scanner's stripe
+//! profiles, beside a joint log or a pose file, become a session with
+//! `sensor.mount: "fixed"`, through the one import entry
+//! ([`import_session`](crate::engine::files::import::import_session) with
+//! [`PoseLog::Fixed`]).
 
 use crate::cli::CliError;
 use crate::cli::import::{ImportArgs, MountArg, joint_log_columns};
 use crate::engine::files::format;
-use crate::engine::files::import::tracker::{TrackerSpec, import_tracker};
-use crate::engine::files::import::{self, LengthUnit};
+use crate::engine::files::import::tracker::{FixedPoints, FixedPoses, TrackerSpec};
+use crate::engine::files::import::{
+    self, ImportRequest, Imported, LengthUnit, PoseLog, ProfileSource, SideChoice,
+};
 
 /// `spherecal import`: a fixed sensor's points here, anything else by
 /// [`crate::cli::import::run`].
@@ -22,51 +26,133 @@ pub fn dispatch(args: &ImportArgs) -> Result<(), CliError> {
     }
 }
 
+/// The engine's spec of a fixed sensor's import from the flags.
+///
+/// # Errors
+/// [`CliError`] (status 2) for a missing or contradicting flag, a robot
+/// that does not load, an unreadable hand-eye.
+fn fixed_spec(args: &ImportArgs) -> Result<TrackerSpec, CliError> {
+    let length_unit = LengthUnit::parse(&args.centre_unit).ok_or_else(|| {
+        CliError::input(format!("--centre-unit {}: mm, m or um", args.centre_unit))
+    })?;
+    let (poses, robot) = match (&args.joints, &args.poses) {
+        (Some(_), Some(_)) => {
+            return Err(CliError::input(
+                "--joints and --poses both given: a fixed sensor's poses come from one of them",
+            ));
+        }
+        (None, None) => {
+            return Err(CliError::input(
+                "--mount fixed needs the poses: a joint log (--joints) or a pose file (--poses)",
+            ));
+        }
+        (Some(_), None) => {
+            let (path, robot, columns) = joint_log_columns(args)?;
+            (
+                FixedPoses::Joints {
+                    path,
+                    id_column: columns.id,
+                    joint_columns: columns.joints,
+                    angle_unit: args.scan.joint_unit,
+                },
+                Some(robot),
+            )
+        }
+        (None, Some(path)) => (
+            FixedPoses::File {
+                path: path.clone(),
+                format: args.scan.pose_format,
+                convention: args.scan.pose_convention,
+                pose_columns: args.scan.pose_columns(),
+            },
+            args.robot
+                .as_deref()
+                .map(|r| args.scan.robot_source(r))
+                .transpose()?,
+        ),
+    };
+    let robot = robot
+        .map(|r| import::load_robot(&r))
+        .transpose()
+        .map_err(|e| CliError::input(e.to_string()))?;
+    let points = match (&args.centres, &args.profiles) {
+        (Some(path), _) => FixedPoints::Table {
+            path: path.clone(),
+            unit: length_unit,
+        },
+        (None, Some(profiles)) => FixedPoints::Profiles {
+            source: if profiles.is_dir() {
+                ProfileSource::Folder(profiles.clone())
+            } else {
+                ProfileSource::File {
+                    path: profiles.clone(),
+                    pose_column: args.scan.pose_column.clone(),
+                }
+            },
+            format: args.scan.profile_format()?,
+            side: match args.side {
+                SideChoice::Minus => -1,
+                // A fixed scanner's side is not decided from the data:
+                // `auto` (the default) reads +1 unless the log says.
+                SideChoice::Plus | SideChoice::Auto => 1,
+            },
+        },
+        (None, None) => {
+            return Err(CliError::input(
+                "--mount fixed needs --centres POINTS.csv (the sensor's points, one `x y z` a target and pose) or --profiles (a fixed line scanner's stripes)",
+            ));
+        }
+    };
+    let hand_eye = args
+        .hand_eye
+        .as_ref()
+        .map(|p| super::hand_eye_file(p))
+        .transpose()?;
+    let name = args.name.clone().unwrap_or_else(|| {
+        poses
+            .path()
+            .file_stem()
+            .map_or_else(|| "imported".into(), |s| s.to_string_lossy().into_owned())
+    });
+    Ok(TrackerSpec {
+        poses,
+        points,
+        robot,
+        diameter: args.sphere_diameter,
+        hand_eye,
+        name,
+    })
+}
+
 /// Imports, writes the session and prints what was read.
 ///
 /// # Errors
 /// [`CliError`] (status 2) for a missing flag or a bad input, naming the
 /// file, line and column.
 fn run(args: &ImportArgs) -> Result<(), CliError> {
-    if args.poses.is_some() {
-        return Err(CliError::input(
-            "--mount fixed reads a joint log (--joints) beside --centres; a pose file is not read for a fixed sensor yet",
-        ));
-    }
-    let Some(points) = &args.centres else {
-        return Err(CliError::input(
-            "--mount fixed needs --centres POINTS.csv: the fixed sensor's points, one `x y z` a target and pose",
-        ));
-    };
     let Some(out) = &args.out else {
         return Err(CliError::input("--out SESSION.json is needed"));
     };
-    let (joint_log, robot, columns) = joint_log_columns(args)?;
-    CliError::guard_output(out, &[points.as_path(), joint_log.as_path()])?;
-    let robot = import::load_robot(&robot).map_err(|e| CliError::input(e.to_string()))?;
-    let length_unit = LengthUnit::parse(&args.centre_unit).ok_or_else(|| {
-        CliError::input(format!("--centre-unit {}: mm, m or um", args.centre_unit))
-    })?;
-    let name = args.name.clone().unwrap_or_else(|| {
-        joint_log
-            .file_stem()
-            .map_or_else(|| "imported".into(), |s| s.to_string_lossy().into_owned())
-    });
-    let spec = TrackerSpec {
-        points: points.clone(),
-        joint_log,
-        id_column: columns.id,
-        joint_columns: columns.joints,
-        angle_unit: args.scan.joint_unit,
-        length_unit,
-        robot,
-        diameter: args.sphere_diameter,
-        name,
-    };
-    let (mut session, notes) = import_tracker(&spec).map_err(|e| CliError::input(e.to_string()))?;
-    if args.range.is_some() {
-        session.sensor_range = args.range;
+    let spec = fixed_spec(args)?;
+    let mut inputs = vec![spec.poses.path().to_path_buf()];
+    inputs.extend(args.centres.iter().chain(&args.hand_eye).cloned());
+    if let Some(p) = args.profiles.as_ref().filter(|p| !p.is_dir()) {
+        inputs.push(p.clone());
     }
+    let inputs: Vec<&std::path::Path> = inputs.iter().map(std::path::PathBuf::as_path).collect();
+    CliError::guard_output(out, &inputs)?;
+    let request = ImportRequest {
+        log: PoseLog::Fixed(spec),
+        range: args.range,
+    };
+    let Imported { session, notes, .. } = import::import_session(&request, &mut |_| {
+        if format::interrupted() {
+            crate::engine::calibrate::solve::Control::Cancel
+        } else {
+            crate::engine::calibrate::solve::Control::Continue
+        }
+    })
+    .map_err(|e| CliError::input(e.to_string()))?;
     let text = format::session_to_json(&session);
     format::write_atomic(out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
     if args.quiet {

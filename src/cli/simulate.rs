@@ -96,6 +96,8 @@ pub enum FixedSensorArg {
     Tracker,
     /// A fixed 3-D scanner, one sphere on the tool.
     Scanner,
+    /// A fixed laser line scanner, one sphere on the tool cut by its plane: stripe profiles.
+    LineScanner,
 }
 
 /// `spherecal simulate`: a simulated session with a known truth, for tests,
@@ -183,7 +185,7 @@ pub struct SimulateArgs {
     /// With --plan: touch every pose up as when teaching (the smallest joint change that puts the sphere at the planned sensor-frame centre on the true robot) instead of running the plan's joints as written.
     #[arg(long, requires = "plan")]
     pub touch_up: bool,
-    /// Also write what `spherecal import` reads: DIR/joints.csv (joint log with the nominal ABB flange pose), DIR/profiles/<id>.csv (y,z mm) and DIR/references.csv (from,to,distance mm).
+    /// Also write what `spherecal import` reads: DIR/joints.csv (joint log with the nominal ABB flange pose), DIR/profiles/<id>.csv (y,z mm) and DIR/references.csv (from,to,distance mm). With --mount fixed: DIR/joints.csv (id,use,j1..jn), DIR/poses.csv (id,use,x,y,z,q1..q4: the nominal flange poses) and DIR/points.csv (pose,target,x,y,z) or, for the line scanner, DIR/profiles/<pose>.csv.
     #[arg(long)]
     pub csv_out: Option<PathBuf>,
     /// Simulate a raw scan of this part instead of a session, with the cell of the same seed, robot and errors. Writes the joint log and profiles (`nan,nan` where a ray meets nothing) into --csv-out and the scan's truth (`spherecal-scan-truth`: the part in the base frame, the true robot, hand-eye and actual joints) to --out.
@@ -201,7 +203,7 @@ pub struct SimulateArgs {
     /// With --mount fixed: a laser tracker and three SMRs on the tool, or a fixed scanner and one sphere.
     #[arg(long, value_enum, default_value_t = FixedSensorArg::Tracker)]
     pub fixed_sensor: FixedSensorArg,
-    /// With --mount fixed: the sensor's noise, mm (1σ a coordinate; the scanner's depth three times it).
+    /// With --mount fixed: the sensor's noise, mm (1σ a coordinate; the scanner's depth three times it; the line scanner's on every stripe point).
     #[arg(long, value_name = "MM", default_value_t = 0.01, value_parser = number(Range::non_negative("mm").at_most(MAX_SENSOR_NOISE_MM)))]
     pub sensor_noise: f64,
 }

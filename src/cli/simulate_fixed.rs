@@ -1,7 +1,9 @@
 //! `spherecal simulate --mount fixed`: a simulated cell with a fixed
 //! sensor (a laser tracker and three SMRs on the tool, or a fixed scanner
-//! and one sphere), its truth, and with `--csv-out` the tracker's table and
-//! the joint log that `import --mount fixed` reads.
+//! and one sphere, or a fixed line scanner's stripes of one sphere), its
+//! truth, and with `--csv-out` the joint log and the tracker's table (or
+//! the line scanner's profiles, `profiles/<pose>.csv`, the flange
+//! sessions' `y,z` format) that `import --mount fixed` reads.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -32,9 +34,24 @@ fn truth_json(truth: &FixedTruth) -> String {
     text
 }
 
-/// The tracker's table (`pose,target,x,y,z`, sensor frame, mm) and the
-/// joint log (`id,use,j1..jn`, deg) of a fixed session.
-fn tables(session: &Session) -> (String, String) {
+/// The files of a fixed session as a cell would leave them.
+struct Tables {
+    /// The tracker's table, `pose,target,x,y,z` (sensor frame, mm).
+    points: String,
+    /// The joint log, `id,use,j1..jn` (deg).
+    joints: String,
+    /// The pose file, `id,use,x,y,z,q1,q2,q3,q4` (mm, ABB's unit
+    /// quaternion w, x, y, z): the flange poses as the controller reports
+    /// them, by the nominal kinematics.
+    poses: String,
+    /// The line scanner's stripe profiles, `(P<k>, "y,z" mm)`.
+    profiles: Vec<(String, String)>,
+}
+
+/// The [`Tables`] of a fixed session.
+fn tables(session: &Session) -> Tables {
+    let mut profiles = Vec::new();
+    let mut poses = String::from("id,use,x,y,z,q1,q2,q3,q4\n");
     let mut points = String::from("pose,target,x,y,z\n");
     let mut joints = String::from("id,use");
     let dof = session.robot.dof();
@@ -53,12 +70,40 @@ fn tables(session: &Session) -> (String, String) {
                 let _ = write!(joints, ",{q}");
             }
             joints.push('\n');
+            let flange = session.robot.base_from_flange(&m.joints);
+            let (t, r) = (flange.translation.vector, flange.rotation);
+            let _ = writeln!(
+                poses,
+                "P{pose},{},{},{},{},{},{},{},{}",
+                m.usage.as_str(),
+                t.x,
+                t.y,
+                t.z,
+                r.w,
+                r.i,
+                r.j,
+                r.k
+            );
         }
-        if let Observation::Centre(c) = &m.observation {
-            let _ = writeln!(points, "P{pose},{},{},{},{}", m.station, c.x, c.y, c.z);
+        match &m.observation {
+            Observation::Centre(c) => {
+                let _ = writeln!(points, "P{pose},{},{},{},{}", m.station, c.x, c.y, c.z);
+            }
+            Observation::Stripe(stripe) => {
+                let mut text = String::from("y,z\n");
+                for [y, z] in stripe {
+                    let _ = writeln!(text, "{y},{z}");
+                }
+                profiles.push((format!("P{pose}"), text));
+            }
         }
     }
-    (points, joints)
+    Tables {
+        points,
+        joints,
+        poses,
+        profiles,
+    }
 }
 
 /// `spherecal simulate`: a fixed sensor's cell here, anything else by
@@ -95,6 +140,7 @@ fn run(args: &SimulateArgs, truth_path: &Path) -> Result<(), CliError> {
     let cell = match args.fixed_sensor {
         FixedSensorArg::Tracker => FixedCell::tracker(noise),
         FixedSensorArg::Scanner => FixedCell::scanner(noise),
+        FixedSensorArg::LineScanner => FixedCell::line_scanner(noise),
     };
     let config = args.to_config();
     config
@@ -107,9 +153,15 @@ fn run(args: &SimulateArgs, truth_path: &Path) -> Result<(), CliError> {
         (truth_path.to_path_buf(), truth_json(&truth)),
     ];
     let folders = if let Some(dir) = &args.csv_out {
-        let (points, joints) = tables(&session);
-        files.push((dir.join("points.csv"), points));
-        files.push((dir.join("joints.csv"), joints));
+        let t = tables(&session);
+        if t.profiles.is_empty() {
+            files.push((dir.join("points.csv"), t.points));
+        }
+        files.push((dir.join("joints.csv"), t.joints));
+        files.push((dir.join("poses.csv"), t.poses));
+        for (pose, text) in t.profiles {
+            files.push((dir.join("profiles").join(format!("{pose}.csv")), text));
+        }
         format::Folders::Create
     } else {
         format::Folders::Existing
@@ -128,6 +180,7 @@ fn run(args: &SimulateArgs, truth_path: &Path) -> Result<(), CliError> {
             match args.fixed_sensor {
                 FixedSensorArg::Tracker => "laser tracker",
                 FixedSensorArg::Scanner => "scanner",
+                FixedSensorArg::LineScanner => "line scanner",
             },
             config.seed,
             noise,

@@ -11,18 +11,24 @@ use spherecal::engine::base::session::{Mount, Session, Use};
 use spherecal::engine::calibrate::solve::{self, Method, Options};
 use spherecal::engine::files::format::stations::prediction_errors;
 use spherecal::engine::files::format::{self, ResultFile};
-use spherecal::engine::files::import::tracker::{TrackerSpec, import_tracker};
+use spherecal::engine::files::import::tracker::{
+    FixedPoints, FixedPoses, TrackerSpec, import_tracker,
+};
 use spherecal::engine::files::import::{AngleUnit, LengthUnit};
 use spherecal::engine::tools::simulate::{FixedCell, FixedTruth, SimConfig, simulate_fixed};
 
-fn rms(v: &[f64]) -> f64 {
+pub(crate) fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
 
 /// Calibrates `session` with `method` and returns the result and, per
 /// validate measurement, the calibrated prediction error beside the true
 /// model's (the floor).
-fn score(session: &Session, truth: &FixedTruth, method: Method) -> (ResultFile, Vec<(f64, f64)>) {
+pub(crate) fn score(
+    session: &Session,
+    truth: &FixedTruth,
+    method: Method,
+) -> (ResultFile, Vec<(f64, f64)>) {
     let noise_free = truth.noise_free;
     let mut options = Options {
         method,
@@ -55,7 +61,7 @@ fn score(session: &Session, truth: &FixedTruth, method: Method) -> (ResultFile, 
     (result, pairs)
 }
 
-fn config(seed: u64) -> SimConfig {
+pub(crate) fn config(seed: u64) -> SimConfig {
     SimConfig {
         seed,
         ..SimConfig::default()
@@ -159,14 +165,19 @@ fn the_first_joint_is_fixed_for_the_sensor_pose_and_the_last_for_the_targets() {
 fn tracker_spec(points: &Path, unit: LengthUnit) -> TrackerSpec {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     TrackerSpec {
-        points: points.to_path_buf(),
-        joint_log: root.join("examples/tracker/joints.csv"),
-        id_column: "id".into(),
-        joint_columns: (1..=6).map(|k| format!("j{k}")).collect(),
-        angle_unit: AngleUnit::Deg,
-        length_unit: unit,
-        robot: spherecal::engine::base::robot::irb2400().robot,
+        poses: FixedPoses::Joints {
+            path: root.join("examples/tracker/joints.csv"),
+            id_column: "id".into(),
+            joint_columns: (1..=6).map(|k| format!("j{k}")).collect(),
+            angle_unit: AngleUnit::Deg,
+        },
+        points: FixedPoints::Table {
+            path: points.to_path_buf(),
+            unit,
+        },
+        robot: Some(spherecal::engine::base::robot::irb2400().robot),
         diameter: 38.1,
+        hand_eye: None,
         name: "tracker".into(),
     }
 }

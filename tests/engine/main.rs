@@ -6,6 +6,7 @@
 mod support;
 
 mod a_posteriori;
+mod fixed_import;
 mod fixed_mount;
 mod formats;
 mod fuzz;

@@ -2,13 +2,16 @@
 //! import` and the workbench's import wizard both call: a joint log
 //! ([`import_with`](super::import_with)) or a pose file
 //! ([`import_poses_with`](super::import_poses_with): the side given, or
-//! decided from the data by calibrating both) into a session, the sensor's
+//! decided from the data by calibrating both), or a fixed sensor's points
+//! or profiles beside either ([`import_tracker_with`](super::tracker::import_tracker_with),
+//! FORMAT.md `sensor.mount: "fixed"`) into a session, the sensor's
 //! measuring range written into it when given, with the progress of every
 //! stage; and the joint log's preview, its header read and its first rows
 //! mapped ([`preview_joint_log`]).
 
 use std::path::Path;
 
+use super::tracker::{TrackerSpec, import_tracker_with};
 use super::{
     ImportError, ImportProgress, ImportSpec, Imported, PoseImportSpec, header, import_poses_with,
     import_with, preview,
@@ -22,6 +25,9 @@ pub enum PoseLog {
     Joints(ImportSpec),
     /// A pose file in any layout the program readers know.
     Poses(PoseImportSpec),
+    /// A fixed sensor's points (a tracker's table) or a fixed line
+    /// scanner's profiles, beside a joint log or a pose file.
+    Fixed(TrackerSpec),
 }
 
 /// Everything an import needs.
@@ -48,6 +54,7 @@ pub fn import_session(
     let mut imported = match &request.log {
         PoseLog::Joints(spec) => import_with(spec, progress)?,
         PoseLog::Poses(spec) => import_poses_with(spec, progress)?,
+        PoseLog::Fixed(spec) => import_tracker_with(spec, progress)?,
     };
     if request.range.is_some() {
         imported.session.sensor_range = request.range;

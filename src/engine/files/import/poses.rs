@@ -308,7 +308,7 @@ pub fn records_of(file: &PoseFile) -> Result<Vec<PoseRecord>, ImportError> {
 
 /// A measurement id for a record without one: `pose<k>` for a table row
 /// or list entry, else its name without brackets or spaces (`P[3]` → `P3`).
-fn record_id(record: &PoseRecord, ordinal: usize) -> String {
+pub(crate) fn record_id(record: &PoseRecord, ordinal: usize) -> String {
     if record.name.starts_with("line ") || record.name.starts_with("pose ") {
         return format!("pose{ordinal}");
     }

@@ -1,7 +1,9 @@
 //! Simulated cells with a fixed sensor and targets on the tool (FORMAT.md
 //! `sensor.mount: "fixed"`, added 2026-11-27): a laser tracker measuring
-//! SMRs, or a fixed 3-D camera or scanner fitting a sphere the robot
-//! carries, each with its ground truth.
+//! SMRs, a fixed 3-D camera or scanner fitting a sphere the robot
+//! carries, or a fixed laser line scanner whose plane cuts that sphere
+//! (stripes, fitted by eq. 21 in the sensor's frame), each with its
+//! ground truth.
 //!
 //! The true robot is the nominal one plus the kinematic errors of the
 //! [`SimConfig`]'s error model (the flange-mount simulator's
@@ -11,11 +13,16 @@
 //! each kept pose measures every target (several measurements with the
 //! same joints, FORMAT.md). The sensor reports each target in its own
 //! frame, `bT_s⁻¹ · bT_e(q) · X_e`, with Gaussian noise of the stated σ
-//! per sensor axis.
+//! per sensor axis; a line scanner ([`LinePlane`]) instead reports the
+//! stripe of the sphere in its laser plane (the flange simulator's
+//! stripes, noise on every point), the first joint turned by Newton's
+//! method until the sphere's centre lies at a drawn distance from the
+//! plane.
 
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
 use super::config::{SimConfig, SimError};
+use super::stripe::stripe;
 use super::with_errors;
 use crate::engine::base::cell::random::{normal, stream, uniform};
 use crate::engine::base::numeric::round_to;
@@ -62,6 +69,24 @@ pub struct FixedCell {
     pub n_identify: usize,
     /// See `n_identify`.
     pub n_validate: usize,
+    /// A laser line scanner: stripes of the (one) target sphere in its
+    /// laser plane instead of points; `None`: points.
+    pub line: Option<LinePlane>,
+}
+
+/// A fixed laser line scanner: where the sphere's centre may lie for its
+/// plane (`x = 0`) to cut a usable stripe, and the stripe's noise.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinePlane {
+    /// The centre's distance from the laser plane, sensor `x`, drawn
+    /// uniform in this range, mm (within the sphere radius; side +1).
+    pub cut_mm: [f64; 2],
+    /// Largest `|y|` of the centre in the sensor frame, mm.
+    pub half_width_mm: f64,
+    /// The centre's sensor `z` range (the scanner's depth of field), mm.
+    pub depth_mm: [f64; 2],
+    /// 1σ noise of every stripe point on each coordinate, mm.
+    pub point_noise_mm: f64,
 }
 
 impl FixedCell {
@@ -86,6 +111,7 @@ impl FixedCell {
             spread: vec![35.0, 25.0, 25.0, 60.0, 40.0, 60.0],
             n_identify: 60,
             n_validate: 12,
+            line: None,
         }
     }
 
@@ -105,6 +131,56 @@ impl FixedCell {
             ..Self::tracker(noise)
         }
     }
+
+    /// A fixed laser line scanner (a profile sensor with a 300 mm deep
+    /// field at 300-600 mm) in front of an IRB 2400's tool, one 25 mm
+    /// sphere on the tool cut by its vertical laser plane; `noise` mm on
+    /// every stripe point.
+    #[must_use]
+    pub fn line_scanner(noise: f64) -> Self {
+        let target = Vector3::new(0.0, 20.0, 140.0);
+        let home = vec![0.0, 20.0, 10.0, 0.0, -30.0, 0.0];
+        let nominal = crate::engine::base::robot::irb2400().robot;
+        let at_home = (nominal.base_from_flange(&home) * Point3::from(target)).coords;
+        Self {
+            name: "fixed line scanner cell".into(),
+            base_from_sensor: line_scanner_at(&at_home, 450.0),
+            targets: vec![("BALL".into(), target)],
+            target_normal: Vector3::z(),
+            cone_deg: 80.0,
+            reach_mm: 1000.0,
+            noise_mm: [0.0; 3],
+            diameter: 25.0,
+            home,
+            spread: vec![8.0, 15.0, 15.0, 50.0, 35.0, 60.0],
+            n_identify: 60,
+            n_validate: 12,
+            line: Some(LinePlane {
+                cut_mm: [5.0, 10.0],
+                half_width_mm: 120.0,
+                depth_mm: [300.0, 600.0],
+                point_noise_mm: noise,
+            }),
+        }
+    }
+}
+
+/// A line scanner `standoff` mm out from `aim` (base frame; outward from
+/// the base axis and up), looking at it along its `z`, its laser plane
+/// (`x = 0`) vertical through the base axis' radial direction, so that
+/// the first joint moves a point across the plane.
+fn line_scanner_at(aim: &Vector3<f64>, standoff: f64) -> Isometry3<f64> {
+    let outward = Vector3::new(aim.x, aim.y, 0.0).normalize();
+    let from = (outward + Vector3::z() * 0.6).normalize();
+    let position = aim + from * standoff;
+    // z toward the aim; x horizontal, along the first joint's motion.
+    let z = -from;
+    let x = Vector3::z().cross(&outward).normalize();
+    let y = z.cross(&x);
+    let rotation = UnitQuaternion::from_rotation_matrix(
+        &nalgebra::Rotation3::from_matrix_unchecked(nalgebra::Matrix3::from_columns(&[x, y, z])),
+    );
+    Isometry3::from_parts(Translation3::from(position), rotation)
 }
 
 /// A sensor at `position` (base frame) looking along its `z` at the
@@ -150,6 +226,45 @@ impl FixedTruth {
     }
 }
 
+/// Turns the first joint of `q` (within `limits`) until the sphere's
+/// centre lies `x` mm from the line scanner's plane (Newton's method on
+/// the true robot), and says whether it then lies in the window.
+fn onto_the_plane(
+    robot: &Robot,
+    cell: &FixedCell,
+    line: &LinePlane,
+    q: &mut [f64],
+    x: f64,
+    limits: (f64, f64),
+) -> bool {
+    let Some((_, target)) = cell.targets.first() else {
+        return false;
+    };
+    let at = |q: &[f64]| {
+        cell.base_from_sensor
+            .inverse_transform_point(&(robot.base_from_flange(q) * Point3::from(*target)))
+            .coords
+    };
+    let h = 1e-4;
+    for _ in 0..20 {
+        let f = at(q).x - x;
+        if f.abs() < 1e-9 {
+            break;
+        }
+        let mut qh = q.to_vec();
+        qh[0] += h;
+        let slope = (at(&qh).x - at(q).x) / h;
+        if slope.abs() < 1e-6 {
+            return false;
+        }
+        q[0] = (q[0] - f / slope).clamp(limits.0, limits.1);
+    }
+    let c = at(q);
+    (c.x - x).abs() < 1e-6
+        && c.y.abs() <= line.half_width_mm
+        && (line.depth_mm[0]..=line.depth_mm[1]).contains(&c.z)
+}
+
 /// A fixed-sensor session of `cell` on `config`'s robot and error model
 /// (seeded by `config.seed`), with its truth. The session gives no
 /// `hand_eye`: the engine's linear start finds `bT_s`.
@@ -187,7 +302,7 @@ pub fn simulate_fixed(
                 cell.cone_deg, cell.reach_mm
             )));
         }
-        let q: Vec<f64> = (0..dof)
+        let mut q: Vec<f64> = (0..dof)
             .map(|j| {
                 let (lo, hi) = (preset.limits[j].min, preset.limits[j].max);
                 uniform(
@@ -198,6 +313,13 @@ pub fn simulate_fixed(
                 .clamp(lo, hi)
             })
             .collect();
+        if let Some(line) = &cell.line {
+            let x = uniform(&mut rng, line.cut_mm[0], line.cut_mm[1]);
+            let limits = (preset.limits[0].min, preset.limits[0].max);
+            if !onto_the_plane(&true_robot, cell, line, &mut q, x, limits) {
+                continue;
+            }
+        }
         let flange = true_robot.base_from_flange(&q);
         let sensor_pos = cell.base_from_sensor.translation.vector;
         let normal_b = flange.rotation * cell.target_normal;
@@ -222,9 +344,23 @@ pub fn simulate_fixed(
                 .base_from_sensor
                 .inverse_transform_point(&(flange * Point3::from(*x_e)))
                 .coords;
-            let measured = Vector3::from_fn(|k, _| {
-                round_to(x_s[k] + cell.noise_mm[k] * normal(&mut noise), DECIMALS)
-            });
+            let observation = match &cell.line {
+                Some(line) => {
+                    let c = SimConfig {
+                        diameter: cell.diameter,
+                        stripe_noise: line.point_noise_mm,
+                        outlier_fraction: 0.0,
+                        // The camera beside the laser, at the sensor's origin.
+                        view_z: 0.0,
+                        stripe_decimals: DECIMALS,
+                        ..config.clone()
+                    };
+                    Observation::Stripe(stripe(&c, &mut noise, &x_s))
+                }
+                None => Observation::Centre(Vector3::from_fn(|k, _| {
+                    round_to(x_s[k] + cell.noise_mm[k] * normal(&mut noise), DECIMALS)
+                })),
+            };
             measurements.push(Measurement {
                 id: format!("p{}-{id}", poses + 1),
                 station: id.clone(),
@@ -233,7 +369,7 @@ pub fn simulate_fixed(
                 side: 1,
                 joints: q_written.clone(),
                 flange: None,
-                observation: Observation::Centre(measured),
+                observation,
             });
         }
         poses += 1;
@@ -252,7 +388,8 @@ pub fn simulate_fixed(
         robot: true_robot,
         base_from_sensor: cell.base_from_sensor,
         targets: cell.targets.clone(),
-        noise_free: cell.noise_mm.iter().all(|s| *s == 0.0),
+        noise_free: cell.noise_mm.iter().all(|s| *s == 0.0)
+            && cell.line.as_ref().is_none_or(|l| l.point_noise_mm == 0.0),
     };
     Ok((session, truth))
 }
