@@ -33,6 +33,11 @@ fn run(args: &ImportArgs) -> Result<(), CliError> {
             "--mount fixed reads a joint log (--joints) beside --centres; a pose file is not read for a fixed sensor yet",
         ));
     }
+    if args.hand_eye.is_some() {
+        return Err(CliError::input(
+            "--hand-eye is the guess of a sensor on the flange; a fixed sensor's pose in the base is found from its points (leave --hand-eye out)",
+        ));
+    }
     let Some(points) = &args.centres else {
         return Err(CliError::input(
             "--mount fixed needs --centres POINTS.csv: the fixed sensor's points, one `x y z` a target and pose",
