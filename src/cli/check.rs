@@ -31,7 +31,7 @@ pub struct CheckArgs {
     /// The false-alarm rate: the share of checks of an unchanged cell that fail.
     #[arg(long, default_value_t = DEFAULT_ALPHA, value_parser = number(Range::positive("").at_most(0.2)))]
     pub alpha: f64,
-    /// Where the check's record goes (`history` lists it); default: X.check.json beside the session X.json.
+    /// Where the check's record goes (`history` lists it) [default: X.check.json beside the session X.json].
     #[arg(long, value_name = "FILE", conflicts_with = "no_record")]
     pub record: Option<PathBuf>,
     /// Write no record of the check.
