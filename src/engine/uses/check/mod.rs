@@ -53,11 +53,6 @@ pub const DEFAULT_ALPHA: f64 = 0.001;
 /// The power `plan --check` quotes its smallest detectable changes at.
 pub const DETECTION_POWER: f64 = 0.95;
 
-/// Poses per check station that `plan --check` plans by default: enough
-/// degrees of freedom for the test and for the hand-eye's six unknowns,
-/// a few minutes at the robot.
-pub const DEFAULT_CHECK_POSES: usize = 10;
-
 /// Translation poses of a planned check: the fewest eq. 6-7 takes.
 pub const CHECK_TRANSLATIONS: usize = 3;
 
