@@ -31,6 +31,12 @@ pub struct CheckArgs {
     /// The false-alarm rate: the share of checks of an unchanged cell that fail.
     #[arg(long, default_value_t = DEFAULT_ALPHA, value_parser = number(Range::positive("").at_most(0.2)))]
     pub alpha: f64,
+    /// Where the check's record goes (`history` lists it) [default: X.check.json beside the session X.json].
+    #[arg(long, value_name = "FILE", conflicts_with = "no_record")]
+    pub record: Option<PathBuf>,
+    /// Write no record of the check.
+    #[arg(long)]
+    pub no_record: bool,
     /// `-q`: [`QUIET_HELP`](super::QUIET_HELP).
     #[arg(long, short, help = QUIET_HELP)]
     pub quiet: bool,
@@ -62,16 +68,19 @@ fn verdict_text(checked: &Checked, alpha: f64) -> Vec<String> {
         ));
     }
     out.push(format!(
-        "test: T = {:.2} on {} degrees of freedom, threshold {:.2} at a false-alarm rate α = {} ({:.2} %); p = {:.3e}",
+        "test: T = {:.2} on {} degrees of freedom, threshold {:.2}; directed T_d = {:.2} on {}, threshold {:.2}; at a false-alarm rate α = {} ({:.2} %, α/2 each); p = {:.3e}",
         t.statistic,
         t.dof,
         t.threshold,
+        t.directed,
+        t.directed_dof,
+        t.directed_threshold,
         alpha,
         100.0 * alpha,
         t.p_value
     ));
     out.push(
-        "  a drift of the whole robot's base moves every centre alike: at one station it cannot be told from a moved sphere, and is not tested".into(),
+        "  a drift of the whole robot's base moves every centre alike: it cannot be told from a moved sphere (each position's sphere is fitted), and is not tested".into(),
     );
     out
 }
@@ -84,9 +93,17 @@ fn verdict_text(checked: &Checked, alpha: f64) -> Vec<String> {
 /// longer holds its calibration.
 pub fn run(args: &CheckArgs) -> Result<(), CliError> {
     let result = format::load_result(&args.result).map_err(|e| CliError::input(e.to_string()))?;
-    let (_, checked) = check::check_file(CheckRequest {
+    let record_path = (!args.no_record).then(|| {
+        args.record
+            .clone()
+            .unwrap_or_else(|| format::check_record_path(&args.session))
+    });
+    if let Some(path) = &record_path {
+        CliError::guard_output(path, &[args.session.as_path(), args.result.as_path()])?;
+    }
+    let (session, checked) = check::check_file(CheckRequest {
         scan: CheckSource::SessionFile(args.session.clone()),
-        result,
+        result: result.clone(),
         alpha: args.alpha,
     })
     .map_err(|e| error(&e))?;
@@ -99,6 +116,19 @@ pub fn run(args: &CheckArgs) -> Result<(), CliError> {
         }
         for line in verdict_text(&checked, args.alpha) {
             sayln!("{line}");
+        }
+    }
+    if let Some(path) = &record_path {
+        let record = check::check_record(
+            &checked,
+            &session,
+            &result,
+            (&args.session, &args.result),
+            std::time::SystemTime::now(),
+        );
+        format::save_check_record(path, &record).map_err(|e| CliError::from_file(&e, false))?;
+        if !args.quiet {
+            sayln!("wrote the check's record {}", path.display());
         }
     }
     if checked.test.holds {

@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 use crate::engine::base::numeric::plural;
 use crate::engine::files::format;
 use crate::engine::tools::history::{
-    self, DEFAULT_K, DEFAULT_TOP, Drift, DriftOptions, Entry, Library, Series, SeriesKind, Verdict,
+    self, CheckEntry, DEFAULT_K, DEFAULT_TOP, Drift, DriftOptions, Entry, Library, Series,
+    SeriesKind, Verdict,
 };
 
 use super::CliError;
@@ -93,8 +94,14 @@ pub fn run(args: &HistoryArgs) -> Result<(), CliError> {
         Some(_) => drifts.iter().flat_map(|d| d.entries.clone()).collect(),
         None => (0..library.entries.len()).collect(),
     };
+    let checks: Vec<&CheckEntry> = library
+        .checks
+        .iter()
+        .filter(|c| args.robot.is_none() || robots.contains(&c.record.robot))
+        .collect();
     if !args.quiet {
         say!("{}", library_text(&library, &shown));
+        say!("{}", checks_text(&checks));
         for d in &drifts {
             say!("{}", drift_text(&library, d));
         }
@@ -107,6 +114,7 @@ pub fn run(args: &HistoryArgs) -> Result<(), CliError> {
             .chain(library.sessions.iter().map(|s| s.path.as_path()))
             .chain(library.problems.iter().map(|p| p.path.as_path()))
             .chain(library.ignored.iter().map(|(p, _)| p.as_path()))
+            .chain(library.checks.iter().map(|c| c.path.as_path()))
             .collect();
         CliError::guard_output(path, &inputs)?;
         format::write_atomic(path, history::drift_csv(&library, &drifts).as_bytes())
@@ -116,6 +124,45 @@ pub fn run(args: &HistoryArgs) -> Result<(), CliError> {
         }
     }
     Ok(())
+}
+
+/// The re-checks (`spherecal check`'s records), oldest first: date,
+/// verdict, robot, the calibration checked, the statistics and what moved.
+fn checks_text(checks: &[&CheckEntry]) -> String {
+    let mut s = String::new();
+    if checks.is_empty() {
+        return s;
+    }
+    let _ = writeln!(s, "\nchecks (spherecal check):");
+    for c in checks {
+        let r = &c.record;
+        let _ = writeln!(
+            s,
+            "  {}  {}  {}  {:?} against {:?}: T {:.1} / {:.1}, T_d {:.1} / {} ({} sightings, α {}){}",
+            c.date,
+            if r.holds { "HOLDS" } else { "FAILS" },
+            cut(&r.robot, 16),
+            cut(&r.session, NAME_WIDTH),
+            r.result_session,
+            r.statistic,
+            r.threshold,
+            r.directed,
+            r.directed_threshold
+                .map_or_else(|| "-".into(), |t| format!("{t:.1}")),
+            r.sightings,
+            r.alpha,
+            if r.hand_eye_only {
+                ", hand-eye only"
+            } else {
+                ""
+            }
+        );
+        if let Some(moved) = &r.moved {
+            let _ = writeln!(s, "      {moved}");
+        }
+        let _ = writeln!(s, "      ({})", c.path.display());
+    }
+    s
 }
 
 fn cut(s: &str, width: usize) -> String {

@@ -365,15 +365,22 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         Some(poses) => PoseLog::Poses(pose_spec(args, poses)?),
         None => PoseLog::Joints(spec(args)?),
     };
+    // A joint log's session starts from the guess given, as a pose file's
+    // does (else calibrate computes one from the translation and rotation
+    // groups, eq. 6-9).
+    let joint_guess = match (&args.poses, &args.hand_eye) {
+        (None, Some(path)) => Some(super::hand_eye_file(path)?),
+        _ => None,
+    };
     let request = ImportRequest {
         log,
         range: args.range,
     };
     let mut lines = progress_lines(args.quiet, Instant::now());
     let Imported {
-        session,
+        mut session,
         checks,
-        notes,
+        mut notes,
         ..
     } = import::import_session(&request, &mut |stage| {
         // The side decision calibrates both sides: said at once.
@@ -383,6 +390,14 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         lines(stage)
     })
     .map_err(|e| input(&e))?;
+    if let Some(he) = joint_guess {
+        let t = he.translation.vector;
+        notes.push(format!(
+            "initial hand-eye: the guess given (translation [{:.2}, {:.2}, {:.2}] mm), written to the session; calibrate starts from it instead of eq. 6-9",
+            t.x, t.y, t.z
+        ));
+        session.hand_eye = Some(he);
+    }
     let out = &out;
     let text = format::session_to_json(&session);
     format::write_atomic(out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;

@@ -144,7 +144,7 @@ pub struct PlanArgs {
     /// Predict the calibrated accuracy from N simulated calibrations (random kinematic errors, default noise, ml); 0 skips.
     #[arg(long, value_name = "N", default_value_t = PredictConfig::default().runs, value_parser = count(0, MAX_PREDICT_RUNS))]
     pub predict: usize,
-    /// Plan a re-check of the cell calibrated in --result instead of a calibration: --identify-poses poses (10 unless given) at the one sphere position --sphere, solved on the calibrated model about the calibrated hand-eye; prints the smallest knock the check detects. Run them, import them, then `spherecal check`.
+    /// Plan a re-check of the cell calibrated in --result instead of a calibration: at most 30 poses at one to three sphere positions about --sphere (the layout that detects the most; --identify-poses sets the poses per position), solved on the calibrated model about the calibrated hand-eye; prints the operator's time and the smallest knock the check detects. Run them, import them, then `spherecal check`.
     #[arg(long, requires = "result")]
     pub check: bool,
     /// The result a re-check (--check) is planned for (an `ml` result).
@@ -307,12 +307,10 @@ pub fn config(args: &PlanArgs) -> Result<PlanConfig, CliError> {
         .config()
         .map_err(|e| CliError::input(e.to_string()))?;
     if let Some(result) = check_result(args)? {
-        let poses = if args.identify_poses == defaults::IDENTIFY_POSES {
-            check::DEFAULT_CHECK_POSES
-        } else {
-            args.identify_poses
-        };
-        check::check_design(&mut config, &result, poses);
+        let poses =
+            (args.identify_poses != defaults::IDENTIFY_POSES).then_some(args.identify_poses);
+        check::choose_check_design(&mut config, &result, poses)
+            .map_err(|e| CliError::input(e.to_string()))?;
     }
     config.validate().map_err(|e| plan_error(&e))?;
     Ok(config)
@@ -339,7 +337,16 @@ fn detectable_text(
     };
     let d = check::plan_check(made, &result, config.stripe_sigma, check::DEFAULT_ALPHA)
         .map_err(|e| CliError::input(e.to_string()))?;
+    let positions = config.design.n_identify;
     let mut text = format!(
+        "  re-check: {} poses at {} sphere position(s), about {:.0} minutes at the robot ({:.0} s a pose, {:.0} s a sphere move)\n",
+        made.poses.len(),
+        positions,
+        check::check_minutes(made.poses.len(), positions),
+        check::design::SECONDS_PER_POSE,
+        check::design::SECONDS_PER_SPHERE_MOVE
+    );
+    text += &format!(
         "  re-check: detects with {:.0} % power at a false-alarm rate of {} % ({} degrees of freedom): the sensor knocked {:.3} mm in its worst direction, or turned {:.3}° about its mount's worst axis",
         100.0 * check::DETECTION_POWER,
         100.0 * check::DEFAULT_ALPHA,
@@ -372,7 +379,7 @@ fn detectable_text(
         ));
     }
     text.push_str(
-        "\n  a drift of the robot's base cannot be told from a moved sphere at one station",
+        "\n  a drift of the robot's base cannot be told from a moved sphere (each position's sphere is fitted)",
     );
     Ok(text)
 }

@@ -12,6 +12,7 @@ mod contract;
 mod doors;
 mod guide;
 mod history;
+mod import_hand_eye;
 mod hostile;
 mod layout;
 mod measure;

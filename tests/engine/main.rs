@@ -19,6 +19,7 @@ mod pose_only;
 mod range;
 mod range_spread;
 mod recheck;
+mod recheck_pose_only;
 mod realdata;
 mod robot_import;
 mod segment;

@@ -10,15 +10,15 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use spherecal::engine::base::robot::{self, Robot};
 use spherecal::engine::base::session::Session;
 use spherecal::engine::calibrate::solve::ml::recheck::Moved;
-use spherecal::engine::calibrate::solve::{self, Control, Method, Options};
+use spherecal::engine::calibrate::solve::{self, Method, Options};
 use spherecal::engine::files::format::ResultFile;
-use spherecal::engine::tools::plan::{self, Plan, PlanConfig};
+use spherecal::engine::tools::plan::{Plan, PlanConfig};
 use spherecal::engine::tools::simulate::{
     self, ErrorModel, InitialHandEye, PlanExecution, SimConfig, Truth, simulate_plan,
 };
 use spherecal::engine::uses::check::{
-    CHECK_ROTATIONS, CHECK_TRANSLATIONS, Checked, DEFAULT_ALPHA, DEFAULT_CHECK_POSES, check_design,
-    check_session, plan_check,
+    Checked, DEFAULT_ALPHA, MAX_CHECK_POSES, MAX_CHECK_STATIONS, check_session,
+    choose_check_design, plan_check,
 };
 
 /// Where the check's sphere is (the IRB 2400's quick-start spot).
@@ -55,8 +55,7 @@ fn check_plan(result: &ResultFile) -> Plan {
 fn check_plan_at(result: &ResultFile, sphere: [f64; 3]) -> Plan {
     let preset = robot::preset("irb2400").unwrap();
     let mut config = PlanConfig::for_preset(&preset, sphere);
-    check_design(&mut config, result, DEFAULT_CHECK_POSES);
-    plan::plan(&config, &mut |_| Control::Continue).unwrap()
+    choose_check_design(&mut config, result, None).unwrap().plan
 }
 
 /// What changed in the cell since the calibration.
@@ -131,15 +130,21 @@ fn param_index(robot: &Robot, label: &str) -> usize {
 fn an_unchanged_cell_holds_and_a_knocked_one_names_what_moved() {
     let (_, truth, result) = cell(1);
     let plan = check_plan(&result);
-    let n = DEFAULT_CHECK_POSES + CHECK_TRANSLATIONS + CHECK_ROTATIONS;
-    assert_eq!(plan.poses.len(), n);
+    let n = plan.poses.len();
+    // P0 (translations, rotations) and P1 at the sphere, then one
+    // station a further sphere position.
+    let stations = plan.stations.len();
+    assert!(n <= MAX_CHECK_POSES, "{n}");
+    assert!(
+        (2..=MAX_CHECK_STATIONS + 1).contains(&stations),
+        "{stations}"
+    );
     let robot = truth.nominal.to_robot();
     let elsewhere = check_plan_at(&result, MOVED);
     for seed in 10..13 {
         let c = check(&truth, &result, &plan, Knock::None, seed);
         assert!(c.test.holds, "seed {seed}: {:?}", c.test);
-        // Two stations at the one sphere: P0 (translations, rotations), P1.
-        assert_eq!(c.test.dof, 3 * n - 6);
+        assert_eq!(c.test.dof, 3 * n - 3 * stations);
         let moved = check(&truth, &result, &elsewhere, Knock::None, seed);
         assert!(
             moved.test.holds,
@@ -243,6 +248,27 @@ fn study(cells: u64, trials: u64) -> Vec<(String, f64)> {
                 s
             }
         };
+        let printed = plan_check(
+            &plan,
+            &result,
+            SimConfig::default().stripe_noise,
+            DEFAULT_ALPHA,
+        )
+        .unwrap();
+        println!(
+            "cell {c}: {} poses at {} sphere position(s); plan --check prints {:.3} mm, {:.3}°, {}",
+            plan.poses.len(),
+            plan.stations.len() - 1,
+            printed.translation_mm,
+            printed.rotation_deg,
+            printed
+                .parameters
+                .iter()
+                .filter(|(l, _, _)| ["theta2", "theta3", "d4"].contains(&l.as_str()))
+                .map(|(l, v, s)| format!("{l} {v:.4} ({:.1}σ)", s.unwrap_or(f64::NAN)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
         for t in 0..trials / cells {
             let seed = 1000 * c + t;
             count(
@@ -275,6 +301,16 @@ fn study(cells: u64, trials: u64) -> Vec<(String, f64)> {
                 run(
                     &format!("{label} 3σ"),
                     Knock::Parameter(k, 3.0 * sigma_of(label)),
+                );
+                // At the size plan --check prints (95 % predicted).
+                let (_, size, _) = printed
+                    .parameters
+                    .iter()
+                    .find(|(l, _, _)| l == label)
+                    .unwrap();
+                run(
+                    &format!("{label} at the printed size (95 % predicted)"),
+                    Knock::Parameter(k, *size),
                 );
             }
         }

@@ -6,6 +6,7 @@
 use std::path::PathBuf;
 
 pub mod atomic;
+pub mod check_record;
 mod json;
 mod layout;
 pub mod read;
@@ -18,6 +19,10 @@ pub mod transform;
 pub use atomic::{
     Folders, check_outputs, interrupted, refuse_inputs, remove_pending, same_file,
     write_all_atomic, write_atomic, write_atomic_with, written,
+};
+pub use check_record::{
+    CHECK_FORMAT, CheckCentre, CheckRecord, check_record_path, load_check_record,
+    parse_check_record, save_check_record,
 };
 pub use read::{Cap, read_bytes, read_text};
 pub use result::{

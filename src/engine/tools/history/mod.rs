@@ -33,6 +33,11 @@
 //! of the result file (UTC). The source is recorded so a view can show it:
 //! a modification time changes when a file is copied.
 //!
+//! **Checks.** A `spherecal-check` file (the record `spherecal check`
+//! writes beside its session) is a [`CheckEntry`], dated by its `date`
+//! key (else its file's modification time), listed with its verdict and
+//! what moved.
+//!
 //! # Parameters and their uncertainty
 //!
 //! Every entry holds 6 hand-eye values and the `5·n` kinematic deviations
@@ -464,9 +469,22 @@ pub struct SessionInfo {
     pub results: Vec<usize>,
 }
 
+/// A re-check's record of the library (`spherecal check`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckEntry {
+    /// The record file.
+    pub path: PathBuf,
+    /// When the check was made (the record's `date`; else its file time).
+    pub date: Timestamp,
+    /// The record.
+    pub record: crate::engine::files::format::CheckRecord,
+}
+
 /// What [`read_library`] found.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Library {
+    /// Re-check records, in date order (then by path).
+    pub checks: Vec<CheckEntry>,
     /// The folder scanned.
     pub root: PathBuf,
     /// One entry per result file, in date order (then by path).

@@ -13,11 +13,13 @@ use serde_json::Value;
 
 use super::entry::build_entry;
 use super::{
-    DateSource, HistoryError, Library, MAX_DEPTH, PairedBy, Problem, RESULT_SUFFIXES, SessionInfo,
-    Timestamp, date_in_name,
+    CheckEntry, DateSource, HistoryError, Library, MAX_DEPTH, PairedBy, Problem, RESULT_SUFFIXES,
+    SessionInfo, Timestamp, date_in_name,
 };
 use crate::engine::files::format::FileError;
-use crate::engine::files::format::{self, RESULT_FORMAT, ResultFile, SESSION_FORMAT};
+use crate::engine::files::format::{
+    self, CHECK_FORMAT, CheckRecord, RESULT_FORMAT, ResultFile, SESSION_FORMAT,
+};
 
 /// Scans `folder` for session and result files (see the module docs).
 ///
@@ -48,6 +50,7 @@ pub fn read_library(folder: &Path) -> Result<Library, HistoryError> {
     let mut results: Vec<(PathBuf, ResultFile, Option<SystemTime>)> = Vec::new();
     let mut sessions: Vec<(SessionInfo, Option<SystemTime>)> = Vec::new();
     let mut ignored = Vec::new();
+    let mut checks = Vec::new();
     for path in files {
         match read_file(&path) {
             Ok(Found::Session {
@@ -71,6 +74,16 @@ pub fn read_library(folder: &Path) -> Result<Library, HistoryError> {
                 ));
             }
             Ok(Found::Result { result, modified }) => results.push((path, *result, modified)),
+            Ok(Found::Check { record, modified }) => {
+                let date = date_in_name(&record.date)
+                    .or_else(|| modified.and_then(Timestamp::from_system_time))
+                    .unwrap_or_else(epoch);
+                checks.push(CheckEntry {
+                    path,
+                    date,
+                    record: *record,
+                });
+            }
             Ok(Found::Other(format)) => ignored.push((path, format)),
             Err(message) => problems.push(Problem { path, message }),
         }
@@ -117,7 +130,9 @@ pub fn read_library(folder: &Path) -> Result<Library, HistoryError> {
         }
     }
     problems.sort_by(|a, b| a.path.cmp(&b.path));
+    checks.sort_by(|a: &CheckEntry, b| a.date.cmp(&b.date).then_with(|| a.path.cmp(&b.path)));
     Ok(Library {
+        checks,
         root: folder.to_path_buf(),
         entries: entries.into_iter().map(|(e, _)| e).collect(),
         sessions,
@@ -216,6 +231,10 @@ pub(super) enum Found {
         result: Box<ResultFile>,
         modified: Option<SystemTime>,
     },
+    Check {
+        record: Box<CheckRecord>,
+        modified: Option<SystemTime>,
+    },
     Other(Option<String>),
 }
 
@@ -264,6 +283,14 @@ pub(super) fn read_file(path: &Path) -> Result<Found, String> {
             let result = format::parse_result(text, path).map_err(|e| file_error_message(&e))?;
             Ok(Found::Result {
                 result: Box::new(result),
+                modified,
+            })
+        }
+        Some(CHECK_FORMAT) => {
+            let record =
+                format::parse_check_record(text, path).map_err(|e| file_error_message(&e))?;
+            Ok(Found::Check {
+                record: Box::new(record),
                 modified,
             })
         }

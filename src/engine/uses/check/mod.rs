@@ -1,6 +1,7 @@
 //! The five-minute re-check (issue 33): does the cell still hold its
-//! calibration? A handful of poses at one rough sphere position, planned
-//! by `plan --check` ([`plan_check`]), imported like any session, are
+//! calibration? At most 30 poses at one to three sphere positions about a
+//! rough one, planned by `plan --check` ([`choose_check_design`]: the
+//! layout that detects the most, [`plan_check`]), imported like any session, are
 //! predicted through the result's calibrated model and hand-eye and
 //! tested against the result's covariance and noise model
 //! ([`recheck`](crate::engine::calibrate::solve::ml::recheck): a χ² test
@@ -18,11 +19,15 @@
 //!
 //! [`entry`] is the one entry the command line calls ([`check_file`]).
 
+pub mod design;
 pub mod entry;
 
 use nalgebra::Isometry3;
 
-pub use entry::{CheckRequest, CheckSource, check_file};
+pub use design::{
+    CheckChoice, MAX_CHECK_POSES, MAX_CHECK_STATIONS, check_minutes, choose_check_design,
+};
+pub use entry::{CheckRequest, CheckSource, check_file, check_record};
 
 use crate::engine::base::robot::Robot;
 use crate::engine::base::session::Mount;
@@ -47,11 +52,6 @@ pub const DEFAULT_ALPHA: f64 = 0.001;
 
 /// The power `plan --check` quotes its smallest detectable changes at.
 pub const DETECTION_POWER: f64 = 0.95;
-
-/// Poses per check station that `plan --check` plans by default: enough
-/// degrees of freedom for the test and for the hand-eye's six unknowns,
-/// a few minutes at the robot.
-pub const DEFAULT_CHECK_POSES: usize = 10;
 
 /// Translation poses of a planned check: the fewest eq. 6-7 takes.
 pub const CHECK_TRANSLATIONS: usize = 3;

@@ -23,10 +23,18 @@
 //!
 //! **Test.** The station centres are fitted by generalised least squares
 //! and `T = rᵀ V⁻¹ r` is χ² with `3N − 3S` degrees of freedom when the cell
-//! holds; it fails at the false-alarm rate `α` when `T` exceeds the
-//! `1 − α` quantile. A moved sphere changes only `c_s` and never fails it;
-//! a base-like drift (a rigid motion of the whole robot) cannot be told
-//! from one at a single station.
+//! holds. Two tests share the false-alarm rate `α` (Bonferroni, `α/2`
+//! each): the omnibus test on `T` (anything that spoils the centres, a
+//! loose or dirty sphere included) and the *directed* test on the part
+//! of the whitened residual that a change of the cell can make,
+//! `T_d = ‖Qᵀ r̃‖²` with `Q` an orthonormal basis of the whitened
+//! sensitivity to the hand-eye and the estimated kinematic parameters
+//! with the station centres projected out: χ² with `k = rank` degrees of
+//! freedom, far fewer than `T`'s, so a change of the cell is seen with
+//! a smaller non-centrality. The cell fails when either exceeds its
+//! `1 − α/2` quantile. A moved sphere changes only `c_s` and never fails
+//! them; a base-like drift (a rigid motion of the whole robot) cannot be
+//! told from one at a single station.
 //!
 //! **What moved.** Each candidate change (the hand-eye's six unknowns
 //! together; each kinematic parameter the calibration estimated, alone) is
@@ -49,6 +57,11 @@ use crate::engine::calibrate::solve::estimate::{
 /// Relative tolerance of the rank of a whitened design (of its largest
 /// singular value): columns the check cannot see are below it by orders.
 const RANK_TOLERANCE: f64 = 1e-9;
+
+/// Relative tolerance (of the largest singular value) of the directions
+/// the directed test counts: a direction weaker than this carries no
+/// detectable change and would only add a degree of freedom.
+const SEEN_TOLERANCE: f64 = 1e-4;
 
 /// One sighting of the check: its station, the pose and the sensor-frame
 /// centre, and that centre's covariance in the sensor frame (mm²).
@@ -121,11 +134,17 @@ pub struct CheckTest {
     pub dof: usize,
     /// The false-alarm rate.
     pub alpha: f64,
-    /// The `1 − α` quantile of χ²(dof).
+    /// The `1 − α/2` quantile of χ²(dof).
     pub threshold: f64,
     /// `P(χ² > T)`.
     pub p_value: f64,
-    /// `T ≤ threshold`.
+    /// The directed statistic `T_d` (module doc).
+    pub directed: f64,
+    /// Its degrees of freedom (the rank of the changes the check sees).
+    pub directed_dof: usize,
+    /// The `1 − α/2` quantile of χ²(`directed_dof`).
+    pub directed_threshold: f64,
+    /// Both tests pass: `T ≤ threshold` and `T_d ≤ directed_threshold`.
     pub holds: bool,
     /// Each station's fitted sphere centre (base frame, mm).
     pub centres: Vec<(String, Vector3<f64>)>,
@@ -283,6 +302,27 @@ fn fit(z: &DVector<f64>, d: &DMatrix<f64>) -> Fit {
     }
 }
 
+/// An orthonormal basis of the whitened changes the check can see: the
+/// columns of `d` (whitened sensitivity to the candidates' unknowns) with
+/// the station design `dp` projected out; `None` when it sees none.
+fn seen_basis(d: &DMatrix<f64>, dp: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+    let base = fit(&DVector::zeros(dp.nrows()), dp);
+    let left = d - dp * (&base.cov * (dp.transpose() * d));
+    let svd = left.svd(true, false);
+    let u = svd.u?;
+    let top = svd.singular_values.amax();
+    let keep: Vec<usize> = (0..svd.singular_values.len())
+        .filter(|&k| top > 0.0 && svd.singular_values[k] > SEEN_TOLERANCE * top)
+        .collect();
+    (!keep.is_empty()).then(|| u.select_columns(&keep))
+}
+
+/// The columns of every candidate change (hand-eye and the estimated
+/// kinematic parameters), indices into `ΔY`.
+fn candidate_columns(model: &CheckModel) -> Vec<usize> {
+    candidates(model).into_iter().flat_map(|(_, c)| c).collect()
+}
+
 /// The candidate changes of a model: the hand-eye, then every kinematic
 /// parameter the calibration estimated (columns of `ΔY`).
 fn candidates(model: &CheckModel) -> Vec<(Moved, Vec<usize>)> {
@@ -320,8 +360,20 @@ pub fn recheck(
     let base = fit(&z, &dp);
     let rows_n = z.len();
     let dof = rows_n.saturating_sub(base.rank).max(1);
-    let threshold = chi2_quantile(1.0 - alpha, dof as f64);
+    let threshold = chi2_quantile(1.0 - 0.5 * alpha, dof as f64);
     let statistic = base.rss;
+    let cols = candidate_columns(model);
+    let seen = &r.whiten * DMatrix::from_fn(r.a.nrows(), cols.len(), |i, j| r.a[(i, cols[j])]);
+    let residual_w = &z - &dp * &base.beta;
+    let (directed, directed_dof) = match seen_basis(&seen, &dp) {
+        Some(q) => ((q.transpose() * &residual_w).norm_squared(), q.ncols()),
+        None => (0.0, 0),
+    };
+    let directed_threshold = if directed_dof > 0 {
+        chi2_quantile(1.0 - 0.5 * alpha, directed_dof as f64)
+    } else {
+        f64::INFINITY
+    };
     let centres: Vec<(String, Vector3<f64>)> = r
         .stations
         .iter()
@@ -369,7 +421,7 @@ pub fn recheck(
             p_drop: chi2_sf(drop, added as f64),
             remaining: f.rss,
             remaining_dof,
-            explains: f.rss <= chi2_quantile(1.0 - alpha, remaining_dof as f64),
+            explains: f.rss <= chi2_quantile(1.0 - 0.5 * alpha, remaining_dof as f64),
         });
     }
     // Best first: what is left the most like noise, as a z-score of χ²
@@ -386,7 +438,10 @@ pub fn recheck(
         alpha,
         threshold,
         p_value: chi2_sf(statistic, dof as f64),
-        holds: statistic <= threshold,
+        directed,
+        directed_dof,
+        directed_threshold,
+        holds: statistic <= threshold && directed <= directed_threshold,
         centres,
         rms_mm,
         explanations,
@@ -406,7 +461,8 @@ pub struct Detectable {
     /// Each estimated kinematic parameter: label, change (mm or deg), and
     /// that change in σ of the calibration's covariance (`None` without).
     pub parameters: Vec<(String, f64, Option<f64>)>,
-    /// Degrees of freedom of the test.
+    /// Degrees of freedom of the directed test the sizes are quoted for
+    /// (the omnibus test only adds to the power).
     pub dof: usize,
 }
 
@@ -428,8 +484,12 @@ pub fn detectable(
     let dp = &r.whiten * &r.p;
     let rows_n = dp.nrows();
     let base = fit(&DVector::zeros(rows_n), &dp);
-    let dof = rows_n.saturating_sub(base.rank).max(1);
-    let threshold = chi2_quantile(1.0 - alpha, dof as f64);
+    // The directed test's (module doc): every change considered here lies
+    // in its span, so its non-centrality is the whole of the change's.
+    let cols = candidate_columns(model);
+    let seen = &r.whiten * DMatrix::from_fn(r.a.nrows(), cols.len(), |i, j| r.a[(i, cols[j])]);
+    let dof = seen_basis(&seen, &dp).map_or(0, |q| q.ncols()).max(1);
+    let threshold = chi2_quantile(1.0 - 0.5 * alpha, dof as f64);
     let lambda = required_noncentrality(threshold, dof as f64, power);
     // (I − Π)·Ẽ for every column of ΔY.
     let e = &r.whiten * &r.a;
