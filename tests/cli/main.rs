@@ -12,6 +12,7 @@ mod contract;
 mod doors;
 mod guide;
 mod history;
+mod history_fixed;
 mod hostile;
 mod layout;
 mod measure;

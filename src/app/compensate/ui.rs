@@ -38,6 +38,7 @@ pub fn compensate_ui(
     forms: &mut Forms,
     commands: &mut Vec<Command>,
 ) {
+    super::scene::scene_panel_ui(ui, state, forms);
     egui::ScrollArea::vertical()
         .id_salt("compensate_scroll")
         .auto_shrink([false, false])

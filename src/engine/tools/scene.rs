@@ -173,8 +173,7 @@ pub fn planned_pose_problem(plan: &Plan, i: usize) -> Option<String> {
 /// without passing it.
 #[must_use]
 pub fn arrow_scale(largest: f64, radius: f64) -> f64 {
-    if !(largest.is_finite() && radius.is_finite()) || largest <= 0.0 || largest >= 0.02 * radius
-    {
+    if !(largest.is_finite() && radius.is_finite()) || largest <= 0.0 || largest >= 0.02 * radius {
         return 1.0;
     }
     let want = 0.1 * radius / largest;
