@@ -2,6 +2,8 @@
 //! values are `base_from_sensor`, and history names them so (the
 //! library's column, the series, the CSV), not the hand-eye.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::Path;
 
 use super::support::bin::run;

@@ -286,7 +286,7 @@ fn a_fixed_sensor_session_shows_its_cell_calibrates_and_shows_base_from_sensor()
     assert_eq!(
         labels_with(
             &h,
-            "Fixed sensor (yellow ball, its frame) in the base frame"
+            "Fixed sensor (yellow ball) at the initial base_from_sensor"
         )
         .len(),
         1
@@ -335,7 +335,11 @@ fn a_fixed_sensor_session_shows_its_cell_calibrates_and_shows_base_from_sensor()
         "3-D scene results"
     ));
     assert_eq!(
-        labels_with(&h, "the calibrated model and base_from_sensor").len(),
+        labels_with(
+            &h,
+            "Fixed sensor (yellow ball) at the calibrated base_from_sensor"
+        )
+        .len(),
         1
     );
     // The Centres view says what its points are.

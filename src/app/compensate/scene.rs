@@ -100,6 +100,10 @@ pub fn compensation_scene(rows: &[TargetRow], selected: Option<usize>) -> (Scene
             crossed: false,
         });
     }
+    // Framed on the targets and their moves; the base frame is a zoom
+    // out away.
+    scene.focus = bounds(wanted.iter().chain(scene.points.iter().map(|p| &p.0)))
+        .map(|(c, r)| (c, (1.15 * r).max(0.2 * MIN_RADIUS_MM)));
     (scene, scale)
 }
 
@@ -123,12 +127,12 @@ pub fn caption(view: &CompensationView, shown: Option<usize>, scale: f64) -> Str
         "the moves drawn to scale".to_string()
     };
     let mut text = format!(
-        "{} targets: as written (orange marks, faded frames, the path in file order) and as compensated (frames at the blue arrows' ends); {moves}. ",
+        "{} targets as written (orange, faded frames, the path in file order) and compensated (frames at the blue arrows' ends); {moves}. ",
         view.rows.len()
     );
     if let Some(r) = shown.and_then(|i| view.rows.get(i)) {
         text.push_str(&format!(
-            "Selected {} (line {}): moved {:.3} mm and {:.4}°, joints up to {:.3}°{}.",
+            "Selected {} (line {}): {:.3} mm, {:.4}°, joints ≤ {:.3}°{}.",
             r.name,
             r.line,
             r.correction_mm,

@@ -39,7 +39,9 @@ pub fn compensate_ui(
     commands: &mut Vec<Command>,
 ) {
     super::scene::scene_panel_ui(ui, state, forms);
-    egui::ScrollArea::vertical()
+    // Both ways: the rows wider than the view beside the scene scroll
+    // instead of running under it.
+    egui::ScrollArea::both()
         .id_salt("compensate_scroll")
         .auto_shrink([false, false])
         .show(ui, |ui| {

@@ -162,7 +162,6 @@ fn plots_ui(
                 &mut forms.centres.camera,
                 selected,
                 magnify,
-                frame,
             ) {
                 commands.push(Command::View(ViewCommand::Select(i)));
             }

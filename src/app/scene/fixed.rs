@@ -212,16 +212,16 @@ pub fn fixed_cell_scene(cell: &FixedCell<'_>, selected: Option<usize>) -> Scene 
 #[must_use]
 pub fn caption(cell: &FixedCell<'_>, shown: Option<usize>, calibrated: bool) -> String {
     let model = if calibrated {
-        "the calibrated model and base_from_sensor"
+        "calibrated base_from_sensor and model"
     } else {
-        "the nominal model and the initial base_from_sensor"
+        "initial base_from_sensor, the nominal model"
     };
     let mut text = format!(
-        "Fixed sensor (yellow ball, its frame) in the base frame, a mark at every pose's target on the flange ({model}); "
+        "Fixed sensor (yellow ball) at the {model}; a dot at every pose's target on the flange. "
     );
     if let Some(p) = shown.and_then(|j| cell.poses.get(j)) {
         text.push_str(&format!(
-            "{} (target {}): {}the flange frame, the lever to the target, the line of sight and the measured point (red).",
+            "{} (target {}): {}the lever to the target, the line of sight, the measured point (red).",
             p.id,
             p.station,
             if cell.robot.is_some() && p.joints.is_some() {

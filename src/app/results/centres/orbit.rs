@@ -131,8 +131,7 @@ pub fn orbit_positions(
         .collect()
 }
 
-/// The orthographic orbit view, `frame` (what the points are, in which
-/// frame) on hover. Returns the measurement clicked.
+/// The orthographic orbit view. Returns the measurement clicked.
 pub(super) fn orbit_ui(
     ui: &mut egui::Ui,
     size: Vec2,
@@ -141,11 +140,12 @@ pub(super) fn orbit_ui(
     cam: &mut Camera,
     selected: Option<usize>,
     magnify: Option<f64>,
-    frame: &str,
 ) -> Option<usize> {
     let (response, painter) = ui.allocate_painter(size, Sense::click_and_drag());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, ORBIT_LABEL));
-    let response = response.on_hover_text(frame);
+    // What the points are and their frame (base for a sensor on the
+    // flange, flange for a fixed sensor) is said above the view.
+    let response = response.on_hover_text("the centres by station, in the frame named above");
     let rect = response.rect;
     painter.rect_filled(rect, 4.0, ui.visuals().extreme_bg_color);
     if response.dragged() {
