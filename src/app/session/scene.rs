@@ -322,15 +322,16 @@ mod tests {
         let scene = session_scene(&loaded, Some(4), &BTreeSet::new());
         assert_eq!(scene.marks.len(), n, "a mark at every pose's target");
         assert!(scene.marks[4].selected);
-        // The sensor stands where base_from_sensor puts it (the initial
-        // estimate from the data): near the true tracker.
+        // The sensor stands where the initial base_from_sensor (the
+        // engine's linear start, nominal model) puts it: the tracker's
+        // place within a few per cent of its distance (the nominal model's
+        // errors are taken up by it).
         let sensor = scene.spheres[0].centre;
+        let start = initial_hand_eye(&loaded).expect("a start").translation.vector;
+        assert_eq!(sensor, [start.x, start.y, start.z]);
         let truth = cell.base_from_sensor.translation.vector;
-        let off = ((sensor[0] - truth.x).powi(2)
-            + (sensor[1] - truth.y).powi(2)
-            + (sensor[2] - truth.z).powi(2))
-        .sqrt();
-        assert!(off < 20.0, "the sensor {off:.1} mm from the truth");
+        let off = (start - truth).norm();
+        assert!(off < 0.05 * truth.norm(), "the sensor {off:.1} mm from the truth");
         // What the tracker measured at pose 4, carried to the base frame,
         // lies at that pose's target (the nominal model: a few mm).
         let measured = scene.points[0].0;
