@@ -327,11 +327,17 @@ mod tests {
         // place within a few per cent of its distance (the nominal model's
         // errors are taken up by it).
         let sensor = scene.spheres[0].centre;
-        let start = initial_hand_eye(&loaded).expect("a start").translation.vector;
+        let start = initial_hand_eye(&loaded)
+            .expect("a start")
+            .translation
+            .vector;
         assert_eq!(sensor, [start.x, start.y, start.z]);
         let truth = cell.base_from_sensor.translation.vector;
         let off = (start - truth).norm();
-        assert!(off < 0.05 * truth.norm(), "the sensor {off:.1} mm from the truth");
+        assert!(
+            off < 0.05 * truth.norm(),
+            "the sensor {off:.1} mm from the truth"
+        );
         // What the tracker measured at pose 4, carried to the base frame,
         // lies at that pose's target (the nominal model: a few mm).
         let measured = scene.points[0].0;
