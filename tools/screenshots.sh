@@ -52,6 +52,7 @@ done
   spherecal simulate --identify-stations 60 --validate-stations 10 --out centres-70.json -q
   spherecal simulate --identify-stations 3000 --centres --poses 3 --out centres-3000.json -q
   spherecal simulate --seed 7 --out seed7.json -q
+  spherecal simulate --mount fixed --seed 4 --out fixed.json -q
   # A sphere knocked by 1.5 mm (in sensor y) at the first identify pose.
   spherecal simulate --centres --name "cell 3, a sphere knocked by 1.5 mm" --out fail.json -q
   awk '

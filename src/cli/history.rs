@@ -198,8 +198,15 @@ fn library_text(library: &Library, shown: &[usize]) -> String {
         let dw = date_width(library, shown);
         let _ = writeln!(
             s,
-            "\n{:<dw$}  {:<17}  {:<16}  {:<NAME_WIDTH$}  {:<6}  {:>10}  {:>10}  hand-eye x, y, z mm; roll, pitch, yaw deg",
-            "date", "date from", "robot", "session", "method", "std before", "std after"
+            "\n{:<dw$}  {:<17}  {:<16}  {:<NAME_WIDTH$}  {:<6}  {:>10}  {:>10}  {} x, y, z mm; roll, pitch, yaw deg",
+            "date",
+            "date from",
+            "robot",
+            "session",
+            "method",
+            "std before",
+            "std after",
+            history::sensor_name(shown.iter().map(|&i| library.entries[i].mount))
         );
         for &i in shown {
             let e = &library.entries[i];
@@ -301,7 +308,14 @@ fn drift_text(library: &Library, d: &Drift) -> String {
     s.push_str(&series_table(
         library,
         d,
-        "hand-eye eT_s (translation mm in the flange frame, roll/pitch/yaw deg), ± 1σ:",
+        match d.mount {
+            history::Mount::Flange => {
+                "hand-eye eT_s (translation mm in the flange frame, roll/pitch/yaw deg), ± 1σ:"
+            }
+            history::Mount::Fixed => {
+                "base_from_sensor bT_s, a fixed sensor (translation mm in the base frame, roll/pitch/yaw deg), ± 1σ:"
+            }
+        },
         &hand_eye,
     ));
     let by_sigma = kinematic

@@ -338,9 +338,12 @@ impl Director {
                 self.glancing = true;
                 self.advance();
             }
-            Act::Scroll(dy) => {
+            Act::Scroll(dy) | Act::ScrollAt(_, dy) => {
                 if first {
-                    self.pointer = Some(CENTRE);
+                    self.pointer = Some(match act {
+                        Act::ScrollAt(at, _) => at,
+                        _ => CENTRE,
+                    });
                     self.glancing = false;
                     self.events.push(egui::Event::MouseWheel {
                         unit: egui::MouseWheelUnit::Point,

@@ -47,6 +47,9 @@ pub enum Act {
     /// Turn the wheel over the central view by this many points (negative:
     /// down the page), then take the pointer away.
     Scroll(f32),
+    /// The same with the pointer here (off a 3-D scene, which takes the
+    /// wheel to zoom).
+    ScrollAt(Pos2, f32),
     /// Let this much time pass, frames drawn.
     Pause(Duration),
     /// A check of what the workbench shows; the message when it fails.
@@ -86,6 +89,18 @@ pub enum Scenario {
     ScenePoses,
     /// The example artefact measured: the cloud in the 3-D scene.
     SceneMeasure,
+    /// The Plan view's 3-D scene of the default IRB 2400 plan, a pose
+    /// picked: the robot there, every pose's flange by station, the
+    /// sphere at every station.
+    ScenePlan,
+    /// The Compensate view's 3-D scene: `examples/path.mod` through the
+    /// seed-7 cell, every target as written and as compensated.
+    SceneCompensate,
+    /// A fixed-sensor cell (`fixed.json`: `spherecal simulate --mount
+    /// fixed --seed 4`) calibrated: the Session view's scene with the
+    /// tracker in the base frame, the targets on the flange, the line of
+    /// sight.
+    SceneFixed,
     /// The demo calibrated: the Centres view, before hollow, after filled.
     Centres,
     /// The Import view on a simulated joint log (`sim/joints.csv`,
@@ -143,7 +158,7 @@ pub enum Scenario {
 
 impl Scenario {
     /// Every scenario, in the order the script takes them.
-    pub const ALL: [Self; 26] = [
+    pub const ALL: [Self; 29] = [
         Self::Steps,
         Self::Results,
         Self::ResultsTables,
@@ -170,6 +185,9 @@ impl Scenario {
         Self::SceneSession,
         Self::ScenePoses,
         Self::SceneMeasure,
+        Self::ScenePlan,
+        Self::SceneCompensate,
+        Self::SceneFixed,
     ];
 
     /// The name given in [`ENV`].
@@ -201,6 +219,9 @@ impl Scenario {
             Self::SceneSession => "scene-session",
             Self::ScenePoses => "scene-poses",
             Self::SceneMeasure => "scene-measure",
+            Self::ScenePlan => "scene-plan",
+            Self::SceneCompensate => "scene-compensate",
+            Self::SceneFixed => "scene-fixed",
             Self::PlotsExport => "plots-export",
         }
     }
@@ -316,6 +337,27 @@ impl Scenario {
             ],
             Self::ScenePoses => [realdata_stripe(), vec![show(Tab::Session)]].concat(),
             Self::SceneMeasure => [measure(), vec![Act::Scroll(-330.0)]].concat(),
+            Self::ScenePlan => vec![
+                Act::Settle,
+                dismiss(),
+                show(Tab::Plan),
+                Act::Do(Command::Plan(PlanCommand::Make)),
+                Act::Settle,
+                Act::Expect(planned),
+                Act::Edit(|f| f.scene.plan_pose = Some(40)),
+                Act::ScrollAt(pos2(1000.0, 78.0), -330.0),
+            ],
+            Self::SceneCompensate => compensate(),
+            Self::SceneFixed => [
+                open_run("fixed.json"),
+                vec![
+                    show(Tab::Session),
+                    Act::Find(|s| {
+                        measurement(s, "p12-SMR1").map(|i| Command::View(ViewCommand::Select(i)))
+                    }),
+                ],
+            ]
+            .concat(),
             Self::PlotsExport => {
                 let mut acts = demo_run();
                 acts.extend([
@@ -352,7 +394,8 @@ impl Scenario {
             Self::Centres3000 => &["centres-3000.json"],
             Self::Fail => &["fail.json"],
             Self::RealdataStripe => &["data/robcalibrator-sphere/RobPoses.rob"],
-            Self::Compensate => &["seed7.json", "examples/path.mod"],
+            Self::Compensate | Self::SceneCompensate => &["seed7.json", "examples/path.mod"],
+            Self::SceneFixed => &["fixed.json"],
             Self::Measure | Self::SceneMeasure => &["seed7.json", "examples/artefact/joints.csv"],
             Self::ScenePoses => &["data/robcalibrator-sphere/RobPoses.rob"],
             _ => &[],

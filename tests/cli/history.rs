@@ -567,7 +567,7 @@ fn chosen_parameters_and_options() {
     let kinds: Vec<(&str, String)> = d
         .series
         .iter()
-        .map(|s| (s.name.as_str(), s.kind.label()))
+        .map(|s| (s.name.as_str(), s.kind.label(d.mount)))
         .collect();
     assert_eq!(
         kinds.len(),

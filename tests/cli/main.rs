@@ -13,6 +13,7 @@ mod doors;
 mod guide;
 mod history;
 mod import_hand_eye;
+mod history_fixed;
 mod hostile;
 mod layout;
 mod measure;

@@ -12,5 +12,6 @@ mod import_poses;
 mod measure;
 mod range;
 mod scene;
+mod scene_views;
 mod trust;
 mod workbench;

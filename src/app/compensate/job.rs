@@ -10,6 +10,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use nalgebra::Isometry3;
+
 use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format::{refuse_inputs, write_atomic};
@@ -125,6 +127,10 @@ pub struct TargetRow {
     pub kept: bool,
     /// What to know about it (a configuration kept or updated).
     pub notes: Vec<String>,
+    /// The TCP pose wanted, base frame, mm.
+    pub wanted: Isometry3<f64>,
+    /// The TCP pose to command, base frame, mm.
+    pub commanded: Isometry3<f64>,
 }
 
 /// A compensation as the view shows it.
@@ -193,6 +199,8 @@ impl CompensationView {
                     .collect(),
                 kept: !t.written,
                 notes: t.notes.clone(),
+                wanted: t.wanted,
+                commanded: t.commanded,
             })
             .collect();
         Self {

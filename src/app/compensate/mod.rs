@@ -3,10 +3,12 @@
 //! compensate` in the window) on a job thread with progress and Cancel
 //! ([`job`]); the compensated file written under a name that follows the
 //! targets, refused while the compensation is stale or the targets had
-//! errors. The form is [`form`], the view [`ui`].
+//! errors. The form is [`form`], the view [`ui`], its 3-D scene of the
+//! targets before and after [`scene`].
 
 pub mod form;
 pub mod job;
+pub mod scene;
 pub mod ui;
 
 use std::path::{Path, PathBuf};

@@ -38,7 +38,10 @@ pub fn compensate_ui(
     forms: &mut Forms,
     commands: &mut Vec<Command>,
 ) {
-    egui::ScrollArea::vertical()
+    super::scene::scene_panel_ui(ui, state, forms);
+    // Both ways: the rows wider than the view beside the scene scroll
+    // instead of running under it.
+    egui::ScrollArea::both()
         .id_salt("compensate_scroll")
         .auto_shrink([false, false])
         .show(ui, |ui| {

@@ -14,7 +14,7 @@ use crate::app::dialog::Purpose;
 use crate::app::job::Slot;
 use crate::app::widgets::plots::{DATE_LABEL_GAP, labelled_x, readable_y};
 use crate::app::widgets::{AFTER, BAD, MUTED, WARN, labelled_field};
-use crate::engine::tools::history::{Drift, Entry, Library, Series, Verdict};
+use crate::engine::tools::history::{Drift, Entry, Library, Mount, Series, Verdict};
 
 /// Height of one drift plot, points.
 const DRIFT_PLOT_HEIGHT: f32 = 170.0;
@@ -175,6 +175,12 @@ fn table_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) {
                 .num_columns(9)
                 .spacing([12.0, 4.0])
                 .show(ui, |ui| {
+                    let sensor = format!(
+                        "{} x y z (mm)",
+                        crate::engine::tools::history::sensor_name(
+                            library.entries.iter().map(|e| e.mount)
+                        )
+                    );
                     for h in [
                         "result file",
                         "date",
@@ -183,7 +189,7 @@ fn table_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) {
                         "method",
                         "validation std after",
                         "ε after",
-                        "hand-eye x y z (mm)",
+                        sensor.as_str(),
                         "roll pitch yaw (deg)",
                     ] {
                         ui.label(RichText::new(h).strong());
@@ -238,7 +244,12 @@ fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) {
     )));
     ui.label(dim(format!("{:.4} mm", e.epsilon_after)));
     let t = e.hand_eye.translation;
-    ui.label(dim(format!("{:.3} {:.3} {:.3}", t[0], t[1], t[2])));
+    let which = match e.mount {
+        Mount::Flange => "hand-eye eT_s",
+        Mount::Fixed => "base_from_sensor bT_s (a fixed sensor)",
+    };
+    ui.label(dim(format!("{:.3} {:.3} {:.3}", t[0], t[1], t[2])))
+        .on_hover_text(which);
     let r = e.hand_eye.rpy_deg;
     ui.label(dim(format!("{:.4} {:.4} {:.4}", r[0], r[1], r[2])));
     ui.end_row();
@@ -356,7 +367,7 @@ fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[St
             "{} ({}) · {}",
             series.name,
             series.unit.as_str(),
-            series.kind.label()
+            series.kind.label(drift.mount)
         ))
         .strong(),
     );

@@ -1,10 +1,11 @@
 //! The pose planner: the Plan form ([`form`]), Make plan with progress
 //! and Cancel ([`job`]), the plan on show and its files (the joint-log
 //! CSV and the controller's program), and a session simulated from it;
-//! the Plan view ([`ui`]).
+//! the Plan view ([`ui`]) with its 3-D scene of the poses ([`scene`]).
 
 pub mod form;
 pub mod job;
+pub mod scene;
 pub mod ui;
 
 use std::path::PathBuf;

@@ -388,11 +388,11 @@ fn outcome_ui(
     export_ui(ui, state, forms, stale.as_ref(), commands);
     crate::app::widgets::dialog_note_ui(ui, state, &[Purpose::ExportFolder]);
     ui.separator();
+    super::scene::plan_scene_ui(ui, forms, plan, stale.is_some());
+    super::scene::poses_table_ui(ui, forms, plan);
+    ui.separator();
     ui.label(RichText::new("Stations seen from above (base frame x, y in mm)").strong());
     map_ui(ui, plan);
-    egui::CollapsingHeader::new(format!("the {} poses in plan order", plan.poses.len()))
-        .id_salt("plan_poses")
-        .show(ui, |ui| poses_ui(ui, plan));
 }
 
 fn map_ui(ui: &mut egui::Ui, plan: &Plan) {
@@ -452,32 +452,5 @@ fn map_ui(ui: &mut egui::Ui, plan: &Plan) {
                     .radius(5.0)
                     .color(BEFORE),
             );
-        });
-}
-
-fn poses_ui(ui: &mut egui::Ui, plan: &Plan) {
-    egui::ScrollArea::vertical()
-        .id_salt("plan_pose_table")
-        .max_height(260.0)
-        .show(ui, |ui| {
-            egui::Grid::new("plan_pose_grid")
-                .striped(true)
-                .num_columns(5)
-                .show(ui, |ui| {
-                    for h in ["id", "station", "use", "side", "joints (deg)"] {
-                        ui.label(RichText::new(h).strong());
-                    }
-                    ui.end_row();
-                    for p in &plan.poses {
-                        ui.label(&p.id);
-                        ui.label(&p.station);
-                        ui.label(p.usage.as_str());
-                        ui.label(format!("{:+}", p.side));
-                        let joints: Vec<String> =
-                            p.joints.iter().map(|q| format!("{q:8.3}")).collect();
-                        ui.label(RichText::new(joints.join(" ")).monospace());
-                        ui.end_row();
-                    }
-                });
         });
 }

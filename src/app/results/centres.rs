@@ -146,10 +146,13 @@ fn plots_ui(
         let w3d = (width * 0.55).max(200.0);
         ui.vertical(|ui| {
             ui.set_width(w3d);
+            let frame = centres_frame(state);
             ui.label(
-                RichText::new("3D (drag to orbit, scroll to zoom, click to select, hover to name)")
-                    .small()
-                    .weak(),
+                RichText::new(format!(
+                    "3D, {frame} (drag to orbit, scroll to zoom, click to select, hover to name)"
+                ))
+                .small()
+                .weak(),
             );
             if let Some(i) = orbit::orbit_ui(
                 ui,
@@ -178,6 +181,29 @@ fn plots_ui(
             }
         });
     });
+}
+
+/// What the centres are and their frame, by the mount of the result on
+/// show (else the open session's): sphere centres in the base frame, or a
+/// fixed sensor's targets in the flange frame.
+#[must_use]
+pub fn centres_frame(state: &AppState) -> &'static str {
+    let mount = state.result.as_ref().map_or_else(
+        || {
+            state
+                .loaded
+                .as_ref()
+                .map(|l| l.session.mount)
+                .unwrap_or_default()
+        },
+        |r| r.file.mount(),
+    );
+    match mount {
+        crate::engine::base::session::Mount::Flange => "sphere centres in the robot base frame",
+        crate::engine::base::session::Mount::Fixed => {
+            "targets in the flange frame (a fixed sensor)"
+        }
+    }
 }
 
 fn options_ui(ui: &mut egui::Ui, f: &mut CentresForm, has_after: bool) {

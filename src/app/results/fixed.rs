@@ -61,4 +61,5 @@ pub(super) fn fixed_ui(ui: &mut egui::Ui, view: &ResultView) {
         )
         .color(MUTED),
     );
+    crate::app::scene::fixed::results_scene_ui(ui, &view.file);
 }

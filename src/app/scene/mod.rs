@@ -9,6 +9,7 @@
 //! picks it.
 
 pub mod content;
+pub mod fixed;
 pub mod ui;
 
 use egui::{Color32, Pos2, Rect, Shape, Stroke};
@@ -20,6 +21,15 @@ pub struct SceneCameras {
     pub session: Camera,
     /// The Measure view's.
     pub measure: Camera,
+    /// The Plan view's.
+    pub plan: Camera,
+    /// The pose of the plan selected (in the scene and the plan's table).
+    pub plan_pose: Option<usize>,
+    /// The Compensate view's.
+    pub compensate: Camera,
+    /// The target selected in the Compensate view's scene (its index in
+    /// the compensation's rows).
+    pub compensate_target: Option<usize>,
 }
 
 /// A polyline of the scene.

@@ -1,6 +1,8 @@
 //! The Session view's 3-D scene: every pose's mark, the robot at the
 //! selected pose with its flange and sensor frames, the laser fan and
-//! the stripe, the sphere at every station. Geometry from the engine
+//! the stripe, the sphere at every station; for a fixed sensor the cell
+//! of [`crate::app::scene::fixed`] (the sensor in the base frame, the
+//! targets on the flange, the line of sight). Geometry from the engine
 //! ([`crate::engine::tools::scene`]); here only what goes in and its
 //! colours.
 
@@ -11,9 +13,10 @@ use nalgebra::Isometry3;
 
 use super::LoadedSession;
 use crate::app::scene::content::{LASER, LINK, axes_lines};
+use crate::app::scene::fixed::{CellPose, FixedCell, Seen, fixed_cell_scene};
 use crate::app::scene::{Line3, Mark, Scene, Sphere3};
 use crate::app::widgets::{MUTED, station_style};
-use crate::engine::base::session::Observation;
+use crate::engine::base::session::{Mount, Observation};
 use crate::engine::tools::scene::{
     fan_extent, frame_axes, laser_fan, link_polyline, stripe_in_base,
 };
@@ -33,13 +36,10 @@ pub fn session_scene(
     let session = &loaded.session;
     let robot = &session.robot;
     let pose_only = session.pose_only();
-    let hand_eye: Option<Isometry3<f64>> = loaded
-        .analysis
-        .hand_eye
-        .as_ref()
-        .ok()
-        .map(|(h, _)| *h)
-        .or(session.hand_eye);
+    let hand_eye = initial_hand_eye(loaded);
+    if session.mount == Mount::Fixed {
+        return fixed_cell_scene(&fixed_cell(loaded, excluded), selected);
+    }
     let flanges: Vec<Isometry3<f64>> = (0..session.measurements.len())
         .map(|i| session.base_from_flange(robot, i))
         .collect();
@@ -147,6 +147,94 @@ pub fn session_scene(
     scene
 }
 
+/// The hand-eye the scene draws: the initial one of the analysis, else
+/// the session's.
+fn initial_hand_eye(loaded: &LoadedSession) -> Option<Isometry3<f64>> {
+    loaded
+        .analysis
+        .hand_eye
+        .as_ref()
+        .ok()
+        .map(|(h, _)| *h)
+        .or(loaded.session.hand_eye)
+}
+
+/// A fixed-sensor session's cell: the nominal robot (none for a
+/// pose-only session), the initial `base_from_sensor`, each target where
+/// the session puts it (its station's mean point in the flange frame),
+/// every pose with what the sensor reported.
+#[must_use]
+pub fn fixed_cell<'a>(loaded: &'a LoadedSession, excluded: &BTreeSet<String>) -> FixedCell<'a> {
+    let session = &loaded.session;
+    let pose_only = session.pose_only();
+    let targets = loaded.before.as_ref().map_or_else(
+        |_| Vec::new(),
+        |c| {
+            c.stations
+                .iter()
+                .cloned()
+                .zip(c.means.iter().map(|m| m.0))
+                .collect()
+        },
+    );
+    let poses = session
+        .measurements
+        .iter()
+        .enumerate()
+        .map(|(i, m)| CellPose {
+            index: i,
+            id: m.id.clone(),
+            station: m.station.clone(),
+            flange: session.base_from_flange(&session.robot, i),
+            joints: (!pose_only).then(|| m.joints.clone()),
+            seen: Some(match &m.observation {
+                Observation::Centre(c) => Seen::Point([c.x, c.y, c.z]),
+                Observation::Stripe(p) => Seen::Stripe(p.clone(), fan_extent(session, i)),
+            }),
+            used: !excluded.contains(&m.id),
+        })
+        .collect();
+    FixedCell {
+        robot: (!pose_only).then_some(&session.robot),
+        base_from_sensor: initial_hand_eye(loaded),
+        targets,
+        poses,
+        radius: session.sphere_radius(),
+    }
+}
+
+/// The Session view's caption under the scene for measurement `shown`.
+#[must_use]
+pub fn session_caption(
+    loaded: &LoadedSession,
+    shown: usize,
+    excluded: &BTreeSet<String>,
+) -> String {
+    if loaded.session.mount == Mount::Fixed {
+        let cell = fixed_cell(loaded, excluded);
+        return crate::app::scene::fixed::caption(
+            &cell,
+            crate::app::scene::fixed::shown_pose(&cell, Some(shown)),
+            false,
+        );
+    }
+    loaded
+        .session
+        .measurements
+        .get(shown)
+        .map_or_else(String::new, |m| {
+            let what = if loaded.session.pose_only() {
+                "pose-only: the flange poses as frames"
+            } else {
+                "the robot from the nominal model"
+            };
+            format!(
+                "{} (station {}): {what}, flange and sensor frames (x red, y green, z blue), the laser fan and stripe; the sphere at every station where the nominal model puts it",
+                m.id, m.station
+            )
+        })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -221,5 +309,53 @@ mod tests {
         assert!(axes >= 3 * n + 9, "{axes} axes for {n} poses");
         assert_eq!(scene.spheres.len(), loaded.station_ids().len());
         assert_eq!(scene.triangles.len(), 1);
+    }
+
+    #[test]
+    fn a_fixed_sensor_session_shows_the_tracker_and_the_targets_on_the_flange() {
+        use crate::engine::tools::simulate::SimConfig;
+        use crate::engine::tools::simulate::fixed::{FixedCell, simulate_fixed};
+        let cell = FixedCell::tracker(0.0);
+        let (session, _) = simulate_fixed(&SimConfig::default(), &cell).expect("simulate");
+        let loaded = analyse(session, Source::Simulated);
+        let n = loaded.session.measurements.len();
+        let scene = session_scene(&loaded, Some(4), &BTreeSet::new());
+        assert_eq!(scene.marks.len(), n, "a mark at every pose's target");
+        assert!(scene.marks[4].selected);
+        // The sensor stands where the initial base_from_sensor (the
+        // engine's linear start, nominal model) puts it: the tracker's
+        // place within a few per cent of its distance (the nominal model's
+        // errors are taken up by it).
+        let sensor = scene.spheres[0].centre;
+        let start = initial_hand_eye(&loaded)
+            .expect("a start")
+            .translation
+            .vector;
+        assert_eq!(sensor, [start.x, start.y, start.z]);
+        let truth = cell.base_from_sensor.translation.vector;
+        let off = (start - truth).norm();
+        assert!(
+            off < 0.05 * truth.norm(),
+            "the sensor {off:.1} mm from the truth"
+        );
+        // What the tracker measured at pose 4, carried to the base frame,
+        // lies at that pose's target (the nominal model: a few mm).
+        let measured = scene.points[0].0;
+        let target = scene.marks[4].at;
+        let d = (0..3)
+            .map(|k| (measured[k] - target[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!(d < 5.0, "{d:.2} mm");
+        // The line of sight from the sensor to it.
+        let sight = scene
+            .lines
+            .iter()
+            .filter(|l| l.stroke.color == crate::app::scene::fixed::SIGHT)
+            .count();
+        assert_eq!(sight, 1);
+        assert!(session_caption(&loaded, 4, &BTreeSet::new()).starts_with("Fixed sensor"));
+        // Not the flange mount's sensor on the flange: no laser fan.
+        assert!(scene.triangles.is_empty());
     }
 }

@@ -82,23 +82,9 @@ fn scene_panel_ui(
         .default_size(SCENE_WIDTH)
         .size_range(260.0..=900.0)
         .show(ui, |ui| {
-            let scene = super::scene::session_scene(
-                loaded,
-                state.selected,
-                &state.excluded,
-            );
-            let shown = state.selected.unwrap_or(0);
-            let caption = loaded.session.measurements.get(shown).map_or_else(String::new, |m| {
-                let what = if loaded.session.pose_only() {
-                    "pose-only: the flange poses as frames"
-                } else {
-                    "the robot from the nominal model"
-                };
-                format!(
-                    "{} (station {}): {what}, flange and sensor frames (x red, y green, z blue), the laser fan and stripe; the sphere at every station where the nominal model puts it",
-                    m.id, m.station
-                )
-            });
+            let scene = super::scene::session_scene(loaded, state.selected, &state.excluded);
+            let caption =
+                super::scene::session_caption(loaded, state.selected.unwrap_or(0), &state.excluded);
             if let Some(i) = crate::app::scene::ui::scene_ui(
                 ui,
                 "session",

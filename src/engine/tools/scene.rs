@@ -9,6 +9,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 
 use crate::engine::base::robot::Robot;
 use crate::engine::base::session::{Observation, Session};
+use crate::engine::tools::plan::Plan;
 
 /// A frame drawn as three axes: its origin and the ends of its x, y and
 /// z axes, mm in **B**.
@@ -92,16 +93,97 @@ pub fn fan_extent(session: &Session, i: usize) -> Option<FanExtent> {
                 )
             },
         ),
-        Observation::Centre(c) => {
-            let r = session.sphere_radius();
-            ([c.y - r, c.z - r], [c.y + r, c.z + r])
-        }
+        Observation::Centre(c) => return Some(fan_around(c, session.sphere_radius())),
         Observation::Stripe(_) => return None,
     };
     Some(FanExtent {
         y: [lo[0] - FAN_MARGIN, hi[0] + FAN_MARGIN],
         z: [(lo[1] - FAN_MARGIN).max(0.0), hi[1] + FAN_MARGIN],
     })
+}
+
+/// The fan around a sphere of `radius` (mm) centred at `centre` (sensor
+/// frame): the sphere's extent in the laser plane with a margin of
+/// [`FAN_MARGIN`].
+#[must_use]
+pub fn fan_around(centre: &Vector3<f64>, radius: f64) -> FanExtent {
+    let r = radius + FAN_MARGIN;
+    FanExtent {
+        y: [centre.y - r, centre.y + r],
+        z: [(centre.z - r).max(0.0), centre.z + r],
+    }
+}
+
+/// Joint-limit slack a planned pose may have, deg (rounding).
+const LIMIT_SLACK_DEG: f64 = 1e-6;
+/// How far the nominal flange at a planned pose's joints may be from the
+/// pose's flange, mm.
+const FLANGE_SLACK_MM: f64 = 0.01;
+/// How far the sphere may be from where the plan says the sensor sees
+/// it, mm.
+const SIGHT_SLACK_MM: f64 = 1.0;
+
+/// Why planned pose `i` of `plan` cannot be run as planned, in words, or
+/// `None` when it can: a joint outside the plan's limits, a flange the
+/// plan's robot does not reach at the pose's joints, or the sphere not
+/// where the sensor is planned to see it. A plan as the planner makes it
+/// has none; a plan read from a file or made for another model may.
+#[must_use]
+pub fn planned_pose_problem(plan: &Plan, i: usize) -> Option<String> {
+    let p = plan.poses.get(i)?;
+    if p.joints.len() != plan.robot.joints.len() {
+        return Some(format!(
+            "{} joints for a {}-joint robot",
+            p.joints.len(),
+            plan.robot.joints.len()
+        ));
+    }
+    for (k, (q, l)) in p.joints.iter().zip(&plan.limits).enumerate() {
+        if *q < l.min - LIMIT_SLACK_DEG || *q > l.max + LIMIT_SLACK_DEG {
+            return Some(format!(
+                "joint {} at {q:.2}° is outside its limits ({:.1}…{:.1}°)",
+                k + 1,
+                l.min,
+                l.max
+            ));
+        }
+    }
+    let flange = plan.robot.base_from_flange(&p.joints);
+    let off = (flange.translation.vector - p.base_from_flange.translation.vector).norm();
+    if off > FLANGE_SLACK_MM {
+        return Some(format!(
+            "the robot's flange at these joints is {off:.2} mm from the planned one"
+        ));
+    }
+    let station = plan.station(&p.station)?;
+    let seen = (flange * plan.flange_from_sensor).inverse() * Point3::from(station.position);
+    let miss = (seen.coords - p.centre_in_sensor).norm();
+    if miss > SIGHT_SLACK_MM {
+        return Some(format!(
+            "the sphere of station {} is {miss:.1} mm from where the sensor should see it",
+            p.station
+        ));
+    }
+    None
+}
+
+/// The factor a vector of `largest` mm is drawn enlarged by in a scene of
+/// `radius` mm so that it can be seen: 1 when it is at least 2 % of the
+/// radius, else the 1-2-5 step that draws it nearest 10 % of the radius
+/// without passing it.
+#[must_use]
+pub fn arrow_scale(largest: f64, radius: f64) -> f64 {
+    if !(largest.is_finite() && radius.is_finite()) || largest <= 0.0 || largest >= 0.02 * radius {
+        return 1.0;
+    }
+    let want = 0.1 * radius / largest;
+    let decade = 10f64.powf(want.log10().floor());
+    [5.0, 2.0, 1.0]
+        .into_iter()
+        .map(|m| m * decade)
+        .find(|s| *s <= want)
+        .unwrap_or(decade)
+        .max(1.0)
 }
 
 /// The laser fan of a sensor at `base_from_sensor` over `extent`, in
@@ -244,6 +326,59 @@ mod tests {
         });
         let r = fan_extent(&session, 0).expect("range");
         assert_eq!((r.y, r.z), ([-40.0, 40.0], [250.0, 350.0]));
+    }
+
+    #[test]
+    fn the_planner_s_poses_have_no_problem_and_a_broken_one_is_named() {
+        let preset = presets::irb2400();
+        let mut config =
+            crate::engine::tools::plan::PlanConfig::for_preset(&preset, [1050.0, 0.0, 475.0]);
+        config.design.n_identify = 3;
+        config.design.n_validate = 2;
+        config.design.identify_poses = 4;
+        config.design.validate_poses = 3;
+        let plan = crate::engine::tools::plan::plan(&config, &mut |_| {
+            crate::engine::calibrate::solve::Control::Continue
+        })
+        .expect("plan");
+        for i in 0..plan.poses.len() {
+            assert_eq!(planned_pose_problem(&plan, i), None, "pose {i}");
+        }
+        assert_eq!(planned_pose_problem(&plan, plan.poses.len()), None);
+        let mut broken = plan.clone();
+        broken.poses[1].joints[2] = broken.limits[2].max + 5.0;
+        let why = planned_pose_problem(&broken, 1).expect("outside");
+        assert!(why.starts_with("joint 3 at"), "{why}");
+        let mut broken = plan.clone();
+        let k = broken
+            .stations
+            .iter()
+            .position(|s| s.id == broken.poses[2].station)
+            .expect("station");
+        broken.stations[k].position.x += 30.0;
+        let why = planned_pose_problem(&broken, 2).expect("not seen");
+        assert!(why.contains("30.0 mm from where the sensor"), "{why}");
+        let mut broken = plan;
+        broken.robot.joints[1].a += 5.0;
+        let why = planned_pose_problem(&broken, 0).expect("other robot");
+        assert!(why.contains("from the planned one"), "{why}");
+    }
+
+    #[test]
+    fn a_tiny_arrow_is_enlarged_by_a_round_factor_said() {
+        assert_eq!(arrow_scale(30.0, 1000.0), 1.0);
+        assert_eq!(arrow_scale(20.0, 1000.0), 1.0);
+        // 0.2 mm in 1000 mm: 100 mm wanted, ×500 draws it 100 mm.
+        assert_eq!(arrow_scale(0.2, 1000.0), 500.0);
+        // 0.3 mm: ×333 wanted, ×200 the step below.
+        assert_eq!(arrow_scale(0.3, 1000.0), 200.0);
+        assert_eq!(arrow_scale(15.0, 1000.0), 5.0);
+        for (l, r) in [(0.013, 800.0), (1.7, 2000.0), (0.9, 50.0)] {
+            let s = arrow_scale(l, r);
+            assert!(s * l <= 0.1 * r + 1e-9 && s * l >= 0.02 * r, "{l} {r} {s}");
+        }
+        assert_eq!(arrow_scale(0.0, 1000.0), 1.0);
+        assert_eq!(arrow_scale(f64::NAN, 1000.0), 1.0);
     }
 
     #[test]

@@ -143,7 +143,9 @@ pub(super) fn orbit_ui(
 ) -> Option<usize> {
     let (response, painter) = ui.allocate_painter(size, Sense::click_and_drag());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, ORBIT_LABEL));
-    let response = response.on_hover_text("sphere centres in the robot base frame");
+    // What the points are and their frame (base for a sensor on the
+    // flange, flange for a fixed sensor) is said above the view.
+    let response = response.on_hover_text("the centres by station, in the frame named above");
     let rect = response.rect;
     painter.rect_filled(rect, 4.0, ui.visuals().extreme_bg_color);
     if response.dragged() {

@@ -35,7 +35,7 @@ pub fn drift_csv(library: &Library, drifts: &[Drift]) -> String {
                             .iter()
                             .find(|p| p.entry == e)
                             .map_or(v.value, |p| p.value),
-                        series.kind.label(),
+                        series.kind.label(d.mount),
                     ),
                     None => (v.value, String::new()),
                 };

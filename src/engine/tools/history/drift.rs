@@ -5,8 +5,8 @@ use std::collections::HashSet;
 
 use super::entry::coupled_twist;
 use super::{
-    Combination, DEFAULT_K, DEFAULT_TOP, Entry, HAND_EYE_NAMES, HistoryError, Library,
-    PRIOR_HELD_FRACTION, ParamValue, Status, Timestamp, Unit,
+    Combination, DEFAULT_K, DEFAULT_TOP, Entry, HistoryError, Library, Mount, PRIOR_HELD_FRACTION,
+    ParamValue, Status, Timestamp, Unit, hand_eye_names,
 };
 use crate::engine::base::geometry::wrap_deg;
 use crate::engine::base::numeric::median;
@@ -37,7 +37,8 @@ impl Default for DriftOptions {
 /// Why a series is shown.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SeriesKind {
-    /// One of the six hand-eye values.
+    /// One of the six sensor values: the hand-eye's, or a fixed sensor's
+    /// `base_from_sensor` ([`Drift::mount`]).
     HandEye,
     /// A main kinematic deviation: `rank` 1 is the largest, `score` the
     /// median `|value| / σ` (or the median `|value|` in mm of effect when
@@ -57,11 +58,15 @@ pub enum SeriesKind {
 }
 
 impl SeriesKind {
-    /// In words, for tables and CSV.
+    /// In words, for tables and CSV; the sensor values by `mount`
+    /// ("hand-eye", "base from sensor").
     #[must_use]
-    pub fn label(&self) -> String {
+    pub fn label(&self, mount: Mount) -> String {
         match self {
-            Self::HandEye => "hand-eye".into(),
+            Self::HandEye => match mount {
+                Mount::Flange => "hand-eye".into(),
+                Mount::Fixed => "base from sensor".into(),
+            },
             Self::Main { rank, .. } => format!("main {rank}"),
             Self::Chosen => "chosen".into(),
             Self::Jumped => "jumped".into(),
@@ -163,6 +168,10 @@ pub struct Drift {
     pub reference: Vec<Joint>,
     /// `k` of the jump check.
     pub k: f64,
+    /// The mount of the earliest result: the six sensor series are the
+    /// hand-eye's (`hand_eye.x` …) or a fixed sensor's `base_from_sensor`
+    /// (`base_from_sensor.x` …).
+    pub mount: Mount,
     /// Hand-eye series, then main, chosen and jumped kinematic ones.
     pub series: Vec<Series>,
     /// Every check between consecutive results, in date order, hand-eye
@@ -243,11 +252,13 @@ pub fn drift(
         });
     };
     let reference = library.entries[first].nominal.clone();
+    let mount = library.entries[first].mount;
+    let sensor_names = hand_eye_names(mount);
     let n_params = 6 + PARAMS_PER_JOINT * reference.len();
     let names: Vec<String> = (0..n_params)
         .map(|i| {
             if i < 6 {
-                HAND_EYE_NAMES[i].to_string()
+                sensor_names[i].to_string()
             } else {
                 Robot::param_label(i - 6)
             }
@@ -263,6 +274,19 @@ pub fn drift(
         }
     }
     let mut notes = drift_notes(library, &entries, &reference);
+    let other_mount = entries
+        .iter()
+        .filter(|&&e| library.entries[e].mount != mount)
+        .count();
+    if other_mount > 0 {
+        notes.push(format!(
+            "{other_mount} of {} results have the sensor {} while the earliest has it {}: their six sensor values ({}) are another transform and are not comparable; keep one mount in the folder",
+            entries.len(),
+            mount_words(if mount == Mount::Flange { Mount::Fixed } else { Mount::Flange }),
+            mount_words(mount),
+            if mount == Mount::Flange { "base_from_sensor, not the hand-eye" } else { "the hand-eye, not base_from_sensor" },
+        ));
+    }
 
     // Values of every parameter at every entry.
     let values: Vec<Vec<Option<ParamValue>>> = (0..n_params)
@@ -353,10 +377,19 @@ pub fn drift(
         entries,
         reference,
         k: options.k,
+        mount,
         series,
         checks,
         notes,
     })
+}
+
+/// Where the sensor stands, in words.
+fn mount_words(mount: Mount) -> &'static str {
+    match mount {
+        Mount::Flange => "on the flange",
+        Mount::Fixed => "fixed in the cell",
+    }
 }
 
 pub(super) fn series_points(

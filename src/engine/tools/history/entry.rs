@@ -9,8 +9,8 @@ use std::path::PathBuf;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 use super::{
-    COUPLING_REL, Combination, DateSource, Entry, HAND_EYE_NAMES, HandEye, PRIOR_HELD_FRACTION,
-    PairedBy, ParamValue, RPY_STEP_DEG, Status, Timestamp, Unit,
+    COUPLING_REL, Combination, DateSource, Entry, HandEye, PRIOR_HELD_FRACTION, PairedBy,
+    ParamValue, RPY_STEP_DEG, Status, Timestamp, Unit, hand_eye_names,
 };
 use crate::engine::base::geometry::wrap_deg;
 use crate::engine::base::robot::{Joint, PARAM_IS_ANGLE, PARAMS_PER_JOINT, Robot};
@@ -184,7 +184,7 @@ pub(super) fn build_entry(
     // Hand-eye: the twist covariance carried through the Jacobians.
     let (jt, jr) = hand_eye_jacobians(&he_iso.rotation);
     let has_cov = info.covariance.is_some();
-    for (i, name) in HAND_EYE_NAMES.iter().enumerate() {
+    for (i, name) in hand_eye_names(result.mount()).iter().enumerate() {
         let block = twist_block(i);
         let (jac, row) = if i < 3 { (&jt, i) } else { (&jr, i - 3) };
         let statuses: Vec<Status> = coupled_twist(&he_iso.rotation, i)
@@ -268,6 +268,7 @@ pub(super) fn build_entry(
         validation_after: validation.map(|v| v.after),
         within_station_before: validation.map(|v| v.within_station.before),
         within_station_after: validation.map(|v| v.within_station.after),
+        mount: result.mount(),
         hand_eye,
         hand_eye_initial,
         nominal,

@@ -123,6 +123,7 @@ use nalgebra::{Isometry3, UnitQuaternion};
 
 use crate::engine::base::geometry::rotation_from_rpy_deg;
 use crate::engine::base::robot::Joint;
+pub use crate::engine::base::session::Mount;
 use crate::engine::calibrate::validate::Stats;
 use crate::engine::tools::result_view::HandEyeView;
 
@@ -151,6 +152,48 @@ pub const HAND_EYE_NAMES: [&str; 6] = [
     "hand_eye.pitch",
     "hand_eye.yaw",
 ];
+/// The six values of a fixed sensor's `base_from_sensor` (`bT_s`: mm in
+/// the base frame, roll, pitch, yaw in deg), what [`HAND_EYE_NAMES`] are
+/// for a sensor on the flange.
+pub const BASE_FROM_SENSOR_NAMES: [&str; 6] = [
+    "base_from_sensor.x",
+    "base_from_sensor.y",
+    "base_from_sensor.z",
+    "base_from_sensor.roll",
+    "base_from_sensor.pitch",
+    "base_from_sensor.yaw",
+];
+
+/// The names of the six sensor values of a result of `mount`: the
+/// hand-eye's for a sensor on the flange, `base_from_sensor`'s for a
+/// fixed sensor.
+#[must_use]
+pub fn hand_eye_names(mount: Mount) -> [&'static str; 6] {
+    match mount {
+        Mount::Flange => HAND_EYE_NAMES,
+        Mount::Fixed => BASE_FROM_SENSOR_NAMES,
+    }
+}
+
+/// What the six sensor values of results of `mounts` are called: the
+/// hand-eye (sensors on the flange), `base_from_sensor` (fixed sensors),
+/// or both named when they mix.
+#[must_use]
+pub fn sensor_name(mounts: impl IntoIterator<Item = Mount>) -> &'static str {
+    let (mut flange, mut fixed) = (false, false);
+    for m in mounts {
+        match m {
+            Mount::Flange => flange = true,
+            Mount::Fixed => fixed = true,
+        }
+    }
+    match (flange, fixed) {
+        (true, true) => "hand-eye or base_from_sensor",
+        (false, true) => "base_from_sensor",
+        _ => "hand-eye",
+    }
+}
+
 /// Step of the central differences of roll, pitch and yaw with respect to
 /// the hand-eye rotation twist, deg: small against the curvature, large
 /// against rounding (error ~1e-9 relative).
@@ -405,7 +448,10 @@ pub struct Entry {
     pub within_station_before: Option<Stats>,
     /// Within-station distances of the validate stations, after, mm.
     pub within_station_after: Option<Stats>,
-    /// The calibrated hand-eye.
+    /// Where the sensor stood: says whether [`Entry::hand_eye`] is the
+    /// hand-eye `eT_s` or a fixed sensor's `base_from_sensor` `bT_s`.
+    pub mount: Mount,
+    /// The calibrated hand-eye (`bT_s` for a fixed sensor).
     pub hand_eye: HandEye,
     /// The initial hand-eye (before identification).
     pub hand_eye_initial: HandEye,
@@ -570,6 +616,21 @@ mod tests {
     use super::entry::{hand_eye_jacobians, roll_pitch_yaw_deg};
     use super::walk::result_stem;
     use super::*;
+
+    #[test]
+    fn the_sensor_values_are_named_by_mount() {
+        assert_eq!(hand_eye_names(Mount::Flange)[0], "hand_eye.x");
+        assert_eq!(hand_eye_names(Mount::Fixed)[5], "base_from_sensor.yaw");
+        assert_eq!(sensor_name([Mount::Flange, Mount::Flange]), "hand-eye");
+        assert_eq!(sensor_name([Mount::Fixed]), "base_from_sensor");
+        assert_eq!(
+            sensor_name([Mount::Fixed, Mount::Flange]),
+            "hand-eye or base_from_sensor"
+        );
+        assert_eq!(sensor_name([]), "hand-eye");
+        assert_eq!(SeriesKind::HandEye.label(Mount::Fixed), "base from sensor");
+        assert_eq!(SeriesKind::HandEye.label(Mount::Flange), "hand-eye");
+    }
     use crate::engine::base::geometry::wrap_deg;
 
     #[test]
