@@ -13,5 +13,6 @@ mod measure;
 mod range;
 mod save_as;
 mod scene;
+mod tabs;
 mod trust;
 mod workbench;

@@ -493,7 +493,8 @@ pub fn tabs_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mu
         }
         // The session's name at the right, cut with … where it would come
         // nearer the last tab than a gap (a long name touched "History").
-        let room = (ui.available_width() - TABS_GAP).max(0.0);
+        ui.add_space(TABS_GAP);
+        let room = (ui.available_width() - ui.spacing().item_spacing.x).max(0.0);
         let size = egui::vec2(room, ui.spacing().interact_size.y);
         let layout = egui::Layout::right_to_left(egui::Align::Center);
         ui.allocate_ui_with_layout(size, layout, |ui| {
