@@ -734,12 +734,7 @@ impl Core {
             self.state.prefs.remember(p);
             self.forms.open_path = p.display().to_string();
         }
-        let dir = loaded
-            .source
-            .folder()
-            .map(Path::to_path_buf)
-            .or_else(|| std::env::current_dir().ok())
-            .unwrap_or_default();
+        let dir = loaded.source.save_folder();
         let file_name = match loaded.source {
             Source::Imported(_) => format!("{}.json", loaded.source.stem()),
             _ => format!("{}-edited.json", loaded.source.stem()),

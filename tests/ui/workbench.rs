@@ -484,7 +484,7 @@ fn clicking_a_centre_in_the_3d_view_selects_its_measurement() {
 
 /// Writes the demo session's poses as a KUKA-style joint log (`Pose`,
 /// `Sphere`, `Use`, `Side`, `A1`..`A6`) and one profile CSV per pose.
-fn write_import_files(dir: &Path) -> spherecal::engine::base::session::Session {
+pub(super) fn write_import_files(dir: &Path) -> spherecal::engine::base::session::Session {
     use std::fmt::Write as _;
     let session = parse_session(
         spherecal::DEMO_SESSION_JSON,

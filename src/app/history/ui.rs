@@ -13,7 +13,9 @@ use crate::app::command::{Command, HistoryCommand};
 use crate::app::dialog::Purpose;
 use crate::app::job::Slot;
 use crate::app::widgets::plots::{DATE_LABEL_GAP, labelled_x, readable_y};
-use crate::app::widgets::{AFTER, BAD, MUTED, WARN, labelled_field};
+use crate::app::widgets::{
+    AFTER, BAD, MUTED, WARN, coloured, command_button, labelled_drag, labelled_field, table, weak,
+};
 use crate::engine::tools::history::{Drift, Entry, Library, Mount, Series, Verdict};
 
 /// Height of one drift plot, points.
@@ -48,13 +50,9 @@ pub fn history_ui(
                 );
                 let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
                 let busy = state.jobs.runs(&Slot::Library);
-                if ui
-                    .add_enabled(!state.jobs.runs(&Slot::Dialog), egui::Button::new("Browse…"))
-                    .on_hover_text("choose the folder with the desktop's dialog")
-                    .clicked()
-                {
-                    commands.push(Command::Browse(Purpose::HistoryFolder));
-                }
+                let hover = "choose the folder with the desktop's dialog";
+                let (idle, browse) = (!state.jobs.runs(&Slot::Dialog), Purpose::HistoryFolder);
+                command_button(ui, idle, "Browse…", hover, Command::Browse(browse), commands);
                 if ui
                     .add_enabled(!busy, egui::Button::new("Scan"))
                     .on_hover_text("read every session and result file in the folder and its subfolders")
@@ -70,15 +68,10 @@ pub fn history_ui(
             crate::app::widgets::dialog_note_ui(ui, state, &[Purpose::HistoryFolder]);
             match &state.history.library {
                 None => {
-                    ui.label(
-                        RichText::new(
-                            "Choose a folder of session and result files (e.g. sessions/history) and press Scan.",
-                        )
-                        .weak(),
-                    );
+                    weak(ui, "Choose a folder of session and result files (e.g. sessions/history) and press Scan.");
                 }
                 Some(Err(e)) => {
-                    ui.label(RichText::new(format!("Could not scan: {e}")).color(BAD));
+                    coloured(ui, BAD, format!("Could not scan: {e}"));
                 }
                 Some(Ok(library)) => {
                     library_ui(ui, library, forms);
@@ -94,9 +87,7 @@ pub fn history_ui(
                     {
                         match drift {
                             Ok(d) => drift_ui(ui, d, of),
-                            Err(e) => {
-                                ui.label(RichText::new(e).color(WARN));
-                            }
+                            Err(e) => drop(coloured(ui, WARN, e)),
                         }
                     }
                 }
@@ -147,16 +138,11 @@ fn library_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) {
             })
             .response
             .labelled_by(l.id);
-        let l = ui.label("Jump beyond");
-        ui.add(
-            egui::DragValue::new(&mut forms.history.k)
-                .range(0.5..=20.0)
-                .speed(0.05)
-                .max_decimals(2)
-                .suffix(" σ combined"),
-        )
-        .labelled_by(l.id)
-        .on_hover_text("flag a change between consecutive results larger than k·sqrt(σ₁² + σ₂²)");
+        let k = egui::DragValue::new(&mut forms.history.k).range(0.5..=20.0);
+        let k = k.speed(0.05).max_decimals(2).suffix(" σ combined");
+        labelled_drag(ui, "Jump beyond", k).on_hover_text(
+            "flag a change between consecutive results larger than k·sqrt(σ₁² + σ₂²)",
+        );
     });
     table_ui(ui, library, forms);
 }
@@ -255,6 +241,12 @@ fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) {
     ui.end_row();
 }
 
+/// The date of the library's result `i` (empty when there is none).
+fn date(library: &Library, i: usize) -> String {
+    let entry = library.entries.get(i);
+    entry.map_or_else(String::new, |e| e.date.to_string())
+}
+
 fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {
     let jumps: Vec<_> = drift.jumps().collect();
     ui.horizontal(|ui| {
@@ -266,10 +258,8 @@ fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {
         ));
     });
     if jumps.is_empty() {
-        ui.label(
-            RichText::new("No jump: every checked change is within its combined uncertainty.")
-                .color(AFTER),
-        );
+        let text = "No jump: every checked change is within its combined uncertainty.";
+        coloured(ui, AFTER, text);
     } else {
         ui.label(
             RichText::new(format!("{} jump(s) flagged", jumps.len()))
@@ -277,42 +267,32 @@ fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {
                 .strong()
                 .size(16.0),
         );
-        egui::Grid::new("history_jumps")
-            .striped(true)
-            .num_columns(6)
-            .show(ui, |ui| {
-                for h in [
-                    "parameter",
-                    "between",
-                    "change",
-                    "combined σ",
-                    "ratio",
-                    "notes",
-                ] {
-                    ui.label(RichText::new(h).strong());
-                }
+        let headers = [
+            "parameter",
+            "between",
+            "change",
+            "combined σ",
+            "ratio",
+            "notes",
+        ];
+        table(ui, "history_jumps", &headers, |ui| {
+            for j in &jumps {
+                let unit = j.unit.as_str();
+                coloured(ui, BAD, &j.parameter);
+                ui.label(format!(
+                    "{} → {}",
+                    date(library, j.from),
+                    date(library, j.to)
+                ));
+                ui.label(format!("{:+.4} {unit}", j.change));
+                ui.label(j.combined.map_or("–".into(), |c| format!("{c:.4} {unit}")));
+                ui.label(j.ratio.map_or("–".into(), |r| format!("{r:.1}")));
+                let notes = j.notes.join("; ");
+                ui.add(egui::Label::new(&notes).truncate())
+                    .on_hover_text(notes);
                 ui.end_row();
-                for j in &jumps {
-                    let date = |i: usize| {
-                        library
-                            .entries
-                            .get(i)
-                            .map_or_else(String::new, |e| e.date.to_string())
-                    };
-                    ui.label(RichText::new(&j.parameter).color(BAD));
-                    ui.label(format!("{} → {}", date(j.from), date(j.to)));
-                    ui.label(format!("{:+.4} {}", j.change, j.unit.as_str()));
-                    ui.label(
-                        j.combined
-                            .map_or("–".into(), |c| format!("{c:.4} {}", j.unit.as_str())),
-                    );
-                    ui.label(j.ratio.map_or("–".into(), |r| format!("{r:.1}")));
-                    let notes = j.notes.join("; ");
-                    ui.add(egui::Label::new(&notes).truncate())
-                        .on_hover_text(notes);
-                    ui.end_row();
-                }
-            });
+            }
+        });
     }
     let unchecked: Vec<_> = drift
         .checks
@@ -335,18 +315,9 @@ fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {
         });
     }
     for note in &drift.notes {
-        ui.label(RichText::new(note).color(WARN));
+        coloured(ui, WARN, note);
     }
-    let dates: Vec<String> = drift
-        .entries
-        .iter()
-        .map(|&i| {
-            library
-                .entries
-                .get(i)
-                .map_or_else(String::new, |e| e.date.to_string())
-        })
-        .collect();
+    let dates: Vec<String> = drift.entries.iter().map(|&i| date(library, i)).collect();
     ui.label(
         RichText::new("Each plot: the value per result in date order, bars ±1σ; a red segment is a flagged jump. Kinematic values are calibrated − the earliest result's nominal.")
             .small()

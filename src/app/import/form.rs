@@ -200,23 +200,12 @@ impl Default for ImportForm {
 }
 
 impl ImportForm {
-    /// The profiles' source, format and the sphere check shared by both
-    /// kinds of log.
-    fn profile_choices(&self) -> Result<(ProfileSource, ProfileFormat), String> {
-        if self.profiles.trim().is_empty() {
+    /// The profiles' source and format, shared by both kinds of log;
+    /// unless `chosen`, an empty path when none is chosen (the preview).
+    fn profile_choices(&self, chosen: bool) -> Result<(ProfileSource, ProfileFormat), String> {
+        if chosen && self.profiles.trim().is_empty() {
             return Err("choose the stripe profiles (a folder or one file) first".into());
         }
-        if !(self.sphere_diameter.is_finite() && self.sphere_diameter > 0.0) {
-            return Err(format!(
-                "the sphere diameter {} mm is not positive",
-                self.sphere_diameter
-            ));
-        }
-        self.profile_choices_unchecked()
-    }
-
-    /// The profiles' source (an empty path when none is chosen) and format.
-    fn profile_choices_unchecked(&self) -> Result<(ProfileSource, ProfileFormat), String> {
         let profiles = self.profiles.trim();
         let source = match self.profiles_kind {
             ProfilesKind::Folder => ProfileSource::Folder(PathBuf::from(profiles)),
@@ -241,6 +230,16 @@ impl ImportForm {
         ))
     }
 
+    /// A sphere diameter that is a positive number of mm, or why not.
+    fn check_diameter(&self) -> Result<(), String> {
+        let d = self.sphere_diameter;
+        if d.is_finite() && d > 0.0 {
+            Ok(())
+        } else {
+            Err(format!("the sphere diameter {d} mm is not positive"))
+        }
+    }
+
     /// The nominal robot: the file (session/result, URDF, DH table) when
     /// one is given, else the preset.
     fn robot_source(&self) -> Result<RobotSource, String> {
@@ -261,7 +260,7 @@ impl ImportForm {
     pub fn pose_spec(&self) -> Result<PoseImportSpec, String> {
         let mut spec = self.pose_preview_spec()?;
         spec.observations = match self.observations {
-            ObservationKind::Profiles => Observations::Profiles(self.profile_choices()?.0),
+            ObservationKind::Profiles => Observations::Profiles(self.profile_choices(true)?.0),
             ObservationKind::Centres => {
                 let centres = self.centres.trim();
                 if centres.is_empty() {
@@ -270,12 +269,7 @@ impl ImportForm {
                 Observations::Centres(PathBuf::from(centres))
             }
         };
-        if !(self.sphere_diameter.is_finite() && self.sphere_diameter > 0.0) {
-            return Err(format!(
-                "the sphere diameter {} mm is not positive",
-                self.sphere_diameter
-            ));
-        }
+        self.check_diameter()?;
         match self.hand_eye {
             HandEyeChoice::Computed => {}
             HandEyeChoice::Numbers => spec.hand_eye = Some(self.typed_hand_eye()?),
@@ -299,7 +293,7 @@ impl ImportForm {
         if poses.is_empty() {
             return Err("choose the pose file first".into());
         }
-        let (source, profile_format) = self.profile_choices_unchecked()?;
+        let (source, profile_format) = self.profile_choices(false)?;
         let name = self.name.trim();
         let references = self.references.trim();
         Ok(PoseImportSpec {
@@ -388,7 +382,8 @@ impl ImportForm {
         if !(self.tolerance_mm > 0.0 && self.tolerance_deg > 0.0) {
             return Err("the flange-check tolerances must be positive".into());
         }
-        let (profiles, profile_format) = self.profile_choices()?;
+        let (profiles, profile_format) = self.profile_choices(true)?;
+        self.check_diameter()?;
         let robot = self.robot_source()?;
         let side = self.side_column.trim();
         let flange = self.flange.map(|convention| {
@@ -443,40 +438,23 @@ impl ImportForm {
                 .find(|h| names.iter().any(|n| h.eq_ignore_ascii_case(n)))
                 .cloned()
         };
-        let words = |list: &[&str]| -> Vec<String> { list.iter().map(|s| (*s).into()).collect() };
         let mut set = 0;
-        let mut assign = |field: &mut String, found: Option<String>| {
-            if let Some(f) = found {
+        let mut assign = |field: &mut String, names: &[String]| {
+            if let Some(f) = find(names) {
                 *field = f;
                 set += 1;
             }
         };
-        assign(
-            &mut self.id_column,
-            find(&words(&["id", "pose", "pose_id", "measurement"])),
-        );
-        assign(
-            &mut self.station_column,
-            find(&words(&["station", "sphere", "station_id"])),
-        );
-        assign(
-            &mut self.use_column,
-            find(&words(&["use", "usage", "group"])),
-        );
-        assign(&mut self.side_column, find(&words(&["side"])));
-        let joints_found: Vec<Option<String>> = (1..=JOINTS)
-            .map(|k| {
-                find(&[
-                    format!("j{k}"),
-                    format!("a{k}"),
-                    format!("joint{k}"),
-                    format!("joint_{k}"),
-                    format!("axis{k}"),
-                ])
-            })
-            .collect();
-        for (slot, found) in self.joint_columns.iter_mut().zip(joints_found) {
-            assign(slot, found);
+        let words = |list: &[&str]| -> Vec<String> { list.iter().map(|s| (*s).into()).collect() };
+        let ids = words(&["id", "pose", "pose_id", "measurement"]);
+        assign(&mut self.id_column, &ids);
+        let stations = words(&["station", "sphere", "station_id"]);
+        assign(&mut self.station_column, &stations);
+        assign(&mut self.use_column, &words(&["use", "usage", "group"]));
+        assign(&mut self.side_column, &words(&["side"]));
+        for (k, slot) in (1..=JOINTS).zip(self.joint_columns.iter_mut()) {
+            let names = ["j", "a", "joint", "joint_", "axis"].map(|p| format!("{p}{k}"));
+            assign(slot, &names);
         }
         set
     }

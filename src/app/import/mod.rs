@@ -88,9 +88,8 @@ impl Core {
             self.observe(ctx);
             stamp = self.state.ledger.stamp(Artefact::ImportView);
         }
-        self.state
-            .ledger
-            .record(Artefact::ImportView, stamp, "the import preview");
+        let what = "the import preview";
+        self.state.ledger.record(Artefact::ImportView, stamp, what);
         self.state.import.header = header;
         match &preview {
             Ok(_) => self
@@ -131,10 +130,8 @@ impl Core {
         job: &Job,
         outcome: Result<Imported, JobError>,
     ) {
-        let what = "the import's outcome";
-        self.state
-            .ledger
-            .record(Artefact::ImportView, job.stamp.clone(), what);
+        let (stamp, what) = (job.stamp.clone(), "the import's outcome");
+        self.state.ledger.record(Artefact::ImportView, stamp, what);
         match outcome {
             Ok(imported) => {
                 let flagged = imported.checks.iter().filter(|c| c.flagged).count();
@@ -142,29 +139,22 @@ impl Core {
                 let refs = imported.loaded.session.reference_distances.len();
                 let mut line = format!("imported {n} measurements and {refs} reference distances");
                 if !imported.checks.is_empty() {
+                    let checked = imported.checks.len();
                     line.push_str(&format!(
-                        "; flange poses: {} checked, {flagged} flagged",
-                        imported.checks.len()
+                        "; flange poses: {checked} checked, {flagged} flagged"
                     ));
                 }
-                let mut outcome = line.clone();
-                for note in &imported.notes {
-                    outcome.push_str(&format!("\n{note}"));
-                }
+                let outcome = [&[line.clone()], &imported.notes[..]].concat().join("\n");
                 self.state.import.checks = imported.checks;
                 self.state.import.outcome = Some(Ok(outcome));
                 self.state.import.guess_needed = None;
                 self.on_session(ctx, *imported.loaded);
-                self.forms.tab = if flagged > 0 {
-                    Tab::Import
+                let (tab, level) = if flagged > 0 {
+                    (Tab::Import, Level::Warning)
                 } else {
-                    Tab::Session
+                    (Tab::Session, Level::Info)
                 };
-                let level = if flagged > 0 {
-                    Level::Warning
-                } else {
-                    Level::Info
-                };
+                self.forms.tab = tab;
                 self.state.say(
                     level,
                     format!("{line}: not saved yet, use Save as… on the Session view"),
@@ -220,10 +210,8 @@ impl Core {
         job: &Job,
         outcome: Result<Box<PosePreview>, JobError>,
     ) {
-        let what = "the pose file's preview";
-        self.state
-            .ledger
-            .record(Artefact::PoseScan, job.stamp.clone(), what);
+        let (stamp, what) = (job.stamp.clone(), "the pose file's preview");
+        self.state.ledger.record(Artefact::PoseScan, stamp, what);
         self.state.import.pose_preview = Some(outcome.map(|p| *p).map_err(|e| e.to_string()));
     }
 }

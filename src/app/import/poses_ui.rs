@@ -15,7 +15,10 @@ use crate::app::command::{Command, ImportCommand};
 use crate::app::dialog::Purpose;
 use crate::app::import::form::{HandEyeChoice, ImportForm, ObservationKind};
 use crate::app::job::Slot;
-use crate::app::widgets::{BAD, GOOD, MUTED, WARN, boxed, path_row, scrolled_text};
+use crate::app::widgets::{
+    BAD, GOOD, MUTED, WARN, boxed, coloured, command_button, form_grid, path_row, scrolled_text,
+    weak,
+};
 use crate::engine::files::import::{FlangeConvention, PairingPreview, PoseFormat, PosePreview};
 
 /// Height of the pairing list, points: a dozen rows, the rest scrolled
@@ -98,25 +101,23 @@ pub fn pose_file_rows(
     ui.end_row();
     // What the layout needs of the convention, once it is known.
     if let Some(p) = preview {
-        match (p.format.convention(), f.pose_convention) {
+        let said = match (p.format.convention(), f.pose_convention) {
             (Some(fixed), None) => {
-                ui.label("");
-                ui.label(RichText::new(format!("the program writes {}", fixed.describe())).weak());
-                ui.end_row();
+                Some(RichText::new(format!("the program writes {}", fixed.describe())).weak())
             }
             (Some(fixed), Some(given)) if fixed != given => {
-                ui.label("");
-                ui.label(
-                    RichText::new(format!(
-                        "a {} writes {}: choose that or \"as the program's language says\"",
-                        p.format.describe(),
-                        fixed.describe()
-                    ))
-                    .color(BAD),
+                let (format, fixed) = (p.format.describe(), fixed.describe());
+                let why = format!(
+                    "a {format} writes {fixed}: choose that or \"as the program's language says\""
                 );
-                ui.end_row();
+                Some(RichText::new(why).color(BAD))
             }
-            _ => {}
+            _ => None,
+        };
+        if let Some(text) = said {
+            ui.label("");
+            ui.label(text);
+            ui.end_row();
         }
     }
     ui.label("The sensor gives");
@@ -159,29 +160,24 @@ pub fn detected_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Comma
         if scanning {
             ui.spinner();
         }
-        if ui
-            .add_enabled(!scanning, egui::Button::new("Read again"))
-            .on_hover_text("read the pose file and list the profiles again (after files changed)")
-            .clicked()
-        {
-            commands.push(Command::Import(ImportCommand::Scan));
-        }
+        let hover = "read the pose file and list the profiles again (after files changed)";
+        let scan = Command::Import(ImportCommand::Scan);
+        command_button(ui, !scanning, "Read again", hover, scan, commands);
     });
     let Some(preview) = &view.pose_preview else {
-        ui.label(
-            RichText::new(
-                "Choose the pose file: its layout is detected and the pairing with the profiles shown here before the import.",
-            )
-            .weak(),
+        weak(
+            ui,
+            "Choose the pose file: its layout is detected and the pairing with the profiles shown here before the import.",
         );
         return;
     };
     let p = match preview {
         Ok(p) => p,
         Err(e) => {
-            ui.label(RichText::new(format!("The pose file cannot be read: {e}")).color(BAD));
-            ui.label(
-                RichText::new("The layout and the convention above change how it is read.").weak(),
+            coloured(ui, BAD, format!("The pose file cannot be read: {e}"));
+            weak(
+                ui,
+                "The layout and the convention above change how it is read.",
             );
             return;
         }
@@ -193,13 +189,11 @@ pub fn detected_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Comma
         "flange poses: a pose-only session (the hand-eye and the sphere centres are calibrated)"
     });
     for w in &p.warnings {
-        ui.label(RichText::new(format!("warning: {w}")).color(WARN));
+        coloured(ui, WARN, format!("warning: {w}"));
     }
     match &p.pairing {
         Ok(pairing) => pairing_ui(ui, p, pairing),
-        Err(why) => {
-            ui.label(RichText::new(format!("Pairing: {why}")).color(MUTED));
-        }
+        Err(why) => drop(coloured(ui, MUTED, format!("Pairing: {why}"))),
     }
 }
 
@@ -225,10 +219,10 @@ fn pairing_ui(ui: &mut egui::Ui, p: &PosePreview, pairing: &PairingPreview) {
         pairing.pairs.len()
     ));
     if let Some(problem) = &pairing.problem {
-        ui.label(RichText::new(problem).color(BAD));
+        coloured(ui, BAD, problem);
     }
     if let Some(w) = &pairing.warning {
-        ui.label(RichText::new(format!("warning: {w}")).color(WARN));
+        coloured(ui, WARN, format!("warning: {w}"));
     }
     if !pairing.pairs.is_empty() {
         let row_height = ui.text_style_height(&egui::TextStyle::Monospace);
@@ -261,16 +255,15 @@ fn pairing_ui(ui: &mut egui::Ui, p: &PosePreview, pairing: &PairingPreview) {
             .iter()
             .filter_map(|&k| p.poses.get(k).map(|(n, l)| format!("{n} (line {l})")))
             .collect();
-        ui.label(RichText::new(format!("poses without a profile: {}", names(&list))).color(BAD));
+        coloured(
+            ui,
+            BAD,
+            format!("poses without a profile: {}", names(&list)),
+        );
     }
     if !pairing.unpaired.is_empty() {
-        ui.label(
-            RichText::new(format!(
-                "profiles without a pose: {}",
-                names(&pairing.unpaired)
-            ))
-            .color(BAD),
-        );
+        let list = names(&pairing.unpaired);
+        coloured(ui, BAD, format!("profiles without a pose: {list}"));
     }
     if !pairing.skipped.is_empty() {
         let list: Vec<String> = pairing
@@ -278,7 +271,7 @@ fn pairing_ui(ui: &mut egui::Ui, p: &PosePreview, pairing: &PairingPreview) {
             .iter()
             .map(|(n, why)| format!("{n} ({why})"))
             .collect();
-        ui.label(RichText::new(format!("skipped: {}", names(&list))).color(MUTED));
+        coloured(ui, MUTED, format!("skipped: {}", names(&list)));
     }
 }
 
@@ -299,11 +292,9 @@ pub fn hand_eye_ui(
         .and_then(|p| p.as_ref().ok());
     if let Some(p) = preview {
         if p.uses_given {
-            ui.label(
-                RichText::new(
-                    "the pose file gives every pose its use: the session's groups start the calibration",
-                )
-                .weak(),
+            weak(
+                ui,
+                "the pose file gives every pose its use: the session's groups start the calibration",
             );
         } else {
             match &p.translation_group {
@@ -312,30 +303,29 @@ pub fn hand_eye_ui(
                         .iter()
                         .filter_map(|&k| p.poses.get(k).map(|(n, _)| n.clone()))
                         .collect();
-                    ui.label(
-                        RichText::new(format!(
-                            "eq. 6-9 can start: {} poses of one orientation (pure translations: {}) and {} others",
-                            group.len(),
-                            names(&list),
-                            p.poses.len() - group.len()
-                        ))
-                        .color(GOOD),
+                    let (n, others) = (group.len(), p.poses.len() - group.len());
+                    let list = names(&list);
+                    coloured(
+                        ui,
+                        GOOD,
+                        format!(
+                            "eq. 6-9 can start: {n} poses of one orientation (pure translations: {list}) and {others} others"
+                        ),
                     );
                 }
                 Some(Err(why)) => {
-                    ui.label(
-                        RichText::new(format!(
+                    coloured(
+                        ui,
+                        WARN,
+                        format!(
                             "No pure-translation group: {why}. The import tries the general solution on all poses at once (it needs orientations turned about two axes); if it cannot, a guess is needed."
-                        ))
-                        .color(WARN),
+                        ),
                     );
                 }
                 None => {
-                    ui.label(
-                        RichText::new(
-                            "joint targets: the groups are judged once the robot places them",
-                        )
-                        .weak(),
+                    weak(
+                        ui,
+                        "joint targets: the groups are judged once the robot places them",
                     );
                 }
             }
@@ -400,20 +390,17 @@ pub fn hand_eye_ui(
             );
         }
         HandEyeChoice::File => {
-            egui::Grid::new("import_hand_eye_file")
-                .num_columns(3)
-                .spacing([8.0, 6.0])
-                .show(ui, |ui| {
-                    path_row(
-                        ui,
-                        "Hand-eye file",
-                        &mut f.hand_eye_file,
-                        "a 4×4 JSON matrix (rows, mm), or a session or result file",
-                        busy,
-                        Purpose::ImportHandEye,
-                        commands,
-                    );
-                });
+            form_grid(ui, "import_hand_eye_file", 3, |ui| {
+                path_row(
+                    ui,
+                    "Hand-eye file",
+                    &mut f.hand_eye_file,
+                    "a 4×4 JSON matrix (rows, mm), or a session or result file",
+                    busy,
+                    Purpose::ImportHandEye,
+                    commands,
+                );
+            });
         }
     }
 }

@@ -18,8 +18,9 @@ use crate::app::dialog::Purpose;
 use crate::app::import::form::{CONVENTIONS, ImportForm, LogKind, ObservationKind, ProfilesKind};
 use crate::app::job::Slot;
 use crate::app::widgets::{
-    BAD, DEFAULT_RANGE, GOOD, PATH_WIDTH, WARN, boxed, choice, labelled_field, path_row, preset_ui,
-    range_fields, range_of, scrolled_text,
+    BAD, DEFAULT_RANGE, GOOD, PATH_WIDTH, WARN, boxed, choice, coloured, command_button, form_grid,
+    labelled_drag, labelled_field, path_row, preset_ui, range_fields, range_of, scrolled_text,
+    table, weak,
 };
 use crate::engine::base::robot::DhConvention;
 use crate::engine::files::import::{AngleUnit, LengthUnit, SideChoice};
@@ -103,46 +104,29 @@ fn actions_ui(
     joints: bool,
     commands: &mut Vec<Command>,
 ) {
+    let import = |c| Command::Import(c);
     ui.horizontal_wrapped(|ui| {
-        let import = ui
-            .add_enabled(
-                !busy,
-                egui::Button::new(RichText::new("Import and open").strong().size(16.0)),
-            )
-            .on_hover_text("build the session and open it (save it with Save as… afterwards)");
-        if import.clicked() {
-            commands.push(Command::Import(ImportCommand::Run));
-        }
+        let text = RichText::new("Import and open").strong().size(16.0);
+        let hover = "build the session and open it (save it with Save as… afterwards)";
+        command_button(ui, !busy, text, hover, import(ImportCommand::Run), commands);
         if joints {
-            if ui
-                .add_enabled(!busy, egui::Button::new("Preview"))
-                .on_hover_text("read the header and show the first rows with this mapping")
-                .clicked()
-            {
-                commands.push(Command::Import(ImportCommand::Preview { guess: false }));
-            }
-            if ui
-                .add_enabled(!busy, egui::Button::new("Guess mapping"))
-                .on_hover_text("fill the column names from the header where they are obvious")
-                .clicked()
-            {
-                commands.push(Command::Import(ImportCommand::Preview { guess: true }));
-            }
+            let hover = "read the header and show the first rows with this mapping";
+            let preview = import(ImportCommand::Preview { guess: false });
+            command_button(ui, !busy, "Preview", hover, preview, commands);
+            let hover = "fill the column names from the header where they are obvious";
+            let guess = import(ImportCommand::Preview { guess: true });
+            command_button(ui, !busy, "Guess mapping", hover, guess, commands);
         }
         if let Some(job) = state.jobs.get(&Slot::Import) {
             crate::app::widgets::job_ui(ui, job);
-            if ui
-                .button("Cancel import")
-                .on_hover_text("stop the import: nothing is opened, what is open stays")
-                .clicked()
-            {
-                commands.push(Command::Import(ImportCommand::Cancel));
-            }
+            let hover = "stop the import: nothing is opened, what is open stays";
+            let cancel = import(ImportCommand::Cancel);
+            command_button(ui, true, "Cancel import", hover, cancel, commands);
         } else if state.jobs.runs(&Slot::ImportPreview) {
             ui.spinner();
         }
         if let Some(Ok(text)) = &state.import.outcome {
-            ui.label(RichText::new(text.lines().next().unwrap_or_default()).color(GOOD));
+            coloured(ui, GOOD, text.lines().next().unwrap_or_default());
         }
     });
     if let Some(Err(e)) = &state.import.outcome {
@@ -177,138 +161,128 @@ fn files_ui(
             "a pose file (robot program or pose table)",
         );
     });
-    egui::Grid::new("import_files")
-        .num_columns(3)
-        .spacing([8.0, 6.0])
-        .show(ui, |ui| {
-            if f.log_kind == LogKind::Joints {
-                path_row(
-                    ui,
-                    "Joint log CSV",
-                    &mut f.joints,
-                    "/path/to/joints.csv",
-                    busy,
-                    Purpose::ImportJoints,
-                    commands,
-                );
-            } else {
-                let preview = state
-                    .import
-                    .pose_preview
-                    .as_ref()
-                    .and_then(|p| p.as_ref().ok());
-                super::poses_ui::pose_file_rows(ui, busy, f, preview, commands);
-                if f.observations == ObservationKind::Profiles {
-                    ui.label("Sphere side");
-                    ui.horizontal(|ui| {
-                        ui.radio_value(&mut f.side, SideChoice::Auto, "decide from the data");
-                        ui.radio_value(&mut f.side, SideChoice::Plus, "+1 (sensor x > 0)");
-                        ui.radio_value(&mut f.side, SideChoice::Minus, "−1");
-                    });
-                    ui.end_row();
-                }
-            }
-            let centres =
-                f.log_kind == LogKind::FlangePoses && f.observations == ObservationKind::Centres;
-            if !centres {
-                let hint = match f.profiles_kind {
-                    ProfilesKind::Folder => {
-                        "/path/to/profiles/ (one file per pose: <id>.csv, .yml …)"
-                    }
-                    ProfilesKind::File => "/path/to/profiles.csv (with a pose column)",
-                };
-                path_row(
-                    ui,
-                    "Stripe profiles",
-                    &mut f.profiles,
-                    hint,
-                    busy,
-                    Purpose::ImportProfiles,
-                    commands,
-                );
-                ui.label("");
+    form_grid(ui, "import_files", 3, |ui| {
+        if f.log_kind == LogKind::Joints {
+            path_row(
+                ui,
+                "Joint log CSV",
+                &mut f.joints,
+                "/path/to/joints.csv",
+                busy,
+                Purpose::ImportJoints,
+                commands,
+            );
+        } else {
+            let preview = state
+                .import
+                .pose_preview
+                .as_ref()
+                .and_then(|p| p.as_ref().ok());
+            super::poses_ui::pose_file_rows(ui, busy, f, preview, commands);
+            if f.observations == ObservationKind::Profiles {
+                ui.label("Sphere side");
                 ui.horizontal(|ui| {
-                    ui.radio_value(
-                        &mut f.profiles_kind,
-                        ProfilesKind::Folder,
-                        "a folder, one file per pose",
-                    );
-                    ui.radio_value(&mut f.profiles_kind, ProfilesKind::File, "one file");
-                    let l = ui.label("pose column");
-                    // Sized, not squeezed by the grid's column.
-                    ui.add_enabled_ui(f.profiles_kind == ProfilesKind::File, |ui| {
-                        ui.add_sized(
-                            [COLUMN_WIDTH, ui.spacing().interact_size.y],
-                            egui::TextEdit::singleline(&mut f.pose_column),
-                        )
-                        .labelled_by(l.id);
-                    });
+                    ui.radio_value(&mut f.side, SideChoice::Auto, "decide from the data");
+                    ui.radio_value(&mut f.side, SideChoice::Plus, "+1 (sensor x > 0)");
+                    ui.radio_value(&mut f.side, SideChoice::Minus, "−1");
                 });
                 ui.end_row();
             }
+        }
+        let centres =
+            f.log_kind == LogKind::FlangePoses && f.observations == ObservationKind::Centres;
+        if !centres {
+            let hint = match f.profiles_kind {
+                ProfilesKind::Folder => "/path/to/profiles/ (one file per pose: <id>.csv, .yml …)",
+                ProfilesKind::File => "/path/to/profiles.csv (with a pose column)",
+            };
             path_row(
                 ui,
-                "Reference distances CSV",
-                &mut f.references,
-                "optional: from,to,distance (mm), from the laser tracker",
+                "Stripe profiles",
+                &mut f.profiles,
+                hint,
                 busy,
-                Purpose::ImportReferences,
+                Purpose::ImportProfiles,
                 commands,
             );
-        });
+            ui.label("");
+            ui.horizontal(|ui| {
+                ui.radio_value(
+                    &mut f.profiles_kind,
+                    ProfilesKind::Folder,
+                    "a folder, one file per pose",
+                );
+                ui.radio_value(&mut f.profiles_kind, ProfilesKind::File, "one file");
+                let l = ui.label("pose column");
+                // Sized, not squeezed by the grid's column.
+                ui.add_enabled_ui(f.profiles_kind == ProfilesKind::File, |ui| {
+                    ui.add_sized(
+                        [COLUMN_WIDTH, ui.spacing().interact_size.y],
+                        egui::TextEdit::singleline(&mut f.pose_column),
+                    )
+                    .labelled_by(l.id);
+                });
+            });
+            ui.end_row();
+        }
+        path_row(
+            ui,
+            "Reference distances CSV",
+            &mut f.references,
+            "optional: from,to,distance (mm), from the laser tracker",
+            busy,
+            Purpose::ImportReferences,
+            commands,
+        );
+    });
 }
 
 fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
     ui.label(RichText::new("2 · Robot, units, sphere").strong());
-    egui::Grid::new("import_robot")
-        .num_columns(2)
-        .spacing([8.0, 6.0])
-        .show(ui, |ui| {
-            let l = ui.label("Nominal robot");
-            ui.horizontal(|ui| {
-                let from_file = !f.robot_file.trim().is_empty();
-                ui.add_enabled_ui(!from_file, |ui| {
-                    preset_ui(ui, "import_robot_preset", &mut f.robot_preset).labelled_by(l.id);
-                });
-                labelled_field(
-                    ui,
-                    "or robot file",
-                    &mut f.robot_file,
-                    "session/result file, URDF or DH table CSV",
-                    260.0,
-                );
-                if f.robot_file.trim().to_ascii_lowercase().ends_with(".csv") {
-                    ui.radio_value(&mut f.dh, DhConvention::Standard, "standard DH");
-                    ui.radio_value(&mut f.dh, DhConvention::Modified, "modified DH");
-                }
+    form_grid(ui, "import_robot", 2, |ui| {
+        let l = ui.label("Nominal robot");
+        ui.horizontal(|ui| {
+            let from_file = !f.robot_file.trim().is_empty();
+            ui.add_enabled_ui(!from_file, |ui| {
+                preset_ui(ui, "import_robot_preset", &mut f.robot_preset).labelled_by(l.id);
             });
-            ui.end_row();
-            if f.log_kind == LogKind::FlangePoses {
-                ui.label("");
-                ui.label(
-                    RichText::new(
-                        "pose-only: no robot model is needed (no kinematic parameter is identified); a robot given here is kept in the session",
-                    )
-                    .weak(),
-                );
-                ui.end_row();
+            labelled_field(
+                ui,
+                "or robot file",
+                &mut f.robot_file,
+                "session/result file, URDF or DH table CSV",
+                260.0,
+            );
+            if f.robot_file.trim().to_ascii_lowercase().ends_with(".csv") {
+                ui.radio_value(&mut f.dh, DhConvention::Standard, "standard DH");
+                ui.radio_value(&mut f.dh, DhConvention::Modified, "modified DH");
             }
-            ui.label("Joint unit");
-            ui.horizontal(|ui| {
-                for u in [AngleUnit::Deg, AngleUnit::Rad] {
-                    ui.radio_value(&mut f.joint_unit, u, u.as_str());
-                }
-            });
+        });
+        ui.end_row();
+        if f.log_kind == LogKind::FlangePoses {
+            ui.label("");
+            weak(
+                ui,
+                "pose-only: no robot model is needed (no kinematic parameter is identified); a robot given here is kept in the session",
+            );
             ui.end_row();
-            ui.label("Profile unit");
-            ui.horizontal(|ui| {
-                for u in [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M] {
-                    ui.radio_value(&mut f.profile_unit, u, u.symbol());
-                }
-            });
-            ui.end_row();
-            let l = ui.label("Profile axes");
-            ui.horizontal(|ui| {
+        }
+        ui.label("Joint unit");
+        ui.horizontal(|ui| {
+            for u in [AngleUnit::Deg, AngleUnit::Rad] {
+                ui.radio_value(&mut f.joint_unit, u, u.as_str());
+            }
+        });
+        ui.end_row();
+        ui.label("Profile unit");
+        ui.horizontal(|ui| {
+            for u in [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M] {
+                ui.radio_value(&mut f.profile_unit, u, u.symbol());
+            }
+        });
+        ui.end_row();
+        let l = ui.label("Profile axes");
+        ui.horizontal(|ui| {
                 ui.add(
                     egui::TextEdit::singleline(&mut f.axes)
                         .hint_text("auto")
@@ -326,17 +300,12 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
                     COLUMN_WIDTH,
                 );
             });
-            ui.end_row();
-            let l = ui.label("Sphere diameter");
-            ui.horizontal(|ui| {
-                ui.add(
-                    egui::DragValue::new(&mut f.sphere_diameter)
-                        .range(1.0..=500.0)
-                        .speed(0.01)
-                        .max_decimals(4)
-                        .suffix(" mm"),
-                )
-                .labelled_by(l.id);
+        ui.end_row();
+        let l = ui.label("Sphere diameter");
+        ui.horizontal(|ui| {
+                let drag = egui::DragValue::new(&mut f.sphere_diameter).range(1.0..=500.0);
+                ui.add(drag.speed(0.01).max_decimals(4).suffix(" mm"))
+                    .labelled_by(l.id);
                 let mut known = f.range.is_some();
                 if ui
                     .checkbox(&mut known, "measuring range known (sensor.range)")
@@ -346,34 +315,29 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
                     f.range = known.then_some(DEFAULT_RANGE);
                 }
             });
+        ui.end_row();
+        if let Some(v) = &mut f.range {
+            ui.label("Measuring range");
+            ui.vertical(|ui| {
+                range_fields(ui, "import_range", v, true);
+                if let Err(why) = range_of(v) {
+                    coloured(ui, BAD, why);
+                }
+            });
             ui.end_row();
-            if let Some(v) = &mut f.range {
-                ui.label("Measuring range");
-                ui.vertical(|ui| {
-                    range_fields(ui, "import_range", v, true);
-                    if let Err(why) = range_of(v) {
-                        ui.label(RichText::new(why).color(BAD));
-                    }
-                });
-                ui.end_row();
-            }
-            let l = ui.label("Session name");
-            ui.add(
-                egui::TextEdit::singleline(&mut f.name)
-                    .hint_text("default: the pose log's file name")
-                    .desired_width(PATH_WIDTH),
-            )
-            .labelled_by(l.id);
-            ui.end_row();
-        });
+        }
+        let hint = "default: the pose log's file name";
+        labelled_field(ui, "Session name", &mut f.name, hint, PATH_WIDTH);
+        ui.end_row();
+    });
 }
 
 fn mapping_ui(ui: &mut egui::Ui, state: &AppState, f: &mut ImportForm) {
     ui.label(RichText::new("3 · Columns of the joint log").strong());
     if state.import.header.is_empty() {
-        ui.label(
-            RichText::new("Preview reads the header; Guess mapping fills the fields from it.")
-                .weak(),
+        weak(
+            ui,
+            "Preview reads the header; Guess mapping fills the fields from it.",
         );
     } else {
         ui.label(format!("Header: {}", state.import.header.join(", ")));
@@ -398,7 +362,11 @@ fn mapping_ui(ui: &mut egui::Ui, state: &AppState, f: &mut ImportForm) {
         .filter(|c| !header.is_empty() && !header.iter().any(|h| h.eq_ignore_ascii_case(c)))
         .collect();
     if !missing.is_empty() {
-        ui.label(RichText::new(format!("not in the header: {}", missing.join(", "))).color(WARN));
+        coloured(
+            ui,
+            WARN,
+            format!("not in the header: {}", missing.join(", ")),
+        );
     }
 }
 
@@ -441,20 +409,10 @@ fn flange_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
                 &c.default_columns().join(","),
                 180.0,
             );
-            let l = ui.label("tolerance");
-            ui.add(
-                egui::DragValue::new(&mut f.tolerance_mm)
-                    .range(0.01..=100.0)
-                    .speed(0.05)
-                    .suffix(" mm"),
-            )
-            .labelled_by(l.id);
-            ui.add(
-                egui::DragValue::new(&mut f.tolerance_deg)
-                    .range(0.01..=45.0)
-                    .speed(0.01)
-                    .suffix(" deg"),
-            );
+            let mm = egui::DragValue::new(&mut f.tolerance_mm).range(0.01..=100.0);
+            labelled_drag(ui, "tolerance", mm.speed(0.05).suffix(" mm"));
+            let deg = egui::DragValue::new(&mut f.tolerance_deg).range(0.01..=45.0);
+            ui.add(deg.speed(0.01).suffix(" deg"));
         }
     });
 }
@@ -471,7 +429,7 @@ fn preview_ui(ui: &mut egui::Ui, state: &AppState) {
                     });
             }
             Err(e) => {
-                ui.label(RichText::new(format!("Preview failed: {e}")).color(BAD));
+                coloured(ui, BAD, format!("Preview failed: {e}"));
             }
         }
     }
@@ -514,20 +472,14 @@ fn outcome_ui(ui: &mut egui::Ui, state: &AppState) {
     if flagged.is_empty() {
         return;
     }
-    egui::Grid::new("import_flagged")
-        .striped(true)
-        .num_columns(4)
-        .show(ui, |ui| {
-            for h in ["pose", "position (mm)", "rotation (deg)", "likely cause"] {
-                ui.label(RichText::new(h).strong());
-            }
+    let headers = ["pose", "position (mm)", "rotation (deg)", "likely cause"];
+    table(ui, "import_flagged", &headers, |ui| {
+        for c in flagged {
+            coloured(ui, WARN, &c.id);
+            ui.label(format!("{:.3}", c.position_error_mm));
+            ui.label(format!("{:.3}", c.rotation_error_deg));
+            ui.label(&c.hint);
             ui.end_row();
-            for c in flagged {
-                ui.label(RichText::new(&c.id).color(WARN));
-                ui.label(format!("{:.3}", c.position_error_mm));
-                ui.label(format!("{:.3}", c.rotation_error_deg));
-                ui.label(&c.hint);
-                ui.end_row();
-            }
-        });
+        }
+    });
 }

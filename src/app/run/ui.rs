@@ -7,7 +7,7 @@ use egui::{RichText, Vec2};
 use crate::app::command::{Command, RunCommand};
 use crate::app::job::Slot;
 use crate::app::ledger::Artefact;
-use crate::app::widgets::{BAD, choice, plots::epsilon_plot_ui};
+use crate::app::widgets::{BAD, WARN, choice, form_grid, labelled_drag, plots::epsilon_plot_ui};
 use crate::app::{AppState, Forms};
 use crate::engine::calibrate::solve::Method;
 use crate::engine::calibrate::solve::paper::Pairing;
@@ -31,23 +31,18 @@ pub fn solver_ui(
     // failing measurements are left out: the run reports what fails.
     let can_run = !running && state.loaded.is_some();
     ui.horizontal(|ui| {
-        let run = ui.add_enabled(
-            can_run,
-            egui::Button::new(RichText::new("▶ Run").size(18.0).strong())
-                .min_size(Vec2::new(110.0, 32.0)),
-        );
-        if run
-            .on_hover_text("calibrate the session with these settings")
-            .clicked()
-        {
+        let text = RichText::new("▶ Run").size(18.0).strong();
+        let run = egui::Button::new(text).min_size(Vec2::new(110.0, 32.0));
+        let hover = "calibrate the session with these settings";
+        if ui.add_enabled(can_run, run).on_hover_text(hover).clicked() {
             commands.push(Command::Run(RunCommand::Start));
         }
-        let cancel = ui.add_enabled(
-            running,
-            egui::Button::new(RichText::new("Cancel").size(16.0)).min_size(Vec2::new(80.0, 32.0)),
-        );
-        if cancel
-            .on_hover_text("stop the run now: the result on show stays")
+        let text = RichText::new("Cancel").size(16.0);
+        let cancel = egui::Button::new(text).min_size(Vec2::new(80.0, 32.0));
+        let hover = "stop the run now: the result on show stays";
+        if ui
+            .add_enabled(running, cancel)
+            .on_hover_text(hover)
             .clicked()
         {
             commands.push(Command::Run(RunCommand::Cancel));
@@ -56,13 +51,8 @@ pub fn solver_ui(
     if let Some(l) = &state.loaded
         && let Err(e) = &l.before
     {
-        ui.label(
-            RichText::new(format!(
-                "the whole session cannot be prepared: {e}; leave out what fails"
-            ))
-            .color(BAD)
-            .small(),
-        );
+        let why = format!("the whole session cannot be prepared: {e}; leave out what fails");
+        ui.label(RichText::new(why).color(BAD).small());
     }
     let excluded = state.excluded_count();
     if excluded > 0 && !running {
@@ -73,14 +63,12 @@ pub fn solver_ui(
         // never sits still without saying what the run is doing.
         ui.horizontal(|ui| {
             ui.spinner();
-            let text = {
-                match run.series.last() {
-                    Some(eps) if run.phase.starts_with("update") && !run.phase.contains(':') => {
-                        let most = forms.solver.max_iterations;
-                        format!("{} of ≤ {most}: ε = {eps:.4} mm", run.phase)
-                    }
-                    _ => run.phase.clone(),
+            let text = match run.series.last() {
+                Some(eps) if run.phase.starts_with("update") && !run.phase.contains(':') => {
+                    let most = forms.solver.max_iterations;
+                    format!("{} of ≤ {most}: ε = {eps:.4} mm", run.phase)
                 }
+                _ => run.phase.clone(),
             };
             ui.add(egui::Label::new(text).wrap());
         });
@@ -95,13 +83,10 @@ pub fn solver_ui(
         );
     } else if let Some(result) = &state.result {
         match state.ledger.stale(Artefact::Result) {
-            Some(s) => ui
-                .label(
-                    RichText::new("ε of the result on show (stale)")
-                        .small()
-                        .color(crate::app::widgets::WARN),
-                )
-                .on_hover_text(s.to_string()),
+            Some(s) => {
+                let text = RichText::new("ε of the result on show (stale)").small();
+                ui.label(text.color(WARN)).on_hover_text(s.to_string())
+            }
             None => ui.label(RichText::new("ε of the result on show").small().weak()),
         };
         epsilon_plot_ui(
@@ -120,17 +105,14 @@ pub fn solver_ui(
 /// Method, pairing, threshold, iteration bound, SVD tolerance.
 fn settings_ui(ui: &mut egui::Ui, forms: &mut Forms) {
     let s = &mut forms.solver;
-    egui::Grid::new("solver_settings")
-        .num_columns(2)
-        .spacing([8.0, 6.0])
-        .show(ui, |ui| {
-            let methods = Method::ALL.map(|m| (m, m.as_str().to_string()));
-            choice(ui, "Method", "method", &mut s.method, methods)
-                .on_hover_text("identification method");
-            ui.end_row();
-            let paper = s.method == Method::Paper;
-            ui.label("Pairs");
-            ui.add_enabled_ui(paper, |ui| {
+    form_grid(ui, "solver_settings", 2, |ui| {
+        let methods = Method::ALL.map(|m| (m, m.as_str().to_string()));
+        choice(ui, "Method", "method", &mut s.method, methods)
+            .on_hover_text("identification method");
+        ui.end_row();
+        let paper = s.method == Method::Paper;
+        ui.label("Pairs");
+        ui.add_enabled_ui(paper, |ui| {
                 egui::ComboBox::from_id_salt("pairing")
                     .selected_text(s.pairing.as_str())
                     .show_ui(ui, |ui| {
@@ -142,34 +124,28 @@ fn settings_ui(ui: &mut egui::Ui, forms: &mut Forms) {
                     .on_hover_text("pairs of a station's measurements: disjoint (1,2),(3,4),… as in the paper, or all")
                     .on_disabled_hover_text("used by the paper's method only");
             });
-            ui.end_row();
-            let l = ui.label("Threshold");
-            ui.add(
-                egui::DragValue::new(&mut s.threshold)
-                    .range(0.0..=10.0)
-                    .speed(0.001)
-                    .max_decimals(4)
-                    .suffix(" mm"),
-            )
-            .labelled_by(l.id)
-            .on_hover_text("stop when ε falls to this");
-            ui.end_row();
-            let l = ui.label("Max iterations");
-            ui.add(egui::DragValue::new(&mut s.max_iterations).range(1..=500).speed(0.2))
-                .labelled_by(l.id);
-            ui.end_row();
-            let l = ui.label("SVD tolerance");
-            ui.add_enabled(
-                paper,
-                egui::DragValue::new(&mut s.svd_tolerance)
-                    .range(1e-12..=0.5)
-                    .speed(1e-5)
-                    .custom_formatter(|v, _| format!("{v:.1e}"))
-                    .custom_parser(|t| t.trim().parse::<f64>().ok()),
-            )
-            .labelled_by(l.id)
-            .on_hover_text("singular values below this fraction of the largest are dropped (truncated SVD)")
-            .on_disabled_hover_text("used by the paper's method only");
-            ui.end_row();
-        });
+        ui.end_row();
+        let threshold = egui::DragValue::new(&mut s.threshold).range(0.0..=10.0);
+        let threshold = threshold.speed(0.001).max_decimals(4).suffix(" mm");
+        labelled_drag(ui, "Threshold", threshold).on_hover_text("stop when ε falls to this");
+        ui.end_row();
+        let most = egui::DragValue::new(&mut s.max_iterations).range(1..=500);
+        labelled_drag(ui, "Max iterations", most.speed(0.2));
+        ui.end_row();
+        let l = ui.label("SVD tolerance");
+        ui.add_enabled(
+            paper,
+            egui::DragValue::new(&mut s.svd_tolerance)
+                .range(1e-12..=0.5)
+                .speed(1e-5)
+                .custom_formatter(|v, _| format!("{v:.1e}"))
+                .custom_parser(|t| t.trim().parse::<f64>().ok()),
+        )
+        .labelled_by(l.id)
+        .on_hover_text(
+            "singular values below this fraction of the largest are dropped (truncated SVD)",
+        )
+        .on_disabled_hover_text("used by the paper's method only");
+        ui.end_row();
+    });
 }

@@ -17,8 +17,8 @@ use crate::engine::base::session::{ExcludeError, SensorRange, Session, exclude_m
 use crate::engine::calibrate::solve::{self, Analysis, SolveError, estimate::Estimate};
 use crate::engine::calibrate::stripe::{StripeError, StripeResult};
 use crate::engine::files::format::{
-    Cap, FileError, RESULT_FORMAT, ResultFile, parse_result, parse_session, read_text,
-    session_to_json, write_atomic,
+    Cap, FileError, RESULT_FORMAT, ResultFile, can_write_in, parse_result, parse_session,
+    read_text, session_to_json, write_atomic,
 };
 
 use super::command::{Command, FilesCommand, Tab, ViewCommand};
@@ -60,6 +60,23 @@ impl Source {
             Self::Demo | Self::Simulated => None,
             Self::File(p) | Self::Imported(p) => p.parent(),
         }
+    }
+
+    /// The folder Save as proposes: [`Self::folder`] when a file can be
+    /// written there, else the current folder, else the user's home (an
+    /// import from a read-only folder proposed a file that could not be
+    /// written there).
+    #[must_use]
+    pub fn save_folder(&self) -> PathBuf {
+        let current = std::env::current_dir().ok();
+        let candidates = [self.folder().map(Path::to_path_buf), current.clone()];
+        candidates
+            .into_iter()
+            .chain([std::env::home_dir()])
+            .flatten()
+            .find(|d| can_write_in(d))
+            .or(current)
+            .unwrap_or_default()
     }
 
     /// A short name for people: the file name, or the demo's.
@@ -596,17 +613,8 @@ impl Core {
             .state
             .selected
             .and_then(|s| rows.iter().position(|&r| r == s));
-        let next = match pos {
-            None => 0,
-            Some(p) => {
-                let last = rows.len() - 1;
-                if delta < 0 {
-                    p.saturating_sub(delta.unsigned_abs() as usize)
-                } else {
-                    (p + delta.unsigned_abs() as usize).min(last)
-                }
-            }
-        };
+        let last = rows.len() - 1;
+        let next = pos.map_or(0, |p| p.saturating_add_signed(delta as isize).min(last));
         self.state.selected = Some(rows[next]);
     }
 

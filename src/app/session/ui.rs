@@ -12,7 +12,8 @@ use crate::app::command::{Command, FilesCommand, ViewCommand};
 use crate::app::dialog::{NO_DIALOG, Purpose};
 use crate::app::job::Slot;
 use crate::app::widgets::{
-    BAD, DEFAULT_RANGE, MUTED, WARN, choice, labelled_field, range_fields, range_of, range_values,
+    BAD, DEFAULT_RANGE, MUTED, WARN, choice, coloured, command_button, labelled_field,
+    range_fields, range_of, range_values, weak,
 };
 use crate::app::{AppState, Forms};
 use crate::engine::base::session::Use;
@@ -47,14 +48,9 @@ pub fn session_ui(
             if stations == 1 { "" } else { "s" }
         ));
         if excluded > 0 {
-            ui.label(
-                RichText::new(format!(
-                    "{excluded} left out: the solver skips them; the opened file is unchanged until you save a copy."
-                ))
-                .color(WARN),
-            );
+            coloured(ui, WARN, format!("{excluded} left out: the solver skips them; the opened file is unchanged until you save a copy."));
         } else {
-            ui.label(RichText::new("Untick a measurement to leave it out of the solver.").weak());
+            weak(ui, "Untick a measurement to leave it out of the solver.");
         }
     });
     range_ui(ui, loaded, forms, commands);
@@ -119,42 +115,23 @@ fn range_ui(
         }
         let parsed = range_of(&edit);
         let differs = parsed.ok() != current;
-        if ui
-            .add_enabled(parsed.is_ok() && differs, egui::Button::new("Set range"))
-            .on_hover_text("keep this range with the session (saved with it); run again to predict the error over it")
-            .clicked()
-            && let Ok(r) = parsed
-        {
-            commands.push(Command::View(ViewCommand::SetSensorRange(Some(r))));
+        let set = |r| Command::View(ViewCommand::SetSensorRange(r));
+        let hover = "keep this range with the session (saved with it); run again to predict the error over it";
+        let enabled = parsed.is_ok() && differs;
+        command_button(ui, enabled, "Set range", hover, set(parsed.ok()), commands);
+        if current.is_some() {
+            let hover = "forget the range: the error is then predicted where the sphere was seen";
+            command_button(ui, true, "Clear", hover, set(None), commands);
         }
-        if current.is_some()
-            && ui
-                .button("Clear")
-                .on_hover_text("forget the range: the error is then predicted where the sphere was seen")
-                .clicked()
-        {
-            commands.push(Command::View(ViewCommand::SetSensorRange(None)));
-        }
-        match (&parsed, current) {
-            (Err(why), _) => {
-                ui.label(RichText::new(*why).color(BAD));
-            }
+        let (colour, text) = match (&parsed, current) {
+            (Err(why), _) => (BAD, (*why).to_string()),
             (_, Some(r)) => {
-                ui.label(
-                    RichText::new(format!(
-                        "set: y {:.0}…{:.0}, z {:.0}…{:.0} mm",
-                        r.y[0], r.y[1], r.z[0], r.z[1]
-                    ))
-                    .color(MUTED),
-                );
+                let [y0, y1, z0, z1] = range_values(&r);
+                (MUTED, format!("set: y {y0:.0}…{y1:.0}, z {z0:.0}…{z1:.0} mm"))
             }
-            (_, None) => {
-                ui.label(
-                    RichText::new("not set: the error is predicted only where the sphere was seen")
-                        .color(WARN),
-                );
-            }
-        }
+            (_, None) => (WARN, "not set: the error is predicted only where the sphere was seen".into()),
+        };
+        coloured(ui, colour, text);
     });
 }
 
@@ -195,13 +172,15 @@ fn filters_ui(
         )
         .labelled_by(search.id)
         .on_hover_text("show only measurements whose id or station contains this text");
-        if ui
-            .button("Use all")
-            .on_hover_text("include every measurement again")
-            .clicked()
-        {
-            commands.push(Command::View(ViewCommand::IncludeAll));
-        }
+        let all = Command::View(ViewCommand::IncludeAll);
+        command_button(
+            ui,
+            true,
+            "Use all",
+            "include every measurement again",
+            all,
+            commands,
+        );
     });
 }
 
@@ -215,13 +194,9 @@ fn save_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
             "/path/to/edited-session.json",
             width,
         );
-        if ui
-            .button("Browse…")
-            .on_hover_text("choose the file with the desktop's dialog")
-            .clicked()
-        {
-            commands.push(Command::Browse(Purpose::SaveSession));
-        }
+        let hover = "choose the file with the desktop's dialog";
+        let browse = Command::Browse(Purpose::SaveSession);
+        command_button(ui, true, "Browse…", hover, browse, commands);
         let save = ui
             .add_enabled(!state.jobs.writing(), egui::Button::new("Save"))
             .on_hover_text("write the session without the left-out measurements (atomic write)");
@@ -397,67 +372,51 @@ fn item_row(
             }));
         }
     });
-    row.col(|ui| {
-        ui.label(dim(m.station.clone()));
-    });
-    row.col(|ui| {
-        ui.label(dim(m.usage.as_str().to_string()));
-    });
-    row.col(|ui| {
-        ui.label(dim(format!("{:+}", m.side)));
-    });
-    row.col(|ui| {
-        ui.label(dim(loaded
-            .points(i)
-            .map_or_else(|| "—".into(), |n| n.to_string())));
-    });
-    let fit = loaded.fit(i);
-    match fit {
+    // A cell of text, and its hover.
+    let mut cell = |text: RichText, hover: Option<String>| {
+        row.col(|ui| {
+            let r = ui.add(egui::Label::new(text).extend());
+            if let Some(h) = hover {
+                r.on_hover_text(h);
+            }
+        });
+    };
+    cell(dim(m.station.clone()), None);
+    cell(dim(m.usage.as_str().to_string()), None);
+    cell(dim(format!("{:+}", m.side)), None);
+    let points = loaded.points(i);
+    cell(
+        dim(points.map_or_else(|| "—".into(), |n| n.to_string())),
+        None,
+    );
+    match loaded.fit(i) {
         Fit::GivenCentre => {
-            row.col(|ui| {
-                ui.label(dim("given centre".into()));
-            });
-            row.col(|ui| {
-                ui.label(dim("—".into()));
-            });
-            row.col(|_| {});
+            cell(dim("given centre".into()), None);
+            cell(dim("—".into()), None);
+            cell(RichText::new(""), None);
         }
         Fit::Failed(e) => {
-            row.col(|ui| {
-                ui.label(RichText::new("fit failed").color(BAD))
-                    .on_hover_text(e.to_string());
-            });
-            row.col(|ui| {
-                ui.label("—");
-            });
-            row.col(|ui| {
-                ui.label(RichText::new(e.to_string()).color(BAD))
-                    .on_hover_text(e.to_string());
-            });
+            cell(RichText::new("fit failed").color(BAD), Some(e.to_string()));
+            cell(RichText::new("—"), None);
+            cell(RichText::new(e.to_string()).color(BAD), Some(e.to_string()));
         }
         Fit::Stripe(s) => {
-            row.col(|ui| {
-                ui.label(dim(format!("{:.4}", s.fit.rms)));
-            });
-            row.col(|ui| {
-                ui.label(dim(format!("{:+.1}", s.sphere.cut_angle_deg)));
-            });
-            row.col(|ui| {
-                if s.warnings.is_empty() {
-                    ui.label(RichText::new("ok").color(Color32::from_rgb(90, 170, 90)));
-                } else {
-                    // Every warning named, in a few words each (the whole
-                    // text on hover and in the Stripe view).
-                    ui.add(
-                        egui::Label::new(RichText::new(warnings_cell(&s.warnings)).color(WARN))
-                            .extend(),
-                    )
-                    .on_hover_text(s.warnings.join("\n"));
-                }
-            });
+            cell(dim(format!("{:.4}", s.fit.rms)), None);
+            cell(dim(format!("{:+.1}", s.sphere.cut_angle_deg)), None);
+            if s.warnings.is_empty() {
+                cell(RichText::new("ok").color(OK_GREEN), None);
+            } else {
+                // Every warning named, in a few words each (the whole
+                // text on hover and in the Stripe view).
+                let text = RichText::new(warnings_cell(&s.warnings)).color(WARN);
+                cell(text, Some(s.warnings.join("\n")));
+            }
         }
     }
 }
+
+/// The colour of a stripe fit without warnings.
+const OK_GREEN: Color32 = Color32::from_rgb(90, 170, 90);
 
 /// Longest tag of a warning without a recognised opening, characters.
 const TAG_CHARS: usize = 32;
@@ -553,29 +512,28 @@ pub fn load_ui(
         .inner;
     let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
     ui.horizontal(|ui| {
+        let open = Command::Files(FilesCommand::OpenPath(forms.open_path.trim().into()));
         if ui
             .button("Open path")
             .on_hover_text("open the file typed above")
             .clicked()
             || entered
         {
-            commands.push(Command::Files(FilesCommand::OpenPath(
-                forms.open_path.trim().into(),
-            )));
+            commands.push(open);
         }
-        let dialog = ui
-            .add_enabled(!state.jobs.runs(&Slot::Dialog), egui::Button::new("Open…"))
-            .on_hover_text("choose a file with the desktop's file dialog");
-        if dialog.clicked() {
-            commands.push(Command::Browse(Purpose::Open));
-        }
-        if ui
-            .button("Demo")
-            .on_hover_text("the demo session built into the program")
-            .clicked()
-        {
-            commands.push(Command::Files(FilesCommand::OpenDemo));
-        }
+        let hover = "choose a file with the desktop's file dialog";
+        let idle = !state.jobs.runs(&Slot::Dialog);
+        command_button(
+            ui,
+            idle,
+            "Open…",
+            hover,
+            Command::Browse(Purpose::Open),
+            commands,
+        );
+        let hover = "the demo session built into the program";
+        let demo = Command::Files(FilesCommand::OpenDemo);
+        command_button(ui, true, "Demo", hover, demo, commands);
     });
     // One line either way: the dialog's note replaces the drop hint.
     let hint = if state.dialog_empty == Some(Purpose::Open) {

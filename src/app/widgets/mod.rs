@@ -107,6 +107,74 @@ pub fn labelled_field(
     .labelled_by(l.id)
 }
 
+/// A button that asks for `command` when clicked, greyed out unless
+/// `enabled`, saying on hover what it does.
+pub fn command_button(
+    ui: &mut egui::Ui,
+    enabled: bool,
+    text: impl Into<egui::WidgetText>,
+    hover: &str,
+    command: Command,
+    commands: &mut Vec<Command>,
+) -> egui::Response {
+    let response = ui.add_enabled(enabled, egui::Button::new(text));
+    let response = response.on_hover_text(hover);
+    if response.clicked() {
+        commands.push(command);
+    }
+    response
+}
+
+/// A line of text in `colour`.
+pub fn coloured(ui: &mut egui::Ui, colour: Color32, text: impl Into<String>) -> egui::Response {
+    ui.label(RichText::new(text).color(colour))
+}
+
+/// A line of weak text (a hint, what to do first).
+pub fn weak(ui: &mut egui::Ui, text: impl Into<String>) -> egui::Response {
+    ui.label(RichText::new(text).weak())
+}
+
+/// A number dragged or typed, after the label `label` tied to it.
+pub fn labelled_drag(ui: &mut egui::Ui, label: &str, drag: egui::DragValue) -> egui::Response {
+    let l = ui.label(label);
+    ui.add(drag).labelled_by(l.id)
+}
+
+/// A form's grid: `columns` columns (label, field, button), spaced alike
+/// in every view.
+pub fn form_grid<R>(
+    ui: &mut egui::Ui,
+    id: &str,
+    columns: usize,
+    add: impl FnOnce(&mut egui::Ui) -> R,
+) -> egui::InnerResponse<R> {
+    egui::Grid::new(id)
+        .num_columns(columns)
+        .spacing([8.0, 6.0])
+        .show(ui, add)
+}
+
+/// A striped table of one row of strong `headers` above the rows `add`
+/// draws (each ended with `ui.end_row()`).
+pub fn table<R>(
+    ui: &mut egui::Ui,
+    id: &str,
+    headers: &[&str],
+    add: impl FnOnce(&mut egui::Ui) -> R,
+) -> egui::InnerResponse<R> {
+    egui::Grid::new(id)
+        .striped(true)
+        .num_columns(headers.len())
+        .show(ui, |ui| {
+            for h in headers {
+                ui.label(RichText::new(*h).strong());
+            }
+            ui.end_row();
+            add(ui)
+        })
+}
+
 /// A drop-down that sets `value` to one of `options` (each with its
 /// text, the chosen one's shown), after the label `label` tied to it
 /// (screen readers and the UI tests find it by that label; none when
@@ -321,13 +389,9 @@ pub fn export_folder_ui(
     commands: &mut Vec<Command>,
 ) {
     labelled_field(ui, label, folder, "/path/to/folder", width);
-    if ui
-        .button("Browse…")
-        .on_hover_text("choose the folder with the desktop's dialog")
-        .clicked()
-    {
-        commands.push(Command::Browse(Purpose::ExportFolder));
-    }
+    let hover = "choose the folder with the desktop's dialog";
+    let browse = Command::Browse(Purpose::ExportFolder);
+    command_button(ui, true, "Browse…", hover, browse, commands);
 }
 
 /// A plot's key on one line above it, each entry in its series' colour
@@ -427,13 +491,24 @@ pub fn tabs_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mu
                 commands.push(Command::View(ViewCommand::ShowTab(tab)));
             }
         }
-        ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+        // The session's name at the right, cut with … where it would come
+        // nearer the last tab than a gap (a long name touched "History").
+        ui.add_space(TABS_GAP);
+        let room = (ui.available_width() - ui.spacing().item_spacing.x).max(0.0);
+        let size = egui::vec2(room, ui.spacing().interact_size.y);
+        let layout = egui::Layout::right_to_left(egui::Align::Center);
+        ui.allocate_ui_with_layout(size, layout, |ui| {
             if let Some(l) = &state.loaded {
-                ui.label(RichText::new(&l.session.name).weak());
+                let name = RichText::new(&l.session.name).weak();
+                ui.add(egui::Label::new(name).truncate())
+                    .on_hover_text(&l.session.name);
             }
         });
     });
 }
+
+/// Least room between the last tab and the session's name, points.
+const TABS_GAP: f32 = 24.0;
 
 /// The question of a write that would replace a file this window did not
 /// write of the same artefact from the same inputs: Replace, or Keep.
@@ -446,12 +521,24 @@ pub fn confirm_ui(ctx: &egui::Context, state: &AppState, commands: &mut Vec<Comm
         ui.label(RichText::new(format!("Replace {}?", c.path.display())).strong());
         ui.add(egui::Label::new(RichText::new(&c.why).color(WARN)).wrap());
         ui.horizontal(|ui| {
-            if ui.button("Replace").clicked() {
-                commands.push(Command::Confirm(true));
-            }
-            if ui.button("Keep the file").clicked() {
-                commands.push(Command::Confirm(false));
-            }
+            let replace = "write the new file over it";
+            command_button(
+                ui,
+                true,
+                "Replace",
+                replace,
+                Command::Confirm(true),
+                commands,
+            );
+            let keep = "write nothing: the file stays as it is";
+            command_button(
+                ui,
+                true,
+                "Keep the file",
+                keep,
+                Command::Confirm(false),
+                commands,
+            );
         });
     });
 }
@@ -461,11 +548,8 @@ pub fn confirm_ui(ctx: &egui::Context, state: &AppState, commands: &mut Vec<Comm
 /// has changed since (what changed on hover).
 pub fn written_ui(ui: &mut egui::Ui, state: &AppState, of: &[Artefact]) {
     let ledger = &state.ledger;
-    let written = ledger.written.iter().rev();
-    let mine: Vec<_> = written
-        .filter(|w| of.contains(&w.from))
-        .take(WRITTEN_SHOWN)
-        .collect();
+    let written = ledger.written.iter().rev().filter(|w| of.contains(&w.from));
+    let mine: Vec<_> = written.take(WRITTEN_SHOWN).collect();
     if mine.is_empty() {
         return;
     }
@@ -568,23 +652,19 @@ pub fn path_row(
     purpose: Purpose,
     commands: &mut Vec<Command>,
 ) {
-    let l = ui.label(label);
-    ui.add(
-        egui::TextEdit::singleline(text)
-            .hint_text(hint)
-            .desired_width(PATH_WIDTH),
-    )
-    .labelled_by(l.id);
-    if ui
-        .add_enabled(!busy, egui::Button::new("Browse…"))
-        .on_hover_text(format!(
-            "choose the {} with the desktop's dialog",
-            label.to_lowercase()
-        ))
-        .clicked()
-    {
-        commands.push(Command::Browse(purpose));
-    }
+    labelled_field(ui, label, text, hint, PATH_WIDTH);
+    let hover = format!(
+        "choose the {} with the desktop's dialog",
+        label.to_lowercase()
+    );
+    command_button(
+        ui,
+        !busy,
+        "Browse…",
+        &hover,
+        Command::Browse(purpose),
+        commands,
+    );
     ui.end_row();
 }
 

@@ -510,6 +510,22 @@ fn check_target(target: &Path) -> io::Result<()> {
     check_writable(target, &meta)
 }
 
+/// Whether a file can be written into the folder `dir`: it has a write
+/// permission bit (checked on the mode, as [`check_writable`] does, so
+/// that root is told the same as anyone) and an empty temporary file,
+/// named as a write's are, can be created in it (and is removed at once).
+/// Lets a caller propose an output where it can be written.
+#[must_use]
+pub fn can_write_in(dir: &Path) -> bool {
+    let mode = fs::metadata(dir).is_ok_and(|m| m.is_dir() && !m.permissions().readonly());
+    mode && create_temp(dir, std::ffi::OsStr::new("probe")).is_ok_and(|(temp, file)| {
+        drop(file);
+        let _ = fs::remove_file(&temp);
+        forget(&temp);
+        true
+    })
+}
+
 /// Refuses a regular file that is read-only: no write permission bit at
 /// all (checked on the mode, so that root, whom the kernel lets write
 /// anything, is refused too), or not writable by the user running
@@ -817,6 +833,25 @@ mod tests {
         assert_eq!(fs::read_to_string(&target).unwrap(), "keep");
         assert!(check_outputs(&[&target], Folders::Existing).is_err());
         assert_eq!(fs::read_dir(&dir).unwrap().count(), 1, "no temporary file");
+        let _ = fs::remove_dir_all(&dir);
+    }
+
+    /// Issue 34: a folder a file can be written into, and not: read-only
+    /// by its mode (root too), a file, none; the probe leaves nothing.
+    #[cfg(unix)]
+    #[test]
+    fn a_folder_is_writable_or_not() {
+        use std::os::unix::fs::PermissionsExt as _;
+        let dir = tempfile_dir();
+        assert!(can_write_in(&dir));
+        assert_eq!(fs::read_dir(&dir).unwrap().count(), 0, "no probe left");
+        let file = dir.join("a.json");
+        fs::write(&file, "{}").unwrap();
+        assert!(!can_write_in(&file));
+        assert!(!can_write_in(&dir.join("none")));
+        fs::set_permissions(&dir, fs::Permissions::from_mode(0o555)).unwrap();
+        assert!(!can_write_in(&dir));
+        fs::set_permissions(&dir, fs::Permissions::from_mode(0o755)).unwrap();
         let _ = fs::remove_dir_all(&dir);
     }
 

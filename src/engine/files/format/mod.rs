@@ -17,7 +17,7 @@ pub mod stations;
 pub mod transform;
 
 pub use atomic::{
-    Folders, check_outputs, interrupted, refuse_inputs, remove_pending, same_file,
+    Folders, can_write_in, check_outputs, interrupted, refuse_inputs, remove_pending, same_file,
     write_all_atomic, write_atomic, write_atomic_with, written,
 };
 pub use check_record::{
