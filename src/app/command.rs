@@ -247,23 +247,25 @@ impl ExportKind {
     /// The file name for a session stem.
     #[must_use]
     pub fn file_name(self, stem: &str) -> String {
-        match self {
-            Self::ResultJson => format!("{stem}-result.json"),
-            Self::CentresCsv => format!("{stem}-centres.csv"),
-            Self::DistancesCsv => format!("{stem}-distances.csv"),
-            Self::PlotsPng => format!("{stem}-plots.png"),
-            Self::ModelJson => format!("{stem}-model.json"),
-            Self::ModelCsv => format!("{stem}-model.csv"),
-            Self::ModelUrdf => format!("{stem}-model.urdf"),
-            Self::ReportHtml => format!("{stem}-report.html"),
-        }
+        let suffix = match self {
+            Self::ResultJson => "result.json",
+            Self::CentresCsv => "centres.csv",
+            Self::DistancesCsv => "distances.csv",
+            Self::PlotsPng => "plots.png",
+            Self::ModelJson => "model.json",
+            Self::ModelCsv => "model.csv",
+            Self::ModelUrdf => "model.urdf",
+            Self::ReportHtml => "report.html",
+        };
+        format!("{stem}-{suffix}")
     }
 }
 
 /// The central views.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Tab {
     /// The measurement table.
+    #[default]
     Session,
     /// One stripe and its circle.
     Stripe,

@@ -92,6 +92,7 @@ pub struct Job {
     pub stamp: Stamp,
 }
 
+#[derive(Debug)]
 enum Report {
     Progress(String, Option<f64>),
     Point(usize, f64),
@@ -99,6 +100,7 @@ enum Report {
     Lost,
 }
 
+#[derive(Debug)]
 struct Message {
     id: u64,
     report: Report,
@@ -169,6 +171,7 @@ type Answer = (u64, Option<Box<dyn Any + Send>>);
 pub type Finished = (Slot, Job, Option<Box<dyn Any + Send>>);
 
 /// The job table: the slots, the answers arrived, one channel.
+#[derive(Debug)]
 pub struct Jobs {
     running: BTreeMap<Slot, Job>,
     /// Cancelled or replaced jobs whose thread has not ended: what they
@@ -178,16 +181,6 @@ pub struct Jobs {
     started: u64,
     tx: SyncSender<Message>,
     rx: Receiver<Message>,
-}
-
-impl std::fmt::Debug for Jobs {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Jobs")
-            .field("running", &self.running)
-            .field("stopping", &self.stopping)
-            .field("arrived", &self.arrived.len())
-            .finish_non_exhaustive()
-    }
 }
 
 impl Default for Jobs {

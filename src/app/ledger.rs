@@ -109,8 +109,9 @@ impl Reading {
     }
 
     /// What changed from `was` to `self`, in words: each field that
-    /// differs as `field old → new`, or "changed" when only what the
-    /// fields do not show did.
+    /// differs as `field old → new`, or when only what the fields do not
+    /// show did (an edited file under the same name), the first field and
+    /// "contents changed".
     #[must_use]
     pub fn changes_from(&self, was: &Self) -> String {
         let mut parts = Vec::new();
@@ -122,7 +123,10 @@ impl Reading {
             }
         }
         if parts.is_empty() {
-            "changed".to_string()
+            match self.fields.first() {
+                Some((name, now)) => format!("{name} {now}: contents changed"),
+                None => "contents changed".to_string(),
+            }
         } else {
             parts.join(", ")
         }
@@ -445,6 +449,13 @@ impl Ledger {
         }
     }
 
+    /// Forgets the files written of artefacts made from `input` (a new
+    /// session: what was written of the last one is not of this one).
+    pub fn forget_written_of(&mut self, input: Input) {
+        self.written
+            .retain(|w| !w.stamp.made_from.contains_key(&input));
+    }
+
     /// Whether the inputs of a written file read otherwise now.
     #[must_use]
     pub fn written_stale(&self, w: &Written) -> Option<Stale> {
@@ -581,6 +592,6 @@ mod tests {
         let was = Reading::new(vec![("session".into(), "demo".into())], 1);
         let now = Reading::new(vec![("session".into(), "demo".into())], 2);
         assert_ne!(was.fingerprint, now.fingerprint);
-        assert_eq!(now.changes_from(&was), "changed");
+        assert_eq!(now.changes_from(&was), "session demo: contents changed");
     }
 }

@@ -251,7 +251,7 @@ impl AppState {
 
 /// Fields the widgets edit in place: text fields, filters, settings of
 /// the next run, view options.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Forms {
     /// The current tab.
     pub tab: Tab,
@@ -296,33 +296,6 @@ pub struct Forms {
     pub measure: measure::MeasureForm,
     /// How the 3-D scenes are looked at, one camera a view.
     pub scene: scene::SceneCameras,
-}
-
-impl Default for Forms {
-    fn default() -> Self {
-        Self {
-            tab: Tab::Session,
-            open_path: String::new(),
-            save_path: String::new(),
-            export_dir: String::new(),
-            filter_station: None,
-            filter_use: None,
-            group: Grouping::None,
-            filter_problems: false,
-            search: String::new(),
-            range_edit: None,
-            solver: run::SolverForm::default(),
-            centres: results::CentresForm::default(),
-            import: import::form::ImportForm::default(),
-            history: history::HistoryForm::default(),
-            plan: plan::form::PlanForm::default(),
-            tolerance: crate::engine::tools::result_view::Tolerance::default(),
-            focus_after_fail: false,
-            compensate: compensate::form::CompensateForm::default(),
-            measure: measure::MeasureForm::default(),
-            scene: scene::SceneCameras::default(),
-        }
-    }
 }
 
 /// The state (with the job table) and the forms, with every feature's
@@ -778,6 +751,8 @@ impl Core {
         self.state.session_loads += 1;
         self.state.ledger.forget(Artefact::Result);
         self.state.ledger.forget(Artefact::Report);
+        // The files written of the last session are not this one's.
+        self.state.ledger.forget_written_of(Input::Session);
         let (level, text) = opened_line(&loaded);
         self.state.say(level, text);
         if let Ok(set) = &loaded.before {

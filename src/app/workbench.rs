@@ -58,17 +58,14 @@ pub fn install_fonts(ctx: &egui::Context) {
     // and buttons 14 px: readable on a shop-floor screen.
     ctx.all_styles_mut(|style| {
         use egui::{FontFamily, FontId, TextStyle};
-        style.text_styles.insert(
-            TextStyle::Small,
-            FontId::new(12.0, FontFamily::Proportional),
-        );
-        style
-            .text_styles
-            .insert(TextStyle::Body, FontId::new(14.0, FontFamily::Proportional));
-        style.text_styles.insert(
-            TextStyle::Button,
-            FontId::new(14.0, FontFamily::Proportional),
-        );
+        for (text, size) in [
+            (TextStyle::Small, 12.0),
+            (TextStyle::Body, 14.0),
+            (TextStyle::Button, 14.0),
+        ] {
+            let font = FontId::new(size, FontFamily::Proportional);
+            style.text_styles.insert(text, font);
+        }
     });
 }
 

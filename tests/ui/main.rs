@@ -11,6 +11,7 @@ mod held_out;
 mod import_poses;
 mod measure;
 mod range;
+mod results_rows;
 mod save_as;
 mod scene;
 mod scene_views;

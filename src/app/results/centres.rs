@@ -1,18 +1,17 @@
 //! The Centres view: sphere centres in the base frame by station, before
-//! and after calibration, in a 3D view the operator can orbit
-//! ([`orbit`]) and in the three plane projections. Clicking a centre
-//! selects its measurement; hovering one names it.
+//! and after calibration, in the 3-D scene ([`scene`]) and in the three
+//! plane projections. Clicking a centre selects its measurement; hovering
+//! one names it.
 //!
 //! Readable from one station to 3,000 and more: up to [`KEY_FULL_MAX`]
 //! stations each is named in the key above the plots; beyond, the key
 //! collapses to one line (the names are on hover, and in a scrolled list
-//! when opened), the 3D view names only the stations whose labels do not
-//! overlap, the projections' deviations switch from µm to mm when they
+//! when opened), the projections' deviations switch from µm to mm when they
 //! exceed a millimetre, and the view scrolls when the window is short.
 //! Markers are drawn as one series per station style (80 styles), not
 //! per station, so 20,000 centres draw in a frame.
 
-pub mod orbit;
+pub mod scene;
 
 use egui::{RichText, Vec2};
 use egui_plot::{MarkerShape, Plot, PlotPoints, Points};
@@ -21,13 +20,11 @@ use crate::app::AppState;
 use crate::app::command::{Command, ViewCommand};
 use crate::app::ledger::Artefact;
 use crate::app::results::CentreSet;
+use crate::app::scene::ui::scene_ui;
 use crate::app::widgets::plots::readable;
 use crate::app::widgets::station_style;
-use crate::app::{
-    Forms,
-    results::{Camera, CentresForm},
-};
-pub use orbit::{ORBIT_LABEL, length_text, orbit_positions, scale_bar};
+use crate::app::{Forms, results::CentresForm};
+pub use scene::{ORBIT_LABEL, orbit_positions};
 
 /// A click selects the nearest centre within this many points of the pointer.
 const PICK_RADIUS: f32 = 10.0;
@@ -51,6 +48,9 @@ pub const PROJECTION_MIN_HEIGHT: f32 = 150.0;
 
 /// Height of a projection's caption, points.
 const CAPTION_HEIGHT: f32 = 22.0;
+
+/// Height of the scene widget's row of buttons, points.
+const SCENE_BUTTONS_HEIGHT: f32 = 24.0;
 
 /// Room around the data of a projection, points: the selection ring
 /// (radius 8) stays whole at the edge.
@@ -124,7 +124,7 @@ pub fn centres_ui(
         });
 }
 
-/// The 3D view beside the three projections, `height` points tall.
+/// The 3-D view beside the three projections, `height` points tall.
 fn plots_ui(
     ui: &mut egui::Ui,
     state: &AppState,
@@ -147,22 +147,18 @@ fn plots_ui(
         ui.vertical(|ui| {
             ui.set_width(w3d);
             let frame = centres_frame(state);
-            ui.label(
-                RichText::new(format!(
-                    "3D, {frame} (drag to orbit, scroll to zoom, click to select, hover to name)"
-                ))
-                .small()
-                .weak(),
-            );
-            if let Some(i) = orbit::orbit_ui(
-                ui,
-                Vec2::new(w3d, height - CAPTION_HEIGHT),
-                &markers,
-                set,
-                &mut forms.centres.camera,
-                selected,
-                magnify,
-            ) {
+            let scene = scene::centres_scene(set, &markers, selected);
+            let caption = match magnify {
+                Some(k) => format!(
+                    "3D, {frame}: deviations ×{k:.0} about each station's mean; before faint, after solid"
+                ),
+                None => format!("3D, {frame}: before faint, after solid"),
+            };
+            let canvas = height - CAPTION_HEIGHT - SCENE_BUTTONS_HEIGHT;
+            let camera = &mut forms.centres.camera;
+            if let Some(i) = scene_ui(ui, scene::ORBIT_ID, camera, &scene, &caption, canvas)
+                .and_then(|k| set.points.get(k)?.index)
+            {
                 commands.push(Command::View(ViewCommand::Select(i)));
             }
         });
@@ -232,9 +228,6 @@ fn options_ui(ui: &mut egui::Ui, f: &mut CentresForm, has_after: bool) {
             )
             .labelled_by(l.id);
         });
-        if ui.button("Reset view").clicked() {
-            f.camera = Camera::default();
-        }
     });
 }
 
@@ -311,7 +304,7 @@ fn placed_markers(
     out
 }
 
-/// The markers of the 3D view: the centres, or in relative mode each
+/// The markers of the 3-D view: the centres, or in relative mode each
 /// centre's deviation from its station's mean magnified about the
 /// station's mean before.
 fn markers(set: &CentreSet, f: &CentresForm) -> Vec<Marker> {
@@ -582,15 +575,7 @@ mod tests {
     }
 
     #[test]
-    fn scale_bar_is_a_round_number_of_micrometres() {
-        // ×250 at 0.5 points per drawn mm: 0.125 points per µm; 60 points
-        // need 480 µm, so 500 µm, 62.5 points.
-        let (um, points) = scale_bar(0.125).unwrap();
-        assert_eq!(um, 500.0);
-        assert!((points - 62.5).abs() < 1e-3);
-        assert!(scale_bar(0.0).is_none());
-        assert_eq!(length_text(um), "500 µm");
-        assert_eq!(length_text(20_000.0), "20 mm");
+    fn a_station_key_is_its_shape_and_name() {
         assert_eq!(station_key(12, "V3"), "■\u{a0}V3");
     }
 }

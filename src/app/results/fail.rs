@@ -53,14 +53,8 @@ pub(super) fn after_fail_ui(
                     "1. Look at the {} measurement(s) the solver flagged as outliers (largest first): inspect the stripe, leave out what is wrong, run again.",
                     outliers.len()
                 ));
-                egui::Grid::new("after_fail_outliers")
-                    .striped(true)
-                    .num_columns(5)
-                    .show(ui, |ui| {
-                        for h in ["measurement", "station", "residual (mm)", "σ", ""] {
-                            ui.strong(h);
-                        }
-                        ui.end_row();
+                let header = ["measurement", "station", "residual (mm)", "σ", ""];
+                super::tables::table(ui, "after_fail_outliers", &header, |ui| {
                         for o in outliers.iter().take(OUTLIERS_SHOWN) {
                             ui.label(&o.measurement);
                             ui.label(&o.station);

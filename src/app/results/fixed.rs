@@ -7,6 +7,7 @@ use egui::RichText;
 use crate::app::results::ResultView;
 use crate::app::widgets::MUTED;
 use crate::engine::base::session::Mount;
+use crate::engine::calibrate::validate::Stats;
 use crate::engine::files::format::stations::prediction_errors;
 
 /// The hand-eye table's title for the result's mount.
@@ -24,22 +25,12 @@ pub(super) fn fixed_ui(ui: &mut egui::Ui, view: &ResultView) {
     }
     ui.add_space(8.0);
     ui.label(RichText::new("Targets on the flange (flange frame, mm)").strong());
-    egui::Grid::new("fixed_targets")
-        .striped(true)
-        .num_columns(4)
-        .show(ui, |ui| {
-            for t in ["target", "x", "y", "z"] {
-                ui.strong(t);
-            }
-            ui.end_row();
-            for st in &view.file.stations {
-                ui.label(&st.id);
-                for v in st.point {
-                    ui.label(format!("{v:.3}"));
-                }
-                ui.end_row();
-            }
-        });
+    super::tables::table(ui, "fixed_targets", &["target", "x", "y", "z"], |ui| {
+        for st in &view.file.stations {
+            let [x, y, z] = st.point.map(|v| format!("{v:.3}"));
+            super::tables::row(ui, [st.id.clone(), x, y, z]);
+        }
+    });
     let errors: Vec<f64> = prediction_errors(&view.file.centres, &view.file.stations)
         .iter()
         .map(|p| p.error)
@@ -47,8 +38,7 @@ pub(super) fn fixed_ui(ui: &mut egui::Ui, view: &ResultView) {
     let text = if errors.is_empty() {
         "No validate measurements: the prediction is not checked.".to_string()
     } else {
-        let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
-        let max = errors.iter().copied().fold(0.0, f64::max);
+        let Stats { rms, max, .. } = Stats::of(&errors);
         format!(
             "Validate poses, predicted point against the measured one (sensor frame): rms {rms:.4} mm, max {max:.4} mm over {} measurements",
             errors.len()

@@ -21,11 +21,8 @@ pub use fail::{MAX_IDENTIFY_STATIONS, more_stations};
 
 use std::path::PathBuf;
 
-use serde_json::Value;
-
 use crate::engine::base::session::Session;
 use crate::engine::files::format::ResultFile;
-use crate::engine::files::format::result::solver_block;
 use crate::engine::tools::result_view::Tolerance;
 
 use super::AppState;
@@ -80,8 +77,6 @@ pub struct ResultView {
     pub estimated: Vec<String>,
     /// What the method says about parameters the data cannot tell apart.
     pub caveats: Vec<String>,
-    /// Every entry of the `solver` block as written (values as compact JSON).
-    pub solver_entries: Vec<(String, String)>,
     /// Base-frame centres before and after.
     pub centres: CentreSet,
     /// Warnings: e.g. the result names another session.
@@ -111,17 +106,6 @@ impl ResultView {
                 .flat_map(|m| &m.strong_correlations)
                 .map(|c| format!("strongly correlated: {c}")),
         );
-        let solver_entries = solver_block(solver)
-            .into_iter()
-            .map(|(k, v)| {
-                let text = match v {
-                    Value::String(t) => t,
-                    other => other.to_string(),
-                };
-                (k, text)
-            })
-            .collect();
-
         let mut notes = Vec::new();
         let ids = session.map(crate::engine::tools::result_view::measurement_index);
         let index_of =
@@ -181,7 +165,6 @@ impl ResultView {
             fixed: solver.fixed().to_vec(),
             estimated: solver.estimated().to_vec(),
             caveats,
-            solver_entries,
             centres: CentreSet::new(points),
             notes,
             hand_eye_only: crate::engine::tools::result_view::hand_eye_only_lines(&file, session),
@@ -190,29 +173,8 @@ impl ResultView {
     }
 }
 
-/// The camera of the 3D centres view (orthographic, orbiting the centres).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Camera {
-    /// Rotation about the base z axis, rad.
-    pub yaw: f32,
-    /// Elevation above the base xy plane, rad.
-    pub pitch: f32,
-    /// Zoom factor (1 = fit all).
-    pub zoom: f32,
-}
-
-impl Default for Camera {
-    fn default() -> Self {
-        Self {
-            yaw: -0.6,
-            pitch: 0.5,
-            zoom: 1.0,
-        }
-    }
-}
-
 /// Display options of the centres view.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct CentresForm {
     /// Draw the centres before calibration.
     pub show_before: bool,
@@ -223,8 +185,8 @@ pub struct CentresForm {
     pub relative: bool,
     /// Magnification of the deviations in relative mode.
     pub magnify: f32,
-    /// The orbit camera.
-    pub camera: Camera,
+    /// The 3-D scene's camera.
+    pub camera: crate::app::scene::Camera,
 }
 
 impl Default for CentresForm {
@@ -234,7 +196,7 @@ impl Default for CentresForm {
             show_after: true,
             relative: true,
             magnify: 50.0,
-            camera: Camera::default(),
+            camera: crate::app::scene::Camera::default(),
         }
     }
 }

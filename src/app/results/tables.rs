@@ -11,10 +11,38 @@ use crate::app::widgets::{MUTED, WARN};
 use crate::engine::base::geometry::{rows_from_isometry, wrap_deg};
 use crate::engine::base::robot::{PARAM_NAMES, PARAMS_PER_JOINT};
 use crate::engine::calibrate::solve::estimate::HAND_EYE_LABELS;
+use crate::engine::files::format::result::solver_block;
 
 /// Longest solver-block value shown in full (longer ones are cut, the
 /// whole value is in the tooltip and the exported JSON).
 const SOLVER_ENTRY_CHARS: usize = 300;
+
+/// A striped grid `id` headed by `header` in bold; `body` adds the rows.
+pub(super) fn table(
+    ui: &mut egui::Ui,
+    id: &str,
+    header: &[&str],
+    body: impl FnOnce(&mut egui::Ui),
+) {
+    egui::Grid::new(id)
+        .striped(true)
+        .num_columns(header.len())
+        .show(ui, |ui| {
+            for h in header {
+                ui.strong(*h);
+            }
+            ui.end_row();
+            body(ui);
+        });
+}
+
+/// One row of plain cells.
+pub(super) fn row(ui: &mut egui::Ui, cells: impl IntoIterator<Item = impl Into<egui::WidgetText>>) {
+    for c in cells {
+        ui.label(c);
+    }
+    ui.end_row();
+}
 
 pub(super) fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
     // One above the other: with ± 1σ the joint table needs the width.
@@ -45,7 +73,11 @@ pub(super) fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
                 .striped(true)
                 .num_columns(2)
                 .show(ui, |ui| {
-                    for (k, v) in &view.solver_entries {
+                    for (k, v) in solver_block(&view.file.solver) {
+                        let v = match v {
+                            serde_json::Value::String(t) => t,
+                            other => other.to_string(),
+                        };
                         ui.monospace(k);
                         let short: String = v.chars().take(SOLVER_ENTRY_CHARS).collect();
                         let shown = if short.len() < v.len() {
@@ -75,68 +107,41 @@ fn hand_eye_ui(ui: &mut egui::Ui, view: &ResultView) {
     let (b, a): (&HandEyeView, &HandEyeView) =
         (&view.shown.hand_eye_before, &view.shown.hand_eye_after);
     let sigma = view.shown.hand_eye_sigma;
-    egui::Grid::new("hand_eye")
-        .striped(true)
-        .num_columns(5)
-        .show(ui, |ui| {
-            for t in ["", "initial", "calibrated", "± 1σ", "change"] {
-                ui.strong(t);
-            }
-            ui.end_row();
-            let rows: [(&str, f64, f64, &str); 6] = [
-                (
-                    "x (mm)",
-                    b.translation[0],
-                    a.translation[0],
-                    HAND_EYE_LABELS[0],
-                ),
-                (
-                    "y (mm)",
-                    b.translation[1],
-                    a.translation[1],
-                    HAND_EYE_LABELS[1],
-                ),
-                (
-                    "z (mm)",
-                    b.translation[2],
-                    a.translation[2],
-                    HAND_EYE_LABELS[2],
-                ),
-                ("roll (deg)", b.rpy_deg[0], a.rpy_deg[0], HAND_EYE_LABELS[3]),
-                (
-                    "pitch (deg)",
-                    b.rpy_deg[1],
-                    a.rpy_deg[1],
-                    HAND_EYE_LABELS[4],
-                ),
-                ("yaw (deg)", b.rpy_deg[2], a.rpy_deg[2], HAND_EYE_LABELS[5]),
-            ];
-            for (k, (name, before, after, label)) in rows.into_iter().enumerate() {
-                ui.label(name);
-                ui.label(format!("{before:.4}"));
-                marked_cell(ui, view, label, format!("{after:.4}"));
-                match sigma {
-                    Some(s) if !view.shown.marked.contains_key(label) => {
-                        ui.label(RichText::new(format!("± {:.4}", s[k])).color(MUTED))
-                    }
-                    _ => ui.label(RichText::new("–").color(MUTED)),
+    let header = ["", "initial", "calibrated", "± 1σ", "change"];
+    table(ui, "hand_eye", &header, |ui| {
+        let names = [
+            "x (mm)",
+            "y (mm)",
+            "z (mm)",
+            "roll (deg)",
+            "pitch (deg)",
+            "yaw (deg)",
+        ];
+        let before = [b.translation, b.rpy_deg].concat();
+        let after = [a.translation, a.rpy_deg].concat();
+        for (k, (name, label)) in names.into_iter().zip(HAND_EYE_LABELS).enumerate() {
+            ui.label(name);
+            ui.label(format!("{:.4}", before[k]));
+            marked_cell(ui, view, label, format!("{:.4}", after[k]));
+            match sigma {
+                Some(s) if !view.shown.marked.contains_key(label) => {
+                    ui.label(RichText::new(format!("± {:.4}", s[k])).color(MUTED))
                 }
-                .on_hover_text(format!(
-                    "1σ a posteriori (ml's covariance × variance factor {:.3}), in the row's frame and unit (flange-frame x, y, z; roll, pitch, yaw); a priori (the covariance as written): ± {}",
-                    view.shown.variance_factor,
-                    view.shown
-                        .hand_eye_sigma_a_priori
-                        .map_or_else(|| "–".to_owned(), |p| format!("{:.4}", p[k]))
-                ));
-                let change = if k < 3 {
-                    after - before
-                } else {
-                    wrap_deg(after - before)
-                };
-                ui.label(format!("{change:+.4}"));
-                ui.end_row();
+                _ => ui.label(RichText::new("–").color(MUTED)),
             }
-        });
+            .on_hover_text(format!(
+                "1σ a posteriori (ml's covariance × variance factor {:.3}), in the row's frame and unit (flange-frame x, y, z; roll, pitch, yaw); a priori (the covariance as written): ± {}",
+                view.shown.variance_factor,
+                view.shown
+                    .hand_eye_sigma_a_priori
+                    .map_or_else(|| "–".to_owned(), |p| format!("{:.4}", p[k]))
+            ));
+            let change = after[k] - before[k];
+            let change = if k < 3 { change } else { wrap_deg(change) };
+            ui.label(format!("{change:+.4}"));
+            ui.end_row();
+        }
+    });
     ui.label(
         RichText::new(format!(
             "rotation changed by {:.4}°",
@@ -185,27 +190,20 @@ fn joint_errors_ui(ui: &mut egui::Ui, view: &ResultView) {
         "Δθ (deg)",
         "Δd (mm)",
     ];
-    egui::Grid::new("joint_errors")
-        .striped(true)
-        .num_columns(HEADER.len())
-        .show(ui, |ui| {
-            for h in HEADER {
-                ui.strong(h);
+    table(ui, "joint_errors", &HEADER, |ui| {
+        for (j, e) in view.file.joint_errors.iter().enumerate() {
+            ui.label(format!("{}", j + 1));
+            for (p, name) in PARAM_NAMES.iter().enumerate() {
+                let label = format!("{name}{}", j + 1);
+                let text = match view.shown.sigma.get(&label) {
+                    Some(s) => format!("{:+.4} ± {:.4}", e.get(p), s.std),
+                    None => format!("{:+.4}", e.get(p)),
+                };
+                marked_cell(ui, view, &label, text);
             }
             ui.end_row();
-            for (j, e) in view.file.joint_errors.iter().enumerate() {
-                ui.label(format!("{}", j + 1));
-                for (p, name) in PARAM_NAMES.iter().enumerate() {
-                    let label = format!("{name}{}", j + 1);
-                    let text = match view.shown.sigma.get(&label) {
-                        Some(s) => format!("{:+.4} ± {:.4}", e.get(p), s.std),
-                        None => format!("{:+.4}", e.get(p)),
-                    };
-                    marked_cell(ui, view, &label, text);
-                }
-                ui.end_row();
-            }
-        });
+        }
+    });
     if !view.shown.marked.is_empty() {
         ui.label(
             RichText::new(format!(
@@ -248,18 +246,15 @@ fn ml_tables_ui(ui: &mut egui::Ui, view: &ResultView) {
             ui.label("No identify measurement's standardised residual exceeds the limit.");
             return;
         }
-        egui::Grid::new("outliers").striped(true).show(ui, |ui| {
-            for h in ["measurement", "station", "residual (mm)", "σ", "reason"] {
-                ui.strong(h);
-            }
-            ui.end_row();
+        let header = ["measurement", "station", "residual (mm)", "σ", "reason"];
+        table(ui, "outliers", &header, |ui| {
             for o in &ml.outliers {
-                ui.label(&o.measurement);
-                ui.label(&o.station);
-                ui.label(format!("{:.4}", o.residual_mm));
-                ui.label(format!("{:.1}", o.sigma));
-                ui.label(&o.reason);
-                ui.end_row();
+                let (residual, sigma) =
+                    (format!("{:.4}", o.residual_mm), format!("{:.1}", o.sigma));
+                row(
+                    ui,
+                    [&o.measurement, &o.station, &residual, &sigma, &o.reason],
+                );
             }
         });
     });
@@ -278,16 +273,9 @@ fn ml_tables_ui(ui: &mut egui::Ui, view: &ResultView) {
             );
             let mut rows: Vec<_> = cv.stations.iter().collect();
             rows.sort_by(|a, b| b.rms.total_cmp(&a.rms));
-            egui::Grid::new("loso").striped(true).show(ui, |ui| {
-                for h in ["station", "pairs", "rms (mm)"] {
-                    ui.strong(h);
-                }
-                ui.end_row();
+            table(ui, "loso", &["station", "pairs", "rms (mm)"], |ui| {
                 for s in rows {
-                    ui.label(&s.station);
-                    ui.label(s.pairs.to_string());
-                    ui.label(format!("{:.4}", s.rms));
-                    ui.end_row();
+                    row(ui, [s.station.clone(), s.pairs.to_string(), format!("{:.4}", s.rms)]);
                 }
             });
         });

@@ -44,7 +44,9 @@ pub fn results_ui(
         return;
     };
     let stale = state.ledger.stale(Artefact::Result);
+    // Its own scroll offset: not the Import view's (it opened mid-page).
     egui::ScrollArea::vertical()
+        .id_salt("results_scroll")
         .auto_shrink([false, false])
         .show(ui, |ui| {
             if let Some(s) = &stale {
@@ -56,7 +58,7 @@ pub fn results_ui(
             }
             origin_ui(ui, view);
             export_ui(ui, state, forms, stale.as_ref(), commands);
-            headline_ui(ui, view, forms, commands);
+            headline_ui(ui, view, forms, stale.is_some(), commands);
             fail::after_fail_ui(ui, state, forms, commands);
             ui.add_space(4.0);
             sets::sets_ui(ui, view);
@@ -101,7 +103,13 @@ fn origin_ui(ui: &mut egui::Ui, view: &ResultView) {
 
 /// Validation std and max before → after in large type, with the ratio,
 /// and the verdict against the acceptance tolerance (editable here).
-fn headline_ui(ui: &mut egui::Ui, view: &ResultView, forms: &Forms, commands: &mut Vec<Command>) {
+fn headline_ui(
+    ui: &mut egui::Ui,
+    view: &ResultView,
+    forms: &Forms,
+    stale: bool,
+    commands: &mut Vec<Command>,
+) {
     egui::Frame::group(ui.style()).show(ui, |ui| {
         ui.set_width(ui.available_width());
         match &view.shown.headline {
@@ -125,7 +133,7 @@ fn headline_ui(ui: &mut egui::Ui, view: &ResultView, forms: &Forms, commands: &m
                 );
             }
         }
-        verdict_ui(ui, view, forms, commands);
+        verdict_ui(ui, view, forms, stale, commands);
         let w = &view.shown.within_stats;
         ui.label(format!(
             "{} stations, centre distances (true value 0): std {:.3} → {:.3} mm, max {:.3} → {:.3} mm · ε {:.4} → {:.4} mm",
@@ -192,23 +200,31 @@ fn held_out_ui(ui: &mut egui::Ui, view: &ResultView) {
 }
 
 /// PASS / FAIL in large type against the tolerance, which is edited
-/// beside it (remembered for the session's robot).
-fn verdict_ui(ui: &mut egui::Ui, view: &ResultView, forms: &Forms, commands: &mut Vec<Command>) {
+/// beside it (remembered for the session's robot); struck out and grey
+/// while the result is stale.
+fn verdict_ui(
+    ui: &mut egui::Ui,
+    view: &ResultView,
+    forms: &Forms,
+    stale: bool,
+    commands: &mut Vec<Command>,
+) {
     let tolerance = forms.tolerance;
     let verdict = Verdict::of(view.shown.headline.as_ref(), &tolerance);
     ui.horizontal_wrapped(|ui| {
         let colour = match verdict {
+            _ if stale => MUTED,
             Verdict::Pass => GOOD,
             Verdict::Fail(_) => BAD,
             Verdict::NotChecked => MUTED,
         };
-        ui.label(
-            RichText::new(verdict.word())
-                .size(28.0)
-                .strong()
-                .color(colour),
-        )
-        .on_hover_text(verdict.describe(&tolerance));
+        let word = RichText::new(verdict.word()).size(28.0).strong();
+        let word = if stale { word.strikethrough() } else { word };
+        ui.label(word.color(colour))
+            .on_hover_text(verdict.describe(&tolerance));
+        if stale {
+            ui.label(RichText::new(STALE_VERDICT).color(WARN));
+        }
         ui.add_space(12.0);
         // Typed, never dragged: a sideways drag must not turn a PASS
         // into a FAIL. A value takes effect on Enter or leaving the field.
@@ -241,6 +257,9 @@ fn verdict_ui(ui: &mut egui::Ui, view: &ResultView, forms: &Forms, commands: &mu
         }
     });
 }
+
+/// Beside the verdict of a stale result.
+pub const STALE_VERDICT: &str = "does not hold: the result is stale, run again";
 
 /// The tolerances one may type, mm.
 const TOLERANCE_MM: std::ops::RangeInclusive<f64> = 0.001..=100.0;

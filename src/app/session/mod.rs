@@ -183,9 +183,10 @@ impl LoadedSession {
 }
 
 /// How the session table groups its rows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Grouping {
     /// File order.
+    #[default]
     None,
     /// By station, stations in order of first appearance.
     Station,
