@@ -64,8 +64,10 @@ pub fn import_session(
     // misread file (another convention, unit or session), refused here
     // rather than written for `calibrate` to refuse. A session with joints
     // only warns (the nominal model's own scatter can exceed the bound and
-    // still calibrate).
+    // still calibrate), and so does a start the user gave (a rough guess
+    // is a start, not a verdict on the data).
     if let PoseLog::Poses(spec) = &request.log
+        && spec.hand_eye.is_none()
         && imported.session.pose_only()
         && let Some(why) = super::initial::implausible_start(&imported.session)
     {
