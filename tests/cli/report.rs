@@ -143,6 +143,8 @@ fn every_section_the_sha256_and_the_headline() {
         "stripes",
         "figures",
         "fig5",
+        "fig5-after",
+        "fig6-after",
         "fig6",
         "epsilon",
         "identifiability",

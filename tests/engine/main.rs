@@ -6,6 +6,7 @@
 mod support;
 
 mod a_posteriori;
+mod diameter;
 mod fixed_mount;
 mod formats;
 mod fuzz;
@@ -13,6 +14,7 @@ mod held_out;
 mod import;
 mod ml;
 mod paper;
+mod plan_progress;
 mod pose_files;
 mod pose_only;
 mod range;
