@@ -103,16 +103,19 @@ fn cancel_latency() {
             let flag = Arc::new(AtomicBool::new(false));
             let config = config.clone();
             let f = Arc::clone(&flag);
-            let job = std::thread::spawn(move || {
-                let r = plan::plan_and_predict(&config, Some(&predict), &mut |_| {
-                    if f.load(Ordering::Relaxed) {
-                        Control::Cancel
-                    } else {
-                        Control::Continue
-                    }
-                });
-                (r.is_err(), Instant::now())
-            });
+            let job = std::thread::Builder::new()
+                .name("plan".into())
+                .spawn(move || {
+                    let r = plan::plan_and_predict(&config, Some(&predict), &mut |_| {
+                        if f.load(Ordering::Relaxed) {
+                            Control::Cancel
+                        } else {
+                            Control::Continue
+                        }
+                    });
+                    (r.is_err(), Instant::now())
+                })
+                .unwrap();
             std::thread::sleep(std::time::Duration::from_secs_f64(at));
             let set = Instant::now();
             flag.store(true, Ordering::Relaxed);
@@ -122,8 +125,7 @@ fn cancel_latency() {
             }
         }
         println!(
-            "{n} identify stations (5 predicted runs): {whole:.2} s whole, cancel within {:.3} s at worst (19 cancels)",
-            worst
+            "{n} identify stations (5 predicted runs): {whole:.2} s whole, cancel within {worst:.3} s at worst (19 cancels)"
         );
     }
 }

@@ -64,7 +64,12 @@ pub(super) fn plots_ui(ui: &mut egui::Ui, view: &ResultView) {
                     .strong()
                     .color(AFTER),
             );
-            let errors = after_points(view.shown.distances.iter().map(|d| d.error_after()));
+            let errors = after_points(
+                view.shown
+                    .distances
+                    .iter()
+                    .map(crate::engine::calibrate::validate::DistanceRecord::error_after),
+            );
             after_only_ui(
                 &mut cols[1],
                 "fig6_after",

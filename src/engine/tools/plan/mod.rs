@@ -570,10 +570,8 @@ fn choose_poses(
         }
     })?;
     let estimated = unknown_indices(&config.robot, &labels);
-    let mut done = of - sites.len();
     let mut infos: Vec<Vec<Info>> = Vec::with_capacity(sites.len());
-    for s in sites.iter() {
-        done += 1;
+    for (done, s) in (of - sites.len() + 1..).zip(sites.iter()) {
         cancel(PlanStage::Analysis { done, of })?;
         infos.push(if s.role == StationRole::Identify {
             s.candidates

@@ -688,9 +688,15 @@ mod tests {
             n,
         };
         let (mut full, mut st_full, mut m_full) = start();
-        greedy.full(&mut full, &mut st_full, &mut m_full, &Objective::LogDet);
+        greedy.full(
+            &mut full,
+            &mut st_full,
+            &mut m_full,
+            &Objective::LogDet,
+            &mut || false,
+        );
         let (mut lazy, mut st_lazy, mut m_lazy) = start();
-        greedy.lazy(&mut lazy, &mut st_lazy, &mut m_lazy);
+        greedy.lazy(&mut lazy, &mut st_lazy, &mut m_lazy, &mut || false);
         assert!(full.iter().all(|c| c.len() == n));
         assert_eq!(full, lazy);
     }
