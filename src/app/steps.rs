@@ -459,7 +459,7 @@ fn colour(step: &Step) -> egui::Color32 {
     }
 }
 
-/// Height of the bar's rows (the steps, Next and the other ways on, the
+/// Height of the bar's rows (the steps; Next, the other ways on and the
 /// stale line), points: fixed, so that the tabs below never move when a
 /// line comes or goes.
 const ROW_HEIGHT: f32 = 22.0;
@@ -481,7 +481,7 @@ fn stripes_seen(ui: &egui::Ui, state: &AppState, forms: &Forms) -> bool {
 }
 
 /// The bar: each step with its mark, then the next action's button and
-/// the other ways on, then what is stale; three rows of fixed height.
+/// the other ways on and what is stale; two rows of fixed height.
 pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mut Vec<Command>) {
     intro_ui(ui, state, commands);
     let all = steps(state, forms, stripes_seen(ui, state, forms));
@@ -524,57 +524,8 @@ pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &m
             }
         }
     });
-    row(ui, &mut |ui| match &next {
-        Some(n) => {
-            let button =
-                egui::Button::new(RichText::new(format!("Next: {}", n.label)).color(AFTER));
-            if ui
-                .add_enabled(n.command.is_some(), button)
-                .on_hover_text(&n.why)
-                .on_disabled_hover_text(&n.why)
-                .clicked()
-                && let Some(c) = &n.command
-            {
-                commands.push(c.clone());
-            }
-            for (label, command) in &n.others {
-                if ui
-                    .small_button(format!("or: {label}"))
-                    .on_hover_text(&n.why)
-                    .clicked()
-                {
-                    commands.push(command.clone());
-                }
-            }
-        }
-        None if state.loaded.is_some() => {
-            let left = optional_left(&all);
-            if left.is_empty() {
-                ui.label(RichText::new("● every step is done").color(GOOD));
-            } else {
-                let names: Vec<&str> = left.iter().map(|(n, _)| n.as_str()).collect();
-                ui.label(
-                    RichText::new(format!(
-                        "● every required step is done; optional, not done: {}",
-                        names.join(", ")
-                    ))
-                    .color(GOOD),
-                );
-                for (_, step) in left {
-                    if ui
-                        .small_button(format!("or: {}", step.action.0))
-                        .on_hover_text(&step.detail)
-                        .clicked()
-                    {
-                        commands.push(step.action.1.clone());
-                    }
-                }
-            }
-        }
-        None => {}
-    });
-    // What changed, in words, under the bar: the stale steps, by cause,
-    // on one line (the whole of it on hover).
+    // What changed, in words: the stale steps, by cause, on the Next
+    // row (the whole of it on hover).
     let mut causes: Vec<(&str, Vec<String>)> = Vec::new();
     for (k, step) in all.iter().enumerate() {
         if let StepState::Stale(what) = &step.state {
@@ -590,7 +541,57 @@ pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &m
         .map(|(what, names)| format!("! stale: {} — {what}", names.join(", ")))
         .collect();
     row(ui, &mut |ui| {
+        match &next {
+            Some(n) => {
+                let button =
+                    egui::Button::new(RichText::new(format!("Next: {}", n.label)).color(AFTER));
+                if ui
+                    .add_enabled(n.command.is_some(), button)
+                    .on_hover_text(&n.why)
+                    .on_disabled_hover_text(&n.why)
+                    .clicked()
+                    && let Some(c) = &n.command
+                {
+                    commands.push(c.clone());
+                }
+                for (label, command) in &n.others {
+                    if ui
+                        .small_button(format!("or: {label}"))
+                        .on_hover_text(&n.why)
+                        .clicked()
+                    {
+                        commands.push(command.clone());
+                    }
+                }
+            }
+            None if state.loaded.is_some() => {
+                let left = optional_left(&all);
+                if left.is_empty() {
+                    ui.label(RichText::new("● every step is done").color(GOOD));
+                } else {
+                    let names: Vec<&str> = left.iter().map(|(n, _)| n.as_str()).collect();
+                    ui.label(
+                        RichText::new(format!(
+                            "● every required step is done; optional, not done: {}",
+                            names.join(", ")
+                        ))
+                        .color(GOOD),
+                    );
+                    for (_, step) in left {
+                        if ui
+                            .small_button(format!("or: {}", step.action.0))
+                            .on_hover_text(&step.detail)
+                            .clicked()
+                        {
+                            commands.push(step.action.1.clone());
+                        }
+                    }
+                }
+            }
+            None => {}
+        }
         if !stale.is_empty() {
+            ui.add_space(12.0);
             let text = stale.join("; ");
             ui.add(egui::Label::new(RichText::new(&text).small().color(WARN)).truncate())
                 .on_hover_text(&text);
