@@ -152,6 +152,9 @@ pub enum CompensateCommand {
     /// Write the compensated file to the form's output path (refused when
     /// the compensation is stale or the targets had errors).
     Write,
+    /// The guide's example targets (`examples/targets.csv`, for the demo's
+    /// cell) written to the export folder, chosen, and compensated.
+    ExampleTargets,
 }
 
 /// The Measure view.

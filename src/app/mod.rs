@@ -366,6 +366,19 @@ impl Core {
                 }
             }
         }
+        // A refusal because something was stale goes once nothing is.
+        let stale_refusal = self
+            .state
+            .notice
+            .as_ref()
+            .is_some_and(|n| n.body.contains("stale"));
+        if stale_refusal
+            && Artefact::ALL
+                .iter()
+                .all(|a| self.state.ledger.stale(*a).is_none())
+        {
+            self.state.notice = None;
+        }
     }
 
     /// Every input as it reads now, from each feature's readings.
@@ -663,6 +676,12 @@ impl Core {
                     .wrote(&what, path.clone(), from, job.stamp.clone());
                 let line = line.unwrap_or_else(|| format!("wrote {what} to {}", path.display()));
                 self.state.say(Level::Info, line);
+                // A refusal to write is answered by this write.
+                if self.state.notice.as_ref().is_some_and(|n| {
+                    n.title.ends_with("not written") || n.title.starts_with("Could not write")
+                }) {
+                    self.state.notice = None;
+                }
             }
             Err(e) => {
                 let status = format!("{what} not written");

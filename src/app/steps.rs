@@ -63,6 +63,10 @@ pub struct Step {
     pub detail: String,
     /// The button that does or shows it, and its command.
     pub action: (String, Command),
+    /// An optional step (compensating targets, a re-check): Next offers
+    /// it once every required step is done, and "every step is done"
+    /// names it while it is not.
+    pub optional: bool,
 }
 
 fn show(tab: Tab) -> Command {
@@ -123,14 +127,18 @@ fn step(
         state,
         detail,
         action,
+        optional: false,
     }
 }
 
 /// The steps of the job for the current state (the Measure step, the
 /// cell's use once calibrated, last). Whether an artefact's step is done,
 /// under way or stale comes from the ledger and the job table only.
+///
+/// `stripes_seen`: the Stripe view was opened on this session, so its
+/// warnings have been looked at (the step is done, no longer "!").
 #[must_use]
-pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
+pub fn steps(state: &AppState, forms: &Forms, stripes_seen: bool) -> Vec<Step> {
     let loaded = state.loaded.as_ref();
     let failed = loaded.map_or(0, |l| l.analysis.failures().count());
     let warned = loaded.map_or(0, |l| l.analysis.warnings.len());
@@ -151,8 +159,8 @@ pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
     );
     plan.action.0 = again("Make the plan again", &plan.state, "Plan the poses");
     if plan.state == StepState::Todo && loaded.is_some() {
-        plan.state = StepState::Done;
-        plan.detail = "a session is open (its poses were planned elsewhere)".into();
+        plan.state = StepState::Skipped;
+        plan.detail = "not planned here: the open session's poses were planned elsewhere".into();
     }
     let mut calibrate = step(
         state,
@@ -202,28 +210,54 @@ pub fn steps(state: &AppState, forms: &Forms) -> Vec<Step> {
                 )
             },
             action: ("Import data".into(), show(Tab::Import)),
+            optional: false,
         },
         Step {
             name: "Stripes checked",
             state: match loaded {
                 None => StepState::Todo,
-                Some(_) if failed + warned > 0 => StepState::Attention,
+                Some(_) if failed + warned > 0 && !stripes_seen => StepState::Attention,
                 Some(_) => StepState::Done,
             },
             detail: match loaded {
                 None => "no session yet".into(),
-                Some(_) if failed + warned > 0 => format!(
+                Some(_) if failed + warned > 0 && !stripes_seen => format!(
                     "{failed} stripe(s) cannot be fitted, {warned} with warnings: look at them in Stripe (Session: only warnings and failures), leave out what is wrong"
+                ),
+                Some(_) if failed + warned > 0 => format!(
+                    "looked at: {failed} stripe(s) cannot be fitted (the run leaves them out), {warned} with warnings"
                 ),
                 Some(_) => "every stripe fits a circle, no warnings".into(),
             },
             action: ("Check the stripes".into(), show(Tab::Stripe)),
+            optional: false,
         },
         calibrate,
         validated(state, forms, calibrated),
         report,
         measure_step(state),
+        compensate_step(state),
     ]
+}
+
+/// The Compensate step (optional): the compensated targets' standing in
+/// the ledger.
+fn compensate_step(state: &AppState) -> Step {
+    let mut c = step(
+        state,
+        Artefact::Compensation,
+        "Compensated",
+        (
+            "compensate the robot's targets through the calibration (optional)",
+            "compensate them again before writing the program",
+        ),
+        (
+            "Compensate targets".to_string(),
+            Command::View(ViewCommand::ShowTab(Tab::Compensate)),
+        ),
+    );
+    c.optional = true;
+    c
 }
 
 /// The Validated step: the verdict of the result on show against the
@@ -250,6 +284,7 @@ fn validated(state: &AppState, forms: &Forms, calibrated: StepState) -> Step {
         state,
         detail,
         action: ("See the verdict".into(), show(Tab::Results)),
+        optional: false,
     }
 }
 
@@ -352,7 +387,40 @@ pub fn next_action(state: &AppState, forms: &Forms, all: &[Step]) -> Option<Next
             others,
         });
     }
-    report_todo.then(|| simple(5)).flatten()
+    if report_todo {
+        return simple(5);
+    }
+    if let Some(s) = all.iter().find(|s| s.state == StepState::Running) {
+        return Some(NextAction {
+            label: format!("{}…", s.name.to_lowercase()),
+            command: None,
+            why: s.detail.clone(),
+            others: Vec::new(),
+        });
+    }
+    // Then the required steps still to do, or showing "!": their action
+    // (measure a scan, make the plan again, look at the stripes).
+    let pending = |s: &Step| {
+        matches!(
+            s.state,
+            StepState::Todo | StepState::Stale(_) | StepState::Attention
+        )
+    };
+    if let Some(k) = all.iter().position(|s| !s.optional && pending(s)) {
+        return simple(k);
+    }
+    None
+}
+
+/// The optional steps not done yet ("8. Compensated"), with their
+/// actions: named when every required step is done.
+#[must_use]
+pub fn optional_left(all: &[Step]) -> Vec<(String, &Step)> {
+    all.iter()
+        .enumerate()
+        .filter(|(_, s)| s.optional && s.state != StepState::Done)
+        .map(|(k, s)| (format!("{}. {}", k + 1, s.name), s))
+        .collect()
 }
 
 /// The first-start "what to do", on the demo until dismissed.
@@ -391,20 +459,56 @@ fn colour(step: &Step) -> egui::Color32 {
     }
 }
 
+/// Height of the bar's rows (the steps; Next, the other ways on and the
+/// stale line), points: fixed, so that the tabs below never move when a
+/// line comes or goes.
+const ROW_HEIGHT: f32 = 22.0;
+
+/// Whether the Stripe view has been opened on the open session (its
+/// warnings looked at), kept in egui's memory by the session's name and
+/// size.
+fn stripes_seen(ui: &egui::Ui, state: &AppState, forms: &Forms) -> bool {
+    let Some(l) = state.loaded.as_ref() else {
+        return false;
+    };
+    let key = format!("{}|{}", l.session.name, l.session.measurements.len());
+    let id = egui::Id::unique("steps_stripes_seen");
+    if forms.tab == Tab::Stripe {
+        ui.data_mut(|d| d.insert_temp(id, key.clone()));
+    }
+    ui.data(|d| d.get_temp::<String>(id))
+        .is_some_and(|k| k == key)
+}
+
 /// The bar: each step with its mark, then the next action's button and
-/// the other ways on.
+/// the other ways on and what is stale; two rows of fixed height.
 pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &mut Vec<Command>) {
     intro_ui(ui, state, commands);
-    let all = steps(state, forms);
+    let all = steps(state, forms, stripes_seen(ui, state, forms));
     let next = next_action(state, forms, &all);
-    ui.horizontal_wrapped(|ui| {
+    let width = ui.available_width();
+    let row = |ui: &mut egui::Ui, add: &mut dyn FnMut(&mut egui::Ui)| {
+        ui.allocate_ui_with_layout(
+            egui::vec2(width, ROW_HEIGHT),
+            egui::Layout::left_to_right(egui::Align::Center),
+            |ui| {
+                ui.set_min_size(egui::vec2(width, ROW_HEIGHT));
+                ui.set_clip_rect(ui.max_rect().intersect(ui.clip_rect()));
+                add(ui);
+            },
+        );
+    };
+    row(ui, &mut |ui| {
         for (k, step) in all.iter().enumerate() {
             if k > 0 {
                 ui.label(RichText::new("›").color(MUTED));
             }
-            let text = RichText::new(format!("{} {}. {}", step.state.mark(), k + 1, step.name))
-                .size(14.0)
-                .color(colour(step));
+            let name = if step.optional {
+                format!("{} {}. {} (optional)", step.state.mark(), k + 1, step.name)
+            } else {
+                format!("{} {}. {}", step.state.mark(), k + 1, step.name)
+            };
+            let text = RichText::new(name).size(14.0).color(colour(step));
             // A step is a link to its view (or does its action).
             let busy = state.jobs.runs(&Slot::Run) && matches!(step.action.1, Command::Run(_));
             let hover = match &step.state {
@@ -419,9 +523,26 @@ pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &m
                 commands.push(step.action.1.clone());
             }
         }
+    });
+    // What changed, in words: the stale steps, by cause, on the Next
+    // row (the whole of it on hover).
+    let mut causes: Vec<(&str, Vec<String>)> = Vec::new();
+    for (k, step) in all.iter().enumerate() {
+        if let StepState::Stale(what) = &step.state {
+            let name = format!("{}. {}", k + 1, step.name);
+            match causes.iter_mut().find(|(w, _)| *w == what.as_str()) {
+                Some((_, names)) => names.push(name),
+                None => causes.push((what, vec![name])),
+            }
+        }
+    }
+    let stale: Vec<String> = causes
+        .into_iter()
+        .map(|(what, names)| format!("! stale: {} — {what}", names.join(", ")))
+        .collect();
+    row(ui, &mut |ui| {
         match &next {
             Some(n) => {
-                ui.add_space(12.0);
                 let button =
                     egui::Button::new(RichText::new(format!("Next: {}", n.label)).color(AFTER));
                 if ui
@@ -444,30 +565,38 @@ pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &m
                 }
             }
             None if state.loaded.is_some() => {
-                ui.add_space(12.0);
-                ui.label(RichText::new("● every step is done").color(GOOD));
+                let left = optional_left(&all);
+                if left.is_empty() {
+                    ui.label(RichText::new("● every step is done").color(GOOD));
+                } else {
+                    let names: Vec<&str> = left.iter().map(|(n, _)| n.as_str()).collect();
+                    ui.label(
+                        RichText::new(format!(
+                            "● every required step is done; optional, not done: {}",
+                            names.join(", ")
+                        ))
+                        .color(GOOD),
+                    );
+                    for (_, step) in left {
+                        if ui
+                            .small_button(format!("or: {}", step.action.0))
+                            .on_hover_text(&step.detail)
+                            .clicked()
+                        {
+                            commands.push(step.action.1.clone());
+                        }
+                    }
+                }
             }
             None => {}
         }
-    });
-    // What changed, in words, under the bar: the stale steps, by cause.
-    let mut causes: Vec<(&str, Vec<String>)> = Vec::new();
-    for (k, step) in all.iter().enumerate() {
-        if let StepState::Stale(what) = &step.state {
-            let name = format!("{}. {}", k + 1, step.name);
-            match causes.iter_mut().find(|(w, _)| *w == what.as_str()) {
-                Some((_, names)) => names.push(name),
-                None => causes.push((what, vec![name])),
-            }
+        if !stale.is_empty() {
+            ui.add_space(12.0);
+            let text = stale.join("; ");
+            ui.add(egui::Label::new(RichText::new(&text).small().color(WARN)).truncate())
+                .on_hover_text(&text);
         }
-    }
-    for (what, names) in causes {
-        ui.label(
-            RichText::new(format!("! stale: {} — {what}", names.join(", ")))
-                .small()
-                .color(WARN),
-        );
-    }
+    });
 }
 
 /// The Measure step of the step bar: to do, under way, done or stale

@@ -155,9 +155,9 @@ pub struct PlanArgs {
     pub quiet: bool,
 }
 
-/// Most simulated calibrations of `--predict`: a few seconds each at
-/// most, and the spread of the prediction settles long before.
-pub const MAX_PREDICT_RUNS: usize = 1000;
+/// Most simulated calibrations of `--predict` (the engine's bound, the
+/// Plan view's too).
+pub use crate::engine::tools::plan::MAX_PREDICT_RUNS;
 
 /// The flags behind each of the plan's setting errors: a phrase of the
 /// engine's message and the flags that set what it names.
@@ -415,7 +415,10 @@ impl Ticker {
             PlanStage::Candidates { done, of } => {
                 format!("candidate poses of {done} of {of} stations solved")
             }
-            PlanStage::Analysis => "identifiability analysis of the candidate poses".to_owned(),
+            PlanStage::Analysis { done, of } => format!(
+                "identifiability analysis of the candidate poses, {:.0} %",
+                100.0 * *done as f64 / (*of).max(1) as f64
+            ),
             PlanStage::Selection => "selecting the identify poses".to_owned(),
             PlanStage::Ordering => "ordering the poses".to_owned(),
             PlanStage::Comparison => "planning without the spread, for comparison".to_owned(),
@@ -444,7 +447,7 @@ impl Ticker {
 fn stage_mark(stage: PlanStage) -> Option<&'static str> {
     match stage {
         PlanStage::Candidates { .. } => None,
-        PlanStage::Analysis => Some("identifiability"),
+        PlanStage::Analysis { .. } => Some("identifiability"),
         PlanStage::Selection => Some("selection"),
         PlanStage::Ordering => Some("ordering and report"),
         PlanStage::Comparison => Some("plan without the spread"),
@@ -732,11 +735,17 @@ mod tests {
             "{line}"
         );
         assert_eq!(
-            ticker.tick(&PlanStage::Analysis, t0 + Duration::from_secs(4)),
+            ticker.tick(
+                &PlanStage::Analysis { done: 0, of: 1 },
+                t0 + Duration::from_secs(4)
+            ),
             None
         );
         let line = ticker
-            .tick(&PlanStage::Analysis, t0 + Duration::from_secs(6))
+            .tick(
+                &PlanStage::Analysis { done: 0, of: 1 },
+                t0 + Duration::from_secs(6),
+            )
             .unwrap();
         assert!(line.contains("identifiability"), "{line}");
         let line = ticker.runs(3, 8, t0 + Duration::from_secs(9)).unwrap();

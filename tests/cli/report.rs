@@ -143,6 +143,8 @@ fn every_section_the_sha256_and_the_headline() {
         "stripes",
         "figures",
         "fig5",
+        "fig5-after",
+        "fig6-after",
         "fig6",
         "epsilon",
         "identifiability",
@@ -181,9 +183,10 @@ fn every_section_the_sha256_and_the_headline() {
     let table = &table[..table.find("</table>").unwrap()];
     assert_eq!(table.matches("<tr><td>").count(), v.distances.len());
     // ml: Fig. 5, Fig. 6 and ε are plotted, each SVG with a title, axes
-    // labelled with units and a legend of both series; and the map of the
-    // predicted error over the region the sphere covered.
-    assert_eq!(html.matches("<svg").count(), 4);
+    // labelled with units and a legend of both series; Fig. 5's and 6's
+    // after series alone (issue 34); and the map of the predicted error
+    // over the region the sphere covered.
+    assert_eq!(html.matches("<svg").count(), 6);
     assert!(html.contains("id=\"range-map\""));
     assert!(html.contains("centre distance (mm)") && html.contains("error (mm)"));
     assert!(html.contains("ε (mm, log scale)"));
@@ -306,9 +309,9 @@ fn a_session_without_validation_says_so() {
     assert!(!html.contains("id=\"distances\""));
     // Fig. 5 falls back to the identify stations; ε is still plotted.
     assert!(html.contains("Centre distances within identify stations"));
-    // Fig. 5, ε and the map of the predicted error over the region the
-    // sphere covered (ml; no sensor.range).
-    assert_eq!(html.matches("<svg").count(), 3);
+    // Fig. 5 (and its after series alone), ε and the map of the predicted
+    // error over the region the sphere covered (ml; no sensor.range).
+    assert_eq!(html.matches("<svg").count(), 4);
     assert!(html.contains("id=\"range-map\""));
     assert_only_report_tags(&html);
 }
@@ -318,8 +321,9 @@ fn the_papers_method_marks_the_dropped_directions() {
     let (_, result, html) = demo_report(Method::Paper);
     assert!(html.contains("<strong>paper</strong> method kept"));
     assert!(html.contains("id=\"dropped\""));
-    // Fig. 5, Fig. 6, ε and the singular values with the truncation line.
-    assert_eq!(html.matches("<svg").count(), 4);
+    // Fig. 5, Fig. 6 (each with its after series alone), ε and the
+    // singular values with the truncation line.
+    assert_eq!(html.matches("<svg").count(), 6);
     assert!(html.contains("truncation"));
     let marks = result_view::identifiability_marks(&result.solver);
     assert!(!marks.is_empty() && marks.contains_key("theta1"));

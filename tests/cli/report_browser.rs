@@ -217,11 +217,12 @@ fn the_report_renders_in_headless_chromium() {
             "heading missing from the DOM: {heading}"
         );
     }
-    // Fig. 5, Fig. 6, ε and the range map as SVG elements with their marks.
-    assert_eq!(dom.matches("<svg").count(), 4, "SVG figures in the DOM");
-    // Two marker paths for each of Fig. 5 and 6, one for ε, the range
-    // map's cross; their lines.
-    assert_eq!(dom.matches("<path").count(), 6);
+    // Fig. 5, Fig. 6 (each with its after series alone, issue 34), ε and
+    // the range map as SVG elements with their marks.
+    assert_eq!(dom.matches("<svg").count(), 6, "SVG figures in the DOM");
+    // Two marker paths for each of Fig. 5 and 6, one for each after
+    // panel, one for ε, the range map's cross; their lines.
+    assert_eq!(dom.matches("<path").count(), 8);
     assert!(dom.matches("<polyline").count() >= 5);
     for id in ["fig5", "fig6", "epsilon", "range-map"] {
         let at = dom.find(&format!("<figure id=\"{id}\">")).unwrap();
@@ -440,8 +441,8 @@ fn plan_to_browser_rendered_report_through_the_csv_import() {
     );
     assert_eq!(
         dom.matches("<svg").count(),
-        4,
-        "Fig. 5, Fig. 6, ε and the range map"
+        6,
+        "Fig. 5, Fig. 6, their after panels, ε and the range map"
     );
     assert!(
         dom.contains(&format!("{:.3}", v.after.std)),

@@ -6,6 +6,7 @@
 mod support;
 
 mod a_posteriori;
+mod diameter;
 mod fixed_import;
 mod fixed_mount;
 mod formats;
@@ -14,6 +15,7 @@ mod held_out;
 mod import;
 mod ml;
 mod paper;
+mod plan_progress;
 mod pose_files;
 mod pose_only;
 mod range;

@@ -9,6 +9,7 @@ mod compensate;
 mod guided;
 mod held_out;
 mod import_poses;
+mod job_end;
 mod measure;
 mod range;
 mod results_rows;

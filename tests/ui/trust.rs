@@ -441,7 +441,7 @@ fn failing_session(dir: &std::path::Path) -> std::path::PathBuf {
 /// Item 5: after a FAIL, Next leads to the outliers (the Results view's
 /// "after a FAIL" box, on screen), then to the planner with more
 /// stations; without validate measurements the validation is skipped
-/// and Next goes on to the report, then says every step is done.
+/// and Next goes on to the report, then to Measure.
 #[test]
 fn next_has_an_action_after_a_fail_and_without_validation() {
     let mut h = demo_app();
@@ -515,8 +515,10 @@ fn next_has_an_action_after_a_fail_and_without_validation() {
     h.get_by_label("Next: Write the report").click();
     settle(&mut h);
     assert!(step_label(&h, "6. Reported").starts_with('●'));
-    assert_eq!(h.query_all_by_label_contains("Next:").count(), 0);
-    assert!(h.query_by_label("● every step is done").is_some());
+    // Then on (issue 34): not done while Measured is ○.
+    assert!(step_label(&h, "7. Measured").starts_with('○'));
+    assert!(h.query_all_by_label_contains("Next: ").next().is_some());
+    assert!(h.query_by_label("● every step is done").is_none());
 }
 
 /// Item 6: a step is done only while its inputs are as they were: the
@@ -701,7 +703,10 @@ fn the_predicted_error_map_has_an_absolute_colour_bar() {
         scroll_to(&mut h, egui::pos2(800.0, 500.0), "Colours from 0 mm"),
         "the map's caption"
     );
-    let top = spherecal::app::results::range_map::scale_top(hi);
+    // Issue 34: the scale runs to the tolerance or the largest value.
+    let tolerance = h.state().forms().tolerance.std_mm;
+    let largest = hi.max(range.max_mm);
+    let top = spherecal::app::results::range_map::map_scale(largest, tolerance);
     let scale = spherecal::app::results::range_map::scale_text(top);
     assert!(
         h.query_all_by_label_contains(&format!("Colours from 0 mm (green) to {scale} mm (red)"))
@@ -709,7 +714,10 @@ fn the_predicted_error_map_has_an_absolute_colour_bar() {
             .is_some(),
         "the caption gives the scale, 0 to {scale} mm"
     );
-    assert!(top >= hi && top < hi * 1.5, "top {top}, cells {lo}..{hi}");
+    assert!(
+        top >= largest && top >= tolerance && top < largest.max(tolerance) * 1.5,
+        "top {top}, cells {lo}..{hi}, tolerance {tolerance}"
+    );
     assert!(
         h.query_all_by_label_contains(&format!("{lo:.3} to {hi:.3} mm"))
             .next()

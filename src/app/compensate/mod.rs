@@ -28,6 +28,14 @@ use job::{CompensationView, compensate_targets, write_compensated};
 /// line, list of files written).
 pub const WRITTEN_WHAT: &str = "compensated program";
 
+/// The guide's example targets (docs/src/workflows/compensating.md): ten
+/// sensor poses along a scan path in the demo's cell, ABB's quaternion
+/// order.
+pub const EXAMPLE_TARGETS: &str = include_str!("../../../examples/targets.csv");
+
+/// The file name the example targets are written as.
+pub const EXAMPLE_TARGETS_NAME: &str = "example-targets.csv";
+
 /// What the Compensate view shows.
 #[derive(Debug, Default)]
 pub struct CompensateState {
@@ -53,7 +61,34 @@ impl Core {
                 }
             }
             CompensateCommand::Write => self.compensate_write(ctx),
+            CompensateCommand::ExampleTargets => self.example_targets(ctx),
         }
+    }
+
+    /// Writes the guide's example targets to the export folder (as
+    /// `example-targets.csv`), chooses them (ABB's quaternion order, as
+    /// the guide gives them) and compensates them.
+    fn example_targets(&mut self, ctx: &egui::Context) {
+        let Some(dir) = self.export_folder() else {
+            return;
+        };
+        let path = dir.join(EXAMPLE_TARGETS_NAME);
+        if let Err(e) =
+            crate::engine::files::format::write_atomic(&path, EXAMPLE_TARGETS.as_bytes())
+        {
+            self.state.notice = Some(Notice {
+                title: "Example targets not written".to_string(),
+                body: e.to_string(),
+            });
+            return;
+        }
+        self.forms.compensate.targets = path.display().to_string();
+        self.forms.compensate.convention =
+            Some(crate::engine::base::robot::controller::FlangeConvention::AbbQuaternion);
+        self.forms.compensate.tcp = TcpChoice::Sensor;
+        // The job is stamped with the fields as they are now.
+        self.observe(ctx);
+        self.compensate_run(ctx);
     }
 
     pub(super) fn compensate_run(&mut self, ctx: &egui::Context) {

@@ -100,6 +100,24 @@ fn inputs_ui(
                 dialog_note_ui(ui, state, &[Purpose::CompensateTargets]);
             });
             ui.end_row();
+            let on_demo = state
+                .loaded
+                .as_ref()
+                .is_some_and(|l| l.source == crate::app::session::Source::Demo);
+            if on_demo && state.result.is_some() {
+                ui.label("");
+                if ui
+                    .button("Use the guide's example targets")
+                    .on_hover_text(format!(
+                        "the demo's cell: ten sensor poses along a scan path (examples/targets.csv of the guide), written to the export folder as {} and compensated",
+                        super::EXAMPLE_TARGETS_NAME
+                    ))
+                    .clicked()
+                {
+                    commands.push(Command::Compensate(CompensateCommand::ExampleTargets));
+                }
+                ui.end_row();
+            }
 
             let l = ui.label("Pose convention");
             ui.horizontal(|ui| {

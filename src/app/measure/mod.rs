@@ -423,10 +423,10 @@ impl Core {
         let refuse = |core: &mut Self, why: String| {
             core.refuse("Cloud not written", "cloud not written", why);
         };
-        let Some(shown) = &self.state.measure.shown else {
+        if self.state.measure.shown.is_none() {
             refuse(self, "no cloud to write: measure a scan first".into());
             return;
-        };
+        }
         // A stale cloud is never written as if it were current.
         let stamp = match self.state.ledger.check(Artefact::Cloud) {
             Ok(stamp) => stamp,
@@ -435,15 +435,15 @@ impl Core {
                 return;
             }
         };
-        let text = self.forms.measure.out.trim();
-        if text.is_empty() {
-            refuse(
-                self,
-                "type where to write the cloud (.ply, .e57 or .csv), or press Save as…".into(),
-            );
-            return;
+        // An empty field writes the default it shows: the export folder's
+        // `<session stem>-cloud.ply`.
+        if self.forms.measure.out.trim().is_empty() {
+            let Some(dir) = self.export_folder() else {
+                return;
+            };
+            self.forms.measure.out = dir.join(self.cloud_file_name()).display().to_string();
         }
-        let path = PathBuf::from(text);
+        let path = PathBuf::from(self.forms.measure.out.trim());
         let Some(format) = CloudFormat::of_path(&path) else {
             refuse(
                 self,
@@ -460,6 +460,9 @@ impl Core {
             refuse(self, e.to_string());
             return;
         }
+        let Some(shown) = &self.state.measure.shown else {
+            return;
+        };
         let cloud = Arc::clone(&shown.cloud);
         let provenance = measure::Provenance {
             result: shown.result.clone(),
@@ -482,22 +485,26 @@ impl Core {
     }
 
     /// The name the export's save dialog offers: the export field's, else
-    /// `<session stem>-cloud.ply`.
+    /// [`default_cloud_name`].
     pub(super) fn cloud_file_name(&self) -> String {
         Path::new(self.forms.measure.out.trim())
             .file_name()
             .map_or_else(
-                || {
-                    let stem = self
-                        .state
-                        .loaded
-                        .as_ref()
-                        .map_or_else(|| "scan".to_string(), |l| l.source.stem());
-                    format!("{stem}-cloud.ply")
-                },
+                || default_cloud_name(&self.state),
                 |n| n.to_string_lossy().into_owned(),
             )
     }
+}
+
+/// The cloud's default file name: `<session stem>-cloud.ply` (`scan`
+/// without a session).
+#[must_use]
+pub fn default_cloud_name(state: &crate::app::AppState) -> String {
+    let stem = state
+        .loaded
+        .as_ref()
+        .map_or_else(|| "scan".to_string(), |l| l.source.stem());
+    format!("{stem}-cloud.ply")
 }
 
 /// The Measure form: what is measured and how (not where it is

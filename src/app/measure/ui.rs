@@ -478,18 +478,23 @@ fn projections_ui(ui: &mut egui::Ui, c: &MeasuredCloud) {
         ] {
             ui.vertical(|ui| {
                 ui.label(RichText::new(name).strong());
-                let response = Plot::new(("measure_projection", a, b))
-                    .width(width)
-                    .height(height)
-                    .data_aspect(1.0)
-                    .include_x(lo[a])
-                    .include_x(hi[a])
-                    .include_y(lo[b])
-                    .include_y(hi[b])
-                    .x_axis_label(format!("{} (mm)", axes[a]))
-                    .y_axis_label(format!("{} (mm)", axes[b]))
-                    .allow_scroll(false)
-                    .show(ui, |_| {});
+                // The workbench's readable axes: a tick every few tens of
+                // points on both axes, not one.
+                let response = crate::app::widgets::plots::readable(
+                    Plot::new(("measure_projection", a, b)),
+                    false,
+                )
+                .width(width)
+                .height(height)
+                .data_aspect(1.0)
+                .include_x(lo[a])
+                .include_x(hi[a])
+                .include_y(lo[b])
+                .include_y(hi[b])
+                .x_axis_label(format!("{} (mm)", axes[a]))
+                .y_axis_label(format!("{} (mm)", axes[b]))
+                .allow_scroll(false)
+                .show(ui, |_| {});
                 paint_points(ui, c, a, b, &response.transform);
             });
         }
@@ -704,7 +709,11 @@ fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
     let stale = state.ledger.stale(Artefact::Cloud);
     ui.horizontal_wrapped(|ui| {
         ui.label(RichText::new("Export:").strong());
-        labelled_field(ui, "Export to", &mut forms.measure.out, "cloud.ply", 260.0)
+        let default = std::path::Path::new(forms.export_dir.trim())
+            .join(super::default_cloud_name(state))
+            .display()
+            .to_string();
+        labelled_field(ui, "Export to", &mut forms.measure.out, &default, 260.0)
             .on_hover_text(
                 "PLY (binary: x y z double mm, sigma_mm float, pose), E57 (a scan per pose with its sensor pose) or CSV (id,x,y,z,sigma_mm), by the extension; written whole or not at all",
             );

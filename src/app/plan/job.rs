@@ -42,7 +42,8 @@ pub fn make_plan(
         match progress {
             PlanProgress::Stage(stage) => {
                 let done = match stage {
-                    PlanStage::Candidates { done, of } => 0.8 * done as f64 / of.max(1) as f64,
+                    PlanStage::Candidates { done, of } => 0.6 * done as f64 / of.max(1) as f64,
+                    PlanStage::Analysis { done, of } => 0.6 + 0.3 * done as f64 / of.max(1) as f64,
                     _ => 0.9,
                 };
                 report(stage_text(stage), Some(share * done));
@@ -68,7 +69,10 @@ pub fn stage_text(stage: PlanStage) -> String {
         PlanStage::Candidates { done, of } => {
             format!("solving candidate poses: station {done} of {of}")
         }
-        PlanStage::Analysis => "identifiability of the candidate pool…".to_string(),
+        PlanStage::Analysis { done, of } => format!(
+            "identifiability of the candidate pool: {:.0} %",
+            100.0 * done as f64 / of.max(1) as f64
+        ),
         PlanStage::Selection => "D-optimal selection…".to_string(),
         PlanStage::Ordering => "ordering for short moves…".to_string(),
         PlanStage::Comparison => "the plan without the spread, for comparison…".to_string(),

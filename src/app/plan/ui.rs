@@ -18,7 +18,7 @@ use crate::app::widgets::{
     range_values,
 };
 use crate::app::{Forms, plan::form::default_sphere};
-use crate::engine::tools::plan::{Plan, PlanStats, Planned, StationRole};
+use crate::engine::tools::plan::{MAX_PREDICT_RUNS, Plan, PlanStats, Planned, StationRole};
 
 /// Width of the settings column, points.
 const FORM_WIDTH: f32 = 330.0;
@@ -96,21 +96,29 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
                 .on_hover_text("rough sphere position in the robot base frame");
                 ui.end_row();
             }
-            let counts: [(&str, &mut usize, usize, &str); 8] = [
-                ("Translations", &mut f.request.design.n_translation, 12, "pure translations at P0 (initial rotation, eq. 6-7)"),
-                ("Rotations", &mut f.request.design.n_rotation, 12, "orientation changes at P0 (initial translation, eq. 8-9)"),
-                ("Identify stations", &mut f.request.design.n_identify, 30, "sphere positions for the identification"),
-                ("Poses per identify station", &mut f.request.design.identify_poses, 20, "measurements at each identify station"),
-                ("Validate stations", &mut f.request.design.n_validate, 30, "sphere positions held out, with tracker distances"),
-                ("Poses per validate station", &mut f.request.design.validate_poses, 20, "measurements at each validate station"),
-                ("Candidates per station", &mut f.request.design.candidates, 200, "orientations tried per station before selection"),
-                ("Predicted by (runs)", &mut f.request.predict_runs, 50, "simulated calibrations for the predicted accuracy (0: none)"),
+            // The engine's bounds (as `spherecal plan` has them); a value
+            // beyond is kept and said below, never clamped silently. A
+            // typed value counts on Enter or when the field loses focus.
+            let counts: [(&str, &mut usize, &str); 8] = [
+                ("Translations", &mut f.request.design.n_translation, "pure translations at P0 (initial rotation, eq. 6-7)"),
+                ("Rotations", &mut f.request.design.n_rotation, "orientation changes at P0 (initial translation, eq. 8-9)"),
+                ("Identify stations", &mut f.request.design.n_identify, "sphere positions for the identification"),
+                ("Poses per identify station", &mut f.request.design.identify_poses, "measurements at each identify station"),
+                ("Validate stations", &mut f.request.design.n_validate, "sphere positions held out, with tracker distances"),
+                ("Poses per validate station", &mut f.request.design.validate_poses, "measurements at each validate station"),
+                ("Candidates per station", &mut f.request.design.candidates, "orientations tried per station before selection"),
+                ("Predicted by (runs)", &mut f.request.predict_runs, "simulated calibrations for the predicted accuracy (0: none)"),
             ];
-            for (label, value, max, hint) in counts {
+            for (label, value, hint) in counts {
                 let l = ui.label(label);
-                ui.add(egui::DragValue::new(value).range(0..=max).speed(0.1))
-                    .labelled_by(l.id)
-                    .on_hover_text(hint);
+                ui.add(
+                    egui::DragValue::new(value)
+                        .range(0..=COUNT_FIELD_MAX)
+                        .speed(0.1)
+                        .update_while_editing(false),
+                )
+                .labelled_by(l.id)
+                .on_hover_text(hint);
                 ui.end_row();
             }
             let l = ui.label("Cut angle");
@@ -129,6 +137,12 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
                 .on_hover_text("the same settings and seed give the same plan");
             ui.end_row();
         });
+    if let Some(why) = settings_error(f) {
+        ui.add(
+            egui::Label::new(RichText::new(format!("not plannable as set: {why}")).color(BAD))
+                .wrap(),
+        );
+    }
     let mut known = f.request.range.is_some();
     if ui
         .checkbox(&mut known, "plan for the measuring range")
@@ -162,11 +176,13 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
     ui.add_space(6.0);
     ui.horizontal(|ui| {
         let running = state.jobs.runs(&Slot::Plan);
+        let wrong = settings_error(f);
         if ui
             .add_enabled(
-                !running,
+                !running && wrong.is_none(),
                 egui::Button::new(RichText::new("Make plan").strong().size(16.0)),
             )
+            .on_disabled_hover_text(wrong.unwrap_or_else(|| "a plan is being made".into()))
             .clicked()
         {
             commands.push(Command::Plan(PlanCommand::Make));
@@ -179,6 +195,30 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
         }
     });
     crate::app::widgets::slot_ui(ui, state, &Slot::Plan);
+}
+
+/// The largest count a field takes: far beyond every bound of the
+/// engine (stations, poses, candidates, runs), so that a value over a
+/// bound is kept and said ([`settings_error`]) rather than clamped.
+const COUNT_FIELD_MAX: usize = 1_000_000;
+
+/// What is wrong with the form's settings, in the engine's words (the
+/// bounds `spherecal plan` checks), or `None`.
+fn settings_error(f: &crate::app::plan::form::PlanForm) -> Option<String> {
+    if f.request.predict_runs > MAX_PREDICT_RUNS {
+        return Some(format!(
+            "{} prediction runs asked for: at most {MAX_PREDICT_RUNS}",
+            f.request.predict_runs
+        ));
+    }
+    let checked = crate::app::plan::form::PlanForm {
+        hand_eye_from_session: false,
+        ..f.clone()
+    };
+    match checked.config(None) {
+        Ok(config) => config.validate().err().map(|e| e.to_string()),
+        Err(e) => Some(e),
+    }
 }
 
 /// The predicted validation std after calibration (simulated

@@ -42,6 +42,43 @@ pub(super) fn plots_ui(ui: &mut egui::Ui, view: &ResultView) {
         }
         fig6_ui(&mut cols[1], view);
     });
+    // The after series on its own scale: on the before's it is a flat
+    // line at zero.
+    ui.columns(2, |cols| {
+        cols[0].label(
+            RichText::new("Fig. 5, after only (its own scale)")
+                .strong()
+                .color(AFTER),
+        );
+        let within: Vec<[f64; 2]> = after_points(view.shown.within.iter().map(|p| p.after));
+        after_only_ui(
+            &mut cols[0],
+            "fig5_after",
+            within,
+            ("pair (station by station)", "distance (mm)"),
+            true,
+        );
+        if !view.shown.distances.is_empty() {
+            cols[1].label(
+                RichText::new("Fig. 6, after only (its own scale)")
+                    .strong()
+                    .color(AFTER),
+            );
+            let errors = after_points(
+                view.shown
+                    .distances
+                    .iter()
+                    .map(crate::engine::calibrate::validate::DistanceRecord::error_after),
+            );
+            after_only_ui(
+                &mut cols[1],
+                "fig6_after",
+                errors,
+                ("reference distance no.", "error (mm)"),
+                false,
+            );
+        }
+    });
     ui.columns(2, |cols| {
         cols[0].label(RichText::new("ε per iteration (paper eq. 20)").strong());
         epsilon_plot_ui(
@@ -143,6 +180,52 @@ fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
             station_bands_ui(p, within, top * 1.1);
             before_after_series(p, before, after);
         });
+}
+
+/// Height of the after-only panels, points.
+const AFTER_HEIGHT: f32 = PLOT_HEIGHT * 0.6;
+
+/// Values numbered from 1 for a plot.
+fn after_points(values: impl Iterator<Item = f64>) -> Vec<[f64; 2]> {
+    values
+        .enumerate()
+        .map(|(k, v)| [(k + 1) as f64, v])
+        .collect()
+}
+
+/// One after series on its own scale (from 0 for distances, around 0
+/// for errors).
+fn after_only_ui(
+    ui: &mut egui::Ui,
+    id: &str,
+    after: Vec<[f64; 2]>,
+    (x_label, y_label): (&str, &str),
+    from_zero: bool,
+) {
+    let mut plot = readable(Plot::new(id), true)
+        .height(AFTER_HEIGHT)
+        .allow_scroll(false)
+        .x_axis_label(x_label)
+        .y_axis_label(y_label);
+    if from_zero {
+        plot = plot.include_y(0.0);
+    }
+    plot.show(ui, |p| {
+        if !from_zero {
+            p.hline(HLine::new("", 0.0).color(MUTED).width(1.0));
+        }
+        p.line(
+            Line::new("after (calibrated)", PlotPoints::from(after.clone()))
+                .color(AFTER)
+                .width(1.0),
+        );
+        p.points(
+            Points::new("after (calibrated)", PlotPoints::from(after))
+                .color(AFTER)
+                .shape(MarkerShape::Circle)
+                .radius(3.0),
+        );
+    });
 }
 
 /// Fig. 5's stations: a dotted line between two (under the names), and each one's name

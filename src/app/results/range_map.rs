@@ -74,7 +74,12 @@ fn bar_tick(value: f64, top: f64) -> String {
 /// coloured by its σ on the absolute scale, the colour bar beside it, the
 /// region the sphere positions covered outlined, the largest σ at one
 /// pose marked.
-pub(super) fn range_map_ui(ui: &mut egui::Ui, r: &RangeError) {
+///
+/// The scale runs from 0 to the tolerance (`tolerance_mm`, the verdict's
+/// std) or the largest value, whichever is larger ([`map_scale`]): a cell
+/// within the tolerance is never red. The tolerance and the largest σ at
+/// one pose are marked on the bar.
+pub(super) fn range_map_ui(ui: &mut egui::Ui, r: &RangeError, tolerance_mm: f64) {
     if r.map.is_empty() || r.grid < 2 {
         return;
     }
@@ -84,17 +89,18 @@ pub(super) fn range_map_ui(ui: &mut egui::Ui, r: &RangeError) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
             (a.min(p[2]), b.max(p[2]))
         });
-    let top = scale_top(hi);
+    let top = map_scale(hi.max(r.max_mm), tolerance_mm);
     let half_y = (r.y[1] - r.y[0]) / (r.grid - 1) as f64 / 2.0;
     let half_z = (r.z[1] - r.z[0]) / (r.grid - 1) as f64 / 2.0;
     ui.label(
         RichText::new(format!(
             "Each cell: the point's predicted 1σ, rms over the {} working poses: {lo:.3} to {hi:.3} mm. \
              The summary's max ({:.3} mm, ×) is the largest at any one pose. \
-             Colours from 0 mm (green) to {} mm (red); the white outline is where the sphere was seen.",
+             Colours from 0 mm (green) to {} mm (red), the tolerance {} mm (std) marked on the bar; the white outline is where the sphere was seen.",
             r.poses,
             r.max_mm,
-            scale_text(top)
+            scale_text(top),
+            crate::engine::base::numeric::show(tolerance_mm)
         ))
         .color(MUTED),
     );
@@ -142,14 +148,27 @@ pub(super) fn range_map_ui(ui: &mut egui::Ui, r: &RangeError) {
                     .color(egui::Color32::WHITE),
                 );
             });
-        colour_bar_ui(ui, top);
+        colour_bar_ui(ui, top, &[("tolerance", tolerance_mm), ("max", r.max_mm)]);
     });
 }
 
+/// The top of the map's colour scale: a round number ([`scale_top`]) at
+/// or above the largest value and the tolerance, whichever is larger.
+#[must_use]
+pub fn map_scale(largest: f64, tolerance_mm: f64) -> f64 {
+    let tolerance = if tolerance_mm.is_finite() {
+        tolerance_mm
+    } else {
+        0.0
+    };
+    scale_top(largest.max(tolerance))
+}
+
 /// The colour bar: 0 mm at the bottom, `top` at the top, labelled at
-/// round steps in mm.
-fn colour_bar_ui(ui: &mut egui::Ui, top: f64) {
-    let label_width = 56.0;
+/// round steps in mm, and each of `marks` (name, mm) as a line across it
+/// with its name and value.
+fn colour_bar_ui(ui: &mut egui::Ui, top: f64, marks: &[(&str, f64)]) {
+    let label_width = 150.0;
     let (rect, response) = ui.allocate_exact_size(
         egui::vec2(BAR_WIDTH + label_width, PLOT_HEIGHT),
         egui::Sense::hover(),
@@ -187,6 +206,39 @@ fn colour_bar_ui(ui: &mut egui::Ui, top: f64) {
     // The top is always labelled (0.12 on steps of 0.05).
     if values.last().is_some_and(|last| top - last > step * 0.3) {
         values.push(top);
+    }
+    let mark_colour = if ui.visuals().dark_mode {
+        egui::Color32::WHITE
+    } else {
+        egui::Color32::BLACK
+    };
+    let mut marked: Vec<f32> = Vec::new();
+    for (name, v) in marks {
+        if !(v.is_finite() && *v >= 0.0 && *v <= top * (1.0 + 1e-9)) {
+            continue;
+        }
+        let y = y_of(*v);
+        painter.line_segment(
+            [
+                egui::pos2(bar.left() - 2.0, y),
+                egui::pos2(bar.right() + 10.0, y),
+            ],
+            egui::Stroke::new(2.0, mark_colour),
+        );
+        // Two marks close together: the second one's words below.
+        let dy = if marked.iter().any(|m| (m - y).abs() < 12.0) {
+            12.0
+        } else {
+            0.0
+        };
+        marked.push(y);
+        painter.text(
+            egui::pos2(bar.right() + 62.0, y + dy),
+            egui::Align2::LEFT_CENTER,
+            format!("{name} {v:.3}"),
+            egui::FontId::proportional(12.0),
+            text,
+        );
     }
     for v in values {
         let y = y_of(v);
@@ -233,5 +285,18 @@ mod tests {
             colour_bar_label(0.12),
             "colour scale: 0 mm (green) to 0.12 mm (red)"
         );
+    }
+
+    /// Issue 34: cells of 0.112 mm passing a 0.5 mm tolerance are green,
+    /// not red: the scale runs to the tolerance when it is larger.
+    #[test]
+    fn the_scale_reaches_the_tolerance() {
+        let top = map_scale(0.150, 0.5);
+        assert!((top - 0.5).abs() < 1e-12, "{top}");
+        let c = cell_colour(0.112, top).to_array();
+        assert!(c[1] > c[0], "a passing cell is green-ish: {c:?}");
+        // Beyond the tolerance, the largest value sets it.
+        assert!((map_scale(0.7, 0.5) - 0.8).abs() < 1e-12);
+        assert!((map_scale(0.113, f64::NAN) - 0.12).abs() < 1e-12);
     }
 }

@@ -44,7 +44,11 @@ pub(super) fn row(ui: &mut egui::Ui, cells: impl IntoIterator<Item = impl Into<e
     ui.end_row();
 }
 
-pub(super) fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
+pub(super) fn tables_ui(
+    ui: &mut egui::Ui,
+    view: &ResultView,
+    tolerance: &crate::engine::tools::result_view::Tolerance,
+) {
     // One above the other: with ± 1σ the joint table needs the width.
     hand_eye_ui(ui, view);
     super::fixed::fixed_ui(ui, view);
@@ -65,7 +69,7 @@ pub(super) fn tables_ui(ui: &mut egui::Ui, view: &ResultView) {
             }
         });
     }
-    ml_tables_ui(ui, view);
+    ml_tables_ui(ui, view, tolerance);
     egui::CollapsingHeader::new("Details: the solver block as written in the result file").show(
         ui,
         |ui| {
@@ -220,7 +224,11 @@ fn joint_errors_ui(ui: &mut egui::Ui, view: &ResultView) {
 /// `ml`'s diagnostics as tables: outliers, leave-one-station-out and the
 /// strong correlations (each collapsible, open when it has something to
 /// say).
-fn ml_tables_ui(ui: &mut egui::Ui, view: &ResultView) {
+fn ml_tables_ui(
+    ui: &mut egui::Ui,
+    view: &ResultView,
+    tolerance: &crate::engine::tools::result_view::Tolerance,
+) {
     let Some(ml) = view.file.solver.ml() else {
         return;
     };
@@ -233,7 +241,7 @@ fn ml_tables_ui(ui: &mut egui::Ui, view: &ResultView) {
         if let Some(w) = &r.warning {
             ui.label(RichText::new(format!("warning: {w}")).color(WARN));
         }
-        super::range_map::range_map_ui(ui, r);
+        super::range_map::range_map_ui(ui, r, tolerance.std_mm);
     }
     egui::CollapsingHeader::new(format!(
         "Outliers ({}; limit {:.1} σ)",

@@ -65,7 +65,7 @@ pub fn results_ui(
             ui.add_space(4.0);
             figures::plots_ui(ui, view);
             ui.add_space(8.0);
-            tables::tables_ui(ui, view);
+            tables::tables_ui(ui, view, &forms.tolerance);
         });
 }
 

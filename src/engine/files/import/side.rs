@@ -131,10 +131,18 @@ pub fn decide_side(spec: &PoseImportSpec, inputs: &PoseInputs) -> Result<Importe
         } else {
             "the two scatters are too close to tell"
         };
+        let diameter = tried
+            .iter()
+            .find_map(|t| t.imported.as_ref().ok())
+            .and_then(|i| diameter_misfit(&i.session));
+        let advice = diameter.map_or_else(
+            || "give the side (--side +1 or --side -1)".to_string(),
+            |d| format!("{d}; if it is right, give the side (--side +1 or --side -1)"),
+        );
         return Err(ImportError::File {
             path: spec.poses.clone(),
             message: format!(
-                "cannot tell from the data on which side of the laser plane the sphere lies: {reason} ({evidence}; one must be {SIDE_EVIDENCE_RATIO}× smaller): give the side (--side +1 or --side -1)"
+                "cannot tell from the data on which side of the laser plane the sphere lies: {reason} ({evidence}; one must be {SIDE_EVIDENCE_RATIO}× smaller): {advice}"
             ),
         });
     };
@@ -145,6 +153,61 @@ pub fn decide_side(spec: &PoseImportSpec, inputs: &PoseInputs) -> Result<Importe
         label(chosen.side)
     ));
     Ok(imported)
+}
+
+/// Stripes whose circle is larger than the sphere, as a share of the
+/// fitted ones, beyond which the diameter is in doubt: a few such stripes
+/// are noise or a bad profile, a tenth is the sphere.
+pub const OVERSIZED_SHARE: f64 = 0.1;
+
+/// Largest stripe circle, as a share of the sphere radius, below which the
+/// diameter is in doubt: every cut would lie more than 66° from the
+/// centre, where the planner's cuts lie at about 40° (r = 0.77 R) and at
+/// most 80°.
+pub const LARGEST_RADIUS_SHARE: f64 = 0.4;
+
+/// Whether the stripes' circle radii fit the session's sphere: `None`
+/// when they do, else "check the sphere diameter" with the figures (many
+/// circles larger than the sphere, or every one far smaller than it).
+#[must_use]
+pub fn diameter_misfit(session: &crate::engine::base::session::Session) -> Option<String> {
+    use crate::engine::calibrate::stripe::StripeError;
+    let big_r = session.sphere_diameter / 2.0;
+    let analysis = solve::prepare::analyse(session);
+    let mut radii = Vec::new();
+    let mut oversized = Vec::new();
+    for m in &analysis.measurements {
+        match m {
+            Ok(p) => {
+                if let Some(s) = &p.stripe {
+                    radii.push(s.fit.radius);
+                }
+            }
+            Err(StripeError::RadiusTooLarge { r, .. }) => oversized.push(*r),
+            Err(_) => {}
+        }
+    }
+    let fitted = radii.len() + oversized.len();
+    if fitted == 0 {
+        return None;
+    }
+    let d = crate::engine::base::numeric::show(session.sphere_diameter);
+    if oversized.len() as f64 >= OVERSIZED_SHARE * fitted as f64 {
+        let largest = oversized.iter().copied().fold(0.0_f64, f64::max);
+        return Some(format!(
+            "{} of {fitted} stripe circles are larger than the sphere (r up to {largest:.2} mm, R = {big_r:.2} mm of the {d} mm diameter given): check the sphere diameter (--sphere-diameter)",
+            oversized.len()
+        ));
+    }
+    let largest = radii.iter().copied().fold(0.0_f64, f64::max);
+    (largest < LARGEST_RADIUS_SHARE * big_r).then(|| {
+        let smallest = radii.iter().copied().fold(f64::INFINITY, f64::min);
+        format!(
+            "the stripe circles' radii run from {smallest:.2} to {largest:.2} mm, at most {:.0} % of the sphere radius R = {big_r:.2} mm of the {d} mm diameter given (the circles need a ball of at least {:.1} mm): check the sphere diameter (--sphere-diameter)",
+            100.0 * largest / big_r,
+            2.0 * largest
+        )
+    })
 }
 
 /// The whole import of a pose file: [`read_pose_inputs`], then the side

@@ -22,7 +22,7 @@ use crate::engine::calibrate::solve::estimate::{
 };
 use crate::engine::calibrate::solve::ml::range::{AlignedGrid, RANGE_POSES};
 use crate::engine::calibrate::solve::ml::{self, MlOptions, MlReport};
-use crate::engine::calibrate::solve::{self, HandEyeSource, Method, Options, Prepared};
+use crate::engine::calibrate::solve::{self, Control, HandEyeSource, Method, Options, Prepared};
 use crate::engine::tools::simulate::SimConfig;
 
 use super::select::{Info, StationInfo, rotation_criterion};
@@ -583,7 +583,13 @@ impl Planner<'_> {
         session: &Session,
         prepared: &Prepared,
     ) -> Result<MlReport, PlanError> {
-        let options = Options {
+        ml::analyse(session, prepared, &self.analysis_options()).map_err(PlanError::Analysis)
+    }
+
+    /// `ml`'s settings for the planner's analyses: no update, the plan's
+    /// joint noise, no cross-validation.
+    fn analysis_options(&self) -> Options {
+        Options {
             method: Method::Ml,
             threshold: 0.0,
             max_iterations: 0,
@@ -594,12 +600,18 @@ impl Planner<'_> {
                 ..MlOptions::default()
             },
             held_out: false,
-        };
-        ml::analyse(session, prepared, &options).map_err(PlanError::Analysis)
+        }
     }
 
-    /// `ml`'s analysis of every identify candidate.
-    pub(super) fn pool_report(&self, sites: &[Site]) -> Result<MlReport, PlanError> {
+    /// The parameters `ml` estimates from every identify candidate (its
+    /// identifiable set; [`ml::identifiable`]). `step` is told each of
+    /// the analysis's looks at the cancel (see [`analysis_steps`]) and
+    /// may cancel.
+    pub(super) fn pool_estimated(
+        &self,
+        sites: &[Site],
+        step: &mut dyn FnMut() -> Control,
+    ) -> Result<Vec<String>, PlanError> {
         let poses: Vec<(String, Use, Candidate)> = sites
             .iter()
             .enumerate()
@@ -611,7 +623,11 @@ impl Planner<'_> {
             })
             .collect();
         let (session, prepared) = self.analysis_input(&poses, &[]);
-        self.analyse(&session, &prepared)
+        ml::identifiable(&session, &prepared, &self.analysis_options(), &mut |_| {
+            step()
+        })
+        .map_err(PlanError::Analysis)?
+        .ok_or(PlanError::Cancelled)
     }
 
     /// `ml`'s analysis of the plan's identify and validate poses.

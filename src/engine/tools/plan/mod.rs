@@ -91,8 +91,8 @@ use crate::engine::base::cell::random;
 use crate::engine::base::robot::ik::{Chain, DOF};
 use crate::engine::base::robot::{JointLimit, Robot};
 use crate::engine::base::session::{SensorRange, Use};
-use crate::engine::calibrate::solve::ml::Inseparable;
 use crate::engine::calibrate::solve::ml::range::RangeError;
+use crate::engine::calibrate::solve::ml::{Inseparable, SETUP_CHECK};
 use crate::engine::calibrate::solve::{Control, SolveError};
 use crate::engine::tools::simulate::{PlanPose, SimError};
 
@@ -127,8 +127,8 @@ pub use export::{
 };
 use order::{Metric, order_groups};
 pub use predict::{
-    PredictConfig, Prediction, RangePrediction, RunScore, VolumePrediction, predict,
-    simulated_true_hand_eye,
+    MAX_PREDICT_RUNS, PredictConfig, Prediction, RangePrediction, RunScore, VolumePrediction,
+    predict, simulated_true_hand_eye,
 };
 pub use request::{PlanRequest, RequestError, read_hand_eye, read_stations};
 pub use select::VolumeError;
@@ -371,8 +371,16 @@ pub enum PlanStage {
         /// Stations in all.
         of: usize,
     },
-    /// The `ml` identifiability analysis of the candidate pool.
-    Analysis,
+    /// The `ml` identifiability analysis of the candidate pool: `done`
+    /// of about `of` steps (the analysis's looks at the cancel: every
+    /// [`ml::SETUP_CHECK`](crate::engine::calibrate::solve::ml::SETUP_CHECK)
+    /// candidates twice, one a pivot), then one a station's information.
+    Analysis {
+        /// Steps done.
+        done: usize,
+        /// Steps in all (an estimate; `done` stays below it).
+        of: usize,
+    },
     /// Greedy selection and exchange passes.
     Selection,
     /// Ordering and the analysis of the chosen plan.
@@ -546,22 +554,34 @@ fn choose_poses(
     cancel: &mut dyn FnMut(PlanStage) -> Result<(), PlanError>,
 ) -> Result<Chosen, PlanError> {
     let config = planner.config;
-    cancel(PlanStage::Analysis)?;
-    let pool = planner.pool_report(sites)?;
-    let estimated = unknown_indices(&config.robot, &pool.estimated);
-    let infos: Vec<Vec<Info>> = sites
+    let pool: usize = sites
         .iter()
-        .map(|s| {
-            if s.role == StationRole::Identify {
-                s.candidates
-                    .iter()
-                    .map(|c| planner.info(c, &estimated))
-                    .collect()
-            } else {
-                Vec::new()
-            }
-        })
-        .collect();
+        .filter(|s| s.role == StationRole::Identify)
+        .map(|s| s.candidates.len())
+        .sum();
+    let of = analysis_steps(pool, config.robot.n_params()) + sites.len();
+    let mut done = 0;
+    cancel(PlanStage::Analysis { done, of })?;
+    let labels = planner.pool_estimated(sites, &mut || {
+        done = (done + 1).min(of - sites.len() - 1);
+        match cancel(PlanStage::Analysis { done, of }) {
+            Ok(()) => Control::Continue,
+            Err(_) => Control::Cancel,
+        }
+    })?;
+    let estimated = unknown_indices(&config.robot, &labels);
+    let mut infos: Vec<Vec<Info>> = Vec::with_capacity(sites.len());
+    for (done, s) in (of - sites.len() + 1..).zip(sites.iter()) {
+        cancel(PlanStage::Analysis { done, of })?;
+        infos.push(if s.role == StationRole::Identify {
+            s.candidates
+                .iter()
+                .map(|c| planner.info(c, &estimated))
+                .collect()
+        } else {
+            Vec::new()
+        });
+    }
     let prior = prior_information(&estimated);
 
     cancel(PlanStage::Selection)?;
@@ -602,7 +622,17 @@ fn choose_poses(
     };
     let chosen = match config.design.selection {
         Selection::Volume | Selection::DOptimal => {
-            greedy_selection(planner, sites, &identify_sites, &infos, &prior, &objective)
+            let mut stop = || cancel(PlanStage::Selection).is_err();
+            greedy_selection(
+                planner,
+                sites,
+                &identify_sites,
+                &infos,
+                &prior,
+                &objective,
+                &mut stop,
+            )
+            .ok_or(PlanError::Cancelled)?
         }
         Selection::Random => random,
     };
@@ -622,6 +652,14 @@ fn choose_poses(
         volume: volume_error(&selection),
         volume_random,
     })
+}
+
+/// About how many times the identifiability analysis of `pool`
+/// candidates of a robot of `n_params` looks at the cancel: every
+/// [`SETUP_CHECK`] candidates while whitening and again while building
+/// the Jacobian, once a pivot of the `6 + n_params` unknowns.
+fn analysis_steps(pool: usize, n_params: usize) -> usize {
+    2 * pool.div_ceil(SETUP_CHECK) + 6 + n_params + 1
 }
 
 /// The chosen poses in visit order: the groups (the hand-eye ones, then

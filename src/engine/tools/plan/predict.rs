@@ -14,6 +14,11 @@ use crate::engine::tools::simulate::{self, ErrorModel, InitialHandEye, PlanExecu
 use super::config::check;
 use super::*;
 
+/// Most simulated calibrations of a prediction (`--predict-runs`, the
+/// Plan view): a few seconds each at most, and the spread of the
+/// prediction settles long before.
+pub const MAX_PREDICT_RUNS: usize = 1000;
+
 /// How [`predict`] simulates the plan.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PredictConfig {
@@ -197,8 +202,21 @@ pub fn predict(
         options.ml.cross_validation = false;
         options.held_out = false;
         let prepared = solve::prepare(&session).map_err(|e| fail(e.into()))?;
-        let cal = solve::run(&session, &prepared, &options, &mut |_| Control::Continue)
-            .map_err(|e| fail(e.into()))?;
+        // A cancel is looked at inside each run too (its ε and phases):
+        // `progress` hears the runs done so far again.
+        let mut cancelled = false;
+        let cal = solve::run(&session, &prepared, &options, &mut |_| {
+            cancelled = progress(k, config.runs) == Control::Cancel;
+            if cancelled {
+                Control::Cancel
+            } else {
+                Control::Continue
+            }
+        })
+        .map_err(|e| fail(e.into()))?;
+        if cancelled {
+            return Err(PlanError::Cancelled);
+        }
         let score = evaluate::score(&session, &prepared, &truth, &cal.calibrated, &cal.hand_eye);
         let range = range_score(
             &session,

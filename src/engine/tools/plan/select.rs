@@ -291,7 +291,8 @@ pub(super) fn greedy_selection(
     infos: &[Vec<Info>],
     prior: &DMatrix<f64>,
     objective: &Objective,
-) -> Vec<(usize, Vec<usize>)> {
+    stop: &mut dyn FnMut() -> bool,
+) -> Option<Vec<(usize, Vec<usize>)>> {
     let n = planner.config.design.identify_poses;
     let k = prior.nrows();
     let mut chosen: Vec<Vec<usize>> = identify
@@ -314,14 +315,20 @@ pub(super) fn greedy_selection(
         infos,
         n,
     };
-    match objective {
-        Objective::LogDet => greedy.lazy(&mut chosen, &mut stations, &mut m),
-        Objective::Range(_) => greedy.full(&mut chosen, &mut stations, &mut m, objective),
+    let went_on = match objective {
+        Objective::LogDet => greedy.lazy(&mut chosen, &mut stations, &mut m, stop),
+        Objective::Range(_) => greedy.full(&mut chosen, &mut stations, &mut m, objective, stop),
+    };
+    if !went_on {
+        return None;
     }
     // Exchange passes: swap a chosen pose for a better one of its side.
     for _ in 0..EXCHANGE_PASSES {
         let mut swapped = false;
         for (slot, &s) in identify.iter().enumerate() {
+            if stop() {
+                return None;
+            }
             for pos in 0..chosen[slot].len() {
                 let Some((current, _)) = m.clone().cholesky().map(|c| objective.at(&c)) else {
                     continue;
@@ -363,7 +370,7 @@ pub(super) fn greedy_selection(
             break;
         }
     }
-    identify.iter().copied().zip(chosen).collect()
+    Some(identify.iter().copied().zip(chosen).collect())
 }
 
 /// The greedy additions of [`greedy_selection`]: until every station is
@@ -412,8 +419,12 @@ impl Greedy<'_> {
         stations: &mut [StationInfo],
         m: &mut DMatrix<f64>,
         objective: &Objective,
-    ) {
+        stop: &mut dyn FnMut() -> bool,
+    ) -> bool {
         while let Some(chol) = m.clone().cholesky() {
+            if stop() {
+                return false;
+            }
             let qt = objective.prepare(&chol);
             let mut best: Option<(f64, usize, usize)> = None;
             for (slot, &s) in self.identify.iter().enumerate() {
@@ -432,6 +443,7 @@ impl Greedy<'_> {
             };
             self.add(slot, cand, chosen, stations, m);
         }
+        true
     }
 
     /// The same additions for `ln det`, lazily (Minoux's accelerated
@@ -450,10 +462,11 @@ impl Greedy<'_> {
         chosen: &mut [Vec<usize>],
         stations: &mut [StationInfo],
         m: &mut DMatrix<f64>,
-    ) {
+        stop: &mut dyn FnMut() -> bool,
+    ) -> bool {
         use std::collections::BinaryHeap;
         let Some(mut chol) = m.clone().cholesky() else {
-            return;
+            return true;
         };
         let mut step = 0_usize;
         // (bound, slot, cand, step of the bound), largest bound first,
@@ -484,8 +497,11 @@ impl Greedy<'_> {
             self.add(slot, cand, chosen, stations, m);
             step += 1;
             changed[slot] = step;
+            if stop() {
+                return false;
+            }
             let Some(c) = m.clone().cholesky() else {
-                return;
+                return true;
             };
             chol = c;
             let s = self.identify[slot];
@@ -496,6 +512,7 @@ impl Greedy<'_> {
                 }
             }
         }
+        true
     }
 }
 
@@ -671,9 +688,15 @@ mod tests {
             n,
         };
         let (mut full, mut st_full, mut m_full) = start();
-        greedy.full(&mut full, &mut st_full, &mut m_full, &Objective::LogDet);
+        greedy.full(
+            &mut full,
+            &mut st_full,
+            &mut m_full,
+            &Objective::LogDet,
+            &mut || false,
+        );
         let (mut lazy, mut st_lazy, mut m_lazy) = start();
-        greedy.lazy(&mut lazy, &mut st_lazy, &mut m_lazy);
+        greedy.lazy(&mut lazy, &mut st_lazy, &mut m_lazy, &mut || false);
         assert!(full.iter().all(|c| c.len() == n));
         assert_eq!(full, lazy);
     }

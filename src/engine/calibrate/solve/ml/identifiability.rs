@@ -8,6 +8,7 @@ use std::fmt;
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
+use super::SETUP_CHECK;
 use super::problem::Obs;
 use crate::engine::base::numeric::as_written;
 use crate::engine::calibrate::handeye::Sighting;
@@ -129,14 +130,10 @@ pub(super) fn pivot_weight(est: &Estimate, u: usize) -> f64 {
     }
 }
 
-/// Stations between two looks at the cancel while the projected Jacobian
-/// is built (a few milliseconds' work).
-const STATIONS_PER_CHECK: usize = 128;
-
 /// QR with column pivoting of the projected, scaled, whitened Jacobian of
 /// all `6 + 5n` parameters (modified Gram-Schmidt, re-orthogonalised), and
 /// the naming of the fixed parameters. `go_on` is asked every
-/// [`STATIONS_PER_CHECK`] stations and at every pivot; `None` when it
+/// [`SETUP_CHECK`] measurements and at every pivot; `None` when it
 /// says stop.
 pub(super) fn identifiability(
     obs: &[Obs],
@@ -156,9 +153,14 @@ pub(super) fn identifiability(
             m.push(o);
         }
     }
-    for (s, mine) in members.into_iter().enumerate() {
-        if s % STATIONS_PER_CHECK == 0 && !go_on() {
-            return None;
+    let mut unchecked = 0;
+    for mine in members {
+        unchecked += mine.len();
+        if unchecked >= SETUP_CHECK {
+            unchecked = 0;
+            if !go_on() {
+                return None;
+            }
         }
         if mine.is_empty() {
             continue;

@@ -110,8 +110,8 @@ pub mod variance;
 
 use nalgebra::Vector3;
 
-use super::estimate::unknown_scale;
 use super::estimate::{Estimate, Station};
+use super::estimate::{unknown_label, unknown_scale};
 use super::prepare::Prepared;
 use super::{
     Control, HeldOut, HeldOutRecord, HeldOutScheme, Options, Phase, SolveError, SolverReport, Step,
@@ -183,7 +183,8 @@ fn whiten_at(
     })
 }
 
-/// Stations between two looks at the cancel while the problem is set up.
+/// Measurements between two looks at the cancel while the problem is set
+/// up (whitened, then in the identifiable set's Jacobian).
 pub const SETUP_CHECK: usize = 128;
 
 /// LM steps in one update of the loop. From the nominal model LM takes
@@ -296,7 +297,7 @@ impl<'a> MlUpdate<'a> {
     /// whitened by the noise model at the start, the identifiable set, the
     /// prior, and every station centre at the mean of its sightings.
     /// `phase` is told [`Phase::Setup`] every [`SETUP_CHECK`] measurements
-    /// and stations and at each pivot of the identifiable set; `Ok(None)`
+    /// (twice: whitened, then in the identifiable set's Jacobian) and at each pivot of the identifiable set; `Ok(None)`
     /// when it cancels.
     ///
     /// # Errors
@@ -326,10 +327,10 @@ impl<'a> MlUpdate<'a> {
             .collect();
         let mut obs = Vec::new();
         for (s, (_, idx)) in groups.iter().enumerate() {
-            if s % SETUP_CHECK == 0 && !go_on() {
-                return Ok(None);
-            }
             for &i in idx {
+                if obs.len() % SETUP_CHECK == 0 && !go_on() {
+                    return Ok(None);
+                }
                 let sighting = prepared.sighting(session, i);
                 let sensor_cov = sensor_covariance(&prepared.measurements[i], mo);
                 let whiten = whiten_at(start, &sighting, &sensor_cov, mo)?;
@@ -580,6 +581,36 @@ pub fn analyse(
         last_change: f64::INFINITY,
     };
     Ok(diagnostics::report(&update, &stop, &mut |_| Control::Continue).0)
+}
+
+/// The parameters `ml` estimates from a session (the labels of its
+/// identifiable set), and nothing more: the setup of [`analyse`] without
+/// its diagnostics (the planner's question about a candidate pool).
+/// `phase` is told [`Phase::Setup`] as [`MlUpdate::new`] tells it;
+/// `Ok(None)` when it cancels.
+///
+/// # Errors
+/// As [`MlUpdate::new`].
+pub fn identifiable(
+    session: &Session,
+    prepared: &Prepared,
+    options: &Options,
+    phase: &mut dyn FnMut(Phase) -> Control,
+) -> Result<Option<Vec<String>>, SolveError> {
+    let start = Estimate {
+        robot: session.robot.clone(),
+        flange_from_sensor: prepared.hand_eye_initial,
+        mount: session.mount,
+    };
+    let stations = prepared.stations(session, Use::Identify);
+    let update = MlUpdate::new(session, prepared, &start, stations, options, phase)?;
+    Ok(update.map(|u| {
+        u.problem
+            .estimated
+            .iter()
+            .map(|&k| unknown_label(k))
+            .collect()
+    }))
 }
 
 /// `ml`'s leave-one-pose-out figure by **exact** refits: the loop of

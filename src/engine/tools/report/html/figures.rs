@@ -112,6 +112,57 @@ pub fn fig6_plot(distances: &[DistanceRecord], width: f64) -> Plot {
     }
 }
 
+/// The after series of Fig. 5 (`errors` false) or Fig. 6 alone, on its
+/// own scale: on the before's it is a flat line at zero.
+#[must_use]
+pub fn after_only_plot(
+    title: &str,
+    y_label: &str,
+    after: Vec<[f64; 2]>,
+    errors: bool,
+    width: f64,
+) -> Plot {
+    Plot {
+        title: title.to_owned(),
+        x_label: if errors {
+            "reference distance no.".into()
+        } else {
+            "pair (station by station)".into()
+        },
+        y_label: y_label.to_owned(),
+        series: vec![Series {
+            name: "after (calibrated)".into(),
+            colour: AFTER_COLOUR.into(),
+            points: after,
+            marker: Marker::Circle,
+            line: true,
+        }],
+        rules: if errors {
+            vec![Rule {
+                y: 0.0,
+                colour: svg::MUTED.into(),
+                dashed: false,
+                label: String::new(),
+            }]
+        } else {
+            Vec::new()
+        },
+        include_zero: true,
+        x_integer: true,
+        width,
+        height: FIG_HEIGHT,
+        ..Plot::default()
+    }
+}
+
+/// Values numbered from 1, as a plot's points.
+fn numbered(values: impl Iterator<Item = f64>) -> Vec<[f64; 2]> {
+    values
+        .enumerate()
+        .map(|(k, v)| [(k + 1) as f64, v])
+        .collect()
+}
+
 /// ε (mm) after 0, 1, … updates on a log scale, with the threshold.
 #[must_use]
 pub fn epsilon_plot(epsilons: &[f64], threshold: Option<f64>, width: f64) -> Plot {
@@ -257,6 +308,43 @@ pub(super) fn figures(h: &mut String, ctx: &Ctx<'_>) {
                 distances.len()
             ),
         );
+    }
+    // The after series alone, each on its own scale.
+    let fig6_after = (!distances.is_empty()).then(|| {
+        after_only_plot(
+            "Fig. 6, after only (its own scale)",
+            "error (mm)",
+            numbered(distances.iter().map(DistanceRecord::error_after)),
+            true,
+            HALF,
+        )
+    });
+    if !ctx.within.is_empty() || fig6_after.is_some() {
+        h.push_str("<div class=\"grid2\">\n");
+        if !ctx.within.is_empty() {
+            let plot = after_only_plot(
+                "Fig. 5, after only (its own scale)",
+                "centre distance (mm)",
+                numbered(ctx.within.iter().map(|p| p.after)),
+                false,
+                HALF,
+            );
+            figure(
+                h,
+                "fig5-after",
+                &svg::render(&plot),
+                "Fig. 5's calibrated distances alone, on their own scale (on the before's they lie flat at zero).",
+            );
+        }
+        if let Some(plot) = fig6_after {
+            figure(
+                h,
+                "fig6-after",
+                &svg::render(&plot),
+                "Fig. 6's calibrated errors alone, on their own scale.",
+            );
+        }
+        h.push_str("</div>\n");
     }
     // ε, and the singular values of the paper's method.
     h.push_str("<div class=\"grid2\">\n");
