@@ -20,3 +20,4 @@ mod model_export;
 mod plan;
 mod report;
 mod report_browser;
+mod volume_check;
