@@ -138,12 +138,8 @@ struct Row {
 }
 
 /// The plan's rows on the true robot: the sphere where each station's
-/// first row sees it; rows that miss it dropped (counted).
-fn plan_rows(
-    rows: &[PlanPose],
-    truth: &Robot,
-    hand_eye: &Isometry3<f64>,
-) -> (Vec<Row>, Vec<(String, Vector3<f64>)>, usize) {
+/// first row sees it; rows that miss it dropped (and counted).
+fn plan_rows(rows: &[PlanPose], truth: &Robot, hand_eye: &Isometry3<f64>) -> (Vec<Row>, usize) {
     let see = |q: &[f64]| truth.base_from_flange(q) * hand_eye;
     let mut stations: Vec<(String, Vector3<f64>)> = Vec::new();
     let (mut out, mut missed) = (Vec::new(), 0);
@@ -169,7 +165,7 @@ fn plan_rows(
             centre,
         });
     }
-    (out, stations, missed)
+    (out, missed)
 }
 
 /// Our validate stations and poses on the true robot.
@@ -316,7 +312,7 @@ fn cell(dir: &Path, plan: &[PlanPose], seed: u64) -> Cell {
     let mut rng = ChaCha8Rng::seed_from_u64(0x5EED_0032_0000 + seed);
     let truth = true_robot(&preset.robot, &mut rng);
     let hand_eye = simulated_true_hand_eye(&config.flange_from_sensor);
-    let (mut rows, _, missed) = plan_rows(plan, &truth, &hand_eye);
+    let (mut rows, missed) = plan_rows(plan, &truth, &hand_eye);
     let planned = plan.iter().filter(|p| p.usage != Use::Validate).count();
     let (validate, v_stations) = validate_rows(
         &mut rng,
