@@ -57,6 +57,16 @@
 //!    until none improves. Validate poses are spread instead (farthest
 //!    point in flange orientation); the rotation group maximises
 //!    `ln det Σ (R_i − R_j)ᵀ(R_i − R_j)` (eq. 8's normal matrix).
+//!    The default objective ([`Selection::Volume`]) is I-optimal instead:
+//!    the same greedy additions and exchanges minimise `tr(Q·M⁻¹)`, the
+//!    mean square predicted σ of a sphere centre (after the rigid
+//!    alignment) over poses sampled in the working volume
+//!    ([`VOLUME_SAMPLES`]: the station box × the viewing axis tilted
+//!    [`VOLUME_TILT_DEG`] from straight down over [`VOLUME_ARC_DEG`] ×
+//!    the spin). In both, the information of the `P0` groups (one station)
+//!    is part of the prior, and identify and validate candidates see the
+//!    sphere within [`DEFAULT_STATION_SPREAD_MM`] of the laser plane's
+//!    centre (`PlanConfig::station_spread`; over the range with a spread).
 //! 4. **Order** for short robot moves: stations in nearest-neighbour order
 //!    of their positions (the tripod moves least too), and within a
 //!    station's group nearest neighbour then 2-opt on the weighted joint
