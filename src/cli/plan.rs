@@ -103,9 +103,12 @@ pub struct PlanArgs {
     /// Half-range of the spin about the viewing axis in the working volume the plan is made for, deg (the flange turned about its approach from the roll with its x axis toward the station).
     #[arg(long, value_name = "DEG", default_value_t = plan::DEFAULT_SPIN_DEG)]
     pub spin: f64,
-    /// Choose identify poses for the smallest predicted measuring error over the working volume (I-optimal: station box × approach cone × spin) instead of D-optimally (ln det, the parameters as a whole).
-    #[arg(long, conflicts_with = "random")]
+    /// Choose identify poses for the smallest predicted measuring error over the working volume (I-optimal: station box × viewing axis 10-40° from straight down over a 200° arc × spin): the default; kept for scripts.
+    #[arg(long, conflicts_with_all = ["random", "d_optimal"])]
     pub volume: bool,
+    /// Choose identify poses D-optimally (ln det, the parameters as a whole) instead of for the working volume.
+    #[arg(long, conflicts_with = "random")]
+    pub d_optimal: bool,
     /// Flange orientations drawn per station (each with every IK branch and both sides).
     #[arg(long, default_value_t = plan::DEFAULT_CANDIDATES)]
     pub candidates: usize,
@@ -264,10 +267,10 @@ pub fn request(args: &PlanArgs) -> Result<PlanRequest, CliError> {
             candidates: args.candidates,
             selection: if args.random {
                 Selection::Random
-            } else if args.volume {
-                Selection::Volume
-            } else {
+            } else if args.d_optimal {
                 Selection::DOptimal
+            } else {
+                Selection::Volume
             },
             seed: args.seed,
         },

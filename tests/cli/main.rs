@@ -23,3 +23,4 @@ mod plan;
 mod report;
 mod report_browser;
 mod tracker_cells;
+mod volume_check;

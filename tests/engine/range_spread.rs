@@ -193,7 +193,10 @@ fn the_planner_spreads_the_sphere_and_compares() {
     let unspread = made.stats.range_error_unspread.as_ref().unwrap();
     assert_eq!(spread.region, "sensor.range");
     assert!(
-        unspread.rms_mm > 2.0 * spread.rms_mm,
+        // Without the spread the sphere is still seen within ±12 mm of
+        // the plane's centre (the plan's default, issue 32), not at the
+        // paper's ±2, ±3 mm spot: the spread still lowers it by a third.
+        unspread.rms_mm > 1.5 * spread.rms_mm,
         "{} vs {}",
         unspread.rms_mm,
         spread.rms_mm
@@ -236,7 +239,8 @@ fn a_spread_plan_is_within_1_2_times_the_floor_over_the_range() {
             .unwrap();
         assert!(spread.ratio <= 1.2, "{errors}: {spread:?}");
         assert!(spot.ratio > spread.ratio + 0.2, "{errors}: {spot:?}");
-        assert!(spot.predicted_rms > 2.0 * spread.predicted_rms);
+        // The spot is the default ±12 mm about the plane's centre.
+        assert!(spot.predicted_rms > 1.5 * spread.predicted_rms);
         assert!(spot.after_max > spread.after_max);
         let agreement = spread.model_rms / spread.predicted_rms;
         assert!((0.8..=1.2).contains(&agreement), "{errors}: {agreement}");

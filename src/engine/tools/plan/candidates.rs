@@ -26,7 +26,10 @@ use crate::engine::calibrate::solve::{self, Control, HandEyeSource, Method, Opti
 use crate::engine::tools::simulate::SimConfig;
 
 use super::select::{Info, StationInfo, rotation_criterion};
-use super::{Plan, PlanConfig, PlanError, PlannedPose, StationLayout, StationRole, VOLUME_SAMPLES};
+use super::{
+    Plan, PlanConfig, PlanError, PlannedPose, StationLayout, StationRole, VOLUME_ARC_DEG,
+    VOLUME_SAMPLES, VOLUME_TILT_DEG,
+};
 use crate::engine::calibrate::solve::estimate::unknown_scale;
 
 /// Reference FK must put the planned centre on the station to this, mm
@@ -238,7 +241,12 @@ impl Planner<'_> {
     pub(super) fn station_offset(&self, rng: &mut ChaCha8Rng, k: usize, n: usize) -> Vector3<f64> {
         let c = self.config;
         let (true, Some(r)) = (c.spread, c.range) else {
-            return self.offset(rng);
+            let [y, z] = c.station_spread;
+            return Vector3::new(
+                0.0,
+                random::uniform(rng, -y, y),
+                random::uniform(rng, -z, z),
+            );
         };
         // A jittered `side × side` grid (the orientations are random, so
         // cell order does not matter).
@@ -704,8 +712,10 @@ impl Planner<'_> {
     }
 
     /// Poses sampled over the working volume: [`VOLUME_SAMPLES`] places
-    /// uniform in [`Self::volume_box`], at each an approach in the cone
-    /// about the look from the eye point and a spin within `±spin_deg`
+    /// uniform in [`Self::volume_box`], at each a viewing axis (the flange
+    /// approach) tilted [`VOLUME_TILT_DEG`] from straight down toward an
+    /// azimuth within [`VOLUME_ARC_DEG`] about the horizontal direction
+    /// from the robot base to the place, and a spin within `±spin_deg`
     /// about it from the reference roll (the flange x axis toward the
     /// station, horizontally away from the robot), the sphere at the
     /// planned centre on alternating sides; the first reachable IK branch
@@ -714,14 +724,12 @@ impl Planner<'_> {
     pub(super) fn volume_samples(&self, rng: &mut ChaCha8Rng) -> Vec<Candidate> {
         let c = self.config;
         let (lo, hi) = self.volume_box();
-        let cone = c.cone_angle.to_radians();
         let spin = c.spin_deg.to_radians();
         let base = self.config.robot.base.translation.vector;
         let mut out = Vec::with_capacity(VOLUME_SAMPLES);
         for k in 0..VOLUME_SAMPLES {
             let place = Vector3::from_fn(|i, _| random::uniform(rng, lo[i], hi[i]));
             let side: i8 = if k % 2 == 0 { 1 } else { -1 };
-            let mean = self.mean_approach(&place);
             let outward = {
                 let d = place - base;
                 let h = Vector3::new(d.x, d.y, 0.0);
@@ -732,7 +740,16 @@ impl Planner<'_> {
                 }
             };
             for _ in 0..VOLUME_TRIES {
-                let approach_dir = approach::direction_in_cone(rng, &mean, cone);
+                let tilt =
+                    random::uniform(rng, VOLUME_TILT_DEG[0], VOLUME_TILT_DEG[1]).to_radians();
+                let azimuth = outward.y.atan2(outward.x)
+                    + random::uniform(rng, -VOLUME_ARC_DEG / 2.0, VOLUME_ARC_DEG / 2.0)
+                        .to_radians();
+                let approach_dir = Vector3::new(
+                    tilt.sin() * azimuth.cos(),
+                    tilt.sin() * azimuth.sin(),
+                    -tilt.cos(),
+                );
                 let turn = random::uniform(rng, -spin, spin);
                 let reference = outward - approach_dir * outward.dot(&approach_dir);
                 let x0 = if reference.norm() > 1e-9 {

@@ -57,6 +57,16 @@
 //!    until none improves. Validate poses are spread instead (farthest
 //!    point in flange orientation); the rotation group maximises
 //!    `ln det Σ (R_i − R_j)ᵀ(R_i − R_j)` (eq. 8's normal matrix).
+//!    The default objective ([`Selection::Volume`]) is I-optimal instead:
+//!    the same greedy additions and exchanges minimise `tr(Q·M⁻¹)`, the
+//!    mean square predicted σ of a sphere centre (after the rigid
+//!    alignment) over poses sampled in the working volume
+//!    ([`VOLUME_SAMPLES`]: the station box × the viewing axis tilted
+//!    [`VOLUME_TILT_DEG`] from straight down over [`VOLUME_ARC_DEG`] ×
+//!    the spin). In both, the information of the `P0` groups (one station)
+//!    is part of the prior, and identify and validate candidates see the
+//!    sphere within [`DEFAULT_STATION_SPREAD_MM`] of the laser plane's
+//!    centre (`PlanConfig::station_spread`; over the range with a spread).
 //! 4. **Order** for short robot moves: stations in nearest-neighbour order
 //!    of their positions (the tripod moves least too), and within a
 //!    station's group nearest neighbour then 2-opt on the weighted joint
@@ -116,9 +126,10 @@ use candidates::{
 pub use config::{
     DEFAULT_BOX_MM, DEFAULT_CANDIDATES, DEFAULT_CENTRE_SPREAD_MM, DEFAULT_CONE_DEG,
     DEFAULT_CUT_ANGLE_DEG, DEFAULT_MIN_WRIST_DEG, DEFAULT_ROTATION_MAX_DEG,
-    DEFAULT_ROTATION_MIN_DEG, DEFAULT_SPIN_DEG, DEFAULT_TRANSLATION_STEP_MM, MAX_CANDIDATES,
-    MAX_GROUP_POSES, MAX_ORIENTATIONS, MAX_STATIONS, PlanConfig, PlanDesign, Selection,
-    StationLayout, VOLUME_SAMPLES, defaults,
+    DEFAULT_ROTATION_MIN_DEG, DEFAULT_SPIN_DEG, DEFAULT_STATION_SPREAD_MM,
+    DEFAULT_TRANSLATION_STEP_MM, MAX_CANDIDATES, MAX_GROUP_POSES, MAX_ORIENTATIONS, MAX_STATIONS,
+    PlanConfig, PlanDesign, Selection, StationLayout, VOLUME_ARC_DEG, VOLUME_SAMPLES,
+    VOLUME_TILT_DEG, defaults,
 };
 pub use entry::{PlanProgress, Planned, plan_and_predict};
 pub use export::{
@@ -582,7 +593,20 @@ fn choose_poses(
             Vec::new()
         });
     }
-    let prior = prior_information(&estimated);
+    // The hand-eye groups at P0 are calibration data too (one station,
+    // its centre eliminated): their information is in the prior the
+    // identify poses add to, so that these are not spent on what P0
+    // already gives.
+    let mut prior = prior_information(&estimated);
+    for s in sites.iter().filter(|s| s.role == StationRole::HandEye) {
+        let infos: Vec<Info> = s
+            .candidates
+            .iter()
+            .map(|c| planner.info(c, &estimated))
+            .collect();
+        let all: Vec<usize> = (0..infos.len()).collect();
+        prior += select::StationInfo::of(&infos, &all, estimated.len()).schur();
+    }
 
     cancel(PlanStage::Selection)?;
     let identify_sites: Vec<usize> = (0..sites.len())
@@ -925,7 +949,7 @@ pub fn summary(plan: &Plan) -> String {
     if let Some(v) = &st.volume_error {
         let _ = writeln!(
             s,
-            "  predicted measuring error over the working volume (σ of a sphere centre after the rigid alignment, {} sampled poses: station box × approach cone × spin): rms {:.4} mm, max {:.4} mm",
+            "  predicted measuring error over the working volume (σ of a sphere centre after the rigid alignment, {} sampled poses: station box × viewing axis 10-40° from straight down × spin): rms {:.4} mm, max {:.4} mm",
             v.samples, v.rms_mm, v.max_mm
         );
         if let Some(r) = &st.volume_error_random {
