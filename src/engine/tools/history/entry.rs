@@ -174,9 +174,7 @@ pub(super) fn build_entry(
         info.stds
             .get(label)
             .copied()
-            .or_else(|| {
-                cov(label, label).map(|v| crate::engine::base::numeric::sigma_of_variance(v))
-            })
+            .or_else(|| cov(label, label).map(crate::engine::base::numeric::sigma_of_variance))
             .filter(|s| s.is_finite())
     };
 
