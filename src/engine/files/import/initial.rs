@@ -121,6 +121,36 @@ fn scatter(
     if n > 0.0 { (ss / n).sqrt() } else { f64::NAN }
 }
 
+/// Each measurement's base-from-flange pose (the session's robot), the
+/// stripes' analysis, each measurement's station index (in order of first
+/// appearance) and the number of stations.
+fn sightings_of(session: &Session) -> (Vec<Isometry3<f64>>, Analysis, Vec<usize>, usize) {
+    let robot = session.robot.clone();
+    let poses = (0..session.measurements.len())
+        .map(|i| session.base_from_flange(&robot, i))
+        .collect();
+    let mut station_index: HashMap<&str, usize> = HashMap::new();
+    let stations = session
+        .measurements
+        .iter()
+        .map(|m| {
+            let next = station_index.len();
+            *station_index.entry(m.station.as_str()).or_insert(next)
+        })
+        .collect();
+    (poses, analyse(session), stations, station_index.len())
+}
+
+/// Each measurement's sphere centre in the sensor frame, where its stripe
+/// gave one.
+fn centres_of(analysis: &Analysis) -> Vec<Option<Vector3<f64>>> {
+    analysis
+        .measurements
+        .iter()
+        .map(|m| m.as_ref().ok().map(|p| p.centre_in_sensor))
+        .collect()
+}
+
 /// The centres' scatter (3-D rms about each station's mean, mm) under
 /// the session's initial hand-eye, when calibrate's verdict refuses it
 /// ([`check_scatter`]): the finished import's last check, a refusal for a
@@ -131,24 +161,8 @@ pub(crate) fn implausible_start(
     session: &Session,
 ) -> Option<crate::engine::calibrate::solve::plausible::ImplausibleScatter> {
     let he = session.hand_eye?;
-    let robot = session.robot.clone();
-    let poses: Vec<Isometry3<f64>> = (0..session.measurements.len())
-        .map(|i| session.base_from_flange(&robot, i))
-        .collect();
-    let centres: Vec<Option<Vector3<f64>>> = analyse(session)
-        .measurements
-        .iter()
-        .map(|m| m.as_ref().ok().map(|p| p.centre_in_sensor))
-        .collect();
-    let mut station_index: HashMap<&str, usize> = HashMap::new();
-    let stations: Vec<usize> = session
-        .measurements
-        .iter()
-        .map(|m| {
-            let next = station_index.len();
-            *station_index.entry(m.station.as_str()).or_insert(next)
-        })
-        .collect();
+    let (poses, analysis, stations, _) = sightings_of(session);
+    let centres = centres_of(&analysis);
     check_scatter(
         scatter(&poses, &centres, &stations, &he),
         session.pose_only(),
@@ -192,25 +206,8 @@ pub(crate) fn settle(
     for m in &mut session.measurements {
         m.usage = Use::Identify;
     }
-    let robot = session.robot.clone();
-    let poses: Vec<Isometry3<f64>> = (0..session.measurements.len())
-        .map(|i| session.base_from_flange(&robot, i))
-        .collect();
-    let analysis = analyse(&session);
-    let centres: Vec<Option<Vector3<f64>>> = analysis
-        .measurements
-        .iter()
-        .map(|m| m.as_ref().ok().map(|p| p.centre_in_sensor))
-        .collect();
-    let mut station_index: HashMap<&str, usize> = HashMap::new();
-    let stations: Vec<usize> = session
-        .measurements
-        .iter()
-        .map(|m| {
-            let next = station_index.len();
-            *station_index.entry(m.station.as_str()).or_insert(next)
-        })
-        .collect();
+    let (poses, analysis, stations, n_stations) = sightings_of(&session);
+    let centres = centres_of(&analysis);
     let ids: Vec<&str> = session.measurements.iter().map(|m| m.id.as_str()).collect();
     // A stripe that gives no sphere centre is bad input: named with its
     // profile file, before any hand-eye is tried.
@@ -231,7 +228,7 @@ pub(crate) fn settle(
         })
         .collect();
     let general: Result<GeneralHandEye, String> =
-        general_hand_eye(&sightings, station_index.len()).map_err(|e| e.to_string());
+        general_hand_eye(&sightings, n_stations).map_err(|e| e.to_string());
     // Eq. 6-9 when one station holds a group of one orientation.
     let paper = paper_hand_eye(&session, &poses, &centres, &stations, &ids);
     let mut notes = Vec::new();
