@@ -10,12 +10,14 @@ use std::time::Instant;
 
 use clap::Args;
 
+use crate::engine::assemble;
+use crate::engine::assemble::{ImportRequest, PoseLog};
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
 use crate::engine::files::import::{
     self, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
-    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportError, ImportRequest, ImportSpec,
-    ImportStage, Imported, Observations, PoseImportSpec, PoseLog, ProfileSource, SideChoice,
+    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportError, ImportSpec, ImportStage,
+    Imported, Observations, PoseImportSpec, ProfileSource, SideChoice,
 };
 
 use super::scan_flags::ScanFlags;
@@ -382,7 +384,7 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         checks,
         mut notes,
         ..
-    } = import::import_session(&request, &mut |stage| {
+    } = assemble::import_session(&request, &mut |stage| {
         // The side decision calibrates both sides: said at once.
         if stage == ImportStage::Side && !args.quiet {
             sayln!("deciding the side of the laser plane from the data (both calibrated)…");

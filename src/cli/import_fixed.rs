@@ -2,16 +2,16 @@
 //! tracker's table, a fixed camera's) or a fixed line scanner's stripe
 //! profiles, beside a joint log or a pose file, become a session with
 //! `sensor.mount: "fixed"`, through the one import entry
-//! ([`import_session`](crate::engine::files::import::import_session) with
+//! ([`import_session`](crate::engine::files::assemble::import_session) with
 //! [`PoseLog::Fixed`]).
 
 use crate::cli::CliError;
 use crate::cli::import::{ImportArgs, MountArg, joint_log_columns};
+use crate::engine::assemble;
+use crate::engine::assemble::{ImportRequest, PoseLog};
 use crate::engine::files::format;
 use crate::engine::files::import::tracker::{FixedPoints, FixedPoses, TrackerSpec};
-use crate::engine::files::import::{
-    self, ImportRequest, Imported, LengthUnit, PoseLog, ProfileSource, SideChoice,
-};
+use crate::engine::files::import::{self, Imported, LengthUnit, ProfileSource, SideChoice};
 
 /// `spherecal import`: a fixed sensor's points here, anything else by
 /// [`crate::cli::import::run`].
@@ -145,7 +145,7 @@ fn run(args: &ImportArgs) -> Result<(), CliError> {
         log: PoseLog::Fixed(spec),
         range: args.range,
     };
-    let Imported { session, notes, .. } = import::import_session(&request, &mut |_| {
+    let Imported { session, notes, .. } = assemble::import_session(&request, &mut |_| {
         if format::interrupted() {
             crate::engine::calibrate::solve::Control::Cancel
         } else {

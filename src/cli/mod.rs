@@ -543,7 +543,7 @@ fn method_parser() -> values::Keywords<Method> {
 }
 
 /// `--dh`: a DH table's convention.
-fn dh_parser() -> values::Keywords<crate::engine::base::robot::DhConvention> {
+fn dh_parser() -> values::Keywords<crate::engine::files::robot_import::DhConvention> {
     values::Keywords::new(
         vec![
             (
@@ -562,10 +562,10 @@ fn dh_parser() -> values::Keywords<crate::engine::base::robot::DhConvention> {
 }
 
 /// `standard` or `modified` (a DH table's convention).
-fn parse_dh(s: &str) -> Option<crate::engine::base::robot::DhConvention> {
+fn parse_dh(s: &str) -> Option<crate::engine::files::robot_import::DhConvention> {
     match s.to_ascii_lowercase().as_str() {
-        "standard" | "dh" => Some(crate::engine::base::robot::DhConvention::Standard),
-        "modified" | "mdh" => Some(crate::engine::base::robot::DhConvention::Modified),
+        "standard" | "dh" => Some(crate::engine::files::robot_import::DhConvention::Standard),
+        "modified" | "mdh" => Some(crate::engine::files::robot_import::DhConvention::Modified),
         _ => None,
     }
 }

@@ -40,7 +40,7 @@ pub struct PlanArgs {
     pub urdf_tip: Option<String>,
     /// The convention of a DH table robot.
     #[arg(long, value_parser = super::dh_parser())]
-    pub dh: Option<crate::engine::base::robot::DhConvention>,
+    pub dh: Option<crate::engine::files::robot_import::DhConvention>,
     /// Joint limits, deg, `min:max` per joint, comma-separated [default: the preset's; a robot from a file needs them unless it is named like a preset]
     #[arg(
         long,

@@ -6,10 +6,10 @@
 
 use clap::Args;
 
-use crate::engine::base::robot::DhConvention;
 use crate::engine::files::import::{
     AngleUnit, AxisMap, FlangeConvention, LengthUnit, PoseFormat, ProfileFormat, RobotSource,
 };
+use crate::engine::files::robot_import::DhConvention;
 
 use super::CliError;
 use super::values::Keywords;

@@ -23,7 +23,8 @@
 //! pipeline.
 
 pub mod base;
-pub mod calibrate;
 pub mod files;
+pub mod calibrate;
+pub mod assemble;
 pub mod tools;
 pub mod uses;

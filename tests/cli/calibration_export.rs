@@ -14,8 +14,9 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
-use spherecal::engine::base::robot::{Joint, Robot, robot_from_urdf, ur5e};
+use spherecal::engine::base::robot::{Joint, Robot, ur5e};
 use spherecal::engine::files::format::{self, ResultFile};
+use spherecal::engine::files::robot_import::robot_from_urdf;
 
 const REAL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/data/robcalibrator-sphere");
 const RESULT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/v1/result.json");

@@ -14,12 +14,12 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use spherecal::engine::base::robot::{DhConvention, robot_from_dh_csv, robot_from_urdf};
 use spherecal::engine::files::format;
 use spherecal::engine::files::import::{
     self, AngleUnit, ColumnMap, DEFAULT_SPHERE_DIAMETER, ImportSpec, ProfileFormat, ProfileSource,
     RobotSource,
 };
+use spherecal::engine::files::robot_import::{DhConvention, robot_from_dh_csv, robot_from_urdf};
 
 fn data(name: &str) -> String {
     fs::read_to_string(

@@ -4,7 +4,7 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
-use spherecal::engine::files::import::side::diameter_misfit;
+use spherecal::engine::assemble::side::diameter_misfit;
 use spherecal::engine::tools::simulate::{self, SimConfig};
 
 fn session() -> spherecal::engine::base::session::Session {

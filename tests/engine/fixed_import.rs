@@ -11,6 +11,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Isometry3, Point3, Vector3};
+use spherecal::engine::assemble::{ImportRequest, PoseLog, import_session};
 use spherecal::engine::base::session::{Mount, Observation, Session, Use};
 use spherecal::engine::calibrate::solve::{self, Method, Options};
 use spherecal::engine::files::format::ResultFile;
@@ -18,8 +19,7 @@ use spherecal::engine::files::import::tracker::{
     FixedPoints, FixedPoses, TrackerSpec, import_tracker,
 };
 use spherecal::engine::files::import::{
-    AngleUnit, FlangeConvention, ImportRequest, LengthUnit, PoseLog, ProfileFormat, ProfileSource,
-    import_session,
+    AngleUnit, FlangeConvention, LengthUnit, ProfileFormat, ProfileSource,
 };
 use spherecal::engine::tools::simulate::{FixedCell, FixedTruth, simulate_fixed};
 

@@ -19,12 +19,12 @@ use std::time::SystemTime;
 use proptest::prelude::*;
 use spherecal::engine::base::robot::RobotChoice;
 use spherecal::engine::base::session::{Observation, Session};
-use spherecal::engine::base::table::Table;
 use spherecal::engine::calibrate::solve::{self, Method, Options};
 use spherecal::engine::files::format::{self, ResultFile};
 use spherecal::engine::files::import::{
     self, AngleUnit, ColumnMap, DEFAULT_SPHERE_DIAMETER, ImportSpec, ProfileSource, RobotSource,
 };
+use spherecal::engine::files::table::Table;
 use spherecal::engine::tools::history;
 use spherecal::engine::tools::report::html::{self, ReportInput, ReportMeta};
 use spherecal::engine::tools::report::model::{self, ModelFormat};
@@ -497,7 +497,7 @@ proptest! {
     ) {
         let text = robot_text(if which { "ur5e.urdf" } else { "abb_irb2400.urdf" });
         let mutated = apply(&text, &mutations);
-        match spherecal::engine::base::robot::robot_from_urdf(&mutated, Path::new("fuzz.urdf")) {
+        match spherecal::engine::files::robot_import::robot_from_urdf(&mutated, Path::new("fuzz.urdf")) {
             Ok(u) => {
                 let text = format::session_to_json(&Session {
                     robot: u.robot,
@@ -524,7 +524,7 @@ proptest! {
         mutations in prop::collection::vec(mutation(), 1..4),
         which in any::<bool>(),
     ) {
-        use spherecal::engine::base::robot::{DhConvention, robot_from_dh_csv};
+        use spherecal::engine::files::robot_import::{DhConvention, robot_from_dh_csv};
         let (name, convention) = if which {
             ("ur5e_dh.csv", DhConvention::Standard)
         } else {
@@ -584,7 +584,7 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 /// once, with the line.
 #[test]
 fn deep_nesting_is_refused_at_once() {
-    use spherecal::engine::base::robot::robot_from_urdf;
+    use spherecal::engine::files::robot_import::robot_from_urdf;
     let n = 20_000;
     let nested = format!(
         "<robot name=\"r\">{}{}</robot>",
@@ -632,8 +632,8 @@ fn deep_nesting_is_refused_at_once() {
 /// naming the file and the line.
 #[test]
 fn one_huge_line_gives_a_short_message() {
-    use spherecal::engine::base::robot::{DhConvention, robot_from_urdf};
     use spherecal::engine::files::import::load_dh_csv;
+    use spherecal::engine::files::robot_import::{DhConvention, robot_from_urdf};
     let dir = tempfile::tempdir().unwrap();
     let junk = "x".repeat(3 << 20);
     let mut messages = Vec::new();

@@ -17,6 +17,7 @@ use std::process::Command;
 
 use nalgebra::{Isometry3, Point3};
 use proptest::prelude::*;
+use spherecal::engine::assemble;
 use spherecal::engine::base::geometry::rigid_from_rows;
 use spherecal::engine::base::session::{Observation, Session, Use};
 use spherecal::engine::calibrate::solve::{self, Options};
@@ -243,7 +244,7 @@ fn every_layout_imports_from_the_profile_folder_it_sits_in() {
             Observations::Profiles(ProfileSource::Folder(dir.path().to_path_buf())),
         );
         s.convention = convention;
-        let imported = import::import_poses(&s).unwrap();
+        let imported = assemble::import_poses(&s).unwrap();
         assert_poses(&imported.session, &poses, name);
         let notes = imported.notes.join("\n");
         assert!(notes.contains(format.describe()), "{name}: {notes}");
@@ -282,7 +283,7 @@ fn a_set_without_pure_translations_starts_from_the_general_hand_eye() {
         Observations::Profiles(ProfileSource::Folder(dir.path().to_path_buf())),
     );
     s.convention = Some(FlangeConvention::FanucWpr);
-    let imported = import::import_poses(&s).unwrap();
+    let imported = assemble::import_poses(&s).unwrap();
     let notes = imported.notes.join("\n");
     assert!(notes.contains("no group of one orientation"), "{notes}");
     let start = imported.session.hand_eye.unwrap();
@@ -313,7 +314,7 @@ fn a_set_without_pure_translations_starts_from_the_general_hand_eye() {
         );
         s.convention = Some(FlangeConvention::FanucWpr);
         s.side = SideChoice::Plus;
-        let imported = import::import_poses(&s).unwrap();
+        let imported = assemble::import_poses(&s).unwrap();
         assert!(
             imported
                 .notes
@@ -338,7 +339,7 @@ fn a_set_without_pure_translations_starts_from_the_general_hand_eye() {
     );
     s.convention = Some(FlangeConvention::FanucWpr);
     s.side = SideChoice::Plus;
-    let e = import::import_poses(&s).unwrap_err().to_string();
+    let e = assemble::import_poses(&s).unwrap_err().to_string();
     assert!(
         e.contains("no initial hand-eye") && e.contains("--hand-eye"),
         "{e}"
@@ -346,7 +347,7 @@ fn a_set_without_pure_translations_starts_from_the_general_hand_eye() {
     assert!(e.contains("all the same"), "the reason is named: {e}");
     // With a guess it imports.
     s.hand_eye = Some(rigid_from_rows(&cell(6, 8, false, 6).2.hand_eye));
-    let imported = import::import_poses(&s).unwrap();
+    let imported = assemble::import_poses(&s).unwrap();
     assert!(imported.notes.iter().any(|n| n.contains("the guess given")));
 }
 
@@ -365,7 +366,7 @@ fn centres_reported_by_the_sensor_import_as_centre_measurements() {
     std::fs::write(&centres_path, centres).unwrap();
     let mut s = spec(&path, Observations::Centres(centres_path));
     s.convention = Some(FlangeConvention::FanucWpr);
-    let imported = import::import_poses(&s).unwrap();
+    let imported = assemble::import_poses(&s).unwrap();
     assert!(
         imported
             .session
@@ -395,7 +396,7 @@ fn profile_names_with_the_number_anywhere_pair_in_numeric_order() {
         Observations::Profiles(ProfileSource::Folder(dir.path().to_path_buf())),
     );
     s.convention = Some(FlangeConvention::FanucWpr);
-    let imported = import::import_poses(&s).unwrap();
+    let imported = assemble::import_poses(&s).unwrap();
     assert_poses(&imported.session, &poses, "N_3C_line");
     assert_eq!(imported.session.measurements[9].id, "10_3C_line");
     let notes = imported.notes.join("\n");
@@ -406,7 +407,7 @@ fn profile_names_with_the_number_anywhere_pair_in_numeric_order() {
     assert!(notes.contains("line 12 ↔ 12_3C_line.txt"), "{notes}");
     // One profile too many: both counts named.
     std::fs::write(dir.path().join("13_3C_line.txt"), "0 1 2\n0 2 3\n").unwrap();
-    let e = import::import_poses(&s).unwrap_err().to_string();
+    let e = assemble::import_poses(&s).unwrap_err().to_string();
     assert!(e.contains("13 profiles for 12 poses"), "{e}");
 }
 
@@ -695,7 +696,7 @@ fn a_pose_import_tells_its_stages_and_can_be_cancelled_at_the_side() {
     );
     s.convention = Some(FlangeConvention::FanucWpr);
     let mut stages = Vec::new();
-    import::import_poses_with(&s, &mut |stage| {
+    assemble::import_poses_with(&s, &mut |stage| {
         stages.push(stage);
         Control::Continue
     })
@@ -705,7 +706,7 @@ fn a_pose_import_tells_its_stages_and_can_be_cancelled_at_the_side() {
         .collect();
     expected.push(ImportStage::Side);
     assert_eq!(stages, expected);
-    let e = import::import_poses_with(&s, &mut |stage| {
+    let e = assemble::import_poses_with(&s, &mut |stage| {
         if stage == ImportStage::Side {
             Control::Cancel
         } else {
@@ -857,7 +858,7 @@ fn an_import_whose_centres_scatter_beyond_any_sensor_is_warned() {
     std::fs::write(&centres_path, centres).unwrap();
     let mut s = spec(&path, Observations::Centres(centres_path));
     s.convention = Some(FlangeConvention::UrRotationVector);
-    let notes = import::import_poses(&s).unwrap().notes.join("\n");
+    let notes = assemble::import_poses(&s).unwrap().notes.join("\n");
     assert!(
         notes.contains(
             "warning: with the initial hand-eye that fits them best the sphere centres scatter by"
@@ -867,11 +868,11 @@ fn an_import_whose_centres_scatter_beyond_any_sensor_is_warned() {
     );
     // The import's one entry (the command line's and the workbench's)
     // refuses the pose-only session: its start is its verdict.
-    let request = import::entry::ImportRequest {
-        log: import::entry::PoseLog::Poses(s),
+    let request = assemble::ImportRequest {
+        log: assemble::PoseLog::Poses(s),
         range: None,
     };
-    let e = import::entry::import_session(&request, &mut import::progress::quiet)
+    let e = assemble::import_session(&request, &mut import::progress::quiet)
         .unwrap_err()
         .to_string();
     assert!(
@@ -901,7 +902,7 @@ fn two_sets_of_profiles_named_alike_are_refused_naming_both() {
         Observations::Profiles(ProfileSource::Folder(dir.path().to_path_buf())),
     );
     s.convention = Some(FlangeConvention::FanucWpr);
-    let e = import::import_poses(&s).unwrap_err().to_string();
+    let e = assemble::import_poses(&s).unwrap_err().to_string();
     assert!(
         e.contains("2 sets of 12 files named alike")
             && e.contains("old_p#.csv (old_p1.csv")

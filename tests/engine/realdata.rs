@@ -12,12 +12,13 @@ use std::path::{Path, PathBuf};
 
 use crate::support::bin::run;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion};
+use spherecal::engine::assemble;
 use spherecal::engine::base::session::Use;
 use spherecal::engine::calibrate::solve::{self, Options};
 use spherecal::engine::calibrate::validate::scatter_rms;
 use spherecal::engine::files::format::{self, ResultFile};
 use spherecal::engine::files::import::{
-    self, AxisMap, DEFAULT_SPHERE_DIAMETER, FlangeConvention, Observations, PoseImportSpec,
+    AxisMap, DEFAULT_SPHERE_DIAMETER, FlangeConvention, Observations, PoseImportSpec,
     ProfileFormat, ProfileSource, SideChoice,
 };
 
@@ -65,7 +66,7 @@ fn robcalibrator_hand_eye(dir: &Path) -> Isometry3<f64> {
 #[test]
 fn robcalibrator_data_calibrates_below_the_reference_scatter() {
     let dir = data();
-    let imported = import::import_poses(&spec(&dir)).unwrap();
+    let imported = assemble::import_poses(&spec(&dir)).unwrap();
     let session = &imported.session;
     assert!(session.pose_only());
     assert_eq!(session.measurements.len(), 15);
@@ -268,7 +269,7 @@ fn bad_real_inputs_exit_2_naming_the_file_and_write_nothing() {
 #[test]
 fn the_real_set_gets_a_held_out_figure_and_the_papers_rise_is_a_warning() {
     let dir = data();
-    let session = import::import_poses(&spec(&dir)).unwrap().session;
+    let session = assemble::import_poses(&spec(&dir)).unwrap().session;
     let mut options = Options::from_session(&session);
     let (prepared, cal) = solve::calibrate(&session, &options).unwrap();
     let text = spherecal::engine::tools::report::summary::summary(&session, &cal);

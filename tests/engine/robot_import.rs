@@ -1,4 +1,4 @@
-//! Robot import from URDF and DH tables (`engine::base::robot::{urdf, dh_table}`):
+//! Robot import from URDF and DH tables (`engine::files::robot_import::{urdf, dh_table}`):
 //! the imported model's forward kinematics against an independent model of
 //! the same file (the URDF chain composed directly, the standard DH
 //! product written out) and against spherecal's presets, over hundreds of
@@ -15,11 +15,12 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use spherecal::engine::base::robot::{
-    DhConvention, JointLimit, Robot, RobotImportError, UrdfOptions, irb2400, robot_from_dh_csv,
-    robot_from_urdf, robot_from_urdf_with, ur5e,
-};
+use spherecal::engine::base::robot::{JointLimit, Robot, irb2400, ur5e};
 use spherecal::engine::files::import::{load_dh_csv, load_urdf};
+use spherecal::engine::files::robot_import::{
+    DhConvention, RobotImportError, UrdfOptions, robot_from_dh_csv, robot_from_urdf,
+    robot_from_urdf_with,
+};
 
 /// Position agreement required, mm.
 const POS_TOL: f64 = 1e-9;

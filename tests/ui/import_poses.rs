@@ -19,9 +19,10 @@ use spherecal::app::WorkbenchApp;
 use spherecal::app::command::Tab;
 use spherecal::app::import::form::{HandEyeChoice, ObservationKind};
 use spherecal::app::job::Slot;
+use spherecal::engine::assemble::PosePreview;
 use spherecal::engine::base::geometry::{rigid_from_rows, roll_pitch_yaw_deg};
 use spherecal::engine::base::session::Observation;
-use spherecal::engine::files::import::{FlangeConvention, PoseFormat, PosePreview, SideChoice};
+use spherecal::engine::files::import::{FlangeConvention, PoseFormat, SideChoice};
 use spherecal::engine::tools::simulate::{self, SimConfig};
 
 use crate::support::pose as pose_support;

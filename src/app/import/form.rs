@@ -8,12 +8,12 @@ use std::path::PathBuf;
 
 use nalgebra::{Isometry3, Translation3};
 
-use crate::engine::base::robot::DhConvention;
 use crate::engine::files::import::{
     AngleUnit, AxisMap, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
     DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportSpec, LengthUnit, Observations,
     PoseFormat, PoseImportSpec, ProfileFormat, ProfileSource, RobotSource, SideChoice,
 };
+use crate::engine::files::robot_import::DhConvention;
 
 /// Rows the preview shows.
 pub const PREVIEW_ROWS: usize = 8;

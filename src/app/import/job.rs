@@ -1,14 +1,16 @@
 //! The import wizard's job work: the joint log's header, the mapping
 //! guessed from it and the first rows mapped; the import itself (the
-//! engine's [`import::import_with`] or [`import::import_poses_with`], as
+//! engine's [`import_with`](crate::engine::files::import::import_with) or [`assemble::import_poses_with`], as
 //! `spherecal import`), analysed like an opened file.
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
+use crate::engine::assemble;
+use crate::engine::assemble::{ImportRequest, PoseLog};
 use crate::engine::calibrate::solve::Control;
-use crate::engine::files::import::{self, ImportError, ImportRequest, ImportStage, PoseLog};
+use crate::engine::files::import::{ImportError, ImportStage};
 
 use super::form::{ImportForm, LogKind, PREVIEW_ROWS};
 use crate::app::error::JobError;
@@ -44,7 +46,7 @@ pub fn import_preview(mut form: ImportForm, guess: bool) -> Previewed {
         return (Vec::new(), None, Err(why));
     }
     let joint_log = PathBuf::from(form.joints.trim());
-    let (header, preview) = import::preview_joint_log(&joint_log, PREVIEW_ROWS, |header| {
+    let (header, preview) = assemble::preview_joint_log(&joint_log, PREVIEW_ROWS, |header| {
         if guess {
             form.guess_mapping(header);
         }
@@ -106,7 +108,7 @@ pub fn import_session(
         .map(|v| crate::app::widgets::range_of(&v))
         .transpose()
         .map_err(|why| JobError::ImportForm(format!("measuring range: {why}")))?;
-    let imported = import::import_session(&ImportRequest { log, range }, &mut stage)?;
+    let imported = assemble::import_session(&ImportRequest { log, range }, &mut stage)?;
     if cancel.load(Ordering::Relaxed) {
         return Err(ImportError::Cancelled.into());
     }

@@ -11,7 +11,9 @@ pub mod job;
 pub mod poses_ui;
 pub mod ui;
 
-use crate::engine::files::import::{self as engine_import, ImportError, PoseCheck, PosePreview};
+use crate::engine::assemble;
+use crate::engine::assemble::PosePreview;
+use crate::engine::files::import::{ImportError, PoseCheck};
 
 use super::command::{ImportCommand, Tab};
 use super::error::JobError;
@@ -198,7 +200,7 @@ impl Core {
             }
         };
         self.start(ctx, Slot::PoseScan, stamp, move |_| {
-            engine_import::preview_pose_import(&spec)
+            assemble::preview_pose_import(&spec)
                 .map(Box::new)
                 .map_err(JobError::from)
         });

@@ -19,7 +19,8 @@ use crate::app::widgets::{
     BAD, GOOD, MUTED, WARN, boxed, coloured, command_button, form_grid, path_row, scrolled_text,
     weak,
 };
-use crate::engine::files::import::{FlangeConvention, PairingPreview, PoseFormat, PosePreview};
+use crate::engine::assemble::{PairingPreview, PosePreview};
+use crate::engine::files::import::{FlangeConvention, PoseFormat};
 
 /// Height of the pairing list, points: a dozen rows, the rest scrolled
 /// (the view must fit 1366×768 with the form above it).

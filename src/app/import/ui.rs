@@ -22,8 +22,8 @@ use crate::app::widgets::{
     labelled_drag, labelled_field, path_row, preset_ui, range_fields, range_of, scrolled_text,
     table, weak,
 };
-use crate::engine::base::robot::DhConvention;
 use crate::engine::files::import::{AngleUnit, LengthUnit, SideChoice};
+use crate::engine::files::robot_import::DhConvention;
 
 /// Largest height of the import's error above the form, points: a long
 /// message scrolls rather than push the form off a 768-pixel screen.

@@ -16,8 +16,8 @@
 pub mod numeric;
 pub mod control;
 pub mod geometry;
-pub mod table;
 pub mod limits;
 pub mod robot;
 pub mod session;
+pub mod records;
 pub mod cell;

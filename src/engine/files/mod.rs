@@ -9,6 +9,8 @@
 //! | [`program`] | robot programs and pose tables (FANUC `.ls`, RAPID, KRL, URScript, tables): poses read with their spans, rewritten in place |
 //! | [`import`] | joint logs, pose files and profiles into a session: pairing, units and axes, the side decision, the initial hand-eye |
 
+pub mod table;
+pub mod robot_import;
 pub mod format;
 pub mod program;
 pub mod import;

@@ -3,7 +3,7 @@
 //! the controller reports (`x,y,z,q1..q4`: ABB's mm and unit quaternion
 //! w, x, y, z), then any further columns. The planner writes it for the
 //! cell to teach, the simulator writes it as a cell would record it, and
-//! the import and the simulator read it back ([`Table`](crate::engine::base::table::Table)):
+//! the import and the simulator read it back ([`Table`](crate::engine::files::table::Table)):
 //! one reader and one writer.
 
 use std::fmt::Write as _;

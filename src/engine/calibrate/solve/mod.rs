@@ -20,11 +20,10 @@ pub mod paper;
 pub mod plausible;
 pub mod prepare;
 pub mod progress;
-pub mod record;
-pub mod report;
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
+pub use crate::engine::base::records::{LoopRecord, SolverReport};
 use crate::engine::base::robot::Robot;
 use crate::engine::base::session::{Session, Use, limits};
 use crate::engine::calibrate::handeye::HandEyeError;
@@ -37,8 +36,6 @@ pub use held_out::{HeldOut, HeldOutRecord, HeldOutScheme};
 use paper::PaperOptions;
 pub use prepare::{Analysis, HandEyeSource, Prepared, PreparedMeasurement, analyse, prepare};
 pub use progress::{Control, Phase, Progress};
-pub use record::LoopRecord;
-pub use report::SolverReport;
 
 /// Why a calibration of a loaded session could not run, or failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

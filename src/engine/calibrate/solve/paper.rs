@@ -17,9 +17,9 @@
 
 use nalgebra::{DMatrix, DVector, Vector3};
 
-use super::report::{Direction, PaperReport, SolverReport};
 use super::{Control, HeldOut, Options, Phase, SolveError, Step, StopReason, Update};
 use crate::engine::base::numeric::as_written;
+use crate::engine::base::records::solver::{Direction, PaperReport, SolverReport};
 
 use super::estimate::{
     ANGLE_SCALE_MM, Estimate, Station, sensitivity, unknown_label, unknown_scale,
@@ -31,7 +31,7 @@ use super::estimate::{
 /// rotation, high enough to drop the rigid-motion directions of joint 1.
 pub const DEFAULT_SVD_TOLERANCE: f64 = 1e-3;
 
-pub use super::report::{EPSILON_RISE_MM, Pairing, epsilon_rise_warning};
+pub use crate::engine::base::records::solver::{EPSILON_RISE_MM, Pairing, epsilon_rise_warning};
 
 /// Settings of the paper's update.
 #[derive(Debug, Clone, Copy, PartialEq)]

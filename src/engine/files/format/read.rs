@@ -15,8 +15,8 @@ use std::fs::File;
 use std::io::{self, Read as _};
 use std::path::Path;
 
-use crate::engine::base::robot::dh_table::MAX_DH_BYTES;
-use crate::engine::base::robot::urdf::MAX_URDF_BYTES;
+use crate::engine::files::robot_import::dh_table::MAX_DH_BYTES;
+use crate::engine::files::robot_import::urdf::MAX_URDF_BYTES;
 
 /// The most bytes a kind of file may have, and the kind in words.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -16,10 +16,10 @@ use super::result_check::{first_non_finite, has_bare_null};
 use super::stations::{StationRecord, mount_of, stations_of};
 use super::{FORMAT_VERSION, FileError, RESULT_FORMAT, write_atomic};
 use crate::engine::base::geometry::{isometry_from_rows, rigid_from_rows, rows_from_isometry};
+use crate::engine::base::records::solver::{Direction, PaperReport, SolverReport};
 use crate::engine::base::robot::{Joint, Robot};
 use crate::engine::base::session::{Mount, Session, Use};
 use crate::engine::calibrate::solve::ml::MlReport;
-use crate::engine::calibrate::solve::report::{Direction, PaperReport, SolverReport};
 use crate::engine::calibrate::solve::{Calibration, HeldOut};
 use crate::engine::calibrate::validate::Validation;
 

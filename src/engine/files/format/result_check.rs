@@ -7,9 +7,9 @@ use serde_json::Value;
 
 use super::result::ResultFile;
 use crate::engine::base::numeric::show;
+use crate::engine::base::records::SolverReport;
 use crate::engine::base::robot::Joint;
 use crate::engine::base::session::limits;
-use crate::engine::calibrate::solve::report::SolverReport;
 
 /// The first finite number of `r` beyond the session file's plausibility
 /// limits ([`limits`]), as its key path, value and limit: a hand-eye of

@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use super::ImportError;
-use crate::engine::base::table::{Table, TableError, excerpt, parse_number, separator};
 use crate::engine::files::format::{Cap, read_text};
+use crate::engine::files::table::{Table, TableError, excerpt, parse_number, separator};
 
 /// A parsed CSV file: header and data rows with their 1-based lines.
 pub(super) struct CsvFile {

@@ -14,7 +14,7 @@ use super::csv_file::CsvFile;
 use super::units::{self, AngleUnit};
 use super::{ImportError, ImportSpec, load_robot};
 use crate::engine::base::session::Use;
-use crate::engine::base::table::side_cell;
+use crate::engine::files::table::side_cell;
 
 /// The side column read when the mapping names none.
 pub const DEFAULT_SIDE_COLUMN: &str = "side";
@@ -209,7 +209,7 @@ impl JointLog {
 pub(crate) fn usage_message(column: &str, cell: &str) -> String {
     format!(
         "column `{column}`: `{}` is not translation, rotation, identify or validate",
-        crate::engine::base::table::excerpt(cell)
+        crate::engine::files::table::excerpt(cell)
     )
 }
 
@@ -295,7 +295,7 @@ fn check_extra_joints(spec: &ImportSpec, log: &CsvFile, dof: usize) -> Result<()
             "the joint log has the joint column(s) {} but the robot has {dof} joint(s): its readings would be dropped; check the robot model (a URDF's tip link, a DH table's rows) or map the columns with --map",
             extra
                 .iter()
-                .map(|h| format!("`{}`", crate::engine::base::table::excerpt(h)))
+                .map(|h| format!("`{}`", crate::engine::files::table::excerpt(h)))
                 .collect::<Vec<_>>()
                 .join(", ")
         ),

@@ -23,24 +23,20 @@
 //! command line and the workbench both call.
 //!
 //! CSV files are read with the `csv` crate
-//! ([`Table`](crate::engine::base::table::Table)): a UTF-8 byte-order
+//! ([`Table`](crate::engine::files::table::Table)): a UTF-8 byte-order
 //! mark, quotes, `,` `;` or tab separators, `#` comment lines; column names
 //! match case-insensitively; line numbers in messages are 1-based lines of
 //! the file.
 
 pub mod check;
-pub mod entry;
 mod csv_file;
-pub mod initial;
 pub mod log;
 pub mod pairing;
 pub mod poses;
-pub mod preview;
 pub mod profiles;
 pub mod progress;
 pub mod references;
 pub mod robot_source;
-pub mod side;
 pub mod tracker;
 pub mod units;
 
@@ -50,18 +46,15 @@ use std::path::{Path, PathBuf};
 pub use self::check::{
     DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG, FlangeCheck, PoseCheck,
 };
-pub use self::entry::{ImportRequest, PoseLog, import_session, preview_joint_log};
 pub use self::log::{ColumnMap, DEFAULT_SIDE_COLUMN, header, preview};
 pub use self::poses::{
     Observations, PoseImportSpec, PoseInputs, SideChoice, build_pose_session, read_pose_inputs,
     read_pose_inputs_with,
 };
-pub use self::preview::{PairingPreview, PosePreview, preview_pose_import};
 pub use self::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource, RawProfile};
 pub use self::progress::{ImportProgress, ImportStage};
 pub use self::references::{read_references, reference_rows};
 pub use self::robot_source::{RobotSource, RobotSourceError, load_dh_csv, load_robot, load_urdf};
-pub use self::side::{decide_side, import_poses, import_poses_with};
 pub use self::units::{AngleUnit, LengthUnit};
 pub use crate::engine::base::robot::controller::FlangeConvention;
 pub use crate::engine::files::program::PoseFormat;
@@ -145,7 +138,7 @@ pub enum ImportError {
     /// The robot's URDF or DH table could not be read (the loader's error,
     /// naming the file and the line).
     #[error(transparent)]
-    Robot(Box<crate::engine::base::robot::RobotImportError>),
+    Robot(Box<crate::engine::files::robot_import::RobotImportError>),
     /// The built session breaks a FORMAT.md rule (the loader's message).
     #[error("{0}")]
     Session(#[from] FileError),

@@ -663,7 +663,7 @@ pub fn build_pose_session(
         spec.references.as_deref(),
         measurements,
     )?;
-    let (session, hand_eye_notes) = super::initial::settle(
+    let (session, hand_eye_notes) = crate::engine::assemble::initial::settle(
         session,
         auto_uses,
         spec.hand_eye,

@@ -52,7 +52,7 @@ pub fn reference_rows(path: &Path) -> Result<Vec<(usize, ReferenceDistance)>, Im
         if row[from] == row[to] {
             return Err(fail(format!(
                 "from and to are both `{}`",
-                crate::engine::base::table::excerpt(&row[from])
+                crate::engine::files::table::excerpt(&row[from])
             )));
         }
         let key = if row[from] < row[to] {
@@ -72,8 +72,8 @@ pub fn reference_rows(path: &Path) -> Result<Vec<(usize, ReferenceDistance)>, Im
             };
             return Err(fail(format!(
                 "the pair {} – {} is given a second time (first on line {first}): {verdict}; keep one",
-                crate::engine::base::table::excerpt(&row[from]),
-                crate::engine::base::table::excerpt(&row[to])
+                crate::engine::files::table::excerpt(&row[from]),
+                crate::engine::files::table::excerpt(&row[to])
             )));
         }
         seen.insert(key, (*line, d));

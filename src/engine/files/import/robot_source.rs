@@ -4,11 +4,11 @@
 use std::path::{Path, PathBuf};
 
 use super::ImportError;
-use crate::engine::base::robot::{
-    self, DhConvention, Robot, RobotImportError, UrdfOptions, UrdfRobot, robot_from_dh_csv,
-    robot_from_urdf_with,
-};
+use crate::engine::base::robot::{self, Robot};
 use crate::engine::files::format::{Cap, parse_result, parse_session, read_text};
+use crate::engine::files::robot_import::{
+    DhConvention, RobotImportError, UrdfOptions, UrdfRobot, robot_from_dh_csv, robot_from_urdf_with,
+};
 
 /// A command-line or form value that names no robot source.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -37,7 +37,7 @@ pub enum RobotSource {
     File(PathBuf),
     /// A URDF: the serial chain of revolute joints from its root link to
     /// `tip` (default: the chain's only end link), converted to FORMAT.md's
-    /// modified DH ([`robot::urdf`]).
+    /// modified DH ([`robot_import::urdf`](crate::engine::files::robot_import::urdf)).
     Urdf {
         /// The file.
         path: PathBuf,
@@ -45,7 +45,7 @@ pub enum RobotSource {
         tip: Option<String>,
     },
     /// A DH table (CSV, columns a, alpha, d, theta), standard or modified
-    /// ([`robot::dh_table`]).
+    /// ([`robot_import::dh_table`](crate::engine::files::robot_import::dh_table)).
     DhTable {
         /// The file.
         path: PathBuf,

@@ -60,7 +60,7 @@ use super::units::{AngleUnit, LengthUnit};
 use super::{FlangeConvention, ImportError, Imported, PoseFormat, ProfileReport};
 use crate::engine::base::robot::Robot;
 use crate::engine::base::session::{Measurement, Mount, Observation, Session, Use};
-use crate::engine::base::table::parse_number;
+use crate::engine::files::table::parse_number;
 
 /// Names a pose column may have.
 const POSE_COLUMNS: [&str; 4] = ["pose", "id", "point", "name"];

@@ -27,7 +27,7 @@ use super::lex::shown;
 use super::{ParseError, Parsed, Target, TargetValue};
 use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::base::session::Use;
-use crate::engine::base::table::{
+use crate::engine::files::table::{
     decimal_comma, parse_number, side_cell, spaced_with_decimal_commas,
 };
 

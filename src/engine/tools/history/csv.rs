@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use super::Library;
 use super::drift::{Drift, value_from};
 use crate::engine::base::robot::PARAMS_PER_JOINT;
-use crate::engine::base::table::csv_field;
+use crate::engine::files::table::csv_field;
 
 /// The drifts as CSV, one row per result and parameter (every hand-eye and
 /// kinematic parameter, not only the shown series), values at full

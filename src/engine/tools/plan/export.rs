@@ -10,7 +10,7 @@ use super::{Plan, PlanError};
 use crate::engine::base::cell::joint_log;
 use crate::engine::base::robot::controller::Controller;
 use crate::engine::base::session::Use;
-use crate::engine::base::table::{Table, side_cell};
+use crate::engine::files::table::{Table, side_cell};
 use crate::engine::tools::simulate::PlanPose;
 
 /// The plan as a joint log CSV that `spherecal import` reads: header

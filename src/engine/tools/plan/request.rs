@@ -10,11 +10,12 @@ use nalgebra::Isometry3;
 use super::config::{DEFAULT_CONE_DEG, PlanConfig, PlanDesign, StationLayout};
 use super::predict::PredictConfig;
 use crate::engine::base::cell::workspace;
-use crate::engine::base::robot::{self, JointLimit, RobotImportError};
+use crate::engine::base::robot::{self, JointLimit};
 use crate::engine::base::session::SensorRange;
-use crate::engine::base::table::Table;
 use crate::engine::files::format::{Cap, read_text};
 use crate::engine::files::import::{ImportError, RobotSource, load_robot, load_urdf};
+use crate::engine::files::robot_import::{self, RobotImportError};
+use crate::engine::files::table::Table;
 
 /// Why a request cannot be made into a plan configuration, or a file it
 /// names cannot be read: what and where.
@@ -116,9 +117,9 @@ impl PlanRequest {
                 PlanConfig::for_preset(&preset, self.design.sphere)
             }
             RobotSource::Urdf { path, tip } => {
-                let options = robot::UrdfOptions {
+                let options = robot_import::UrdfOptions {
                     tip: tip.clone(),
-                    ..robot::UrdfOptions::default()
+                    ..robot_import::UrdfOptions::default()
                 };
                 let urdf = load_urdf(path, &options)?;
                 // A continuous joint has no limits: one turn each way.
@@ -229,7 +230,7 @@ pub fn read_stations(path: &Path) -> Result<StationLayout, RequestError> {
                         *line,
                         format!(
                             "`{}` is not a finite number",
-                            crate::engine::base::table::excerpt(&f[c])
+                            crate::engine::files::table::excerpt(&f[c])
                         ),
                     )
                 })
@@ -243,7 +244,7 @@ pub fn read_stations(path: &Path) -> Result<StationLayout, RequestError> {
                     *line,
                     format!(
                         "use `{}` is not identify or validate",
-                        crate::engine::base::table::excerpt(other)
+                        crate::engine::files::table::excerpt(other)
                     ),
                 ));
             }

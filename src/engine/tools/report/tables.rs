@@ -5,10 +5,10 @@
 
 use std::fmt::Write as _;
 
-use crate::engine::base::table::csv_field;
 use crate::engine::calibrate::validate::DistanceRecord;
 use crate::engine::files::format::ResultFile;
 use crate::engine::files::format::result::CentreRecord;
+use crate::engine::files::table::csv_field;
 use crate::engine::tools::result_view::{PairDistance, ResultFigures};
 
 /// CSV of every sphere centre: sensor frame and base frame before and

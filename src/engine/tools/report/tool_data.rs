@@ -12,9 +12,9 @@ use std::fmt::Write as _;
 use nalgebra::{Isometry3, Matrix6, Translation3, UnitQuaternion, Vector3};
 
 use super::model::{urdf_number, urdf_origin};
+use crate::engine::base::records::ml::LabelledMatrix;
 use crate::engine::base::robot::controller::{Controller, ToolDigits};
 use crate::engine::calibrate::solve::estimate::HAND_EYE_LABELS;
-use crate::engine::calibrate::solve::ml::report::LabelledMatrix;
 use crate::engine::files::format::ResultFile;
 
 /// What the tool data is for (`--controller`).

@@ -15,10 +15,10 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 use super::model::{urdf_number, urdf_origin};
 use super::tool_data::{ROS_SENSOR_FRAME, sensor_urdf};
-use crate::engine::base::robot::RobotImportError;
 use crate::engine::base::robot::chain_origins::{ChainFitError, ChainStep, calibrated_origins};
-use crate::engine::base::robot::urdf::{UrdfOptions, robot_from_urdf_with};
 use crate::engine::files::format::ResultFile;
+use crate::engine::files::robot_import::RobotImportError;
+use crate::engine::files::robot_import::urdf::{UrdfOptions, robot_from_urdf_with};
 
 /// Millimetres per metre.
 const MM_PER_M: f64 = 1000.0;

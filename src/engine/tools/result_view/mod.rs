@@ -413,7 +413,7 @@ impl ResultFigures {
 #[must_use]
 pub fn hand_eye_sigma(
     hand_eye: &Isometry3<f64>,
-    covariance: &crate::engine::calibrate::solve::ml::report::LabelledMatrix,
+    covariance: &crate::engine::base::records::ml::LabelledMatrix,
 ) -> Option<[f64; 6]> {
     use crate::engine::calibrate::solve::estimate::HAND_EYE_LABELS;
     use nalgebra::{Matrix6, UnitQuaternion};
@@ -517,8 +517,8 @@ pub fn within_pairs(centres: &[CentreRecord], usage: Use) -> Vec<PairDistance> {
 #[cfg(test)]
 mod sigma_tests {
     use super::*;
+    use crate::engine::base::records::ml::LabelledMatrix;
     use crate::engine::calibrate::solve::estimate::HAND_EYE_LABELS;
-    use crate::engine::calibrate::solve::ml::report::LabelledMatrix;
     use nalgebra::{Translation3, UnitQuaternion, Vector3};
 
     fn diagonal(values: [f64; 6]) -> LabelledMatrix {

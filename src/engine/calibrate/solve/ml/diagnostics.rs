@@ -8,7 +8,7 @@ use super::MlUpdate;
 use super::identifiability::raw_per_file_unit;
 use super::noise::{OUTLIER_QUANTILE, base_covariance, chi3_quantile, sensor_covariance};
 use super::problem::{InverseBlocks, Problem, State};
-use super::report::{
+use crate::engine::base::records::ml::{
     DistanceStd, IdentifiabilityRecord, LabelledMatrix, LossRecord, MlReport, NoiseModel,
     OutlierRecord, ParameterRecord, PivotRecord, PriorRecord,
 };

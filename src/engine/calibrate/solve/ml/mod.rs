@@ -105,7 +105,6 @@ mod prior;
 mod problem;
 pub mod range;
 pub mod recheck;
-pub mod report;
 pub mod variance;
 
 use nalgebra::Vector3;
@@ -116,6 +115,10 @@ use super::prepare::Prepared;
 use super::{
     Control, HeldOut, HeldOutRecord, HeldOutScheme, Options, Phase, SolveError, SolverReport, Step,
     StopReason, Update,
+};
+pub use crate::engine::base::records::ml::{
+    CrossStation, CrossValidation, DistanceStd, IterationRecord, LabelledMatrix, MlReport,
+    OutlierRecord, ParameterRecord,
 };
 use crate::engine::base::session::{Session, Use};
 use crate::engine::calibrate::validate::epsilon;
@@ -128,10 +131,6 @@ use noise::{
 };
 use prior::{DEFAULT_PRIOR_ANGLE_DEG, DEFAULT_PRIOR_LENGTH_MM, chart_prior};
 use problem::{HeldOutPrediction, LAMBDA_START, Obs, Problem, State};
-pub use report::{
-    CrossStation, CrossValidation, DistanceStd, IterationRecord, LabelledMatrix, MlReport,
-    OutlierRecord, ParameterRecord,
-};
 use variance::MIN_POSE_SIGMA_MM;
 
 /// The σ (mm, each base-frame coordinate) of the flange poses' error

@@ -7,7 +7,7 @@
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use super::noise::Loss;
-use super::report::{CrossStation, CrossValidation};
+use crate::engine::base::records::ml::{CrossStation, CrossValidation};
 use crate::engine::calibrate::handeye::Sighting;
 use crate::engine::calibrate::solve::estimate::{Estimate, sensitivity};
 use crate::engine::calibrate::solve::{Control, HeldOutScheme, Phase};

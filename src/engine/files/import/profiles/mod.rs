@@ -45,8 +45,8 @@ use super::csv_file::CsvFile;
 use super::{ImportError, LengthUnit};
 use crate::engine::base::limits;
 use crate::engine::base::numeric::show;
-use crate::engine::base::table::parse_number;
 use crate::engine::files::format::{Cap, read_text};
+use crate::engine::files::table::parse_number;
 
 /// Names of the sensor's axes, in order.
 const AXIS_NAMES: [&str; 3] = ["x", "y", "z"];

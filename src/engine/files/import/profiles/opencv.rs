@@ -8,8 +8,8 @@ use std::path::Path;
 use serde_json::Value;
 
 use super::{Collector, PROFILE_KEYS, ProfileFormat, RawProfile, number};
-use crate::engine::base::table::{excerpt, overlong_line, overlong_line_message};
 use crate::engine::files::import::ImportError;
+use crate::engine::files::table::{excerpt, overlong_line, overlong_line_message};
 
 /// The flat numbers of a profile and how many make a point (2 or 3, when
 /// the file says).

@@ -4,11 +4,11 @@
 use std::path::Path;
 
 use super::{AXIS_NAMES, Collector, ProfileFormat, RawProfile, number_in};
-use crate::engine::base::table::{
-    excerpt, overlong_line, overlong_line_message, spaced_with_decimal_commas,
-};
 use crate::engine::files::import::ImportError;
 use crate::engine::files::import::csv_file::CsvFile;
+use crate::engine::files::table::{
+    excerpt, overlong_line, overlong_line_message, spaced_with_decimal_commas,
+};
 
 /// A CSV/TXT profile with or without a header.
 pub(super) fn read_text_profile(

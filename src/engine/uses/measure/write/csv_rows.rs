@@ -2,7 +2,7 @@
 
 use std::io::{self, BufWriter, Write};
 
-use crate::engine::base::table::csv_field;
+use crate::engine::files::table::csv_field;
 use crate::engine::uses::measure::cloud::Cloud;
 
 /// The header row.

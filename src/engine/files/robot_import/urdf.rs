@@ -75,11 +75,11 @@ use std::path::Path;
 
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
-use super::import_error::RobotImportError;
-use super::kinematics::{Joint, JointLimit, Robot};
+use super::error::RobotImportError;
 use crate::engine::base::limits;
 use crate::engine::base::numeric::show;
-use crate::engine::base::table::excerpt;
+use crate::engine::base::robot::kinematics::{Joint, JointLimit, Robot};
+use crate::engine::files::table::excerpt;
 
 /// Sine of the angle between consecutive axes below which they are treated
 /// as (nearly) parallel: frame placed with the perpendicular plane, the
@@ -290,7 +290,7 @@ pub fn robot_from_urdf_with(
     })?;
     let urdf = urdf_rs::read_from_string(text).map_err(|e| RobotImportError::UrdfSyntax {
         path: source.to_path_buf(),
-        message: crate::engine::base::table::clip(&e.to_string(), MAX_PARSER_MESSAGE_CHARS),
+        message: crate::engine::files::table::clip(&e.to_string(), MAX_PARSER_MESSAGE_CHARS),
     })?;
     let tree = Tree::new(&urdf, source)?;
     let tip = match &options.tip {

@@ -15,7 +15,6 @@ use std::path::Path;
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
-use super::{ImportError, ProfileReport};
 use crate::engine::base::numeric::approx;
 use crate::engine::base::session::{Session, Use};
 use crate::engine::calibrate::handeye::general::{
@@ -24,6 +23,7 @@ use crate::engine::calibrate::handeye::general::{
 use crate::engine::calibrate::handeye::{Sighting, initial_hand_eye};
 use crate::engine::calibrate::solve::plausible::{MAX_PLAUSIBLE_SCATTER_MM, check_scatter};
 use crate::engine::calibrate::solve::{Analysis, analyse};
+use crate::engine::files::import::{ImportError, ProfileReport};
 
 /// Largest orientation difference (deg) between poses counted as "the
 /// same orientation" when the translation group is found: controllers

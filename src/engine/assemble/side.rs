@@ -8,12 +8,12 @@
 //! calibrated, or the two are too close to tell, the error says why,
 //! with both sides' outcome.
 
-use super::poses::{
+use crate::engine::calibrate::solve::{self, Options};
+use crate::engine::files::import::poses::{
     PoseImportSpec, PoseInputs, SideChoice, build_pose_session, read_pose_inputs_with,
 };
-use super::progress::{self, ImportProgress, ImportStage};
-use super::{ImportError, Imported};
-use crate::engine::calibrate::solve::{self, Options};
+use crate::engine::files::import::progress::{self, ImportProgress, ImportStage};
+use crate::engine::files::import::{ImportError, Imported};
 
 /// How many times smaller the scatter ε of one side must be than the
 /// other's for the data to decide: the wrong side moves every centre by

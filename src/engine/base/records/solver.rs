@@ -8,8 +8,8 @@ use std::str::FromStr;
 
 use serde_json::{Map, Value};
 
+pub use super::loop_record::LoopRecord;
 use super::ml::MlReport;
-pub use super::record::LoopRecord;
 
 /// A rise of ε over the paper's loop up to this (mm) is rounding, not a
 /// worse calibration: a tenth of a micrometre, below any stripe sensor's

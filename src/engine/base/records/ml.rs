@@ -7,9 +7,10 @@ use std::fmt::Write as _;
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
-use super::identifiability::Inseparable;
-use super::noise::Loss;
-use crate::engine::calibrate::solve::record::LoopRecord;
+use super::loop_record::LoopRecord;
+use crate::engine::calibrate::solve::ml::identifiability::Inseparable;
+use crate::engine::calibrate::solve::ml::noise::Loss;
+use crate::engine::calibrate::solve::ml::range;
 
 /// What one accepted LM step did (the `iterations` of the solver block).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -237,12 +238,12 @@ pub struct MlReport {
     /// Predicted error over the sensor's range (or the region the sphere
     /// covered), from the covariance ([`super::range`]).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub range_error: Option<super::range::RangeError>,
+    pub range_error: Option<range::RangeError>,
     /// Predicted measuring error over the session's volume (a posteriori),
     /// with 2 or more stations ([`super::range::VolumeError`]); absent in
     /// results written before 2026-11-28.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub volume_error: Option<super::range::VolumeError>,
+    pub volume_error: Option<range::VolumeError>,
     /// Outlier limit, σ of the standardised residual norm.
     pub outlier_limit_sigma: f64,
     /// Measurements beyond the limit.

@@ -4,8 +4,8 @@
 //! never moved to), which pose goes with which profile file or centre
 //! row, what is left over on either side, the files of the folder
 //! skipped and why, and whether the paper's eq. 6-9 can give the initial
-//! hand-eye. The pairing is the import's own ([`super::pairing`],
-//! [`super::poses::paired_by_id`]); nothing is decided here that the
+//! hand-eye. The pairing is the import's own ([`pairing`](crate::engine::files::import::pairing),
+//! [`paired_by_id`](crate::engine::files::import::poses::paired_by_id)); nothing is decided here that the
 //! import decides otherwise.
 //!
 //! Cheap on a folder of thousands of profiles: the pose file is read and
@@ -19,13 +19,13 @@ use std::path::{Path, PathBuf};
 use nalgebra::Isometry3;
 
 use super::initial::eq69_group;
-use super::pairing::list_profiles;
-use super::poses::{
+use crate::engine::files::import::pairing::list_profiles;
+use crate::engine::files::import::poses::{
     NUMBERS_DIFFER_WARNING, Observations, PoseImportSpec, PoseRecord, PoseValue, centre_rows,
     numbers_differ, paired_by_id, program_error, records_of,
 };
-use super::profiles::{self, ProfileSource};
-use super::{ImportError, load_robot};
+use crate::engine::files::import::profiles::{self, ProfileSource};
+use crate::engine::files::import::{ImportError, load_robot};
 use crate::engine::files::program::{self, PoseFormat, ReadSpec};
 
 /// The pose file as the import will read it, and the pairing.

@@ -1,9 +1,9 @@
 //! The import use case in one entry, [`import_session`], that `spherecal
 //! import` and the workbench's import wizard both call: a joint log
-//! ([`import_with`](super::import_with)) or a pose file
+//! ([`import_with`](crate::engine::files::import::import_with)) or a pose file
 //! ([`import_poses_with`](super::import_poses_with): the side given, or
 //! decided from the data by calibrating both), or a fixed sensor's points
-//! or profiles beside either ([`import_tracker_with`](super::tracker::import_tracker_with),
+//! or profiles beside either ([`import_tracker_with`](crate::engine::files::import::tracker::import_tracker_with),
 //! FORMAT.md `sensor.mount: "fixed"`) into a session, the sensor's
 //! measuring range written into it when given, with the progress of every
 //! stage; and the joint log's preview, its header read and its first rows
@@ -11,12 +11,12 @@
 
 use std::path::Path;
 
-use super::tracker::{TrackerSpec, import_tracker_with};
-use super::{
-    ImportError, ImportProgress, ImportSpec, Imported, PoseImportSpec, header, import_poses_with,
-    import_with, preview,
-};
+use super::side::import_poses_with;
 use crate::engine::base::session::SensorRange;
+use crate::engine::files::import::tracker::{TrackerSpec, import_tracker_with};
+use crate::engine::files::import::{
+    ImportError, ImportProgress, ImportSpec, Imported, PoseImportSpec, header, import_with, preview,
+};
 
 /// The pose log an import reads.
 #[derive(Debug, Clone)]

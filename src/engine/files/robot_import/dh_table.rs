@@ -52,12 +52,12 @@ use std::path::Path;
 
 use nalgebra::Isometry3;
 
-use super::import_error::RobotImportError;
-use super::kinematics::{Joint, Robot};
+use super::error::RobotImportError;
 use crate::engine::base::geometry::{rot_x, trans};
 use crate::engine::base::limits;
 use crate::engine::base::numeric::show;
-use crate::engine::base::table::{Table, excerpt, parse_number, separator};
+use crate::engine::base::robot::kinematics::{Joint, Robot};
+use crate::engine::files::table::{Table, excerpt, parse_number, separator};
 
 /// Largest DH table read, bytes (1 MiB): a table has a row per joint.
 pub const MAX_DH_BYTES: u64 = 1 << 20;
