@@ -2,7 +2,7 @@
 //! tracker's table, a fixed camera's) or a fixed line scanner's stripe
 //! profiles, beside a joint log or a pose file, become a session with
 //! `sensor.mount: "fixed"`, through the one import entry
-//! ([`import_session`](crate::engine::files::assemble::import_session) with
+//! ([`import_session`](crate::engine::assemble::import_session) with
 //! [`PoseLog::Fixed`]).
 
 use crate::cli::CliError;

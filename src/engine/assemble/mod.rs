@@ -9,15 +9,18 @@
 //! | unit | holds |
 //! |---|---|
 //! | [`initial`] | the initial hand-eye of an imported session, the uses settled, the start's plausibility |
+//! | [`pose_session`] | a pose file's session: measurements on their side, uses and the initial hand-eye settled, the rules checked |
 //! | [`side`] | the stripe side decided by calibrating both, the pose import that runs it |
 //! | [`preview`] | what a pose import will read and pair, before it runs |
 //! | [`entry`] | the import use case in one entry, and the joint log's preview |
 
 pub mod initial;
+pub mod pose_session;
 pub mod side;
 pub mod preview;
 pub mod entry;
 
 pub use entry::{ImportRequest, PoseLog, import_session, preview_joint_log};
+pub use pose_session::build_pose_session;
 pub use preview::{PairingPreview, PosePreview, preview_pose_import};
 pub use side::{decide_side, import_poses, import_poses_with};

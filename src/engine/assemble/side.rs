@@ -8,9 +8,10 @@
 //! calibrated, or the two are too close to tell, the error says why,
 //! with both sides' outcome.
 
+use super::pose_session::build_pose_session;
 use crate::engine::calibrate::solve::{self, Options};
 use crate::engine::files::import::poses::{
-    PoseImportSpec, PoseInputs, SideChoice, build_pose_session, read_pose_inputs_with,
+    PoseImportSpec, PoseInputs, SideChoice, read_pose_inputs_with,
 };
 use crate::engine::files::import::progress::{self, ImportProgress, ImportStage};
 use crate::engine::files::import::{ImportError, Imported};
@@ -210,12 +211,12 @@ pub fn diameter_misfit(session: &crate::engine::base::session::Session) -> Optio
     })
 }
 
-/// The whole import of a pose file: [`read_pose_inputs`], then the side
+/// The whole import of a pose file: [`read_pose_inputs`](crate::engine::files::import::read_pose_inputs), then the side
 /// given, or with [`SideChoice::Auto`] (and no side column, and no
 /// centres) [`decide_side`], which calibrates both sides.
 ///
 /// # Errors
-/// As [`read_pose_inputs`], [`build_pose_session`] and
+/// As [`read_pose_inputs`](crate::engine::files::import::read_pose_inputs), [`build_pose_session`] and
 /// [`decide_side`].
 pub fn import_poses(spec: &PoseImportSpec) -> Result<Imported, ImportError> {
     import_poses_with(spec, &mut progress::quiet)

@@ -1,4 +1,4 @@
-//! Layer 2, the paper's method, in the order it runs: the stripe's circle
+//! Layer 3, the paper's method, in the order it runs: the stripe's circle
 //! and the sphere centre (eq. 21), the initial hand-eye (eq. 3-9), the
 //! centre-distance error ε and the validation distances (eq. 20), and the
 //! iterative identification of the hand-eye and kinematic errors

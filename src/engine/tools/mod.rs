@@ -1,4 +1,4 @@
-//! Layer 4, the tools around the method: views and reports of a result,
+//! Layer 5, the tools around the method: views and reports of a result,
 //! a library of results over time, simulated sessions with their truth,
 //! scoring against the truth, and the planner of poses.
 //!

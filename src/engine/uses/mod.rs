@@ -1,4 +1,4 @@
-//! Layer 5, using a calibration: measuring parts into one frame with each
+//! Layer 6, using a calibration: measuring parts into one frame with each
 //! point's uncertainty, and driving the robot where it is meant to go.
 //!
 //! | unit | holds |

@@ -2,15 +2,12 @@
 //! as data (the format module writes and reads them), and the command
 //! line's summary lines.
 
-use std::fmt::Write as _;
+use std::fmt::{self, Write as _};
 
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use serde_json::{Map, Value};
 
 use super::loop_record::LoopRecord;
-use crate::engine::calibrate::solve::ml::identifiability::Inseparable;
-use crate::engine::calibrate::solve::ml::noise::Loss;
-use crate::engine::calibrate::solve::ml::range;
 
 /// What one accepted LM step did (the `iterations` of the solver block).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -236,14 +233,14 @@ pub struct MlReport {
     /// Leave-one-station-out cross-validation, when enabled.
     pub cross_validation: Option<CrossValidation>,
     /// Predicted error over the sensor's range (or the region the sphere
-    /// covered), from the covariance ([`super::range`]).
+    /// covered), from the covariance (`calibrate::solve::ml::range`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub range_error: Option<range::RangeError>,
+    pub range_error: Option<RangeError>,
     /// Predicted measuring error over the session's volume (a posteriori),
-    /// with 2 or more stations ([`super::range::VolumeError`]); absent in
+    /// with 2 or more stations ([`VolumeError`]); absent in
     /// results written before 2026-11-28.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub volume_error: Option<range::VolumeError>,
+    pub volume_error: Option<VolumeError>,
     /// Outlier limit, σ of the standardised residual norm.
     pub outlier_limit_sigma: f64,
     /// Measurements beyond the limit.
@@ -399,5 +396,321 @@ impl MlReport {
             );
         }
         s
+    }
+}
+
+/// Robust loss on the norm `s` of a whitened 3-vector residual.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Loss {
+    /// Plain least squares, `ρ(s) = s²/2`.
+    Squared,
+    /// Huber: quadratic up to `k`, linear beyond (the default).
+    #[default]
+    Huber,
+    /// Cauchy: `ρ(s) = k²/2 · ln(1 + s²/k²)`, redescending.
+    Cauchy,
+}
+
+impl Loss {
+    /// The name used on the command line and in the result.
+    #[must_use]
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Squared => "squared",
+            Self::Huber => "huber",
+            Self::Cauchy => "cauchy",
+        }
+    }
+
+    /// Parses a loss name.
+    #[must_use]
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|l| l.as_str() == s)
+    }
+
+    /// Every loss.
+    pub const ALL: [Self; 3] = [Self::Squared, Self::Huber, Self::Cauchy];
+}
+
+/// Whether a parameter label names an angle (deg in files): the hand-eye
+/// rotation and every joint's alpha, beta and theta.
+fn label_is_angle(label: &str) -> bool {
+    label.starts_with("he_r")
+        || label.starts_with("alpha")
+        || label.starts_with("beta")
+        || label.starts_with("theta")
+}
+
+/// A parameter change of one file unit as text, by label.
+fn label_unit(label: &str) -> &'static str {
+    if label_is_angle(label) { "°" } else { " mm" }
+}
+
+/// An estimated parameter that undoes part of a fixed one's effect.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Partner {
+    /// Its label (`he_z`, `theta3`, …).
+    pub parameter: String,
+    /// Its change (file units: mm or deg) that undoes one file unit of the
+    /// fixed parameter.
+    pub undo: f64,
+}
+
+/// A parameter `ml` held fixed, and why: what the data cannot separate it
+/// from. Written in the result file as one sentence each, e.g.
+/// `d6 ~ he_z: d6 +1 mm is undone by he_z +1.000 mm`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Inseparable {
+    /// Parameters that move no centre distance at all: a rigid motion of
+    /// the base frame, absorbed by the station centres.
+    NoEffect(Vec<String>),
+    /// A fixed parameter whose combination could not be computed.
+    Unresolved(String),
+    /// A fixed parameter whose effect estimated parameters undo.
+    Combination {
+        /// The fixed parameter.
+        fixed: String,
+        /// The estimated parameters that undo it, largest share first.
+        partners: Vec<Partner>,
+        /// The share of its effect they undo, %, when not all of it.
+        explained_pct: Option<f64>,
+    },
+    /// A sentence this build cannot read (a later version's wording).
+    Text(String),
+}
+
+/// End of the "no effect" sentence.
+const NO_EFFECT_TEXT: &str = ": no effect on any centre distance (a rigid motion of the base frame, absorbed by the station centres)";
+/// End of the "unresolved" sentence.
+const UNRESOLVED_TEXT: &str = ": fixed (no estimated combination computed)";
+
+impl Inseparable {
+    /// The fixed parameters it names.
+    #[must_use]
+    pub fn fixed(&self) -> Vec<&str> {
+        match self {
+            Self::NoEffect(list) => list.iter().map(String::as_str).collect(),
+            Self::Unresolved(f) | Self::Combination { fixed: f, .. } => vec![f.as_str()],
+            Self::Text(t) => text_head(t).0,
+        }
+    }
+
+    /// The estimated parameters that carry the fixed ones' effect (empty
+    /// when they move no distance at all).
+    #[must_use]
+    pub fn partners(&self) -> Vec<&str> {
+        match self {
+            Self::Combination { partners, .. } => {
+                partners.iter().map(|p| p.parameter.as_str()).collect()
+            }
+            Self::Text(t) => text_head(t).1,
+            _ => Vec::new(),
+        }
+    }
+
+    fn parse(text: &str) -> Option<Self> {
+        if let Some(list) = text.strip_suffix(NO_EFFECT_TEXT) {
+            return Some(Self::NoEffect(
+                list.split(", ").map(str::to_string).collect(),
+            ));
+        }
+        if let Some(f) = text.strip_suffix(UNRESOLVED_TEXT) {
+            return Some(Self::Unresolved(f.to_string()));
+        }
+        let (head, rest) = text.split_once(": ")?;
+        let (fixed, _) = head.split_once(" ~ ")?;
+        let (undo, explained_pct) = match rest.rsplit_once(" (to ") {
+            Some((u, tail)) => (
+                u,
+                Some(tail.strip_suffix(" % of its effect)")?.parse().ok()?),
+            ),
+            None => (rest, None),
+        };
+        let (_, parts) = undo.split_once(" is undone by ")?;
+        let partners = parts
+            .split(", ")
+            .map(|part| {
+                let (parameter, value) = part.split_once(' ')?;
+                let number = value
+                    .strip_suffix(label_unit(parameter))
+                    .or_else(|| value.strip_suffix('°'))?;
+                Some(Partner {
+                    parameter: parameter.to_string(),
+                    undo: number.parse().ok()?,
+                })
+            })
+            .collect::<Option<Vec<_>>>()?;
+        Some(Self::Combination {
+            fixed: fixed.to_string(),
+            partners,
+            explained_pct,
+        })
+    }
+}
+
+/// The parameters a sentence of another wording names before its colon:
+/// `fixed, … ~ partner, …: …` or `fixed, …: …`.
+fn text_head(text: &str) -> (Vec<&str>, Vec<&str>) {
+    let head = text.split_once(':').map_or(text, |(h, _)| h);
+    match head.split_once(" ~ ") {
+        Some((f, p)) => (names(f), names(p)),
+        None => (names(head), Vec::new()),
+    }
+}
+
+/// The comma-separated names of a list, blanks dropped.
+fn names(list: &str) -> Vec<&str> {
+    list.split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .collect()
+}
+
+impl fmt::Display for Inseparable {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NoEffect(list) => write!(f, "{}{NO_EFFECT_TEXT}", list.join(", ")),
+            Self::Unresolved(p) => write!(f, "{p}{UNRESOLVED_TEXT}"),
+            Self::Text(t) => f.write_str(t),
+            Self::Combination {
+                fixed,
+                partners,
+                explained_pct,
+            } => {
+                let names: Vec<&str> = partners.iter().map(|p| p.parameter.as_str()).collect();
+                let undo: Vec<String> = partners
+                    .iter()
+                    .map(|p| format!("{} {:+.3}{}", p.parameter, p.undo, label_unit(&p.parameter)))
+                    .collect();
+                write!(
+                    f,
+                    "{fixed} ~ {}: {fixed} +1{} is undone by {}",
+                    names.join(", "),
+                    label_unit(fixed),
+                    undo.join(", ")
+                )?;
+                if let Some(pct) = explained_pct {
+                    write!(f, " (to {pct:.1} % of its effect)")?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+impl Serialize for Inseparable {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+impl<'de> Deserialize<'de> for Inseparable {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let text = String::deserialize(d)?;
+        Ok(Self::parse(&text).unwrap_or(Self::Text(text)))
+    }
+}
+
+/// The predicted error over the range (result file: `solver.range_error`).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RangeError {
+    /// What the grid covers: `sensor.range`, or `sphere positions` when
+    /// the session gives no range.
+    pub region: String,
+    /// The grid's `[min, max]` along the line, mm (sensor frame).
+    pub y: [f64; 2],
+    /// The grid's `[min, max]` in depth, mm.
+    pub z: [f64; 2],
+    /// Grid points per side.
+    pub grid: usize,
+    /// Working poses the figures are over.
+    pub poses: usize,
+    /// RMS over grid points and poses of the 3-D 1σ, mm.
+    pub rms_mm: f64,
+    /// Mean of the 3-D 1σ, mm.
+    pub mean_mm: f64,
+    /// Largest 3-D 1σ (at any pose), mm.
+    pub max_mm: f64,
+    /// Where the largest is, `[y, z]` mm.
+    pub max_at: [f64; 2],
+    /// RMS 3-D 1σ at the mean sphere position, mm.
+    pub at_sphere_mm: f64,
+    /// `[min, max]` of the measured sphere positions along the line, mm.
+    pub sphere_y: [f64; 2],
+    /// `[min, max]` of the measured sphere positions in depth, mm.
+    pub sphere_z: [f64; 2],
+    /// Fraction of the range's area inside the sphere positions' extent
+    /// (1 when the region is the sphere positions).
+    pub coverage: f64,
+    /// The map: `[y, z, σ]` (mm) of every grid point, σ the rms over the
+    /// working poses.
+    pub map: Vec<[f64; 3]>,
+    /// Set when the sphere covered less than `calibrate::solve::ml::range::RANGE_COVERAGE_WARNING`
+    /// of the range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warning: Option<String>,
+}
+
+impl RangeError {
+    /// One line for people.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let what = if self.region == "sensor.range" {
+            format!(
+                "over sensor.range (y {:.0}…{:.0}, z {:.0}…{:.0} mm)",
+                self.y[0], self.y[1], self.z[0], self.z[1]
+            )
+        } else {
+            format!(
+                "over the region the sphere covered (y {:.1}…{:.1}, z {:.1}…{:.1} mm; no sensor.range in the session)",
+                self.y[0], self.y[1], self.z[0], self.z[1]
+            )
+        };
+        format!(
+            "predicted point error {what}: rms {:.3} mm, max {:.3} mm at (y {:.0}, z {:.0}); {:.3} mm at the sphere",
+            self.rms_mm, self.max_mm, self.max_at[0], self.max_at[1], self.at_sphere_mm
+        )
+    }
+}
+
+/// The predicted measuring error over the session's volume (result file:
+/// `solver.volume_error`): the 1σ a measured sphere centre gets
+/// (`measure`'s per-point σ: 3-D, after the best rigid alignment of all
+/// of them, the covariance times the variance factor) at every identify
+/// and validate pose of the session, i.e. over the box its stations span
+/// and the orientations it used.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct VolumeError {
+    /// Poses the figures are over.
+    pub poses: usize,
+    /// Stations they are at.
+    pub stations: usize,
+    /// RMS of the 1σ, mm.
+    pub rms_mm: f64,
+    /// Largest 1σ, mm.
+    pub max_mm: f64,
+    /// The box the stations span (base frame, mm): `[min, max]` of x, y, z
+    /// of the measured centres.
+    pub box_mm: [[f64; 2]; 3],
+}
+
+impl VolumeError {
+    /// One line for people.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let e = |k: usize| self.box_mm[k][1] - self.box_mm[k][0];
+        format!(
+            "predicted measuring error over the session's volume (a sphere centre's σ after the rigid alignment, a posteriori, at its {} poses at {} stations, a {:.0} × {:.0} × {:.0} mm box): rms {:.4} mm, max {:.4} mm",
+            self.poses,
+            self.stations,
+            e(0),
+            e(1),
+            e(2),
+            self.rms_mm,
+            self.max_mm
+        )
     }
 }

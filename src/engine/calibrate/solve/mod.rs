@@ -20,6 +20,7 @@ pub mod paper;
 pub mod plausible;
 pub mod prepare;
 pub mod progress;
+pub mod result;
 
 use nalgebra::{Isometry3, Point3, Vector3};
 

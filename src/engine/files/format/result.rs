@@ -13,15 +13,13 @@ use nalgebra::Isometry3;
 use super::json::{Ctx, UniqueValue, join, read_text, render, render_lossy, settle, some};
 pub use super::result_check::implausible_number;
 use super::result_check::{first_non_finite, has_bare_null};
-use super::stations::{StationRecord, mount_of, stations_of};
+use super::stations::{StationRecord, mount_of};
 use super::{FORMAT_VERSION, FileError, RESULT_FORMAT, write_atomic};
 use crate::engine::base::geometry::{isometry_from_rows, rigid_from_rows, rows_from_isometry};
 use crate::engine::base::records::solver::{Direction, PaperReport, SolverReport};
+use crate::engine::base::records::{HeldOut, MlReport, Validation};
 use crate::engine::base::robot::{Joint, Robot};
-use crate::engine::base::session::{Mount, Session, Use};
-use crate::engine::calibrate::solve::ml::MlReport;
-use crate::engine::calibrate::solve::{Calibration, HeldOut};
-use crate::engine::calibrate::validate::Validation;
+use crate::engine::base::session::{Mount, Use};
 
 /// A result (FORMAT.md "Result file") as the engine holds it: transforms
 /// as [`Isometry3`], the robot as a [`Robot`], the method's report typed.
@@ -106,63 +104,6 @@ impl PartialEq for ResultFile {
 }
 
 impl ResultFile {
-    /// The result of a run on `session`.
-    #[must_use]
-    pub fn from_calibration(session: &Session, cal: &Calibration) -> Self {
-        let mut result = Self {
-            session: session.name.clone(),
-            hand_eye_initial: cal.hand_eye_initial,
-            hand_eye: cal.hand_eye,
-            robot: if session.pose_only() {
-                session.robot_given.then(|| session.robot.clone())
-            } else {
-                Some(cal.calibrated.clone())
-            },
-            joint_errors: if session.pose_only() {
-                Vec::new()
-            } else {
-                cal.calibrated.joint_errors(&cal.nominal)
-            },
-            solver: cal.report.clone(),
-            iterations: cal
-                .iterations
-                .iter()
-                .map(|&epsilon| IterationRecord { epsilon })
-                .collect(),
-            epsilon_before: cal.epsilon_before(),
-            epsilon_after: cal.epsilon_after(),
-            centres: cal
-                .centres
-                .iter()
-                .map(|c| {
-                    let m = &session.measurements[c.index];
-                    CentreRecord {
-                        measurement: m.id.clone(),
-                        station: m.station.clone(),
-                        usage: m.usage,
-                        sensor: c.sensor.into(),
-                        before: c.before.into(),
-                        after: c.after.into(),
-                    }
-                })
-                .collect(),
-            validation: cal.validation.clone(),
-            held_out: cal.held_out.clone(),
-            pose_joints: cal
-                .centres
-                .iter()
-                .map(|c| &session.measurements[c.index])
-                .filter(|m| {
-                    matches!(m.usage, Use::Identify | Use::Validate) && !m.joints.is_empty()
-                })
-                .map(|m| (m.id.clone(), m.joints.clone()))
-                .collect(),
-            stations: Vec::new(),
-        };
-        result.stations = stations_of(&result.centres, session.mount);
-        result
-    }
-
     /// Where the sensor stood: fixed when the stations are points on the
     /// flange (FORMAT.md 2026-11-27), else on the flange.
     #[must_use]

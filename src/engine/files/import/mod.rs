@@ -1,26 +1,30 @@
-//! Import of real data: a pose log plus stripe profiles become a
-//! [`Session`], validated by the same typed rules as the session loader
-//! ([`Session::validate`]), a broken rule blamed on the file it came from.
+//! The readers of what real cells publish: a pose log plus stripe
+//! profiles (or a fixed sensor's points) read into measurements, and a
+//! joint log's whole session, validated by the same typed rules as the
+//! session loader ([`Session::validate`]), a broken rule blamed on the
+//! file it came from. What the files do not say and the data must decide
+//! (the stripe side, a pose file's uses and initial hand-eye) is the next
+//! layers' ([`crate::engine::assemble`]): nothing here calibrates.
 //!
 //! Two kinds of pose log:
 //!
 //! - a **joint log** ([`import`], [`log`]): one CSV row a pose with its id,
 //!   station, use, side and joint readings, optionally with the flange pose
 //!   the controller reports, checked against the nominal model ([`check`]);
-//! - a **pose file** ([`import_poses`], [`poses`]): a pose table, a JSON
-//!   list or a robot program (FANUC `.ls`, RAPID, KUKA, URScript; read by
-//!   [`crate::engine::files::program`]): flange poses give a pose-only session
-//!   (FORMAT.md "Additions to version 1"), which calibrates the hand-eye
-//!   and the station centres only; joint targets a session with joints.
+//! - a **pose file** ([`poses`]): a pose table, a JSON list or a robot
+//!   program (FANUC `.ls`, RAPID, KUKA, URScript; read by
+//!   [`crate::engine::files::program`]) read with its profiles into
+//!   [`PoseInputs`]; flange poses give a pose-only session (FORMAT.md
+//!   "Additions to version 1"), joint targets a session with joints, built
+//!   by [`assemble::pose_session`](crate::engine::assemble::pose_session).
 //!
 //! Profiles ([`profiles`]) come as CSV/TXT or OpenCV YAML/JSON in the
 //! sensor's own axes and units; an axis map puts them in FORMAT.md's laser
-//! plane, and no-return points are dropped and counted.
+//! plane, and no-return points are dropped and counted. A fixed sensor's
+//! points or profiles are read by [`tracker`].
 //!
-//! A long import tells its stage ([`progress`]: each profile read, the side
-//! decision, the check) through [`import_with`] and [`import_poses_with`],
-//! and stops when the callback cancels. [`entry`] is the one entry the
-//! command line and the workbench both call.
+//! A long import tells its stage ([`progress`]: each profile read, the
+//! check) through [`import_with`] and stops when the callback cancels.
 //!
 //! CSV files are read with the `csv` crate
 //! ([`Table`](crate::engine::files::table::Table)): a UTF-8 byte-order
@@ -48,8 +52,7 @@ pub use self::check::{
 };
 pub use self::log::{ColumnMap, DEFAULT_SIDE_COLUMN, header, preview};
 pub use self::poses::{
-    Observations, PoseImportSpec, PoseInputs, SideChoice, build_pose_session, read_pose_inputs,
-    read_pose_inputs_with,
+    Observations, PoseImportSpec, PoseInputs, SideChoice, read_pose_inputs, read_pose_inputs_with,
 };
 pub use self::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource, RawProfile};
 pub use self::progress::{ImportProgress, ImportStage};

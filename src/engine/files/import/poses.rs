@@ -25,14 +25,14 @@
 //! # What the import decides, and says
 //!
 //! - **Stations**: the table's `station` column, else one station `S1`.
-//! - **Uses and the initial hand-eye** ([`super::initial`]): the table's
+//! - **Uses and the initial hand-eye** ([`initial`](crate::engine::assemble::initial)): the table's
 //!   `use` column, else every pose `identify` with an initial hand-eye
 //!   written into the session: the one given (`hand_eye`), else the
 //!   paper's eq. 6-9 when the poses hold a group of one orientation, else
 //!   the general solution of [`crate::engine::calibrate::handeye::general`]; both
 //!   are printed when both can be had.
 //! - **Side**: the table's `side` column, or the side given; with
-//!   [`SideChoice::Auto`], [`super::side::decide_side`] (a step of its
+//!   [`SideChoice::Auto`], [`decide_side`](crate::engine::assemble::decide_side) (a step of its
 //!   own, run by the caller) calibrates both and keeps the clearly better.
 
 use std::collections::HashMap;
@@ -43,10 +43,10 @@ use nalgebra::{Isometry3, Vector3};
 use super::pairing::{self, FolderListing};
 use super::profiles::{AxisMap, PlaneProfile, ProfileFormat, ProfileSource};
 use super::progress::{self, ImportProgress};
-use super::{FlangeConvention, ImportError, Imported, ProfileReport, RobotSource, load_robot};
+use super::{FlangeConvention, ImportError, ProfileReport, RobotSource, load_robot};
 use crate::engine::base::limits;
 use crate::engine::base::robot::Robot;
-use crate::engine::base::session::{Measurement, Observation, Use, rules};
+use crate::engine::base::session::{Observation, Use, rules};
 use crate::engine::files::program::{
     self, PoseFile, PoseFormat, ProgramError, ReadSpec, TargetValue, read_number_table,
 };
@@ -62,7 +62,7 @@ pub enum SideChoice {
     /// `x < 0` (side −1).
     Minus,
     /// Decided from the data: both are calibrated, the clearly better
-    /// one is chosen ([`super::side::decide_side`]).
+    /// one is chosen ([`decide_side`](crate::engine::assemble::decide_side)).
     Auto,
 }
 
@@ -603,107 +603,6 @@ fn pairing_note(records: &[PoseRecord], listing: &FolderListing) -> String {
             ""
         }
     )
-}
-
-/// The session of `inputs` with every measurement on side `side` (unless
-/// the file gave one), its uses and initial hand-eye settled
-/// ([`super::initial::settle`]). Runs no calibration.
-///
-/// # Errors
-/// The initial hand-eye cannot be had (naming why), or the session breaks
-/// a FORMAT.md rule (naming the file and line it came from).
-pub fn build_pose_session(
-    spec: &PoseImportSpec,
-    inputs: &PoseInputs,
-    side: i8,
-) -> Result<Imported, ImportError> {
-    let given_uses = inputs.records.iter().filter(|r| r.usage.is_some()).count();
-    if given_uses != 0 && given_uses != inputs.records.len() {
-        return Err(ImportError::File {
-            path: spec.poses.clone(),
-            message: "some poses have a use and some not: give every pose a use, or none".into(),
-        });
-    }
-    let auto_uses = given_uses == 0;
-    let measurements: Vec<Measurement> = inputs
-        .records
-        .iter()
-        .zip(&inputs.ids)
-        .zip(&inputs.observations)
-        .map(|((r, id), observation)| {
-            let (joints, flange) = match &r.value {
-                PoseValue::Flange(pose) => (Vec::new(), Some(*pose)),
-                PoseValue::Joints(q) => (q.clone(), None),
-            };
-            Measurement {
-                id: id.clone(),
-                station: r
-                    .station
-                    .clone()
-                    .unwrap_or_else(|| DEFAULT_STATION.to_string()),
-                usage: r.usage.unwrap_or(Use::Identify),
-                side_given: r.side,
-                side: r.side.unwrap_or(side),
-                joints,
-                flange,
-                observation: observation.clone(),
-            }
-        })
-        .collect();
-    let name = spec.name.clone().unwrap_or_else(|| {
-        spec.poses
-            .file_stem()
-            .map_or_else(|| "imported".into(), |s| s.to_string_lossy().into_owned())
-    });
-    let session = super::new_session(
-        name,
-        inputs.robot.clone(),
-        spec.sphere_diameter,
-        (!inputs.centres()).then_some(side),
-        spec.references.as_deref(),
-        measurements,
-    )?;
-    let (session, hand_eye_notes) = crate::engine::assemble::initial::settle(
-        session,
-        auto_uses,
-        spec.hand_eye,
-        &spec.poses,
-        &inputs.report,
-    )?;
-    let mut notes = inputs.notes.clone();
-    notes.push(if inputs.joints() {
-        format!(
-            "{} joint targets: the robot's kinematic errors are identified with the hand-eye",
-            inputs.records.len()
-        )
-    } else {
-        format!(
-            "{} flange poses, pose-only: only the hand-eye and the station centres are calibrated, no kinematic parameter",
-            inputs.records.len()
-        )
-    });
-    notes.extend(hand_eye_notes);
-    let lines: HashMap<&str, usize> = inputs
-        .ids
-        .iter()
-        .zip(&inputs.records)
-        .map(|(id, r)| (id.as_str(), r.line))
-        .collect();
-    let session = super::recheck(
-        session,
-        &super::Sources {
-            log: &spec.poses,
-            lines: &lines,
-            profiles: &inputs.report,
-            references: spec.references.as_deref(),
-        },
-    )?;
-    Ok(Imported {
-        session,
-        checks: Vec::new(),
-        profiles: inputs.report.clone(),
-        notes,
-    })
 }
 
 #[cfg(test)]

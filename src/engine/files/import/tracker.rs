@@ -186,7 +186,7 @@ pub fn import_tracker(spec: &TrackerSpec) -> Result<(Session, Vec<String>), Impo
 }
 
 /// [`import_tracker`] as the one import entry runs it
-/// ([`super::entry::import_session`]), telling `progress` each profile
+/// ([`import_session`](crate::engine::assemble::import_session)), telling `progress` each profile
 /// read and the check.
 ///
 /// # Errors

@@ -4,10 +4,10 @@
 //! whitening, and the Huber and Cauchy losses with their χ(3) scales.
 
 use nalgebra::{Matrix3, SymmetricEigen};
-use serde::{Deserialize, Serialize};
 
 use super::MlOptions;
 use crate::engine::base::geometry::twist_rows;
+pub use crate::engine::base::records::ml::Loss;
 use crate::engine::base::session::Mount;
 use crate::engine::calibrate::handeye::Sighting;
 use crate::engine::calibrate::solve::estimate::Estimate;
@@ -36,39 +36,8 @@ pub const LOSS_QUANTILE: f64 = 0.99;
 /// an outlier: one false alarm per thousand clean measurements.
 pub const OUTLIER_QUANTILE: f64 = 0.999;
 
-/// Robust loss on the norm `s` of a whitened 3-vector residual.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Loss {
-    /// Plain least squares, `ρ(s) = s²/2`.
-    Squared,
-    /// Huber: quadratic up to `k`, linear beyond (the default).
-    #[default]
-    Huber,
-    /// Cauchy: `ρ(s) = k²/2 · ln(1 + s²/k²)`, redescending.
-    Cauchy,
-}
-
+/// The losses' functions, used by the solver only.
 impl Loss {
-    /// The name used on the command line and in the result.
-    #[must_use]
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Self::Squared => "squared",
-            Self::Huber => "huber",
-            Self::Cauchy => "cauchy",
-        }
-    }
-
-    /// Parses a loss name.
-    #[must_use]
-    pub fn parse(s: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|l| l.as_str() == s)
-    }
-
-    /// Every loss.
-    pub const ALL: [Self; 3] = [Self::Squared, Self::Huber, Self::Cauchy];
-
     /// `ρ(s)` for scale `k` (both in σ).
     pub(super) fn rho(self, s: f64, k: f64) -> f64 {
         match self {

@@ -17,10 +17,10 @@
 //! says so).
 
 use nalgebra::{DMatrix, Vector3};
-use serde::{Deserialize, Serialize};
 
 use super::covariance::{RigidFit, aligned_sigma};
 use super::problem::Problem;
+pub use crate::engine::base::records::ml::{RangeError, VolumeError};
 use crate::engine::base::session::{SensorRange, Session, Use};
 use crate::engine::calibrate::solve::Prepared;
 use crate::engine::calibrate::solve::estimate::{Estimate, PoseSensitivity};
@@ -35,69 +35,6 @@ pub const RANGE_POSES: usize = 20;
 /// Below this fraction of `sensor.range` covered by the sphere positions
 /// the report warns.
 pub const RANGE_COVERAGE_WARNING: f64 = 0.25;
-
-/// The predicted error over the range (result file: `solver.range_error`).
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(default)]
-pub struct RangeError {
-    /// What the grid covers: `sensor.range`, or `sphere positions` when
-    /// the session gives no range.
-    pub region: String,
-    /// The grid's `[min, max]` along the line, mm (sensor frame).
-    pub y: [f64; 2],
-    /// The grid's `[min, max]` in depth, mm.
-    pub z: [f64; 2],
-    /// Grid points per side.
-    pub grid: usize,
-    /// Working poses the figures are over.
-    pub poses: usize,
-    /// RMS over grid points and poses of the 3-D 1σ, mm.
-    pub rms_mm: f64,
-    /// Mean of the 3-D 1σ, mm.
-    pub mean_mm: f64,
-    /// Largest 3-D 1σ (at any pose), mm.
-    pub max_mm: f64,
-    /// Where the largest is, `[y, z]` mm.
-    pub max_at: [f64; 2],
-    /// RMS 3-D 1σ at the mean sphere position, mm.
-    pub at_sphere_mm: f64,
-    /// `[min, max]` of the measured sphere positions along the line, mm.
-    pub sphere_y: [f64; 2],
-    /// `[min, max]` of the measured sphere positions in depth, mm.
-    pub sphere_z: [f64; 2],
-    /// Fraction of the range's area inside the sphere positions' extent
-    /// (1 when the region is the sphere positions).
-    pub coverage: f64,
-    /// The map: `[y, z, σ]` (mm) of every grid point, σ the rms over the
-    /// working poses.
-    pub map: Vec<[f64; 3]>,
-    /// Set when the sphere covered less than [`RANGE_COVERAGE_WARNING`]
-    /// of the range.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub warning: Option<String>,
-}
-
-impl RangeError {
-    /// One line for people.
-    #[must_use]
-    pub fn summary(&self) -> String {
-        let what = if self.region == "sensor.range" {
-            format!(
-                "over sensor.range (y {:.0}…{:.0}, z {:.0}…{:.0} mm)",
-                self.y[0], self.y[1], self.z[0], self.z[1]
-            )
-        } else {
-            format!(
-                "over the region the sphere covered (y {:.1}…{:.1}, z {:.1}…{:.1} mm; no sensor.range in the session)",
-                self.y[0], self.y[1], self.z[0], self.z[1]
-            )
-        };
-        format!(
-            "predicted point error {what}: rms {:.3} mm, max {:.3} mm at (y {:.0}, z {:.0}); {:.3} mm at the sphere",
-            self.rms_mm, self.max_mm, self.max_at[0], self.max_at[1], self.at_sphere_mm
-        )
-    }
-}
 
 /// The restricted sensitivity `G` (3 × k, scaled units: column `c` is
 /// parameter `estimated[c]` divided by `scale[c]`) of sensor point `g` at
@@ -326,46 +263,6 @@ pub(super) fn range_error(
 
 /// Most poses the volume error is taken over (an even sample beyond).
 pub const VOLUME_POSES: usize = 400;
-
-/// The predicted measuring error over the session's volume (result file:
-/// `solver.volume_error`): the 1σ a measured sphere centre gets
-/// (`measure`'s per-point σ: 3-D, after the best rigid alignment of all
-/// of them, the covariance times the variance factor) at every identify
-/// and validate pose of the session, i.e. over the box its stations span
-/// and the orientations it used.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(default)]
-pub struct VolumeError {
-    /// Poses the figures are over.
-    pub poses: usize,
-    /// Stations they are at.
-    pub stations: usize,
-    /// RMS of the 1σ, mm.
-    pub rms_mm: f64,
-    /// Largest 1σ, mm.
-    pub max_mm: f64,
-    /// The box the stations span (base frame, mm): `[min, max]` of x, y, z
-    /// of the measured centres.
-    pub box_mm: [[f64; 2]; 3],
-}
-
-impl VolumeError {
-    /// One line for people.
-    #[must_use]
-    pub fn summary(&self) -> String {
-        let e = |k: usize| self.box_mm[k][1] - self.box_mm[k][0];
-        format!(
-            "predicted measuring error over the session's volume (a sphere centre's σ after the rigid alignment, a posteriori, at its {} poses at {} stations, a {:.0} × {:.0} × {:.0} mm box): rms {:.4} mm, max {:.4} mm",
-            self.poses,
-            self.stations,
-            e(0),
-            e(1),
-            e(2),
-            self.rms_mm,
-            self.max_mm
-        )
-    }
-}
 
 /// The prediction over the session's volume ([`VolumeError`]) with the
 /// covariance `cov` (scaled units, a posteriori); `None` with fewer than
