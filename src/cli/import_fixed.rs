@@ -91,10 +91,10 @@ fn fixed_spec(args: &ImportArgs) -> Result<TrackerSpec, CliError> {
             },
             format: args.scan.profile_format()?,
             side: match args.side {
-                SideChoice::Minus => -1,
-                // A fixed scanner's side is not decided from the data:
-                // `auto` (the default) reads +1 unless the log says.
-                SideChoice::Plus | SideChoice::Auto => 1,
+                SideChoice::Minus => Some(-1),
+                SideChoice::Plus => Some(1),
+                // Decided from the data unless the log says.
+                SideChoice::Auto => None,
             },
         },
         (None, None) => {

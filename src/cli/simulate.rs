@@ -194,7 +194,7 @@ pub struct SimulateArgs {
     /// With --scan: poses along the path (per sphere for `spheres`).
     #[arg(long, requires = "scan", default_value_t = ScanConfig::default().poses, value_parser = count(1, MAX_SCAN_POSES))]
     pub scan_poses: usize,
-    /// A pose-only session: every measurement reports its flange pose (the true flange position plus Gaussian error of this σ, mm, each base-frame coordinate) instead of joints, and the session has no robot (as a cell whose controller reports poses).
+    /// A pose-only session: every measurement reports its flange pose (the true flange position plus Gaussian error of this σ, mm, each base-frame coordinate) instead of joints, and the session has no robot (as a cell whose controller reports poses). With --mount fixed: each pose's flange pose with its error, shared by the pose's targets.
     #[arg(long, value_name = "MM", conflicts_with_all = ["plan", "scan", "csv_out"], value_parser = number(Range::non_negative("mm").at_most(MAX_SENSOR_NOISE_MM)))]
     pub pose_only: Option<f64>,
     /// Where the sensor stands: `flange` (the paper's cell) or `fixed` (a sensor fixed in the cell measuring targets on the tool; see --fixed-sensor).

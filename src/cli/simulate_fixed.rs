@@ -131,9 +131,9 @@ pub fn dispatch(args: &SimulateArgs) -> Result<(), CliError> {
 /// [`CliError`] for flags that do not apply to a fixed sensor, a bad
 /// setting or an output that cannot be written.
 fn run(args: &SimulateArgs, truth_path: &Path) -> Result<(), CliError> {
-    if args.plan.is_some() || args.scan.is_some() || args.pose_only.is_some() {
+    if args.plan.is_some() || args.scan.is_some() {
         return Err(CliError::input(
-            "--mount fixed simulates its own poses: --plan, --scan and --pose-only do not apply",
+            "--mount fixed simulates its own poses: --plan and --scan do not apply",
         ));
     }
     let noise = args.sensor_noise;
@@ -176,7 +176,7 @@ fn run(args: &SimulateArgs, truth_path: &Path) -> Result<(), CliError> {
     if !args.quiet {
         let count = |u: Use| session.with_use(u).count();
         sayln!(
-            "simulated a fixed {} (seed {}, σ {} mm) and {} target(s) on the tool of {}: {} measurements ({} identify, {} validate) -> {}, truth {}",
+            "simulated a fixed {} (seed {}, σ {} mm) and {} target(s) on the tool of {}{}: {} measurements ({} identify, {} validate) -> {}, truth {}",
             match args.fixed_sensor {
                 FixedSensorArg::Tracker => "laser tracker",
                 FixedSensorArg::Scanner => "scanner",
@@ -185,7 +185,10 @@ fn run(args: &SimulateArgs, truth_path: &Path) -> Result<(), CliError> {
             config.seed,
             noise,
             cell.targets.len(),
-            session.robot.name,
+            truth.robot.name,
+            config.pose_only.map_or_else(String::new, |sigma| format!(
+                " (pose-only: its flange poses off by {sigma} mm)"
+            )),
             session.measurements.len(),
             count(Use::Identify),
             count(Use::Validate),

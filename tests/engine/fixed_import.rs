@@ -16,7 +16,7 @@ use spherecal::engine::base::session::{Mount, Observation, Session, Use};
 use spherecal::engine::calibrate::solve::{self, Method, Options};
 use spherecal::engine::files::format::ResultFile;
 use spherecal::engine::files::import::tracker::{
-    FixedPoints, FixedPoses, TrackerSpec, import_tracker,
+    FixedPoints, FixedPoses, TrackerSpec, read_tracker,
 };
 use spherecal::engine::files::import::{
     AngleUnit, FlangeConvention, LengthUnit, ProfileFormat, ProfileSource,
@@ -171,7 +171,7 @@ fn a_pose_only_tracker_session_with_noise_predicts_near_the_floor() {
         let (session, truth) = simulate_fixed(&config(seed), &FixedCell::tracker(0.01)).unwrap();
         let dir = tempfile::tempdir().unwrap();
         let (poses, points) = pose_file_and_table(&session, &truth, dir.path());
-        let (pose_only, _) = import_tracker(&pose_spec(&poses, &points, LengthUnit::Mm)).unwrap();
+        let (pose_only, _) = read_tracker(&pose_spec(&poses, &points, LengthUnit::Mm)).unwrap();
         let (result, pairs) = score_pose_only(&pose_only, &truth);
         let (cal, floor): (Vec<f64>, Vec<f64>) = pairs.into_iter().unzip();
         let (cal, floor) = (rms(&cal), rms(&floor));
@@ -197,7 +197,7 @@ fn the_fixed_doors_errors_name_the_file_the_pose_and_what_is_wrong() {
     let message = |points_text: &str, unit: LengthUnit| {
         let path = dir.path().join("bad.csv");
         std::fs::write(&path, points_text).unwrap();
-        import_tracker(&pose_spec(&poses, &path, unit))
+        read_tracker(&pose_spec(&poses, &path, unit))
             .unwrap_err()
             .to_string()
     };
@@ -241,7 +241,7 @@ fn the_fixed_doors_errors_name_the_file_the_pose_and_what_is_wrong() {
     let e = message(&metres, LengthUnit::Mm);
     assert!(e.contains("--centre-unit m"), "{e}");
     assert!(
-        import_tracker(&pose_spec(
+        read_tracker(&pose_spec(
             &poses,
             &dir.path().join("bad.csv"),
             LengthUnit::M
@@ -260,7 +260,7 @@ fn the_fixed_doors_errors_name_the_file_the_pose_and_what_is_wrong() {
         },
         ..pose_spec(&poses, &points, LengthUnit::Mm)
     };
-    let e = import_tracker(&spec).unwrap_err().to_string();
+    let e = read_tracker(&spec).unwrap_err().to_string();
     assert!(e.contains("joints.csv") && e.contains("--robot"), "{e}");
 }
 
@@ -292,7 +292,7 @@ fn line_scanner_import(session: &Session, dir: &Path) -> Session {
         points: FixedPoints::Profiles {
             source: ProfileSource::Folder(dir.join("profiles")),
             format: ProfileFormat::default(),
-            side: 1,
+            side: Some(1),
         },
         robot: Some(spherecal::engine::base::robot::irb2400().robot),
         diameter: session.sphere_diameter,

@@ -12,7 +12,7 @@ use spherecal::engine::calibrate::solve::{self, Method, Options};
 use spherecal::engine::files::format::stations::prediction_errors;
 use spherecal::engine::files::format::{self, ResultFile};
 use spherecal::engine::files::import::tracker::{
-    FixedPoints, FixedPoses, TrackerSpec, import_tracker,
+    FixedPoints, FixedPoses, TrackerSpec, read_tracker,
 };
 use spherecal::engine::files::import::{AngleUnit, LengthUnit};
 use spherecal::engine::tools::simulate::{FixedCell, FixedTruth, SimConfig, simulate_fixed};
@@ -186,7 +186,7 @@ fn tracker_spec(points: &Path, unit: LengthUnit) -> TrackerSpec {
 fn a_trackers_table_in_metres_with_named_columns_and_repeats_imports_averaged() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let named = root.join("examples/tracker/points-m.csv");
-    let (session, notes) = import_tracker(&tracker_spec(&named, LengthUnit::M)).unwrap();
+    let (session, notes) = read_tracker(&tracker_spec(&named, LengthUnit::M)).unwrap();
     assert_eq!(session.mount, Mount::Fixed);
     assert_eq!(session.measurements.len(), 24);
     assert_eq!(session.with_use(Use::Validate).count(), 6);
@@ -206,7 +206,7 @@ fn a_trackers_table_in_metres_with_named_columns_and_repeats_imports_averaged() 
         text += &format!("{pose},{},{},{},{}\n", m.station, c.x, c.y, c.z);
     }
     std::fs::write(&rows, text).unwrap();
-    let (again, _) = import_tracker(&tracker_spec(&rows, LengthUnit::Mm)).unwrap();
+    let (again, _) = read_tracker(&tracker_spec(&rows, LengthUnit::Mm)).unwrap();
     assert_eq!(again.measurements.len(), 24);
     // Poses in the log's order, targets in the table's order within one.
     let key = |s: &Session| {
@@ -222,7 +222,7 @@ fn a_trackers_table_in_metres_with_named_columns_and_repeats_imports_averaged() 
     assert_eq!(again.measurements[0].id, "P1-SMR3");
     // A pose the joint log does not have is named with its line.
     std::fs::write(&rows, "pose,x,y,z\nP1,1,2,3\nP99,1,2,3\n").unwrap();
-    let e = import_tracker(&tracker_spec(&rows, LengthUnit::Mm)).unwrap_err();
+    let e = read_tracker(&tracker_spec(&rows, LengthUnit::Mm)).unwrap_err();
     assert!(
         e.to_string().contains("line 3") && e.to_string().contains("P99"),
         "{e}"

@@ -9,6 +9,7 @@ mod a_posteriori;
 mod diameter;
 mod fixed_import;
 mod fixed_mount;
+mod fixed_side;
 mod formats;
 mod fuzz;
 mod held_out;

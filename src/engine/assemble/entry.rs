@@ -3,7 +3,7 @@
 //! ([`import_with`](crate::engine::files::import::import_with)) or a pose file
 //! ([`import_poses_with`](super::import_poses_with): the side given, or
 //! decided from the data by calibrating both), or a fixed sensor's points
-//! or profiles beside either ([`import_tracker_with`](crate::engine::files::import::tracker::import_tracker_with),
+//! or profiles beside either ([`import_tracker_with`](super::side::import_tracker_with),
 //! FORMAT.md `sensor.mount: "fixed"`) into a session, the sensor's
 //! measuring range written into it when given, with the progress of every
 //! stage; and the joint log's preview, its header read and its first rows
@@ -12,8 +12,9 @@
 use std::path::Path;
 
 use super::side::import_poses_with;
+use super::side::import_tracker_with;
 use crate::engine::base::session::SensorRange;
-use crate::engine::files::import::tracker::{TrackerSpec, import_tracker_with};
+use crate::engine::files::import::tracker::TrackerSpec;
 use crate::engine::files::import::{
     ImportError, ImportProgress, ImportSpec, Imported, PoseImportSpec, header, import_with, preview,
 };

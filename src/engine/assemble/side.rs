@@ -8,12 +8,15 @@
 //! calibrated, or the two are too close to tell, the error says why,
 //! with both sides' outcome.
 
+use std::path::Path;
+
 use super::pose_session::build_pose_session;
 use crate::engine::calibrate::solve::{self, Options};
 use crate::engine::files::import::poses::{
     PoseImportSpec, PoseInputs, SideChoice, read_pose_inputs_with,
 };
 use crate::engine::files::import::progress::{self, ImportProgress, ImportStage};
+use crate::engine::files::import::tracker::{FixedPoints, TrackerSpec, read_tracker_with};
 use crate::engine::files::import::{ImportError, Imported};
 
 /// How many times smaller the scatter ε of one side must be than the
@@ -33,6 +36,39 @@ fn label(side: i8) -> &'static str {
     if side > 0 { "+1" } else { "−1" }
 }
 
+/// One side tried: the session built on `side` (or why not) and its ε
+/// after a calibration without the cross-checks (or why it failed).
+fn attempt(side: i8, imported: Result<Imported, ImportError>) -> Tried {
+    let epsilon = match &imported {
+        Ok(i) => {
+            let mut options = Options::from_session(&i.session);
+            options.ml.cross_validation = false;
+            options.held_out = false;
+            solve::calibrate(&i.session, &options)
+                .map(|(_, cal)| cal.epsilon_after())
+                .map_err(|e| {
+                    // A stripe that gives no centre is its profile's fault.
+                    let file = match &e {
+                        solve::SolveError::Stripe { id, .. } => i
+                            .profiles
+                            .poses
+                            .iter()
+                            .find(|p| p.id == *id)
+                            .map(|p| format!(" ({})", p.file.display())),
+                        _ => None,
+                    };
+                    format!("the calibration failed: {e}{}", file.unwrap_or_default())
+                })
+        }
+        Err(e) => Err(e.to_string()),
+    };
+    Tried {
+        side,
+        imported,
+        epsilon,
+    }
+}
+
 /// Builds and calibrates both sides of `inputs` and keeps the clearly
 /// better one, with the evidence in its notes.
 ///
@@ -40,40 +76,16 @@ fn label(side: i8) -> &'static str {
 /// Neither side can be built (the reason is the same for both: it is
 /// returned as it is), or the data cannot tell (both outcomes named).
 pub fn decide_side(spec: &PoseImportSpec, inputs: &PoseInputs) -> Result<Imported, ImportError> {
-    let mut tried: Vec<Tried> = [1_i8, -1]
+    let tried = [1_i8, -1]
         .into_iter()
-        .map(|side| {
-            let imported = build_pose_session(spec, inputs, side);
-            let epsilon = match &imported {
-                Ok(i) => {
-                    let mut options = Options::from_session(&i.session);
-                    options.ml.cross_validation = false;
-                    options.held_out = false;
-                    solve::calibrate(&i.session, &options)
-                        .map(|(_, cal)| cal.epsilon_after())
-                        .map_err(|e| {
-                            // A stripe that gives no centre is its profile's fault.
-                            let file = match &e {
-                                solve::SolveError::Stripe { id, .. } => i
-                                    .profiles
-                                    .poses
-                                    .iter()
-                                    .find(|p| p.id == *id)
-                                    .map(|p| format!(" ({})", p.file.display())),
-                                _ => None,
-                            };
-                            format!("the calibration failed: {e}{}", file.unwrap_or_default())
-                        })
-                }
-                Err(e) => Err(e.to_string()),
-            };
-            Tried {
-                side,
-                imported,
-                epsilon,
-            }
-        })
+        .map(|side| attempt(side, build_pose_session(spec, inputs, side)))
         .collect();
+    choose(&spec.poses, tried)
+}
+
+/// The clearly better of the two sides `tried` (+1 first), with the
+/// evidence in its notes; errors name `path`, the pose log.
+fn choose(path: &Path, mut tried: Vec<Tried>) -> Result<Imported, ImportError> {
     if tried.iter().all(|t| t.imported.is_err()) {
         let plus = tried.swap_remove(0);
         let same = tried[0].epsilon.as_ref().err() == plus.epsilon.as_ref().err();
@@ -96,7 +108,7 @@ pub fn decide_side(spec: &PoseImportSpec, inputs: &PoseInputs) -> Result<Importe
                 })
             }
             _ => Err(ImportError::File {
-                path: spec.poses.clone(),
+                path: path.to_path_buf(),
                 message: format!(
                     "neither side of the laser plane gives a session: side +1: {}; side −1: {}",
                     plus.epsilon.err().unwrap_or_default(),
@@ -110,7 +122,7 @@ pub fn decide_side(spec: &PoseImportSpec, inputs: &PoseInputs) -> Result<Importe
     {
         // The same failure whichever the side: that is the real reason.
         return Err(ImportError::File {
-            path: spec.poses.clone(),
+            path: path.to_path_buf(),
             message: format!("{a} (the same on either side of the laser plane)"),
         });
     }
@@ -141,7 +153,7 @@ pub fn decide_side(spec: &PoseImportSpec, inputs: &PoseInputs) -> Result<Importe
             |d| format!("{d}; if it is right, give the side (--side +1 or --side -1)"),
         );
         return Err(ImportError::File {
-            path: spec.poses.clone(),
+            path: path.to_path_buf(),
             message: format!(
                 "cannot tell from the data on which side of the laser plane the sphere lies: {reason} ({evidence}; one must be {SIDE_EVIDENCE_RATIO}× smaller): {advice}"
             ),
@@ -246,4 +258,47 @@ pub fn import_poses_with(
             )
         }
     }
+}
+
+/// The import of a fixed sensor's points or profiles (FORMAT.md
+/// `sensor.mount: "fixed"`): [`read_tracker_with`], and for a fixed line
+/// scanner's profiles without a side (`--side auto`, and no `side` column
+/// for every pose) the side decided from the data as for a flange-mounted
+/// sensor: the session read on both sides, both calibrated, the clearly
+/// better kept ([`SIDE_EVIDENCE_RATIO`]). On the wrong side every centre
+/// moves twice its distance from the plane along the sensor's `x`, which
+/// no `base_from_sensor` undoes where that distance varies.
+///
+/// # Errors
+/// As [`read_tracker_with`]; the data cannot tell the side (both outcomes
+/// named); [`ImportError::Cancelled`].
+pub fn import_tracker_with(
+    spec: &TrackerSpec,
+    progress: &mut ImportProgress<'_>,
+) -> Result<Imported, ImportError> {
+    let FixedPoints::Profiles { side: None, .. } = &spec.points else {
+        return read_tracker_with(spec, progress);
+    };
+    let on = |side: i8| {
+        let mut sided = spec.clone();
+        if let FixedPoints::Profiles { side: s, .. } = &mut sided.points {
+            *s = Some(side);
+        }
+        sided
+    };
+    let plus = read_tracker_with(&on(1), progress)?;
+    if plus
+        .session
+        .measurements
+        .iter()
+        .all(|m| m.side_given.is_some())
+    {
+        return Ok(plus);
+    }
+    progress::report(progress, ImportStage::Side)?;
+    let minus = read_tracker_with(&on(-1), &mut progress::quiet);
+    choose(
+        spec.poses.path(),
+        vec![attempt(1, Ok(plus)), attempt(-1, minus)],
+    )
 }

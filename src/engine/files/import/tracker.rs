@@ -133,8 +133,10 @@ pub enum FixedPoints {
         /// How to read them.
         format: ProfileFormat,
         /// Side of the sphere centre (+1: sensor `x > 0`) where the log
-        /// gives none.
-        side: i8,
+        /// gives none; `None`: decided from the data by calibrating both
+        /// ([`import_tracker_with`](crate::engine::assemble::side::import_tracker_with)),
+        /// read here as +1.
+        side: Option<i8>,
     },
 }
 
@@ -180,18 +182,18 @@ struct PoseRow {
 /// (naming the file, line and column), a point whose pose is not among
 /// the poses, a pose without a point, points in the wrong unit, counts
 /// that do not pair, or a session that breaks a rule.
-pub fn import_tracker(spec: &TrackerSpec) -> Result<(Session, Vec<String>), ImportError> {
-    let imported = import_tracker_with(spec, &mut progress::quiet)?;
+pub fn read_tracker(spec: &TrackerSpec) -> Result<(Session, Vec<String>), ImportError> {
+    let imported = read_tracker_with(spec, &mut progress::quiet)?;
     Ok((imported.session, imported.notes))
 }
 
-/// [`import_tracker`] as the one import entry runs it
+/// [`read_tracker`] as the one import entry runs it
 /// ([`import_session`](crate::engine::assemble::import_session)), telling `progress` each profile
 /// read and the check.
 ///
 /// # Errors
-/// As [`import_tracker`]; [`ImportError::Cancelled`].
-pub fn import_tracker_with(
+/// As [`read_tracker`]; [`ImportError::Cancelled`].
+pub fn read_tracker_with(
     spec: &TrackerSpec,
     progress: &mut ImportProgress<'_>,
 ) -> Result<Imported, ImportError> {
@@ -211,6 +213,7 @@ pub fn import_tracker_with(
             format,
             side,
         } => {
+            let side = side.unwrap_or(1);
             let ids: Vec<String> = rows.iter().map(|r| r.id.clone()).collect();
             let (planes, report) = super::read_profiles(source, format, &ids, progress)?;
             super::check_profile_size(&planes, format, spec.diameter)?;
@@ -223,7 +226,7 @@ pub fn import_tracker_with(
                     station: DEFAULT_TARGET.to_string(),
                     usage: r.usage.unwrap_or(Use::Identify),
                     side_given: r.side,
-                    side: r.side.unwrap_or(*side),
+                    side: r.side.unwrap_or(side),
                     joints: r.joints.clone(),
                     flange: r.flange,
                     observation: Observation::Stripe(plane.points),
@@ -249,7 +252,7 @@ pub fn import_tracker_with(
         .clone()
         .unwrap_or_else(|| Robot::new(String::new(), Vec::new()));
     let side = match &spec.points {
-        FixedPoints::Profiles { side, .. } => *side,
+        FixedPoints::Profiles { side, .. } => side.unwrap_or(1),
         FixedPoints::Table { .. } => 1,
     };
     let session = Session {

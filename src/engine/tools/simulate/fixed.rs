@@ -33,6 +33,10 @@ use crate::engine::base::session::{Measurement, Mount, Observation, Session, Sol
 const STREAM_FIXED_POSES: u64 = 11;
 /// Random stream of the sensor noise.
 const STREAM_FIXED_NOISE: u64 = 12;
+/// Random stream of the reported flange poses' error of a pose-only cell
+/// ([`SimConfig::pose_only`]), its own so that the poses and the sensor's
+/// readings are those of the joint session of the same seed.
+const STREAM_FIXED_FLANGE: u64 = 13;
 /// Draws per wanted pose before the simulator gives up.
 const TRIES_PER_POSE: usize = 400;
 /// Decimals of the written sensor coordinates (1 nm: far below any noise,
@@ -79,7 +83,8 @@ pub struct FixedCell {
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinePlane {
     /// The centre's distance from the laser plane, sensor `x`, drawn
-    /// uniform in this range, mm (within the sphere radius; side +1).
+    /// uniform in this range, mm (within the sphere radius): positive on
+    /// side +1, negative on side −1 (the measurements' side).
     pub cut_mm: [f64; 2],
     /// Largest `|y|` of the centre in the sensor frame, mm.
     pub half_width_mm: f64,
@@ -289,6 +294,11 @@ pub fn simulate_fixed(
     }
     let mut rng = stream(config.seed, STREAM_FIXED_POSES);
     let mut noise = stream(config.seed, STREAM_FIXED_NOISE);
+    let mut flange_noise = stream(config.seed, STREAM_FIXED_FLANGE);
+    let side: i8 = match &cell.line {
+        Some(line) if line.cut_mm[1] < 0.0 => -1,
+        _ => 1,
+    };
     let wanted = cell.n_identify + cell.n_validate;
     let cos_cone = cell.cone_deg.to_radians().cos();
     let mut measurements = Vec::new();
@@ -338,6 +348,17 @@ pub fn simulate_fixed(
             Use::Validate
         };
         let q_written: Vec<f64> = q.iter().map(|v| round_to(*v, JOINT_DECIMALS)).collect();
+        // A pose-only cell reports the pose's true flange pose, its
+        // position off by N(0, σ²) in each base coordinate (one error a
+        // pose, shared by its targets), as the flange mount's pose-only
+        // sessions do.
+        let reported = config.pose_only.map(|sigma| {
+            let mut f = true_robot.base_from_flange(&q_written);
+            for k in 0..3 {
+                f.translation.vector[k] += sigma * normal(&mut flange_noise);
+            }
+            f
+        });
         for (id, x_e) in &cell.targets {
             let flange = true_robot.base_from_flange(&q_written);
             let x_s = cell
@@ -366,30 +387,47 @@ pub fn simulate_fixed(
                 station: id.clone(),
                 usage,
                 side_given: None,
-                side: 1,
-                joints: q_written.clone(),
-                flange: None,
+                side,
+                joints: if reported.is_some() {
+                    Vec::new()
+                } else {
+                    q_written.clone()
+                },
+                flange: reported,
                 observation,
             });
         }
         poses += 1;
     }
+    let pose_only = config.pose_only.is_some();
     let session = Session {
         mount: Mount::Fixed,
         sensor_given: true,
+        default_side: side,
+        robot_given: !pose_only,
         solver: SolverSettings {
             threshold: config.threshold,
             max_iterations: config.max_iterations,
         },
         solver_given: true,
-        ..Session::made(cell.name.clone(), nominal, cell.diameter, measurements)
+        ..Session::made(
+            cell.name.clone(),
+            if pose_only {
+                Robot::new(String::new(), Vec::new())
+            } else {
+                nominal
+            },
+            cell.diameter,
+            measurements,
+        )
     };
     let truth = FixedTruth {
         robot: true_robot,
         base_from_sensor: cell.base_from_sensor,
         targets: cell.targets.clone(),
         noise_free: cell.noise_mm.iter().all(|s| *s == 0.0)
-            && cell.line.as_ref().is_none_or(|l| l.point_noise_mm == 0.0),
+            && cell.line.as_ref().is_none_or(|l| l.point_noise_mm == 0.0)
+            && config.pose_only.is_none_or(|s| s == 0.0),
     };
     Ok((session, truth))
 }
