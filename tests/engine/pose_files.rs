@@ -870,6 +870,7 @@ fn an_import_whose_centres_scatter_beyond_any_sensor_is_warned() {
     let request = import::entry::ImportRequest {
         log: import::entry::PoseLog::Poses(s),
         range: None,
+        hand_eye: None,
     };
     let e = import::entry::import_session(&request, &mut import::progress::quiet)
         .unwrap_err()

@@ -29,6 +29,7 @@
 //! the file.
 
 pub mod check;
+pub mod choices;
 pub mod entry;
 mod csv_file;
 pub mod initial;
@@ -50,6 +51,7 @@ use std::path::{Path, PathBuf};
 pub use self::check::{
     DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG, FlangeCheck, PoseCheck,
 };
+pub use self::choices::{HandEyeChoice, ImportChoices, LogKind, ObservationKind, ProfilesKind};
 pub use self::entry::{ImportRequest, PoseLog, import_session, preview_joint_log};
 pub use self::log::{ColumnMap, DEFAULT_SIDE_COLUMN, header, preview};
 pub use self::poses::{
