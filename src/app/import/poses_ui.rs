@@ -10,7 +10,7 @@
 
 use egui::RichText;
 
-use crate::app::AppState;
+use super::ui::Ctx;
 use crate::app::command::{Command, ImportCommand};
 use crate::app::dialog::Purpose;
 use crate::app::import::form::{HandEyeChoice, ImportChoices};
@@ -36,18 +36,18 @@ const NUMBER_WIDTH: f32 = 70.0;
 
 /// The pose file's rows of the Files grid: the file, its layout and
 /// convention, and what the sensor gave (profiles or centres).
-pub fn pose_file_rows(
-    ui: &mut egui::Ui,
-    busy: bool,
-    f: &mut ImportChoices,
-    preview: Option<&PosePreview>,
-    commands: &mut Vec<Command>,
-) {
+pub(super) fn pose_file_rows(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
+    let preview = cx
+        .state
+        .import
+        .pose_preview
+        .as_ref()
+        .and_then(|p| p.as_ref().ok());
     let what = (
         "Pose file",
         "program (.ls .mod .dat .script) or pose table, .rob",
     );
-    super::ui::path_edit(ui, what, &mut f.poses, busy, Purpose::ImportPoses, commands);
+    cx.path(ui, what, &mut f.poses, Purpose::ImportPoses);
     let l = ui.label("Layout");
     ui.horizontal(|ui| {
         let layouts = PoseFormat::ALL.map(|p| (p, format!("{} ({})", p.describe(), p.key())));
@@ -113,7 +113,8 @@ fn optional_combo<T: Copy + PartialEq>(
 
 /// What the engine read in the pose file and the pairing, below the
 /// Files grid.
-pub fn detected_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
+pub(super) fn detected_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>) {
+    let (state, commands) = (cx.state, &mut *cx.commands);
     let view = &state.import;
     let scanning = state.jobs.runs(&Slot::PoseScan);
     ui.horizontal(|ui| {
@@ -238,13 +239,8 @@ fn pairing_ui(ui: &mut egui::Ui, p: &PosePreview, pairing: &PairingPreview) {
 
 /// The initial hand-eye: whether eq. 6-9 can start, the choice of a
 /// guess, and the engine's reason when the last import found none.
-pub fn hand_eye_ui(
-    ui: &mut egui::Ui,
-    state: &AppState,
-    busy: bool,
-    f: &mut ImportChoices,
-    commands: &mut Vec<Command>,
-) {
+pub(super) fn hand_eye_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
+    let state = cx.state;
     ui.label(RichText::new("Initial hand-eye").strong());
     let preview = state
         .import
@@ -357,7 +353,7 @@ pub fn hand_eye_ui(
                     "a 4×4 JSON matrix (rows, mm), or a session or result file",
                 );
                 let (path, purpose) = (&mut f.hand_eye_file, Purpose::ImportHandEye);
-                super::ui::path_edit(ui, what, path, busy, purpose, commands);
+                cx.path(ui, what, path, purpose);
             });
         }
     }

@@ -71,22 +71,27 @@ pub fn import_ui(
     let busy = [Slot::Import, Slot::ImportPreview, Slot::Dialog]
         .iter()
         .any(|s| jobs.runs(s));
+    let cx = &mut Ctx {
+        state,
+        busy,
+        commands,
+    };
     let f = &mut forms.import;
     let joints = f.log_kind == LogKind::Joints;
     let poses = !joints && f.mount == Mount::Flange;
     // The actions stay in view above the form (it is taller than the
     // window at 1366×768); the full outcome is at the form's end.
-    actions_ui(ui, state, busy, joints, commands);
+    actions_ui(ui, cx, joints);
     ui.separator();
     egui::ScrollArea::vertical()
         .auto_shrink([false, false])
         .show(ui, |ui| {
-            files_ui(ui, state, busy, f, commands);
+            files_ui(ui, cx, f);
             ui.separator();
             if poses {
-                super::poses_ui::detected_ui(ui, state, commands);
+                super::poses_ui::detected_ui(ui, cx);
                 ui.separator();
-                super::poses_ui::hand_eye_ui(ui, state, busy, f, commands);
+                super::poses_ui::hand_eye_ui(ui, cx, f);
                 ui.separator();
             }
             robot_ui(ui, f);
@@ -106,31 +111,29 @@ pub fn import_ui(
 
 /// Preview and Guess mapping (joint logs), Import and open, and the last
 /// outcome in one line.
-fn actions_ui(
-    ui: &mut egui::Ui,
-    state: &AppState,
-    busy: bool,
-    joints: bool,
-    commands: &mut Vec<Command>,
-) {
-    let import = |c| Command::Import(c);
+fn actions_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, joints: bool) {
+    let state = cx.state;
     ui.horizontal_wrapped(|ui| {
         let text = RichText::new("Import and open").strong().size(16.0);
         let hover = "build the session and open it (save it with Save as… afterwards)";
-        command_button(ui, !busy, text, hover, import(ImportCommand::Run), commands);
+        cx.button(ui, text, hover, ImportCommand::Run);
         if joints {
             let hover = "read the header and show the first rows with this mapping";
-            let preview = import(ImportCommand::Preview { guess: false });
-            command_button(ui, !busy, "Preview", hover, preview, commands);
+            cx.button(
+                ui,
+                "Preview",
+                hover,
+                ImportCommand::Preview { guess: false },
+            );
             let hover = "fill the column names from the header where they are obvious";
-            let guess = import(ImportCommand::Preview { guess: true });
-            command_button(ui, !busy, "Guess mapping", hover, guess, commands);
+            let guess = ImportCommand::Preview { guess: true };
+            cx.button(ui, "Guess mapping", hover, guess);
         }
         if let Some(job) = state.jobs.get(&Slot::Import) {
             crate::app::widgets::job_ui(ui, job);
             let hover = "stop the import: nothing is opened, what is open stays";
-            let cancel = import(ImportCommand::Cancel);
-            command_button(ui, true, "Cancel import", hover, cancel, commands);
+            let cancel = Command::Import(ImportCommand::Cancel);
+            command_button(ui, true, "Cancel import", hover, cancel, cx.commands);
         } else if state.jobs.runs(&Slot::ImportPreview) {
             ui.spinner();
         }
@@ -167,30 +170,54 @@ fn row(ui: &mut egui::Ui, label: &str, add: impl FnOnce(&mut egui::Ui)) {
     ui.end_row();
 }
 
-/// A path field with its Browse… button (a row of a three-column grid).
-pub(super) fn path_edit(
-    ui: &mut egui::Ui,
-    (label, hint): (&str, &str),
-    path: &mut PathBuf,
-    busy: bool,
-    purpose: Purpose,
-    commands: &mut Vec<Command>,
-) {
-    let shown = path.to_string_lossy().into_owned();
-    let mut text = shown.clone();
-    path_row(ui, label, &mut text, hint, busy, purpose, commands);
-    if text != shown {
-        *path = PathBuf::from(text);
+/// What the Import view's parts share: the state shown, whether a job
+/// runs (the buttons wait for it), the commands asked for.
+pub(super) struct Ctx<'a> {
+    pub state: &'a AppState,
+    pub busy: bool,
+    pub commands: &'a mut Vec<Command>,
+}
+
+impl Ctx<'_> {
+    /// A path field with its Browse… button (a row of a three-column
+    /// grid).
+    pub(super) fn path(
+        &mut self,
+        ui: &mut egui::Ui,
+        (label, hint): (&str, &str),
+        path: &mut PathBuf,
+        purpose: Purpose,
+    ) {
+        let shown = path.to_string_lossy().into_owned();
+        let mut text = shown.clone();
+        path_row(
+            ui,
+            label,
+            &mut text,
+            hint,
+            self.busy,
+            purpose,
+            self.commands,
+        );
+        if text != shown {
+            *path = PathBuf::from(text);
+        }
+    }
+
+    /// A button asking for `command` (greyed out while a job runs).
+    pub(super) fn button(
+        &mut self,
+        ui: &mut egui::Ui,
+        text: impl Into<egui::WidgetText>,
+        hover: &str,
+        command: ImportCommand,
+    ) -> egui::Response {
+        let command = Command::Import(command);
+        command_button(ui, !self.busy, text, hover, command, self.commands)
     }
 }
 
-fn files_ui(
-    ui: &mut egui::Ui,
-    state: &AppState,
-    busy: bool,
-    f: &mut ImportChoices,
-    commands: &mut Vec<Command>,
-) {
+fn files_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
     ui.label(RichText::new("1 · Files").strong());
     ui.horizontal(|ui| {
         ui.label("Sensor");
@@ -220,21 +247,9 @@ fn files_ui(
     form_grid(ui, "import_files", 3, |ui| {
         if f.log_kind == LogKind::Joints {
             let what = ("Joint log CSV", "/path/to/joints.csv");
-            path_edit(
-                ui,
-                what,
-                &mut f.joints,
-                busy,
-                Purpose::ImportJoints,
-                commands,
-            );
+            cx.path(ui, what, &mut f.joints, Purpose::ImportJoints);
         } else {
-            let preview = state
-                .import
-                .pose_preview
-                .as_ref()
-                .and_then(|p| p.as_ref().ok());
-            super::poses_ui::pose_file_rows(ui, busy, f, preview, commands);
+            super::poses_ui::pose_file_rows(ui, cx, f);
         }
         if fixed || f.log_kind == LogKind::FlangePoses {
             observations_row(ui, f);
@@ -253,45 +268,26 @@ fn files_ui(
                     "x y z a pose (sensor frame, mm), paired with the poses in order",
                 )
             };
-            path_edit(
-                ui,
-                what,
-                &mut f.centres,
-                busy,
-                Purpose::ImportCentres,
-                commands,
-            );
+            cx.path(ui, what, &mut f.centres, Purpose::ImportCentres);
             if fixed {
                 row(ui, "Points unit", |ui| length_units(ui, &mut f.centre_unit));
             }
         } else {
-            profiles_rows(ui, busy, f, commands);
+            profiles_rows(ui, cx, f);
         }
         if !fixed {
             let what = (
                 "Reference distances CSV",
                 "optional: from,to,distance (mm), from the laser tracker",
             );
-            path_edit(
-                ui,
-                what,
-                &mut f.references,
-                busy,
-                Purpose::ImportReferences,
-                commands,
-            );
+            cx.path(ui, what, &mut f.references, Purpose::ImportReferences);
         }
     });
 }
 
 /// The stripe profiles' rows (and a pose file's or a fixed scanner's
 /// side).
-fn profiles_rows(
-    ui: &mut egui::Ui,
-    busy: bool,
-    f: &mut ImportChoices,
-    commands: &mut Vec<Command>,
-) {
+fn profiles_rows(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
     let fixed = f.mount == Mount::Fixed;
     if fixed || f.log_kind == LogKind::FlangePoses {
         row(ui, "Sphere side", |ui| {
@@ -309,14 +305,8 @@ fn profiles_rows(
         ProfilesKind::Folder => "/path/to/profiles/ (one file per pose: <id>.csv, .yml …)",
         ProfilesKind::File => "/path/to/profiles.csv (with a pose column)",
     };
-    path_edit(
-        ui,
-        ("Stripe profiles", hint),
-        &mut f.profiles,
-        busy,
-        Purpose::ImportProfiles,
-        commands,
-    );
+    let what = ("Stripe profiles", hint);
+    cx.path(ui, what, &mut f.profiles, Purpose::ImportProfiles);
     row(ui, "", |ui| {
         let folder = "a folder, one file per pose";
         radios(
@@ -410,7 +400,7 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportChoices) {
             );
         });
         row(ui, "Profile unit", |ui| {
-            length_units(ui, &mut f.profile_unit)
+            length_units(ui, &mut f.profile_unit);
         });
         let l = ui.label("Profile axes");
         ui.horizontal(|ui| {
