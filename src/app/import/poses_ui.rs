@@ -18,6 +18,7 @@ use crate::app::job::Slot;
 use crate::app::widgets::{
     BAD, GOOD, MUTED, WARN, boxed, coloured, command_button, form_grid, scrolled_text, weak,
 };
+use crate::engine::base::session::Mount;
 use crate::engine::files::import::{FlangeConvention, PairingPreview, PoseFormat, PosePreview};
 
 /// Height of the pairing list, points: a dozen rows, the rest scrolled
@@ -241,7 +242,13 @@ fn pairing_ui(ui: &mut egui::Ui, p: &PosePreview, pairing: &PairingPreview) {
 /// guess, and the engine's reason when the last import found none.
 pub(super) fn hand_eye_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
     let state = cx.state;
-    ui.label(RichText::new("Initial hand-eye").strong());
+    let fixed = f.mount == Mount::Fixed;
+    let title = if fixed {
+        "Initial base_from_sensor"
+    } else {
+        "Initial hand-eye"
+    };
+    ui.label(RichText::new(title).strong());
     let preview = state
         .import
         .pose_preview
@@ -310,7 +317,11 @@ pub(super) fn hand_eye_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportCho
         ui.radio_value(
             &mut f.hand_eye,
             HandEyeChoice::Computed,
-            "computed (eq. 6-9, else the general solution)",
+            if fixed {
+                "computed (the linear start from all identify poses)"
+            } else {
+                "computed (eq. 6-9, else the general solution)"
+            },
         );
         ui.radio_value(&mut f.hand_eye, HandEyeChoice::Numbers, "a guess: numbers");
         ui.radio_value(&mut f.hand_eye, HandEyeChoice::File, "a guess from a file");
@@ -339,9 +350,11 @@ pub(super) fn hand_eye_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportCho
                 });
             }
             ui.label(
-                RichText::new(
-                    "eT_s, the sensor frame in the flange frame: R = Rz(yaw)·Ry(pitch)·Rx(roll)",
-                )
+                RichText::new(if fixed {
+                    "bT_s, the sensor frame in the base frame: R = Rz(yaw)·Ry(pitch)·Rx(roll)"
+                } else {
+                    "eT_s, the sensor frame in the flange frame: R = Rz(yaw)·Ry(pitch)·Rx(roll)"
+                })
                 .weak()
                 .small(),
             );

@@ -104,6 +104,12 @@ pub fn import_ui(
                 flange_ui(ui, f);
                 ui.separator();
             }
+            if !poses {
+                // A start for a joint log's or a fixed sensor's session
+                // (`--hand-eye`), below what the import needs.
+                super::poses_ui::hand_eye_ui(ui, cx, f);
+                ui.separator();
+            }
             outcome_ui(ui, state);
             preview_ui(ui, state);
         });

@@ -297,22 +297,24 @@ impl ImportChoices {
         Ok((source, format))
     }
 
-    /// The nominal robot: the one given, else (when `needed`, a joint
-    /// log's) the preset.
-    fn robot_source(&self, needed: bool) -> Result<Option<RobotSource>, ImportError> {
-        let text = match (self.robot.trim(), self.robot_preset.trim()) {
-            ("", "") if needed => {
-                return Err(ImportError::Spec(
-                    "a joint log needs the nominal robot: a preset key, a session/result file, a URDF or a DH table".into(),
-                ));
-            }
-            ("", preset) if needed => preset,
-            ("", _) => return Ok(None),
-            (text, _) => text,
-        };
-        RobotSource::from_text(text, self.urdf_tip.clone(), self.dh)
-            .map(Some)
+    /// The nominal robot given, if any.
+    fn robot_given(&self) -> Result<Option<RobotSource>, ImportError> {
+        let text = self.robot.trim();
+        (!text.is_empty())
+            .then(|| RobotSource::from_text(text, self.urdf_tip.clone(), self.dh))
+            .transpose()
             .map_err(|e| ImportError::Spec(e.to_string()))
+    }
+
+    /// A joint log's nominal robot: the one given, else the preset.
+    fn robot_needed(&self) -> Result<RobotSource, ImportError> {
+        match (self.robot_given()?, self.robot_preset.trim()) {
+            (Some(robot), _) => Ok(robot),
+            (None, "") => Err(ImportError::Spec(
+                "a joint log needs the nominal robot: a preset key, a session/result file, a URDF or a DH table".into(),
+            )),
+            (None, preset) => Ok(RobotSource::Preset(preset.to_string())),
+        }
     }
 
     /// The joint log's spec (also what its preview maps the rows with).
@@ -328,9 +330,7 @@ impl ImportChoices {
             ));
         }
         let (profiles, profile_format) = self.profile_choices(true)?;
-        let robot = self
-            .robot_source(true)?
-            .unwrap_or_else(|| RobotSource::Preset(String::new()));
+        let robot = self.robot_needed()?;
         let flange = self.flange.map(|convention| {
             let mut check = FlangeCheck::new(convention);
             let columns = words(&self.flange_columns);
@@ -395,7 +395,7 @@ impl ImportChoices {
             pose_columns: (!self.pose_columns.is_empty()).then(|| self.pose_columns.clone()),
             observations,
             profile_format,
-            robot: self.robot_source(false)?,
+            robot: self.robot_given()?,
             sphere_diameter: self.sphere_diameter,
             side: self.side,
             hand_eye: None,
@@ -440,7 +440,7 @@ impl ImportChoices {
                     joint_columns: c.joints.iter().map(|j| j.trim().to_string()).collect(),
                     angle_unit: self.joint_unit,
                 };
-                (poses, self.robot_source(true)?)
+                (poses, Some(self.robot_needed()?))
             }
             LogKind::FlangePoses => {
                 let poses = FixedPoses::File {
@@ -450,7 +450,7 @@ impl ImportChoices {
                     pose_columns: (!self.pose_columns.is_empty())
                         .then(|| self.pose_columns.clone()),
                 };
-                (poses, self.robot_source(false)?)
+                (poses, self.robot_given()?)
             }
         };
         let points = if self.centres_read() {
