@@ -19,7 +19,7 @@ fn main() -> ExitCode {
         Some(Command::Gui(args)) => gui(args.session, args.result),
         Some(Command::Evaluate(args)) => cli::evaluate::run(&args),
         Some(Command::ExportModel(args)) => cli::export_model::run(&args),
-        Some(Command::Import(args)) => cli::import_fixed::dispatch(&args),
+        Some(Command::Import(args)) => cli::import::run(&args),
         Some(Command::Measure(args)) => cli::measure::run(&args),
         Some(Command::Plan(args)) => cli::plan_fixed::dispatch(&args),
         Some(Command::Report(args)) => cli::html_report::run(&args),

@@ -30,9 +30,6 @@ pub enum JobError {
     /// The import failed.
     #[error(transparent)]
     Import(#[from] ImportError),
-    /// The import form is incomplete.
-    #[error("{0}")]
-    ImportForm(String),
     /// The history library could not be scanned, or no drift computed.
     #[error(transparent)]
     History(#[from] HistoryError),

@@ -279,7 +279,7 @@ pub struct Forms {
     /// Centres view options.
     pub centres: results::CentresForm,
     /// The import wizard's fields.
-    pub import: import::form::ImportForm,
+    pub import: import::form::ImportChoices,
     /// The History view's fields.
     pub history: history::HistoryForm,
     /// The Plan view's fields.
@@ -505,11 +505,8 @@ impl Core {
         let last = prefs.last_folder.clone();
         let import = &self.forms.import;
         let beside_log = || {
-            let log = match import.log_kind {
-                crate::app::import::form::LogKind::Joints => &import.joints,
-                crate::app::import::form::LogKind::FlangePoses => &import.poses,
-            };
-            Path::new(log.trim())
+            import
+                .log()
                 .parent()
                 .map(Path::to_path_buf)
                 .filter(|d| !d.as_os_str().is_empty())
@@ -567,14 +564,14 @@ impl Core {
                     .say(Level::Info, format!("exports go to {}", path.display()));
             }
             Purpose::ImportJoints => {
-                f.import.joints = text;
+                f.import.joints = path;
                 self.import_preview(ctx, true);
             }
-            Purpose::ImportPoses => f.import.poses = text,
-            Purpose::ImportProfiles => f.import.profiles = text,
-            Purpose::ImportReferences => f.import.references = text,
-            Purpose::ImportCentres => f.import.centres = text,
-            Purpose::ImportHandEye => f.import.hand_eye_file = text,
+            Purpose::ImportPoses => f.import.poses = path,
+            Purpose::ImportProfiles => f.import.profiles = path,
+            Purpose::ImportReferences => f.import.references = path,
+            Purpose::ImportCentres => f.import.centres = path,
+            Purpose::ImportHandEye => f.import.hand_eye_file = path,
             Purpose::HistoryFolder => {
                 f.history.folder = text;
                 self.history_scan(ctx);

@@ -2,8 +2,12 @@
 //! file (written atomically). A joint log (`--joints`) gives a session
 //! with joint readings, with an optional check of the controller's flange
 //! poses against the nominal model; a flange-pose log (`--poses`, e.g.
-//! RobCalibrator's `RobPoses.rob`) gives a pose-only session. A thin
-//! caller of [`crate::engine::files::import`].
+//! RobCalibrator's `RobPoses.rob`) gives a pose-only session; with
+//! `--mount fixed` a fixed sensor's points (a laser tracker's table) or a
+//! fixed line scanner's profiles beside either give a session with
+//! `sensor.mount: "fixed"`. A thin caller of
+//! [`crate::engine::files::import`]: the flags become its
+//! [`ImportChoices`], the one import request.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -11,13 +15,14 @@ use std::time::Instant;
 use clap::Args;
 
 use crate::engine::assemble;
-use crate::engine::assemble::{ImportRequest, PoseLog};
+use crate::engine::assemble::{ImportChoices, LogKind, ObservationKind, ProfilesKind};
+use crate::engine::base::session::Mount;
 use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
 use crate::engine::files::import::{
     self, ColumnMap, DEFAULT_POSITION_TOLERANCE_MM, DEFAULT_ROTATION_TOLERANCE_DEG,
-    DEFAULT_SPHERE_DIAMETER, FlangeCheck, FlangeConvention, ImportError, ImportSpec, ImportStage,
-    Imported, Observations, PoseImportSpec, ProfileSource, SideChoice,
+    DEFAULT_SPHERE_DIAMETER, FlangeConvention, ImportError, ImportStage, Imported, LengthUnit,
+    SideChoice,
 };
 
 use super::scan_flags::ScanFlags;
@@ -122,101 +127,82 @@ fn side_parser() -> Keywords<SideChoice> {
     )
 }
 
-/// Where the profiles are, from the flag.
-fn profile_source(args: &ImportArgs) -> Result<ProfileSource, CliError> {
-    let Some(profiles) = &args.profiles else {
-        return Err(CliError::input("--profiles DIR|FILE is needed here"));
-    };
-    Ok(if profiles.is_dir() {
-        ProfileSource::Folder(profiles.clone())
-    } else {
-        ProfileSource::File {
-            path: profiles.clone(),
-            pose_column: args.scan.pose_column.clone(),
-        }
-    })
-}
-
-/// The engine's spec of a pose file from the flags.
+/// The import's choices from the flags (the workbench's form fills the
+/// same [`ImportChoices`]). A hand-eye file is read by the caller, with
+/// the command line's own words (see [`super::hand_eye_file`]).
 ///
 /// # Errors
-/// [`CliError`] (status 2) for a bad axis map or an unreadable hand-eye.
-pub fn pose_spec(args: &ImportArgs, poses: &std::path::Path) -> Result<PoseImportSpec, CliError> {
-    let observations = match &args.centres {
-        Some(c) => Observations::Centres(c.clone()),
-        None => Observations::Profiles(profile_source(args)?),
-    };
-    let hand_eye = args
-        .hand_eye
-        .as_ref()
-        .map(|p| super::hand_eye_file(p))
-        .transpose()?;
-    Ok(PoseImportSpec {
-        poses: poses.to_path_buf(),
-        format: args.scan.pose_format,
-        convention: args.scan.pose_convention,
-        pose_columns: args.scan.pose_columns(),
-        observations,
-        profile_format: args.scan.profile_format()?,
-        robot: args
-            .robot
-            .as_deref()
-            .map(|r| args.scan.robot_source(r))
-            .transpose()?,
-        sphere_diameter: args.sphere_diameter,
+/// [`CliError`] (status 2) for a bad `--map` entry or an unknown robot.
+pub fn choices(args: &ImportArgs) -> Result<ImportChoices, CliError> {
+    let scan = &args.scan;
+    let centres = args.centres.is_some();
+    let mut choices = ImportChoices {
+        mount: match args.mount {
+            MountArg::Flange => Mount::Flange,
+            MountArg::Fixed => Mount::Fixed,
+        },
+        log_kind: if args.poses.is_some() {
+            LogKind::FlangePoses
+        } else {
+            LogKind::Joints
+        },
+        joints: args.joints.clone().unwrap_or_default(),
+        poses: args.poses.clone().unwrap_or_default(),
+        pose_format: scan.pose_format,
+        pose_convention: scan.pose_convention,
+        pose_columns: scan.pose_columns.clone(),
+        observations: if centres {
+            ObservationKind::Centres
+        } else {
+            ObservationKind::Profiles
+        },
+        profiles: args.profiles.clone().unwrap_or_default(),
+        profiles_kind: match &args.profiles {
+            Some(p) if !p.is_dir() => ProfilesKind::File,
+            _ => ProfilesKind::Folder,
+        },
+        pose_column: scan.pose_column.clone(),
+        profile_unit: scan.profile_unit,
+        axes: scan.axes.clone(),
+        no_return: scan.no_return.map(|v| v.to_string()).unwrap_or_default(),
+        profile_key: scan.profile_key.clone(),
+        centres: args.centres.clone().unwrap_or_default(),
+        centre_unit: LengthUnit::parse(&args.centre_unit).ok_or_else(|| {
+            CliError::input(format!("--centre-unit {}: mm, m or um", args.centre_unit))
+        })?,
         side: args.side,
-        hand_eye,
-        name: args.name.clone(),
-        references: args.references.clone(),
-    })
+        robot_preset: String::new(),
+        robot: args.robot.clone().unwrap_or_default(),
+        urdf_tip: scan.urdf_tip.clone(),
+        dh: scan.dh,
+        joint_unit: scan.joint_unit,
+        sphere_diameter: args.sphere_diameter,
+        range: args.range.map(|r| [r.y[0], r.y[1], r.z[0], r.z[1]]),
+        name: args.name.clone().unwrap_or_default(),
+        flange: args.flange_poses,
+        flange_columns: args.flange_columns.join(","),
+        tolerance_mm: args.position_tolerance,
+        tolerance_deg: args.rotation_tolerance,
+        references: args.references.clone().unwrap_or_default(),
+        ..ImportChoices::default()
+    };
+    if args.joints.is_some() {
+        choices.columns = joint_log_columns(args)?;
+    }
+    Ok(choices)
 }
 
 fn input(e: &ImportError) -> CliError {
     CliError::input(e.to_string())
 }
 
-/// The engine's spec from the flags.
+/// The joint log's columns: `--map` over the defaults `id`, `station`,
+/// `use`, `j1..jn` (n the robot's joints).
 ///
 /// # Errors
-/// [`CliError`] (status 2) for a bad `--map` entry or an unknown robot.
-pub fn spec(args: &ImportArgs) -> Result<ImportSpec, CliError> {
-    let (joint_log, robot, columns) = joint_log_columns(args)?;
-    let profiles = profile_source(args)?;
-    let flange = args.flange_poses.map(|convention| {
-        let mut check = FlangeCheck::new(convention);
-        if !args.flange_columns.is_empty() {
-            check.columns.clone_from(&args.flange_columns);
-        }
-        check.tolerance_mm = args.position_tolerance;
-        check.tolerance_deg = args.rotation_tolerance;
-        check
-    });
-    Ok(ImportSpec {
-        joint_log,
-        columns,
-        joint_unit: args.scan.joint_unit,
-        profiles,
-        profile_format: args.scan.profile_format()?,
-        robot,
-        sphere_diameter: args.sphere_diameter,
-        name: args.name.clone(),
-        flange,
-        references: args.references.clone(),
-    })
-}
-
-/// The joint log, the robot and the log's columns (`--map` over the
-/// defaults `id`, `station`, `use`, `j1..jn`).
-///
-/// # Errors
-/// [`CliError`] (status 2): no `--joints` or `--robot`, a robot that does
-/// not load, a bad `--map` entry.
-pub fn joint_log_columns(
-    args: &ImportArgs,
-) -> Result<(PathBuf, import::RobotSource, ColumnMap), CliError> {
-    let Some(joint_log) = &args.joints else {
-        return Err(CliError::input("a joint log (--joints) is needed here"));
-    };
+/// [`CliError`] (status 2): no `--robot`, a robot that does not load, a
+/// bad `--map` entry.
+fn joint_log_columns(args: &ImportArgs) -> Result<ColumnMap, CliError> {
     let robot = args
         .scan
         .robot_source(args.robot.as_deref().ok_or_else(|| {
@@ -226,11 +212,8 @@ pub fn joint_log_columns(
     })?)?;
     let dof = import::load_robot(&robot).map_err(|e| input(&e))?.dof();
     let mut columns = ColumnMap {
-        id: "id".into(),
-        station: "station".into(),
-        usage: "use".into(),
-        side: None,
         joints: (1..=dof).map(|k| format!("j{k}")).collect(),
+        ..ImportChoices::default().columns
     };
     for entry in &args.map {
         let Some((key, col)) = entry.split_once('=') else {
@@ -258,7 +241,7 @@ pub fn joint_log_columns(
             }
         }
     }
-    Ok((joint_log.clone(), robot, columns))
+    Ok(columns)
 }
 
 /// The `--out` path, required unless only previewing, refused when it is one of the import's inputs (the
@@ -339,15 +322,22 @@ fn progress_line(
     ))
 }
 
-/// Runs `spherecal import`.
+/// Runs `spherecal import`: a flange-mounted sensor's profiles or
+/// centres, or (`--mount fixed`) a fixed sensor's points or profiles.
 ///
 /// # Errors
 /// [`CliError`] with status 2 for bad input, 1 when the session cannot be
 /// written.
 pub fn run(args: &ImportArgs) -> Result<(), CliError> {
-    if args.centres.is_some() && args.poses.is_none() {
+    let fixed = args.mount == MountArg::Fixed;
+    if args.centres.is_some() && args.poses.is_none() && !fixed {
         return Err(CliError::input(
             "--centres reads beside a pose file (--poses), or beside a joint log with --mount fixed",
+        ));
+    }
+    if fixed && args.centres.is_none() && args.profiles.is_none() {
+        return Err(CliError::input(
+            "--mount fixed needs --centres POINTS.csv (the sensor's points, one `x y z` a target and pose) or --profiles (a fixed line scanner's stripes)",
         ));
     }
     match (&args.poses, args.preview) {
@@ -355,7 +345,7 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
             return Err(CliError::input("--preview reads a joint log (--joints)"));
         }
         (None, Some(n)) => {
-            let spec = spec(args)?;
+            let spec = choices(args)?.joint_spec().map_err(|e| input(&e))?;
             say!("{}", import::preview(&spec, n).map_err(|e| input(&e))?);
             return Ok(());
         }
@@ -363,26 +353,17 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
     }
     // Every input refused as the output before any is read.
     let out = out_path(args)?;
-    let log = match &args.poses {
-        Some(poses) => PoseLog::Poses(pose_spec(args, poses)?),
-        None => PoseLog::Joints(spec(args)?),
-    };
-    // A joint log's session starts from the guess given, as a pose file's
-    // does (else calibrate computes one from the translation and rotation
-    // groups, eq. 6-9).
-    let joint_guess = match (&args.poses, &args.hand_eye) {
-        (None, Some(path)) => Some(super::hand_eye_file(path)?),
-        _ => None,
-    };
-    let request = ImportRequest {
-        log,
-        range: args.range,
-    };
+    let mut request = choices(args)?.request().map_err(|e| input(&e))?;
+    request.hand_eye = args
+        .hand_eye
+        .as_ref()
+        .map(|path| super::hand_eye_file(path))
+        .transpose()?;
     let mut lines = progress_lines(args.quiet, Instant::now());
     let Imported {
-        mut session,
+        session,
         checks,
-        mut notes,
+        notes,
         ..
     } = assemble::import_session(&request, &mut |stage| {
         // The side decision calibrates both sides: said at once.
@@ -392,18 +373,21 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         lines(stage)
     })
     .map_err(|e| input(&e))?;
-    if let Some(he) = joint_guess {
-        let t = he.translation.vector;
-        notes.push(format!(
-            "initial hand-eye: the guess given (translation [{:.2}, {:.2}, {:.2}] mm), written to the session; calibrate starts from it instead of eq. 6-9",
-            t.x, t.y, t.z
-        ));
-        session.hand_eye = Some(he);
-    }
     let out = &out;
     let text = format::session_to_json(&session);
     format::write_atomic(out, text.as_bytes()).map_err(|e| CliError::from_file(&e, false))?;
     if args.quiet {
+        return Ok(());
+    }
+    if fixed {
+        for note in &notes {
+            sayln!("{note}");
+        }
+        let n = session.measurements.len();
+        sayln!(
+            "imported {n} measurements (sensor.mount fixed) into {}",
+            out.display()
+        );
         return Ok(());
     }
     if !session.reference_distances.is_empty() {

@@ -34,7 +34,6 @@ pub mod export_model;
 pub mod history;
 pub mod html_report;
 pub mod import;
-pub mod import_fixed;
 pub mod measure;
 pub mod message;
 pub mod plan;

@@ -506,7 +506,7 @@ fn realdata_stripe() -> Vec<Act> {
         Act::Edit(|f| {
             let dir = "data/robcalibrator-sphere";
             f.import.log_kind = crate::app::import::form::LogKind::FlangePoses;
-            f.import.poses = format!("{dir}/RobPoses.rob");
+            f.import.poses = format!("{dir}/RobPoses.rob").into();
             f.import.profiles = dir.into();
             f.import.pose_convention =
                 Some(crate::engine::files::import::FlangeConvention::FanucWpr);

@@ -137,6 +137,7 @@ fn a_pose_file_beside_a_trackers_table_calibrates_the_tracker_and_the_targets_ex
         &ImportRequest {
             log: PoseLog::Fixed(pose_spec(&poses, &points, LengthUnit::Mm)),
             range: None,
+            hand_eye: None,
         },
         &mut |_| solve::Control::Continue,
     )
@@ -303,6 +304,7 @@ fn line_scanner_import(session: &Session, dir: &Path) -> Session {
         &ImportRequest {
             log: PoseLog::Fixed(spec),
             range: None,
+            hand_eye: None,
         },
         &mut |_| solve::Control::Continue,
     )

@@ -72,6 +72,7 @@ fn import_auto(session: &Session, dir: &Path) -> (Session, Vec<String>) {
         &ImportRequest {
             log: PoseLog::Fixed(spec),
             range: None,
+            hand_eye: None,
         },
         &mut |_| solve::Control::Continue,
     )

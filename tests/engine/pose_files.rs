@@ -871,6 +871,7 @@ fn an_import_whose_centres_scatter_beyond_any_sensor_is_warned() {
     let request = assemble::ImportRequest {
         log: assemble::PoseLog::Poses(s),
         range: None,
+        hand_eye: None,
     };
     let e = assemble::import_session(&request, &mut import::progress::quiet)
         .unwrap_err()

@@ -93,7 +93,7 @@ fn import_view(poses: &Path, profiles: &Path) -> Harness<'static, WorkbenchApp> 
     h.run();
     {
         let form = &mut h.state_mut().forms_mut().import;
-        form.profiles = profiles.display().to_string();
+        form.profiles = profiles.display().to_string().into();
     }
     h.get_by_label("Pose file").click();
     h.run();
@@ -335,7 +335,7 @@ fn a_set_without_pure_translations_asks_for_a_guess_with_the_reason() {
     {
         let form = &mut h.state_mut().forms_mut().import;
         form.hand_eye = HandEyeChoice::File;
-        form.hand_eye_file = file.display().to_string();
+        form.hand_eye_file = file.display().to_string().into();
     }
     h.state_mut().forms_mut().tab = Tab::Import;
     settle(&mut h);

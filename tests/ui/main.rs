@@ -8,6 +8,7 @@ mod support;
 mod compensate;
 mod guided;
 mod held_out;
+mod import_fixed;
 mod import_poses;
 mod job_end;
 mod measure;

@@ -131,8 +131,8 @@ fn the_import_wizard_sets_the_measuring_range() {
     }
     {
         let form = &mut h.state_mut().forms_mut().import;
-        form.joints = dir.path().join("joints.csv").display().to_string();
-        form.profiles = dir.path().join("profiles").display().to_string();
+        form.joints = dir.path().join("joints.csv").display().to_string().into();
+        form.profiles = dir.path().join("profiles").display().to_string().into();
     }
     h.get_by_label("Import").click();
     h.run();

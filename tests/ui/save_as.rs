@@ -19,8 +19,8 @@ use crate::workbench::write_import_files;
 fn import_from(h: &mut Harness<'_, WorkbenchApp>, logs: &Path) -> PathBuf {
     {
         let form = &mut h.state_mut().forms_mut().import;
-        form.joints = logs.join("joints.csv").display().to_string();
-        form.profiles = logs.join("profiles").display().to_string();
+        form.joints = logs.join("joints.csv").display().to_string().into();
+        form.profiles = logs.join("profiles").display().to_string().into();
     }
     h.get_by_label("Import").click();
     h.run();

@@ -570,9 +570,9 @@ fn the_import_wizard_guesses_the_mapping_previews_and_opens_the_session() {
     h.get_by_label("Guess mapping").click();
     settle(&mut h);
     let form = &h.state().forms().import;
-    assert_eq!(form.id_column, "Pose");
-    assert_eq!(form.side_column, "Side");
-    assert_eq!(form.joint_columns[5], "A6");
+    assert_eq!(form.columns.id, "Pose");
+    assert_eq!(form.columns.side.as_deref().unwrap_or_default(), "Side");
+    assert_eq!(form.columns.joints[5], "A6");
     let preview = h.state().state().import.preview.clone().expect("preview");
     let text = preview.expect("the preview works with the guessed mapping");
     let first = &original.measurements[0];
@@ -638,8 +638,8 @@ fn a_failed_import_names_the_pose_and_keeps_the_open_session() {
     let before = session_name();
     {
         let form = &mut h.state_mut().forms_mut().import;
-        form.joints = dir.path().join("joints.csv").display().to_string();
-        form.profiles = dir.path().join("profiles").display().to_string();
+        form.joints = dir.path().join("joints.csv").display().to_string().into();
+        form.profiles = dir.path().join("profiles").display().to_string().into();
     }
     h.get_by_label("Import").click();
     h.run();
@@ -823,8 +823,8 @@ fn the_wizard_imports_flange_poses_and_the_run_calibrates_the_hand_eye_only() {
     {
         let form = &mut h.state_mut().forms_mut().import;
         form.log_kind = spherecal::app::import::form::LogKind::FlangePoses;
-        form.poses = dir.join("RobPoses.rob").display().to_string();
-        form.profiles = dir.display().to_string();
+        form.poses = dir.join("RobPoses.rob").display().to_string().into();
+        form.profiles = dir.display().to_string().into();
         form.pose_convention = Some(spherecal::engine::files::import::FlangeConvention::FanucWpr);
         form.sphere_diameter = 80.0;
     }

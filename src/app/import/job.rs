@@ -1,29 +1,24 @@
 //! The import wizard's job work: the joint log's header, the mapping
 //! guessed from it and the first rows mapped; the import itself (the
-//! engine's [`import_with`](crate::engine::files::import::import_with) or [`assemble::import_poses_with`], as
-//! `spherecal import`), analysed like an opened file.
+//! engine's one entry, [`assemble::import_session`], with the request the
+//! form's [`ImportChoices`] builds, as `spherecal import`), analysed like
+//! an opened file.
 
-use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use crate::engine::assemble;
-use crate::engine::assemble::{ImportRequest, PoseLog};
-use crate::engine::calibrate::solve::Control;
-use crate::engine::files::import::{ImportError, ImportStage};
-
-use super::form::{ImportForm, LogKind, PREVIEW_ROWS};
 use crate::app::error::JobError;
+use crate::app::job::Worker;
 use crate::app::session::{LoadedSession, Source, analyse};
+use crate::engine::assemble::{self, ImportChoices, LogKind};
+use crate::engine::calibrate::solve::Control;
+use crate::engine::files::import::{ColumnMap, ImportError, ImportStage, PoseCheck};
+
+use super::form::PREVIEW_ROWS;
 
 /// What a preview job answers: the joint log's header (empty when it
-/// cannot be read), the form with the guessed mapping (when asked), and
-/// the mapped rows or why not.
-pub type Previewed = (
-    Vec<String>,
-    Option<Box<ImportForm>>,
-    Result<String, JobError>,
-);
+/// cannot be read), the mapping guessed from it (when asked), and the
+/// mapped rows or why not.
+pub type Previewed = (Vec<String>, Option<ColumnMap>, Result<String, JobError>);
 
 /// The outcome of an import job.
 #[derive(Debug)]
@@ -31,50 +26,48 @@ pub struct Imported {
     /// The session, analysed like an opened file.
     pub loaded: Box<LoadedSession>,
     /// The flange-pose checks (empty without a check).
-    pub checks: Vec<crate::engine::files::import::PoseCheck>,
+    pub checks: Vec<PoseCheck>,
     /// What the import decided, in words (axis map, side, initial
     /// hand-eye).
     pub notes: Vec<String>,
 }
 
-/// The wizard's preview: the joint log's header (empty when it cannot be
-/// read), the form with the mapping guessed from it (when `guess`), and
-/// the first rows mapped.
-pub fn import_preview(mut form: ImportForm, guess: bool) -> Previewed {
-    if form.joints.trim().is_empty() {
-        let why = JobError::ImportForm("choose the joint log CSV first".into());
-        return (Vec::new(), None, Err(why));
+/// The wizard's preview: the joint log's header, the mapping guessed
+/// from it (when `guess`), and the first rows mapped.
+pub fn import_preview(mut form: ImportChoices, guess: bool) -> Previewed {
+    if form.joints.as_os_str().is_empty() {
+        // Nothing to read: the engine's sentence why.
+        let why = form
+            .joint_spec()
+            .map(|_| String::new())
+            .map_err(JobError::from);
+        return (Vec::new(), None, why);
     }
-    let joint_log = PathBuf::from(form.joints.trim());
-    let (header, preview) = assemble::preview_joint_log(&joint_log, PREVIEW_ROWS, |header| {
+    let log = form.joints.clone();
+    let (header, preview) = assemble::preview_joint_log(&log, PREVIEW_ROWS, |header| {
         if guess {
             form.guess_mapping(header);
         }
-        form.spec().map_err(JobError::ImportForm)
+        form.joint_spec().map_err(JobError::from)
     });
-    (header, guess.then(|| Box::new(form)), preview)
+    (header, guess.then_some(form.columns), preview)
 }
 
 /// How often an import job tells the window its progress.
 const PROGRESS_EVERY: Duration = Duration::from_millis(100);
 
-/// Runs the import of the wizard's form (a joint log or a flange-pose
-/// log) and analyses the session like an opened file, telling `progress`
-/// its stage (profiles read, side, check, stripe fits) and stopping when
-/// `cancel` is set.
+/// Runs the import the form chose and analyses the session like an
+/// opened file, telling the job its stage (profiles read, side, check,
+/// stripe fits) and stopping when it is cancelled.
 ///
 /// # Errors
 /// The form is incomplete or the engine's import failed (naming the file,
 /// line, column or pose id); [`ImportError::Cancelled`].
-pub fn import_session(
-    form: &ImportForm,
-    cancel: &AtomicBool,
-    progress: &mut dyn FnMut(String, Option<f64>),
-) -> Result<Imported, JobError> {
+pub fn import_session(form: &ImportChoices, job: &Worker) -> Result<Imported, JobError> {
     // Told at most every 0.1 s, and at every stage that is not a profile.
     let mut told: Option<Instant> = None;
     let mut stage = |s: ImportStage| {
-        if cancel.load(Ordering::Relaxed) {
+        if job.cancelled() {
             return Control::Cancel;
         }
         let profile = matches!(s, ImportStage::Profiles { done, total } if done < total);
@@ -84,35 +77,15 @@ pub fn import_session(
                 ImportStage::Profiles { done, total } => Some(done as f64 / total.max(1) as f64),
                 _ => None,
             };
-            progress(s.describe(), fraction);
+            job.progress(s.describe(), fraction);
         }
         Control::Continue
     };
-    let (log, path) = match form.log_kind {
-        LogKind::Joints => {
-            let spec = form.spec().map_err(JobError::ImportForm)?;
-            let path = spec.joint_log.clone();
-            (PoseLog::Joints(spec), path)
-        }
-        LogKind::FlangePoses => {
-            let mut spec = form.pose_spec().map_err(JobError::ImportForm)?;
-            if spec.hand_eye.is_none() {
-                spec.hand_eye = form.hand_eye_guess().map_err(JobError::ImportForm)?;
-            }
-            let path = spec.poses.clone();
-            (PoseLog::Poses(spec), path)
-        }
-    };
-    let range = form
-        .range
-        .map(|v| crate::app::widgets::range_of(&v))
-        .transpose()
-        .map_err(|why| JobError::ImportForm(format!("measuring range: {why}")))?;
-    let imported = assemble::import_session(&ImportRequest { log, range }, &mut stage)?;
-    if cancel.load(Ordering::Relaxed) {
+    let imported = assemble::import_session(&form.request()?, &mut stage)?;
+    if job.cancelled() {
         return Err(ImportError::Cancelled.into());
     }
-    progress("fitting the stripes".to_string(), None);
+    job.progress("fitting the stripes", None);
     let session = imported.session;
     let mut notes = imported.notes;
     if form.log_kind == LogKind::FlangePoses
@@ -126,7 +99,7 @@ pub fn import_session(
         ));
     }
     Ok(Imported {
-        loaded: Box::new(analyse(session, Source::Imported(path))),
+        loaded: Box::new(analyse(session, Source::Imported(form.log().to_path_buf()))),
         checks: imported.checks,
         notes,
     })

@@ -1,6 +1,7 @@
 //! The import wizard: a pose log (a joint log CSV, or a pose file in any
-//! layout the engine reads) and stripe profiles or the sensor's centres
-//! into a session, as `spherecal import` does. The form ([`form`]), the
+//! layout the engine reads) and stripe profiles or the sensor's centres,
+//! or a fixed sensor's points or profiles, into a session, as `spherecal
+//! import` does. The form ([`form`]: the engine's import choices), the
 //! pose file read and paired before the import (made again whenever what
 //! it reads changes), the joint log's preview and guessed mapping, the
 //! import with progress and Cancel ([`job`]); the Import view ([`ui`],
@@ -21,7 +22,6 @@ use super::job::{Job, Slot};
 use super::ledger::{Artefact, Reading};
 use super::state::Level;
 use super::{Core, Forms};
-use form::LogKind;
 use job::{Imported, Previewed, import_preview, import_session};
 
 /// What the wizard shows besides its form.
@@ -78,13 +78,8 @@ impl Core {
         (header, guessed, preview): Previewed,
     ) {
         let mut stamp = job.stamp.clone();
-        if let Some(form) = guessed {
-            let f = &mut self.forms.import;
-            f.id_column = form.id_column;
-            f.station_column = form.station_column;
-            f.use_column = form.use_column;
-            f.side_column = form.side_column;
-            f.joint_columns = form.joint_columns;
+        if let Some(columns) = guessed {
+            self.forms.import.columns = columns;
             // Previewed with the mapping guessed: made from the form as
             // it reads now.
             self.observe(ctx);
@@ -102,27 +97,13 @@ impl Core {
         self.state.import.preview = Some(preview.map_err(|e| e.to_string()));
     }
 
+    /// Starts the import (the form's choices are checked by the engine
+    /// on the job: a missing file is the import's failure, said).
     fn import_run(&mut self, ctx: &egui::Context) {
         let form = self.forms.import.clone();
-        let ready = match form.log_kind {
-            LogKind::Joints => form.spec().map(|_| ()),
-            LogKind::FlangePoses => form.pose_spec().map(|_| ()),
-        };
         let stamp = self.state.ledger.stamp(Artefact::ImportView);
-        if let Err(e) = ready {
-            self.state.import.outcome = Some(Err(e.clone()));
-            self.state
-                .ledger
-                .record(Artefact::ImportView, stamp, "why not");
-            self.state.say(Level::Warning, e);
-            return;
-        }
         self.state.say(Level::Info, "importing…");
-        self.start(ctx, Slot::Import, stamp, move |w| {
-            import_session(&form, w.flag(), &mut |text, fraction| {
-                w.progress(text, fraction);
-            })
-        });
+        self.start(ctx, Slot::Import, stamp, move |w| import_session(&form, w));
     }
 
     /// Shows an import's outcome: the session opened, or why not.
@@ -184,12 +165,12 @@ impl Core {
         let stamp = self.state.ledger.stamp(Artefact::PoseScan);
         let view = &mut self.state.import;
         let form = &self.forms.import;
-        let spec = match (form.pose_preview_spec(), form.pose_scan_key()) {
+        let spec = match (form.pose_spec(false), form.pose_scan_key()) {
             (Ok(spec), Some(_)) => spec,
             (spec, _) => {
                 // Nothing to read: why, or nothing at all.
                 view.pose_preview = match spec {
-                    Err(why) if !form.poses.trim().is_empty() => Some(Err(why)),
+                    Err(why) if !form.poses.as_os_str().is_empty() => Some(Err(why.to_string())),
                     _ => None,
                 };
                 self.state.jobs.cancel(&Slot::PoseScan);

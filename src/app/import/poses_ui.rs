@@ -10,16 +10,16 @@
 
 use egui::RichText;
 
-use crate::app::AppState;
+use super::ui::Ctx;
 use crate::app::command::{Command, ImportCommand};
 use crate::app::dialog::Purpose;
-use crate::app::import::form::{HandEyeChoice, ImportForm, ObservationKind};
+use crate::app::import::form::{HandEyeChoice, ImportChoices};
 use crate::app::job::Slot;
 use crate::app::widgets::{
-    BAD, GOOD, MUTED, WARN, boxed, coloured, command_button, form_grid, path_row, scrolled_text,
-    weak,
+    BAD, GOOD, MUTED, WARN, boxed, coloured, command_button, form_grid, scrolled_text, weak,
 };
 use crate::engine::assemble::{PairingPreview, PosePreview};
+use crate::engine::base::session::Mount;
 use crate::engine::files::import::{FlangeConvention, PoseFormat};
 
 /// Height of the pairing list, points: a dozen rows, the rest scrolled
@@ -38,66 +38,31 @@ const NUMBER_WIDTH: f32 = 70.0;
 
 /// The pose file's rows of the Files grid: the file, its layout and
 /// convention, and what the sensor gave (profiles or centres).
-pub fn pose_file_rows(
-    ui: &mut egui::Ui,
-    busy: bool,
-    f: &mut ImportForm,
-    preview: Option<&PosePreview>,
-    commands: &mut Vec<Command>,
-) {
-    path_row(
-        ui,
+pub(super) fn pose_file_rows(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
+    let preview = cx
+        .state
+        .import
+        .pose_preview
+        .as_ref()
+        .and_then(|p| p.as_ref().ok());
+    let what = (
         "Pose file",
-        &mut f.poses,
         "program (.ls .mod .dat .script) or pose table, .rob",
-        busy,
-        Purpose::ImportPoses,
-        commands,
     );
+    cx.path(ui, what, &mut f.poses, Purpose::ImportPoses);
     let l = ui.label("Layout");
     ui.horizontal(|ui| {
-        let shown = f.pose_format.map_or_else(
-            || "detected from the content".to_string(),
-            |p| format!("{} ({})", p.describe(), p.key()),
-        );
-        egui::ComboBox::from_id_salt("import_pose_format")
-            .selected_text(shown)
-            .width(260.0)
-            .show_ui(ui, |ui| {
-                ui.selectable_value(&mut f.pose_format, None, "detected from the content");
-                for p in PoseFormat::ALL {
-                    ui.selectable_value(
-                        &mut f.pose_format,
-                        Some(p),
-                        format!("{} ({})", p.describe(), p.key()),
-                    );
-                }
-            })
-            .response
-            .labelled_by(l.id)
-            .on_hover_text("force the layout as --pose-format does");
+        let layouts = PoseFormat::ALL.map(|p| (p, format!("{} ({})", p.describe(), p.key())));
+        let none = "detected from the content";
+        let hover = "force the layout as --pose-format does";
+        let id = ("import_pose_format", l.id);
+        optional_combo(ui, id, &mut f.pose_format, none, &layouts).on_hover_text(hover);
         let l = ui.label("convention");
-        let shown = f
-            .pose_convention
-            .map_or("as the program's language says", FlangeConvention::describe);
-        egui::ComboBox::from_id_salt("import_pose_convention")
-            .selected_text(shown)
-            .width(260.0)
-            .show_ui(ui, |ui| {
-                ui.selectable_value(
-                    &mut f.pose_convention,
-                    None,
-                    "as the program's language says",
-                );
-                for c in FlangeConvention::ALL {
-                    ui.selectable_value(&mut f.pose_convention, Some(c), c.describe());
-                }
-            })
-            .response
-            .labelled_by(l.id)
-            .on_hover_text(
-                "how a pose table or JSON list writes a pose (--pose-convention); a robot program's language fixes its own",
-            );
+        let conventions = FlangeConvention::ALL.map(|c| (c, c.describe().to_string()));
+        let none = "as the program's language says";
+        let hover = "how a pose table or JSON list writes a pose (--pose-convention); a robot program's language fixes its own";
+        let id = ("import_pose_convention", l.id);
+        optional_combo(ui, id, &mut f.pose_convention, none, &conventions).on_hover_text(hover);
     });
     ui.end_row();
     // What the layout needs of the convention, once it is known.
@@ -121,39 +86,37 @@ pub fn pose_file_rows(
             ui.end_row();
         }
     }
-    ui.label("The sensor gives");
-    ui.horizontal(|ui| {
-        ui.radio_value(
-            &mut f.observations,
-            ObservationKind::Profiles,
-            "stripe profiles",
-        );
-        ui.radio_value(
-            &mut f.observations,
-            ObservationKind::Centres,
-            "sphere centres (its own sphere fit)",
-        )
-        .on_hover_text(
-            "a table with one x y z a pose, sensor frame, mm (any separator, header optional): --centres",
-        );
-    });
-    ui.end_row();
-    if f.observations == ObservationKind::Centres {
-        path_row(
-            ui,
-            "Centres file",
-            &mut f.centres,
-            "x y z a pose (sensor frame, mm), paired with the poses in order",
-            busy,
-            Purpose::ImportCentres,
-            commands,
-        );
-    }
+}
+
+/// A drop-down of `none` and `options`, labelled by `label`.
+fn optional_combo<T: Copy + PartialEq>(
+    ui: &mut egui::Ui,
+    (id, label): (&str, egui::Id),
+    value: &mut Option<T>,
+    none: &str,
+    options: &[(T, String)],
+) -> egui::Response {
+    let shown = options
+        .iter()
+        .find(|(v, _)| Some(*v) == *value)
+        .map_or(none, |(_, text)| text);
+    egui::ComboBox::from_id_salt(id)
+        .selected_text(shown)
+        .width(260.0)
+        .show_ui(ui, |ui| {
+            ui.selectable_value(value, None, none);
+            for (v, text) in options {
+                ui.selectable_value(value, Some(*v), text);
+            }
+        })
+        .response
+        .labelled_by(label)
 }
 
 /// What the engine read in the pose file and the pairing, below the
 /// Files grid.
-pub fn detected_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
+pub(super) fn detected_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>) {
+    let (state, commands) = (cx.state, &mut *cx.commands);
     let view = &state.import;
     let scanning = state.jobs.runs(&Slot::PoseScan);
     ui.horizontal(|ui| {
@@ -278,14 +241,15 @@ fn pairing_ui(ui: &mut egui::Ui, p: &PosePreview, pairing: &PairingPreview) {
 
 /// The initial hand-eye: whether eq. 6-9 can start, the choice of a
 /// guess, and the engine's reason when the last import found none.
-pub fn hand_eye_ui(
-    ui: &mut egui::Ui,
-    state: &AppState,
-    busy: bool,
-    f: &mut ImportForm,
-    commands: &mut Vec<Command>,
-) {
-    ui.label(RichText::new("Initial hand-eye").strong());
+pub(super) fn hand_eye_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
+    let state = cx.state;
+    let fixed = f.mount == Mount::Fixed;
+    let title = if fixed {
+        "Initial base_from_sensor"
+    } else {
+        "Initial hand-eye"
+    };
+    ui.label(RichText::new(title).strong());
     let preview = state
         .import
         .pose_preview
@@ -354,7 +318,11 @@ pub fn hand_eye_ui(
         ui.radio_value(
             &mut f.hand_eye,
             HandEyeChoice::Computed,
-            "computed (eq. 6-9, else the general solution)",
+            if fixed {
+                "computed (the linear start from all identify poses)"
+            } else {
+                "computed (eq. 6-9, else the general solution)"
+            },
         );
         ui.radio_value(&mut f.hand_eye, HandEyeChoice::Numbers, "a guess: numbers");
         ui.radio_value(&mut f.hand_eye, HandEyeChoice::File, "a guess from a file");
@@ -383,24 +351,23 @@ pub fn hand_eye_ui(
                 });
             }
             ui.label(
-                RichText::new(
-                    "eT_s, the sensor frame in the flange frame: R = Rz(yaw)·Ry(pitch)·Rx(roll)",
-                )
+                RichText::new(if fixed {
+                    "bT_s, the sensor frame in the base frame: R = Rz(yaw)·Ry(pitch)·Rx(roll)"
+                } else {
+                    "eT_s, the sensor frame in the flange frame: R = Rz(yaw)·Ry(pitch)·Rx(roll)"
+                })
                 .weak()
                 .small(),
             );
         }
         HandEyeChoice::File => {
             form_grid(ui, "import_hand_eye_file", 3, |ui| {
-                path_row(
-                    ui,
+                let what = (
                     "Hand-eye file",
-                    &mut f.hand_eye_file,
                     "a 4×4 JSON matrix (rows, mm), or a session or result file",
-                    busy,
-                    Purpose::ImportHandEye,
-                    commands,
                 );
+                let (path, purpose) = (&mut f.hand_eye_file, Purpose::ImportHandEye);
+                cx.path(ui, what, path, purpose);
             });
         }
     }

@@ -9,19 +9,24 @@
 //! first rows (joint logs); then Import opens the session and says what it
 //! decided (axis map, side, initial hand-eye) and the flange-pose checks.
 
+use std::path::PathBuf;
+
 use egui::RichText;
 
 use crate::app::AppState;
 use crate::app::Forms;
 use crate::app::command::{Command, ImportCommand};
 use crate::app::dialog::Purpose;
-use crate::app::import::form::{CONVENTIONS, ImportForm, LogKind, ObservationKind, ProfilesKind};
+use crate::app::import::form::{
+    CONVENTIONS, ImportChoices, LogKind, ObservationKind, ProfilesKind,
+};
 use crate::app::job::Slot;
 use crate::app::widgets::{
     BAD, DEFAULT_RANGE, GOOD, PATH_WIDTH, WARN, boxed, choice, coloured, command_button, form_grid,
     labelled_drag, labelled_field, path_row, preset_ui, range_fields, range_of, scrolled_text,
     table, weak,
 };
+use crate::engine::base::session::Mount;
 use crate::engine::files::import::{AngleUnit, LengthUnit, SideChoice};
 use crate::engine::files::robot_import::DhConvention;
 
@@ -66,28 +71,43 @@ pub fn import_ui(
     let busy = [Slot::Import, Slot::ImportPreview, Slot::Dialog]
         .iter()
         .any(|s| jobs.runs(s));
-    let joints = forms.import.log_kind == LogKind::Joints;
+    let cx = &mut Ctx {
+        state,
+        busy,
+        commands,
+    };
+    let f = &mut forms.import;
+    let joints = f.log_kind == LogKind::Joints;
+    let poses = !joints && f.mount == Mount::Flange;
     // The actions stay in view above the form (it is taller than the
     // window at 1366×768); the full outcome is at the form's end.
-    actions_ui(ui, state, busy, joints, commands);
+    actions_ui(ui, cx, joints);
     ui.separator();
     egui::ScrollArea::vertical()
         .auto_shrink([false, false])
         .show(ui, |ui| {
-            files_ui(ui, state, busy, &mut forms.import, commands);
+            files_ui(ui, cx, f);
             ui.separator();
-            if !joints {
-                super::poses_ui::detected_ui(ui, state, commands);
+            if poses {
+                super::poses_ui::detected_ui(ui, cx);
                 ui.separator();
-                super::poses_ui::hand_eye_ui(ui, state, busy, &mut forms.import, commands);
+                super::poses_ui::hand_eye_ui(ui, cx, f);
                 ui.separator();
             }
-            robot_ui(ui, &mut forms.import);
+            robot_ui(ui, f);
             ui.separator();
             if joints {
-                mapping_ui(ui, state, &mut forms.import);
+                mapping_ui(ui, state, f);
                 ui.separator();
-                flange_ui(ui, &mut forms.import);
+            }
+            if joints && f.mount == Mount::Flange {
+                flange_ui(ui, f);
+                ui.separator();
+            }
+            if !poses {
+                // A start for a joint log's or a fixed sensor's session
+                // (`--hand-eye`), below what the import needs.
+                super::poses_ui::hand_eye_ui(ui, cx, f);
                 ui.separator();
             }
             outcome_ui(ui, state);
@@ -97,31 +117,29 @@ pub fn import_ui(
 
 /// Preview and Guess mapping (joint logs), Import and open, and the last
 /// outcome in one line.
-fn actions_ui(
-    ui: &mut egui::Ui,
-    state: &AppState,
-    busy: bool,
-    joints: bool,
-    commands: &mut Vec<Command>,
-) {
-    let import = |c| Command::Import(c);
+fn actions_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, joints: bool) {
+    let state = cx.state;
     ui.horizontal_wrapped(|ui| {
         let text = RichText::new("Import and open").strong().size(16.0);
         let hover = "build the session and open it (save it with Save as… afterwards)";
-        command_button(ui, !busy, text, hover, import(ImportCommand::Run), commands);
+        cx.button(ui, text, hover, ImportCommand::Run);
         if joints {
             let hover = "read the header and show the first rows with this mapping";
-            let preview = import(ImportCommand::Preview { guess: false });
-            command_button(ui, !busy, "Preview", hover, preview, commands);
+            cx.button(
+                ui,
+                "Preview",
+                hover,
+                ImportCommand::Preview { guess: false },
+            );
             let hover = "fill the column names from the header where they are obvious";
-            let guess = import(ImportCommand::Preview { guess: true });
-            command_button(ui, !busy, "Guess mapping", hover, guess, commands);
+            let guess = ImportCommand::Preview { guess: true };
+            cx.button(ui, "Guess mapping", hover, guess);
         }
         if let Some(job) = state.jobs.get(&Slot::Import) {
             crate::app::widgets::job_ui(ui, job);
             let hover = "stop the import: nothing is opened, what is open stays";
-            let cancel = import(ImportCommand::Cancel);
-            command_button(ui, true, "Cancel import", hover, cancel, commands);
+            let cancel = Command::Import(ImportCommand::Cancel);
+            command_button(ui, true, "Cancel import", hover, cancel, cx.commands);
         } else if state.jobs.runs(&Slot::ImportPreview) {
             ui.spinner();
         }
@@ -144,143 +162,252 @@ fn actions_ui(
     }
 }
 
-fn files_ui(
-    ui: &mut egui::Ui,
-    state: &AppState,
-    busy: bool,
-    f: &mut ImportForm,
-    commands: &mut Vec<Command>,
-) {
-    ui.label(RichText::new("1 · Files").strong());
-    ui.horizontal(|ui| {
-        ui.label("Pose log");
-        ui.radio_value(&mut f.log_kind, LogKind::Joints, "joint log (CSV)");
-        ui.radio_value(
-            &mut f.log_kind,
-            LogKind::FlangePoses,
-            "a pose file (robot program or pose table)",
-        );
-    });
-    form_grid(ui, "import_files", 3, |ui| {
-        if f.log_kind == LogKind::Joints {
-            path_row(
-                ui,
-                "Joint log CSV",
-                &mut f.joints,
-                "/path/to/joints.csv",
-                busy,
-                Purpose::ImportJoints,
-                commands,
-            );
-        } else {
-            let preview = state
-                .import
-                .pose_preview
-                .as_ref()
-                .and_then(|p| p.as_ref().ok());
-            super::poses_ui::pose_file_rows(ui, busy, f, preview, commands);
-            if f.observations == ObservationKind::Profiles {
-                ui.label("Sphere side");
-                ui.horizontal(|ui| {
-                    ui.radio_value(&mut f.side, SideChoice::Auto, "decide from the data");
-                    ui.radio_value(&mut f.side, SideChoice::Plus, "+1 (sensor x > 0)");
-                    ui.radio_value(&mut f.side, SideChoice::Minus, "−1");
-                });
-                ui.end_row();
-            }
-        }
-        let centres =
-            f.log_kind == LogKind::FlangePoses && f.observations == ObservationKind::Centres;
-        if !centres {
-            let hint = match f.profiles_kind {
-                ProfilesKind::Folder => "/path/to/profiles/ (one file per pose: <id>.csv, .yml …)",
-                ProfilesKind::File => "/path/to/profiles.csv (with a pose column)",
-            };
-            path_row(
-                ui,
-                "Stripe profiles",
-                &mut f.profiles,
-                hint,
-                busy,
-                Purpose::ImportProfiles,
-                commands,
-            );
-            ui.label("");
-            ui.horizontal(|ui| {
-                ui.radio_value(
-                    &mut f.profiles_kind,
-                    ProfilesKind::Folder,
-                    "a folder, one file per pose",
-                );
-                ui.radio_value(&mut f.profiles_kind, ProfilesKind::File, "one file");
-                let l = ui.label("pose column");
-                // Sized, not squeezed by the grid's column.
-                ui.add_enabled_ui(f.profiles_kind == ProfilesKind::File, |ui| {
-                    ui.add_sized(
-                        [COLUMN_WIDTH, ui.spacing().interact_size.y],
-                        egui::TextEdit::singleline(&mut f.pose_column),
-                    )
-                    .labelled_by(l.id);
-                });
-            });
-            ui.end_row();
-        }
+/// A row of radio buttons, one a choice.
+pub(super) fn radios<T: PartialEq + Copy>(ui: &mut egui::Ui, value: &mut T, choices: &[(T, &str)]) {
+    for (v, text) in choices {
+        ui.radio_value(value, *v, *text);
+    }
+}
+
+/// A grid row: `label`, then `add`'s widgets side by side.
+fn row(ui: &mut egui::Ui, label: &str, add: impl FnOnce(&mut egui::Ui)) {
+    ui.label(label);
+    ui.horizontal(add);
+    ui.end_row();
+}
+
+/// What the Import view's parts share: the state shown, whether a job
+/// runs (the buttons wait for it), the commands asked for.
+pub(super) struct Ctx<'a> {
+    pub state: &'a AppState,
+    pub busy: bool,
+    pub commands: &'a mut Vec<Command>,
+}
+
+impl Ctx<'_> {
+    /// A path field with its Browse… button (a row of a three-column
+    /// grid).
+    pub(super) fn path(
+        &mut self,
+        ui: &mut egui::Ui,
+        (label, hint): (&str, &str),
+        path: &mut PathBuf,
+        purpose: Purpose,
+    ) {
+        let shown = path.to_string_lossy().into_owned();
+        let mut text = shown.clone();
         path_row(
             ui,
-            "Reference distances CSV",
-            &mut f.references,
-            "optional: from,to,distance (mm), from the laser tracker",
-            busy,
-            Purpose::ImportReferences,
-            commands,
+            label,
+            &mut text,
+            hint,
+            self.busy,
+            purpose,
+            self.commands,
         );
+        if text != shown {
+            *path = PathBuf::from(text);
+        }
+    }
+
+    /// A button asking for `command` (greyed out while a job runs).
+    pub(super) fn button(
+        &mut self,
+        ui: &mut egui::Ui,
+        text: impl Into<egui::WidgetText>,
+        hover: &str,
+        command: ImportCommand,
+    ) -> egui::Response {
+        let command = Command::Import(command);
+        command_button(ui, !self.busy, text, hover, command, self.commands)
+    }
+}
+
+fn files_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
+    ui.label(RichText::new("1 · Files").strong());
+    ui.horizontal(|ui| {
+        ui.label("Sensor");
+        let fixed = "fixed in the cell, targets on the tool (a tracker, camera or line scanner)";
+        radios(
+            ui,
+            &mut f.mount,
+            &[
+                (Mount::Flange, "on the flange, the sphere in the cell"),
+                (Mount::Fixed, fixed),
+            ],
+        );
+    });
+    ui.horizontal(|ui| {
+        ui.label("Pose log");
+        let poses = "a pose file (robot program or pose table)";
+        radios(
+            ui,
+            &mut f.log_kind,
+            &[
+                (LogKind::Joints, "joint log (CSV)"),
+                (LogKind::FlangePoses, poses),
+            ],
+        );
+    });
+    let fixed = f.mount == Mount::Fixed;
+    form_grid(ui, "import_files", 3, |ui| {
+        if f.log_kind == LogKind::Joints {
+            let what = ("Joint log CSV", "/path/to/joints.csv");
+            cx.path(ui, what, &mut f.joints, Purpose::ImportJoints);
+        } else {
+            super::poses_ui::pose_file_rows(ui, cx, f);
+        }
+        if fixed || f.log_kind == LogKind::FlangePoses {
+            observations_row(ui, f);
+        }
+        if f.observations == ObservationKind::Centres
+            && (fixed || f.log_kind == LogKind::FlangePoses)
+        {
+            let what = if fixed {
+                (
+                    "Points table",
+                    "x y z a target and pose (sensor frame), a tracker's export",
+                )
+            } else {
+                (
+                    "Centres file",
+                    "x y z a pose (sensor frame, mm), paired with the poses in order",
+                )
+            };
+            cx.path(ui, what, &mut f.centres, Purpose::ImportCentres);
+            if fixed {
+                row(ui, "Points unit", |ui| length_units(ui, &mut f.centre_unit));
+            }
+        } else {
+            profiles_rows(ui, cx, f);
+        }
+        if !fixed {
+            let what = (
+                "Reference distances CSV",
+                "optional: from,to,distance (mm), from the laser tracker",
+            );
+            cx.path(ui, what, &mut f.references, Purpose::ImportReferences);
+        }
     });
 }
 
-fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
+/// The stripe profiles' rows (and a pose file's or a fixed scanner's
+/// side).
+fn profiles_rows(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
+    let fixed = f.mount == Mount::Fixed;
+    if fixed || f.log_kind == LogKind::FlangePoses {
+        row(ui, "Sphere side", |ui| {
+            if !fixed {
+                ui.radio_value(&mut f.side, SideChoice::Auto, "decide from the data");
+            }
+            let sides = [
+                (SideChoice::Plus, "+1 (sensor x > 0)"),
+                (SideChoice::Minus, "−1"),
+            ];
+            radios(ui, &mut f.side, &sides);
+        });
+    }
+    let hint = match f.profiles_kind {
+        ProfilesKind::Folder => "/path/to/profiles/ (one file per pose: <id>.csv, .yml …)",
+        ProfilesKind::File => "/path/to/profiles.csv (with a pose column)",
+    };
+    let what = ("Stripe profiles", hint);
+    cx.path(ui, what, &mut f.profiles, Purpose::ImportProfiles);
+    row(ui, "", |ui| {
+        let folder = "a folder, one file per pose";
+        radios(
+            ui,
+            &mut f.profiles_kind,
+            &[
+                (ProfilesKind::Folder, folder),
+                (ProfilesKind::File, "one file"),
+            ],
+        );
+        let l = ui.label("pose column");
+        // Sized, not squeezed by the grid's column.
+        ui.add_enabled_ui(f.profiles_kind == ProfilesKind::File, |ui| {
+            ui.add_sized(
+                [COLUMN_WIDTH, ui.spacing().interact_size.y],
+                egui::TextEdit::singleline(&mut f.pose_column),
+            )
+            .labelled_by(l.id);
+        });
+    });
+}
+
+/// The length units a file may be written in.
+fn length_units(ui: &mut egui::Ui, unit: &mut LengthUnit) {
+    for u in [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M] {
+        ui.radio_value(unit, u, u.symbol());
+    }
+}
+
+/// What the sensor gave: profiles, or the points it measured itself
+/// (a pose file's sphere centres, a fixed sensor's target points).
+fn observations_row(ui: &mut egui::Ui, f: &mut ImportChoices) {
+    row(ui, "The sensor gives", |ui| {
+        let (profiles, points, hover) = if f.mount == Mount::Fixed {
+            (
+                "stripe profiles (a fixed line scanner)",
+                "target points (a tracker's or camera's table)",
+                "one x y z a target and pose (any separator, header optional, targets as named columns or rows): --mount fixed --centres",
+            )
+        } else {
+            (
+                "stripe profiles",
+                "sphere centres (its own sphere fit)",
+                "a table with one x y z a pose, sensor frame, mm (any separator, header optional): --centres",
+            )
+        };
+        ui.radio_value(&mut f.observations, ObservationKind::Profiles, profiles);
+        ui.radio_value(&mut f.observations, ObservationKind::Centres, points)
+            .on_hover_text(hover);
+    });
+}
+
+fn robot_ui(ui: &mut egui::Ui, f: &mut ImportChoices) {
     ui.label(RichText::new("2 · Robot, units, sphere").strong());
     form_grid(ui, "import_robot", 2, |ui| {
         let l = ui.label("Nominal robot");
         ui.horizontal(|ui| {
-            let from_file = !f.robot_file.trim().is_empty();
+            let from_file = !f.robot.trim().is_empty();
             ui.add_enabled_ui(!from_file, |ui| {
                 preset_ui(ui, "import_robot_preset", &mut f.robot_preset).labelled_by(l.id);
             });
             labelled_field(
                 ui,
                 "or robot file",
-                &mut f.robot_file,
+                &mut f.robot,
                 "session/result file, URDF or DH table CSV",
                 260.0,
             );
-            if f.robot_file.trim().to_ascii_lowercase().ends_with(".csv") {
-                ui.radio_value(&mut f.dh, DhConvention::Standard, "standard DH");
-                ui.radio_value(&mut f.dh, DhConvention::Modified, "modified DH");
+            if f.robot.trim().to_ascii_lowercase().ends_with(".csv") {
+                let dh = [
+                    (Some(DhConvention::Standard), "standard DH"),
+                    (Some(DhConvention::Modified), "modified DH"),
+                ];
+                radios(ui, &mut f.dh, &dh);
             }
         });
         ui.end_row();
         if f.log_kind == LogKind::FlangePoses {
-            ui.label("");
-            weak(
-                ui,
-                "pose-only: no robot model is needed (no kinematic parameter is identified); a robot given here is kept in the session",
-            );
-            ui.end_row();
+            row(ui, "", |ui| {
+                weak(
+                    ui,
+                    "pose-only: no robot model is needed (no kinematic parameter is identified); a robot given here is kept in the session",
+                );
+            });
         }
-        ui.label("Joint unit");
-        ui.horizontal(|ui| {
-            for u in [AngleUnit::Deg, AngleUnit::Rad] {
-                ui.radio_value(&mut f.joint_unit, u, u.as_str());
-            }
+        row(ui, "Joint unit", |ui| {
+            radios(
+                ui,
+                &mut f.joint_unit,
+                &[(AngleUnit::Deg, "deg"), (AngleUnit::Rad, "rad")],
+            );
         });
-        ui.end_row();
-        ui.label("Profile unit");
-        ui.horizontal(|ui| {
-            for u in [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M] {
-                ui.radio_value(&mut f.profile_unit, u, u.symbol());
-            }
+        row(ui, "Profile unit", |ui| {
+            length_units(ui, &mut f.profile_unit);
         });
-        ui.end_row();
         let l = ui.label("Profile axes");
         ui.horizontal(|ui| {
                 ui.add(
@@ -332,7 +459,7 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
     });
 }
 
-fn mapping_ui(ui: &mut egui::Ui, state: &AppState, f: &mut ImportForm) {
+fn mapping_ui(ui: &mut egui::Ui, state: &AppState, f: &mut ImportChoices) {
     ui.label(RichText::new("3 · Columns of the joint log").strong());
     if state.import.header.is_empty() {
         weak(
@@ -343,21 +470,25 @@ fn mapping_ui(ui: &mut egui::Ui, state: &AppState, f: &mut ImportForm) {
         ui.label(format!("Header: {}", state.import.header.join(", ")));
     }
     let header = &state.import.header;
+    let c = &mut f.columns;
     ui.horizontal_wrapped(|ui| {
-        column_field(ui, "id", &mut f.id_column, header);
-        column_field(ui, "station", &mut f.station_column, header);
-        column_field(ui, "use", &mut f.use_column, header);
-        column_field(ui, "side", &mut f.side_column, header);
+        column_field(ui, "id", &mut c.id, header);
+        column_field(ui, "station", &mut c.station, header);
+        column_field(ui, "use", &mut c.usage, header);
+        // No side column: every side +1.
+        let mut side = c.side.clone().unwrap_or_default();
+        column_field(ui, "side", &mut side, header);
+        c.side = (!side.is_empty()).then_some(side);
     });
     ui.horizontal_wrapped(|ui| {
-        for (k, c) in f.joint_columns.iter_mut().enumerate() {
-            column_field(ui, &format!("joint {}", k + 1), c, header);
+        for (k, j) in c.joints.iter_mut().enumerate() {
+            column_field(ui, &format!("joint {}", k + 1), j, header);
         }
     });
-    let missing: Vec<&str> = [&f.id_column, &f.station_column, &f.use_column]
+    let missing: Vec<&str> = [&c.id, &c.station, &c.usage]
         .into_iter()
-        .chain(&f.joint_columns)
-        .chain(std::iter::once(&f.side_column).filter(|s| !s.trim().is_empty()))
+        .chain(&c.joints)
+        .chain(c.side.iter().filter(|s| !s.trim().is_empty()))
         .map(|s| s.trim())
         .filter(|c| !header.is_empty() && !header.iter().any(|h| h.eq_ignore_ascii_case(c)))
         .collect();
@@ -393,7 +524,7 @@ fn column_field(ui: &mut egui::Ui, label: &str, value: &mut String, header: &[St
     ui.add_space(8.0);
 }
 
-fn flange_ui(ui: &mut egui::Ui, f: &mut ImportForm) {
+fn flange_ui(ui: &mut egui::Ui, f: &mut ImportChoices) {
     ui.label(RichText::new("4 · Flange poses from the controller (optional)").strong());
     ui.horizontal(|ui| {
         let conventions = CONVENTIONS.map(|(c, l)| (Some(c), l.to_string()));

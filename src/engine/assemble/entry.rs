@@ -7,9 +7,13 @@
 //! FORMAT.md `sensor.mount: "fixed"`) into a session, the sensor's
 //! measuring range written into it when given, with the progress of every
 //! stage; and the joint log's preview, its header read and its first rows
-//! mapped ([`preview_joint_log`]).
+//! mapped ([`preview_joint_log`]). The request is built from every import
+//! choice by [`ImportChoices::request`](super::choices::ImportChoices::request),
+//! which the command line's flags and the workbench's form both fill.
 
 use std::path::Path;
+
+use nalgebra::Isometry3;
 
 use super::side::import_poses_with;
 use super::side::import_tracker_with;
@@ -39,6 +43,10 @@ pub struct ImportRequest {
     /// The sensor's measuring range to write as `sensor.range`; `None`:
     /// the session keeps what the import found (none).
     pub range: Option<SensorRange>,
+    /// A start for the hand-eye (`base_from_sensor` for a fixed sensor)
+    /// written to the session instead of computing one; `None`: computed
+    /// (or the pose log's spec's own).
+    pub hand_eye: Option<Isometry3<f64>>,
 }
 
 /// Imports `request`'s pose log into a session, telling `progress` each
@@ -52,9 +60,38 @@ pub fn import_session(
     request: &ImportRequest,
     progress: &mut ImportProgress<'_>,
 ) -> Result<Imported, ImportError> {
+    let guess = request.hand_eye;
     let mut imported = match &request.log {
-        PoseLog::Joints(spec) => import_with(spec, progress)?,
+        PoseLog::Joints(spec) => {
+            let mut imported = import_with(spec, progress)?;
+            // A joint log's session starts from the guess given, as a pose
+            // file's does (else calibrate computes one from the
+            // translation and rotation groups, eq. 6-9).
+            if let Some(he) = guess {
+                let t = he.translation.vector;
+                imported.notes.push(format!(
+                    "initial hand-eye: the guess given (translation [{:.2}, {:.2}, {:.2}] mm), written to the session; calibrate starts from it instead of eq. 6-9",
+                    t.x, t.y, t.z
+                ));
+                imported.session.hand_eye = Some(he);
+            }
+            imported
+        }
+        PoseLog::Poses(spec) if guess.is_some() => {
+            let spec = PoseImportSpec {
+                hand_eye: guess,
+                ..spec.clone()
+            };
+            import_poses_with(&spec, progress)?
+        }
         PoseLog::Poses(spec) => import_poses_with(spec, progress)?,
+        PoseLog::Fixed(spec) if guess.is_some() => {
+            let spec = TrackerSpec {
+                hand_eye: guess,
+                ..spec.clone()
+            };
+            import_tracker_with(&spec, progress)?
+        }
         PoseLog::Fixed(spec) => import_tracker_with(spec, progress)?,
     };
     if request.range.is_some() {
@@ -69,6 +106,7 @@ pub fn import_session(
     // is a start, not a verdict on the data).
     if let PoseLog::Poses(spec) = &request.log
         && spec.hand_eye.is_none()
+        && guess.is_none()
         && imported.session.pose_only()
         && let Some(why) = super::initial::implausible_start(&imported.session)
     {

@@ -13,13 +13,16 @@
 //! | [`side`] | the stripe side decided by calibrating both, the pose import that runs it |
 //! | [`preview`] | what a pose import will read and pair, before it runs |
 //! | [`entry`] | the import use case in one entry, and the joint log's preview |
+//! | [`choices`] | every choice of an import with its default and checks, filled by the CLI's flags and the workbench's form |
 
 pub mod initial;
 pub mod pose_session;
 pub mod side;
 pub mod preview;
 pub mod entry;
+pub mod choices;
 
+pub use choices::{HandEyeChoice, ImportChoices, LogKind, ObservationKind, ProfilesKind};
 pub use entry::{ImportRequest, PoseLog, import_session, preview_joint_log};
 pub use pose_session::build_pose_session;
 pub use preview::{PairingPreview, PosePreview, preview_pose_import};
