@@ -114,10 +114,11 @@ pub struct MeasureForm {
     /// A workpiece frame file (a JSON 4×4 `base_from_workpiece`, mm);
     /// empty for the robot base frame.
     pub frame: String,
-    /// The sensor's own noise: 1σ of each in-plane coordinate, mm.
-    pub sensor_noise_mm: f64,
-    /// Write no σ (`--no-sigma`): for a result without covariance.
-    pub no_sigma: bool,
+    /// How it is measured, the engine's options as the request carries
+    /// them: σ or not (`--no-sigma`), the sensor's own noise (1σ of each
+    /// in-plane coordinate, mm); the calibrated model, the frame from
+    /// [`MeasureForm::frame`].
+    pub options: MeasureOptions,
     /// Where Export writes the cloud; the extension chooses the format
     /// (`.ply`, `.e57`, `.csv`).
     pub out: String,
@@ -140,8 +141,10 @@ impl Default for MeasureForm {
             sphere_diameter: String::new(),
             references: String::new(),
             frame: String::new(),
-            sensor_noise_mm: 0.0,
-            no_sigma: false,
+            options: MeasureOptions {
+                sigma: true,
+                ..MeasureOptions::default()
+            },
             out: String::new(),
         }
     }
@@ -259,8 +262,7 @@ impl Core {
             .check(Artefact::Result)
             .map_err(|why| format!("{why}: run the calibration again, then measure"))?;
         let form = &self.forms.measure;
-        let sigma = !form.no_sigma;
-        if sigma && !has_covariance(&view.file) {
+        if form.options.sigma && !has_covariance(&view.file) {
             return Err(format!(
                 "σ is unavailable: the result (method {}) has no parameter covariance; tick \"no σ\" to measure without it (as --no-sigma), or calibrate with method ml",
                 view.file.solver.method()
@@ -299,11 +301,7 @@ impl Core {
             result: view.file.clone(),
             joint_range: loaded.and_then(|l| JointRange::of_session(&l.session)),
             frame: form.frame_path(),
-            options: MeasureOptions {
-                sigma,
-                sensor_noise_mm: form.sensor_noise_mm,
-                ..MeasureOptions::default()
-            },
+            options: form.options.clone(),
         };
         Ok((request, result_label))
     }
@@ -499,10 +497,13 @@ pub fn reading(f: &MeasureForm) -> Reading {
             f.frame_path()
                 .map_or_else(|| "base".to_string(), |p| p.display().to_string()),
         ),
-        ("sensor noise".into(), format!("{} mm", f.sensor_noise_mm)),
+        (
+            "sensor noise".into(),
+            format!("{} mm", f.options.sensor_noise_mm),
+        ),
         (
             "σ".into(),
-            if f.no_sigma { "no" } else { "yes" }.to_string(),
+            if f.options.sigma { "yes" } else { "no" }.to_string(),
         ),
     ];
     let mut unseen = f.clone();

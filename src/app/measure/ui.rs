@@ -173,14 +173,16 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
             ui,
             "measure_noise",
             "Sensor noise (1σ in-plane)",
-            form.sensor_noise_mm,
+            form.options.sensor_noise_mm,
             0.0..=MAX_SENSOR_NOISE_MM,
             "mm",
         ) {
-            form.sensor_noise_mm = v;
+            form.options.sensor_noise_mm = v;
         }
-        ui.checkbox(&mut form.no_sigma, "no σ (as --no-sigma)")
+        let mut no_sigma = !form.options.sigma;
+        ui.checkbox(&mut no_sigma, "no σ (as --no-sigma)")
             .on_hover_text("measure without σ: for a result without covariance (method paper)");
+        form.options.sigma = !no_sigma;
         ui.add_space(12.0);
         let running = state.jobs.runs(&Slot::Measure);
         let (start, cancel) = (MeasureCommand::Start, MeasureCommand::Cancel);
