@@ -15,7 +15,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::time::Instant;
 
 use super::ledger::{Artefact, Stamp};
@@ -289,30 +289,22 @@ impl Jobs {
     /// its job, an answer is held for [`Jobs::finish`], anything of a job
     /// no longer in its slot is dropped.
     pub fn drain(&mut self) {
-        loop {
-            let Message { id, report } = match self.rx.try_recv() {
-                Ok(m) => m,
-                Err(TryRecvError::Empty | TryRecvError::Disconnected) => return,
-            };
-            let answer = match report {
-                Report::Done(a) => Some(a),
-                Report::Lost => None,
-                other => {
-                    if let Some(job) = self.running.values_mut().find(|j| j.id == id) {
-                        match other {
-                            Report::Progress(phase, f) => {
-                                job.phase = phase;
-                                job.fraction = f.map(|f| job.fraction.map_or(f, |g| g.max(f)));
-                            }
-                            Report::Point(k, v) => {
-                                job.series.truncate(k);
-                                job.series.push(v);
-                            }
-                            Report::Done(_) | Report::Lost => {}
-                        }
-                    }
+        while let Ok(Message { id, report }) = self.rx.try_recv() {
+            let job = self.running.values_mut().find(|j| j.id == id);
+            let answer = match (report, job) {
+                (Report::Done(a), _) => Some(a),
+                (Report::Lost, _) => None,
+                (Report::Progress(phase, f), Some(job)) => {
+                    job.phase = phase;
+                    job.fraction = f.map(|f| job.fraction.map_or(f, |g| g.max(f)));
                     continue;
                 }
+                (Report::Point(k, v), Some(job)) => {
+                    job.series.truncate(k);
+                    job.series.push(v);
+                    continue;
+                }
+                (Report::Progress(..) | Report::Point(..), None) => continue,
             };
             if !self.stopping.remove(&id) && self.running.values().any(|j| j.id == id) {
                 self.arrived.push((id, answer));
@@ -323,16 +315,14 @@ impl Jobs {
     /// The answers arrived and not cancelled since, with their jobs, out
     /// of their slots. `None`: the thread ended without one.
     pub fn finish(&mut self) -> Vec<Finished> {
+        let arrived = std::mem::take(&mut self.arrived);
         let mut out = Vec::new();
-        for (id, answer) in std::mem::take(&mut self.arrived) {
-            let slot = self
-                .running
-                .iter()
-                .find(|(_, j)| j.id == id)
-                .map(|(s, _)| s.clone());
-            if let Some(job) = slot.as_ref().and_then(|s| self.running.remove(s)) {
-                out.extend(slot.map(|s| (s, job, answer)));
-            }
+        for (id, answer) in arrived {
+            let slot = self.running.iter().find(|(_, j)| j.id == id);
+            let Some(slot) = slot.map(|(s, _)| s.clone()) else {
+                continue;
+            };
+            out.extend(self.running.remove(&slot).map(|job| (slot, job, answer)));
         }
         out
     }

@@ -62,7 +62,6 @@ use dialog::{Ask, NO_DIALOG, Purpose};
 use error::JobError;
 use job::{Job, Jobs, Slot, Worker};
 use ledger::{Artefact, Input, Ledger, Reading, Stamp, WhenStale};
-use run::SolverForm;
 use session::{Grouping, LoadedSession, Source, opened_line};
 use state::{Confirm, Level, Notice, Prefs, Status};
 
@@ -275,7 +274,7 @@ pub struct Forms {
     /// z0, z1]` mm; `None`: the session's (or the default) on show.
     pub range_edit: Option<[f64; 4]>,
     /// Settings of the next run.
-    pub solver: run::SolverForm,
+    pub solver: crate::engine::calibrate::solve::Options,
     /// Centres view options.
     pub centres: results::CentresForm,
     /// The import wizard's fields.
@@ -729,7 +728,7 @@ impl Core {
             _ => format!("{}-edited.json", loaded.source.stem()),
         };
         self.forms.save_path = dir.join(file_name).display().to_string();
-        self.forms.solver = SolverForm::from_session(&loaded.session);
+        self.forms.solver = crate::engine::calibrate::solve::Options::from_session(&loaded.session);
         // The Plan view follows the open session's robot (a preset of the
         // same name), so a plan and its program are for that robot.
         if let Some(p) = crate::engine::base::robot::presets::presets()

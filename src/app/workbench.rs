@@ -180,7 +180,18 @@ impl WorkbenchApp {
             .default_size(290.0)
             .size_range(240.0..=420.0)
             .show(ui, |ui| {
-                side_ui(ui, state, forms, &mut commands);
+                let scroll = egui::ScrollArea::vertical().auto_shrink([false, false]);
+                scroll.show(ui, |ui| {
+                    ui.add_space(4.0);
+                    session::ui::load_ui(ui, state, forms, &mut commands);
+                    ui.separator();
+                    run::ui::solver_ui(ui, state, forms, &mut commands);
+                    // What comes and goes sits below the solver, so that Run
+                    // and the ε plot stay where they are (and on screen at
+                    // 1366×768).
+                    session::ui::notice_ui(ui, state, &mut commands);
+                    session::ui::recent_ui(ui, state, &mut commands);
+                });
             });
         egui::CentralPanel::default().show(ui, |ui| {
             steps::steps_ui(ui, state, forms, &mut commands);
@@ -269,25 +280,4 @@ impl eframe::App for WorkbenchApp {
             storage.set_string(PREFS_KEY, text);
         }
     }
-}
-
-/// The whole left panel.
-pub fn side_ui(
-    ui: &mut egui::Ui,
-    state: &AppState,
-    forms: &mut Forms,
-    commands: &mut Vec<Command>,
-) {
-    egui::ScrollArea::vertical()
-        .auto_shrink([false, false])
-        .show(ui, |ui| {
-            ui.add_space(4.0);
-            session::ui::load_ui(ui, state, forms, commands);
-            ui.separator();
-            run::ui::solver_ui(ui, state, forms, commands);
-            // What comes and goes sits below the solver, so that Run and
-            // the ε plot stay where they are (and on screen at 1366×768).
-            session::ui::notice_ui(ui, state, commands);
-            session::ui::recent_ui(ui, state, commands);
-        });
 }

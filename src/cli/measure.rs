@@ -317,6 +317,7 @@ fn print_warnings(measured: &measure::Measured) {
 fn print_summary(
     args: &MeasureArgs,
     result: &format::ResultFile,
+    options: &MeasureOptions,
     format: CloudFormat,
     done: &Outcome,
     (started, loaded, written): (Instant, f64, f64),
@@ -353,20 +354,8 @@ fn print_summary(
     }
     match cloud.sigma_stats() {
         Some(s) => sayln!(
-            "σ of a point (3-D, after the cloud's best rigid alignment; covariance {}{}): median {:.4} mm, rms {:.4} mm, max {:.4} mm",
-            if args.covariance_as_written {
-                "as written".to_string()
-            } else {
-                format!("× variance factor {:.3}", measure::variance_factor(result))
-            },
-            if args.sensor_noise > 0.0 {
-                format!(
-                    ", sensor noise {} mm",
-                    crate::engine::base::numeric::show(args.sensor_noise)
-                )
-            } else {
-                String::new()
-            },
+            "σ of a point (3-D, after the cloud's best rigid alignment; {}): median {:.4} mm, rms {:.4} mm, max {:.4} mm",
+            options.sigma_basis(result),
             s.median,
             s.rms,
             s.max
@@ -437,6 +426,7 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
             covariance_as_written: args.covariance_as_written,
         },
     };
+    let options = request.options.clone();
     let done =
         measure::measure_scan(request, &mut |_| Control::Continue).map_err(|e| from_measure(&e))?;
     let provenance = Provenance {
@@ -452,6 +442,6 @@ pub fn run(args: &MeasureArgs) -> Result<(), CliError> {
     }
     print_warnings(&done.measured);
     let timing = (started, loaded + done.read_secs, written);
-    print_summary(args, &result, format, &done, timing);
+    print_summary(args, &result, &options, format, &done, timing);
     Ok(())
 }

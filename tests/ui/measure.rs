@@ -92,9 +92,12 @@ fn the_session_is_measured_shown_and_written_as_ply() {
     assert!(step_label(&h, "7. Measured").starts_with('●'), "measured");
     let n = stripe_points(&h);
     let shown = h.state().state().measure.shown.clone().expect("a cloud");
-    assert_eq!(shown.points, n, "every stripe point is in the cloud");
+    assert_eq!(shown.cloud().len(), n, "every stripe point is in the cloud");
     assert_eq!(shown.drawn.len(), n, "a small cloud is drawn whole");
-    assert_eq!(shown.dropped.non_finite + shown.dropped.no_return, 0);
+    assert_eq!(
+        shown.cloud().dropped().non_finite + shown.cloud().dropped().no_return,
+        0
+    );
     let counts = format!("{} points kept of", group(n));
     assert!(h.query_by_label_contains(&counts).is_some(), "{counts}");
     assert!(
@@ -119,7 +122,7 @@ fn the_session_is_measured_shown_and_written_as_ply() {
     assert!(h.query_by_label(unit).is_some(), "the colour bar: {unit}");
     // The self-validation: the calibrated model fits the validate
     // spheres better than the nominal one (Table 1 errors are mm).
-    let check = shown.check.as_ref().expect("validate stations");
+    let check = shown.outcome.check.as_ref().expect("validate stations");
     assert_eq!(check.after.stations.len(), 4);
     assert!(check.after.spread().0 * 3.0 < check.before.spread().0);
     assert!(check.after.size().0 * 10.0 < check.before.size().0);
@@ -147,7 +150,7 @@ fn the_session_is_measured_shown_and_written_as_ply() {
         .unwrap();
     let vertices = &read.payload["vertex"];
     assert_eq!(vertices.len(), n);
-    for (v, p) in vertices.iter().zip(shown.cloud.points()) {
+    for (v, p) in vertices.iter().zip(shown.cloud().points()) {
         use ply_rs_bw::ply::Property;
         let d = |k: &str| match v[k] {
             Property::Double(x) => x,
@@ -221,7 +224,10 @@ fn cancel_stops_the_job_and_keeps_the_previous_cloud() {
     let m = &h.state().state().measure;
     assert!(h.state().state().jobs.get(&Slot::Measure).is_none());
     let kept = m.shown.as_ref().expect("the previous cloud");
-    assert!(Arc::ptr_eq(&kept.cloud, &first.cloud), "the same cloud");
+    assert!(
+        Arc::ptr_eq(&kept.outcome.measured.cloud, &first.outcome.measured.cloud),
+        "the same cloud"
+    );
     assert!(status(&h).contains("cancelled"), "{}", status(&h));
 
     // The job's work stops at the flag and gives nothing.
@@ -265,12 +271,16 @@ fn a_dense_scan_is_drawn_decimated_and_says_so() {
     form.session_file = dense.display().to_string();
     measure(&mut h);
     let shown = h.state().state().measure.shown.clone().expect("a cloud");
-    assert!(shown.points > DRAWN_MAX, "{} points", shown.points);
+    assert!(
+        shown.cloud().len() > DRAWN_MAX,
+        "{} points",
+        shown.cloud().len()
+    );
     assert_eq!(shown.drawn.len(), DRAWN_MAX);
     let text = format!(
         "showing {} of {} points",
         group(DRAWN_MAX),
-        group(shown.points)
+        group(shown.cloud().len())
     );
     assert!(h.query_by_label_contains(&text).is_some(), "{text}");
     // Drawn in σ order (the largest on top) and spread over the cloud:
@@ -319,7 +329,7 @@ fn a_paper_result_is_measured_only_without_sigma() {
     settle(&mut h);
     let shown = h.state().state().measure.shown.clone().expect("a cloud");
     assert!(shown.sigma.is_none());
-    assert_eq!(shown.points, stripe_points(&h));
+    assert_eq!(shown.cloud().len(), stripe_points(&h));
     assert!(
         h.query_all_by_label_contains("has no parameter covariance")
             .count()
@@ -377,14 +387,18 @@ fn a_raw_scan_of_an_artefact_is_measured_through_the_form() {
     form.references = scan.join("references.csv").display().to_string();
     measure(&mut h);
     let first = h.state().state().measure.shown.clone().expect("a cloud");
-    assert_eq!(first.points, finite);
-    assert_eq!(first.dropped.non_finite, nan);
+    assert_eq!(first.cloud().len(), finite);
+    assert_eq!(first.cloud().dropped().non_finite, nan);
     assert!(nan > 0, "the artefact scan has rays that meet nothing");
     assert!(
         h.query_by_label_contains(&format!("dropped {} NaN", group(nan)))
             .is_some()
     );
-    let check = first.check.as_ref().expect("the artefact's stations");
+    let check = first
+        .outcome
+        .check
+        .as_ref()
+        .expect("the artefact's stations");
     assert_eq!(check.after.stations.len(), 3);
     let (b, a) = (
         check.before.spacing_error().unwrap(),
@@ -405,8 +419,12 @@ fn a_raw_scan_of_an_artefact_is_measured_through_the_form() {
     h.get_by_label("▶ Measure").click();
     settle(&mut h);
     let moved = h.state().state().measure.shown.clone().unwrap();
-    assert!(moved.frame.contains("workpiece frame"), "{}", moved.frame);
-    for (p, q) in first.cloud.points().zip(moved.cloud.points()) {
+    assert!(
+        moved.cloud().frame.to_string().contains("workpiece frame"),
+        "{}",
+        moved.cloud().frame
+    );
+    for (p, q) in first.cloud().points().zip(moved.cloud().points()) {
         assert!((p.position[0] - 100.0 - q.position[0]).abs() < 1e-9);
         assert!((p.position[1] - q.position[1]).abs() < 1e-9);
         assert!((p.position[2] - q.position[2]).abs() < 1e-9);

@@ -9,7 +9,7 @@ pub mod ui;
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 
-use crate::engine::tools::history::{self, DEFAULT_K, Drift, DriftOptions, HistoryError, Library};
+use crate::engine::tools::history::{self, Drift, DriftOptions, HistoryError, Library};
 
 use super::command::HistoryCommand;
 use super::error::JobError;
@@ -38,7 +38,7 @@ pub struct HistoryView {
 }
 
 /// The History view's fields.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct HistoryForm {
     /// The library folder.
     pub folder: String,
@@ -46,19 +46,9 @@ pub struct HistoryForm {
     pub robot: Option<String>,
     /// Result files left out of the drift (unticked in the table).
     pub unselected: BTreeSet<PathBuf>,
-    /// Flag a change beyond `k` combined σ.
-    pub k: f64,
-}
-
-impl Default for HistoryForm {
-    fn default() -> Self {
-        Self {
-            folder: String::new(),
-            robot: None,
-            unselected: BTreeSet::new(),
-            k: DEFAULT_K,
-        }
-    }
+    /// The engine's drift settings (the form edits `k`: flag a change
+    /// beyond `k` combined σ).
+    pub options: DriftOptions,
 }
 
 impl Core {
@@ -109,12 +99,10 @@ impl Core {
         ticked
             .entries
             .retain(|e| !self.forms.history.unselected.contains(&e.path));
-        let options = DriftOptions {
-            k: self.forms.history.k,
-            ..DriftOptions::default()
-        };
+        let options = self.forms.history.options.clone();
         let robot = robot.clone();
-        self.start(ctx, Slot::Drift, stamp, move |_| {
+        self.start(ctx, Slot::Drift, stamp, move |w| {
+            w.progress("computing the drift of the ticked results…", None);
             let outcome = history::drift(&ticked, &robot, &options);
             let outcome = outcome.map(Box::new).map_err(JobError::from);
             (robot, Box::new(ticked), outcome)
@@ -166,12 +154,11 @@ impl Core {
                 }
                 self.forms.history.unselected.clear();
                 let problems = library.problems.len();
+                let (results, sessions) = (library.entries.len(), library.sessions.len());
                 let mut line = format!(
-                    "{}: {} results of {} robot(s), {} sessions",
+                    "{}: {results} results of {} robot(s), {sessions} sessions",
                     folder.display(),
-                    library.entries.len(),
                     robots.len(),
-                    library.sessions.len()
                 );
                 if problems > 0 {
                     line.push_str(&format!(", {problems} file(s) could not be used"));
@@ -212,9 +199,9 @@ pub(super) fn readings(state: &AppState, forms: &Forms) -> [(Input, Reading); 2]
                 vec![
                     ("robot".into(), f.robot.clone().unwrap_or_default()),
                     ("unticked".into(), f.unselected.len().to_string()),
-                    ("k".into(), f.k.to_string()),
+                    ("k".into(), f.options.k.to_string()),
                 ],
-                (&f.unselected, f.k.to_bits()),
+                (&f.unselected, f.options.k.to_bits()),
             ),
         ),
     ]

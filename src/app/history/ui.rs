@@ -16,7 +16,7 @@ use crate::app::widgets::plots::{DATE_LABEL_GAP, labelled_x, readable_y};
 use crate::app::widgets::{
     AFTER, BAD, MUTED, WARN, coloured, command_button, labelled_drag, labelled_field, table, weak,
 };
-use crate::engine::tools::history::{Drift, Entry, Library, Mount, Series, Verdict};
+use crate::engine::tools::history::{self, Drift, Entry, Library, Mount, Series, Verdict};
 
 /// Height of one drift plot, points.
 const DRIFT_PLOT_HEIGHT: f32 = 170.0;
@@ -53,13 +53,11 @@ pub fn history_ui(
                 let hover = "choose the folder with the desktop's dialog";
                 let (idle, browse) = (!state.jobs.runs(&Slot::Dialog), Purpose::HistoryFolder);
                 command_button(ui, idle, "Browse…", hover, Command::Browse(browse), commands);
-                if ui
-                    .add_enabled(!busy, egui::Button::new("Scan"))
-                    .on_hover_text("read every session and result file in the folder and its subfolders")
-                    .clicked()
-                    || (entered && !busy)
-                {
-                    commands.push(Command::History(HistoryCommand::Scan));
+                let scan = Command::History(HistoryCommand::Scan);
+                let hover = "read every session and result file in the folder and its subfolders";
+                let clicked = command_button(ui, !busy, "Scan", hover, scan.clone(), commands);
+                if entered && !busy && !clicked.clicked() {
+                    commands.push(scan);
                 }
                 if busy {
                     ui.spinner();
@@ -76,11 +74,8 @@ pub fn history_ui(
                 Some(Ok(library)) => {
                     library_ui(ui, library, forms);
                     ui.separator();
-                    if state.jobs.runs(&Slot::Drift) {
-                        ui.horizontal(|ui| {
-                            ui.spinner();
-                            ui.label("computing the drift of the ticked results…");
-                        });
+                    if let Some(job) = state.jobs.get(&Slot::Drift) {
+                        ui.horizontal(|ui| crate::app::widgets::job_ui(ui, job));
                     }
                     if let (Some(drift), Some(of)) =
                         (&state.history.drift, &state.history.drift_of)
@@ -105,19 +100,14 @@ fn library_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) {
         library.ignored.len()
     ));
     if !library.problems.is_empty() {
-        egui::CollapsingHeader::new(
-            RichText::new(format!(
-                "{} file(s) could not be used",
-                library.problems.len()
-            ))
-            .color(WARN),
-        )
-        .id_salt("history_problems")
-        .show(ui, |ui| {
-            for p in &library.problems {
-                ui.label(p.to_string());
-            }
-        });
+        let title = format!("{} file(s) could not be used", library.problems.len());
+        egui::CollapsingHeader::new(RichText::new(title).color(WARN))
+            .id_salt("history_problems")
+            .show(ui, |ui| {
+                for p in &library.problems {
+                    ui.label(p.to_string());
+                }
+            });
     }
     let robots = library.robots();
     // A choice made here makes the drift on show stale: the ledger has
@@ -138,7 +128,7 @@ fn library_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) {
             })
             .response
             .labelled_by(l.id);
-        let k = egui::DragValue::new(&mut forms.history.k).range(0.5..=20.0);
+        let k = egui::DragValue::new(&mut forms.history.options.k).range(0.5..=20.0);
         let k = k.speed(0.05).max_decimals(2).suffix(" σ combined");
         labelled_drag(ui, "Jump beyond", k).on_hover_text(
             "flag a change between consecutive results larger than k·sqrt(σ₁² + σ₂²)",
@@ -152,39 +142,30 @@ fn table_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) {
     // Solid scroll bars take their own space: a floating one would cover
     // the last row's tick box.
     ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
+    let mounts = library.entries.iter().map(|e| e.mount);
+    let sensor = format!("{} x y z (mm)", history::sensor_name(mounts));
+    let headers = [
+        "result file",
+        "date",
+        "robot",
+        "session",
+        "method",
+        "validation std after",
+        "ε after",
+        sensor.as_str(),
+        "roll pitch yaw (deg)",
+    ];
     egui::ScrollArea::both()
         .id_salt("history_table")
         .max_height(TABLE_HEIGHT)
         .show(ui, |ui| {
-            egui::Grid::new("history_entries")
-                .striped(true)
-                .num_columns(9)
-                .spacing([12.0, 4.0])
-                .show(ui, |ui| {
-                    let sensor = format!(
-                        "{} x y z (mm)",
-                        crate::engine::tools::history::sensor_name(
-                            library.entries.iter().map(|e| e.mount)
-                        )
-                    );
-                    for h in [
-                        "result file",
-                        "date",
-                        "robot",
-                        "session",
-                        "method",
-                        "validation std after",
-                        "ε after",
-                        sensor.as_str(),
-                        "roll pitch yaw (deg)",
-                    ] {
-                        ui.label(RichText::new(h).strong());
-                    }
-                    ui.end_row();
-                    for e in &library.entries {
-                        entry_row(ui, e, forms);
-                    }
-                });
+            // The table's spacing: a gap between columns, rows close.
+            ui.spacing_mut().item_spacing = egui::vec2(12.0, 4.0);
+            table(ui, "history_entries", &headers, |ui| {
+                for e in &library.entries {
+                    entry_row(ui, e, forms);
+                }
+            });
         });
 }
 
@@ -200,44 +181,40 @@ fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) {
         .on_hover_text(e.path.display().to_string())
         .on_disabled_hover_text("another robot: choose it above to plot its drift")
         .changed();
-    if changed {
-        if ticked {
-            forms.history.unselected.remove(&e.path);
-        } else {
-            forms.history.unselected.insert(e.path.clone());
-        }
+    if changed && ticked {
+        forms.history.unselected.remove(&e.path);
+    } else if changed {
+        forms.history.unselected.insert(e.path.clone());
     }
-    let dim = |t: String| {
-        if of_robot {
-            RichText::new(t)
-        } else {
-            RichText::new(t).color(MUTED)
-        }
+    let mut cell = |t: String| {
+        let t = RichText::new(t);
+        ui.label(if of_robot { t } else { t.color(MUTED) })
     };
     let source = if e.date_source.is_from_name() {
         String::new()
     } else {
         format!(" ({})", e.date_source.as_str())
     };
-    ui.label(dim(format!("{}{source}", e.date)))
+    cell(format!("{}{source}", e.date))
         .on_hover_text(format!("date from the {}", e.date_source.as_str()));
-    ui.label(dim(e.robot.clone()));
-    ui.label(dim(e.session.clone()));
-    ui.label(dim(e.method.clone()));
-    ui.label(dim(e.validation_std_after().map_or_else(
-        || "no validation".to_string(),
-        |s| format!("{s:.3} mm"),
-    )));
-    ui.label(dim(format!("{:.4} mm", e.epsilon_after)));
-    let t = e.hand_eye.translation;
+    let validation = e.validation_std_after();
+    let validation = validation.map_or_else(|| "no validation".into(), |s| format!("{s:.3} mm"));
+    for text in [
+        e.robot.clone(),
+        e.session.clone(),
+        e.method.clone(),
+        validation,
+    ] {
+        cell(text);
+    }
+    cell(format!("{:.4} mm", e.epsilon_after));
+    let (t, r) = (e.hand_eye.translation, e.hand_eye.rpy_deg);
     let which = match e.mount {
         Mount::Flange => "hand-eye eT_s",
         Mount::Fixed => "base_from_sensor bT_s (a fixed sensor)",
     };
-    ui.label(dim(format!("{:.3} {:.3} {:.3}", t[0], t[1], t[2])))
-        .on_hover_text(which);
-    let r = e.hand_eye.rpy_deg;
-    ui.label(dim(format!("{:.4} {:.4} {:.4}", r[0], r[1], r[2])));
+    cell(format!("{:.3} {:.3} {:.3}", t[0], t[1], t[2])).on_hover_text(which);
+    cell(format!("{:.4} {:.4} {:.4}", r[0], r[1], r[2]));
     ui.end_row();
 }
 
@@ -349,14 +326,17 @@ fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[St
         .iter()
         .filter_map(|p| position(p.entry).map(|x| [x as f64, p.value]))
         .collect();
-    let jumps: Vec<[[f64; 2]; 2]> = drift
-        .jumps()
-        .filter(|j| j.parameter == series.name)
+    // The ±1σ bars (muted) and the jumps (red): a segment each.
+    let segment = |name: &str, ends: [[f64; 2]; 2], colour, width| {
+        Line::new(name, PlotPoints::from(ends.to_vec()))
+            .color(colour)
+            .width(width)
+    };
+    let jumps = drift.jumps().filter(|j| j.parameter == series.name);
+    let jumps: Vec<[[f64; 2]; 2]> = jumps
         .filter_map(|j| {
-            Some([
-                [position(j.from)? as f64, j.before],
-                [position(j.to)? as f64, j.after],
-            ])
+            let (from, to) = (position(j.from)? as f64, position(j.to)? as f64);
+            Some([[from, j.before], [to, j.after]])
         })
         .collect();
     // Half a result of room each side: the first and last dates, centred
@@ -371,18 +351,15 @@ fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[St
         .y_axis_label(series.unit.as_str())
         .show(ui, |p| {
             for pt in &series.points {
-                let (Some(x), Some(s)) = (position(pt.entry), pt.sigma) else {
-                    continue;
-                };
-                let x = x as f64;
-                p.line(
-                    Line::new(
+                if let (Some(x), Some(s)) = (position(pt.entry), pt.sigma) {
+                    let x = x as f64;
+                    p.line(segment(
                         "",
-                        PlotPoints::from(vec![[x, pt.value - s], [x, pt.value + s]]),
-                    )
-                    .color(MUTED)
-                    .width(1.5),
-                );
+                        [[x, pt.value - s], [x, pt.value + s]],
+                        MUTED,
+                        1.5,
+                    ));
+                }
             }
             p.line(
                 Line::new(series.name.as_str(), PlotPoints::from(points.clone()))
@@ -396,12 +373,8 @@ fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[St
                     .shape(MarkerShape::Circle)
                     .radius(3.5),
             );
-            for seg in jumps {
-                p.line(
-                    Line::new("jump", PlotPoints::from(seg.to_vec()))
-                        .color(BAD)
-                        .width(2.5),
-                );
+            for ends in jumps {
+                p.line(segment("jump", ends, BAD, 2.5));
             }
         });
 }

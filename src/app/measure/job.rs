@@ -8,7 +8,6 @@
 //! figures, so that a cloud of millions costs the frame only the points
 //! drawn.
 
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -16,8 +15,7 @@ use crate::engine::calibrate::solve::{Control, SolverReport};
 pub use crate::engine::calibrate::stripe::segment::grouped as group;
 use crate::engine::files::format::ResultFile;
 use crate::engine::uses::measure::{
-    self, Cloud, CloudFormat, CloudPoint, Dropped, MeasureError, MeasureOptions, MeasureRequest,
-    Outcome, SelfValidation, SigmaStats,
+    self, Cloud, CloudPoint, MeasureError, MeasureRequest, Outcome, SigmaStats,
 };
 
 use crate::app::error::JobError;
@@ -40,52 +38,48 @@ pub fn has_covariance(result: &ResultFile) -> bool {
     matches!(&result.solver, SolverReport::Ml(r) if !r.covariance.labels.is_empty())
 }
 
-/// The points drawn (at most [`DRAWN_MAX`], the largest σ last so that
-/// it is drawn on top) and the range of their finite σ (mm).
-fn drawn_points(cloud: &Cloud) -> (Vec<CloudPoint>, Option<(f64, f64)>) {
-    let mut drawn = cloud.decimated(DRAWN_MAX);
-    drawn.sort_by(|a, b| a.sigma_mm.total_cmp(&b.sigma_mm));
-    let sigma_range = drawn
-        .iter()
-        .map(|p| p.sigma_mm)
-        .filter(|s| s.is_finite())
-        .fold(None, |r: Option<(f64, f64)>, s| {
-            Some(r.map_or((s, s), |(lo, hi)| (lo.min(s), hi.max(s))))
-        });
-    (drawn, sigma_range)
+/// Why a measuring job gave no cloud.
+#[derive(Debug)]
+pub enum MeasureFailure {
+    /// Cancel was pressed.
+    Cancelled,
+    /// The inputs or the engine failed.
+    Failed(JobError),
 }
 
-/// Why the cloud has no σ (`None` when it has), and what its σ rests on
-/// (the covariance as written or scaled, the sensor noise).
-fn sigma_words(
-    cloud: &Cloud,
-    result: &ResultFile,
-    options: &MeasureOptions,
-) -> (Option<String>, String) {
-    let no_sigma = (!cloud.has_sigma()).then(|| {
-        if options.sigma {
-            "σ is unavailable".to_string()
-        } else if has_covariance(result) {
-            "no σ (as asked)".to_string()
-        } else {
-            format!(
-                "σ is unavailable: the result (method {}) has no parameter covariance",
-                result.solver.method()
-            )
-        }
-    });
-    let mut sigma_basis = if options.covariance_as_written {
-        "covariance as written".to_string()
-    } else {
-        format!(
-            "covariance × variance factor {:.3}",
-            measure::variance_factor(result)
-        )
-    };
-    if options.sensor_noise_mm > 0.0 {
-        sigma_basis.push_str(&format!(", sensor noise {} mm", options.sensor_noise_mm));
+/// A cloud measured in the workbench: the engine's outcome as it came,
+/// and what the view draws of it (made once: a median of millions is
+/// not a frame's work).
+#[derive(Debug, Clone)]
+pub struct MeasuredCloud {
+    /// The engine's outcome: the cloud (shared with export jobs), its
+    /// warnings, the self-validation, what was measured.
+    pub outcome: Outcome,
+    /// At most [`DRAWN_MAX`] points spread evenly over the cloud, sorted
+    /// by σ (largest drawn last, on top).
+    pub drawn: Vec<CloudPoint>,
+    /// The colour scale's ends, mm: smallest and largest finite σ drawn.
+    pub sigma_range: Option<(f64, f64)>,
+    /// σ over every point (rms, median, max), mm; `None` without σ.
+    pub sigma: Option<SigmaStats>,
+    /// Bounding box `(min, max)` of every point, mm, output frame.
+    pub bounds: Option<([f64; 3], [f64; 3])>,
+    /// Why there is no σ, when there is none.
+    pub no_sigma: Option<String>,
+    /// What σ rests on (the covariance's scale, the sensor noise).
+    pub sigma_basis: String,
+    /// The result it was measured with, for people and the file header.
+    pub result: String,
+    /// Wall time of the job, s.
+    pub seconds: f64,
+}
+
+impl MeasuredCloud {
+    /// The whole cloud.
+    #[must_use]
+    pub fn cloud(&self) -> &Cloud {
+        &self.outcome.measured.cloud
     }
-    (no_sigma, sigma_basis)
 }
 
 /// Measures `request` by the engine's [`measure::measure_scan`] (what
@@ -96,8 +90,8 @@ fn sigma_words(
 /// between the phases.
 ///
 /// # Errors
-/// [`MeasureFailure::Cancelled`] after a cancel, [`MeasureFailure::Failed`]
-/// with the engine's error (naming the file, pose or parameter) otherwise.
+/// [`MeasureFailure::Cancelled`] after a cancel, [`MeasureFailure::Failed`] with
+/// the engine's error (naming the file, pose or parameter) otherwise.
 pub fn measure_cloud(
     request: MeasureRequest,
     result_label: String,
@@ -108,7 +102,7 @@ pub fn measure_cloud(
     let cancelled = || cancel.load(Ordering::Relaxed);
     let (result, options) = (request.result.clone(), request.options.clone());
     let mut last = -1.0;
-    let done = measure::measure_scan(request, &mut |p| {
+    let outcome = measure::measure_scan(request, &mut |p| {
         let f = p.fraction();
         let mut alive = true;
         if f - last >= PROGRESS_STEP || p.done == p.of {
@@ -129,111 +123,34 @@ pub fn measure_cloud(
         return Err(MeasureFailure::Cancelled);
     }
     progress("the view of the cloud (decimated, σ colours)", 0.95);
-    let Outcome {
-        measured,
-        check,
-        scan,
-        notes,
-        skipped,
-        ..
-    } = done;
-    let cloud = measured.cloud;
-    let (drawn, sigma_range) = drawn_points(&cloud);
-    let (no_sigma, sigma_basis) = sigma_words(&cloud, &result, &options);
+    let cloud = &outcome.measured.cloud;
+    let mut drawn = cloud.decimated(DRAWN_MAX);
+    drawn.sort_by(|a, b| a.sigma_mm.total_cmp(&b.sigma_mm));
+    let finite = drawn.iter().map(|p| p.sigma_mm).filter(|s| s.is_finite());
+    let sigma_range = finite.fold(None, |r: Option<(f64, f64)>, s| {
+        Some(r.map_or((s, s), |(lo, hi)| (lo.min(s), hi.max(s))))
+    });
+    let no_sigma = (!cloud.has_sigma()).then(|| match (options.sigma, has_covariance(&result)) {
+        (true, _) => "σ is unavailable".to_string(),
+        (false, true) => "no σ (as asked)".to_string(),
+        (false, false) => format!(
+            "σ is unavailable: the result (method {}) has no parameter covariance",
+            result.solver.method()
+        ),
+    });
+    let (sigma, bounds) = (cloud.sigma_stats(), cloud.bounds());
     if cancelled() {
         return Err(MeasureFailure::Cancelled);
     }
     Ok(MeasuredCloud {
-        out_of_range_count: measured.out_of_range.len(),
-        out_of_range: measure::listed(&measured.out_of_range),
-        points: cloud.len(),
-        poses: cloud.poses.len(),
-        dropped: cloud.dropped(),
-        bounds: cloud.bounds(),
-        sigma: cloud.sigma_stats(),
-        sigma_range,
-        no_sigma,
-        sigma_basis,
-        check,
-        warnings: measured.warnings,
-        skipped: skipped.len(),
-        notes,
-        scan,
-        result: result_label,
-        frame: cloud.frame.to_string(),
-        model: cloud.model,
-        seconds: started.elapsed().as_secs_f64(),
         drawn,
-        cloud: Arc::new(cloud),
+        sigma_range,
+        sigma,
+        bounds,
+        no_sigma,
+        sigma_basis: options.sigma_basis(&result),
+        result: result_label,
+        seconds: started.elapsed().as_secs_f64(),
+        outcome,
     })
-}
-
-/// The file format's name for people.
-#[must_use]
-pub fn format_label(format: CloudFormat) -> &'static str {
-    match format {
-        CloudFormat::Ply => "PLY cloud",
-        CloudFormat::E57 => "E57 cloud",
-        CloudFormat::Csv => "CSV cloud",
-    }
-}
-
-/// A cloud measured in the workbench, with what the view draws of it.
-#[derive(Debug, Clone)]
-pub struct MeasuredCloud {
-    /// The whole cloud (what Export writes), shared with export jobs.
-    pub cloud: Arc<Cloud>,
-    /// At most [`crate::app::measure::job::DRAWN_MAX`] points spread
-    /// evenly over the cloud, sorted by σ (largest drawn last, on top).
-    pub drawn: Vec<CloudPoint>,
-    /// Points in the cloud.
-    pub points: usize,
-    /// Poses in the cloud.
-    pub poses: usize,
-    /// Points dropped while reading (NaN, no-return), all poses.
-    pub dropped: Dropped,
-    /// Bounding box `(min, max)` of every point, mm, output frame.
-    pub bounds: Option<([f64; 3], [f64; 3])>,
-    /// σ over every point (rms, median, max), mm; `None` without σ.
-    pub sigma: Option<SigmaStats>,
-    /// The colour scale's ends, mm: smallest and largest σ of the drawn
-    /// points.
-    pub sigma_range: Option<(f64, f64)>,
-    /// Why there is no σ, when there is none.
-    pub no_sigma: Option<String>,
-    /// How σ was scaled ("covariance × variance factor 1.031", sensor
-    /// noise), for the caption.
-    pub sigma_basis: String,
-    /// The self-validation on the sphere stations, if the scan saw any.
-    pub check: Option<SelfValidation>,
-    /// Warnings of the measurement (flange poses, robots).
-    pub warnings: Vec<String>,
-    /// Poses outside the joint range the calibration saw, in words (the
-    /// first few).
-    pub out_of_range: Vec<String>,
-    /// How many poses are outside that range.
-    pub out_of_range_count: usize,
-    /// Measurements without a profile (given centres), not in the cloud.
-    pub skipped: usize,
-    /// How the scan was read (axis map, units).
-    pub notes: Vec<String>,
-    /// What was measured, for people and the file header.
-    pub scan: String,
-    /// The result it was measured with, for people and the file header.
-    pub result: String,
-    /// The output frame, in words.
-    pub frame: String,
-    /// The model that placed the sensor (`calibrated`).
-    pub model: &'static str,
-    /// Wall time of the job, s.
-    pub seconds: f64,
-}
-
-/// Why a measuring job gave no cloud.
-#[derive(Debug)]
-pub enum MeasureFailure {
-    /// Cancel was pressed.
-    Cancelled,
-    /// The inputs or the engine failed.
-    Failed(JobError),
 }

@@ -14,24 +14,25 @@ pub mod ui;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use crate::engine::base::robot::kinematics::Robot;
 use crate::engine::base::session::Use;
 use crate::engine::files::format::refuse_inputs;
 use crate::engine::files::import::{
     AngleUnit, AxisMap, FlangeConvention, LengthUnit, ProfileFormat, ProfileSource,
 };
 use crate::engine::uses::measure::{
-    self, CloudFormat, JointRange, MeasureOptions, MeasureRequest, ModelChoice, ScanColumns,
-    ScanFiles, ScanLog, ScanSource,
+    self, CloudFormat, JointRange, MeasureOptions, MeasureRequest, ScanColumns, ScanFiles, ScanLog,
+    ScanSource,
 };
 
 use super::command::{Command, MeasureCommand};
 use super::import::form::no_return;
 use super::job::{Job, Slot};
-use super::ledger::{Artefact, Reading};
+use super::ledger::{Artefact, Reading, Stamp};
 use super::results::ResultOrigin;
-use super::state::{Level, Notice};
+use super::state::Level;
 use super::{Core, Write};
-use job::{MeasureFailure, MeasuredCloud, format_label, group, has_covariance, measure_cloud};
+use job::{MeasureFailure, MeasuredCloud, group, has_covariance, measure_cloud};
 
 /// The Measure view's state.
 #[derive(Debug, Default)]
@@ -113,10 +114,11 @@ pub struct MeasureForm {
     /// A workpiece frame file (a JSON 4×4 `base_from_workpiece`, mm);
     /// empty for the robot base frame.
     pub frame: String,
-    /// The sensor's own noise: 1σ of each in-plane coordinate, mm.
-    pub sensor_noise_mm: f64,
-    /// Write no σ (`--no-sigma`): for a result without covariance.
-    pub no_sigma: bool,
+    /// How it is measured, the engine's options as the request carries
+    /// them: σ or not (`--no-sigma`), the sensor's own noise (1σ of each
+    /// in-plane coordinate, mm); the calibrated model, the frame from
+    /// [`MeasureForm::frame`].
+    pub options: MeasureOptions,
     /// Where Export writes the cloud; the extension chooses the format
     /// (`.ply`, `.e57`, `.csv`).
     pub out: String,
@@ -139,17 +141,14 @@ impl Default for MeasureForm {
             sphere_diameter: String::new(),
             references: String::new(),
             frame: String::new(),
-            sensor_noise_mm: 0.0,
-            no_sigma: false,
+            options: MeasureOptions {
+                sigma: true,
+                ..MeasureOptions::default()
+            },
             out: String::new(),
         }
     }
 }
-
-/// Largest sensor noise the form takes, mm: a laser-stripe sensor's
-/// in-plane noise is micrometres to a few tenths of a millimetre; more
-/// is a typing error (a value in µm).
-pub const MAX_SENSOR_NOISE_MM: f64 = 10.0;
 
 impl MeasureForm {
     /// The uses `--use` names: empty for all.
@@ -173,21 +172,18 @@ impl MeasureForm {
     /// # Errors
     /// A field is missing or not valid, in words.
     pub fn scan_files(&self, dof: usize) -> Result<ScanFiles, String> {
-        let log = PathBuf::from(self.log.trim());
-        if log.as_os_str().is_empty() {
-            return Err("choose the raw scan's pose log (joint log CSV or pose file) first".into());
-        }
-        let profiles = self.profiles.trim();
-        if profiles.is_empty() {
-            return Err("choose the raw scan's profiles (a folder or one CSV) first".into());
-        }
-        let profiles = PathBuf::from(profiles);
+        let path = |text: &str| (!text.trim().is_empty()).then(|| PathBuf::from(text.trim()));
+        let log = path(&self.log)
+            .ok_or("choose the raw scan's pose log (joint log CSV or pose file) first")?;
+        let profiles = path(&self.profiles)
+            .ok_or("choose the raw scan's profiles (a folder or one CSV) first")?;
         let profiles = if profiles.is_dir() {
             ProfileSource::Folder(profiles)
         } else {
+            let pose_column = "pose".into();
             ProfileSource::File {
                 path: profiles,
-                pose_column: "pose".into(),
+                pose_column,
             }
         };
         let axes = match self.axes.trim() {
@@ -198,15 +194,14 @@ impl MeasureForm {
         let sphere_diameter = match self.sphere_diameter.trim() {
             "" => None,
             text => Some(
-                text.parse::<f64>()
+                text.parse()
                     .ok()
-                    .filter(|v| v.is_finite() && *v > 0.0)
+                    .filter(|v: &f64| v.is_finite() && *v > 0.0)
                     .ok_or_else(|| {
                         format!("the sphere diameter `{text}` is not a positive number of mm")
                     })?,
             ),
         };
-        let references = self.references.trim();
         let log = match self.raw_log {
             RawLog::Joints => ScanLog::Joints {
                 path: log,
@@ -220,18 +215,19 @@ impl MeasureForm {
                 columns: None,
             },
         };
+        let (unit, key) = (self.profile_unit, None);
         Ok(ScanFiles {
             log,
             profiles,
             profile_format: ProfileFormat {
-                unit: self.profile_unit,
+                unit,
                 axes,
                 no_return,
-                key: None,
+                key,
             },
             robot: None,
             sphere_diameter,
-            references: (!references.is_empty()).then(|| PathBuf::from(references)),
+            references: path(&self.references),
             uses: self.uses(),
         })
     }
@@ -244,14 +240,11 @@ impl Core {
             MeasureCommand::Start => self.start_measure(ctx),
             MeasureCommand::Cancel => {
                 if let Some(job) = self.state.jobs.cancel(&Slot::Measure) {
-                    self.state.say(
-                        Level::Warning,
-                        format!(
-                            "measuring cancelled in \"{}\" ({:.2} s); the cloud on show is unchanged",
-                            job.phase,
-                            job.started.elapsed().as_secs_f64()
-                        ),
+                    let (phase, s) = (&job.phase, job.started.elapsed().as_secs_f64());
+                    let text = format!(
+                        "measuring cancelled in \"{phase}\" ({s:.2} s); the cloud on show is unchanged"
                     );
+                    self.state.say(Level::Warning, text);
                 }
             }
             MeasureCommand::Export => self.export_cloud(ctx),
@@ -269,15 +262,11 @@ impl Core {
             .check(Artefact::Result)
             .map_err(|why| format!("{why}: run the calibration again, then measure"))?;
         let form = &self.forms.measure;
-        let sigma = !form.no_sigma;
-        if sigma && !has_covariance(&view.file) {
+        if form.options.sigma && !has_covariance(&view.file) {
             return Err(format!(
                 "σ is unavailable: the result (method {}) has no parameter covariance; tick \"no σ\" to measure without it (as --no-sigma), or calibrate with method ml",
                 view.file.solver.method()
             ));
-        }
-        if !(form.sensor_noise_mm.is_finite() && form.sensor_noise_mm >= 0.0) {
-            return Err("the sensor noise must be a finite number ≥ 0 mm".into());
         }
         let loaded = self.state.loaded.as_ref();
         let scan = match form.choice {
@@ -291,19 +280,12 @@ impl Core {
                     format!("\"{}\" ({})", l.session.name, l.source.label()),
                 )
             }
-            ScanChoice::SessionFile => {
-                let path = form.session_file.trim();
-                if path.is_empty() {
-                    return Err("type or choose the session file to measure".into());
-                }
-                ScanSource::SessionFile(PathBuf::from(path), form.uses())
-            }
+            ScanChoice::SessionFile => match form.session_file.trim() {
+                "" => return Err("type or choose the session file to measure".into()),
+                path => ScanSource::SessionFile(PathBuf::from(path), form.uses()),
+            },
             ScanChoice::RawScan => {
-                let dof = view
-                    .file
-                    .robot
-                    .as_ref()
-                    .map_or(0, crate::engine::base::robot::kinematics::Robot::dof);
+                let dof = view.file.robot.as_ref().map_or(0, Robot::dof);
                 ScanSource::Files(Box::new(form.scan_files(dof)?))
             }
         };
@@ -319,13 +301,7 @@ impl Core {
             result: view.file.clone(),
             joint_range: loaded.and_then(|l| JointRange::of_session(&l.session)),
             frame: form.frame_path(),
-            options: MeasureOptions {
-                model: ModelChoice::Calibrated,
-                frame: None,
-                sigma,
-                sensor_noise_mm: form.sensor_noise_mm,
-                covariance_as_written: false,
-            },
+            options: form.options.clone(),
         };
         Ok((request, result_label))
     }
@@ -363,15 +339,15 @@ impl Core {
     ) {
         let m = &mut self.state.measure;
         match outcome {
-            Ok(cloud) => {
+            Ok(shown) => {
+                let (cloud, scan) = (shown.cloud(), &shown.outcome.scan);
+                let (points, poses) = (group(cloud.len()), group(cloud.poses.len()));
                 let text = format!(
-                    "measured {} points of {} poses in {:.2} s (Measure view)",
-                    group(cloud.points),
-                    group(cloud.poses),
-                    cloud.seconds
+                    "measured {points} points of {poses} poses in {:.2} s (Measure view)",
+                    shown.seconds
                 );
-                let what = format!("{} points measured of {}", group(cloud.points), cloud.scan);
-                m.shown = Some(*cloud);
+                let what = format!("{points} points measured of {scan}");
+                m.shown = Some(*shown);
                 self.state
                     .ledger
                     .record(Artefact::Cloud, job.stamp.clone(), what);
@@ -383,12 +359,9 @@ impl Core {
             ),
             Err(MeasureFailure::Failed(e)) => {
                 m.failure = Some(e.to_string());
+                self.refuse("The scan could not be measured", "", e.to_string());
                 self.state
                     .say(Level::Error, "the scan could not be measured");
-                self.state.notice = Some(Notice {
-                    title: "The scan could not be measured".to_string(),
-                    body: e.to_string(),
-                });
             }
         }
     }
@@ -396,88 +369,85 @@ impl Core {
     /// Every input file of the cloud on show and of the form, to refuse
     /// an export over one of them.
     fn measure_inputs(&self) -> Vec<PathBuf> {
-        let form = &self.forms.measure;
-        let mut out: Vec<PathBuf> = [
-            form.session_file.trim(),
-            form.log.trim(),
-            form.profiles.trim(),
-            form.frame.trim(),
-            form.references.trim(),
-        ]
-        .iter()
-        .filter(|s| !s.is_empty())
-        .map(PathBuf::from)
-        .collect();
-        if let Some(p) = self.state.loaded.as_ref().and_then(|l| l.source.path()) {
-            out.push(p.to_path_buf());
-        }
+        let f = &self.forms.measure;
+        let typed = [
+            &f.session_file,
+            &f.log,
+            &f.profiles,
+            &f.frame,
+            &f.references,
+        ];
+        let typed = typed
+            .into_iter()
+            .map(|t| t.trim())
+            .filter(|t| !t.is_empty());
+        let mut out: Vec<PathBuf> = typed.map(PathBuf::from).collect();
+        out.extend(
+            self.state
+                .loaded
+                .as_ref()
+                .and_then(|l| l.source.path())
+                .map(Path::to_path_buf),
+        );
         if let Some(ResultOrigin::Review(p)) = self.state.result.as_ref().map(|v| &v.origin) {
             out.push(p.clone());
         }
         out
     }
 
-    /// Writes the cloud on show to the form's path, refused when it is
-    /// stale or the path is not a cloud file.
-    pub(super) fn export_cloud(&mut self, ctx: &egui::Context) {
-        let refuse = |core: &mut Self, why: String| {
-            core.refuse("Cloud not written", "cloud not written", why);
-        };
+    /// Where and in which format the cloud on show is written, or why it
+    /// is not; `None` when the export folder is missing (that says so).
+    fn cloud_target(&mut self) -> Result<Option<(PathBuf, CloudFormat, Stamp)>, String> {
         if self.state.measure.shown.is_none() {
-            refuse(self, "no cloud to write: measure a scan first".into());
-            return;
+            return Err("no cloud to write: measure a scan first".into());
         }
         // A stale cloud is never written as if it were current.
-        let stamp = match self.state.ledger.check(Artefact::Cloud) {
-            Ok(stamp) => stamp,
-            Err(why) => {
-                refuse(self, format!("{why}: measure again, then export"));
-                return;
-            }
-        };
+        let stamp = (self.state.ledger.check(Artefact::Cloud))
+            .map_err(|why| format!("{why}: measure again, then export"))?;
         // An empty field writes the default it shows: the export folder's
         // `<session stem>-cloud.ply`.
         if self.forms.measure.out.trim().is_empty() {
             let Some(dir) = self.export_folder() else {
-                return;
+                return Ok(None);
             };
             self.forms.measure.out = dir.join(self.cloud_file_name()).display().to_string();
         }
         let path = PathBuf::from(self.forms.measure.out.trim());
-        let Some(format) = CloudFormat::of_path(&path) else {
-            refuse(
-                self,
-                format!(
-                    "{}: the extension chooses the format: .ply, .e57 or .csv",
-                    path.display()
-                ),
-            );
-            return;
-        };
+        let format = CloudFormat::of_path(&path).ok_or_else(|| {
+            let path = path.display();
+            format!("{path}: the extension chooses the format: .ply, .e57 or .csv")
+        })?;
         let inputs = self.measure_inputs();
         let refs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
-        if let Err(e) = refuse_inputs(&path, &refs) {
-            refuse(self, e.to_string());
-            return;
-        }
+        refuse_inputs(&path, &refs).map_err(|e| e.to_string())?;
+        Ok(Some((path, format, stamp)))
+    }
+
+    /// Writes the cloud on show to the form's path, refused when it is
+    /// stale or the path is not a cloud file.
+    pub(super) fn export_cloud(&mut self, ctx: &egui::Context) {
+        let (path, format, stamp) = match self.cloud_target() {
+            Ok(Some(target)) => target,
+            Ok(None) => return,
+            Err(why) => return self.refuse("Cloud not written", "cloud not written", why),
+        };
         let Some(shown) = &self.state.measure.shown else {
             return;
         };
-        let cloud = Arc::clone(&shown.cloud);
+        let cloud = Arc::clone(&shown.outcome.measured.cloud);
         let provenance = measure::Provenance {
             result: shown.result.clone(),
-            scan: shown.scan.clone(),
+            scan: shown.outcome.scan.clone(),
         };
+        let what = format!("{} cloud", format!("{format:?}").to_uppercase());
+        self.state.say(Level::Info, format!("writing the {what}…"));
+        let (from, again) = (Artefact::Cloud, Command::Measure(MeasureCommand::Export));
         let write = Write {
-            what: format_label(format).to_string(),
-            from: Artefact::Cloud,
+            what,
+            from,
             stamp,
-            again: Command::Measure(MeasureCommand::Export),
+            again,
         };
-        self.state.say(
-            Level::Info,
-            format!("writing the {}…", format_label(format)),
-        );
         self.write(ctx, path, write, move |path| {
             measure::write_cloud(&cloud, path, format, &provenance)?;
             Ok(None)
@@ -527,10 +497,13 @@ pub fn reading(f: &MeasureForm) -> Reading {
             f.frame_path()
                 .map_or_else(|| "base".to_string(), |p| p.display().to_string()),
         ),
-        ("sensor noise".into(), format!("{} mm", f.sensor_noise_mm)),
+        (
+            "sensor noise".into(),
+            format!("{} mm", f.options.sensor_noise_mm),
+        ),
         (
             "σ".into(),
-            if f.no_sigma { "no" } else { "yes" }.to_string(),
+            if f.options.sigma { "yes" } else { "no" }.to_string(),
         ),
     ];
     let mut unseen = f.clone();

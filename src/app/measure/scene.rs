@@ -5,10 +5,10 @@ use egui::Stroke;
 use nalgebra::Isometry3;
 
 use super::job::MeasuredCloud;
-use super::ui::scale_colour;
+use super::ui::sigma_colour;
 use crate::app::scene::content::axes_lines;
 use crate::app::scene::{Line3, Scene};
-use crate::app::widgets::{AFTER, BAD};
+use crate::app::widgets::BAD;
 use crate::engine::tools::scene::frame_axes;
 
 /// The measured cloud's scene: its drawn points (at most
@@ -18,16 +18,10 @@ use crate::engine::tools::scene::frame_axes;
 #[must_use]
 pub fn cloud_scene(c: &MeasuredCloud) -> Scene {
     let mut scene = Scene::default();
-    let colour = |s: f64| match c.sigma_range {
-        Some((lo, hi)) if s.is_finite() => {
-            scale_colour(if hi > lo { (s - lo) / (hi - lo) } else { 0.5 })
-        }
-        _ => AFTER,
-    };
     scene.points = c
         .drawn
         .iter()
-        .map(|p| (p.position, colour(p.sigma_mm)))
+        .map(|p| (p.position, sigma_colour(c, p.sigma_mm)))
         .collect();
     // Framed on the cloud; the base frame's axes and the sensor's path
     // are a zoom out away.
@@ -39,7 +33,7 @@ pub fn cloud_scene(c: &MeasuredCloud) -> Scene {
         &mut scene.lines,
     );
     let path: Vec<[f64; 3]> = c
-        .cloud
+        .cloud()
         .poses
         .iter()
         .map(|p| {

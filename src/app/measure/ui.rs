@@ -21,13 +21,15 @@ use crate::app::job::Slot;
 use crate::app::ledger::Artefact;
 use crate::app::measure::job::MeasuredCloud;
 use crate::app::measure::job::{DRAWN_MAX, group, has_covariance};
-use crate::app::measure::{MAX_SENSOR_NOISE_MM, RawLog, ScanChoice};
+use crate::app::measure::{RawLog, ScanChoice};
 use crate::app::widgets::{
-    AFTER, BAD, GOOD, MUTED, WARN, choice, labelled_field, number_field, stale_banner_ui,
+    AFTER, BAD, GOOD, MUTED, WARN, choice, coloured, command_button, labelled_field, number_field,
+    path_row, stale_banner_ui, table,
 };
 use crate::engine::base::session::Use;
 use crate::engine::files::import::{AngleUnit, LengthUnit};
-use crate::engine::uses::measure::selfcheck::ModelCheck;
+use crate::engine::tools::simulate::config::MAX_SENSOR_NOISE_MM;
+use crate::engine::uses::measure::{self, selfcheck::ModelCheck, selfcheck::Spacing};
 
 /// Side of a drawn point, screen points: one or two pixels, so that
 /// 50,000 points show the part's shape rather than a blot.
@@ -70,6 +72,18 @@ pub fn scale_colour(t: f64) -> Color32 {
         (a + (b - a) * f).round() as u8
     };
     Color32::from_rgb(mix(0), mix(1), mix(2))
+}
+
+/// The colour of a point of σ `s` (mm) on the cloud's scale; no σ:
+/// the "after" colour.
+#[must_use]
+pub fn sigma_colour(c: &MeasuredCloud, s: f64) -> Color32 {
+    match c.sigma_range {
+        Some((lo, hi)) if s.is_finite() => {
+            scale_colour(if hi > lo { (s - lo) / (hi - lo) } else { 0.5 })
+        }
+        _ => AFTER,
+    }
 }
 
 /// The unit σ is shown in, and millimetres to it: µm when the largest σ
@@ -117,22 +131,6 @@ pub fn measure_ui(
         });
 }
 
-/// A path field with its Browse… button (the note when a dialog chose
-/// nothing is under the scan's fields).
-fn path_row(
-    ui: &mut egui::Ui,
-    state: &AppState,
-    (label, hint): (&str, &str),
-    text: &mut String,
-    purpose: Purpose,
-    commands: &mut Vec<Command>,
-) {
-    let busy = state.jobs.runs(&Slot::Dialog);
-    ui.horizontal(|ui| {
-        crate::app::widgets::path_row(ui, label, text, hint, busy, purpose, commands);
-    });
-}
-
 /// The result, the scan and the options, Measure and Cancel.
 fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mut Vec<Command>) {
     let form = &mut forms.measure;
@@ -149,24 +147,16 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
                     v.method, v.file.session
                 ));
                 if !has_covariance(&v.file) {
-                    ui.label(
-                        RichText::new(format!(
-                            "σ is unavailable: method {} gives no parameter covariance; tick \"no σ\" to measure without it",
-                            v.file.solver.method()
-                        ))
-                        .color(WARN),
-                    );
+                    let method = v.file.solver.method();
+                    coloured(ui, WARN, format!(
+                        "σ is unavailable: method {method} gives no parameter covariance; tick \"no σ\" to measure without it"
+                    ));
                 }
                 if let Some(s) = state.ledger.stale(Artefact::Result) {
-                    ui.label(RichText::new(format!("{s}")).color(WARN));
+                    coloured(ui, WARN, s.to_string());
                 }
             }
-            None => {
-                ui.label(
-                    RichText::new("none: run the calibration (or open a result file) first")
-                        .color(WARN),
-                );
-            }
+            None => drop(coloured(ui, WARN, "none: run the calibration (or open a result file) first")),
         }
     });
     let summary = match form.choice {
@@ -183,40 +173,33 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
             ui,
             "measure_noise",
             "Sensor noise (1σ in-plane)",
-            form.sensor_noise_mm,
+            form.options.sensor_noise_mm,
             0.0..=MAX_SENSOR_NOISE_MM,
             "mm",
         ) {
-            form.sensor_noise_mm = v;
+            form.options.sensor_noise_mm = v;
         }
-        ui.checkbox(&mut form.no_sigma, "no σ (as --no-sigma)")
+        let mut no_sigma = !form.options.sigma;
+        ui.checkbox(&mut no_sigma, "no σ (as --no-sigma)")
             .on_hover_text("measure without σ: for a result without covariance (method paper)");
+        form.options.sigma = !no_sigma;
         ui.add_space(12.0);
         let running = state.jobs.runs(&Slot::Measure);
-        if ui
-            .add_enabled(
-                !running && state.result.is_some(),
-                egui::Button::new(RichText::new("▶ Measure").size(16.0)),
-            )
-            .on_hover_text("measure the scan with the result on show, on a background thread")
-            .on_disabled_hover_text("a result is needed (and no measuring under way)")
-            .clicked()
-        {
-            commands.push(Command::Measure(MeasureCommand::Start));
-        }
-        if ui
-            .add_enabled(running, egui::Button::new("Cancel measuring"))
-            .on_hover_text("stop the measuring job; the cloud on show stays")
-            .clicked()
-        {
-            commands.push(Command::Measure(MeasureCommand::Cancel));
-        }
+        let (start, cancel) = (MeasureCommand::Start, MeasureCommand::Cancel);
+        let text = RichText::new("▶ Measure").size(16.0);
+        let hover = "measure the scan with the result on show, on a background thread";
+        let idle = !running && state.result.is_some();
+        command_button(ui, idle, text, hover, Command::Measure(start), commands)
+            .on_disabled_hover_text("a result is needed (and no measuring under way)");
+        let hover = "stop the measuring job; the cloud on show stays";
+        let cancel = Command::Measure(cancel);
+        command_button(ui, running, "Cancel measuring", hover, cancel, commands);
         if let Some(job) = state.jobs.get(&Slot::Measure) {
             crate::app::widgets::job_ui(ui, job);
         }
     });
     if let Some(why) = &state.measure.failure {
-        ui.label(RichText::new(why).color(BAD));
+        coloured(ui, BAD, why);
     }
 }
 
@@ -240,6 +223,12 @@ fn scan_ui(
                 .on_hover_text("which measurements of the session are measured (as --use)");
         }
     });
+    // A path field with its Browse… button (the note when a dialog chose
+    // nothing is under the scan's fields).
+    let busy = state.jobs.runs(&Slot::Dialog);
+    let mut row = |ui: &mut egui::Ui, label, hint, text: &mut String, purpose| {
+        ui.horizontal(|ui| path_row(ui, label, text, hint, busy, purpose, commands));
+    };
     match form.choice {
         ScanChoice::OpenSession => {
             let what = state.loaded.as_ref().map_or_else(
@@ -253,14 +242,10 @@ fn scan_ui(
             );
             ui.label(RichText::new(what).small().color(MUTED));
         }
-        ScanChoice::SessionFile => path_row(
-            ui,
-            state,
-            ("Session file", "a session .json"),
-            &mut form.session_file,
-            Purpose::MeasureSession,
-            commands,
-        ),
+        ScanChoice::SessionFile => {
+            let (text, purpose) = (&mut form.session_file, Purpose::MeasureSession);
+            row(ui, "Session file", "a session .json", text, purpose);
+        }
         ScanChoice::RawScan => {
             ui.horizontal_wrapped(|ui| {
                 ui.radio_value(&mut form.raw_log, RawLog::Joints, "joint log CSV")
@@ -268,49 +253,29 @@ fn scan_ui(
                 ui.radio_value(&mut form.raw_log, RawLog::Poses, "pose file")
                     .on_hover_text("a table, a JSON list or a robot program (layout detected); only the hand-eye applies to flange poses");
             });
-            path_row(
+            let hint = "joint log CSV or pose file";
+            row(ui, "Pose log", hint, &mut form.log, Purpose::MeasureLog);
+            let hint = "a folder of <id>.csv…, or one CSV with a pose column";
+            row(
                 ui,
-                state,
-                ("Pose log", "joint log CSV or pose file"),
-                &mut form.log,
-                Purpose::MeasureLog,
-                commands,
-            );
-            path_row(
-                ui,
-                state,
-                (
-                    "Profiles",
-                    "a folder of <id>.csv…, or one CSV with a pose column",
-                ),
+                "Profiles",
+                hint,
                 &mut form.profiles,
                 Purpose::MeasureProfiles,
-                commands,
             );
             raw_units_ui(ui, form);
-            path_row(
-                ui,
-                state,
-                (
-                    "References",
-                    "optional: the artefact's distances CSV (from,to,distance mm)",
-                ),
-                &mut form.references,
-                Purpose::MeasureReferences,
-                commands,
-            );
+            let hint = "optional: the artefact's distances CSV (from,to,distance mm)";
+            let (text, purpose) = (&mut form.references, Purpose::MeasureReferences);
+            row(ui, "References", hint, text, purpose);
         }
     }
-    path_row(
+    let hint = "optional: a JSON 4×4 base_from_workpiece (mm); empty: robot base frame";
+    row(
         ui,
-        state,
-        (
-            "Workpiece frame",
-            "optional: a JSON 4×4 base_from_workpiece (mm); empty: robot base frame",
-        ),
+        "Workpiece frame",
+        hint,
         &mut form.frame,
         Purpose::MeasureFrame,
-        commands,
     );
     let purposes = [
         Purpose::MeasureSession,
@@ -355,36 +320,31 @@ fn raw_units_ui(ui: &mut egui::Ui, form: &mut crate::app::measure::MeasureForm) 
 
 /// The counts, the σ figures, the warnings.
 fn summary_ui(ui: &mut egui::Ui, c: &MeasuredCloud) {
+    let (cloud, o) = (c.cloud(), &c.outcome);
+    let (points, dropped) = (cloud.len(), cloud.dropped());
     ui.label(
         RichText::new(format!(
             "{} points kept of {} poses ({} model, {}); dropped {} NaN and {} no-return points",
-            group(c.points),
-            group(c.poses),
-            c.model,
-            c.frame,
-            group(c.dropped.non_finite),
-            group(c.dropped.no_return)
+            group(points),
+            group(cloud.poses.len()),
+            cloud.model,
+            cloud.frame,
+            group(dropped.non_finite),
+            group(dropped.no_return)
         ))
         .strong(),
     );
-    ui.label(
-        RichText::new(format!(
-            "scan {} · result {} · {:.2} s",
-            c.scan, c.result, c.seconds
-        ))
-        .small()
-        .color(MUTED),
-    );
-    let shown = c.drawn.len();
-    let decimation = if shown < c.points {
+    let origin = format!("scan {} · result {} · {:.2} s", o.scan, c.result, c.seconds);
+    ui.label(RichText::new(origin).small().color(MUTED));
+    let decimation = if c.drawn.len() < points {
         format!(
             "showing {} of {} points (spread evenly; at most {} are drawn)",
-            group(shown),
-            group(c.points),
+            group(c.drawn.len()),
+            group(points),
             group(DRAWN_MAX)
         )
     } else {
-        format!("showing all {} points", group(c.points))
+        format!("showing all {} points", group(points))
     };
     ui.horizontal_wrapped(|ui| {
         ui.label(decimation);
@@ -399,40 +359,32 @@ fn summary_ui(ui: &mut egui::Ui, c: &MeasuredCloud) {
                     c.sigma_basis
                 ));
             }
-            (None, Some(why)) => {
-                ui.label(RichText::new(format!("· {why}")).color(WARN));
-            }
+            (None, Some(why)) => drop(coloured(ui, WARN, format!("· {why}"))),
             (None, None) => {}
         }
     });
-    if c.skipped > 0 {
-        ui.label(
-            RichText::new(format!(
-                "{} measurement(s) give a sphere centre, no profile: not in the cloud",
-                c.skipped
-            ))
-            .small(),
-        );
+    if !o.skipped.is_empty() {
+        let n = o.skipped.len();
+        let text = format!("{n} measurement(s) give a sphere centre, no profile: not in the cloud");
+        ui.label(RichText::new(text).small());
     }
-    for note in &c.notes {
+    for note in &o.notes {
         ui.label(RichText::new(note).small());
     }
-    for w in &c.warnings {
-        ui.label(RichText::new(format!("warning: {w}")).color(WARN));
+    for w in &o.measured.warnings {
+        coloured(ui, WARN, format!("warning: {w}"));
     }
-    if !c.out_of_range.is_empty() {
-        ui.collapsing(
-            RichText::new(format!(
-                "warning: {} pose(s) outside the joint range the calibration saw (the model was not checked there)",
-                c.out_of_range_count
-            ))
-            .color(WARN),
-            |ui| {
-                for o in &c.out_of_range {
-                    ui.label(RichText::new(o).small());
-                }
-            },
+    let outside = &o.measured.out_of_range;
+    if !outside.is_empty() {
+        let title = format!(
+            "warning: {} pose(s) outside the joint range the calibration saw (the model was not checked there)",
+            outside.len()
         );
+        ui.collapsing(RichText::new(title).color(WARN), |ui| {
+            for o in measure::listed(outside) {
+                ui.label(RichText::new(o).small());
+            }
+        });
     }
 }
 
@@ -446,9 +398,9 @@ fn scene_ui(ui: &mut egui::Ui, c: &MeasuredCloud, forms: &mut Forms) {
     let caption = format!(
         "3-D: {} of {} points drawn (budget {}, spread evenly), coloured by σ as the bar below; axes of the {} (x red, y green, z blue); the sensor's path in red",
         group(c.drawn.len()),
-        group(c.points),
+        group(c.cloud().len()),
         group(DRAWN_MAX),
-        c.frame
+        c.cloud().frame
     );
     crate::app::scene::ui::scene_ui(
         ui,
@@ -515,17 +467,14 @@ fn paint_points(
     let mut mesh = egui::Mesh::default();
     mesh.reserve_vertices(4 * c.drawn.len());
     mesh.reserve_triangles(2 * c.drawn.len());
-    let colour = |s: f64| match c.sigma_range {
-        Some((lo, hi)) if s.is_finite() => {
-            scale_colour(if hi > lo { (s - lo) / (hi - lo) } else { 0.5 })
-        }
-        _ => AFTER,
-    };
     let size = egui::vec2(POINT_SIZE, POINT_SIZE);
     for p in &c.drawn {
         let at = transform.position_from_point(&PlotPoint::new(p.position[a], p.position[b]));
         if frame.contains(at) {
-            mesh.add_colored_rect(egui::Rect::from_center_size(at, size), colour(p.sigma_mm));
+            mesh.add_colored_rect(
+                egui::Rect::from_center_size(at, size),
+                sigma_colour(c, p.sigma_mm),
+            );
         }
     }
     ui.painter_at(frame).add(egui::Shape::mesh(mesh));
@@ -577,19 +526,16 @@ fn colour_bar_ui(ui: &mut egui::Ui, c: &MeasuredCloud, height: f32) {
     });
 }
 
-/// A figure's rms and largest value, mm.
-type RmsMax = (f64, f64);
-
-/// `rms / max` of a figure in `unit`.
-fn pair(v: (f64, f64), k: f64, unit: &str) -> String {
-    format!("{:.4} / {:.4} {unit}", v.0 * k, v.1 * k)
+/// `rms / max` of a figure, mm.
+fn pair(v: (f64, f64)) -> String {
+    format!("{:.4} / {:.4} mm", v.0, v.1)
 }
 
 /// The self-validation table: the ISO 10360-8-style figures before and
 /// after calibration, with units.
 fn self_check_ui(ui: &mut egui::Ui, c: &MeasuredCloud) {
     ui.label(RichText::new("Self-validation with the cell's own scanner").strong());
-    let Some(v) = &c.check else {
+    let Some(v) = &c.outcome.check else {
         ui.label(
             RichText::new(
                 "no sphere station in the scan (a session's validate stations, or a raw scan with a station column): nothing to check",
@@ -607,61 +553,42 @@ fn self_check_ui(ui: &mut egui::Ui, c: &MeasuredCloud) {
         ))
         .small(),
     );
-    let rows: Vec<(String, RmsMax, RmsMax)> = {
-        let mut rows = vec![
-            (
-                "size error (fitted − calibrated diameter)".to_string(),
-                v.before.size(),
-                v.after.size(),
-            ),
-            (
-                "form error (range of radial residuals)".to_string(),
-                v.before.form(),
-                v.after.form(),
-            ),
-            (
-                "position spread (each pose's centre)".to_string(),
-                v.before.spread(),
-                v.after.spread(),
-            ),
-        ];
-        if let (Some(b), Some(a)) = (v.before.spacing_error(), v.after.spacing_error()) {
-            rows.push((
-                format!(
-                    "spacing error ({} reference distances)",
-                    v.after
-                        .spacings
-                        .iter()
-                        .filter(|s| s.reference.is_some())
-                        .count()
-                ),
-                b,
-                a,
-            ));
-        }
-        rows
-    };
-    egui::Grid::new("measure_selfcheck")
-        .striped(true)
-        .num_columns(4)
-        .show(ui, |ui| {
-            ui.label(RichText::new("figure").strong());
-            ui.label(RichText::new("before (nominal)").strong());
-            ui.label(RichText::new("after (calibrated)").strong());
-            ui.label(RichText::new("").strong());
+    let (b, a) = (&v.before, &v.after);
+    let mut rows = vec![
+        (
+            "size error (fitted − calibrated diameter)".to_string(),
+            b.size(),
+            a.size(),
+        ),
+        (
+            "form error (range of radial residuals)".to_string(),
+            b.form(),
+            a.form(),
+        ),
+        (
+            "position spread (each pose's centre)".to_string(),
+            b.spread(),
+            a.spread(),
+        ),
+    ];
+    if let (Some(before), Some(after)) = (b.spacing_error(), a.spacing_error()) {
+        let n = a.spacings.iter().filter(|s| s.reference.is_some()).count();
+        rows.push((
+            format!("spacing error ({n} reference distances)"),
+            before,
+            after,
+        ));
+    }
+    let headers = ["figure", "before (nominal)", "after (calibrated)", ""];
+    table(ui, "measure_selfcheck", &headers, |ui| {
+        for (name, b, a) in &rows {
+            ui.label(name);
+            ui.label(pair(*b));
+            coloured(ui, if a.0 <= b.0 { GOOD } else { WARN }, pair(*a));
+            ui.label(RichText::new(crate::app::widgets::ratio_text(b.0, a.0)).small());
             ui.end_row();
-            for (name, b, a) in &rows {
-                ui.label(name);
-                ui.label(pair(*b, 1.0, "mm"));
-                ui.label(RichText::new(pair(*a, 1.0, "mm")).color(if a.0 <= b.0 {
-                    GOOD
-                } else {
-                    WARN
-                }));
-                ui.label(RichText::new(crate::app::widgets::ratio_text(b.0, a.0)).small());
-                ui.end_row();
-            }
-        });
+        }
+    });
     distances_ui(ui, &v.before, &v.after);
 }
 
@@ -674,30 +601,19 @@ fn distances_ui(ui: &mut egui::Ui, before: &ModelCheck, after: &ModelCheck) {
     ui.collapsing(
         format!("distances between spheres ({})", after.spacings.len()),
         |ui| {
-            egui::Grid::new("measure_spacings")
-                .striped(true)
-                .num_columns(4)
-                .show(ui, |ui| {
-                    for h in ["spheres", "before", "after", "reference"] {
-                        ui.label(RichText::new(h).strong());
-                    }
+            let headers = ["spheres", "before", "after", "reference"];
+            table(ui, "measure_spacings", &headers, |ui| {
+                let mm =
+                    |v: Option<f64>| v.map_or_else(|| "–".to_string(), |v| format!("{v:.4} mm"));
+                for s in &after.spacings {
+                    let same = |x: &&Spacing| x.from == s.from && x.to == s.to;
+                    ui.label(format!("{}–{}", s.from, s.to));
+                    ui.label(mm(before.spacings.iter().find(same).map(|x| x.measured)));
+                    ui.label(mm(Some(s.measured)));
+                    ui.label(mm(s.reference));
                     ui.end_row();
-                    for s in &after.spacings {
-                        let b = before
-                            .spacings
-                            .iter()
-                            .find(|x| x.from == s.from && x.to == s.to)
-                            .map_or_else(|| "–".to_string(), |x| format!("{:.4} mm", x.measured));
-                        ui.label(format!("{}–{}", s.from, s.to));
-                        ui.label(b);
-                        ui.label(format!("{:.4} mm", s.measured));
-                        ui.label(
-                            s.reference
-                                .map_or_else(|| "–".to_string(), |r| format!("{r:.4} mm")),
-                        );
-                        ui.end_row();
-                    }
-                });
+                }
+            });
         },
     );
 }
@@ -722,20 +638,11 @@ fn export_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
             || "write the cloud on show to the typed file".to_string(),
             |s| format!("refused: {s}; measure again first"),
         );
-        if ui
-            .add_enabled(!busy, egui::Button::new("Write cloud"))
-            .on_hover_text(&why)
-            .clicked()
-        {
-            commands.push(Command::Measure(MeasureCommand::Export));
-        }
-        if ui
-            .add_enabled(!busy, egui::Button::new("Save as…"))
-            .on_hover_text("choose the file (.ply, .e57, .csv) in a dialog, then write it")
-            .clicked()
-        {
-            commands.push(Command::Browse(Purpose::MeasureExport));
-        }
+        let export = Command::Measure(MeasureCommand::Export);
+        command_button(ui, !busy, "Write cloud", &why, export, commands);
+        let hover = "choose the file (.ply, .e57, .csv) in a dialog, then write it";
+        let save_as = Command::Browse(Purpose::MeasureExport);
+        command_button(ui, !busy, "Save as…", hover, save_as, commands);
         ui.label(RichText::new(".ply · .e57 · .csv").small().color(MUTED));
         crate::app::widgets::dialog_note_ui(ui, state, &[Purpose::MeasureExport]);
     });

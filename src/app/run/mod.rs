@@ -1,7 +1,8 @@
 //! The calibration run: the whole engine calibration of the loaded
 //! session without the left-out measurements, on a job thread, reporting
 //! every ε and stopping at the next one after Cancel; the settings of
-//! the next run ([`SolverForm`]) and the solver panel ([`ui`]).
+//! the next run are the engine's [`Options`], which the solver panel
+//! ([`ui`]) edits.
 
 pub mod ui;
 
@@ -9,8 +10,6 @@ use std::collections::BTreeSet;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use crate::engine::base::session::Session;
-use crate::engine::calibrate::solve::paper::{DEFAULT_SVD_TOLERANCE, Pairing, PaperOptions};
 use crate::engine::calibrate::solve::{
     self, Control, Method, Options, Phase, Progress, StopReason,
 };
@@ -24,62 +23,6 @@ use super::ledger::{Artefact, Reading};
 use super::results::{ResultOrigin, ResultView};
 use super::session::{LoadedSession, without};
 use super::state::{Level, Notice};
-
-/// The solver settings as the form edits them.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SolverForm {
-    /// Identification method.
-    pub method: Method,
-    /// Pairing of a station's measurements (paper's method).
-    pub pairing: Pairing,
-    /// Stop when ε ≤ this, mm.
-    pub threshold: f64,
-    /// Most updates.
-    pub max_iterations: usize,
-    /// Relative SVD truncation tolerance (fraction of σ_max).
-    pub svd_tolerance: f64,
-}
-
-impl Default for SolverForm {
-    fn default() -> Self {
-        Self {
-            method: Method::ALL[0],
-            pairing: Pairing::Disjoint,
-            threshold: crate::engine::base::session::DEFAULT_THRESHOLD,
-            max_iterations: crate::engine::base::session::DEFAULT_MAX_ITERATIONS,
-            svd_tolerance: DEFAULT_SVD_TOLERANCE,
-        }
-    }
-}
-
-impl SolverForm {
-    /// The session's settings (threshold and iteration bound from its file).
-    #[must_use]
-    pub fn from_session(session: &Session) -> Self {
-        let o = Options::from_session(session);
-        Self {
-            method: o.method,
-            pairing: o.paper.pairing,
-            threshold: o.threshold,
-            max_iterations: o.max_iterations,
-            svd_tolerance: o.paper.svd_tolerance,
-        }
-    }
-
-    /// The engine options these settings stand for.
-    #[must_use]
-    pub fn options(&self, session: &Session) -> Options {
-        let mut o = Options::from_session(session);
-        o.method = self.method;
-        o.threshold = self.threshold;
-        o.max_iterations = self.max_iterations;
-        o.paper = PaperOptions {
-            pairing: self.pairing,
-            svd_tolerance: self.svd_tolerance,
-        };
-        o
-    }
-}
 
 /// Why a run gave no result.
 #[derive(Debug)]
@@ -212,7 +155,7 @@ impl Core {
             self.state.say(Level::Warning, "open a session first");
             return;
         };
-        let options = self.forms.solver.options(&loaded.session);
+        let options = self.forms.solver;
         let loaded = loaded.clone();
         let excluded = self.state.excluded.clone();
         let stamp = self.state.ledger.stamp(Artefact::Result);
@@ -279,15 +222,18 @@ impl Core {
 /// The solver settings (pairing and SVD tolerance only for the paper's
 /// method, which alone uses them).
 #[must_use]
-pub fn reading(s: &SolverForm) -> Reading {
+pub fn reading(s: &Options) -> Reading {
     let mut fields = vec![
         ("method".into(), s.method.as_str().to_string()),
         ("threshold".into(), format!("{} mm", s.threshold)),
         ("max iterations".into(), s.max_iterations.to_string()),
     ];
     if s.method == Method::Paper {
-        fields.push(("pairs".into(), s.pairing.as_str().to_string()));
-        fields.push(("SVD tolerance".into(), format!("{:e}", s.svd_tolerance)));
+        fields.push(("pairs".into(), s.paper.pairing.as_str().to_string()));
+        fields.push((
+            "SVD tolerance".into(),
+            format!("{:e}", s.paper.svd_tolerance),
+        ));
     }
     Reading::new(fields, ())
 }

@@ -114,10 +114,10 @@ fn settings_ui(ui: &mut egui::Ui, forms: &mut Forms) {
         ui.label("Pairs");
         ui.add_enabled_ui(paper, |ui| {
                 egui::ComboBox::from_id_salt("pairing")
-                    .selected_text(s.pairing.as_str())
+                    .selected_text(s.paper.pairing.as_str())
                     .show_ui(ui, |ui| {
                         for p in [Pairing::Disjoint, Pairing::All] {
-                            ui.selectable_value(&mut s.pairing, p, p.as_str());
+                            ui.selectable_value(&mut s.paper.pairing, p, p.as_str());
                         }
                     })
                     .response
@@ -135,7 +135,7 @@ fn settings_ui(ui: &mut egui::Ui, forms: &mut Forms) {
         let l = ui.label("SVD tolerance");
         ui.add_enabled(
             paper,
-            egui::DragValue::new(&mut s.svd_tolerance)
+            egui::DragValue::new(&mut s.paper.svd_tolerance)
                 .range(1e-12..=0.5)
                 .speed(1e-5)
                 .custom_formatter(|v, _| format!("{v:.1e}"))

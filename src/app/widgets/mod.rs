@@ -521,24 +521,16 @@ pub fn confirm_ui(ctx: &egui::Context, state: &AppState, commands: &mut Vec<Comm
         ui.label(RichText::new(format!("Replace {}?", c.path.display())).strong());
         ui.add(egui::Label::new(RichText::new(&c.why).color(WARN)).wrap());
         ui.horizontal(|ui| {
-            let replace = "write the new file over it";
-            command_button(
-                ui,
-                true,
-                "Replace",
-                replace,
-                Command::Confirm(true),
-                commands,
-            );
-            let keep = "write nothing: the file stays as it is";
-            command_button(
-                ui,
-                true,
-                "Keep the file",
-                keep,
-                Command::Confirm(false),
-                commands,
-            );
+            for (text, hover, replace) in [
+                ("Replace", "write the new file over it", true),
+                (
+                    "Keep the file",
+                    "write nothing: the file stays as it is",
+                    false,
+                ),
+            ] {
+                command_button(ui, true, text, hover, Command::Confirm(replace), commands);
+            }
         });
     });
 }

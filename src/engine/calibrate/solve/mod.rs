@@ -134,6 +134,20 @@ pub struct Options {
     pub held_out: bool,
 }
 
+impl Default for Options {
+    /// The defaults of a session file that says nothing of its solver.
+    fn default() -> Self {
+        Self {
+            method: Method::Ml,
+            threshold: crate::engine::base::session::DEFAULT_THRESHOLD,
+            max_iterations: crate::engine::base::session::DEFAULT_MAX_ITERATIONS,
+            paper: PaperOptions::default(),
+            ml: ml::MlOptions::default(),
+            held_out: true,
+        }
+    }
+}
+
 impl Options {
     /// Defaults, with threshold and iteration bound from the session file.
     /// The method is `ml`: over five simulated scenarios it comes nearer the

@@ -120,6 +120,27 @@ pub struct MeasureOptions {
     pub covariance_as_written: bool,
 }
 
+impl MeasureOptions {
+    /// What σ rests on, in words: "covariance × variance factor 1.031"
+    /// (or "as written"), and the sensor noise when it is added.
+    #[must_use]
+    pub fn sigma_basis(&self, result: &ResultFile) -> String {
+        let mut basis = if self.covariance_as_written {
+            "covariance as written".to_string()
+        } else {
+            format!(
+                "covariance × variance factor {:.3}",
+                variance_factor(result)
+            )
+        };
+        if self.sensor_noise_mm > 0.0 {
+            let noise = crate::engine::base::numeric::show(self.sensor_noise_mm);
+            basis.push_str(&format!(", sensor noise {noise} mm"));
+        }
+        basis
+    }
+}
+
 /// What a measurement is doing, for a progress display.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stage {
@@ -147,8 +168,9 @@ pub struct MeasureProgress {
 /// A measured cloud and what was noticed on the way.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measured {
-    /// The cloud.
-    pub cloud: Cloud,
+    /// The cloud (shared: the workbench keeps it on show while an export
+    /// job writes it).
+    pub cloud: std::sync::Arc<Cloud>,
     /// Warnings (e.g. only the hand-eye applies to flange poses).
     pub warnings: Vec<String>,
     /// Scan poses outside the joint range the calibration saw.
@@ -293,7 +315,7 @@ pub fn measure(
         .map(|((pose, t), form)| CloudPose::new(pose, workpiece_from_base * t, form))
         .collect();
     Ok(Measured {
-        cloud: Cloud {
+        cloud: std::sync::Arc::new(Cloud {
             poses,
             frame: options
                 .frame
@@ -302,7 +324,7 @@ pub fn measure(
                     FrameLabel::Workpiece(label.clone())
                 }),
             model: options.model.as_str(),
-        },
+        }),
         warnings,
         out_of_range,
     })
