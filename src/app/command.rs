@@ -34,6 +34,26 @@ pub enum Command {
     Compensate(CompensateCommand),
     /// The Measure view.
     Measure(MeasureCommand),
+    /// The Re-check view.
+    Check(CheckCommand),
+    /// A file for the controller or the planner from the result on show
+    /// (tool data, the robot's URDF back, UR's calibration).
+    UseExport(crate::app::results::export::UseExport),
+}
+
+/// The Re-check view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CheckCommand {
+    /// Plan the check poses for the result on show (`plan --check`).
+    Plan,
+    /// Stop the job in flight (planning or checking).
+    Cancel,
+    /// Write the check's plan into the export folder.
+    Export(PlanExport),
+    /// Test the check session against the result on show.
+    Run,
+    /// Write the check's record (`X.check.json` beside the session).
+    Record,
 }
 
 /// Opening and saving files.
@@ -286,6 +306,8 @@ pub enum Tab {
     Compensate,
     /// Scans measured with the calibrated cell: the point cloud.
     Measure,
+    /// The five-minute re-check of a calibrated cell.
+    Check,
 }
 
 impl Tab {
@@ -293,7 +315,7 @@ impl Tab {
     /// in, check the stripes and centres, calibrate and validate, measure
     /// with the calibrated cell, compensate the robot's targets, follow the
     /// cell over time.
-    pub const ALL: [Self; 9] = [
+    pub const ALL: [Self; 10] = [
         Self::Plan,
         Self::Import,
         Self::Session,
@@ -302,6 +324,7 @@ impl Tab {
         Self::Results,
         Self::Measure,
         Self::Compensate,
+        Self::Check,
         Self::History,
     ];
 
@@ -318,6 +341,7 @@ impl Tab {
             Self::Plan => "Plan",
             Self::Compensate => "Compensate",
             Self::Measure => "Measure",
+            Self::Check => "Re-check",
         }
     }
 }

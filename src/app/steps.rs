@@ -237,7 +237,21 @@ pub fn steps(state: &AppState, forms: &Forms, stripes_seen: bool) -> Vec<Step> {
         report,
         measure_step(state),
         compensate_step(state),
+        check_step(state),
     ]
+}
+
+/// The re-check (optional, after Compensate): its verdict's standing in
+/// the ledger.
+fn check_step(state: &AppState) -> Step {
+    let todo = (
+        "re-check the cell with a short scan (optional)",
+        "check again",
+    );
+    let action = ("Re-check the cell".to_string(), show(Tab::Check));
+    let mut c = step(state, Artefact::Check, "Re-checked", todo, action);
+    c.optional = true;
+    c
 }
 
 /// The Compensate step (optional): the compensated targets' standing in
