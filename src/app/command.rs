@@ -38,7 +38,7 @@ pub enum Command {
     Check(CheckCommand),
     /// A file for the controller or the planner from the result on show
     /// (tool data, the robot's URDF back, UR's calibration).
-    UseExport(crate::app::results::export::UseExport),
+    UseExport(UseExport),
 }
 
 /// The Re-check view.
@@ -281,6 +281,41 @@ impl ExportKind {
             Self::ReportHtml => "report.html",
         };
         format!("{stem}-{suffix}")
+    }
+}
+
+/// A file of the result on show for the controller or the planner
+/// (`spherecal export-model --format tool|urdf --robot|ur-calibration`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum UseExport {
+    /// The calibrated hand-eye as a controller's tool data (or ROS 2's).
+    Tool(crate::engine::tools::report::tool_data::ToolTarget),
+    /// The URDF the robot came from, with the calibrated joint origins
+    /// and a `sensor` link.
+    UrdfBack,
+    /// Universal Robots' calibration YAML.
+    UrCalibration,
+}
+
+impl UseExport {
+    /// The button text.
+    #[must_use]
+    pub fn label(self) -> String {
+        match self {
+            Self::Tool(t) => format!("Tool data {}", t.key().to_uppercase()),
+            Self::UrdfBack => "URDF back".to_string(),
+            Self::UrCalibration => "UR calibration".to_string(),
+        }
+    }
+
+    /// The file name for a session stem.
+    #[must_use]
+    pub fn file_name(self, stem: &str) -> String {
+        match self {
+            Self::Tool(t) => format!("{stem}-tool-{}.txt", t.key()),
+            Self::UrdfBack => format!("{stem}-calibrated.urdf"),
+            Self::UrCalibration => format!("{stem}-ur_calibration.yaml"),
+        }
     }
 }
 

@@ -522,7 +522,7 @@ pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &m
             } else {
                 format!("{} {}. {}", step.state.mark(), k + 1, step.name)
             };
-            let text = RichText::new(name).size(14.0).color(colour(step));
+            let text = RichText::new(name).size(13.0).color(colour(step));
             // A step is a link to its view (or does its action).
             let busy = state.jobs.runs(&Slot::Run) && matches!(step.action.1, Command::Run(_));
             let hover = match &step.state {

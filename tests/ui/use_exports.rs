@@ -16,8 +16,9 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
 use nalgebra::Isometry3;
 use spherecal::app::WorkbenchApp;
+use spherecal::app::command::UseExport;
 use spherecal::app::command::{Command, CompensateCommand, Tab, ViewCommand};
-use spherecal::app::results::export::UseExport;
+use spherecal::app::results::export::unavailable;
 use spherecal::engine::base::robot::controller::FlangeConvention;
 use spherecal::engine::base::robot::{Robot, robot_from_urdf, ur5e};
 use spherecal::engine::calibrate::solve::Control;
@@ -67,6 +68,9 @@ fn export(h: &mut Harness<'_, WorkbenchApp>, kind: UseExport, dir: &Path) -> Pat
     path
 }
 
+/// A reader of one syntax.
+type Reader = fn(&str) -> Isometry3<f64>;
+
 #[test]
 fn tool_data_of_joint_and_pose_only_results_reads_back_for_every_controller() {
     let dir = tempfile::tempdir().unwrap();
@@ -78,7 +82,7 @@ fn tool_data_of_joint_and_pose_only_results_reads_back_for_every_controller() {
         open_path(&mut h, path);
         let out = dir.path().join(k.to_string());
         std::fs::create_dir(&out).unwrap();
-        let readers: [(ToolTarget, fn(&str) -> Isometry3<f64>); 5] = [
+        let readers: [(ToolTarget, Reader); 5] = [
             (ToolTarget::ALL[0], read_rapid_tooldata),
             (ToolTarget::ALL[1], read_krl_tool),
             (ToolTarget::ALL[2], read_fanuc_utool),
@@ -158,11 +162,10 @@ fn the_urdf_back_and_ur_calibration_are_the_engines_and_parse_back() {
     let button = h.get_by_label("URDF back");
     assert!(button.accesskit_node().is_disabled());
     let view = h.state().state().result.clone().unwrap();
-    let why = UseExport::UrdfBack.unavailable(&view, "").unwrap();
+    let why = unavailable(UseExport::UrdfBack, &view, "").unwrap();
     assert!(why.contains("URDF"), "{why}");
     assert!(
-        UseExport::UrCalibration
-            .unavailable(&view, "")
+        unavailable(UseExport::UrCalibration, &view, "")
             .is_some_and(|w| w.contains("not a Universal Robots arm")),
         "an IRB 2400 has no UR calibration"
     );

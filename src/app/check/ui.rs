@@ -13,7 +13,7 @@ use crate::app::job::Slot;
 use crate::app::ledger::Artefact;
 use crate::app::widgets::{
     BAD, GOOD, MUTED, WARN, boxed, coloured, command_button, dialog_note_ui, export_folder_ui,
-    form_grid, job_ui, labelled_drag, path_row, stale_banner_ui, weak, written_ui,
+    job_ui, labelled_drag, labelled_field, stale_banner_ui, weak, written_ui,
 };
 use crate::app::{AppState, Forms};
 
@@ -147,18 +147,21 @@ fn planned_ui(
 fn run_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mut Vec<Command>) {
     ui.label(RichText::new("2. Check the scan of those poses").strong());
     let busy = state.jobs.runs(&Slot::Dialog);
-    form_grid(ui, "check_inputs", 3, |ui| {
+    let form = &mut forms.check;
+    ui.horizontal(|ui| {
         let hint = "the check's scan imported as a session (.json)";
-        let form = &mut forms.check;
-        path_row(
+        labelled_field(ui, "Check session", &mut form.session, hint, 420.0);
+        let browse = Command::Browse(Purpose::CheckSession);
+        command_button(
             ui,
-            "Check session",
-            &mut form.session,
-            hint,
-            busy,
-            Purpose::CheckSession,
+            !busy,
+            "Browse…",
+            "choose the check's session",
+            browse,
             commands,
         );
+    });
+    ui.horizontal(|ui| {
         let drag = egui::DragValue::new(&mut form.alpha)
             .range(1e-5..=0.2)
             .speed(0.0001)
@@ -166,7 +169,6 @@ fn run_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mut
         labelled_drag(ui, "False-alarm rate α", drag).on_hover_text(
             "the share of checks of an unchanged cell that fail (0.001: one in a thousand)",
         );
-        ui.end_row();
     });
     dialog_note_ui(ui, state, &[Purpose::CheckSession]);
     if !running_ui(ui, state, &Slot::Check, commands) {

@@ -25,6 +25,7 @@ use crate::engine::tools::result_view::{self, Tolerance};
 
 use crate::app::command::Command;
 use crate::app::command::ExportKind;
+use crate::app::command::UseExport;
 use crate::app::error::JobError;
 use crate::app::ledger::Artefact;
 use crate::app::results::{ResultOrigin, ResultView};
@@ -282,61 +283,26 @@ impl Core {
     }
 }
 
-/// A file of the result on show for the controller or the planner
-/// (`spherecal export-model --format tool|urdf --robot|ur-calibration`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum UseExport {
-    /// The calibrated hand-eye as a controller's tool data (or ROS 2's).
-    Tool(ToolTarget),
-    /// The URDF the robot came from, with the calibrated joint origins
-    /// and a `sensor` link.
-    UrdfBack,
-    /// Universal Robots' calibration YAML.
-    UrCalibration,
-}
-
-impl UseExport {
-    /// The button text.
-    #[must_use]
-    pub fn label(self) -> String {
-        match self {
-            Self::Tool(t) => format!("Tool data {}", t.key().to_uppercase()),
-            Self::UrdfBack => "URDF back".to_string(),
-            Self::UrCalibration => "UR calibration".to_string(),
+/// Why `kind` cannot be written of `view` (`urdf`: the source URDF's
+/// path field), or `None`.
+#[must_use]
+pub fn unavailable(kind: UseExport, view: &ResultView, urdf: &str) -> Option<String> {
+    let robot = view.file.robot.as_ref();
+    match kind {
+        UseExport::Tool(_) => None,
+        UseExport::UrdfBack if robot.is_none() => {
+            Some("the result has no robot to write back".to_string())
         }
-    }
-
-    /// The file name for a session stem.
-    #[must_use]
-    pub fn file_name(self, stem: &str) -> String {
-        match self {
-            Self::Tool(t) => format!("{stem}-tool-{}.txt", t.key()),
-            Self::UrdfBack => format!("{stem}-calibrated.urdf"),
-            Self::UrCalibration => format!("{stem}-ur_calibration.yaml"),
-        }
-    }
-
-    /// Why it cannot be written of `view` (`urdf`: the source URDF's
-    /// path field), or `None`.
-    #[must_use]
-    pub fn unavailable(self, view: &ResultView, urdf: &str) -> Option<String> {
-        let robot = view.file.robot.as_ref();
-        match self {
-            Self::Tool(_) => None,
-            Self::UrdfBack if robot.is_none() => {
-                Some("the result has no robot to write back".to_string())
-            }
-            Self::UrdfBack if urdf.trim().is_empty() => Some(
-                "type the path of the URDF the session's robot came from (its joint origins are calibrated, every other byte kept)"
-                    .to_string(),
-            ),
-            Self::UrCalibration => match robot {
-                Some(r) if ur_calibration::is_ur(r) => None,
-                Some(r) => Some(format!("{} is not a Universal Robots arm", r.name)),
-                None => Some("the result has no robot".to_string()),
-            },
-            Self::UrdfBack => None,
-        }
+        UseExport::UrdfBack if urdf.trim().is_empty() => Some(
+            "type the path of the URDF the session's robot came from (its joint origins are calibrated, every other byte kept)"
+                .to_string(),
+        ),
+        UseExport::UrCalibration => match robot {
+            Some(r) if ur_calibration::is_ur(r) => None,
+            Some(r) => Some(format!("{} is not a Universal Robots arm", r.name)),
+            None => Some("the result has no robot".to_string()),
+        },
+        UseExport::UrdfBack => None,
     }
 }
 
@@ -384,7 +350,7 @@ pub fn use_exports_ui(
         ui.label("For the controller:");
         let kinds = ToolTarget::ALL.map(UseExport::Tool);
         for kind in kinds.into_iter().chain([UseExport::UrCalibration]) {
-            let why = kind.unavailable(view, &forms.urdf_source);
+            let why = unavailable(kind, view, &forms.urdf_source);
             let hover = match (&why, stale) {
                 (_, true) => "refused: the result is stale; run again, then export",
                 (Some(w), _) => w.as_str(),
@@ -401,7 +367,7 @@ pub fn use_exports_ui(
             let browse = Command::Browse(crate::app::dialog::Purpose::UrdfSource);
             command_button(ui, true, "Browse…", "choose the URDF", browse, commands);
             let kind = UseExport::UrdfBack;
-            let why = kind.unavailable(view, &forms.urdf_source);
+            let why = unavailable(kind, view, &forms.urdf_source);
             let hover = why.as_deref().unwrap_or(
                 "that file with only the calibrated joint origins changed and a sensor link added",
             );
@@ -430,7 +396,7 @@ impl Core {
             return;
         };
         let title = format!("{} not written", kind.label());
-        if let Some(why) = kind.unavailable(view, &self.forms.urdf_source) {
+        if let Some(why) = unavailable(kind, view, &self.forms.urdf_source) {
             self.refuse(&title, &title, why);
             return;
         }
