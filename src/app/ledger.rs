@@ -219,8 +219,8 @@ impl Artefact {
             Self::ImportView => &[Input::ImportForm],
             Self::PoseScan => &[Input::PoseFile],
             Self::Drift => &[Input::Library, Input::HistoryChoice],
-            Self::CheckPlan => &[Input::PlanForm, Input::CheckForm],
-            Self::Check => &[Input::CheckSession],
+            Self::CheckPlan => &[Input::Calibration, Input::PlanForm, Input::CheckForm],
+            Self::Check => &[Input::Calibration, Input::CheckSession],
         }
     }
 

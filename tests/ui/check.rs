@@ -4,8 +4,8 @@
 //! on the true cell by the simulator, unchanged and with the sensor
 //! knocked 0.5 mm, imported as sessions and checked in the view. The
 //! unchanged cell HOLDS and its record parses back; the knocked one
-//! FAILS naming the hand-eye; once the result changes (a measurement
-//! left out) the verdict is STALE and its record is refused.
+//! FAILS naming the hand-eye; once the result changes (a new run, a
+//! measurement left out) the verdict is STALE and its record is refused.
 //! egui_kittest, no display.
 
 #![cfg(feature = "gui")]
@@ -181,25 +181,12 @@ fn the_check_view_holds_on_an_unchanged_cell_flags_a_knock_and_goes_stale() {
         v.lines
     );
 
-    // 4. The result changes (a measurement left out): the verdict and the
-    // check's plan are STALE, the record and the plan's files refused.
-    let id = h
-        .state()
-        .state()
-        .loaded
-        .as_ref()
-        .unwrap()
-        .session
-        .measurements[0]
-        .id
-        .clone();
-    command(
-        &mut h,
-        Command::View(ViewCommand::SetIncluded {
-            id,
-            included: false,
-        }),
-    );
+    // 4. The result changes (a new run of the same session): the verdict
+    // and the check's plan are STALE, the record and the plan's files
+    // refused.
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    assert!(h.state().state().ledger.stale(Artefact::Result).is_none());
     command(&mut h, Command::View(ViewCommand::ShowTab(Tab::Check)));
     assert!(h.state().state().ledger.stale(Artefact::Check).is_some());
     assert!(
@@ -224,10 +211,31 @@ fn the_check_view_holds_on_an_unchanged_cell_flags_a_knock_and_goes_stale() {
         Command::Check(CheckCommand::Export(PlanExport::Csv)),
     );
     assert!(!csv.exists(), "a stale check plan is not written");
-    // Checking again against the current result (Check is refused while
-    // the result itself is stale: run first).
-    h.get_by_label("▶ Run").click();
-    settle(&mut h);
+    // Checked again: current.
     command(&mut h, Command::Check(CheckCommand::Run));
     assert!(h.state().state().ledger.stale(Artefact::Check).is_none());
+    // A measurement left out: the result and the verdict are stale, and
+    // no check is made against a stale result.
+    let id = h
+        .state()
+        .state()
+        .loaded
+        .as_ref()
+        .unwrap()
+        .session
+        .measurements[0]
+        .id
+        .clone();
+    command(
+        &mut h,
+        Command::View(ViewCommand::SetIncluded {
+            id,
+            included: false,
+        }),
+    );
+    assert!(h.state().state().ledger.stale(Artefact::Check).is_some());
+    command(&mut h, Command::Check(CheckCommand::Run));
+    assert!(h.state().state().ledger.stale(Artefact::Check).is_some());
+    let notice = h.state().state().notice.clone().expect("a refusal");
+    assert_eq!(notice.title, "Not checked");
 }

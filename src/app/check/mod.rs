@@ -114,7 +114,8 @@ impl Core {
         }
     }
 
-    /// The result on show when it is current; `None` (said why) else.
+    /// The result on show when it is current; `None` (said why, under
+    /// the title `what`) else.
     fn result_to_check(&mut self, what: &str) -> Option<ResultFile> {
         let Some(view) = &self.state.result else {
             self.state.say(
@@ -127,8 +128,7 @@ impl Core {
         match self.state.ledger.check(Artefact::Result) {
             Ok(_) => Some(file),
             Err(why) => {
-                let title = format!("{what} refused");
-                self.refuse(&title, &title, format!("{why}: run the calibration again"));
+                self.refuse(what, what, format!("{why}: run the calibration again"));
                 None
             }
         }
@@ -138,7 +138,7 @@ impl Core {
         if self.state.jobs.runs(&Slot::CheckPlan) {
             return;
         }
-        let Some(result) = self.result_to_check("check not planned") else {
+        let Some(result) = self.result_to_check("Check not planned") else {
             return;
         };
         let mut config = match self.forms.plan.config(None) {
@@ -222,7 +222,7 @@ impl Core {
         if self.state.jobs.runs(&Slot::Check) {
             return;
         }
-        let Some(result) = self.result_to_check("not checked") else {
+        let Some(result) = self.result_to_check("Not checked") else {
             return;
         };
         let path = PathBuf::from(self.forms.check.session.trim());
