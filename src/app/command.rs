@@ -34,6 +34,26 @@ pub enum Command {
     Compensate(CompensateCommand),
     /// The Measure view.
     Measure(MeasureCommand),
+    /// The Re-check view.
+    Check(CheckCommand),
+    /// A file for the controller or the planner from the result on show
+    /// (tool data, the robot's URDF back, UR's calibration).
+    UseExport(UseExport),
+}
+
+/// The Re-check view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CheckCommand {
+    /// Plan the check poses for the result on show (`plan --check`).
+    Plan,
+    /// Stop the job in flight (planning or checking).
+    Cancel,
+    /// Write the check's plan into the export folder.
+    Export(PlanExport),
+    /// Test the check session against the result on show.
+    Run,
+    /// Write the check's record (`X.check.json` beside the session).
+    Record,
 }
 
 /// Opening and saving files.
@@ -264,6 +284,41 @@ impl ExportKind {
     }
 }
 
+/// A file of the result on show for the controller or the planner
+/// (`spherecal export-model --format tool|urdf --robot|ur-calibration`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum UseExport {
+    /// The calibrated hand-eye as a controller's tool data (or ROS 2's).
+    Tool(crate::engine::tools::report::tool_data::ToolTarget),
+    /// The URDF the robot came from, with the calibrated joint origins
+    /// and a `sensor` link.
+    UrdfBack,
+    /// Universal Robots' calibration YAML.
+    UrCalibration,
+}
+
+impl UseExport {
+    /// The button text.
+    #[must_use]
+    pub fn label(self) -> String {
+        match self {
+            Self::Tool(t) => format!("Tool data {}", t.key().to_uppercase()),
+            Self::UrdfBack => "URDF back".to_string(),
+            Self::UrCalibration => "UR calibration".to_string(),
+        }
+    }
+
+    /// The file name for a session stem.
+    #[must_use]
+    pub fn file_name(self, stem: &str) -> String {
+        match self {
+            Self::Tool(t) => format!("{stem}-tool-{}.txt", t.key()),
+            Self::UrdfBack => format!("{stem}-calibrated.urdf"),
+            Self::UrCalibration => format!("{stem}-ur_calibration.yaml"),
+        }
+    }
+}
+
 /// The central views.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Tab {
@@ -286,6 +341,8 @@ pub enum Tab {
     Compensate,
     /// Scans measured with the calibrated cell: the point cloud.
     Measure,
+    /// The five-minute re-check of a calibrated cell.
+    Check,
 }
 
 impl Tab {
@@ -293,7 +350,7 @@ impl Tab {
     /// in, check the stripes and centres, calibrate and validate, measure
     /// with the calibrated cell, compensate the robot's targets, follow the
     /// cell over time.
-    pub const ALL: [Self; 9] = [
+    pub const ALL: [Self; 10] = [
         Self::Plan,
         Self::Import,
         Self::Session,
@@ -302,6 +359,7 @@ impl Tab {
         Self::Results,
         Self::Measure,
         Self::Compensate,
+        Self::Check,
         Self::History,
     ];
 
@@ -318,6 +376,7 @@ impl Tab {
             Self::Plan => "Plan",
             Self::Compensate => "Compensate",
             Self::Measure => "Measure",
+            Self::Check => "Re-check",
         }
     }
 }

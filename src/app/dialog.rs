@@ -57,6 +57,12 @@ pub enum Purpose {
     MeasureReferences,
     /// Measure: where the cloud goes (writes once chosen).
     MeasureExport,
+    /// Re-check: the check's session.
+    CheckSession,
+    /// Compensate: the tool the controller holds now (pose-only result).
+    CompensateCurrentTool,
+    /// Results: the URDF the robot came from.
+    UrdfSource,
 }
 
 /// Pose logs and programs a dialog offers.
@@ -94,7 +100,14 @@ impl Purpose {
                 ("all files", &["*"]),
             ],
             Self::CompensateTool => &[("tool (JSON)", &["json"])],
-            Self::MeasureSession | Self::MeasureFrame => &[("JSON", &["json"])],
+            Self::MeasureSession | Self::MeasureFrame | Self::CheckSession => {
+                &[("JSON", &["json"])]
+            }
+            Self::CompensateCurrentTool => &[
+                ("tool (JSON or values)", &["json", "txt"]),
+                ("any file", &["*"]),
+            ],
+            Self::UrdfSource => &[("URDF", &["urdf", "xml"])],
             Self::MeasureExport => &[("PLY", &["ply"]), ("E57", &["e57"]), ("CSV", &["csv"])],
             Self::ExportFolder
             | Self::HistoryFolder

@@ -51,6 +51,10 @@ pub enum Slot {
     Measure,
     /// A native file dialog.
     Dialog,
+    /// The check poses planned for the result on show.
+    CheckPlan,
+    /// A check session tested against the result on show.
+    Check,
     /// A file written (one write a file at a time).
     Write(PathBuf),
 }
@@ -66,6 +70,8 @@ impl Slot {
             Artefact::Cloud => Some(Self::Measure),
             Artefact::PoseScan => Some(Self::PoseScan),
             Artefact::Drift => Some(Self::Drift),
+            Artefact::CheckPlan => Some(Self::CheckPlan),
+            Artefact::Check => Some(Self::Check),
             Artefact::ImportView => Some(Self::ImportPreview),
             Artefact::Report | Artefact::EditedSession => None,
         }

@@ -61,6 +61,10 @@ pub enum Input {
     Library,
     /// The History view's choice: the robot, the ticked results, `k`.
     HistoryChoice,
+    /// The Re-check view's sphere position (its plan of check poses).
+    CheckForm,
+    /// The Re-check view's check session (its path, size and time) and α.
+    CheckSession,
 }
 
 impl Input {
@@ -80,6 +84,8 @@ impl Input {
             Self::PoseFile => "the pose file",
             Self::Library => "the library",
             Self::HistoryChoice => "the robot or the ticked results",
+            Self::CheckForm => "the check's sphere position",
+            Self::CheckSession => "the check session",
         }
     }
 }
@@ -167,11 +173,15 @@ pub enum Artefact {
     PoseScan,
     /// The drift of the chosen robot over the ticked results.
     Drift,
+    /// The check poses planned for the result on show (and their program).
+    CheckPlan,
+    /// The re-check's verdict on the result on show (and its record).
+    Check,
 }
 
 impl Artefact {
     /// Every artefact.
-    pub const ALL: [Self; 9] = [
+    pub const ALL: [Self; 11] = [
         Self::Plan,
         Self::Result,
         Self::Report,
@@ -181,13 +191,17 @@ impl Artefact {
         Self::ImportView,
         Self::PoseScan,
         Self::Drift,
+        Self::CheckPlan,
+        Self::Check,
     ];
 
     /// The artefact it is made from, whose stamp it starts from.
     #[must_use]
     pub fn upstream(self) -> Option<Self> {
         match self {
-            Self::Report | Self::Compensation | Self::Cloud => Some(Self::Result),
+            Self::Report | Self::Compensation | Self::Cloud | Self::CheckPlan | Self::Check => {
+                Some(Self::Result)
+            }
             _ => None,
         }
     }
@@ -205,6 +219,8 @@ impl Artefact {
             Self::ImportView => &[Input::ImportForm],
             Self::PoseScan => &[Input::PoseFile],
             Self::Drift => &[Input::Library, Input::HistoryChoice],
+            Self::CheckPlan => &[Input::Calibration, Input::PlanForm, Input::CheckForm],
+            Self::Check => &[Input::Calibration, Input::CheckSession],
         }
     }
 
@@ -231,6 +247,8 @@ impl Artefact {
             Self::ImportView => "the import preview",
             Self::PoseScan => "the pose file's preview",
             Self::Drift => "the drift",
+            Self::CheckPlan => "the check's plan",
+            Self::Check => "the check's verdict",
         }
     }
 }

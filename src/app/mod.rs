@@ -33,6 +33,7 @@
 //! Measure, Compensate and History views in the middle, a status bar at
 //! the bottom.
 
+pub mod check;
 pub mod command;
 pub mod compensate;
 pub mod dialog;
@@ -158,6 +159,8 @@ pub struct AppState {
     pub compensate: compensate::CompensateState,
     /// The Measure view: its job, the cloud on show, its exports.
     pub measure: measure::MeasureView,
+    /// The Re-check view: the check's plan and verdict.
+    pub check: check::CheckState,
 }
 
 impl AppState {
@@ -295,6 +298,10 @@ pub struct Forms {
     pub measure: measure::MeasureForm,
     /// How the 3-D scenes are looked at, one camera a view.
     pub scene: scene::SceneCameras,
+    /// The Re-check view's fields.
+    pub check: check::CheckForm,
+    /// The URDF the robot came from, for "URDF back" (Results' exports).
+    pub urdf_source: String,
 }
 
 /// The state (with the job table) and the forms, with every feature's
@@ -395,6 +402,8 @@ impl Core {
             (Input::Calibration, results::calibration(state)),
             (Input::Targets, compensate::reading(&forms.compensate)),
             (Input::MeasureForm, measure::reading(&forms.measure)),
+            (Input::CheckForm, check::form_reading(forms)),
+            (Input::CheckSession, check::session_reading(&forms.check)),
         ];
         out.extend(import::readings(forms));
         out.extend(history::readings(state, forms));
@@ -435,6 +444,8 @@ impl Core {
             Command::Plan(c) => self.plan(ctx, c),
             Command::Compensate(c) => self.compensate(ctx, c),
             Command::Measure(c) => self.measure(ctx, c),
+            Command::Check(c) => self.check(ctx, c),
+            Command::UseExport(kind) => self.use_export(ctx, kind),
         }
     }
 
@@ -478,6 +489,8 @@ impl Core {
                 Slot::Drift => take(a).map(|o| self.on_drift(&job, o)),
                 Slot::Compensate => take(a).map(|o| self.on_compensated(&job, o)),
                 Slot::Measure => take(a).map(|o| self.on_measured(&job, o)),
+                Slot::CheckPlan => take(a).map(|o| self.on_check_planned(&job, o)),
+                Slot::Check => take(a).map(|o| self.on_checked(&job, o)),
                 Slot::Dialog => take(a).map(|(p, path)| self.on_dialog(ctx, p, path)),
                 Slot::Write(path) => take(a).map(|w| self.on_written(path, &job, w)),
             };
@@ -593,6 +606,9 @@ impl Core {
             Purpose::MeasureProfiles => f.measure.profiles = text,
             Purpose::MeasureFrame => f.measure.frame = text,
             Purpose::MeasureReferences => f.measure.references = text,
+            Purpose::CheckSession => f.check.session = text,
+            Purpose::CompensateCurrentTool => f.compensate.current_tool = text,
+            Purpose::UrdfSource => f.urdf_source = text,
             Purpose::MeasureExport => {
                 f.measure.out = text;
                 self.state.ledger.allow(path);

@@ -237,7 +237,21 @@ pub fn steps(state: &AppState, forms: &Forms, stripes_seen: bool) -> Vec<Step> {
         report,
         measure_step(state),
         compensate_step(state),
+        check_step(state),
     ]
+}
+
+/// The re-check (optional, after Compensate): its verdict's standing in
+/// the ledger.
+fn check_step(state: &AppState) -> Step {
+    let todo = (
+        "re-check the cell with a short scan (optional)",
+        "check again",
+    );
+    let action = ("Re-check the cell".to_string(), show(Tab::Check));
+    let mut c = step(state, Artefact::Check, "Re-checked", todo, action);
+    c.optional = true;
+    c
 }
 
 /// The Compensate step (optional): the compensated targets' standing in
@@ -508,7 +522,7 @@ pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &m
             } else {
                 format!("{} {}. {}", step.state.mark(), k + 1, step.name)
             };
-            let text = RichText::new(name).size(14.0).color(colour(step));
+            let text = RichText::new(name).size(13.0).color(colour(step));
             // A step is a link to its view (or does its action).
             let busy = state.jobs.runs(&Slot::Run) && matches!(step.action.1, Command::Run(_));
             let hover = match &step.state {

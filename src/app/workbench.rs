@@ -13,7 +13,7 @@ use super::Forms;
 use super::command::Tab;
 use super::command::{Command, FilesCommand, ViewCommand};
 use super::state::Prefs;
-use super::{compensate, history, import, steps};
+use super::{check, compensate, history, import, steps};
 use super::{measure, plan, results, run, session, widgets};
 
 /// Key of the preferences in eframe's storage (JSON text).
@@ -209,6 +209,7 @@ impl WorkbenchApp {
                     compensate::ui::compensate_ui(ui, state, forms, &mut commands);
                 }
                 Tab::Measure => measure::ui::measure_ui(ui, state, forms, &mut commands),
+                Tab::Check => check::ui::check_ui(ui, state, forms, &mut commands),
             }
         });
         widgets::drop_overlay_ui(&ctx);

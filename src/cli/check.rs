@@ -11,10 +11,9 @@ use clap::Args;
 
 use super::values::{Range, number};
 use super::{CliError, QUIET_HELP};
+use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format;
-use crate::engine::uses::check::{
-    self, CheckError, CheckRequest, CheckSource, Checked, DEFAULT_ALPHA,
-};
+use crate::engine::uses::check::{self, CheckError, CheckRequest, CheckSource, DEFAULT_ALPHA};
 
 /// The exit status of a check that fails: the cell no longer holds its
 /// calibration (not an error of the input).
@@ -46,45 +45,6 @@ fn error(e: &CheckError) -> CliError {
     CliError::input(e.to_string())
 }
 
-/// The verdict's lines.
-fn verdict_text(checked: &Checked, alpha: f64) -> Vec<String> {
-    let t = &checked.test;
-    let mut out = Vec::new();
-    let what = if checked.hand_eye_only {
-        "the hand-eye (flange poses)"
-    } else {
-        "the calibrated model and hand-eye"
-    };
-    out.push(format!(
-        "{} sightings at {} station(s) predicted through {what}: {:.4} mm rms about the fitted sphere",
-        checked.sightings,
-        t.centres.len(),
-        t.rms_mm
-    ));
-    for (id, c) in &t.centres {
-        out.push(format!(
-            "  sphere at {id}: {:.3}, {:.3}, {:.3} mm (fitted: it may have been moved)",
-            c.x, c.y, c.z
-        ));
-    }
-    out.push(format!(
-        "test: T = {:.2} on {} degrees of freedom, threshold {:.2}; directed T_d = {:.2} on {}, threshold {:.2}; at a false-alarm rate α = {} ({:.2} %, α/2 each); p = {:.3e}",
-        t.statistic,
-        t.dof,
-        t.threshold,
-        t.directed,
-        t.directed_dof,
-        t.directed_threshold,
-        alpha,
-        100.0 * alpha,
-        t.p_value
-    ));
-    out.push(
-        "  a drift of the whole robot's base moves every centre alike: it cannot be told from a moved sphere (each position's sphere is fitted), and is not tested".into(),
-    );
-    out
-}
-
 /// Runs `spherecal check`.
 ///
 /// # Errors
@@ -101,11 +61,14 @@ pub fn run(args: &CheckArgs) -> Result<(), CliError> {
     if let Some(path) = &record_path {
         CliError::guard_output(path, &[args.session.as_path(), args.result.as_path()])?;
     }
-    let (session, checked) = check::check_file(CheckRequest {
-        scan: CheckSource::SessionFile(args.session.clone()),
-        result: result.clone(),
-        alpha: args.alpha,
-    })
+    let (session, checked) = check::check_file(
+        CheckRequest {
+            scan: CheckSource::SessionFile(args.session.clone()),
+            result: result.clone(),
+            alpha: args.alpha,
+        },
+        &mut |_, _| Control::Continue,
+    )
     .map_err(|e| error(&e))?;
     if !args.quiet {
         for note in &checked.notes {
@@ -114,19 +77,19 @@ pub fn run(args: &CheckArgs) -> Result<(), CliError> {
         for s in &checked.skipped {
             sayln!("warning: left out: {s}");
         }
-        for line in verdict_text(&checked, args.alpha) {
+        for line in check::verdict_lines(&checked, args.alpha) {
             sayln!("{line}");
         }
     }
     if let Some(path) = &record_path {
-        let record = check::check_record(
+        check::write_record(
+            path,
             &checked,
             &session,
             &result,
             (&args.session, &args.result),
-            std::time::SystemTime::now(),
-        );
-        format::save_check_record(path, &record).map_err(|e| CliError::from_file(&e, false))?;
+        )
+        .map_err(|e| CliError::from_file(&e, false))?;
         if !args.quiet {
             sayln!("wrote the check's record {}", path.display());
         }

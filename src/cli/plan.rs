@@ -340,51 +340,12 @@ fn detectable_text(
     };
     let d = check::plan_check(made, &result, config.stripe_sigma, check::DEFAULT_ALPHA)
         .map_err(|e| CliError::input(e.to_string()))?;
-    let positions = config.design.n_identify;
-    let mut text = format!(
-        "  re-check: {} poses at {} sphere position(s), about {:.0} minutes at the robot ({:.0} s a pose, {:.0} s a sphere move)\n",
-        made.poses.len(),
-        positions,
-        check::check_minutes(made.poses.len(), positions),
-        check::design::SECONDS_PER_POSE,
-        check::design::SECONDS_PER_SPHERE_MOVE
-    );
-    text += &format!(
-        "  re-check: detects with {:.0} % power at a false-alarm rate of {} % ({} degrees of freedom): the sensor knocked {:.3} mm in its worst direction, or turned {:.3}° about its mount's worst axis",
-        100.0 * check::DETECTION_POWER,
-        100.0 * check::DEFAULT_ALPHA,
-        d.dof,
-        d.translation_mm,
-        d.rotation_deg
-    );
-    let mut seen: Vec<(String, f64, f64)> = d
-        .parameters
+    let lines = check::detectable_lines(made, config.design.n_identify, &d);
+    Ok(lines
         .iter()
-        .filter_map(|(l, v, s)| s.map(|s| (l.clone(), *v, s)))
-        .collect();
-    seen.sort_by(|a, b| a.2.total_cmp(&b.2));
-    let listed: Vec<String> = seen
-        .iter()
-        .take(4)
-        .map(|(l, v, s)| {
-            let unit = if l.starts_with('a') && !l.starts_with("alpha") || l.starts_with('d') {
-                "mm"
-            } else {
-                "°"
-            };
-            format!("{l} {v:.3} {unit} ({s:.1}σ)")
-        })
-        .collect();
-    if !listed.is_empty() {
-        text.push_str(&format!(
-            "\n  robot parameters best seen from here (change detected, in σ of the calibration): {}",
-            listed.join(", ")
-        ));
-    }
-    text.push_str(
-        "\n  a drift of the robot's base cannot be told from a moved sphere (each position's sphere is fitted)",
-    );
-    Ok(text)
+        .map(|l| format!("  {l}"))
+        .collect::<Vec<_>>()
+        .join("\n"))
 }
 
 fn plan_error(e: &PlanError) -> CliError {

@@ -154,11 +154,14 @@ pub enum Scenario {
     /// The demo calibrated: the Results view's Plots PNG export itself
     /// (not a window picture).
     PlotsExport,
+    /// The demo calibrated, a check planned for it and the demo's own
+    /// session checked against it: the Re-check view.
+    Check,
 }
 
 impl Scenario {
     /// Every scenario, in the order the script takes them.
-    pub const ALL: [Self; 29] = [
+    pub const ALL: [Self; 30] = [
         Self::Steps,
         Self::Results,
         Self::ResultsTables,
@@ -188,6 +191,7 @@ impl Scenario {
         Self::ScenePlan,
         Self::SceneCompensate,
         Self::SceneFixed,
+        Self::Check,
     ];
 
     /// The name given in [`ENV`].
@@ -223,6 +227,7 @@ impl Scenario {
             Self::SceneCompensate => "scene-compensate",
             Self::SceneFixed => "scene-fixed",
             Self::PlotsExport => "plots-export",
+            Self::Check => "check",
         }
     }
 
@@ -329,6 +334,7 @@ impl Scenario {
             Self::RealdataStripe => realdata_stripe(),
             Self::Compensate => compensate(),
             Self::Measure => measure(),
+            Self::Check => check(),
             Self::SceneSession => vec![
                 Act::Settle,
                 dismiss(),
@@ -537,6 +543,28 @@ fn compensate() -> Vec<Act> {
                 Some(Ok(_)) => Ok(()),
                 Some(Err(e)) => Err(format!("nothing compensated: {e}")),
                 None => Err("nothing compensated".into()),
+            }),
+        ],
+    ]
+    .concat()
+}
+
+/// The demo calibrated, its check planned, the demo's session checked.
+fn check() -> Vec<Act> {
+    use crate::app::command::CheckCommand;
+    [
+        demo_run(),
+        vec![
+            show(Tab::Check),
+            Act::Do(Command::Check(CheckCommand::Plan)),
+            Act::Settle,
+            Act::Edit(|f| f.check.session = "sessions/demo-irb2400.json".into()),
+            Act::Do(Command::Check(CheckCommand::Run)),
+            Act::Settle,
+            Act::Expect(|s, _| match &s.check.outcome {
+                Some(Ok(_)) => Ok(()),
+                Some(Err(e)) => Err(format!("not checked: {e}")),
+                None => Err("not checked".into()),
             }),
         ],
     ]

@@ -9,5 +9,6 @@ pub mod measure;
 pub mod one_station;
 pub mod pose;
 pub mod sim;
+pub mod tool_readers;
 #[cfg(feature = "gui")]
 pub mod ui;

@@ -39,6 +39,7 @@ fn the_step_bar_walks_the_job_in_order() {
             "Results",
             "Measure",
             "Compensate",
+            "Re-check",
             "History"
         ]
     );

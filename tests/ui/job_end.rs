@@ -101,6 +101,19 @@ fn next_leads_from_the_report_to_a_compensated_program() {
         other => panic!("{other:?}"),
     }
     assert!(step_label(&h, "8. Compensated (optional)").starts_with('●'));
+    // The re-check is the optional step left: the demo's own session
+    // checked against its calibration.
+    let said = labels_with(&h, "every required step is done");
+    assert!(said[0].contains("9. Re-checked"), "{}", said[0]);
+    h.get_by_label("or: Re-check the cell").click();
+    h.run();
+    assert_eq!(h.state().forms().tab, Tab::Check);
+    let demo = concat!(env!("CARGO_MANIFEST_DIR"), "/sessions/demo-irb2400.json");
+    h.state_mut().forms_mut().check.session = demo.to_string();
+    h.run();
+    h.get_by_label("Check").click();
+    settle(&mut h);
+    assert!(step_label(&h, "9. Re-checked (optional)").starts_with('●'));
     assert!(h.query_by_label("● every step is done").is_some());
     assert_eq!(next(&h), None);
 }

@@ -5,6 +5,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod check;
 mod compensate;
 mod guided;
 mod held_out;
@@ -19,4 +20,5 @@ mod scene;
 mod scene_views;
 mod tabs;
 mod trust;
+mod use_exports;
 mod workbench;

@@ -62,6 +62,9 @@ pub struct CompensateForm {
     pub tool: String,
     /// Where "Write compensated program" writes.
     pub out: String,
+    /// The tool the controller holds now (a pose-only result's targets
+    /// are rewritten for it: `--current-tool`).
+    pub current_tool: String,
     /// What joint targets mean and when a target is flagged
     /// (`--joint-targets`, `--sigma-tolerance`, `--far-joints`,
     /// `--region-margin`).

@@ -22,7 +22,9 @@ use crate::engine::uses::compensate::{
 };
 
 /// Compensates the request's targets by the one engine entry `spherecal
-/// compensate` calls too ([`compensate::compensate_file`]) and makes the
+/// compensate` calls too ([`compensate::compensate_file`]; with
+/// `current_tool`, a pose-only result's targets for the controller's
+/// current tool, [`compensate::compensate_file_tool_only`]) and makes the
 /// view of it; `progress` hears of each target, `cancel` stops at the
 /// next one.
 ///
@@ -32,11 +34,12 @@ use crate::engine::uses::compensate::{
 /// target, "cancelled".
 pub fn compensate_targets(
     request: CompensateRequest,
+    current_tool: Option<PathBuf>,
     cancel: &AtomicBool,
     progress: &mut dyn FnMut(String, f64),
 ) -> Result<CompensationView, String> {
     let (targets, convention) = (request.targets.clone(), request.read.convention);
-    let done = compensate::compensate_file(request, &mut |p| {
+    let mut each = |p: &compensate::CompensateProgress| {
         let fraction = p.done as f64 / p.total.max(1) as f64;
         progress(
             format!("target {}: {} of {}", p.target, p.done, p.total),
@@ -47,15 +50,36 @@ pub fn compensate_targets(
         } else {
             Control::Continue
         }
-    })
-    .map_err(|e| match e {
+    };
+    let fail = |e: CompensateFileError| match e {
         CompensateFileError::Model(e) => format!("{e} (the result on show)"),
         CompensateFileError::Compensate(CompensateError::Targets(failed)) if failed.len() > 1 => {
             failures_text(&failed, &targets)
         }
         CompensateFileError::Compensate(e) => format!("{e} ({})", targets.display()),
         e => e.to_string(),
-    })?;
+    };
+    if let Some(tool) = current_tool {
+        let done = compensate::compensate_file_tool_only(
+            &request.result,
+            &request.targets,
+            &request.read,
+            &tool,
+            &mut each,
+        )
+        .map_err(fail)?;
+        let what = format!(
+            "the controller's current tool ({}), moved to the calibrated sensor",
+            tool.display()
+        );
+        return Ok(CompensationView::from_parts(
+            done.compensation,
+            &done.file,
+            what,
+            Vec::new(),
+        ));
+    }
+    let done = compensate::compensate_file(request, &mut each).map_err(fail)?;
     let mut view = CompensationView::new(done.compensation, &done.file, &done.model, convention);
     view.notes.extend(done.notes);
     Ok(view)
@@ -172,7 +196,6 @@ impl CompensationView {
         model: &Model,
         convention: Option<FlangeConvention>,
     ) -> Self {
-        let file_line = report::file_line(file);
         let tool_data = if model.tcp == Tcp::Sensor {
             report::tool_data(file, convention, &model.tool)
                 .into_iter()
@@ -181,6 +204,19 @@ impl CompensationView {
         } else {
             Vec::new()
         };
+        Self::from_parts(done, file, model.tcp.describe().to_string(), tool_data)
+    }
+
+    /// The view of `done`, the compensation of `file` for the TCP `tcp`
+    /// (in words), with the tool data to set (controller, text).
+    #[must_use]
+    pub fn from_parts(
+        done: Compensation,
+        file: &PoseFile,
+        tcp: String,
+        tool_data: Vec<(String, String)>,
+    ) -> Self {
+        let file_line = report::file_line(file);
         // Largest first, as the command line's table.
         let rows = report::largest_first(&done.targets)
             .into_iter()
@@ -207,7 +243,7 @@ impl CompensationView {
             targets: file.path.clone(),
             file_line,
             warnings: file.warnings.clone(),
-            tcp: model.tcp.describe().to_string(),
+            tcp,
             tool_data,
             rows,
             summary: done.summary.line(),

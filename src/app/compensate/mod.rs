@@ -24,6 +24,9 @@ use crate::engine::uses::compensate::{CompensateRequest, TcpSource};
 use form::{CompensateForm, TcpChoice};
 use job::{CompensationView, compensate_targets, write_compensated};
 
+/// What the view says of a pose-only result without the current tool.
+pub const POSE_ONLY_WHAT_TO_DO: &str = "a pose-only result: the sensor was calibrated, the robot's kinematics were not, so there is no model to compensate targets with. Install the calibrated sensor as the controller's tool data (below), or give the tool the controller holds now (Current tool) to rewrite the targets for it";
+
 /// What "Write compensated program" calls the file it writes (status
 /// line, list of files written).
 pub const WRITTEN_WHAT: &str = "compensated program";
@@ -122,6 +125,18 @@ impl Core {
             return;
         }
         let result = view.file.clone();
+        // A pose-only result moves the targets for the controller's
+        // current tool, or says to install the tool data instead.
+        let current_tool = result
+            .hand_eye_only()
+            .then(|| PathBuf::from(form.current_tool.trim()));
+        if current_tool
+            .as_ref()
+            .is_some_and(|t| t.as_os_str().is_empty())
+        {
+            self.state.say(Level::Warning, POSE_ONLY_WHAT_TO_DO);
+            return;
+        }
         let session = if result.pose_joints.is_empty() {
             self.state.loaded.as_ref().map(|l| l.session.clone())
         } else {
@@ -147,7 +162,7 @@ impl Core {
         };
         let stamp = self.state.ledger.stamp(Artefact::Compensation);
         if self.start(ctx, Slot::Compensate, stamp, move |w| {
-            compensate_targets(request, w.flag(), &mut |text, fraction| {
+            compensate_targets(request, current_tool, w.flag(), &mut |text, fraction| {
                 w.progress(text, Some(fraction));
             })
             .map(Box::new)
@@ -208,8 +223,9 @@ impl Core {
             return;
         }
         let path = PathBuf::from(out);
-        let tool = (self.forms.compensate.tcp == TcpChoice::ToolFile)
-            .then(|| PathBuf::from(self.forms.compensate.tool.trim()));
+        let form = &self.forms.compensate;
+        let tool = (form.tcp == TcpChoice::ToolFile).then(|| PathBuf::from(form.tool.trim()));
+        let current = PathBuf::from(form.current_tool.trim());
         let write = Write {
             what: WRITTEN_WHAT.to_string(),
             from: Artefact::Compensation,
@@ -220,6 +236,9 @@ impl Core {
             let mut inputs: Vec<&Path> = vec![targets.as_path()];
             if let Some(t) = &tool {
                 inputs.push(t.as_path());
+            }
+            if !current.as_os_str().is_empty() {
+                inputs.push(current.as_path());
             }
             write_compensated(&text, path, &inputs).map(|()| None)
         });
@@ -340,6 +359,11 @@ pub fn reading(f: &CompensateForm) -> Reading {
             format!("{} mm", f.options.region_margin_mm),
         ),
     ];
+    let mut fields = fields;
+    if !f.current_tool.trim().is_empty() {
+        fields.push(("current tool".into(), f.current_tool.trim().to_string()));
+    }
     let tool = (f.tcp == TcpChoice::ToolFile).then(|| file_stamp(&f.tool));
-    Reading::new(fields, (file_stamp(&f.targets), tool))
+    let current = file_stamp(&f.current_tool);
+    Reading::new(fields, (file_stamp(&f.targets), tool, current))
 }

@@ -64,10 +64,61 @@ pub fn compensate_ui(
                     .color(WARN),
                 );
             }
+            pose_only_ui(ui, state, &mut forms.compensate, commands);
             inputs_ui(ui, state, &mut forms.compensate, commands);
             ui.separator();
             outcome_ui(ui, state, &mut forms.compensate, commands);
         });
+}
+
+/// A pose-only result: the current tool's path (`--current-tool`), and
+/// without it what to do instead, with the tool data to install.
+fn pose_only_ui(
+    ui: &mut egui::Ui,
+    state: &AppState,
+    form: &mut CompensateForm,
+    commands: &mut Vec<Command>,
+) {
+    let Some(view) = state.result.as_ref().filter(|r| r.file.hand_eye_only()) else {
+        return;
+    };
+    crate::app::widgets::boxed(ui, WARN, "A pose-only result", |ui| {
+        crate::app::widgets::form_grid(ui, "compensate_current_tool", 3, |ui| {
+            let hint = "the tool the controller holds now, with which the program was taught (JSON flange_from_tcp, or one line of the tool's values)";
+            let busy = state.jobs.runs(&Slot::Dialog);
+            crate::app::widgets::path_row(
+                ui,
+                "Current tool",
+                &mut form.current_tool,
+                hint,
+                busy,
+                Purpose::CompensateCurrentTool,
+                commands,
+            );
+        });
+        dialog_note_ui(ui, state, &[Purpose::CompensateCurrentTool]);
+        if !form.current_tool.trim().is_empty() {
+            ui.label(
+                RichText::new(crate::engine::uses::compensate::tool_only::TOOL_ONLY_NOTE)
+                    .small()
+                    .color(MUTED),
+            );
+            return;
+        }
+        ui.add(egui::Label::new(RichText::new(super::POSE_ONLY_WHAT_TO_DO).color(WARN)).wrap());
+        let tool = &view.file.hand_eye;
+        let data: Vec<(String, String)> = crate::engine::base::robot::controller::Controller::ALL
+            .iter()
+            .map(|c| {
+                (
+                    c.tool_data_kind().to_string(),
+                    c.tool_data(tool, crate::engine::uses::compensate::report::TOOL_NAME),
+                )
+            })
+            .collect();
+        let stale = state.ledger.stale(Artefact::Result).map(|s| s.to_string());
+        tool_data_list_ui(ui, &data, stale.as_deref());
+    });
 }
 
 /// The targets file, the pose convention, the TCP, and Compensate.
@@ -186,8 +237,14 @@ fn inputs_ui(
             }
             return;
         }
+        let pose_only = state
+            .result
+            .as_ref()
+            .is_some_and(|r| r.file.hand_eye_only());
         let why_not = if state.result.is_none() {
             Some("calibrate first: there is no result on show")
+        } else if pose_only && form.current_tool.trim().is_empty() {
+            Some("a pose-only result: give the current tool, or install the tool data above")
         } else if form.targets.trim().is_empty() {
             Some("choose a targets file first")
         } else {
@@ -321,7 +378,8 @@ fn outcome_ui(
                         .wrap(),
                 );
             }
-            tool_data_ui(ui, view);
+            let stale_why = stale.as_ref().map(ToString::to_string);
+            tool_data_ui(ui, view, stale_why.as_deref());
             ui.add_space(4.0);
             write_ui(ui, state, form, stale.is_some(), commands);
             ui.add_space(6.0);
@@ -330,8 +388,9 @@ fn outcome_ui(
     }
 }
 
-/// The tool data to set on the controller, each with a Copy button.
-fn tool_data_ui(ui: &mut egui::Ui, view: &CompensationView) {
+/// The tool data to set on the controller, each with a Copy button
+/// (disabled with `stale`'s reason while the compensation is stale).
+fn tool_data_ui(ui: &mut egui::Ui, view: &CompensationView, stale: Option<&str>) {
     if view.tool_data.is_empty() {
         return;
     }
@@ -340,15 +399,23 @@ fn tool_data_ui(ui: &mut egui::Ui, view: &CompensationView) {
         RichText::new("Tool data to set on the controller (the calibrated hand-eye): the compensated targets assume it")
             .strong(),
     );
-    for (k, (controller, text)) in view.tool_data.iter().enumerate() {
+    tool_data_list_ui(ui, &view.tool_data, stale);
+}
+
+/// Each controller's tool data with a Copy button, disabled with why
+/// while `stale` (the result it was made of is out of date).
+fn tool_data_list_ui(ui: &mut egui::Ui, data: &[(String, String)], stale: Option<&str>) {
+    for (k, (controller, text)) in data.iter().enumerate() {
         ui.horizontal(|ui| {
             ui.label(RichText::new(controller).small());
-            if ui
-                .push_id(("copy_tool", k), |ui| ui.small_button("Copy"))
+            let copy = ui
+                .push_id(("copy_tool", k), |ui| {
+                    ui.add_enabled(stale.is_none(), egui::Button::new("Copy").small())
+                })
                 .inner
                 .on_hover_text(format!("copy the {controller} to the clipboard"))
-                .clicked()
-            {
+                .on_disabled_hover_text(format!("not copied: {}", stale.unwrap_or_default()));
+            if copy.clicked() {
                 ui.ctx().copy_text(text.clone());
             }
         });

@@ -3,7 +3,9 @@
 //! drawn off-screen on white, whole whatever is on screen), the
 //! self-contained HTML report, and the calibrated model
 //! (JSON robot block, MDH CSV, URDF fragment, as `spherecal
-//! export-model`). Every file is written atomically by the engine's
+//! export-model`), and the files for the controller and the planner
+//! ([`UseExport`]: tool data for every controller, the robot's own URDF
+//! back calibrated, UR's calibration YAML). Every file is written atomically by the engine's
 //! [`write_atomic`], on a job thread.
 
 use std::path::Path;
@@ -12,15 +14,18 @@ use std::time::SystemTime;
 
 use crate::engine::base::session::Session;
 use crate::engine::calibrate::solve::Analysis;
-use crate::engine::files::format::{result_text_checked, write_atomic};
+use crate::engine::files::format::{Cap, ResultFile, read_text, result_text_checked, write_atomic};
 use crate::engine::tools::report::html::{self, ReportInput, ReportMeta};
 use crate::engine::tools::report::model::{self, ModelFormat};
 use crate::engine::tools::report::sheet::{self, SheetInput};
 use crate::engine::tools::report::tables;
+use crate::engine::tools::report::tool_data::{self, ToolTarget};
+use crate::engine::tools::report::{ur_calibration, urdf_back};
 use crate::engine::tools::result_view::{self, Tolerance};
 
 use crate::app::command::Command;
 use crate::app::command::ExportKind;
+use crate::app::command::UseExport;
 use crate::app::error::JobError;
 use crate::app::ledger::Artefact;
 use crate::app::results::{ResultOrigin, ResultView};
@@ -274,6 +279,164 @@ impl Core {
                 None => write_text(kind, &view, path),
             }
             .map(|()| None)
+        });
+    }
+}
+
+/// Why `kind` cannot be written of `view` (`urdf`: the source URDF's
+/// path field), or `None`.
+#[must_use]
+pub fn unavailable(kind: UseExport, view: &ResultView, urdf: &str) -> Option<String> {
+    let robot = view.file.robot.as_ref();
+    match kind {
+        UseExport::Tool(_) => None,
+        UseExport::UrdfBack if robot.is_none() => {
+            Some("the result has no robot to write back".to_string())
+        }
+        UseExport::UrdfBack if urdf.trim().is_empty() => Some(
+            "type the path of the URDF the session's robot came from (its joint origins are calibrated, every other byte kept)"
+                .to_string(),
+        ),
+        UseExport::UrCalibration => match robot {
+            Some(r) if ur_calibration::is_ur(r) => None,
+            Some(r) => Some(format!("{} is not a Universal Robots arm", r.name)),
+            None => Some("the result has no robot".to_string()),
+        },
+        UseExport::UrdfBack => None,
+    }
+}
+
+/// The text of `kind` of `result` (from `source`, in words) by the
+/// engine's exporters, with what to know about it.
+///
+/// # Errors
+/// What the engine refuses (naming the URDF), or a URDF that cannot be read.
+pub fn use_export_text(
+    kind: UseExport,
+    result: &ResultFile,
+    source: &str,
+    urdf: &Path,
+) -> Result<String, JobError> {
+    let fail = |e: &dyn std::fmt::Display| JobError::Missing(format!("{e} ({source})"));
+    match kind {
+        UseExport::Tool(target) => Ok(tool_data::tool_export(result, target, source)),
+        UseExport::UrCalibration => {
+            ur_calibration::ur_calibration(result, source, false).map_err(|e| fail(&e))
+        }
+        UseExport::UrdfBack => {
+            let text = read_text(urdf, Cap::URDF).map_err(|e| JobError::Path {
+                what: format!("the robot's URDF cannot be read: {e}"),
+                path: urdf.to_path_buf(),
+            })?;
+            let done =
+                urdf_back::calibrated_urdf(result, &text, urdf, None).map_err(|e| fail(&e))?;
+            Ok(done.text)
+        }
+    }
+}
+
+/// The row of the files for the controller and the planner: tool data
+/// for every controller, the URDF back (with its source's path), UR's
+/// calibration; each disabled with why.
+pub fn use_exports_ui(
+    ui: &mut egui::Ui,
+    view: &ResultView,
+    forms: &mut crate::app::Forms,
+    stale: bool,
+    commands: &mut Vec<Command>,
+) {
+    use crate::app::widgets::{command_button, labelled_field};
+    ui.horizontal_wrapped(|ui| {
+        ui.label("For the controller:");
+        let kinds = ToolTarget::ALL.map(UseExport::Tool);
+        for kind in kinds.into_iter().chain([UseExport::UrCalibration]) {
+            let why = unavailable(kind, view, &forms.urdf_source);
+            let hover = match (&why, stale) {
+                (_, true) => "refused: the result is stale; run again, then export",
+                (Some(w), _) => w.as_str(),
+                (None, _) => "the calibrated hand-eye (and model) in the controller's own syntax, with its 1σ",
+            };
+            let enabled = why.is_none() && !stale;
+            command_button(ui, enabled, kind.label(), hover, Command::UseExport(kind), commands);
+        }
+    });
+    if view.file.robot.is_some() {
+        ui.horizontal_wrapped(|ui| {
+            let hint = "the robot's URDF (.urdf), for URDF back";
+            labelled_field(ui, "Robot's URDF", &mut forms.urdf_source, hint, 300.0);
+            let browse = Command::Browse(crate::app::dialog::Purpose::UrdfSource);
+            command_button(ui, true, "Browse…", "choose the URDF", browse, commands);
+            let kind = UseExport::UrdfBack;
+            let why = unavailable(kind, view, &forms.urdf_source);
+            let hover = why.as_deref().unwrap_or(
+                "that file with only the calibrated joint origins changed and a sensor link added",
+            );
+            let enabled = why.is_none() && !stale;
+            command_button(
+                ui,
+                enabled,
+                kind.label(),
+                hover,
+                Command::UseExport(kind),
+                commands,
+            );
+        });
+    }
+}
+
+impl Core {
+    /// Writes a file of the result on show for the controller or the
+    /// planner into the export folder: refused while the result is stale.
+    pub(in crate::app) fn use_export(&mut self, ctx: &egui::Context, kind: UseExport) {
+        let Some(view) = &self.state.result else {
+            self.state.say(
+                Level::Warning,
+                "nothing to export: run the solver or open a result first",
+            );
+            return;
+        };
+        let title = format!("{} not written", kind.label());
+        if let Some(why) = unavailable(kind, view, &self.forms.urdf_source) {
+            self.refuse(&title, &title, why);
+            return;
+        }
+        let stamp = match self.state.ledger.check(Artefact::Result) {
+            Ok(stamp) => stamp,
+            Err(why) => {
+                self.refuse(
+                    &title,
+                    &title,
+                    format!("{why}: run the calibration again, then export"),
+                );
+                return;
+            }
+        };
+        let result = view.file.clone();
+        let source = match &view.origin {
+            ResultOrigin::Review(p) => p.display().to_string(),
+            ResultOrigin::Run { .. } => format!("a workbench run of {}", view.file.session),
+        };
+        let Some(dir) = self.export_folder() else {
+            return;
+        };
+        let stem = self
+            .state
+            .loaded
+            .as_ref()
+            .map_or_else(|| "result".to_string(), |l| l.source.stem());
+        let path = dir.join(kind.file_name(&stem));
+        let urdf = std::path::PathBuf::from(self.forms.urdf_source.trim());
+        let write = Write {
+            what: kind.label(),
+            from: Artefact::Result,
+            stamp,
+            again: Command::UseExport(kind),
+        };
+        self.write(ctx, path, write, move |path| {
+            crate::engine::files::format::refuse_inputs(path, &[urdf.as_path()])?;
+            let text = use_export_text(kind, &result, &source, &urdf)?;
+            write_atomic(path, text.as_bytes())?;
+            Ok(None)
         });
     }
 }

@@ -302,7 +302,10 @@ fn export_ui(
             }
         }
     });
-    crate::app::widgets::dialog_note_ui(ui, state, &[Purpose::ExportFolder]);
+    if let Some(view) = &state.result {
+        super::export::use_exports_ui(ui, view, forms, stale.is_some(), commands);
+    }
+    crate::app::widgets::dialog_note_ui(ui, state, &[Purpose::ExportFolder, Purpose::UrdfSource]);
     crate::app::widgets::written_ui(ui, state, &[Artefact::Result, Artefact::Report]);
 }
 

@@ -17,7 +17,8 @@
 //! pose list: the hand-eye alone, the controller's flange poses taken as
 //! they are with the result's pose σ.
 //!
-//! [`entry`] is the one entry the command line calls ([`check_file`]).
+//! [`entry`] is the one entry the command line and the workbench call
+//! ([`check_file`]).
 
 pub mod design;
 pub mod entry;
@@ -27,7 +28,10 @@ use nalgebra::Isometry3;
 pub use design::{
     CheckChoice, MAX_CHECK_POSES, MAX_CHECK_STATIONS, check_minutes, choose_check_design,
 };
-pub use entry::{CheckRequest, CheckSource, check_file, check_record};
+pub use entry::{
+    CheckRequest, CheckSource, check_file, check_record, detectable_lines, verdict_lines,
+    write_record,
+};
 
 use crate::engine::base::robot::Robot;
 use crate::engine::base::session::Mount;
@@ -72,6 +76,9 @@ pub enum CheckError {
     /// A session or result file could not be read.
     #[error(transparent)]
     File(#[from] FileError),
+    /// Stopped on request (the workbench's Cancel).
+    #[error("the check was cancelled")]
+    Cancelled,
 }
 
 /// A session checked against a result.
