@@ -11,6 +11,7 @@ mod held_out;
 mod import_poses;
 mod job_end;
 mod measure;
+mod plan_objective;
 mod range;
 mod results_rows;
 mod save_as;
