@@ -483,3 +483,58 @@ fn issue_32_check() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The rows of the check's plan that miss the sphere on the cells' true
+/// robots, by use, without calibrating (seconds, not minutes): the
+/// robustness of a plan to the true robot's error.
+#[test]
+#[ignore = "bench: rows missed by the check's plan on the cells' true robots"]
+fn rows_missed() {
+    let dir = std::env::temp_dir().join(format!("spherecal-rows-missed-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("P.csv");
+    let extra = std::env::var("VOLUME_CHECK_PLAN").unwrap_or_default();
+    let mut args: Vec<String> = [
+        "plan",
+        "--sphere",
+        "1050,0,475",
+        "--identify-stations",
+        "20",
+        "--csv",
+    ]
+    .iter()
+    .map(|s| (*s).to_owned())
+    .collect();
+    args.push(csv.display().to_string());
+    args.extend(extra.split_whitespace().map(str::to_owned));
+    let (code, out, err) = run(&args);
+    assert_eq!(code, 0, "plan: {out}{err}");
+    let plan = read_plan_csv(&std::fs::read_to_string(&csv).unwrap()).unwrap();
+    let preset = robot::preset("irb2400").unwrap();
+    let config = PlanConfig::for_preset(&preset, SPHERE);
+    let hand_eye = simulated_true_hand_eye(&config.flange_from_sensor);
+    let mut total = BTreeMap::<String, usize>::new();
+    let mut counts = Vec::new();
+    for seed in seeds() {
+        let mut rng = ChaCha8Rng::seed_from_u64(0x5EED_0032_0000 + seed);
+        let truth = true_robot(&preset.robot, &mut rng);
+        let (rows, missed) = plan_rows(&plan, &truth, &hand_eye);
+        let kept: std::collections::BTreeSet<&str> = rows.iter().map(|r| r.id.as_str()).collect();
+        let mut by = BTreeMap::<String, usize>::new();
+        for p in plan.iter().filter(|p| p.usage != Use::Validate) {
+            if !kept.contains(p.id.as_str()) {
+                *by.entry(format!("{:?}", p.usage)).or_default() += 1;
+                *total.entry(format!("{:?}", p.usage)).or_default() += 1;
+            }
+        }
+        counts.push(missed);
+        println!("cell {seed}: {missed} missed {by:?}");
+    }
+    println!(
+        "rows missed over {} cells: total {}, worst {}, by use {total:?}",
+        counts.len(),
+        counts.iter().sum::<usize>(),
+        counts.iter().max().unwrap_or(&0)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -24,6 +24,7 @@ mod range_spread;
 mod recheck;
 mod recheck_pose_only;
 mod realdata;
+mod realdata_starts;
 mod robot_import;
 mod segment;
 mod simulate;

@@ -73,7 +73,7 @@ pub fn stage_text(stage: PlanStage) -> String {
             "identifiability of the candidate pool: {:.0} %",
             100.0 * done as f64 / of.max(1) as f64
         ),
-        PlanStage::Selection => "D-optimal selection…".to_string(),
+        PlanStage::Selection => "choosing the identify poses…".to_string(),
         PlanStage::Ordering => "ordering for short moves…".to_string(),
         PlanStage::Comparison => "the plan without the spread, for comparison…".to_string(),
     }

@@ -14,7 +14,7 @@ use nalgebra::Isometry3;
 
 use crate::engine::base::session::Use;
 use crate::engine::files::format::write_atomic;
-use crate::engine::tools::plan::{self, Plan, PlanError, Planned};
+use crate::engine::tools::plan::{self, Plan, PlanError, Planned, Selection};
 
 use super::command::{Command, PlanCommand, PlanExport, Tab};
 use super::error::JobError;
@@ -282,6 +282,10 @@ pub fn reading(f: &PlanForm, session_hand_eye: Option<Isometry3<f64>>) -> Readin
         ("prediction runs".into(), r.predict_runs.to_string()),
         ("cut angle".into(), format!("{}°", r.design.cut_angle)),
         ("seed".into(), r.design.seed.to_string()),
+        (
+            "objective".into(),
+            objective_text(r.design.selection).into(),
+        ),
         ("range".into(), range_text(r.range.as_ref())),
         ("spread".into(), r.spread.to_string()),
         ("hand-eye guess".into(), hand_eye),
@@ -289,4 +293,14 @@ pub fn reading(f: &PlanForm, session_hand_eye: Option<Isometry3<f64>>) -> Readin
     // Fields the view does not show (cone, box, …) still count.
     let unseen = format!("{r:?}");
     Reading::new(fields, unseen)
+}
+
+/// The plan's objective in words (the form's and the settings' reading).
+#[must_use]
+pub fn objective_text(selection: Selection) -> &'static str {
+    match selection {
+        Selection::Volume => "working volume (I-optimal)",
+        Selection::DOptimal => "D-optimal",
+        Selection::Random => "random",
+    }
 }

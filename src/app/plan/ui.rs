@@ -18,7 +18,9 @@ use crate::app::widgets::{
     range_values,
 };
 use crate::app::{Forms, plan::form::default_sphere};
-use crate::engine::tools::plan::{MAX_PREDICT_RUNS, Plan, PlanStats, Planned, StationRole};
+use crate::engine::tools::plan::{
+    MAX_PREDICT_RUNS, Plan, PlanStats, Planned, Selection, StationRole,
+};
 
 /// Width of the settings column, points.
 const FORM_WIDTH: f32 = 330.0;
@@ -135,6 +137,14 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
             ui.add(egui::DragValue::new(&mut f.request.design.seed).speed(0.2))
                 .labelled_by(l.id)
                 .on_hover_text("the same settings and seed give the same plan");
+            ui.end_row();
+            ui.label("Objective");
+            ui.horizontal(|ui| {
+                ui.radio_value(&mut f.request.design.selection, Selection::Volume, "working volume")
+                    .on_hover_text("the smallest mean predicted measuring error over the working volume (I-optimal; the default, as `spherecal plan`)");
+                ui.radio_value(&mut f.request.design.selection, Selection::DOptimal, "D-optimal")
+                    .on_hover_text("the largest ln det of the identification's information (as `spherecal plan --d-optimal`)");
+            });
             ui.end_row();
         });
     if let Some(why) = settings_error(f) {
