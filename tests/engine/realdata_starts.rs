@@ -11,7 +11,7 @@ use std::path::Path;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion};
 use spherecal::engine::calibrate::solve::{self, Options, SolverReport};
 use spherecal::engine::files::import::{
-    self, AxisMap, FlangeConvention, Observations, PoseImportSpec, ProfileFormat, ProfileSource,
+    AxisMap, FlangeConvention, Observations, PoseImportSpec, ProfileFormat, ProfileSource,
     SideChoice,
 };
 
@@ -54,7 +54,7 @@ fn robcalibrator_hand_eye(dir: &Path) -> Isometry3<f64> {
 /// (pose σ, variance factor, hand-eye 1σ per axis: x y z mm, rx ry rz deg,
 /// the hand-eye).
 fn calibrated(spec: &PoseImportSpec) -> (f64, f64, Vec<f64>, Isometry3<f64>) {
-    let imported = import::import_poses(spec).unwrap();
+    let imported = spherecal::engine::assemble::import_poses(spec).unwrap();
     let session = &imported.session;
     let (_, cal) = solve::calibrate(session, &Options::from_session(session)).unwrap();
     let SolverReport::Ml(ml) = &cal.report else {
