@@ -13,7 +13,6 @@ mod import_fixed;
 mod import_poses;
 mod job_end;
 mod measure;
-mod plan_objective;
 mod range;
 mod results_rows;
 mod save_as;

@@ -138,14 +138,6 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
                 .labelled_by(l.id)
                 .on_hover_text("the same settings and seed give the same plan");
             ui.end_row();
-            ui.label("Objective");
-            ui.horizontal(|ui| {
-                ui.radio_value(&mut f.request.design.selection, Selection::Volume, "working volume")
-                    .on_hover_text("the smallest mean predicted measuring error over the working volume (I-optimal; the default, as `spherecal plan`)");
-                ui.radio_value(&mut f.request.design.selection, Selection::DOptimal, "D-optimal")
-                    .on_hover_text("the largest ln det of the identification's information (as `spherecal plan --d-optimal`)");
-            });
-            ui.end_row();
         });
     if let Some(why) = settings_error(f) {
         ui.add(
