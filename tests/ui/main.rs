@@ -10,6 +10,7 @@ mod guided;
 mod held_out;
 mod import_poses;
 mod job_end;
+mod leftovers34;
 mod measure;
 mod range;
 mod results_rows;

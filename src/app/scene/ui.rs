@@ -125,10 +125,13 @@ pub fn scene_ui(
 
 /// A mark's name beside it, kept inside the canvas.
 fn name_at(painter: &egui::Painter, rect: egui::Rect, at: egui::Pos2, text: &str) {
-    let galley = painter.layout_no_wrap(
+    // Wrapped to the canvas: a name wider than a narrow view was cut at
+    // its edge.
+    let galley = painter.layout(
         text.to_string(),
         egui::FontId::proportional(13.0),
         Color32::WHITE,
+        (rect.width() - 8.0).max(40.0),
     );
     let size = galley.size() + egui::vec2(8.0, 4.0);
     let mut min = at + egui::vec2(10.0, -size.y - 4.0);
