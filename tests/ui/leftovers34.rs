@@ -55,7 +55,11 @@ fn the_run_button_stays_in_one_place() {
     std::fs::create_dir_all(&deep).expect("folders");
     let long = "cell 3 of line 7, the second sphere stand, after the gripper change, measured by the night shift";
     let cases = [
-        simulated(&deep, "a-long-file-name-for-this-session.json", &small(long, false)),
+        simulated(
+            &deep,
+            "a-long-file-name-for-this-session.json",
+            &small(long, false),
+        ),
         simulated(dir.path(), "p.json", &small("p", true)),
         simulated(dir.path(), "s.json", &small("s", false)),
     ];
@@ -140,7 +144,15 @@ fn a_pose_only_result_says_what_it_is() {
     let path = simulated(dir.path(), "p.json", &small("pose-only cell", true));
     let mut h = demo_app();
     open_path(&mut h, path);
-    assert!(h.state().state().loaded.as_ref().unwrap().session.pose_only());
+    assert!(
+        h.state()
+            .state()
+            .loaded
+            .as_ref()
+            .unwrap()
+            .session
+            .pose_only()
+    );
     h.state_mut().forms_mut().solver.method = Method::Ml;
     h.get_by_label("▶ Run").click();
     settle(&mut h);
@@ -182,7 +194,11 @@ fn the_identifiable_set_stays_inside_the_window() {
     settle(&mut h);
     command(&mut h, Command::View(ViewCommand::ShowTab(Tab::Results)));
     h.run();
-    assert!(scroll_to(&mut h, egui::pos2(800.0, 500.0), "Identifiable set"));
+    assert!(scroll_to(
+        &mut h,
+        egui::pos2(800.0, 500.0),
+        "Identifiable set"
+    ));
     for _ in 0..3 {
         h.run();
     }
@@ -194,4 +210,44 @@ fn the_identifiable_set_stays_inside_the_window() {
     for r in lines {
         assert!(r.right() <= 1366.0 - 8.0, "inside the window: {r:?}");
     }
+}
+
+/// The operator review: the Results view scrolled down to the
+/// identifiable set, then a run of another session: its Results opened
+/// at the same offset, the verdict off screen. Each new result opens at
+/// the top.
+#[test]
+fn a_new_result_opens_at_its_verdict() {
+    let mut h = demo_app();
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    command(&mut h, Command::View(ViewCommand::ShowTab(Tab::Results)));
+    h.run();
+    // The export row, just above the verdict, whatever the verdict says.
+    let top = |h: &Harness<'_, WorkbenchApp>| h.get_by_label("Report HTML").rect().top();
+    let first = top(&h);
+    assert!(
+        (80.0..HEIGHT).contains(&first),
+        "the verdict on show: {first}"
+    );
+    assert!(scroll_to(
+        &mut h,
+        egui::pos2(800.0, 500.0),
+        "Identifiable set"
+    ));
+    for _ in 0..3 {
+        h.run();
+    }
+    assert!(top(&h) < 80.0, "scrolled past the verdict: {}", top(&h));
+    let dir = tempfile::tempdir().expect("temp dir");
+    open_path(&mut h, simulated(dir.path(), "s.json", &small("s", false)));
+    h.get_by_label("▶ Run").click();
+    settle(&mut h);
+    command(&mut h, Command::View(ViewCommand::ShowTab(Tab::Results)));
+    h.run();
+    let again = top(&h);
+    assert!(
+        (80.0..HEIGHT).contains(&again),
+        "the new result opens at its verdict: {again}"
+    );
 }

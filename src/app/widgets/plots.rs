@@ -298,10 +298,14 @@ pub fn epsilon_plot_ui(
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
             (a.min(v), b.max(v))
         });
+    // Within a decade, room above and below the data: the threshold's
+    // name is written above its line, and at the top of the range (a
+    // pose-only run stopping at once under it) it was cut by the frame.
     let decades = if hi - lo >= WHOLE_DECADES_FROM {
         vec![lo.floor(), hi.ceil()]
     } else {
-        Vec::new()
+        let pad = (0.25 * (hi - lo)).max(0.02);
+        vec![lo - pad, hi + pad]
     };
     let mut plot = super::plots::readable_log_y(Plot::new(id));
     for d in decades {

@@ -518,7 +518,13 @@ pub(super) fn range_map_svg(
         marks.push(("tolerance", t));
     }
     marks.push(("max", re.max_mm));
-    colour_bar_svg(&mut svg, pad + size + 14.0, (10.0, 10.0 + size), top, &marks);
+    colour_bar_svg(
+        &mut svg,
+        pad + size + 14.0,
+        (10.0, 10.0 + size),
+        top,
+        &marks,
+    );
     svg.push_str("</svg>");
     let tolerance = tolerance_mm.map_or_else(String::new, |t| {
         format!(", the tolerance {} mm (std) marked on the bar", short(t))
