@@ -230,12 +230,19 @@ fn a_new_result_opens_at_its_verdict() {
         (80.0..HEIGHT).contains(&first),
         "the verdict on show: {first}"
     );
-    assert!(scroll_to(
-        &mut h,
-        egui::pos2(800.0, 500.0),
-        "Identifiable set"
-    ));
-    for _ in 0..3 {
+    // Down the page with the wheel, as the operator does.
+    for _ in 0..4 {
+        h.hover_at(egui::pos2(800.0, 500.0));
+        h.event(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Point,
+            delta: egui::vec2(0.0, -200.0),
+            phase: egui::TouchPhase::Move,
+            source: egui::MouseWheelSource::Unknown,
+            modifiers: egui::Modifiers::NONE,
+        });
+        h.run();
+    }
+    for _ in 0..10 {
         h.run();
     }
     assert!(top(&h) < 80.0, "scrolled past the verdict: {}", top(&h));
@@ -250,4 +257,40 @@ fn a_new_result_opens_at_its_verdict() {
         (80.0..HEIGHT).contains(&again),
         "the new result opens at its verdict: {again}"
     );
+}
+
+/// The operator review: step 3's "Check the stripes" opened the Stripe
+/// view on the selected measurement (t1, no warning) and marked the step
+/// done, the demo's warned stripe never shown. The view names the flagged
+/// stripes; a click shows one.
+#[test]
+fn the_stripe_view_names_the_flagged_stripes() {
+    let mut h = demo_app();
+    command(&mut h, Command::View(ViewCommand::ShowTab(Tab::Stripe)));
+    h.run();
+    let loaded = h.state().state().loaded.as_ref().expect("the demo");
+    let flagged: Vec<(usize, String)> = (0..loaded.session.measurements.len())
+        .filter(|&k| {
+            loaded
+                .fit(k)
+                .stripe()
+                .is_none_or(|s| !s.warnings.is_empty())
+        })
+        .map(|k| (k, loaded.session.measurements[k].id.clone()))
+        .collect();
+    assert_eq!(
+        flagged.len(),
+        1,
+        "the demo has one warned stripe: {flagged:?}"
+    );
+    let (k, id) = flagged[0].clone();
+    assert_ne!(h.state().state().selected, Some(k));
+    assert!(
+        h.query_all_by_label_contains("1 with warnings or failures")
+            .next()
+            .is_some()
+    );
+    h.get_by_label(&id).click();
+    h.run();
+    assert_eq!(h.state().state().selected, Some(k), "{id} is shown");
 }

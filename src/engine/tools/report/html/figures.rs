@@ -564,12 +564,6 @@ fn short(v: f64) -> String {
 fn colour_bar_svg(svg: &mut String, x: f64, y: (f64, f64), top: f64, marks: &[(&str, f64)]) {
     let (y_top, y_bottom) = y;
     let y_of = |v: f64| y_bottom - (v / top).clamp(0.0, 1.0) * (y_bottom - y_top);
-    let _ = write!(
-        svg,
-        "<g id=\"range-map-scale\" data-top=\"{}\"><title>colour scale: 0 mm (green) to {} mm (red)</title>",
-        short(top),
-        short(top)
-    );
     for k in 0..MAP_BAR_BANDS {
         let (a, b) = (
             top * k as f64 / MAP_BAR_BANDS as f64,
@@ -585,8 +579,10 @@ fn colour_bar_svg(svg: &mut String, x: f64, y: (f64, f64), top: f64, marks: &[(&
     }
     let _ = write!(
         svg,
-        "<rect x=\"{x:.1}\" y=\"{y_top:.1}\" width=\"{MAP_BAR_WIDTH:.1}\" height=\"{:.1}\" fill=\"none\" stroke=\"#444\"/>",
-        y_bottom - y_top
+        "<rect id=\"range-map-scale\" data-top=\"{}\" x=\"{x:.1}\" y=\"{y_top:.1}\" width=\"{MAP_BAR_WIDTH:.1}\" height=\"{:.1}\" fill=\"none\" stroke=\"#444\"><title>colour scale: 0 mm (green) to {} mm (red)</title></rect>",
+        short(top),
+        y_bottom - y_top,
+        short(top)
     );
     let ticks = crate::engine::tools::report::svg::nice_ticks(0.0, top, 4, false);
     let step = ticks.get(1).map_or(top, |t| t - ticks[0]);
@@ -626,7 +622,6 @@ fn colour_bar_svg(svg: &mut String, x: f64, y: (f64, f64), top: f64, marks: &[(&
             short(*v)
         );
     }
-    svg.push_str("</g>");
 }
 
 #[cfg(test)]
