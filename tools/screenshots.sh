@@ -32,7 +32,7 @@ fi
 
 started=$(date +%s)
 cargo build --quiet
-bin="$repo/target/debug/spherecal"
+bin="${CARGO_TARGET_DIR:-$repo/target}/debug/spherecal"
 spherecal() { "$bin" "$@"; }
 
 # The scratch folder the window runs in: the repository's data folders

@@ -734,9 +734,14 @@ impl Core {
     pub(super) fn on_session(&mut self, ctx: &egui::Context, loaded: LoadedSession) {
         // A run of the previous session: stopped and forgotten.
         self.state.jobs.cancel(&Slot::Run);
-        if let Some(p) = loaded.source.path() {
-            self.state.prefs.remember(p);
-            self.forms.open_path = p.display().to_string();
+        match loaded.source.path() {
+            Some(p) => {
+                self.state.prefs.remember(p);
+                self.forms.open_path = p.display().to_string();
+            }
+            // The demo, an import or a simulation: the field shows no
+            // file rather than the previous one.
+            None => self.forms.open_path.clear(),
         }
         let dir = loaded.source.save_folder();
         let file_name = match loaded.source {

@@ -12,6 +12,7 @@ mod held_out;
 mod import_fixed;
 mod import_poses;
 mod job_end;
+mod leftovers34;
 mod measure;
 mod range;
 mod results_rows;

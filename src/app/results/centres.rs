@@ -20,7 +20,7 @@ use crate::app::AppState;
 use crate::app::command::{Command, ViewCommand};
 use crate::app::ledger::Artefact;
 use crate::app::results::CentreSet;
-use crate::app::scene::ui::scene_ui;
+use crate::app::scene::ui::scene_ui_within;
 use crate::app::widgets::plots::readable;
 use crate::app::widgets::station_style;
 use crate::app::{Forms, results::CentresForm};
@@ -48,9 +48,6 @@ pub const PROJECTION_MIN_HEIGHT: f32 = 150.0;
 
 /// Height of a projection's caption, points.
 const CAPTION_HEIGHT: f32 = 22.0;
-
-/// Height of the scene widget's row of buttons, points.
-const SCENE_BUTTONS_HEIGHT: f32 = 24.0;
 
 /// Room around the data of a projection, points: the selection ring
 /// (radius 8) stays whole at the edge.
@@ -154,9 +151,8 @@ fn plots_ui(
                 ),
                 None => format!("3D, {frame}: before faint, after solid"),
             };
-            let canvas = height - CAPTION_HEIGHT - SCENE_BUTTONS_HEIGHT;
             let camera = &mut forms.centres.camera;
-            if let Some(i) = scene_ui(ui, scene::ORBIT_ID, camera, &scene, &caption, canvas)
+            if let Some(i) = scene_ui_within(ui, scene::ORBIT_ID, camera, &scene, &caption, height)
                 .and_then(|k| set.points.get(k)?.index)
             {
                 commands.push(Command::View(ViewCommand::Select(i)));

@@ -88,7 +88,11 @@ pub(super) fn plots_ui(ui: &mut egui::Ui, view: &ResultView) {
             view.threshold,
             PLOT_HEIGHT,
         );
-        let title = if view.singular_values.is_empty() && !view.fixed.is_empty() {
+        let title = if view.hand_eye_only.is_some() {
+            "Identified: the hand-eye only"
+        } else if view.singular_values.is_empty()
+            && !(view.fixed.is_empty() && view.estimated.is_empty())
+        {
             "Identifiable set"
         } else {
             "Singular values of the last update"
@@ -330,8 +334,15 @@ fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
         .filter(|(_, s)| *s > 0.0)
         .collect();
     if values.is_empty() {
-        ui.allocate_ui(egui::vec2(ui.available_width(), PLOT_HEIGHT), |ui| {
-            if view.fixed.is_empty() && view.estimated.is_empty() {
+        let size = egui::vec2(ui.available_width() - TEXT_MARGIN, PLOT_HEIGHT);
+        // Left-aligned, not justified to the column, a margin short of its
+        // edge: the text ran into the window's right edge.
+        let layout = egui::Layout::top_down(egui::Align::Min);
+        ui.allocate_ui_with_layout(size, layout, |ui| {
+            ui.set_max_width(size.x);
+            if view.hand_eye_only.is_some() {
+                pose_only_ui(ui, view);
+            } else if view.fixed.is_empty() && view.estimated.is_empty() {
                 ui.label(
                     RichText::new("No update was made: ε started below the threshold.")
                         .color(MUTED),
@@ -403,24 +414,58 @@ fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
     }
 }
 
+/// Room kept between a column's text and its right edge, points.
+const TEXT_MARGIN: f32 = 12.0;
+
+/// A pose-only result (flange poses, no joint readings): no kinematic
+/// parameter was identified, so there is no identifiable set to list.
+fn pose_only_ui(ui: &mut egui::Ui, view: &ResultView) {
+    ui.add(
+        egui::Label::new(format!(
+            "A pose-only result: the session gives flange poses, no joint readings, so method {} identified the hand-eye (sensor on the flange) and the station centres and no kinematic parameter: there is no identifiable set of the model to show. How well the hand-eye is determined: under “Hand-eye only”.",
+            view.method
+        ))
+        .wrap(),
+    );
+    for c in &view.caveats {
+        ui.add(egui::Label::new(RichText::new(c).small()).wrap());
+    }
+}
+
 /// What a method that chooses its identifiable set (rather than truncating
-/// an SVD) estimated and held fixed.
+/// an SVD) estimated and held fixed (the list only when it held some).
 fn identifiable_set_ui(ui: &mut egui::Ui, view: &ResultView) {
-    ui.label(format!(
-        "Method {} estimated {} parameter(s) and held {} fixed (not identifiable from centre distances):",
-        view.method,
-        view.estimated.len(),
-        view.fixed.len()
-    ));
+    let text = if view.fixed.is_empty() {
+        format!(
+            "Method {} estimated {} parameter(s) and held none fixed.",
+            view.method,
+            view.estimated.len()
+        )
+    } else {
+        format!(
+            "Method {} estimated {} parameter(s) and held {} fixed (not identifiable from centre distances):",
+            view.method,
+            view.estimated.len(),
+            view.fixed.len()
+        )
+    };
+    // Wrapped in its column: the text at the right edge was cut at
+    // 1366 × 768.
+    ui.add(egui::Label::new(text).wrap());
     egui::ScrollArea::vertical()
         .id_salt("identifiable_set")
         .max_height(PLOT_HEIGHT - 30.0)
         .show(ui, |ui| {
             if !view.fixed.is_empty() {
-                ui.label(RichText::new(format!("fixed: {}", view.fixed.join(", "))).color(MUTED));
+                ui.add(
+                    egui::Label::new(
+                        RichText::new(format!("fixed: {}", view.fixed.join(", "))).color(MUTED),
+                    )
+                    .wrap(),
+                );
             }
             for c in &view.caveats {
-                ui.label(RichText::new(c).small());
+                ui.add(egui::Label::new(RichText::new(c).small()).wrap());
             }
         });
 }

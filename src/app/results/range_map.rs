@@ -12,10 +12,6 @@ use crate::app::widgets::MUTED;
 use crate::app::widgets::plots::{nice_step, readable, tick_label};
 use crate::engine::calibrate::solve::ml::range::RangeError;
 
-/// The ends of the colour scale's top: 1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6,
-/// 8 times a power of ten (a round number just above the largest cell).
-const SCALE_STEPS: [f64; 10] = [1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0];
-
 /// Width of the colour bar, points.
 const BAR_WIDTH: f32 = 16.0;
 
@@ -25,22 +21,7 @@ const BAR_BANDS: usize = 48;
 /// Labelled ticks on the colour bar, at most.
 const BAR_TICKS: f64 = 5.0;
 
-/// The top of the colour scale for cells up to `largest` mm: the
-/// smallest round number (`SCALE_STEPS`) at or above it; 0 mm is the
-/// bottom.
-#[must_use]
-pub fn scale_top(largest: f64) -> f64 {
-    if !(largest.is_finite() && largest > 0.0) {
-        return 1.0;
-    }
-    let decade = 10f64.powf(largest.log10().floor());
-    SCALE_STEPS
-        .iter()
-        .chain(std::iter::once(&10.0))
-        .map(|m| m * decade)
-        .find(|v| *v >= largest * (1.0 - 1e-12))
-        .unwrap_or(10.0 * decade)
-}
+pub use crate::engine::tools::report::svg::{map_scale, scale_top};
 
 /// The engine's map colour at `sigma` on the scale 0 … `top` mm
 /// ([`heat_rgb`](crate::engine::tools::report::svg::heat_rgb): green at 0, red
@@ -152,18 +133,6 @@ pub(super) fn range_map_ui(ui: &mut egui::Ui, r: &RangeError, tolerance_mm: f64)
     });
 }
 
-/// The top of the map's colour scale: a round number ([`scale_top`]) at
-/// or above the largest value and the tolerance, whichever is larger.
-#[must_use]
-pub fn map_scale(largest: f64, tolerance_mm: f64) -> f64 {
-    let tolerance = if tolerance_mm.is_finite() {
-        tolerance_mm
-    } else {
-        0.0
-    };
-    scale_top(largest.max(tolerance))
-}
-
 /// The colour bar: 0 mm at the bottom, `top` at the top, labelled at
 /// round steps in mm, and each of `marks` (name, mm) as a line across it
 /// with its name and value.
@@ -221,7 +190,9 @@ fn colour_bar_ui(ui: &mut egui::Ui, top: f64, marks: &[(&str, f64)]) {
         painter.line_segment(
             [
                 egui::pos2(bar.left() - 2.0, y),
-                egui::pos2(bar.right() + 10.0, y),
+                // Across the bar only: a line to the tick labels struck
+                // their numbers through.
+                egui::pos2(bar.right() + 2.0, y),
             ],
             egui::Stroke::new(2.0, mark_colour),
         );

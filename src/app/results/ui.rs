@@ -44,9 +44,11 @@ pub fn results_ui(
         return;
     };
     let stale = state.ledger.stale(Artefact::Result);
-    // Its own scroll offset: not the Import view's (it opened mid-page).
+    // Its own scroll offset: not the Import view's (it opened mid-page),
+    // and each new result's from the top (a run of another session opened
+    // where the last one was scrolled to, its verdict off screen).
     egui::ScrollArea::vertical()
-        .id_salt("results_scroll")
+        .id_salt(("results_scroll", state.results_shown))
         .auto_shrink([false, false])
         .show(ui, |ui| {
             if let Some(s) = &stale {

@@ -15,7 +15,7 @@ const ZOOM_PER_POINT: f64 = 1.0 / 200.0;
 const BACKGROUND: Color32 = Color32::from_rgb(24, 26, 30);
 
 /// The scene `scene` in a canvas `height` points tall (0: the height
-/// left, less three small lines for the caption), as `camera` looks at
+/// left, less the caption's), as `camera` looks at
 /// it, with `caption` under it; the index of the mark a click picked.
 pub fn scene_ui(
     ui: &mut egui::Ui,
@@ -25,6 +25,49 @@ pub fn scene_ui(
     caption: &str,
     height: f32,
 ) -> Option<usize> {
+    let room = if height > 0.0 {
+        Room::Canvas(height)
+    } else {
+        Room::Fill
+    };
+    scene_in(ui, id, camera, scene, caption, room)
+}
+
+/// [`scene_ui`] with its buttons, canvas and caption together `total`
+/// points tall, whatever the buttons' and the caption's rows take at this
+/// width (the Centres view's caption ran off the bottom when its rows
+/// wrapped).
+pub fn scene_ui_within(
+    ui: &mut egui::Ui,
+    id: &str,
+    camera: &mut Camera,
+    scene: &Scene,
+    caption: &str,
+    total: f32,
+) -> Option<usize> {
+    scene_in(ui, id, camera, scene, caption, Room::Total(total))
+}
+
+/// The height a scene is given.
+#[derive(Debug, Clone, Copy)]
+enum Room {
+    /// The canvas this tall.
+    Canvas(f32),
+    /// The height left, less the caption's.
+    Fill,
+    /// Buttons, canvas and caption together this tall.
+    Total(f32),
+}
+
+fn scene_in(
+    ui: &mut egui::Ui,
+    id: &str,
+    camera: &mut Camera,
+    scene: &Scene,
+    caption: &str,
+    room: Room,
+) -> Option<usize> {
+    let top = ui.cursor().min.y;
     ui.horizontal_wrapped(|ui| {
         ui.label(RichText::new("3-D").strong());
         for v in StandardView::ALL {
@@ -58,11 +101,24 @@ pub fn scene_ui(
                 .color(MUTED),
         );
     });
-    let height = if height > 0.0 {
-        height
+    // The caption's own height at this width (a four-line caption was
+    // cut at the bottom of a view that kept room for three).
+    let caption_height = if caption.is_empty() {
+        0.0
     } else {
-        let line = ui.text_style_height(&egui::TextStyle::Small) + ui.spacing().item_spacing.y;
-        (ui.available_height() - 3.0 * line).max(120.0)
+        let font = egui::TextStyle::Small.resolve(ui.style());
+        let galley = ui
+            .painter()
+            .layout(caption.to_string(), font, MUTED, ui.available_width());
+        galley.size().y + 2.0 * ui.spacing().item_spacing.y
+    };
+    let height = match room {
+        Room::Canvas(h) => h,
+        Room::Fill => (ui.available_height() - caption_height).max(120.0),
+        Room::Total(t) => {
+            let buttons = ui.cursor().min.y - top;
+            (t - buttons - caption_height).max(120.0)
+        }
     };
     let size = egui::vec2(ui.available_width().max(120.0), height);
     let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
@@ -125,10 +181,13 @@ pub fn scene_ui(
 
 /// A mark's name beside it, kept inside the canvas.
 fn name_at(painter: &egui::Painter, rect: egui::Rect, at: egui::Pos2, text: &str) {
-    let galley = painter.layout_no_wrap(
+    // Wrapped to the canvas: a name wider than a narrow view was cut at
+    // its edge.
+    let galley = painter.layout(
         text.to_string(),
         egui::FontId::proportional(13.0),
         Color32::WHITE,
+        (rect.width() - 8.0).max(40.0),
     );
     let size = galley.size() + egui::vec2(8.0, 4.0);
     let mut min = at + egui::vec2(10.0, -size.y - 4.0);

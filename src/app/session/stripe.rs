@@ -10,7 +10,7 @@ use egui_plot::{HLine, Line, LineStyle, MarkerShape, Plot, PlotPoints, Points};
 use crate::app::AppState;
 use crate::app::Forms;
 use crate::app::command::{Command, ViewCommand};
-use crate::app::session::Fit;
+use crate::app::session::{Fit, LoadedSession};
 use crate::app::widgets::{AFTER, BAD, BEFORE, MUTED, WARN};
 use crate::engine::base::geometry::roll_pitch_yaw_deg;
 use crate::engine::base::session::Observation;
@@ -18,6 +18,58 @@ use crate::engine::calibrate::stripe::StripeResult;
 
 /// Points on the drawn circle.
 const CIRCLE_SEGMENTS: usize = 256;
+
+/// Stripes listed by name at most, in the row of flagged stripes.
+const FLAGGED_SHOWN: usize = 8;
+
+/// The stripes with warnings or failures, each a button that shows it:
+/// "Check the stripes" (step 3) opens this view, which showed the first
+/// measurement whatever it was, so a warned stripe could go unseen.
+fn flagged_ui(
+    ui: &mut egui::Ui,
+    loaded: &LoadedSession,
+    shown: usize,
+    commands: &mut Vec<Command>,
+) {
+    let flagged: Vec<usize> = (0..loaded.session.measurements.len())
+        .filter(|&k| match loaded.fit(k) {
+            Fit::Failed(_) => true,
+            Fit::Stripe(s) => !s.warnings.is_empty(),
+            Fit::GivenCentre => false,
+        })
+        .collect();
+    if flagged.is_empty() {
+        return;
+    }
+    ui.horizontal_wrapped(|ui| {
+        let text = format!("{} with warnings or failures:", flagged.len());
+        ui.label(RichText::new(text).color(WARN));
+        for &k in flagged.iter().take(FLAGGED_SHOWN) {
+            let id = &loaded.session.measurements[k].id;
+            let hover = match loaded.fit(k) {
+                Fit::Failed(e) => e.to_string(),
+                Fit::Stripe(s) => s.warnings.join("; "),
+                Fit::GivenCentre => String::new(),
+            };
+            if ui
+                .selectable_label(k == shown, id)
+                .on_hover_text(hover)
+                .clicked()
+            {
+                commands.push(Command::View(ViewCommand::Select(k)));
+            }
+        }
+        if flagged.len() > FLAGGED_SHOWN {
+            ui.label(
+                RichText::new(format!(
+                    "and {} more (Session: only warnings and failures)",
+                    flagged.len() - FLAGGED_SHOWN
+                ))
+                .small(),
+            );
+        }
+    });
+}
 
 /// The Stripe view.
 pub fn stripe_ui(
@@ -95,6 +147,7 @@ pub fn stripe_ui(
         }
         ui.label(RichText::new("arrow keys: previous / next").small().weak());
     });
+    flagged_ui(ui, loaded, i, commands);
     let pose = match &m.flange {
         Some(f) => {
             let t = f.translation.vector;

@@ -471,11 +471,13 @@ pub fn load_ui(
 ) {
     ui.heading("Session");
     let line = |ui: &mut egui::Ui, text: RichText| ui.add(egui::Label::new(text).truncate());
-    // Whole, wrapped: a cut path or count hides what is open.
-    let whole = |ui: &mut egui::Ui, text: RichText| ui.add(egui::Label::new(text).wrap());
+    // Each line in a fixed number of rows whatever its length (cut with
+    // …, whole on hover), so that Run below never moves: it sat at 368,
+    // 382 or 410 px as the name, source or counts wrapped.
     if let Some(l) = &state.loaded {
         name_ui(ui, &l.session.name);
-        whole(ui, RichText::new(l.source.label()).small().weak());
+        let weak = ui.visuals().weak_text_color();
+        rows_ui(ui, &l.source.label(), egui::TextStyle::Small, weak, 2);
         let n = l.session.measurements.len();
         let stations = l.station_ids().len();
         let text = format!(
@@ -488,14 +490,16 @@ pub fn load_ui(
                 ""
             }
         );
-        whole(ui, RichText::new(text).small());
+        let text_colour = ui.visuals().text_color();
+        rows_ui(ui, &text, egui::TextStyle::Small, text_colour, 2);
     } else {
         match state.jobs.get(&Slot::Load) {
             Some(job) => name_ui(ui, &job.phase),
             None => name_ui(ui, "no session open"),
         }
-        line(ui, RichText::new(" ").small());
-        line(ui, RichText::new(" ").small());
+        let colour = ui.visuals().text_color();
+        rows_ui(ui, "", egui::TextStyle::Small, colour, 2);
+        rows_ui(ui, "", egui::TextStyle::Small, colour, 2);
     }
     ui.add_space(4.0);
     let width = ui.available_width();
@@ -547,47 +551,80 @@ pub fn load_ui(
 /// The session's name in two lines of room whatever its length (wrapped,
 /// cut with … beyond two lines, whole on hover).
 fn name_ui(ui: &mut egui::Ui, name: &str) {
-    let style = egui::TextStyle::Body;
+    let colour = ui.visuals().strong_text_color();
+    rows_ui(ui, name, egui::TextStyle::Body, colour, 2);
+}
+
+/// `text` in exactly `rows` lines of room of `style` whatever its length:
+/// wrapped (anywhere in a path), cut with … beyond `rows` lines, whole
+/// on hover; the room is kept when the text is shorter or empty.
+pub fn rows_ui(
+    ui: &mut egui::Ui,
+    text: &str,
+    style: egui::TextStyle,
+    colour: egui::Color32,
+    rows: usize,
+) {
     let width = ui.available_width();
-    let height = 2.0 * ui.text_style_height(&style);
+    let height = rows as f32 * ui.text_style_height(&style);
     let mut job = egui::text::LayoutJob::single_section(
-        name.to_string(),
+        text.to_string(),
         egui::TextFormat {
             font_id: style.resolve(ui.style()),
-            color: ui.visuals().strong_text_color(),
+            color: colour,
             ..Default::default()
         },
     );
     job.wrap = egui::text::TextWrapping {
         max_width: width,
-        max_rows: 2,
+        max_rows: rows,
         break_anywhere: false,
         overflow_character: Some('…'),
     };
     let rect = egui::Rect::from_min_size(ui.cursor().min, egui::vec2(width, height));
-    let used = ui
-        .scope_builder(egui::UiBuilder::new().max_rect(rect), |ui| {
-            ui.add(egui::Label::new(job)).on_hover_text(name);
-        })
-        .response
-        .rect
-        .height();
-    if used < height {
-        ui.add_space(height - used);
-    }
+    ui.scope_builder(egui::UiBuilder::new().max_rect(rect), |ui| {
+        if !text.is_empty() {
+            ui.add(egui::Label::new(job)).on_hover_text(text);
+        }
+    });
+    // The whole room, whatever the label took.
+    ui.advance_cursor_after_rect(rect);
 }
+
+/// Height of the notice's body before it scrolls, points (about seven
+/// lines: the box stays on screen at 768 px).
+const NOTICE_BODY_HEIGHT: f32 = 110.0;
 
 /// The error of the last thing that failed (a file that did not open, an
 /// export not written), until dismissed.
 pub fn notice_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
     if let Some(notice) = &state.notice {
         ui.add_space(6.0);
-        crate::app::widgets::boxed(ui, BAD, &notice.title, |ui| {
-            ui.label(&notice.body);
+        let frame = egui::Frame::group(ui.style()).stroke(egui::Stroke::new(1.5, BAD));
+        let shown = frame.show(ui, |ui| {
+            ui.set_width(ui.available_width());
+            // Wrapped (a long path in the title was cut at the panel's
+            // edge), a long body scrolled within the box.
+            let title = RichText::new(&notice.title).strong().color(BAD);
+            ui.add(egui::Label::new(title).wrap());
+            crate::app::widgets::scrolled_text(
+                ui,
+                "notice_body",
+                NOTICE_BODY_HEIGHT,
+                egui::WidgetText::from(notice.body.as_str()),
+            );
             if ui.button("Dismiss").clicked() {
                 commands.push(Command::View(ViewCommand::DismissNotice));
             }
         });
+        // The panel scrolls the whole box into sight once when it comes
+        // (it sits below the ε plot, under the fold at 768 px).
+        let key = egui::Id::unique("notice_in_sight");
+        let this = (notice.title.clone(), notice.body.clone());
+        if ui.data(|d| d.get_temp::<(String, String)>(key)).as_ref() != Some(&this) {
+            ui.data_mut(|d| d.insert_temp(key, this));
+            shown.response.scroll_to_me(Some(egui::Align::Max));
+        }
     }
 }
 

@@ -32,6 +32,16 @@ const Y_FADE: (f32, f32) = (16.0, 22.0);
 /// wider than its spacing).
 const X_FADE: (f32, f32) = (36.0, 44.0);
 
+/// Least width of a y axis, points: its tick labels ("-10", "0.25") and
+/// its rotated title. egui_plot sizes an axis from the last frame's
+/// labels, so on a plot's first frame the title sat over the ticks (the
+/// Centres views at 3,201 stations); wider labels still widen it.
+const Y_AXIS_MIN: f32 = 48.0;
+
+/// Least height of an x axis, points: a line of tick labels and the
+/// title below it.
+const X_AXIS_MIN: f32 = 38.0;
+
 /// Least distance between two date labels ("2026-01-12"), points.
 pub const DATE_LABEL_GAP: f64 = 96.0;
 
@@ -103,7 +113,9 @@ fn spacer(gap: f64, whole: bool) -> impl Fn(GridInput) -> Vec<GridMark> {
 pub fn readable(plot: Plot<'_>, whole_x: bool) -> Plot<'_> {
     readable_y(plot)
         .custom_x_axes(vec![
-            AxisHints::new_x().label_spacing(egui::Rangef::new(X_FADE.0, X_FADE.1)),
+            AxisHints::new_x()
+                .label_spacing(egui::Rangef::new(X_FADE.0, X_FADE.1))
+                .min_thickness(X_AXIS_MIN),
         ])
         .x_grid_spacer(spacer(X_LABEL_GAP, whole_x))
         .x_axis_formatter(|mark, _| tick_label(mark))
@@ -115,7 +127,9 @@ pub fn readable(plot: Plot<'_>, whole_x: bool) -> Plot<'_> {
 pub fn readable_y(plot: Plot<'_>) -> Plot<'_> {
     plot.grid_spacing(egui::Rangef::new(GRID_SPACING_MIN, 300.0))
         .custom_y_axes(vec![
-            AxisHints::new_y().label_spacing(egui::Rangef::new(Y_FADE.0, Y_FADE.1)),
+            AxisHints::new_y()
+                .label_spacing(egui::Rangef::new(Y_FADE.0, Y_FADE.1))
+                .min_thickness(Y_AXIS_MIN),
         ])
         .y_grid_spacer(spacer(Y_LABEL_GAP, false))
         .y_axis_formatter(|mark, _| tick_label(mark))
@@ -207,7 +221,9 @@ pub fn log_ticks(bounds: (f64, f64), units_per_point: f64, gap: f64) -> Vec<Grid
 pub fn readable_log_y(plot: Plot<'_>) -> Plot<'_> {
     plot.grid_spacing(egui::Rangef::new(GRID_SPACING_MIN, 300.0))
         .custom_y_axes(vec![
-            AxisHints::new_y().label_spacing(egui::Rangef::new(Y_FADE.0, Y_FADE.1)),
+            AxisHints::new_y()
+                .label_spacing(egui::Rangef::new(Y_FADE.0, Y_FADE.1))
+                .min_thickness(Y_AXIS_MIN),
         ])
         .y_grid_spacer(|input: GridInput| {
             let units_per_point = input.base_step_size / f64::from(GRID_SPACING_MIN);
@@ -282,10 +298,14 @@ pub fn epsilon_plot_ui(
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
             (a.min(v), b.max(v))
         });
+    // Within a decade, room above and below the data: the threshold's
+    // name is written above its line, and at the top of the range (a
+    // pose-only run stopping at once under it) it was cut by the frame.
     let decades = if hi - lo >= WHOLE_DECADES_FROM {
         vec![lo.floor(), hi.ceil()]
     } else {
-        Vec::new()
+        let pad = (0.25 * (hi - lo)).max(0.02);
+        vec![lo - pad, hi + pad]
     };
     let mut plot = super::plots::readable_log_y(Plot::new(id));
     for d in decades {

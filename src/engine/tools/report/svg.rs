@@ -129,6 +129,42 @@ pub fn heat_rgb(t: f64) -> [u8; 3] {
     std::array::from_fn(|k| (a[k] + (b[k] - a[k]) * f).round() as u8)
 }
 
+/// The ends of a map colour scale's top: 1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6,
+/// 8 times a power of ten (a round number just above the largest cell).
+const SCALE_STEPS: [f64; 10] = [1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0];
+
+/// The top of a map's colour scale for cells up to `largest` mm: the
+/// smallest round number (`SCALE_STEPS`) at or above it; 0 mm is the
+/// bottom, 1 mm when `largest` is not a positive number.
+#[must_use]
+pub fn scale_top(largest: f64) -> f64 {
+    if !(largest.is_finite() && largest > 0.0) {
+        return 1.0;
+    }
+    let decade = 10f64.powf(largest.log10().floor());
+    SCALE_STEPS
+        .iter()
+        .chain(std::iter::once(&10.0))
+        .map(|m| m * decade)
+        .find(|v| *v >= largest * (1.0 - 1e-12))
+        .unwrap_or(10.0 * decade)
+}
+
+/// The top of the predicted-error map's colour scale (the report's and
+/// the workbench's): a round number ([`scale_top`]) at or above the
+/// largest value and the verdict's tolerance (std, mm), whichever is
+/// larger, so that a cell within the tolerance is never red. A tolerance
+/// that is not a finite number is ignored.
+#[must_use]
+pub fn map_scale(largest: f64, tolerance_mm: f64) -> f64 {
+    let tolerance = if tolerance_mm.is_finite() {
+        tolerance_mm
+    } else {
+        0.0
+    };
+    scale_top(largest.max(tolerance))
+}
+
 /// Escapes text for XML: HTML and SVG content and attribute values, the
 /// URDF export's attributes (the one XML escape of the crate).
 #[must_use]

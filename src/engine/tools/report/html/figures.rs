@@ -5,7 +5,9 @@ use std::fmt::Write as _;
 
 use super::*;
 use crate::engine::calibrate::validate::DistanceRecord;
-use crate::engine::tools::report::svg::{self, Band, Marker, Plot, Rule, Series, escape};
+use crate::engine::tools::report::svg::{
+    self, Band, Marker, Plot, Rule, Series, escape, map_scale,
+};
 use crate::engine::tools::result_view::PairDistance;
 
 /// Width of a full-width figure, px (the page is about 930 px wide).
@@ -410,9 +412,16 @@ fn heat_hex(t: f64) -> String {
 }
 
 /// The predicted error over the range as an inline SVG map: one cell per
-/// grid point coloured by its σ, the sphere positions outlined, the
-/// largest σ marked, the range's limits on the axes.
-pub(super) fn range_map_svg(re: &crate::engine::calibrate::solve::ml::range::RangeError) -> String {
+/// grid point coloured by its σ on an absolute scale from 0 mm to the
+/// verdict's tolerance (std, `tolerance_mm`) or the largest value,
+/// whichever is larger ([`map_scale`], the workbench's scale), the
+/// colour bar beside it with the tolerance and the largest σ marked, the
+/// sphere positions outlined, the largest σ marked, the range's limits
+/// on the axes.
+pub(super) fn range_map_svg(
+    re: &crate::engine::calibrate::solve::ml::range::RangeError,
+    tolerance_mm: Option<f64>,
+) -> String {
     use std::fmt::Write as _;
     if re.map.is_empty() || re.grid < 2 {
         return String::new();
@@ -424,7 +433,7 @@ pub(super) fn range_map_svg(re: &crate::engine::calibrate::solve::ml::range::Ran
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
             (a.min(p[2]), b.max(p[2]))
         });
-    let span = (hi - lo).max(1e-12);
+    let top = map_scale(hi.max(re.max_mm), tolerance_mm.unwrap_or(f64::NAN));
     let cells = re.grid as f64;
     let (y0, y1, z0, z1) = (re.y[0], re.y[1], re.z[0], re.z[1]);
     let half_y = (y1 - y0) / (cells - 1.0) / 2.0;
@@ -437,7 +446,7 @@ pub(super) fn range_map_svg(re: &crate::engine::calibrate::solve::ml::range::Ran
     let _ = write!(
         svg,
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\" role=\"img\" aria-label=\"predicted error over the range\">",
-        w = size + pad + 20.0,
+        w = size + pad + MAP_BAR_ROOM,
         h = size + 56.0
     );
     for c in &re.map {
@@ -448,7 +457,7 @@ pub(super) fn range_map_svg(re: &crate::engine::calibrate::solve::ml::range::Ran
             pz(c[1] + half_z),
             px(c[0] + half_y) - px(c[0] - half_y),
             pz(c[1] - half_z) - pz(c[1] + half_z),
-            heat_hex((c[2] - lo) / span),
+            heat_hex(c[2] / top),
             c[0],
             c[1],
             c[2]
@@ -504,9 +513,192 @@ pub(super) fn range_map_svg(re: &crate::engine::calibrate::solve::ml::range::Ran
         10.0 + size / 2.0,
         10.0 + size / 2.0
     );
+    let mut marks = Vec::new();
+    if let Some(t) = tolerance_mm.filter(|t| t.is_finite() && *t >= 0.0) {
+        marks.push(("tolerance", t));
+    }
+    marks.push(("max", re.max_mm));
+    colour_bar_svg(
+        &mut svg,
+        pad + size + 14.0,
+        (10.0, 10.0 + size),
+        top,
+        &marks,
+    );
     svg.push_str("</svg>");
+    let tolerance = tolerance_mm.map_or_else(String::new, |t| {
+        format!(", the tolerance {} mm (std) marked on the bar", short(t))
+    });
     format!(
-        "<figure id=\"range-map\">{svg}<figcaption>Predicted 1σ over the range (rms over {} working poses): {lo:.3} mm (green) to {hi:.3} mm (red); white outline: where the sphere was seen; ×: the largest σ.</figcaption></figure>\n",
-        re.poses
+        "<figure id=\"range-map\">{svg}<figcaption>Predicted 1σ over the range (rms over {} working poses): {lo:.3} to {hi:.3} mm; the summary's max {:.3} mm (×) is the largest at any one pose. Colours from 0 mm (green) to {} mm (red){tolerance}; white outline: where the sphere was seen.</figcaption></figure>\n",
+        re.poses,
+        re.max_mm,
+        short(top)
     )
+}
+
+/// Room right of the map for its colour bar and labels, px.
+const MAP_BAR_ROOM: f64 = 170.0;
+
+/// Width of the map's colour bar, px.
+const MAP_BAR_WIDTH: f64 = 14.0;
+
+/// Bands the map's colour bar is drawn in.
+const MAP_BAR_BANDS: usize = 48;
+
+/// A number as the map's bar and caption give it: at most four
+/// significant decimals, no trailing zeros (0.12, 0.2, 0.1125).
+fn short(v: f64) -> String {
+    let text = format!("{v:.4}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text.is_empty() || text == "-" {
+        "0".to_string()
+    } else {
+        text.to_string()
+    }
+}
+
+/// The map's colour bar at `x`, from `y.1` (0 mm) up to `y.0` (`top`
+/// mm): labelled round values in mm on its right, and each of `marks`
+/// (name, mm) as a dark line across it with its name and value.
+fn colour_bar_svg(svg: &mut String, x: f64, y: (f64, f64), top: f64, marks: &[(&str, f64)]) {
+    let (y_top, y_bottom) = y;
+    let y_of = |v: f64| y_bottom - (v / top).clamp(0.0, 1.0) * (y_bottom - y_top);
+    for k in 0..MAP_BAR_BANDS {
+        let (a, b) = (
+            top * k as f64 / MAP_BAR_BANDS as f64,
+            top * (k + 1) as f64 / MAP_BAR_BANDS as f64,
+        );
+        let _ = write!(
+            svg,
+            "<rect x=\"{x:.1}\" y=\"{:.2}\" width=\"{MAP_BAR_WIDTH:.1}\" height=\"{:.2}\" fill=\"{}\"/>",
+            y_of(b),
+            y_of(a) - y_of(b) + 0.3,
+            heat_hex(f64::midpoint(a, b) / top)
+        );
+    }
+    let _ = write!(
+        svg,
+        "<rect id=\"range-map-scale\" data-top=\"{}\" x=\"{x:.1}\" y=\"{y_top:.1}\" width=\"{MAP_BAR_WIDTH:.1}\" height=\"{:.1}\" fill=\"none\" stroke=\"#444\"><title>colour scale: 0 mm (green) to {} mm (red)</title></rect>",
+        short(top),
+        y_bottom - y_top,
+        short(top)
+    );
+    let ticks = crate::engine::tools::report::svg::nice_ticks(0.0, top, 4, false);
+    let step = ticks.get(1).map_or(top, |t| t - ticks[0]);
+    let mut values = ticks;
+    if values.last().is_some_and(|last| top - last > step * 0.3) {
+        values.push(top);
+    }
+    for v in values {
+        let _ = write!(
+            svg,
+            "<text class=\"tick\" x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" dominant-baseline=\"middle\">{} mm</text>",
+            x + MAP_BAR_WIDTH + 4.0,
+            y_of(v),
+            short(v)
+        );
+    }
+    let mut placed: Vec<f64> = Vec::new();
+    for (name, v) in marks {
+        if !(v.is_finite() && *v >= 0.0) {
+            continue;
+        }
+        let at = y_of(*v);
+        // Two marks close together: the second one's words below.
+        let dy = if placed.iter().any(|p| (p - at).abs() < 12.0) {
+            12.0
+        } else {
+            0.0
+        };
+        placed.push(at);
+        let _ = write!(
+            svg,
+            "<line class=\"mark\" x1=\"{:.1}\" y1=\"{at:.1}\" x2=\"{:.1}\" y2=\"{at:.1}\" stroke=\"#000\" stroke-width=\"2\"/><text class=\"mark\" x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" dominant-baseline=\"middle\">{name} {}</text>",
+            x - 2.0,
+            x + MAP_BAR_WIDTH + 2.0,
+            x + MAP_BAR_WIDTH + 54.0,
+            at + dy,
+            short(*v)
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::calibrate::solve::ml::range::RangeError;
+
+    /// A 3 × 3 map of σ from 0.100 to 0.112 mm (the issue's passing cell).
+    fn map() -> RangeError {
+        let mut map = Vec::new();
+        for (k, (y, z)) in [-20.0, 0.0, 20.0]
+            .iter()
+            .flat_map(|y| [-10.0, 0.0, 10.0].map(move |z| (*y, z)))
+            .enumerate()
+        {
+            map.push([y, z, 0.100 + 0.0015 * k as f64]);
+        }
+        RangeError {
+            y: [-20.0, 20.0],
+            z: [-10.0, 10.0],
+            grid: 3,
+            poses: 12,
+            max_mm: 0.150,
+            max_at: [20.0, 10.0],
+            sphere_y: [-5.0, 5.0],
+            sphere_z: [-2.0, 2.0],
+            map,
+            ..RangeError::default()
+        }
+    }
+
+    fn fills(svg: &str) -> Vec<String> {
+        svg.split("<rect ")
+            .filter(|r| r.contains("<title>y "))
+            .filter_map(|r| r.split("fill=\"").nth(1))
+            .filter_map(|r| r.split('"').next())
+            .map(str::to_string)
+            .collect()
+    }
+
+    /// Issue 34: the report's map ran from the smallest to the largest
+    /// cell, so cells of 0.100-0.112 mm passing a 0.2 mm tolerance were
+    /// green to solid red. Now the scale is the workbench's: 0 to the
+    /// tolerance (or the largest value), the tolerance and the maximum
+    /// marked on the bar, and the caption says so.
+    #[test]
+    fn the_reports_map_runs_from_zero_to_the_tolerance() {
+        let svg = range_map_svg(&map(), Some(0.2));
+        assert!(svg.contains("data-top=\"0.2\""), "{svg}");
+        assert!(svg.contains(">tolerance 0.2</text>"), "{svg}");
+        assert!(svg.contains(">max 0.15</text>"), "{svg}");
+        assert!(svg.contains(">0 mm</text>") && svg.contains(">0.2 mm</text>"));
+        assert!(svg.contains("Colours from 0 mm (green) to 0.2 mm (red), the tolerance 0.2 mm (std) marked on the bar"));
+        let cells = fills(&svg);
+        assert_eq!(cells.len(), 9);
+        // 0.100 to 0.112 mm on 0 … 0.2 mm: at most half-way (yellow),
+        // never the red end; the largest cell is the workbench's colour.
+        let red = heat_hex(1.0);
+        assert!(cells.iter().all(|c| *c != red), "{cells:?}");
+        assert_eq!(cells[8], heat_hex(0.112 / 0.2));
+        assert_eq!(cells[0], heat_hex(0.5));
+    }
+
+    /// Beyond the tolerance the largest value sets the top (a round
+    /// number at or above it); without a tolerance only the maximum is
+    /// marked.
+    #[test]
+    fn the_largest_value_sets_the_top_beyond_the_tolerance() {
+        let mut re = map();
+        re.max_mm = 0.7;
+        let svg = range_map_svg(&re, Some(0.5));
+        assert!(svg.contains("data-top=\"0.8\""), "{svg}");
+        assert!(svg.contains(">tolerance 0.5</text>") && svg.contains(">max 0.7</text>"));
+        let svg = range_map_svg(&map(), None);
+        assert!(svg.contains("data-top=\"0.15\""), "{svg}");
+        assert!(!svg.contains("tolerance"), "{svg}");
+        assert!(svg.contains(">max 0.15</text>"));
+        assert!(svg.contains("to 0.15 mm (red); white outline"));
+    }
 }

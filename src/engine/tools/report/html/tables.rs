@@ -120,7 +120,10 @@ pub(super) fn identifiability(h: &mut String, ctx: &Ctx<'_>) {
             );
         }
         if let Some(re) = &ml.range_error {
-            h.push_str(&super::figures::range_map_svg(re));
+            h.push_str(&super::figures::range_map_svg(
+                re,
+                ctx.input.tolerance.map(|t| t.std_mm),
+            ));
         }
         h.push_str("<p class=\"muted\">σ of every estimated parameter: in the hand-eye and joint-error tables below (± values).</p>\n");
     } else {
