@@ -18,9 +18,7 @@ use crate::app::widgets::{
     range_values,
 };
 use crate::app::{Forms, plan::form::default_sphere};
-use crate::engine::tools::plan::{
-    MAX_PREDICT_RUNS, Plan, PlanStats, Planned, Selection, StationRole,
-};
+use crate::engine::tools::plan::{MAX_PREDICT_RUNS, Plan, PlanStats, Planned, StationRole};
 
 /// Width of the settings column, points.
 const FORM_WIDTH: f32 = 330.0;
