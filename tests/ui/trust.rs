@@ -230,7 +230,23 @@ fn cancel_always_wins_and_the_previous_result_stays() {
             h.query_all_by_label_contains(&phase).next().is_some(),
             "the side panel names the phase {phase}"
         );
-        h.get_by_label("Cancel").click();
+        // kittest runs one frame an event: the pointer's move and press
+        // first; the click is its release, one frame. A run that ended
+        // before the release was not cancelled (a user's click is the same).
+        let at = h.get_by_label("Cancel").rect().center();
+        for pressed in [None, Some(true)] {
+            h.event(match pressed {
+                None => egui::Event::PointerMoved(at),
+                Some(pressed) => pointer_button(at, pressed),
+            });
+        }
+        h.step();
+        if h.state().state().jobs.get(&Slot::Run).is_none() {
+            h.event(pointer_button(at, false));
+            h.step();
+            continue;
+        }
+        h.event(pointer_button(at, false));
         h.step();
         let state = h.state().state();
         assert!(
@@ -773,5 +789,15 @@ fn every_stripe_warning_is_named_and_marks_step_3() {
             "{c}"
         );
         assert!(!c.contains('…'), "{c}");
+    }
+}
+
+/// A primary-button press or release at `at`.
+fn pointer_button(at: egui::Pos2, pressed: bool) -> egui::Event {
+    egui::Event::PointerButton {
+        pos: at,
+        button: egui::PointerButton::Primary,
+        pressed,
+        modifiers: egui::Modifiers::NONE,
     }
 }
