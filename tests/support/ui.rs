@@ -95,6 +95,29 @@ pub fn labels_with(h: &Harness<'_, WorkbenchApp>, part: &str) -> Vec<String> {
 }
 
 /// The status line's text.
+/// A command applied as the window would, then settled.
+pub fn command(h: &mut Harness<'_, WorkbenchApp>, c: spherecal::app::command::Command) {
+    let ctx = h.ctx.clone();
+    h.state_mut().command(&ctx, c);
+    settle(h);
+}
+
+/// The open session's first measurement left out (what makes the result
+/// on show stale).
+pub fn leave_out_first(h: &mut Harness<'_, WorkbenchApp>) {
+    let Some(loaded) = h.state().state().loaded.as_ref() else {
+        panic!("no session open");
+    };
+    let id = loaded.session.measurements[0].id.clone();
+    command(
+        h,
+        spherecal::app::command::Command::View(spherecal::app::command::ViewCommand::SetIncluded {
+            id,
+            included: false,
+        }),
+    );
+}
+
 pub fn status(h: &Harness<'_, WorkbenchApp>) -> String {
     h.state()
         .state()

@@ -28,16 +28,10 @@ use spherecal::engine::tools::simulate::{
 };
 
 use crate::support::ui as ui_support;
-use ui_support::{demo_app, labels_with, open_path, settle, step_label};
+use ui_support::{command, demo_app, labels_with, leave_out_first, open_path, settle, step_label};
 
 /// Where the check's sphere stands (the IRB 2400's quick-start spot).
 const SPHERE: [f64; 3] = [1050.0, 0.0, 475.0];
-
-fn command(h: &mut Harness<'_, WorkbenchApp>, c: Command) {
-    let ctx = h.ctx.clone();
-    h.state_mut().command(&ctx, c);
-    settle(h);
-}
 
 /// A simulated cell calibrated by `ml`: its session and result written to
 /// `dir` and opened in the window (the result for review); the truth.
@@ -216,23 +210,7 @@ fn the_check_view_holds_on_an_unchanged_cell_flags_a_knock_and_goes_stale() {
     assert!(h.state().state().ledger.stale(Artefact::Check).is_none());
     // A measurement left out: the result and the verdict are stale, and
     // no check is made against a stale result.
-    let id = h
-        .state()
-        .state()
-        .loaded
-        .as_ref()
-        .unwrap()
-        .session
-        .measurements[0]
-        .id
-        .clone();
-    command(
-        &mut h,
-        Command::View(ViewCommand::SetIncluded {
-            id,
-            included: false,
-        }),
-    );
+    leave_out_first(&mut h);
     assert!(h.state().state().ledger.stale(Artefact::Check).is_some());
     command(&mut h, Command::Check(CheckCommand::Run));
     assert!(h.state().state().ledger.stale(Artefact::Check).is_some());

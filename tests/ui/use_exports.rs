@@ -33,15 +33,9 @@ use crate::support::tool_readers::{
     assert_same, read_fanuc_utool, read_krl_tool, read_rapid_tooldata, read_ros, read_ur_tcp,
 };
 use crate::support::ui as ui_support;
-use ui_support::{demo_app, open_path, settle};
+use ui_support::{command, demo_app, leave_out_first, open_path};
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data");
-
-fn command(h: &mut Harness<'_, WorkbenchApp>, c: Command) {
-    let ctx = h.ctx.clone();
-    h.state_mut().command(&ctx, c);
-    settle(h);
-}
 
 /// The file last written, by what the list of files calls it.
 fn written(h: &Harness<'_, WorkbenchApp>, what: &str) -> Option<PathBuf> {
@@ -99,23 +93,7 @@ fn tool_data_of_joint_and_pose_only_results_reads_back_for_every_controller() {
     }
     // Stale: a measurement left out of the session the result is shown
     // against; every export refused, nothing written.
-    let id = h
-        .state()
-        .state()
-        .loaded
-        .as_ref()
-        .unwrap()
-        .session
-        .measurements[0]
-        .id
-        .clone();
-    command(
-        &mut h,
-        Command::View(ViewCommand::SetIncluded {
-            id,
-            included: false,
-        }),
-    );
+    leave_out_first(&mut h);
     let out = dir.path().join("stale");
     std::fs::create_dir(&out).unwrap();
     h.state_mut().forms_mut().export_dir = out.display().to_string();
@@ -261,23 +239,7 @@ fn compensate_takes_the_current_tool_of_a_pose_only_result_and_copy_is_disabled_
         engine.compensation.text
     );
     // The result goes stale: the tool data's Copy is disabled, saying why.
-    let id = h
-        .state()
-        .state()
-        .loaded
-        .as_ref()
-        .unwrap()
-        .session
-        .measurements[0]
-        .id
-        .clone();
-    command(
-        &mut h,
-        Command::View(ViewCommand::SetIncluded {
-            id,
-            included: false,
-        }),
-    );
+    leave_out_first(&mut h);
     h.state_mut().forms_mut().compensate.current_tool.clear();
     command(&mut h, Command::View(ViewCommand::ShowTab(Tab::Compensate)));
     h.run();
