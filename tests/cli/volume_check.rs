@@ -292,16 +292,129 @@ fn fitted(
         .collect()
 }
 
-/// The score of one cell: (after, floor) rms mm, rows missed, seconds.
+/// The score of one cell: (after, floor) rms mm, rows missed, seconds,
+/// and its anatomy.
 struct Cell {
     after: f64,
     floor: f64,
     missed: usize,
     rows: usize,
     seconds: f64,
+    /// The calibration's own error over the validate poses, noise-free:
+    /// each validate pose's true sensor-frame centre carried to the base
+    /// frame by the calibrated model, averaged by station, aligned
+    /// rigidly to the truth, rms (mm).
+    param: f64,
+    /// What the result predicts for it (`volume_error.rms_mm`).
+    predicted: f64,
+    /// Largest |measure − own mapping| over the validate points (mm): 0
+    /// when the rescoring below maps as `measure` does.
+    mapping_check: f64,
+    truth: Robot,
+    hand_eye: Isometry3<f64>,
+    calibrated: (Robot, Isometry3<f64>),
+}
+
+/// The calibration's noise-free error at `rows` (validate) over
+/// `stations`: see [`Cell::param`].
+fn param_error(
+    stations: &[(String, Vector3<f64>)],
+    rows: &[Row],
+    robot: &Robot,
+    hand_eye: &Isometry3<f64>,
+) -> f64 {
+    let mapped: Vec<Vector3<f64>> = stations
+        .iter()
+        .map(|(id, _)| {
+            let own: Vec<Vector3<f64>> = rows
+                .iter()
+                .filter(|r| r.station == *id)
+                .map(|r| {
+                    (robot.base_from_flange(&r.joints) * hand_eye * Point3::from(r.centre)).coords
+                })
+                .collect();
+            own.iter().sum::<Vector3<f64>>() / own.len() as f64
+        })
+        .collect();
+    let exact: Vec<Vector3<f64>> = stations.iter().map(|(_, p)| *p).collect();
+    aligned_rms(&mapped, &exact)
+}
+
+/// The predicted volume error (`volume_error.rms_mm`) of a result file.
+fn predicted_volume_error(text: &str) -> f64 {
+    let v: serde_json::Value = serde_json::from_str(text).unwrap();
+    v["solver"]["volume_error"]["rms_mm"]
+        .as_f64()
+        .unwrap_or(f64::NAN)
+}
+
+/// A fresh validate set for a calibrated cell, scored in-process (the
+/// calibrated model maps as `measure` does: [`Cell::mapping_check`]):
+/// (after, floor, param) mm.
+fn rescore(c: &Cell, rng: &mut ChaCha8Rng) -> (f64, f64, f64) {
+    let preset = robot::preset("irb2400").unwrap();
+    let config = PlanConfig::for_preset(&preset, SPHERE);
+    let StationLayout::Box { size } = config.stations else {
+        unreachable!()
+    };
+    let centre = Vector3::from(SPHERE);
+    let half = Vector3::from(size) / 2.0;
+    let (rows, stations) = validate_rows(
+        rng,
+        &c.truth,
+        &c.hand_eye,
+        &config.limits,
+        &(centre - half),
+        &(centre + half),
+    );
+    let readings: Vec<(Vec<f64>, Vec<[f64; 2]>)> = rows
+        .iter()
+        .map(|r| {
+            let q = r
+                .joints
+                .iter()
+                .map(|q| q + JOINT_NOISE_DEG * normal(rng))
+                .collect();
+            (q, stripe(rng, &r.centre))
+        })
+        .collect();
+    let points_of = |robot: &Robot, he: &Isometry3<f64>| -> BTreeMap<String, Vec<Vector3<f64>>> {
+        rows.iter()
+            .zip(&readings)
+            .map(|(r, (q, s))| {
+                let t = robot.base_from_flange(q) * he;
+                let pts = s
+                    .iter()
+                    .map(|p| (t * Point3::new(0.0, p[0], p[1])).coords)
+                    .collect();
+                (r.id.clone(), pts)
+            })
+            .collect()
+    };
+    let exact: Vec<Vector3<f64>> = stations.iter().map(|(_, p)| *p).collect();
+    let floor = aligned_rms(
+        &fitted(&stations, &rows, &points_of(&c.truth, &c.hand_eye)),
+        &exact,
+    );
+    let after = aligned_rms(
+        &fitted(
+            &stations,
+            &rows,
+            &points_of(&c.calibrated.0, &c.calibrated.1),
+        ),
+        &exact,
+    );
+    let param = param_error(&stations, &rows, &c.calibrated.0, &c.calibrated.1);
+    (after, floor, param)
 }
 
 fn cell(dir: &Path, plan: &[PlanPose], seed: u64) -> Cell {
+    cell_rep(dir, plan, seed, 0)
+}
+
+/// Cell `seed` with its readings' noise drawn afresh for `rep` > 0 (the
+/// same true robot, plan rows and validate poses).
+fn cell_rep(dir: &Path, plan: &[PlanPose], seed: u64, rep: u64) -> Cell {
     let preset = robot::preset("irb2400").unwrap();
     let config = PlanConfig::for_preset(&preset, SPHERE);
     let StationLayout::Box { size } = config.stations else {
@@ -322,7 +435,21 @@ fn cell(dir: &Path, plan: &[PlanPose], seed: u64) -> Cell {
         &(centre - half),
         &(centre + half),
     );
+    let validate_only: Vec<Row> = validate
+        .iter()
+        .map(|r| Row {
+            id: r.id.clone(),
+            station: r.station.clone(),
+            usage: r.usage,
+            side: r.side,
+            joints: r.joints.clone(),
+            centre: r.centre,
+        })
+        .collect();
     rows.extend(validate);
+    if rep > 0 {
+        rng = ChaCha8Rng::seed_from_u64(0x5EED_0032_1000_0000 + 1000 * seed + rep);
+    }
     let measurements: Vec<Measurement> = rows
         .iter()
         .map(|r| Measurement {
@@ -367,7 +494,7 @@ fn cell(dir: &Path, plan: &[PlanPose], seed: u64) -> Cell {
         format!("volume check, cell {seed}"),
         preset.robot.clone(),
         DIAMETER,
-        measurements,
+        measurements.clone(),
     );
     let (s, r, v) = (
         dir.join(format!("cell{seed}.json")),
@@ -376,13 +503,16 @@ fn cell(dir: &Path, plan: &[PlanPose], seed: u64) -> Cell {
     );
     format::save_session(&session, &s).unwrap();
     let t = Instant::now();
-    let (code, out, err) = run(&[
+    let extra = std::env::var("VOLUME_CHECK_CALIBRATE").unwrap_or_default();
+    let mut args: Vec<&std::ffi::OsStr> = vec![
         "calibrate".as_ref(),
         s.as_os_str(),
         "--out".as_ref(),
         r.as_os_str(),
         "-q".as_ref(),
-    ]);
+    ];
+    args.extend(extra.split_whitespace().map(std::ffi::OsStr::new));
+    let (code, out, err) = run(&args);
     let seconds = t.elapsed().as_secs_f64();
     assert_eq!(code, 0, "calibrate: {out}{err}");
     let (code, out, err) = run(&[
@@ -407,12 +537,27 @@ fn cell(dir: &Path, plan: &[PlanPose], seed: u64) -> Cell {
             .push(Vector3::new(f(1), f(2), f(3)));
     }
     let after = aligned_rms(&fitted(&v_stations, &rows, &measured), &exact);
+    let text = std::fs::read_to_string(&r).unwrap();
+    let result = format::load_result(&r).unwrap();
+    let calibrated = (result.robot.clone().unwrap(), result.hand_eye);
+    let predicted = predicted_volume_error(&text);
+    let own = points_of(&calibrated.0, &calibrated.1);
+    let mapping_check = measured
+        .iter()
+        .flat_map(|(id, pts)| pts.iter().zip(&own[id]).map(|(a, b)| (a - b).norm()))
+        .fold(0.0, f64::max);
     Cell {
         after,
         floor,
         missed,
         rows: planned,
         seconds,
+        param: param_error(&v_stations, &validate_only, &calibrated.0, &calibrated.1),
+        predicted,
+        mapping_check,
+        truth,
+        hand_eye,
+        calibrated,
     }
 }
 
@@ -463,16 +608,18 @@ fn issue_32_check() {
             &extra
         }
     );
-    println!("| cell | after, mm | floor, mm | after / floor | rows missed | calibrate, s |");
-    println!("|---|---|---|---|---|---|");
+    println!(
+        "| cell | after, mm | floor, mm | after / floor | rows missed | calibrate, s | parameters' part, mm | predicted, mm |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
     let mut ratios = Vec::new();
     for seed in seeds() {
         let c = cell(&dir, &plan, seed);
         let ratio = c.after / c.floor;
         ratios.push(ratio);
         println!(
-            "| {seed} | {:.4} | {:.4} | {ratio:.2} | {} of {} | {:.1} |",
-            c.after, c.floor, c.missed, c.rows, c.seconds
+            "| {seed} | {:.4} | {:.4} | {ratio:.2} | {} of {} | {:.1} | {:.4} | {:.4} |",
+            c.after, c.floor, c.missed, c.rows, c.seconds, c.param, c.predicted
         );
     }
     let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
@@ -535,6 +682,104 @@ fn rows_missed() {
         counts.len(),
         counts.iter().sum::<usize>(),
         counts.iter().max().unwrap_or(&0)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// What makes a bad cell bad: each cell of `VOLUME_CHECK_SEEDS` as the
+/// check scores it, then (a) the same calibration scored on
+/// `VOLUME_ANATOMY_RESCORES` fresh validate sets (the score's own noise:
+/// the calibration fixed, the validate stations and noise drawn again)
+/// and (b) calibrated again from `VOLUME_ANATOMY_REPS` fresh draws of the
+/// readings' noise (the same true robot and rows: is the cell bad
+/// through its robot or through its noise?). Each row: the ratio, the
+/// parameters' part of the error (noise-free, see [`Cell::param`])
+/// against what the result predicts; last, a summary over them all.
+/// `VOLUME_CHECK_CALIBRATE` adds options to `calibrate`.
+#[test]
+#[ignore = "bench: the anatomy of the check's cells"]
+fn anatomy() {
+    let dir = std::env::temp_dir().join(format!("spherecal-volume-anatomy-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("P.csv");
+    let extra = std::env::var("VOLUME_CHECK_PLAN").unwrap_or_default();
+    let env = |k: &str, d: u64| {
+        std::env::var(k)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(d)
+    };
+    let (reps, rescores) = (
+        env("VOLUME_ANATOMY_REPS", 3),
+        env("VOLUME_ANATOMY_RESCORES", 20),
+    );
+    let mut args: Vec<String> = [
+        "plan",
+        "--sphere",
+        "1050,0,475",
+        "--identify-stations",
+        "20",
+        "--csv",
+    ]
+    .iter()
+    .map(|s| (*s).to_owned())
+    .collect();
+    args.push(csv.display().to_string());
+    args.extend(extra.split_whitespace().map(str::to_owned));
+    let (code, out, err) = run(&args);
+    assert_eq!(code, 0, "plan: {out}{err}");
+    let plan = read_plan_csv(&std::fs::read_to_string(&csv).unwrap()).unwrap();
+    println!(
+        "| cell | noise | after / floor | floor, mm | parameters' part, mm | predicted, mm | part / predicted | rescored: ratio median [10 %, 90 %], parameters' part mean |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    let (mut ratios, mut parts, mut shares) = (Vec::new(), Vec::new(), Vec::new());
+    for seed in seeds() {
+        for rep in 0..=reps {
+            let c = cell_rep(&dir, &plan, seed, rep);
+            let rescored = if rep == 0 && rescores > 0 {
+                let mut rng = ChaCha8Rng::seed_from_u64(0x5EED_0032_2000_0000 + seed);
+                let s: Vec<(f64, f64, f64)> =
+                    (0..rescores).map(|_| rescore(&c, &mut rng)).collect();
+                let mut r: Vec<f64> = s.iter().map(|(a, f, _)| a / f).collect();
+                r.sort_by(f64::total_cmp);
+                let at = |f: f64| r[((r.len() - 1) as f64 * f).round() as usize];
+                format!(
+                    "{:.2} [{:.2}, {:.2}], {:.4} (mapping check {:.1e} mm)",
+                    at(0.5),
+                    at(0.1),
+                    at(0.9),
+                    s.iter().map(|x| x.2).sum::<f64>() / s.len() as f64,
+                    c.mapping_check
+                )
+            } else {
+                String::new()
+            };
+            println!(
+                "| {seed} | {rep} | {:.2} | {:.4} | {:.4} | {:.4} | {:.2} | {rescored} |",
+                c.after / c.floor,
+                c.floor,
+                c.param,
+                c.predicted,
+                c.param / c.predicted,
+            );
+            ratios.push(c.after / c.floor);
+            parts.push(c.param);
+            shares.push(c.param / c.predicted);
+        }
+    }
+    let n = ratios.len() as f64;
+    ratios.sort_by(f64::total_cmp);
+    println!(
+        "{} calibrations: after / floor mean {:.3}, 90th percentile {:.2}, worst {:.2}, over 1.6: {}; parameters' part mean {:.4} mm, rms {:.4} mm; part / predicted mean {:.2}",
+        ratios.len(),
+        ratios.iter().sum::<f64>() / n,
+        ratios[((n - 1.0) * 0.9).round() as usize],
+        ratios[ratios.len() - 1],
+        ratios.iter().filter(|r| **r > 1.6).count(),
+        parts.iter().sum::<f64>() / n,
+        (parts.iter().map(|p| p * p).sum::<f64>() / n).sqrt(),
+        shares.iter().sum::<f64>() / n
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
