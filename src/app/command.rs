@@ -39,6 +39,12 @@ pub enum Command {
     /// A file for the controller or the planner from the result on show
     /// (tool data, the robot's URDF back, UR's calibration).
     UseExport(UseExport),
+    /// Run the calibration with these settings (the solver panel's are
+    /// set to them first): "Run again with threshold 0".
+    RunWith(Box<crate::engine::calibrate::solve::Options>),
+    /// A command given by the step bar's Next: a run it starts opens
+    /// Results (the verdict) when it ends.
+    Next(Box<Command>),
 }
 
 /// The Re-check view.
@@ -252,35 +258,30 @@ impl ExportKind {
         Self::ModelUrdf,
     ];
 
+    /// The button text and the file name's suffix.
+    fn words(self) -> (&'static str, &'static str) {
+        match self {
+            Self::ResultJson => ("Result JSON", "result.json"),
+            Self::CentresCsv => ("Centres CSV", "centres.csv"),
+            Self::DistancesCsv => ("Distances CSV", "distances.csv"),
+            Self::PlotsPng => ("Plots PNG", "plots.png"),
+            Self::ModelJson => ("Model JSON", "model.json"),
+            Self::ModelCsv => ("Model CSV", "model.csv"),
+            Self::ModelUrdf => ("Model URDF", "model.urdf"),
+            Self::ReportHtml => ("Report HTML", "report.html"),
+        }
+    }
+
     /// The button text.
     #[must_use]
     pub fn label(self) -> &'static str {
-        match self {
-            Self::ResultJson => "Result JSON",
-            Self::CentresCsv => "Centres CSV",
-            Self::DistancesCsv => "Distances CSV",
-            Self::PlotsPng => "Plots PNG",
-            Self::ModelJson => "Model JSON",
-            Self::ModelCsv => "Model CSV",
-            Self::ModelUrdf => "Model URDF",
-            Self::ReportHtml => "Report HTML",
-        }
+        self.words().0
     }
 
     /// The file name for a session stem.
     #[must_use]
     pub fn file_name(self, stem: &str) -> String {
-        let suffix = match self {
-            Self::ResultJson => "result.json",
-            Self::CentresCsv => "centres.csv",
-            Self::DistancesCsv => "distances.csv",
-            Self::PlotsPng => "plots.png",
-            Self::ModelJson => "model.json",
-            Self::ModelCsv => "model.csv",
-            Self::ModelUrdf => "model.urdf",
-            Self::ReportHtml => "report.html",
-        };
-        format!("{stem}-{suffix}")
+        format!("{stem}-{}", self.words().1)
     }
 }
 

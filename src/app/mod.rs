@@ -122,8 +122,12 @@ pub struct AppState {
     /// The result on show (from a run or a reviewed file).
     pub result: Option<results::ResultView>,
     /// A run finished while another view was on show: the Results tab
-    /// is marked until it is opened.
+    /// is marked until it is opened (and Next shows the verdict before
+    /// offering the report).
     pub result_unseen: bool,
+    /// The run under way was started by Next: Results (the verdict)
+    /// opens when it ends.
+    pub run_by_next: bool,
     /// The status line.
     pub status: Option<Status>,
     /// An error shown until dismissed.
@@ -410,13 +414,21 @@ impl Core {
         out
     }
 
-    /// Clears an artefact that went stale (its [`WhenStale::Clear`]).
+    /// Clears an artefact's view: one that went stale (its
+    /// [`WhenStale::Clear`]), or one made from the previous session.
     fn clear(&mut self, artefact: Artefact) {
-        if artefact == Artefact::ImportView {
-            let view = &mut self.state.import;
-            view.preview = None;
-            view.outcome = None;
-            view.checks.clear();
+        let state = &mut self.state;
+        match artefact {
+            Artefact::ImportView => {
+                state.import.preview = None;
+                state.import.outcome = None;
+                state.import.checks.clear();
+            }
+            Artefact::Cloud => state.measure = measure::MeasureView::default(),
+            Artefact::Compensation => state.compensate.outcome = None,
+            Artefact::CheckPlan => state.check.plan = None,
+            Artefact::Check => state.check.outcome = None,
+            _ => {}
         }
     }
 
@@ -446,6 +458,36 @@ impl Core {
             Command::Measure(c) => self.measure(ctx, c),
             Command::Check(c) => self.check(ctx, c),
             Command::UseExport(kind) => self.use_export(ctx, kind),
+            Command::RunWith(options) => {
+                self.forms.solver = *options;
+                self.observe(ctx);
+                self.run(ctx, command::RunCommand::Start);
+            }
+            Command::Next(c) => {
+                let idle = !self.state.jobs.runs(&Slot::Run);
+                self.apply(ctx, *c);
+                self.state.run_by_next |= idle && self.state.jobs.runs(&Slot::Run);
+            }
+        }
+    }
+
+    /// A run ended: when Next started it, Results (the verdict) opens;
+    /// a result made without any update says so in the status line.
+    fn after_run(&mut self, shown_before: u64) {
+        let by_next = std::mem::take(&mut self.state.run_by_next);
+        if self.state.results_shown == shown_before {
+            return;
+        }
+        if by_next {
+            self.view(command::ViewCommand::ShowTab(Tab::Results));
+        }
+        let warning = self
+            .state
+            .result
+            .as_ref()
+            .and_then(|r| r.file.no_update_warning());
+        if let Some(w) = warning {
+            self.state.say(Level::Warning, format!("calibrated: {w}"));
         }
     }
 
@@ -479,7 +521,11 @@ impl Core {
             };
             match slot {
                 Slot::Load => take(a).map(|l| self.on_loaded(ctx, l)),
-                Slot::Run => take(a).map(|o| self.on_run(&job, o)),
+                Slot::Run => take(a).map(|o| {
+                    let shown = self.state.results_shown;
+                    self.on_run(&job, o);
+                    self.after_run(shown);
+                }),
                 Slot::Plan => take(a).map(|o| self.on_plan(&job, o)),
                 Slot::Simulate => take(a).map(|o| self.on_simulated(ctx, o)),
                 Slot::Import => take(a).map(|o| self.on_imported(ctx, &job, o)),
@@ -732,7 +778,8 @@ impl Core {
     /// forms and the selection, says what was found, and opens the result
     /// waiting for it.
     pub(super) fn on_session(&mut self, ctx: &egui::Context, loaded: LoadedSession) {
-        // A run of the previous session: stopped and forgotten.
+        // A run of the previous session: stopped and forgotten (and the
+        // jobs of what was made of its result, below).
         self.state.jobs.cancel(&Slot::Run);
         match loaded.source.path() {
             Some(p) => {
@@ -785,11 +832,40 @@ impl Core {
         self.state.result_unseen = false;
         self.state.notice = None;
         self.state.session_loads += 1;
+        // What was made of the last session's result goes with it, the
+        // result and report aside (forgotten, not said); what was never
+        // written is said.
+        let mut cleared = Vec::new();
+        for a in Artefact::ALL.into_iter().filter(|a| a.upstream().is_some()) {
+            let ledger = &self.state.ledger;
+            if let Some(made) = ledger.made(a).filter(|_| a != Artefact::Report) {
+                let saved = ledger
+                    .written
+                    .iter()
+                    .any(|w| w.from == a && w.stamp == made.stamp);
+                cleared.push(format!(
+                    "{}{}",
+                    a.name(),
+                    if saved { "" } else { " (never written)" }
+                ));
+            }
+            if let Some(slot) = Slot::of(a) {
+                self.state.jobs.cancel(&slot);
+            }
+            self.state.ledger.forget(a);
+            self.clear(a);
+        }
         self.state.ledger.forget(Artefact::Result);
-        self.state.ledger.forget(Artefact::Report);
         // The files written of the last session are not this one's.
         self.state.ledger.forget_written_of(Input::Session);
-        let (level, text) = opened_line(&loaded);
+        let (mut level, mut text) = opened_line(&loaded);
+        if !cleared.is_empty() {
+            level = Level::Warning.max(level);
+            text = format!(
+                "{text}; cleared what was made of the previous session: {}",
+                cleared.join(", ")
+            );
+        }
         self.state.say(level, text);
         if let Ok(set) = &loaded.before {
             self.forms.centres.magnify = set.suggested_magnify;

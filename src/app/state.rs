@@ -13,7 +13,7 @@ use crate::engine::tools::result_view::Tolerance;
 pub const RECENT_MAX: usize = 8;
 
 /// How serious a status line is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Level {
     /// Plain information.
     Info,

@@ -82,6 +82,16 @@ pub fn verdict(state: &AppState, forms: &Forms) -> Option<Verdict> {
         .map(|r| Verdict::of(r.shown.headline.as_ref(), &forms.tolerance))
 }
 
+/// The label of the one click that refines a result the loop made no
+/// update to (the engine's warning names it).
+const RUN_AT_ZERO: &str = "Run again with threshold 0";
+
+/// The warning when the result on show was made without any update
+/// (ε started within the threshold).
+fn no_update(state: &AppState) -> Option<String> {
+    state.result.as_ref()?.file.no_update_warning()
+}
+
 /// Measurements `ml` listed as outliers in the result on show.
 fn outliers(state: &AppState) -> usize {
     state
@@ -107,6 +117,21 @@ pub fn standing(state: &AppState, artefact: Artefact) -> (StepState, String) {
     }
 }
 
+/// A required step `name`, where it stands and why, and its action.
+fn plain(
+    name: &'static str,
+    (state, detail): (StepState, String),
+    action: (&str, Command),
+) -> Step {
+    Step {
+        name,
+        state,
+        detail,
+        action: (action.0.into(), action.1),
+        optional: false,
+    }
+}
+
 /// A step of `artefact` ([`standing`]) with its words for each state:
 /// `todo` before it is made, `again` added to what makes it stale.
 fn step(
@@ -114,7 +139,7 @@ fn step(
     artefact: Artefact,
     name: &'static str,
     (todo, again): (&str, &str),
-    action: (String, Command),
+    action: (&str, Command),
 ) -> Step {
     let (state, words) = standing(state, artefact);
     let detail = match &state {
@@ -122,13 +147,7 @@ fn step(
         StepState::Stale(_) => format!("{words}: {again}"),
         _ => words,
     };
-    Step {
-        name,
-        state,
-        detail,
-        action,
-        optional: false,
-    }
+    plain(name, (state, detail), action)
 }
 
 /// The steps of the job for the current state (the Measure step, the
@@ -142,7 +161,6 @@ pub fn steps(state: &AppState, forms: &Forms, stripes_seen: bool) -> Vec<Step> {
     let loaded = state.loaded.as_ref();
     let failed = loaded.map_or(0, |l| l.analysis.failures().count());
     let warned = loaded.map_or(0, |l| l.analysis.warnings.len());
-    let calibrated = standing(state, Artefact::Result).0;
     let again = |label: &str, state: &StepState, first: &str| match state {
         StepState::Stale(_) => label.to_string(),
         _ => first.to_string(),
@@ -155,7 +173,7 @@ pub fn steps(state: &AppState, forms: &Forms, stripes_seen: bool) -> Vec<Step> {
             "plan the poses for the robot and the sphere",
             "make it again before writing its program",
         ),
-        (String::new(), show(Tab::Plan)),
+        ("", show(Tab::Plan)),
     );
     plan.action.0 = again("Make the plan again", &plan.state, "Plan the poses");
     if plan.state == StepState::Todo && loaded.is_some() {
@@ -167,12 +185,23 @@ pub fn steps(state: &AppState, forms: &Forms, stripes_seen: bool) -> Vec<Step> {
         Artefact::Result,
         "Calibrated",
         ("run the calibration", "run again"),
-        (String::new(), Command::Run(RunCommand::Start)),
+        ("", Command::Run(RunCommand::Start)),
     );
     if calibrate.state == StepState::Running {
         calibrate.detail = format!("calibrating: {}", calibrate.detail);
     }
     calibrate.action.0 = again("▶ Run again", &calibrate.state, "▶ Run the calibration");
+    // A result the loop made no update to is the start, not a
+    // calibration: said, with the one click that refines it anyway.
+    if let (StepState::Done, Some(w)) = (&calibrate.state, no_update(state)) {
+        calibrate.state = StepState::Attention;
+        calibrate.detail = w;
+        let options = crate::engine::calibrate::solve::Options {
+            threshold: 0.0,
+            ..forms.solver
+        };
+        calibrate.action = (RUN_AT_ZERO.into(), Command::RunWith(Box::new(options)));
+    }
     let mut report = step(
         state,
         Artefact::Report,
@@ -181,95 +210,89 @@ pub fn steps(state: &AppState, forms: &Forms, stripes_seen: bool) -> Vec<Step> {
             "write the HTML report",
             "it no longer says what is on show; write it again",
         ),
-        (String::new(), Command::Export(ExportKind::ReportHtml)),
+        ("", Command::Export(ExportKind::ReportHtml)),
     );
     report.action.0 = again("Write the report again", &report.state, "Write the report");
+    let validated = validated(state, forms, calibrate.state.clone());
+    let data_in = match (state.jobs.get(&Slot::Load), loaded) {
+        (Some(job), _) => (StepState::Running, job.phase.clone()),
+        (None, Some(l)) => (
+            StepState::Done,
+            format!(
+                "{} measurements in \"{}\"",
+                l.session.measurements.len(),
+                l.session.name
+            ),
+        ),
+        (None, None) => (
+            StepState::Todo,
+            "import the robot's log and the sensor's profiles, or open a session".into(),
+        ),
+    };
+    let stripes = match loaded {
+        None => (StepState::Todo, "no session yet".into()),
+        Some(_) if failed + warned > 0 && !stripes_seen => (
+            StepState::Attention,
+            format!(
+                "{failed} stripe(s) cannot be fitted, {warned} with warnings: look at them in Stripe (Session: only warnings and failures), leave out what is wrong"
+            ),
+        ),
+        Some(_) if failed + warned > 0 => (
+            StepState::Done,
+            format!(
+                "looked at: {failed} stripe(s) cannot be fitted (the run leaves them out), {warned} with warnings"
+            ),
+        ),
+        Some(_) => (
+            StepState::Done,
+            "every stripe fits a circle, no warnings".into(),
+        ),
+    };
     vec![
         plan,
-        Step {
-            name: "Data in",
-            state: if state.jobs.runs(&Slot::Load) {
-                StepState::Running
-            } else if loaded.is_some() {
-                StepState::Done
-            } else {
-                StepState::Todo
-            },
-            detail: if let Some(job) = state.jobs.get(&Slot::Load) {
-                job.phase.clone()
-            } else {
-                loaded.map_or_else(
-                    || "import the robot's log and the sensor's profiles, or open a session".into(),
-                    |l| {
-                        format!(
-                            "{} measurements in \"{}\"",
-                            l.session.measurements.len(),
-                            l.session.name
-                        )
-                    },
-                )
-            },
-            action: ("Import data".into(), show(Tab::Import)),
-            optional: false,
-        },
-        Step {
-            name: "Stripes checked",
-            state: match loaded {
-                None => StepState::Todo,
-                Some(_) if failed + warned > 0 && !stripes_seen => StepState::Attention,
-                Some(_) => StepState::Done,
-            },
-            detail: match loaded {
-                None => "no session yet".into(),
-                Some(_) if failed + warned > 0 && !stripes_seen => format!(
-                    "{failed} stripe(s) cannot be fitted, {warned} with warnings: look at them in Stripe (Session: only warnings and failures), leave out what is wrong"
-                ),
-                Some(_) if failed + warned > 0 => format!(
-                    "looked at: {failed} stripe(s) cannot be fitted (the run leaves them out), {warned} with warnings"
-                ),
-                Some(_) => "every stripe fits a circle, no warnings".into(),
-            },
-            action: ("Check the stripes".into(), show(Tab::Stripe)),
-            optional: false,
-        },
+        plain("Data in", data_in, ("Import data", show(Tab::Import))),
+        plain(
+            "Stripes checked",
+            stripes,
+            ("Check the stripes", show(Tab::Stripe)),
+        ),
         calibrate,
-        validated(state, forms, calibrated),
+        validated,
         report,
         measure_step(state),
-        compensate_step(state),
-        check_step(state),
+        optional(
+            state,
+            Artefact::Compensation,
+            "Compensated",
+            (
+                "compensate the robot's targets through the calibration (optional)",
+                "compensate them again before writing the program",
+            ),
+            ("Compensate targets", Tab::Compensate),
+        ),
+        optional(
+            state,
+            Artefact::Check,
+            "Re-checked",
+            (
+                "re-check the cell with a short scan (optional)",
+                "check again",
+            ),
+            ("Re-check the cell", Tab::Check),
+        ),
     ]
 }
 
-/// The re-check (optional, after Compensate): its verdict's standing in
-/// the ledger.
-fn check_step(state: &AppState) -> Step {
-    let todo = (
-        "re-check the cell with a short scan (optional)",
-        "check again",
-    );
-    let action = ("Re-check the cell".to_string(), show(Tab::Check));
-    let mut c = step(state, Artefact::Check, "Re-checked", todo, action);
-    c.optional = true;
-    c
-}
-
-/// The Compensate step (optional): the compensated targets' standing in
-/// the ledger.
-fn compensate_step(state: &AppState) -> Step {
-    let mut c = step(
-        state,
-        Artefact::Compensation,
-        "Compensated",
-        (
-            "compensate the robot's targets through the calibration (optional)",
-            "compensate them again before writing the program",
-        ),
-        (
-            "Compensate targets".to_string(),
-            Command::View(ViewCommand::ShowTab(Tab::Compensate)),
-        ),
-    );
+/// An optional step of `artefact` (compensating targets, a re-check):
+/// its standing in the ledger, its view as its action.
+fn optional(
+    state: &AppState,
+    artefact: Artefact,
+    name: &'static str,
+    words: (&str, &str),
+    (label, tab): (&str, Tab),
+) -> Step {
+    let mut c = step(state, artefact, name, words, (label, show(tab)));
     c.optional = true;
     c
 }
@@ -282,6 +305,13 @@ fn validated(state: &AppState, forms: &Forms, calibrated: StepState) -> Step {
         (StepState::Running | StepState::Todo, _) | (_, None) => {
             (StepState::Todo, "calibrate first".to_string())
         }
+        (StepState::Attention, Some(v)) => (
+            StepState::Todo,
+            format!(
+                "calibrate first: no update was made, so the verdict ({}) is of the uncalibrated start",
+                v.describe(&forms.tolerance)
+            ),
+        ),
         (StepState::Stale(s), Some(_)) => (
             StepState::Stale(s.clone()),
             format!("the result is stale: {s}; its verdict no longer holds"),
@@ -293,13 +323,11 @@ fn validated(state: &AppState, forms: &Forms, calibrated: StepState) -> Step {
             "skipped: no validate data (the session has no validate measurements)".to_string(),
         ),
     };
-    Step {
-        name: "Validated",
-        state,
-        detail,
-        action: ("See the verdict".into(), show(Tab::Results)),
-        optional: false,
-    }
+    plain(
+        "Validated",
+        (state, detail),
+        ("See the verdict", show(Tab::Results)),
+    )
 }
 
 /// What the Next button offers: its text, its command (`None`: shown
@@ -365,6 +393,21 @@ pub fn next_action(state: &AppState, forms: &Forms, all: &[Step]) -> Option<Next
     }
     let report = &all[5];
     let report_todo = !matches!(report.state, StepState::Done);
+    // The verdict is seen before anything is written of it.
+    if state.result_unseen && report_todo {
+        return simple(4);
+    }
+    // No update made: refine first (or write the report anyway).
+    if all[3].state == StepState::Attention {
+        let mut next = simple(3);
+        if let Some(n) = &mut next
+            && report_todo
+        {
+            let write = ("write the report anyway".into(), report.action.1.clone());
+            n.others.push(write);
+        }
+        return next;
+    }
     if let Some(Verdict::Fail(reasons)) = verdict(state, forms) {
         let n = outliers(state);
         let mut others = Vec::new();
@@ -566,7 +609,7 @@ pub fn steps_ui(ui: &mut egui::Ui, state: &AppState, forms: &Forms, commands: &m
                     .clicked()
                     && let Some(c) = &n.command
                 {
-                    commands.push(c.clone());
+                    commands.push(Command::Next(Box::new(c.clone())));
                 }
                 for (label, command) in &n.others {
                     if ui
@@ -625,10 +668,7 @@ pub fn measure_step(state: &AppState) -> Step {
             "measure a scan with the calibrated cell (optional)",
             "measure again before exporting",
         ),
-        (
-            "Measure a scan".to_string(),
-            Command::View(ViewCommand::ShowTab(Tab::Measure)),
-        ),
+        ("Measure a scan", show(Tab::Measure)),
     );
     if let (StepState::Running, Some(job)) = (&m.state, state.jobs.get(&Slot::Measure)) {
         let percent = job.fraction.unwrap_or_default() * 100.0;

@@ -50,6 +50,7 @@ use clap::{Args, Parser, Subcommand};
 
 pub use message::{MAX_MESSAGE_CHARS, bounded_message, error_line, name_flags, readable_numbers};
 
+use crate::engine::base::records::solver::no_update_warning;
 use crate::engine::base::{limits, session};
 use crate::engine::calibrate::solve::ml::{Loss, MlOptions};
 use crate::engine::calibrate::solve::paper::Pairing;
@@ -738,17 +739,14 @@ pub fn calibrate_command(args: &CalibrateArgs) -> Result<(), CliError> {
     if let StopReason::Converged {
         epsilon,
         threshold,
-        updates: 0,
+        updates,
     } = cal.stop
+        && let Some(w) = no_update_warning(updates, epsilon, Some(threshold))
         && !quiet
     {
         // Said plainly: a threshold at or above the starting ε calibrates
         // nothing.
-        eprintln!(
-            "warning: ε = {} mm is already within the threshold {} mm before any update: nothing was identified, the result holds the uncalibrated model and initial hand-eye",
-            crate::engine::base::numeric::approx(epsilon),
-            crate::engine::base::numeric::show(threshold)
-        );
+        eprintln!("warning: {w}");
     }
     check_plausible(
         &session,

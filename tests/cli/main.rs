@@ -19,6 +19,7 @@ mod layout;
 mod measure;
 mod measure_scans;
 mod model_export;
+mod no_update;
 mod plan;
 mod report;
 mod report_browser;

@@ -7,6 +7,7 @@ mod support;
 
 mod check;
 mod compensate;
+mod flow34;
 mod guided;
 mod held_out;
 mod import_fixed;

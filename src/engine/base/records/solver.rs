@@ -47,6 +47,22 @@ pub fn epsilon_rise_warning(pairs: Option<&str>, before: f64, after: f64) -> Opt
     ))
 }
 
+/// The warning when the loop made no update because ε started at or
+/// below the threshold (FORMAT.md "The iteration": one `iterations`
+/// entry): nothing was identified, the result is the start. `updates`:
+/// updates made; `threshold`: the loop's, when known. One wording for
+/// `calibrate`'s console, the workbench's Results, its status line and
+/// its step bar.
+#[must_use]
+pub fn no_update_warning(updates: usize, epsilon: f64, threshold: Option<f64>) -> Option<String> {
+    let threshold = threshold.filter(|t| updates == 0 && epsilon <= *t)?;
+    Some(format!(
+        "no update: ε = {} mm started within the threshold {} mm, so nothing was identified and the result holds the uncalibrated model and initial hand-eye; to refine anyway, run again with threshold 0 (`--threshold 0`; in the workbench, Next's \"Run again with threshold 0\"), which makes updates until ε stops falling (or the most updates are made)",
+        crate::engine::base::numeric::approx(epsilon),
+        crate::engine::base::numeric::show(threshold)
+    ))
+}
+
 /// How the measurements of a station are paired into eq. 17 rows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Pairing {

@@ -128,6 +128,18 @@ impl ResultFile {
         })
     }
 
+    /// The warning when the loop made no update (ε started within the
+    /// threshold: one `iterations` entry), from the one wording
+    /// ([`no_update_warning`](crate::engine::base::records::solver::no_update_warning)).
+    #[must_use]
+    pub fn no_update_warning(&self) -> Option<String> {
+        crate::engine::base::records::solver::no_update_warning(
+            self.iterations.len().saturating_sub(1),
+            self.epsilon_before,
+            self.solver.threshold(),
+        )
+    }
+
     /// The robot's name, or [`NO_ROBOT`] for a pose-only result without
     /// a robot (what history groups such results under).
     #[must_use]

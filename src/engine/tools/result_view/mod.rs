@@ -313,7 +313,8 @@ pub struct ResultFigures {
     /// without it).
     pub held_out: Option<HeldOut>,
     /// Warnings about the run itself: the paper's loop ending with ε above
-    /// its start ([`SolverReport::epsilon_warning`]).
+    /// its start ([`SolverReport::epsilon_warning`]), or no update made
+    /// ([`ResultFile::no_update_warning`]).
     pub warnings: Vec<String>,
 }
 
@@ -399,6 +400,7 @@ impl ResultFigures {
                 .solver
                 .epsilon_warning(result.epsilon_before, result.epsilon_after)
                 .into_iter()
+                .chain(result.no_update_warning())
                 .collect(),
         }
     }
