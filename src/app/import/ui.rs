@@ -125,12 +125,8 @@ fn actions_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, joints: bool) {
         cx.button(ui, text, hover, ImportCommand::Run);
         if joints {
             let hover = "read the header and show the first rows with this mapping";
-            cx.button(
-                ui,
-                "Preview",
-                hover,
-                ImportCommand::Preview { guess: false },
-            );
+            let preview = ImportCommand::Preview { guess: false };
+            cx.button(ui, "Preview", hover, preview);
             let hover = "fill the column names from the header where they are obvious";
             let guess = ImportCommand::Preview { guess: true };
             cx.button(ui, "Guess mapping", hover, guess);
@@ -150,12 +146,8 @@ fn actions_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, joints: bool) {
     if let Some(Err(e)) = &state.import.outcome {
         boxed(ui, BAD, "The import failed", |ui| {
             if state.import.guess_needed.is_some() {
-                ui.label(
-                    RichText::new(
-                        "A hand-eye guess is needed: give one under \"Initial hand-eye\" below (numbers or a file).",
-                    )
-                    .strong(),
-                );
+                let what = "A hand-eye guess is needed: give one under \"Initial hand-eye\" below (numbers or a file).";
+                ui.label(RichText::new(what).strong());
             }
             scrolled_text(ui, "import_error", ERROR_HEIGHT, e);
         });

@@ -176,14 +176,10 @@ impl LoadedSession {
     /// that a session of 3,000 stations draws in a frame.
     #[must_use]
     pub fn station_ids(&self) -> Vec<String> {
-        let mut seen: std::collections::HashSet<&str> = std::collections::HashSet::new();
-        let mut out: Vec<String> = Vec::new();
-        for m in &self.session.measurements {
-            if seen.insert(m.station.as_str()) {
-                out.push(m.station.clone());
-            }
-        }
-        out
+        let mut seen = std::collections::HashSet::new();
+        let ms = self.session.measurements.iter();
+        let first = ms.filter(|m| seen.insert(m.station.as_str()));
+        first.map(|m| m.station.clone()).collect()
     }
 }
 
