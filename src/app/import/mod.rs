@@ -117,15 +117,13 @@ impl Core {
         self.state.ledger.record(Artefact::ImportView, stamp, what);
         match outcome {
             Ok(imported) => {
-                let flagged = imported.checks.iter().filter(|c| c.flagged).count();
-                let n = imported.loaded.session.measurements.len();
-                let refs = imported.loaded.session.reference_distances.len();
+                let (checks, s) = (&imported.checks, &imported.loaded.session);
+                let flagged = checks.iter().filter(|c| c.flagged).count();
+                let (n, refs) = (s.measurements.len(), s.reference_distances.len());
                 let mut line = format!("imported {n} measurements and {refs} reference distances");
-                if !imported.checks.is_empty() {
-                    let checked = imported.checks.len();
-                    line.push_str(&format!(
-                        "; flange poses: {checked} checked, {flagged} flagged"
-                    ));
+                if !checks.is_empty() {
+                    let checked = checks.len();
+                    line += &format!("; flange poses: {checked} checked, {flagged} flagged");
                 }
                 let outcome = [&[line.clone()], &imported.notes[..]].concat().join("\n");
                 self.state.import.checks = imported.checks;

@@ -10,7 +10,7 @@
 
 use egui::RichText;
 
-use super::ui::Ctx;
+use super::ui::{Ctx, radios};
 use crate::app::command::{Command, ImportCommand};
 use crate::app::dialog::Purpose;
 use crate::app::import::form::{HandEyeChoice, ImportChoices};
@@ -21,13 +21,11 @@ use crate::app::widgets::{
 use crate::engine::assemble::{PairingPreview, PosePreview};
 use crate::engine::base::session::Mount;
 use crate::engine::files::import::{FlangeConvention, PoseFormat};
+use crate::engine::files::program::name_list;
 
 /// Height of the pairing list, points: a dozen rows, the rest scrolled
 /// (the view must fit 1366×768 with the form above it).
 const PAIRING_HEIGHT: f32 = 190.0;
-
-/// Names listed in one line before "… (n in all)".
-const NAMES_SHOWN: usize = 12;
 
 /// Largest height of the reason a guess is needed, points (it names
 /// both reasons for both sides: long; the rest scrolls).
@@ -161,19 +159,6 @@ pub(super) fn detected_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>) {
     }
 }
 
-/// "a, b, c, … (n in all)".
-fn names(list: &[String]) -> String {
-    if list.len() <= NAMES_SHOWN {
-        list.join(", ")
-    } else {
-        format!(
-            "{}, … ({} in all)",
-            list[..NAMES_SHOWN].join(", "),
-            list.len()
-        )
-    }
-}
-
 /// The pairing: how, each pair (a scrolled list that draws only the rows
 /// on show), what is left over, the files skipped.
 fn pairing_ui(ui: &mut egui::Ui, p: &PosePreview, pairing: &PairingPreview) {
@@ -213,30 +198,21 @@ fn pairing_ui(ui: &mut egui::Ui, p: &PosePreview, pairing: &PairingPreview) {
                 });
         });
     }
-    if !pairing.poses_without.is_empty() {
-        let list: Vec<String> = pairing
-            .poses_without
-            .iter()
-            .filter_map(|&k| p.poses.get(k).map(|(n, l)| format!("{n} (line {l})")))
-            .collect();
-        coloured(
-            ui,
-            BAD,
-            format!("poses without a profile: {}", names(&list)),
-        );
-    }
-    if !pairing.unpaired.is_empty() {
-        let list = names(&pairing.unpaired);
-        coloured(ui, BAD, format!("profiles without a pose: {list}"));
-    }
-    if !pairing.skipped.is_empty() {
-        let list: Vec<String> = pairing
-            .skipped
-            .iter()
-            .map(|(n, why)| format!("{n} ({why})"))
-            .collect();
-        coloured(ui, MUTED, format!("skipped: {}", names(&list)));
-    }
+    // What is left over, a line each.
+    let mut left = |colour, what: &str, list: Vec<String>| {
+        if !list.is_empty() {
+            coloured(ui, colour, format!("{what}: {}", name_list(&list)));
+        }
+    };
+    let without = pairing.poses_without.iter();
+    let without = without.filter_map(|&k| p.poses.get(k).map(|(n, l)| format!("{n} (line {l})")));
+    left(BAD, "poses without a profile", without.collect());
+    left(BAD, "profiles without a pose", pairing.unpaired.clone());
+    let skipped = pairing
+        .skipped
+        .iter()
+        .map(|(n, why)| format!("{n} ({why})"));
+    left(MUTED, "skipped", skipped.collect());
 }
 
 /// The initial hand-eye: whether eq. 6-9 can start, the choice of a
@@ -269,7 +245,7 @@ pub(super) fn hand_eye_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportCho
                         .filter_map(|&k| p.poses.get(k).map(|(n, _)| n.clone()))
                         .collect();
                     let (n, others) = (group.len(), p.poses.len() - group.len());
-                    let list = names(&list);
+                    let list = name_list(&list);
                     coloured(
                         ui,
                         GOOD,
@@ -314,19 +290,17 @@ pub(super) fn hand_eye_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportCho
             );
         });
     }
-    ui.horizontal_wrapped(|ui| {
-        ui.radio_value(
-            &mut f.hand_eye,
-            HandEyeChoice::Computed,
-            if fixed {
-                "computed (the linear start from all identify poses)"
-            } else {
-                "computed (eq. 6-9, else the general solution)"
-            },
-        );
-        ui.radio_value(&mut f.hand_eye, HandEyeChoice::Numbers, "a guess: numbers");
-        ui.radio_value(&mut f.hand_eye, HandEyeChoice::File, "a guess from a file");
-    });
+    let computed = if fixed {
+        "computed (the linear start from all identify poses)"
+    } else {
+        "computed (eq. 6-9, else the general solution)"
+    };
+    let choices = [
+        (HandEyeChoice::Computed, computed),
+        (HandEyeChoice::Numbers, "a guess: numbers"),
+        (HandEyeChoice::File, "a guess from a file"),
+    ];
+    ui.horizontal_wrapped(|ui| radios(ui, &mut f.hand_eye, &choices));
     match f.hand_eye {
         HandEyeChoice::Computed => {}
         HandEyeChoice::Numbers => {

@@ -125,12 +125,8 @@ fn actions_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, joints: bool) {
         cx.button(ui, text, hover, ImportCommand::Run);
         if joints {
             let hover = "read the header and show the first rows with this mapping";
-            cx.button(
-                ui,
-                "Preview",
-                hover,
-                ImportCommand::Preview { guess: false },
-            );
+            let preview = ImportCommand::Preview { guess: false };
+            cx.button(ui, "Preview", hover, preview);
             let hover = "fill the column names from the header where they are obvious";
             let guess = ImportCommand::Preview { guess: true };
             cx.button(ui, "Guess mapping", hover, guess);
@@ -150,12 +146,8 @@ fn actions_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, joints: bool) {
     if let Some(Err(e)) = &state.import.outcome {
         boxed(ui, BAD, "The import failed", |ui| {
             if state.import.guess_needed.is_some() {
-                ui.label(
-                    RichText::new(
-                        "A hand-eye guess is needed: give one under \"Initial hand-eye\" below (numbers or a file).",
-                    )
-                    .strong(),
-                );
+                let what = "A hand-eye guess is needed: give one under \"Initial hand-eye\" below (numbers or a file).";
+                ui.label(RichText::new(what).strong());
             }
             scrolled_text(ui, "import_error", ERROR_HEIGHT, e);
         });
@@ -174,6 +166,19 @@ fn row(ui: &mut egui::Ui, label: &str, add: impl FnOnce(&mut egui::Ui)) {
     ui.label(label);
     ui.horizontal(add);
     ui.end_row();
+}
+
+/// A line of its own: `label`, then a radio button a choice.
+fn radio_line<T: PartialEq + Copy>(
+    ui: &mut egui::Ui,
+    label: &str,
+    value: &mut T,
+    choices: &[(T, &str)],
+) {
+    ui.horizontal(|ui| {
+        ui.label(label);
+        radios(ui, value, choices);
+    });
 }
 
 /// What the Import view's parts share: the state shown, whether a job
@@ -225,30 +230,22 @@ impl Ctx<'_> {
 
 fn files_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
     ui.label(RichText::new("1 · Files").strong());
-    ui.horizontal(|ui| {
-        ui.label("Sensor");
-        let fixed = "fixed in the cell, targets on the tool (a tracker, camera or line scanner)";
-        radios(
-            ui,
-            &mut f.mount,
-            &[
-                (Mount::Flange, "on the flange, the sphere in the cell"),
-                (Mount::Fixed, fixed),
-            ],
-        );
-    });
-    ui.horizontal(|ui| {
-        ui.label("Pose log");
-        let poses = "a pose file (robot program or pose table)";
-        radios(
-            ui,
-            &mut f.log_kind,
-            &[
-                (LogKind::Joints, "joint log (CSV)"),
-                (LogKind::FlangePoses, poses),
-            ],
-        );
-    });
+    let mounts = [
+        (Mount::Flange, "on the flange, the sphere in the cell"),
+        (
+            Mount::Fixed,
+            "fixed in the cell, targets on the tool (a tracker, camera or line scanner)",
+        ),
+    ];
+    radio_line(ui, "Sensor", &mut f.mount, &mounts);
+    let logs = [
+        (LogKind::Joints, "joint log (CSV)"),
+        (
+            LogKind::FlangePoses,
+            "a pose file (robot program or pose table)",
+        ),
+    ];
+    radio_line(ui, "Pose log", &mut f.log_kind, &logs);
     let fixed = f.mount == Mount::Fixed;
     form_grid(ui, "import_files", 3, |ui| {
         if f.log_kind == LogKind::Joints {
@@ -276,7 +273,9 @@ fn files_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
             };
             cx.path(ui, what, &mut f.centres, Purpose::ImportCentres);
             if fixed {
-                row(ui, "Points unit", |ui| length_units(ui, &mut f.centre_unit));
+                row(ui, "Points unit", |ui| {
+                    radios(ui, &mut f.centre_unit, &lengths());
+                });
             }
         } else {
             profiles_rows(ui, cx, f);
@@ -296,16 +295,14 @@ fn files_ui(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
 fn profiles_rows(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
     let fixed = f.mount == Mount::Fixed;
     if fixed || f.log_kind == LogKind::FlangePoses {
-        row(ui, "Sphere side", |ui| {
-            if !fixed {
-                ui.radio_value(&mut f.side, SideChoice::Auto, "decide from the data");
-            }
-            let sides = [
-                (SideChoice::Plus, "+1 (sensor x > 0)"),
-                (SideChoice::Minus, "−1"),
-            ];
-            radios(ui, &mut f.side, &sides);
-        });
+        // A fixed scanner's side is given: nothing decides it.
+        let sides = [
+            (SideChoice::Auto, "decide from the data"),
+            (SideChoice::Plus, "+1 (sensor x > 0)"),
+            (SideChoice::Minus, "−1"),
+        ];
+        let sides = &sides[usize::from(fixed)..];
+        row(ui, "Sphere side", |ui| radios(ui, &mut f.side, sides));
     }
     let hint = match f.profiles_kind {
         ProfilesKind::Folder => "/path/to/profiles/ (one file per pose: <id>.csv, .yml …)",
@@ -336,10 +333,8 @@ fn profiles_rows(ui: &mut egui::Ui, cx: &mut Ctx<'_>, f: &mut ImportChoices) {
 }
 
 /// The length units a file may be written in.
-fn length_units(ui: &mut egui::Ui, unit: &mut LengthUnit) {
-    for u in [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M] {
-        ui.radio_value(unit, u, u.symbol());
-    }
+fn lengths() -> [(LengthUnit, &'static str); 3] {
+    [LengthUnit::Mm, LengthUnit::Um, LengthUnit::M].map(|u| (u, u.symbol()))
 }
 
 /// What the sensor gave: profiles, or the points it measured itself
@@ -398,15 +393,12 @@ fn robot_ui(ui: &mut egui::Ui, f: &mut ImportChoices) {
                 );
             });
         }
+        let angles = [(AngleUnit::Deg, "deg"), (AngleUnit::Rad, "rad")];
         row(ui, "Joint unit", |ui| {
-            radios(
-                ui,
-                &mut f.joint_unit,
-                &[(AngleUnit::Deg, "deg"), (AngleUnit::Rad, "rad")],
-            );
+            radios(ui, &mut f.joint_unit, &angles);
         });
         row(ui, "Profile unit", |ui| {
-            length_units(ui, &mut f.profile_unit);
+            radios(ui, &mut f.profile_unit, &lengths());
         });
         let l = ui.label("Profile axes");
         ui.horizontal(|ui| {

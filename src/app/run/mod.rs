@@ -19,7 +19,7 @@ use super::Core;
 use super::command::{RunCommand, Tab};
 use super::error::JobError;
 use super::job::{Job, Slot};
-use super::ledger::{Artefact, Reading};
+use super::ledger::{Artefact, Reading, Stamp};
 use super::results::{ResultOrigin, ResultView};
 use super::session::{LoadedSession, without};
 use super::state::{Level, Notice};
@@ -83,16 +83,14 @@ pub fn calibrate_session(
     on_progress: &mut dyn FnMut(RunStage) -> bool,
 ) -> Result<ResultView, RunFailure> {
     let started = Instant::now();
-    let (kept, indices) =
-        without(&loaded.session, excluded).map_err(|e| RunFailure::Failed(JobError::from(e)))?;
+    let failed = |e: JobError| RunFailure::Failed(e);
+    let (kept, indices) = without(&loaded.session, excluded).map_err(|e| failed(e.into()))?;
     let analysis = if excluded.is_empty() {
         loaded.analysis.clone()
     } else {
         loaded.analysis.subset(&kept, &indices)
     };
-    let prepared = analysis
-        .prepared(&kept)
-        .map_err(|e| RunFailure::Failed(JobError::from(e)))?;
+    let prepared = analysis.prepared(&kept).map_err(|e| failed(e.into()))?;
     let mut updates = 0;
     let cal = solve::run(&kept, &prepared, options, &mut |p| {
         updates = p.updates;
@@ -103,27 +101,25 @@ pub fn calibrate_session(
             Control::Continue
         }
     })
-    .map_err(|e| RunFailure::Failed(JobError::from(e)))?;
+    .map_err(|e| failed(e.into()))?;
     if let StopReason::Cancelled { updates, .. } = cal.stop {
         return Err(RunFailure::Cancelled(updates));
     }
-    let stopped = |cancel: &AtomicBool| cancel.load(Ordering::Relaxed);
-    if stopped(cancel) || !on_progress(RunStage::Views) || stopped(cancel) {
-        return Err(RunFailure::Cancelled(updates));
-    }
+    // Goes on when `ok` and not cancelled.
+    let go_on = |ok: bool| {
+        let on = ok && !cancel.load(Ordering::Relaxed);
+        on.then_some(()).ok_or(RunFailure::Cancelled(updates))
+    };
+    go_on(true)?;
+    go_on(on_progress(RunStage::Views))?;
     let file = ResultFile::from_calibration(&kept, &cal);
-    if stopped(cancel) {
-        return Err(RunFailure::Cancelled(updates));
-    }
+    go_on(true)?;
     let origin = ResultOrigin::Run {
         seconds: started.elapsed().as_secs_f64(),
         excluded: loaded.session.measurements.len() - kept.measurements.len(),
     };
     let view = ResultView::new(file, origin, Some(&loaded.session));
-    if stopped(cancel) {
-        return Err(RunFailure::Cancelled(updates));
-    }
-    Ok(view)
+    go_on(true).map(|()| view)
 }
 
 impl Core {
@@ -187,15 +183,8 @@ impl Core {
                 if let ResultOrigin::Run { seconds: s, .. } = &mut view.origin {
                     *s = seconds;
                 }
-                self.forms.centres.magnify = view.centres.suggested_magnify;
                 let what = format!("method {}", view.method);
-                self.state.result = Some(view);
-                self.state.results_shown += 1;
-                self.state.outliers_seen = false;
-                self.state
-                    .ledger
-                    .record(Artefact::Result, run.stamp.clone(), what);
-                self.state.ledger.forget(Artefact::Report);
+                self.show_result(view, run.stamp.clone(), what);
                 // The operator stays where they are; the status line and
                 // the Results tab say a result is ready.
                 self.state.result_unseen = self.forms.tab != Tab::Results;
@@ -216,6 +205,19 @@ impl Core {
                 });
             }
         }
+    }
+}
+
+impl Core {
+    /// Shows `view` as the result, made from `stamp` (`what` in words);
+    /// the report of the last one is forgotten.
+    pub(super) fn show_result(&mut self, view: ResultView, stamp: Stamp, what: String) {
+        self.forms.centres.magnify = view.centres.suggested_magnify;
+        self.state.result = Some(view);
+        self.state.results_shown += 1;
+        self.state.outliers_seen = false;
+        self.state.ledger.record(Artefact::Result, stamp, what);
+        self.state.ledger.forget(Artefact::Report);
     }
 }
 

@@ -113,17 +113,11 @@ fn settings_ui(ui: &mut egui::Ui, forms: &mut Forms) {
         let paper = s.method == Method::Paper;
         ui.label("Pairs");
         ui.add_enabled_ui(paper, |ui| {
-                egui::ComboBox::from_id_salt("pairing")
-                    .selected_text(s.paper.pairing.as_str())
-                    .show_ui(ui, |ui| {
-                        for p in [Pairing::Disjoint, Pairing::All] {
-                            ui.selectable_value(&mut s.paper.pairing, p, p.as_str());
-                        }
-                    })
-                    .response
-                    .on_hover_text("pairs of a station's measurements: disjoint (1,2),(3,4),… as in the paper, or all")
-                    .on_disabled_hover_text("used by the paper's method only");
-            });
+            let pairings = [Pairing::Disjoint, Pairing::All].map(|p| (p, p.as_str().to_string()));
+            choice(ui, "", "pairing", &mut s.paper.pairing, pairings)
+                .on_hover_text("pairs of a station's measurements: disjoint (1,2),(3,4),… as in the paper, or all")
+                .on_disabled_hover_text("used by the paper's method only");
+        });
         ui.end_row();
         let threshold = egui::DragValue::new(&mut s.threshold).range(0.0..=10.0);
         let threshold = threshold.speed(0.001).max_decimals(4).suffix(" mm");

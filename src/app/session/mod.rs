@@ -52,24 +52,18 @@ impl Source {
         }
     }
 
-    /// The folder derived files go to by default: the session file's or
-    /// the joint log's.
-    #[must_use]
-    pub fn folder(&self) -> Option<&Path> {
-        match self {
-            Self::Demo | Self::Simulated => None,
-            Self::File(p) | Self::Imported(p) => p.parent(),
-        }
-    }
-
-    /// The folder Save as proposes: [`Self::folder`] when a file can be
-    /// written there, else the current folder, else the user's home (an
-    /// import from a read-only folder proposed a file that could not be
-    /// written there).
+    /// The folder Save as proposes: the session file's or the joint log's
+    /// when a file can be written there, else the current folder, else
+    /// the user's home (an import from a read-only folder proposed a file
+    /// that could not be written there).
     #[must_use]
     pub fn save_folder(&self) -> PathBuf {
+        let folder = match self {
+            Self::Demo | Self::Simulated => None,
+            Self::File(p) | Self::Imported(p) => p.parent().map(Path::to_path_buf),
+        };
         let current = std::env::current_dir().ok();
-        let candidates = [self.folder().map(Path::to_path_buf), current.clone()];
+        let candidates = [folder, current.clone()];
         candidates
             .into_iter()
             .chain([std::env::home_dir()])
@@ -126,6 +120,17 @@ impl<'a> Fit<'a> {
             _ => None,
         }
     }
+
+    /// What is wrong with the stripe in words, its failure or its
+    /// warnings; `None` when nothing is.
+    #[must_use]
+    pub fn problem(&self) -> Option<String> {
+        match self {
+            Self::Failed(e) => Some(e.to_string()),
+            Self::Stripe(s) if !s.warnings.is_empty() => Some(s.warnings.join("; ")),
+            _ => None,
+        }
+    }
 }
 
 /// A session as the workbench holds it.
@@ -171,14 +176,10 @@ impl LoadedSession {
     /// that a session of 3,000 stations draws in a frame.
     #[must_use]
     pub fn station_ids(&self) -> Vec<String> {
-        let mut seen: std::collections::HashSet<&str> = std::collections::HashSet::new();
-        let mut out: Vec<String> = Vec::new();
-        for m in &self.session.measurements {
-            if seen.insert(m.station.as_str()) {
-                out.push(m.station.clone());
-            }
-        }
-        out
+        let mut seen = std::collections::HashSet::new();
+        let ms = self.session.measurements.iter();
+        let first = ms.filter(|m| seen.insert(m.station.as_str()));
+        first.map(|m| m.station.clone()).collect()
     }
 }
 
@@ -243,15 +244,8 @@ pub fn open_path(path: &Path) -> Result<Opened, FileError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let is_result = serde_json::from_str::<serde_json::Value>(&text)
-        .ok()
-        .and_then(|v| {
-            v.get("format")
-                .and_then(|f| f.as_str())
-                .map(|f| f == RESULT_FORMAT)
-        })
-        .unwrap_or(false);
-    if is_result {
+    let format = |v: serde_json::Value| v.get("format")?.as_str().map(|f| f == RESULT_FORMAT);
+    if serde_json::from_str(&text).ok().and_then(format) == Some(true) {
         Ok(Opened::Result(Box::new(parse_result(&text, path)?)))
     } else {
         let session = parse_session(&text, path)?;
@@ -446,21 +440,11 @@ impl Core {
             Loaded::Result(path, view) => {
                 self.state.prefs.remember(&path);
                 let notes = view.notes.join("; ");
-                let view_method = view.method.clone();
-                self.forms.centres.magnify = view.centres.suggested_magnify;
-                self.state.result = Some(*view);
-                self.state.results_shown += 1;
-                self.state.result_unseen = false;
-                self.state.outliers_seen = false;
                 // Made elsewhere: not with this window's solver settings.
-                let stamp = self
-                    .state
-                    .ledger
-                    .stamp(Artefact::Result)
-                    .without(Input::Solver);
-                let what = format!("method {view_method} (reviewed)");
-                self.state.ledger.record(Artefact::Result, stamp, what);
-                self.state.ledger.forget(Artefact::Report);
+                let stamp = self.state.ledger.stamp(Artefact::Result);
+                let what = format!("method {} (reviewed)", view.method);
+                self.show_result(*view, stamp.without(Input::Solver), what);
+                self.state.result_unseen = false;
                 self.forms.tab = Tab::Results;
                 if notes.is_empty() {
                     self.state.say(
@@ -541,30 +525,18 @@ impl Core {
                 self.forms.tab = Tab::Stripe;
             }
             ViewCommand::Step(delta) => self.step(delta),
-            ViewCommand::SetIncluded { id, included } => {
-                if included {
-                    self.state.excluded.remove(&id);
-                } else {
-                    self.state.excluded.insert(id);
-                }
-                self.say_excluded();
-            }
+            ViewCommand::SetIncluded { id, included } => self.include([id], included),
             ViewCommand::SetStationIncluded { station, included } => {
-                if let Some(l) = &self.state.loaded {
-                    for m in l
-                        .session
-                        .measurements
-                        .iter()
-                        .filter(|m| m.station == station)
-                    {
-                        if included {
-                            self.state.excluded.remove(&m.id);
-                        } else {
-                            self.state.excluded.insert(m.id.clone());
-                        }
-                    }
-                }
-                self.say_excluded();
+                let ms = self
+                    .state
+                    .loaded
+                    .iter()
+                    .flat_map(|l| &l.session.measurements);
+                let ids: Vec<String> = ms
+                    .filter(|m| m.station == station)
+                    .map(|m| m.id.clone())
+                    .collect();
+                self.include(ids, included);
             }
             ViewCommand::IncludeAll => {
                 self.state.excluded.clear();
@@ -617,6 +589,18 @@ impl Core {
         let last = rows.len() - 1;
         let next = pos.map_or(0, |p| p.saturating_add_signed(delta as isize).min(last));
         self.state.selected = Some(rows[next]);
+    }
+
+    /// Uses the measurements `ids` in the next run, or leaves them out.
+    fn include(&mut self, ids: impl IntoIterator<Item = String>, included: bool) {
+        for id in ids {
+            if included {
+                self.state.excluded.remove(&id);
+            } else {
+                self.state.excluded.insert(id);
+            }
+        }
+        self.say_excluded();
     }
 
     fn say_excluded(&mut self) {

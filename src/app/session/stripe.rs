@@ -11,7 +11,7 @@ use crate::app::AppState;
 use crate::app::Forms;
 use crate::app::command::{Command, ViewCommand};
 use crate::app::session::{Fit, LoadedSession};
-use crate::app::widgets::{AFTER, BAD, BEFORE, MUTED, WARN};
+use crate::app::widgets::{AFTER, BAD, BEFORE, MUTED, WARN, command_button};
 use crate::engine::base::geometry::roll_pitch_yaw_deg;
 use crate::engine::base::session::Observation;
 use crate::engine::calibrate::stripe::StripeResult;
@@ -31,12 +31,8 @@ fn flagged_ui(
     shown: usize,
     commands: &mut Vec<Command>,
 ) {
-    let flagged: Vec<usize> = (0..loaded.session.measurements.len())
-        .filter(|&k| match loaded.fit(k) {
-            Fit::Failed(_) => true,
-            Fit::Stripe(s) => !s.warnings.is_empty(),
-            Fit::GivenCentre => false,
-        })
+    let flagged: Vec<(usize, String)> = (0..loaded.session.measurements.len())
+        .filter_map(|k| loaded.fit(k).problem().map(|why| (k, why)))
         .collect();
     if flagged.is_empty() {
         return;
@@ -44,29 +40,20 @@ fn flagged_ui(
     ui.horizontal_wrapped(|ui| {
         let text = format!("{} with warnings or failures:", flagged.len());
         ui.label(RichText::new(text).color(WARN));
-        for &k in flagged.iter().take(FLAGGED_SHOWN) {
-            let id = &loaded.session.measurements[k].id;
-            let hover = match loaded.fit(k) {
-                Fit::Failed(e) => e.to_string(),
-                Fit::Stripe(s) => s.warnings.join("; "),
-                Fit::GivenCentre => String::new(),
-            };
+        for (k, why) in flagged.iter().take(FLAGGED_SHOWN) {
+            let id = &loaded.session.measurements[*k].id;
             if ui
-                .selectable_label(k == shown, id)
-                .on_hover_text(hover)
+                .selectable_label(*k == shown, id)
+                .on_hover_text(why)
                 .clicked()
             {
-                commands.push(Command::View(ViewCommand::Select(k)));
+                commands.push(Command::View(ViewCommand::Select(*k)));
             }
         }
         if flagged.len() > FLAGGED_SHOWN {
-            ui.label(
-                RichText::new(format!(
-                    "and {} more (Session: only warnings and failures)",
-                    flagged.len() - FLAGGED_SHOWN
-                ))
-                .small(),
-            );
+            let more = flagged.len() - FLAGGED_SHOWN;
+            let text = format!("and {more} more (Session: only warnings and failures)");
+            ui.label(RichText::new(text).small());
         }
     });
 }
@@ -93,12 +80,13 @@ pub fn stripe_ui(
     let m = &loaded.session.measurements[i];
     ui.horizontal(|ui| {
         let pos = rows.iter().position(|&r| r == i);
-        if ui
-            .add_enabled(pos.is_some_and(|p| p > 0), egui::Button::new("◀ Previous"))
-            .clicked()
-        {
-            commands.push(Command::View(ViewCommand::Step(-1)));
-        }
+        let step = |delta| Command::View(ViewCommand::Step(delta));
+        let (first, last) = (
+            pos.is_none_or(|p| p == 0),
+            pos.is_none_or(|p| p + 1 == rows.len()),
+        );
+        let hover = "the previous row in the Session table's order";
+        command_button(ui, !first, "◀ Previous", hover, step(-1), commands);
         // The same search as the Session table's: narrows the picker and
         // Previous/Next (a session has a hundred measurements and more).
         let find = ui.label("Find");
@@ -128,15 +116,8 @@ pub fn stripe_ui(
             })
             .response
             .on_hover_text("measurement");
-        if ui
-            .add_enabled(
-                pos.is_some_and(|p| p + 1 < rows.len()),
-                egui::Button::new("Next ▶"),
-            )
-            .clicked()
-        {
-            commands.push(Command::View(ViewCommand::Step(1)));
-        }
+        let hover = "the next row in the Session table's order";
+        command_button(ui, !last, "Next ▶", hover, step(1), commands);
         let used = !state.excluded.contains(&m.id);
         let mut v = used;
         if ui.checkbox(&mut v, "use in solver").changed() {
@@ -251,32 +232,38 @@ pub fn residual_limit(used: &[[f64; 2]], rms_um: f64) -> f64 {
 /// Height of a plot's title and key lines above it, points.
 const KEY_HEIGHT: f32 = 44.0;
 
+/// How the fit took a stripe point.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Taken {
+    /// Used by the fit.
+    Kept,
+    /// Rejected by the fit as an outlier.
+    Rejected,
+    /// Left out by a raw profile's arc search (background, the stand).
+    OffArc,
+}
+
 /// The stripe plot beside the residual plot, the points sorted into
 /// kept, rejected by the fit and off the arc.
 fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) {
-    let inlier = |k: usize| fit.is_none_or(|s| s.fit.inlier.get(k).copied().unwrap_or(true));
-    // Points a raw profile's arc search left out (background, the stand).
-    let off_arc = |k: usize| {
-        fit.and_then(|s| s.segment.as_ref())
-            .is_some_and(|seg| !seg.on_arc.get(k).copied().unwrap_or(true))
-    };
-    let pick = |keep: &dyn Fn(usize) -> bool| -> Vec<[f64; 2]> {
-        points
-            .iter()
-            .enumerate()
-            .filter(|(k, _)| keep(*k))
-            .map(|(_, p)| *p)
-            .collect()
-    };
-    let kept = pick(&|k| inlier(k));
-    let rejected = pick(&|k| !inlier(k) && !off_arc(k));
-    let dropped = pick(&|k| off_arc(k));
+    let flag = |flags: Option<&Vec<bool>>, k: usize| flags.is_none_or(|f| f.get(k) != Some(&false));
+    let taken: Vec<Taken> = (0..points.len())
+        .map(|k| {
+            if flag(fit.map(|s| &s.fit.inlier), k) {
+                Taken::Kept
+            } else if flag(fit.and_then(|s| s.segment.as_ref()).map(|s| &s.on_arc), k) {
+                Taken::Rejected
+            } else {
+                Taken::OffArc
+            }
+        })
+        .collect();
     let height = ui.available_height().max(200.0);
     let width = ui.available_width();
     ui.horizontal(|ui| {
         ui.vertical(|ui| {
             ui.set_width(width * 0.58);
-            stripe_plot_ui(ui, height, fit, [kept, rejected, dropped]);
+            stripe_plot_ui(ui, height, fit, points, &taken);
         });
         ui.vertical(|ui| {
             let Some(s) = fit else {
@@ -284,20 +271,32 @@ fn plots_ui(ui: &mut egui::Ui, points: &[[f64; 2]], fit: Option<&StripeResult>) 
                 ui.label(RichText::new("no fit").color(MUTED));
                 return;
             };
-            residual_plot_ui(ui, height, points.len(), s, &inlier, &off_arc);
+            residual_plot_ui(ui, height, s, &taken);
         });
     });
 }
 
+/// The points (or, by `value`, another of their figures) taken as `how`,
+/// `[index or y, value]`.
+fn of(taken: &[Taken], how: Taken, value: impl Fn(usize) -> [f64; 2]) -> Vec<[f64; 2]> {
+    (0..taken.len())
+        .filter(|&k| taken[k] == how)
+        .map(value)
+        .collect()
+}
+
 /// The stripe in the laser plane with its key: the points kept by the
 /// fit, the fitted circle and its centre, the points the fit rejected
-/// and those off the arc (`[kept, rejected, dropped]`, `[y, z]` mm).
+/// and those off the arc (`[y, z]` mm).
 fn stripe_plot_ui(
     ui: &mut egui::Ui,
     height: f32,
     fit: Option<&StripeResult>,
-    [kept, rejected, dropped]: [Vec<[f64; 2]>; 3],
+    points: &[[f64; 2]],
+    taken: &[Taken],
 ) {
+    let [kept, rejected, dropped] =
+        [Taken::Kept, Taken::Rejected, Taken::OffArc].map(|how| of(taken, how, |k| points[k]));
     ui.label(RichText::new("Stripe in the laser plane (sensor x = 0)").strong());
     // The key above the plot, off the data.
     let mut key = vec![("● stripe points", AFTER)];
@@ -366,30 +365,22 @@ fn stripe_plot_ui(
 /// The fit's residuals of each point (µm) with ± RMS and its key; the
 /// scale is the used points' and the rejected beyond it are drawn at its
 /// edge (points off the arc are not drawn).
-fn residual_plot_ui(
-    ui: &mut egui::Ui,
-    height: f32,
-    n_points: usize,
-    s: &StripeResult,
-    inlier: &dyn Fn(usize) -> bool,
-    off_arc: &dyn Fn(usize) -> bool,
-) {
+fn residual_plot_ui(ui: &mut egui::Ui, height: f32, s: &StripeResult, taken: &[Taken]) {
     ui.label(RichText::new("Residuals |p − c| − r").strong());
-    let um = |k: usize| s.fit.residuals.get(k).copied().unwrap_or(0.0) * 1000.0;
-    let used: Vec<[f64; 2]> = (0..n_points)
-        .filter(|&k| inlier(k))
-        .map(|k| [k as f64, um(k)])
-        .collect();
+    let um = |k: usize| {
+        [
+            k as f64,
+            s.fit.residuals.get(k).copied().unwrap_or(0.0) * 1000.0,
+        ]
+    };
+    let used = of(taken, Taken::Kept, um);
     let rms = s.fit.rms * 1000.0;
     // The scale is the used points' (and ±RMS): a rejected point
     // of 783 µm must not flatten residuals of ±10 µm. Rejected
     // points beyond it are drawn at its edge.
     let limit = residual_limit(&used, rms);
     // Points off the arc are far from the circle: not plotted here.
-    let rejected_um: Vec<[f64; 2]> = (0..n_points)
-        .filter(|&k| !inlier(k) && !off_arc(k))
-        .map(|k| [k as f64, um(k)])
-        .collect();
+    let rejected_um = of(taken, Taken::Rejected, um);
     let beyond = rejected_um.iter().filter(|p| p[1].abs() > limit).count();
     let largest = rejected_um.iter().fold(0.0_f64, |m, p| m.max(p[1].abs()));
     let out: Vec<[f64; 2]> = rejected_um
@@ -431,16 +422,10 @@ fn residual_plot_ui(
                         .stems(0.0),
                 );
             }
-            p.hline(
-                HLine::new("± RMS", rms)
-                    .color(MUTED)
-                    .style(LineStyle::dashed_dense()),
-            );
-            p.hline(
-                HLine::new("± RMS", -rms)
-                    .color(MUTED)
-                    .style(LineStyle::dashed_dense()),
-            );
+            for y in [rms, -rms] {
+                let line = HLine::new("± RMS", y).color(MUTED);
+                p.hline(line.style(LineStyle::dashed_dense()));
+            }
         });
 }
 

@@ -12,11 +12,12 @@ use crate::app::command::{Command, FilesCommand, ViewCommand};
 use crate::app::dialog::{NO_DIALOG, Purpose};
 use crate::app::job::Slot;
 use crate::app::widgets::{
-    BAD, DEFAULT_RANGE, MUTED, WARN, choice, coloured, command_button, labelled_field,
-    range_fields, range_of, range_values, weak,
+    BAD, DEFAULT_RANGE, MUTED, WARN, boxed, choice, coloured, command_button, labelled_field,
+    range_fields, range_of, range_values, scrolled_text, weak,
 };
 use crate::app::{AppState, Forms};
-use crate::engine::base::session::Use;
+use crate::engine::base::numeric::plural;
+use crate::engine::base::session::{Measurement, Use};
 
 /// A row of the table: a group header or a measurement.
 enum Row {
@@ -42,11 +43,8 @@ pub fn session_ui(
     let n = loaded.session.measurements.len();
     let excluded = state.excluded_count();
     ui.horizontal_wrapped(|ui| {
-        let stations = loaded.station_ids().len();
-        ui.label(format!(
-            "{n} measurements in {stations} station{}.",
-            if stations == 1 { "" } else { "s" }
-        ));
+        let stations = plural(loaded.station_ids().len(), "station", "stations");
+        ui.label(format!("{n} measurements in {stations}."));
         if excluded > 0 {
             coloured(ui, WARN, format!("{excluded} left out: the solver skips them; the opened file is unchanged until you save a copy."));
         } else {
@@ -209,40 +207,30 @@ fn save_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
 
 fn rows(state: &AppState, loaded: &LoadedSession, forms: &Forms) -> Vec<Row> {
     let ms = &loaded.session.measurements;
-    let mut out = Vec::new();
-    let mut current: Option<String> = None;
-    for i in state.visible_rows(forms) {
-        let key = match forms.group {
+    // The group a measurement is in.
+    fn of(group: Grouping, m: &Measurement) -> Option<&str> {
+        match group {
             Grouping::None => None,
-            Grouping::Station => Some(ms[i].station.clone()),
-            Grouping::Use => Some(ms[i].usage.as_str().to_string()),
-        };
-        if key.is_some() && key != current {
-            let k = key.clone().unwrap_or_default();
-            let members: Vec<&crate::engine::base::session::Measurement> = ms
-                .iter()
-                .filter(|m| match forms.group {
-                    Grouping::Station => m.station == k,
-                    _ => m.usage.as_str() == k,
-                })
-                .collect();
-            let used = members
-                .iter()
-                .filter(|m| !state.excluded.contains(&m.id))
-                .count();
-            let (title, station) = match forms.group {
-                Grouping::Station => (
-                    format!("station {k}: {} measurements, {used} used", members.len()),
-                    Some(k),
-                ),
-                _ => (
-                    format!("{k}: {} measurements, {used} used", members.len()),
-                    None,
-                ),
-            };
-            out.push(Row::Header(title, station));
-            current = key;
+            Grouping::Station => Some(m.station.as_str()),
+            Grouping::Use => Some(m.usage.as_str()),
         }
+    }
+    let key = |m| of(forms.group, m);
+    let mut out = Vec::new();
+    let mut current = None;
+    for i in state.visible_rows(forms) {
+        let k = key(&ms[i]);
+        if let Some(k) = k.filter(|_| k != current) {
+            let members: Vec<_> = ms.iter().filter(|m| key(m) == Some(k)).collect();
+            let used = members.iter().filter(|m| !state.excluded.contains(&m.id));
+            let (n, used) = (members.len(), used.count());
+            // A station group has its checkbox.
+            let station = (forms.group == Grouping::Station).then(|| k.to_string());
+            let what = if station.is_some() { "station " } else { "" };
+            let title = format!("{what}{k}: {n} measurements, {used} used");
+            out.push(Row::Header(title, station));
+        }
+        current = k;
         out.push(Row::Item(i));
     }
     out
@@ -479,17 +467,14 @@ pub fn load_ui(
         let weak = ui.visuals().weak_text_color();
         rows_ui(ui, &l.source.label(), egui::TextStyle::Small, weak, 2);
         let n = l.session.measurements.len();
-        let stations = l.station_ids().len();
-        let text = format!(
-            "{n} measurements, {stations} station{}, sphere Ø {} mm{}",
-            if stations == 1 { "" } else { "s" },
-            l.session.sphere_diameter,
-            if l.session.pose_only() {
-                " · pose-only (flange poses)"
-            } else {
-                ""
-            }
-        );
+        let stations = plural(l.station_ids().len(), "station", "stations");
+        let pose_only = if l.session.pose_only() {
+            " · pose-only (flange poses)"
+        } else {
+            ""
+        };
+        let d = l.session.sphere_diameter;
+        let text = format!("{n} measurements, {stations}, sphere Ø {d} mm{pose_only}");
         let text_colour = ui.visuals().text_color();
         rows_ui(ui, &text, egui::TextStyle::Small, text_colour, 2);
     } else {
@@ -600,19 +585,11 @@ const NOTICE_BODY_HEIGHT: f32 = 110.0;
 pub fn notice_ui(ui: &mut egui::Ui, state: &AppState, commands: &mut Vec<Command>) {
     if let Some(notice) = &state.notice {
         ui.add_space(6.0);
-        let frame = egui::Frame::group(ui.style()).stroke(egui::Stroke::new(1.5, BAD));
-        let shown = frame.show(ui, |ui| {
-            ui.set_width(ui.available_width());
-            // Wrapped (a long path in the title was cut at the panel's
-            // edge), a long body scrolled within the box.
-            let title = RichText::new(&notice.title).strong().color(BAD);
-            ui.add(egui::Label::new(title).wrap());
-            crate::app::widgets::scrolled_text(
-                ui,
-                "notice_body",
-                NOTICE_BODY_HEIGHT,
-                egui::WidgetText::from(notice.body.as_str()),
-            );
+        // The title wrapped (a long path in it was cut at the panel's
+        // edge), a long body scrolled within the box.
+        let shown = boxed(ui, BAD, &notice.title, |ui| {
+            let body = notice.body.as_str();
+            scrolled_text(ui, "notice_body", NOTICE_BODY_HEIGHT, body);
             if ui.button("Dismiss").clicked() {
                 commands.push(Command::View(ViewCommand::DismissNotice));
             }

@@ -202,7 +202,7 @@ pub(super) fn motion_order(
             } else {
                 format!("{} positions are", never.len())
             },
-            list(&never)
+            name_list(&never)
         ));
     }
     let mut repeated: Vec<(usize, usize)> = seen.into_iter().filter(|(_, c)| *c > 1).collect();
@@ -226,7 +226,7 @@ pub(super) fn motion_order(
         format!(
             "{} in the order the motion instructions first move to them (it differs from the order written: {})",
             plural(order.len(), "pose", "poses"),
-            list(
+            name_list(
                 &order
                     .iter()
                     .map(|&i| targets[i].name.as_str())
@@ -238,7 +238,8 @@ pub(super) fn motion_order(
 }
 
 /// Up to 12 names joined with commas, then "… (n in all)".
-pub(super) fn list(names: &[&str]) -> String {
+pub fn name_list<S: AsRef<str>>(names: &[S]) -> String {
+    let names: Vec<&str> = names.iter().map(AsRef::as_ref).collect();
     if names.len() <= 12 {
         names.join(", ")
     } else {

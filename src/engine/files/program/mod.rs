@@ -36,7 +36,7 @@ use crate::engine::base::robot::controller::FlangeConvention;
 use crate::engine::base::session::Use;
 use crate::engine::files::format::{Cap, read_bytes, read_text};
 
-pub use self::lex::MAX_SHOWN_CHARS;
+pub use self::lex::{MAX_SHOWN_CHARS, name_list};
 pub use self::table::Row;
 
 /// The layout of a pose file.
