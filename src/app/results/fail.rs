@@ -54,7 +54,7 @@ pub(super) fn after_fail_ui(
                     outliers.len()
                 ));
                 let header = ["measurement", "station", "residual (mm)", "σ", ""];
-                super::tables::table(ui, "after_fail_outliers", &header, |ui| {
+                crate::app::widgets::table(ui, "after_fail_outliers", &header, |ui| {
                         for o in outliers.iter().take(OUTLIERS_SHOWN) {
                             ui.label(&o.measurement);
                             ui.label(&o.station);

@@ -7,7 +7,7 @@
 use egui::RichText;
 
 use crate::app::results::{HandEyeView, ResultView};
-use crate::app::widgets::{MUTED, WARN};
+use crate::app::widgets::{MUTED, WARN, table};
 use crate::engine::base::geometry::{rows_from_isometry, wrap_deg};
 use crate::engine::base::robot::{PARAM_NAMES, PARAMS_PER_JOINT};
 use crate::engine::calibrate::solve::estimate::HAND_EYE_LABELS;
@@ -16,25 +16,6 @@ use crate::engine::files::format::result::solver_block;
 /// Longest solver-block value shown in full (longer ones are cut, the
 /// whole value is in the tooltip and the exported JSON).
 const SOLVER_ENTRY_CHARS: usize = 300;
-
-/// A striped grid `id` headed by `header` in bold; `body` adds the rows.
-pub(super) fn table(
-    ui: &mut egui::Ui,
-    id: &str,
-    header: &[&str],
-    body: impl FnOnce(&mut egui::Ui),
-) {
-    egui::Grid::new(id)
-        .striped(true)
-        .num_columns(header.len())
-        .show(ui, |ui| {
-            for h in header {
-                ui.strong(*h);
-            }
-            ui.end_row();
-            body(ui);
-        });
-}
 
 /// One row of plain cells.
 pub(super) fn row(ui: &mut egui::Ui, cells: impl IntoIterator<Item = impl Into<egui::WidgetText>>) {
@@ -57,15 +38,14 @@ pub(super) fn tables_ui(
         Some(lines) => hand_eye_only_ui(ui, lines),
         None => joint_errors_ui(ui, view),
     }
-    if !view.dropped.is_empty() {
+    let paper = view.file.solver.paper();
+    let dropped = paper.and_then(|p| p.dropped_directions.as_deref());
+    if let Some(dropped) = dropped.filter(|d| !d.is_empty()) {
         ui.add_space(6.0);
-        egui::CollapsingHeader::new(format!(
-            "Directions the SVD dropped ({})",
-            view.dropped.len()
-        ))
-        .show(ui, |ui| {
-            for d in &view.dropped {
-                ui.monospace(d);
+        let title = format!("Directions the SVD dropped ({})", dropped.len());
+        egui::CollapsingHeader::new(title).show(ui, |ui| {
+            for d in dropped {
+                ui.monospace(d.to_string());
             }
         });
     }

@@ -81,18 +81,19 @@ fn origin_ui(ui: &mut egui::Ui, view: &ResultView) {
             };
             format!(
                 "Run of session \"{}\" in this window ({seconds:.2} s{left_out}), method {}.",
-                view.file.session, view.method
+                view.file.session,
+                view.method()
             )
         }
         ResultOrigin::Review(path) => format!(
             "Reviewing {} (session \"{}\", method {}): shown as it was computed, the solver was not run.",
             path.display(),
             view.file.session,
-            view.method
+            view.method()
         ),
     };
     ui.label(RichText::new(text).weak());
-    if let Some(stop) = &view.stop_reason {
+    if let Some(stop) = view.file.solver.stop_reason() {
         ui.label(RichText::new(stop).small());
     }
     for w in &view.shown.warnings {

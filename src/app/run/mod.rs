@@ -182,13 +182,18 @@ impl Core {
         let seconds = run.started.elapsed().as_secs_f64();
         match outcome {
             Ok(mut view) => {
-                let stop = view.stop_reason.clone().unwrap_or_default();
+                let stop = view
+                    .file
+                    .solver
+                    .stop_reason()
+                    .unwrap_or_default()
+                    .to_string();
                 // One wall time for the header and the status line.
                 if let ResultOrigin::Run { seconds: s, .. } = &mut view.origin {
                     *s = seconds;
                 }
                 self.forms.centres.magnify = view.centres.suggested_magnify;
-                let what = format!("method {}", view.method);
+                let what = format!("method {}", view.method());
                 self.state.result = Some(view);
                 self.state.results_shown += 1;
                 self.state.outliers_seen = false;

@@ -446,7 +446,7 @@ impl Core {
             Loaded::Result(path, view) => {
                 self.state.prefs.remember(&path);
                 let notes = view.notes.join("; ");
-                let view_method = view.method.clone();
+                let view_method = view.method().to_string();
                 self.forms.centres.magnify = view.centres.suggested_magnify;
                 self.state.result = Some(*view);
                 self.state.results_shown += 1;
