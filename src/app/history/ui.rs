@@ -171,13 +171,11 @@ fn table_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) {
 
 fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) {
     let of_robot = forms.history.robot.as_deref() == Some(e.robot.as_str());
-    let name = e.path.file_name().map_or_else(
-        || e.path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    );
+    let name = e.path.file_name().unwrap_or(e.path.as_os_str());
     let mut ticked = !forms.history.unselected.contains(&e.path);
+    let tick = egui::Checkbox::new(&mut ticked, name.to_string_lossy());
     let changed = ui
-        .add_enabled(of_robot, egui::Checkbox::new(&mut ticked, name))
+        .add_enabled(of_robot, tick)
         .on_hover_text(e.path.display().to_string())
         .on_disabled_hover_text("another robot: choose it above to plot its drift")
         .changed();
@@ -190,13 +188,13 @@ fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) {
         let t = RichText::new(t);
         ui.label(if of_robot { t } else { t.color(MUTED) })
     };
-    let source = if e.date_source.is_from_name() {
+    let source = e.date_source.as_str();
+    let shown = if e.date_source.is_from_name() {
         String::new()
     } else {
-        format!(" ({})", e.date_source.as_str())
+        format!(" ({source})")
     };
-    cell(format!("{}{source}", e.date))
-        .on_hover_text(format!("date from the {}", e.date_source.as_str()));
+    cell(format!("{}{shown}", e.date)).on_hover_text(format!("date from the {source}"));
     let validation = e.validation_std_after();
     let validation = validation.map_or_else(|| "no validation".into(), |s| format!("{s:.3} mm"));
     for text in [
@@ -208,13 +206,13 @@ fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) {
         cell(text);
     }
     cell(format!("{:.4} mm", e.epsilon_after));
-    let (t, r) = (e.hand_eye.translation, e.hand_eye.rpy_deg);
+    let ([x, y, z], [r, p, w]) = (e.hand_eye.translation, e.hand_eye.rpy_deg);
     let which = match e.mount {
         Mount::Flange => "hand-eye eT_s",
         Mount::Fixed => "base_from_sensor bT_s (a fixed sensor)",
     };
-    cell(format!("{:.3} {:.3} {:.3}", t[0], t[1], t[2])).on_hover_text(which);
-    cell(format!("{:.4} {:.4} {:.4}", r[0], r[1], r[2]));
+    cell(format!("{x:.3} {y:.3} {z:.3}")).on_hover_text(which);
+    cell(format!("{r:.4} {p:.4} {w:.4}"));
     ui.end_row();
 }
 
@@ -256,11 +254,8 @@ fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {
             for j in &jumps {
                 let unit = j.unit.as_str();
                 coloured(ui, BAD, &j.parameter);
-                ui.label(format!(
-                    "{} → {}",
-                    date(library, j.from),
-                    date(library, j.to)
-                ));
+                let (from, to) = (date(library, j.from), date(library, j.to));
+                ui.label(format!("{from} → {to}"));
                 ui.label(format!("{:+.4} {unit}", j.change));
                 ui.label(j.combined.map_or("–".into(), |c| format!("{c:.4} {unit}")));
                 ui.label(j.ratio.map_or("–".into(), |r| format!("{r:.1}")));
@@ -280,12 +275,9 @@ fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {
         })
         .collect();
     if !unchecked.is_empty() {
-        egui::CollapsingHeader::new(format!(
-            "{} change(s) could not be checked",
-            unchecked.len()
-        ))
-        .id_salt("history_unchecked")
-        .show(ui, |ui| {
+        let title = format!("{} change(s) could not be checked", unchecked.len());
+        let header = egui::CollapsingHeader::new(title).id_salt("history_unchecked");
+        header.show(ui, |ui| {
             for (c, why) in unchecked {
                 ui.label(format!("{}: {why}", c.parameter));
             }

@@ -46,7 +46,7 @@ pub(super) fn plots_ui(ui: &mut egui::Ui, view: &ResultView) {
         let after = numbered(within.iter().map(|p| p.after));
         let plot = compare_plot("fig5_after", AFTER_HEIGHT, FIG5_AXES).include_y(0.0);
         plot.show(&mut cols[0], |p| {
-            series(p, AFTER_NAME, after, AFTER, MarkerShape::Circle)
+            series(p, AFTER_NAME, after, AFTER, MarkerShape::Circle);
         });
         if !distances.is_empty() {
             let title = RichText::new("Fig. 6, after only (its own scale)").strong();

@@ -50,31 +50,22 @@ pub(super) fn tables_ui(
         });
     }
     ml_tables_ui(ui, view, tolerance);
-    egui::CollapsingHeader::new("Details: the solver block as written in the result file").show(
-        ui,
-        |ui| {
-            egui::Grid::new("solver_entries")
-                .striped(true)
-                .num_columns(2)
-                .show(ui, |ui| {
-                    for (k, v) in solver_block(&view.file.solver) {
-                        let v = match v {
-                            serde_json::Value::String(t) => t,
-                            other => other.to_string(),
-                        };
-                        ui.monospace(k);
-                        let short: String = v.chars().take(SOLVER_ENTRY_CHARS).collect();
-                        let shown = if short.len() < v.len() {
-                            format!("{short}…")
-                        } else {
-                            short
-                        };
-                        ui.add(egui::Label::new(shown).wrap()).on_hover_text(v);
-                        ui.end_row();
-                    }
-                });
-        },
-    );
+    let title = "Details: the solver block as written in the result file";
+    egui::CollapsingHeader::new(title).show(ui, |ui| {
+        let grid = egui::Grid::new("solver_entries").striped(true);
+        grid.num_columns(2).show(ui, |ui| {
+            for (k, v) in solver_block(&view.file.solver) {
+                let v = v.as_str().map_or_else(|| v.to_string(), str::to_owned);
+                ui.monospace(k);
+                let mut shown: String = v.chars().take(SOLVER_ENTRY_CHARS).collect();
+                if shown.len() < v.len() {
+                    shown.push('…');
+                }
+                ui.add(egui::Label::new(shown).wrap()).on_hover_text(v);
+                ui.end_row();
+            }
+        });
+    });
 }
 
 fn marked_cell(ui: &mut egui::Ui, view: &ResultView, label: &str, text: String) {
@@ -247,18 +238,11 @@ fn ml_tables_ui(
         });
     });
     if let Some(cv) = &ml.cross_validation {
-        egui::CollapsingHeader::new(format!(
-            "Leave-one-station-out: rms {:.4} mm over {} stations",
-            cv.rms,
-            cv.stations.len()
-        ))
-        .show(ui, |ui| {
-            ui.label(
-                RichText::new(
-                    "Each station's within-station centre distances predicted by the model fitted without it: an accuracy estimate without a tracker.",
-                )
-                .color(MUTED),
-            );
+        let (rms, n) = (cv.rms, cv.stations.len());
+        let title = format!("Leave-one-station-out: rms {rms:.4} mm over {n} stations");
+        egui::CollapsingHeader::new(title).show(ui, |ui| {
+            let text = "Each station's within-station centre distances predicted by the model fitted without it: an accuracy estimate without a tracker.";
+            ui.label(RichText::new(text).color(MUTED));
             let mut rows: Vec<_> = cv.stations.iter().collect();
             rows.sort_by(|a, b| b.rms.total_cmp(&a.rms));
             table(ui, "loso", &["station", "pairs", "rms (mm)"], |ui| {
