@@ -302,15 +302,12 @@ fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {
 }
 
 fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[String]) {
-    ui.label(
-        RichText::new(format!(
-            "{} ({}) · {}",
-            series.name,
-            series.unit.as_str(),
-            series.kind.label(drift.mount)
-        ))
-        .strong(),
+    let (name, unit, kind) = (
+        &series.name,
+        series.unit.as_str(),
+        series.kind.label(drift.mount),
     );
+    ui.label(RichText::new(format!("{name} ({unit}) · {kind}")).strong());
     // x = position in date order; the tick labels are the dates.
     let position = |entry: usize| drift.entries.iter().position(|&e| e == entry);
     let points: Vec<[f64; 2]> = series
@@ -320,9 +317,8 @@ fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[St
         .collect();
     // The ±1σ bars (muted) and the jumps (red): a segment each.
     let segment = |name: &str, ends: [[f64; 2]; 2], colour, width| {
-        Line::new(name, PlotPoints::from(ends.to_vec()))
-            .color(colour)
-            .width(width)
+        let line = Line::new(name, PlotPoints::from(ends.to_vec()));
+        line.color(colour).width(width)
     };
     let jumps = drift.jumps().filter(|j| j.parameter == series.name);
     let jumps: Vec<[[f64; 2]; 2]> = jumps
@@ -334,37 +330,28 @@ fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[St
     // Half a result of room each side: the first and last dates, centred
     // on their ticks, stay inside the plot.
     let last = dates.len().saturating_sub(1) as f64;
-    let plot = Plot::new(("drift", series.name.as_str()))
+    let plot = Plot::new(("drift", name.as_str()))
         .height(DRIFT_PLOT_HEIGHT)
         .include_x(-DATE_ROOM)
         .include_x(last + DATE_ROOM)
         .allow_scroll(false);
     labelled_x(readable_y(plot), dates.to_vec(), DATE_LABEL_GAP)
-        .y_axis_label(series.unit.as_str())
+        .y_axis_label(unit)
         .show(ui, |p| {
             for pt in &series.points {
                 if let (Some(x), Some(s)) = (position(pt.entry), pt.sigma) {
-                    let x = x as f64;
-                    p.line(segment(
-                        "",
-                        [[x, pt.value - s], [x, pt.value + s]],
-                        MUTED,
-                        1.5,
-                    ));
+                    let (x, y) = (x as f64, pt.value);
+                    p.line(segment("", [[x, y - s], [x, y + s]], MUTED, 1.5));
                 }
             }
+            let line = Line::new(name.as_str(), PlotPoints::from(points.clone()));
             p.line(
-                Line::new(series.name.as_str(), PlotPoints::from(points.clone()))
-                    .color(AFTER)
+                line.color(AFTER)
                     .style(LineStyle::dotted_loose())
                     .width(1.0),
             );
-            p.points(
-                Points::new(series.name.as_str(), PlotPoints::from(points))
-                    .color(AFTER)
-                    .shape(MarkerShape::Circle)
-                    .radius(3.5),
-            );
+            let points = Points::new(name.as_str(), PlotPoints::from(points));
+            p.points(points.color(AFTER).shape(MarkerShape::Circle).radius(3.5));
             for ends in jumps {
                 p.line(segment("jump", ends, BAD, 2.5));
             }

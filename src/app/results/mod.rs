@@ -194,15 +194,10 @@ pub fn calibration(state: &AppState) -> Reading {
             ResultOrigin::Run { .. } => {
                 format!("run #{} ({})", state.results_shown, r.method())
             }
-            ResultOrigin::Review(p) => format!(
-                "{} (#{}, {})",
-                p.file_name().map_or_else(
-                    || p.display().to_string(),
-                    |n| n.to_string_lossy().into_owned()
-                ),
-                state.results_shown,
-                r.method()
-            ),
+            ResultOrigin::Review(p) => {
+                let name = p.file_name().unwrap_or(p.as_os_str()).to_string_lossy();
+                format!("{name} (#{}, {})", state.results_shown, r.method())
+            }
         },
     };
     Reading::new(
