@@ -12,6 +12,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::SystemTime;
 
+use crate::engine::base::session::Session;
+use crate::engine::calibrate::solve::Analysis;
 use crate::engine::files::format::{Cap, ResultFile, read_text, result_text_checked, write_atomic};
 use crate::engine::tools::report::html::{self, ReportInput, ReportMeta};
 use crate::engine::tools::report::model::{self, ModelFormat};
@@ -27,7 +29,6 @@ use crate::app::command::UseExport;
 use crate::app::error::JobError;
 use crate::app::ledger::{Artefact, Stamp};
 use crate::app::results::ResultView;
-use crate::app::session::LoadedSession;
 use crate::app::state::Level;
 use crate::app::{Core, Write};
 
@@ -57,6 +58,20 @@ pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<()
     Ok(write_atomic(path, text.as_bytes())?)
 }
 
+/// The session a report is written against: the session, its file's
+/// bytes (for the SHA-256), the stripe fits made when it was loaded, and
+/// where it came from, in words.
+pub struct ReportSession<'a> {
+    /// The session.
+    pub session: &'a Session,
+    /// Its file's bytes.
+    pub bytes: &'a [u8],
+    /// Its stripe fits.
+    pub analysis: &'a Analysis,
+    /// Where it came from.
+    pub source: String,
+}
+
 /// Writes the HTML report of `view` against its session atomically (the
 /// engine's [`html::render`], as `spherecal report --result`), with the
 /// stripe fits made when the session was loaded.
@@ -65,17 +80,17 @@ pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<()
 /// The result is not of this session, or the file cannot be written.
 pub fn write_report(
     view: &ResultView,
-    of: &LoadedSession,
+    of: &ReportSession<'_>,
     tolerance: Tolerance,
     path: &Path,
 ) -> Result<(), JobError> {
-    let session = &of.session;
+    let session = of.session;
     result_view::check_result(session, &view.file, None)?;
     let prepared = of.analysis.clone().prepared(session).ok();
-    let meta = ReportMeta::new(of.source.label(), SystemTime::now());
+    let meta = ReportMeta::new(of.source.clone(), SystemTime::now());
     let html = html::render(&ReportInput {
         session,
-        session_bytes: &of.bytes,
+        session_bytes: of.bytes,
         result: &view.file,
         prepared: prepared.as_ref(),
         meta: &meta,
@@ -251,7 +266,15 @@ impl Core {
         };
         self.write(ctx, path, write, move |path| {
             match &loaded {
-                Some(l) => write_report(&view, l, tolerance, path),
+                Some(l) => {
+                    let of = ReportSession {
+                        session: &l.session,
+                        bytes: &l.bytes,
+                        analysis: &l.analysis,
+                        source: l.source.label(),
+                    };
+                    write_report(&view, &of, tolerance, path)
+                }
                 None => write_text(kind, &view, path),
             }
             .map(|()| None)
