@@ -131,7 +131,7 @@ fn demo_loads_select_run_and_headline_matches_engine() {
         .result
         .as_ref()
         .expect("a result is shown");
-    assert_eq!(view.epsilons, cal.iterations);
+    assert_eq!(view.epsilons(), cal.iterations);
     assert!(
         view.shown
             .headline

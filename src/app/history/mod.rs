@@ -139,35 +139,23 @@ impl Core {
             Ok(library) => {
                 self.state.prefs.history_folder = Some(folder.clone());
                 let robots = library.robots();
-                let keep = self
-                    .forms
-                    .history
-                    .robot
-                    .as_ref()
-                    .is_some_and(|r| robots.iter().any(|(n, _)| n == r));
-                if !keep {
+                let form = &mut self.forms.history;
+                if !robots.iter().any(|(n, _)| Some(n) == form.robot.as_ref()) {
                     // The robot with the most results.
-                    self.forms.history.robot = robots
-                        .iter()
-                        .max_by_key(|(_, n)| *n)
-                        .map(|(name, _)| name.clone());
+                    let most = robots.iter().max_by_key(|(_, n)| *n);
+                    form.robot = most.map(|(name, _)| name.clone());
                 }
-                self.forms.history.unselected.clear();
+                form.unselected.clear();
                 let problems = library.problems.len();
                 let (results, sessions) = (library.entries.len(), library.sessions.len());
-                let mut line = format!(
-                    "{}: {results} results of {} robot(s), {sessions} sessions",
-                    folder.display(),
-                    robots.len(),
-                );
+                let (folder, n) = (folder.display(), robots.len());
+                let mut line =
+                    format!("{folder}: {results} results of {n} robot(s), {sessions} sessions");
+                let mut level = Level::Info;
                 if problems > 0 {
                     line.push_str(&format!(", {problems} file(s) could not be used"));
+                    level = Level::Warning;
                 }
-                let level = if problems > 0 {
-                    Level::Warning
-                } else {
-                    Level::Info
-                };
                 self.state.say(level, line);
                 self.state.history.library = Some(Ok(*library));
             }

@@ -171,13 +171,11 @@ fn table_ui(ui: &mut egui::Ui, library: &Library, forms: &mut Forms) {
 
 fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) {
     let of_robot = forms.history.robot.as_deref() == Some(e.robot.as_str());
-    let name = e.path.file_name().map_or_else(
-        || e.path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    );
+    let name = e.path.file_name().unwrap_or(e.path.as_os_str());
     let mut ticked = !forms.history.unselected.contains(&e.path);
+    let tick = egui::Checkbox::new(&mut ticked, name.to_string_lossy());
     let changed = ui
-        .add_enabled(of_robot, egui::Checkbox::new(&mut ticked, name))
+        .add_enabled(of_robot, tick)
         .on_hover_text(e.path.display().to_string())
         .on_disabled_hover_text("another robot: choose it above to plot its drift")
         .changed();
@@ -190,13 +188,13 @@ fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) {
         let t = RichText::new(t);
         ui.label(if of_robot { t } else { t.color(MUTED) })
     };
-    let source = if e.date_source.is_from_name() {
+    let source = e.date_source.as_str();
+    let shown = if e.date_source.is_from_name() {
         String::new()
     } else {
-        format!(" ({})", e.date_source.as_str())
+        format!(" ({source})")
     };
-    cell(format!("{}{source}", e.date))
-        .on_hover_text(format!("date from the {}", e.date_source.as_str()));
+    cell(format!("{}{shown}", e.date)).on_hover_text(format!("date from the {source}"));
     let validation = e.validation_std_after();
     let validation = validation.map_or_else(|| "no validation".into(), |s| format!("{s:.3} mm"));
     for text in [
@@ -208,13 +206,13 @@ fn entry_row(ui: &mut egui::Ui, e: &Entry, forms: &mut Forms) {
         cell(text);
     }
     cell(format!("{:.4} mm", e.epsilon_after));
-    let (t, r) = (e.hand_eye.translation, e.hand_eye.rpy_deg);
+    let ([x, y, z], [r, p, w]) = (e.hand_eye.translation, e.hand_eye.rpy_deg);
     let which = match e.mount {
         Mount::Flange => "hand-eye eT_s",
         Mount::Fixed => "base_from_sensor bT_s (a fixed sensor)",
     };
-    cell(format!("{:.3} {:.3} {:.3}", t[0], t[1], t[2])).on_hover_text(which);
-    cell(format!("{:.4} {:.4} {:.4}", r[0], r[1], r[2]));
+    cell(format!("{x:.3} {y:.3} {z:.3}")).on_hover_text(which);
+    cell(format!("{r:.4} {p:.4} {w:.4}"));
     ui.end_row();
 }
 
@@ -256,11 +254,8 @@ fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {
             for j in &jumps {
                 let unit = j.unit.as_str();
                 coloured(ui, BAD, &j.parameter);
-                ui.label(format!(
-                    "{} → {}",
-                    date(library, j.from),
-                    date(library, j.to)
-                ));
+                let (from, to) = (date(library, j.from), date(library, j.to));
+                ui.label(format!("{from} → {to}"));
                 ui.label(format!("{:+.4} {unit}", j.change));
                 ui.label(j.combined.map_or("–".into(), |c| format!("{c:.4} {unit}")));
                 ui.label(j.ratio.map_or("–".into(), |r| format!("{r:.1}")));
@@ -280,12 +275,9 @@ fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {
         })
         .collect();
     if !unchecked.is_empty() {
-        egui::CollapsingHeader::new(format!(
-            "{} change(s) could not be checked",
-            unchecked.len()
-        ))
-        .id_salt("history_unchecked")
-        .show(ui, |ui| {
+        let title = format!("{} change(s) could not be checked", unchecked.len());
+        let header = egui::CollapsingHeader::new(title).id_salt("history_unchecked");
+        header.show(ui, |ui| {
             for (c, why) in unchecked {
                 ui.label(format!("{}: {why}", c.parameter));
             }
@@ -310,15 +302,12 @@ fn drift_ui(ui: &mut egui::Ui, drift: &Drift, library: &Library) {
 }
 
 fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[String]) {
-    ui.label(
-        RichText::new(format!(
-            "{} ({}) · {}",
-            series.name,
-            series.unit.as_str(),
-            series.kind.label(drift.mount)
-        ))
-        .strong(),
+    let (name, unit, kind) = (
+        &series.name,
+        series.unit.as_str(),
+        series.kind.label(drift.mount),
     );
+    ui.label(RichText::new(format!("{name} ({unit}) · {kind}")).strong());
     // x = position in date order; the tick labels are the dates.
     let position = |entry: usize| drift.entries.iter().position(|&e| e == entry);
     let points: Vec<[f64; 2]> = series
@@ -328,9 +317,8 @@ fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[St
         .collect();
     // The ±1σ bars (muted) and the jumps (red): a segment each.
     let segment = |name: &str, ends: [[f64; 2]; 2], colour, width| {
-        Line::new(name, PlotPoints::from(ends.to_vec()))
-            .color(colour)
-            .width(width)
+        let line = Line::new(name, PlotPoints::from(ends.to_vec()));
+        line.color(colour).width(width)
     };
     let jumps = drift.jumps().filter(|j| j.parameter == series.name);
     let jumps: Vec<[[f64; 2]; 2]> = jumps
@@ -342,37 +330,28 @@ fn series_plot_ui(ui: &mut egui::Ui, series: &Series, drift: &Drift, dates: &[St
     // Half a result of room each side: the first and last dates, centred
     // on their ticks, stay inside the plot.
     let last = dates.len().saturating_sub(1) as f64;
-    let plot = Plot::new(("drift", series.name.as_str()))
+    let plot = Plot::new(("drift", name.as_str()))
         .height(DRIFT_PLOT_HEIGHT)
         .include_x(-DATE_ROOM)
         .include_x(last + DATE_ROOM)
         .allow_scroll(false);
     labelled_x(readable_y(plot), dates.to_vec(), DATE_LABEL_GAP)
-        .y_axis_label(series.unit.as_str())
+        .y_axis_label(unit)
         .show(ui, |p| {
             for pt in &series.points {
                 if let (Some(x), Some(s)) = (position(pt.entry), pt.sigma) {
-                    let x = x as f64;
-                    p.line(segment(
-                        "",
-                        [[x, pt.value - s], [x, pt.value + s]],
-                        MUTED,
-                        1.5,
-                    ));
+                    let (x, y) = (x as f64, pt.value);
+                    p.line(segment("", [[x, y - s], [x, y + s]], MUTED, 1.5));
                 }
             }
+            let line = Line::new(name.as_str(), PlotPoints::from(points.clone()));
             p.line(
-                Line::new(series.name.as_str(), PlotPoints::from(points.clone()))
-                    .color(AFTER)
+                line.color(AFTER)
                     .style(LineStyle::dotted_loose())
                     .width(1.0),
             );
-            p.points(
-                Points::new(series.name.as_str(), PlotPoints::from(points))
-                    .color(AFTER)
-                    .shape(MarkerShape::Circle)
-                    .radius(3.5),
-            );
+            let points = Points::new(name.as_str(), PlotPoints::from(points));
+            p.points(points.color(AFTER).shape(MarkerShape::Circle).radius(3.5));
             for ends in jumps {
                 p.line(segment("jump", ends, BAD, 2.5));
             }

@@ -293,7 +293,8 @@ impl Core {
             ResultOrigin::Review(p) => p.display().to_string(),
             ResultOrigin::Run { .. } => format!(
                 "a workbench run (method {}) of \"{}\"",
-                view.method, view.file.session
+                view.method(),
+                view.file.session
             ),
         };
         let request = MeasureRequest {

@@ -144,7 +144,7 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
                 };
                 ui.label(format!(
                     "the result on show: {origin} (method {}, session \"{}\")",
-                    v.method, v.file.session
+                    v.method(), v.file.session
                 ));
                 if !has_covariance(&v.file) {
                     let method = v.file.solver.method();

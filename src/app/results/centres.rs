@@ -24,6 +24,7 @@ use crate::app::scene::ui::scene_ui_within;
 use crate::app::widgets::plots::readable;
 use crate::app::widgets::station_style;
 use crate::app::{Forms, results::CentresForm};
+use crate::engine::base::session::Mount;
 pub use scene::{ORBIT_LABEL, orbit_positions};
 
 /// A click selects the nearest centre within this many points of the pointer.
@@ -180,21 +181,14 @@ fn plots_ui(
 /// fixed sensor's targets in the flange frame.
 #[must_use]
 pub fn centres_frame(state: &AppState) -> &'static str {
-    let mount = state.result.as_ref().map_or_else(
-        || {
-            state
-                .loaded
-                .as_ref()
-                .map(|l| l.session.mount)
-                .unwrap_or_default()
-        },
-        |r| r.file.mount(),
-    );
+    let mount = match (&state.result, &state.loaded) {
+        (Some(r), _) => r.file.mount(),
+        (None, Some(l)) => l.session.mount,
+        (None, None) => Mount::default(),
+    };
     match mount {
-        crate::engine::base::session::Mount::Flange => "sphere centres in the robot base frame",
-        crate::engine::base::session::Mount::Fixed => {
-            "targets in the flange frame (a fixed sensor)"
-        }
+        Mount::Flange => "sphere centres in the robot base frame",
+        Mount::Fixed => "targets in the flange frame (a fixed sensor)",
     }
 }
 

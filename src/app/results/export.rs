@@ -8,7 +8,7 @@
 //! back calibrated, UR's calibration YAML). Every file is written atomically by the engine's
 //! [`write_atomic`], on a job thread.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::SystemTime;
 
@@ -27,8 +27,8 @@ use crate::app::command::Command;
 use crate::app::command::ExportKind;
 use crate::app::command::UseExport;
 use crate::app::error::JobError;
-use crate::app::ledger::Artefact;
-use crate::app::results::{ResultOrigin, ResultView};
+use crate::app::ledger::{Artefact, Stamp};
+use crate::app::results::ResultView;
 use crate::app::state::Level;
 use crate::app::{Core, Write};
 
@@ -42,7 +42,7 @@ pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<()
         ExportKind::ResultJson => result_text_checked(&view.file, path)?,
         ExportKind::CentresCsv => tables::centres_csv(&view.file),
         ExportKind::DistancesCsv => tables::distances_csv(&view.shown),
-        ExportKind::PlotsPng => return write_plots_png(view, path),
+        ExportKind::PlotsPng => return Ok(write_atomic(path, &plots_png(view)?)?),
         ExportKind::ReportHtml => {
             return Err(JobError::Missing("a report needs its session".to_string()));
         }
@@ -52,11 +52,7 @@ pub fn write_text(kind: ExportKind, view: &ResultView, path: &Path) -> Result<()
                 ExportKind::ModelCsv => ModelFormat::Csv,
                 _ => ModelFormat::Urdf,
             };
-            let source = match &view.origin {
-                ResultOrigin::Review(p) => p.display().to_string(),
-                ResultOrigin::Run { .. } => format!("a workbench run of {}", view.file.session),
-            };
-            model::export(&view.file, format, &source)?
+            model::export(&view.file, format, &view.source())?
         }
     };
     Ok(write_atomic(path, text.as_bytes())?)
@@ -111,7 +107,7 @@ pub const PNG_SCALE: f32 = 2.0;
 /// session and method, the lines under it the headline figures and ε.
 #[must_use]
 pub fn plots_sheet(view: &ResultView) -> sheet::Sheet {
-    let title = format!("{} · method {}", view.file.session, view.method);
+    let title = format!("{} · method {}", view.file.session, view.method());
     // Words rather than arrows: the built-in proportional font has no →.
     let mut lines = Vec::new();
     if let Some(h) = &view.shown.headline {
@@ -126,17 +122,20 @@ pub fn plots_sheet(view: &ResultView) -> sheet::Sheet {
         "ε {:.4} mm before, {:.4} mm after",
         view.file.epsilon_before, view.file.epsilon_after
     ));
+    let paper = view.file.solver.paper();
     sheet::plots_sheet(&SheetInput {
         title: &title,
         lines: &lines,
         within: &view.shown.within,
         within_of: view.shown.within_of.as_str(),
         distances: &view.shown.distances,
-        epsilons: &view.epsilons,
-        threshold: view.threshold,
-        singular_values: &view.singular_values,
-        kept: view.kept,
-        svd_tolerance: view.svd_tolerance,
+        epsilons: &view.epsilons(),
+        threshold: view.file.solver.threshold(),
+        singular_values: paper
+            .and_then(|p| p.singular_values.as_deref())
+            .unwrap_or_default(),
+        kept: paper.and_then(|p| p.kept_directions),
+        svd_tolerance: paper.and_then(|p| p.svd_tolerance),
     })
 }
 
@@ -203,67 +202,67 @@ pub fn plots_png(view: &ResultView) -> Result<Vec<u8>, JobError> {
         .map_err(|e| JobError::Png(format!("could not encode the PNG: {e}")))
 }
 
-/// Writes the plots PNG of `view` ([`plots_png`]) to `path` atomically.
-///
-/// # Errors
-/// As [`plots_png`], or the file cannot be written.
-pub fn write_plots_png(view: &ResultView, path: &Path) -> Result<(), JobError> {
-    let bytes = plots_png(view)?;
-    Ok(write_atomic(path, &bytes)?)
-}
-
 impl Core {
+    /// The result on show, what it was made from and the path of
+    /// `file_name(stem)` in the export folder, to write `label` of it; `None`
+    /// (saying why) without a result, when `unavailable` says why not,
+    /// while the result is stale (it is never written as if it were
+    /// current), or without the folder.
+    fn export_target(
+        &mut self,
+        label: &str,
+        unavailable: impl FnOnce(&ResultView) -> Option<String>,
+        file_name: impl FnOnce(&str) -> String,
+    ) -> Option<(ResultView, Stamp, PathBuf)> {
+        let Some(view) = &self.state.result else {
+            let text = "nothing to export: run the solver or open a result first";
+            self.state.say(Level::Warning, text);
+            return None;
+        };
+        let title = format!("{label} not written");
+        let why = unavailable(view).map_or_else(
+            || {
+                self.state
+                    .ledger
+                    .check(Artefact::Result)
+                    .map_err(|why| format!("{why}: run the calibration again, then export"))
+            },
+            Err,
+        );
+        let view = view.clone();
+        let stamp = why.map_err(|why| self.refuse(&title, &title, why)).ok()?;
+        let dir = self.export_folder()?;
+        let loaded = self.state.loaded.as_ref();
+        let stem = loaded.map_or_else(|| "result".to_string(), |l| l.source.stem());
+        Some((view, stamp, dir.join(file_name(&stem))))
+    }
+
     /// Writes one export of the result on show into the export folder.
     pub(in crate::app) fn export(&mut self, ctx: &egui::Context, kind: ExportKind) {
-        let Some(view) = &self.state.result else {
-            self.state.say(
-                Level::Warning,
-                "nothing to export: run the solver or open a result first",
-            );
+        let report = kind == ExportKind::ReportHtml;
+        if report && self.state.result.is_some() && self.state.loaded.is_none() {
+            let text = "a report needs the session: open it first";
+            return self.state.say(Level::Warning, text);
+        }
+        let target = self.export_target(kind.label(), |_| None, |stem| kind.file_name(stem));
+        let Some((view, stamp, path)) = target else {
             return;
         };
-        // A stale result is never written as if it were current.
-        let stamp = match self.state.ledger.check(Artefact::Result) {
-            Ok(stamp) => stamp,
-            Err(why) => {
-                let title = format!("{} not written", kind.label());
-                let why = format!("{why}: run the calibration again, then export");
-                self.refuse(&title, &title, why);
-                return;
-            }
-        };
-        let view = view.clone();
         // The report judges by the tolerance: made from the result and it.
-        let (from, stamp) = if kind == ExportKind::ReportHtml {
+        let (from, stamp) = if report {
             (Artefact::Report, self.state.ledger.stamp(Artefact::Report))
         } else {
             (Artefact::Result, stamp)
         };
-        let loaded = if kind == ExportKind::ReportHtml {
-            let Some(loaded) = &self.state.loaded else {
-                self.state
-                    .say(Level::Warning, "a report needs the session: open it first");
-                return;
-            };
-            Some(loaded.clone())
-        } else {
-            None
-        };
-        let Some(dir) = self.export_folder() else {
-            return;
-        };
-        let stem = self
-            .state
-            .loaded
-            .as_ref()
-            .map_or_else(|| "result".to_string(), |l| l.source.stem());
-        let path = dir.join(kind.file_name(&stem));
+        let loaded = self.state.loaded.clone().filter(|_| report);
         let tolerance = self.forms.tolerance;
+        let what = kind.label().to_string();
+        let again = Command::Export(kind);
         let write = Write {
-            what: kind.label().to_string(),
+            what,
             from,
             stamp,
-            again: Command::Export(kind),
+            again,
         };
         self.write(ctx, path, write, move |path| {
             match &loaded {
@@ -388,53 +387,25 @@ impl Core {
     /// Writes a file of the result on show for the controller or the
     /// planner into the export folder: refused while the result is stale.
     pub(in crate::app) fn use_export(&mut self, ctx: &egui::Context, kind: UseExport) {
-        let Some(view) = &self.state.result else {
-            self.state.say(
-                Level::Warning,
-                "nothing to export: run the solver or open a result first",
-            );
+        let urdf = self.forms.urdf_source.clone();
+        let unavailable = |view: &ResultView| unavailable(kind, view, &urdf);
+        let target = self.export_target(&kind.label(), unavailable, |stem| kind.file_name(stem));
+        let Some((view, stamp, path)) = target else {
             return;
         };
-        let title = format!("{} not written", kind.label());
-        if let Some(why) = unavailable(kind, view, &self.forms.urdf_source) {
-            self.refuse(&title, &title, why);
-            return;
-        }
-        let stamp = match self.state.ledger.check(Artefact::Result) {
-            Ok(stamp) => stamp,
-            Err(why) => {
-                self.refuse(
-                    &title,
-                    &title,
-                    format!("{why}: run the calibration again, then export"),
-                );
-                return;
-            }
-        };
-        let result = view.file.clone();
-        let source = match &view.origin {
-            ResultOrigin::Review(p) => p.display().to_string(),
-            ResultOrigin::Run { .. } => format!("a workbench run of {}", view.file.session),
-        };
-        let Some(dir) = self.export_folder() else {
-            return;
-        };
-        let stem = self
-            .state
-            .loaded
-            .as_ref()
-            .map_or_else(|| "result".to_string(), |l| l.source.stem());
-        let path = dir.join(kind.file_name(&stem));
-        let urdf = std::path::PathBuf::from(self.forms.urdf_source.trim());
+        let source = view.source();
+        let urdf = PathBuf::from(urdf.trim());
+        let what = kind.label();
+        let again = Command::UseExport(kind);
         let write = Write {
-            what: kind.label(),
+            what,
             from: Artefact::Result,
             stamp,
-            again: Command::UseExport(kind),
+            again,
         };
         self.write(ctx, path, write, move |path| {
             crate::engine::files::format::refuse_inputs(path, &[urdf.as_path()])?;
-            let text = use_export_text(kind, &result, &source, &urdf)?;
+            let text = use_export_text(kind, &view.file, &source, &urdf)?;
             write_atomic(path, text.as_bytes())?;
             Ok(None)
         });

@@ -39,110 +39,79 @@ pub(super) fn after_fail_ui(
         .map(|m| m.outliers.as_slice())
         .unwrap_or_default();
     let running = state.jobs.runs(&crate::app::job::Slot::Run);
+    let leave_out = |id: &String| {
+        let (id, included) = (id.clone(), false);
+        Command::View(ViewCommand::SetIncluded { id, included })
+    };
     let response = crate::app::widgets::boxed(ui, BAD, AFTER_FAIL_TITLE, |ui| {
+        let reasons = reasons.join(", ");
+        ui.label(format!("The validation is beyond the tolerance ({reasons})."));
+        if outliers.is_empty() {
+            ui.label(
+                "1. No measurement stands out: the solver flags none as an outlier, so the data agree with each other and the error is in what the stations determine.",
+            );
+        } else {
             ui.label(format!(
-                "The validation is beyond the tolerance ({}).",
-                reasons.join(", ")
+                "1. Look at the {} measurement(s) the solver flagged as outliers (largest first): inspect the stripe, leave out what is wrong, run again.",
+                outliers.len()
             ));
-            if outliers.is_empty() {
-                ui.label(
-                    "1. No measurement stands out: the solver flags none as an outlier, so the data agree with each other and the error is in what the stations determine.",
-                );
-            } else {
-                ui.label(format!(
-                    "1. Look at the {} measurement(s) the solver flagged as outliers (largest first): inspect the stripe, leave out what is wrong, run again.",
-                    outliers.len()
-                ));
-                let header = ["measurement", "station", "residual (mm)", "σ", ""];
-                super::tables::table(ui, "after_fail_outliers", &header, |ui| {
-                        for o in outliers.iter().take(OUTLIERS_SHOWN) {
-                            ui.label(&o.measurement);
-                            ui.label(&o.station);
-                            ui.label(format!("{:.3}", o.residual_mm));
-                            ui.label(format!("{:.1}", o.sigma));
-                            let index = view
-                                .centres
-                                .points
-                                .iter()
-                                .find(|p| p.id == o.measurement)
-                                .and_then(|p| p.index);
-                            ui.horizontal(|ui| {
-                                if ui
-                                    .add_enabled(index.is_some(), egui::Button::new("Inspect"))
-                                    .on_hover_text("its stripe in the Stripe view")
-                                    .clicked()
-                                    && let Some(i) = index
-                                {
-                                    commands.push(Command::View(ViewCommand::Inspect(i)));
-                                }
-                                let out = state.excluded.contains(&o.measurement);
-                                if ui
-                                    .add_enabled(!out, egui::Button::new("Leave out"))
-                                    .on_disabled_hover_text("left out of the next run")
-                                    .clicked()
-                                {
-                                    commands.push(Command::View(ViewCommand::SetIncluded {
-                                        id: o.measurement.clone(),
-                                        included: false,
-                                    }));
-                                }
-                            });
-                            ui.end_row();
+            let header = ["measurement", "station", "residual (mm)", "σ", ""];
+            crate::app::widgets::table(ui, "after_fail_outliers", &header, |ui| {
+                for o in outliers.iter().take(OUTLIERS_SHOWN) {
+                    ui.label(&o.measurement);
+                    ui.label(&o.station);
+                    ui.label(format!("{:.3}", o.residual_mm));
+                    ui.label(format!("{:.1}", o.sigma));
+                    let mut points = view.centres.points.iter();
+                    let index = points.find(|p| p.id == o.measurement).and_then(|p| p.index);
+                    ui.horizontal(|ui| {
+                        let inspect = ui.add_enabled(index.is_some(), egui::Button::new("Inspect"));
+                        if inspect.on_hover_text("its stripe in the Stripe view").clicked()
+                            && let Some(i) = index
+                        {
+                            commands.push(Command::View(ViewCommand::Inspect(i)));
+                        }
+                        let out = state.excluded.contains(&o.measurement);
+                        let button = ui.add_enabled(!out, egui::Button::new("Leave out"));
+                        if button.on_disabled_hover_text("left out of the next run").clicked() {
+                            commands.push(leave_out(&o.measurement));
                         }
                     });
-                if outliers.len() > OUTLIERS_SHOWN {
-                    ui.label(
-                        RichText::new(format!(
-                            "and {} more in the Outliers table below",
-                            outliers.len() - OUTLIERS_SHOWN
-                        ))
-                        .color(MUTED),
-                    );
-                }
-                if ui
-                    .add_enabled(
-                        !running,
-                        egui::Button::new(format!(
-                            "Leave out all {} and run again",
-                            outliers.len()
-                        )),
-                    )
-                    .clicked()
-                {
-                    for o in outliers {
-                        commands.push(Command::View(ViewCommand::SetIncluded {
-                            id: o.measurement.clone(),
-                            included: false,
-                        }));
-                    }
-                    commands.push(Command::Run(RunCommand::Start));
-                }
-            }
-            let have = state
-                .loaded
-                .as_ref()
-                .map_or(0, |l| l.session.stations(Use::Identify).len());
-            ui.horizontal_wrapped(|ui| {
-                ui.label("2. Measure more stations: more identify stations determine the parameters better.");
-                if ui
-                    .button(format!(
-                        "Plan more stations ({have} → {} identify)",
-                        more_stations(have)
-                    ))
-                    .on_hover_text("the Plan view, set for this robot with more identify stations; Make plan there, measure the new poses, import and run")
-                    .clicked()
-                {
-                    commands.push(Command::Plan(PlanCommand::MoreStations));
+                    ui.end_row();
                 }
             });
-            ui.label(
-                RichText::new(
-                    "3. If the tolerance is tighter than the job needs, set it above; the report can also be written with the FAIL.",
-                )
-                .color(MUTED),
-            );
-        })
-        .response;
+            if outliers.len() > OUTLIERS_SHOWN {
+                let more = outliers.len() - OUTLIERS_SHOWN;
+                let text = format!("and {more} more in the Outliers table below");
+                ui.label(RichText::new(text).color(MUTED));
+            }
+            let text = format!("Leave out all {} and run again", outliers.len());
+            if ui.add_enabled(!running, egui::Button::new(text)).clicked() {
+                commands.extend(outliers.iter().map(|o| leave_out(&o.measurement)));
+                commands.push(Command::Run(RunCommand::Start));
+            }
+        }
+        let stations = state.loaded.as_ref().map(|l| l.session.stations(Use::Identify));
+        let have = stations.as_ref().map_or(0, Vec::len);
+        ui.horizontal_wrapped(|ui| {
+            ui.label("2. Measure more stations: more identify stations determine the parameters better.");
+            let text = format!("Plan more stations ({have} → {} identify)", more_stations(have));
+            if ui
+                .button(text)
+                .on_hover_text("the Plan view, set for this robot with more identify stations; Make plan there, measure the new poses, import and run")
+                .clicked()
+            {
+                commands.push(Command::Plan(PlanCommand::MoreStations));
+            }
+        });
+        ui.label(
+            RichText::new(
+                "3. If the tolerance is tighter than the job needs, set it above; the report can also be written with the FAIL.",
+            )
+            .color(MUTED),
+        );
+    })
+    .response;
     if std::mem::take(&mut forms.focus_after_fail) {
         ui.scroll_to_rect(response.rect, Some(egui::Align::TOP));
     }

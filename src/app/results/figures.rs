@@ -12,6 +12,7 @@ use crate::app::results::ResultView;
 use crate::app::widgets::plots::epsilon_plot_ui;
 use crate::app::widgets::plots::{readable, spaced_labels};
 use crate::app::widgets::{AFTER, BAD, BEFORE, MUTED};
+use crate::engine::calibrate::validate::DistanceRecord;
 use crate::engine::tools::result_view::PairDistance;
 
 /// Singular values with their index.
@@ -22,77 +23,49 @@ const STATION_LABEL_GAP: f32 = 10.0;
 
 /// The four plots, two by two.
 pub(super) fn plots_ui(ui: &mut egui::Ui, view: &ResultView) {
+    let (within, distances) = (&view.shown.within, &view.shown.distances);
     ui.columns(2, |cols| {
-        cols[0].label(
-            RichText::new(format!(
-                "Centre distances within {} stations, per pair (cf. paper Fig. 5)",
-                view.shown.within_of.as_str()
-            ))
-            .strong(),
-        );
+        let of = view.shown.within_of.as_str();
+        let title = format!("Centre distances within {of} stations, per pair (cf. paper Fig. 5)");
+        cols[0].label(RichText::new(title).strong());
         key_ui(&mut cols[0]);
-        fig5_ui(&mut cols[0], view);
-        cols[1].label(
-            RichText::new("Reference-distance errors, measured − reference (cf. paper Fig. 6)")
-                .strong(),
-        );
+        fig5_ui(&mut cols[0], within);
+        let title = "Reference-distance errors, measured − reference (cf. paper Fig. 6)";
+        cols[1].label(RichText::new(title).strong());
         // No key over an empty plot.
-        if !view.shown.distances.is_empty() {
+        if !distances.is_empty() {
             key_ui(&mut cols[1]);
         }
-        fig6_ui(&mut cols[1], view);
+        fig6_ui(&mut cols[1], distances);
     });
     // The after series on its own scale: on the before's it is a flat
     // line at zero.
     ui.columns(2, |cols| {
-        cols[0].label(
-            RichText::new("Fig. 5, after only (its own scale)")
-                .strong()
-                .color(AFTER),
-        );
-        let within: Vec<[f64; 2]> = after_points(view.shown.within.iter().map(|p| p.after));
-        after_only_ui(
-            &mut cols[0],
-            "fig5_after",
-            within,
-            ("pair (station by station)", "distance (mm)"),
-            true,
-        );
-        if !view.shown.distances.is_empty() {
-            cols[1].label(
-                RichText::new("Fig. 6, after only (its own scale)")
-                    .strong()
-                    .color(AFTER),
-            );
-            let errors = after_points(
-                view.shown
-                    .distances
-                    .iter()
-                    .map(crate::engine::calibrate::validate::DistanceRecord::error_after),
-            );
-            after_only_ui(
-                &mut cols[1],
-                "fig6_after",
-                errors,
-                ("reference distance no.", "error (mm)"),
-                false,
-            );
+        let title = RichText::new("Fig. 5, after only (its own scale)").strong();
+        cols[0].label(title.color(AFTER));
+        let after = numbered(within.iter().map(|p| p.after));
+        let plot = compare_plot("fig5_after", AFTER_HEIGHT, FIG5_AXES).include_y(0.0);
+        plot.show(&mut cols[0], |p| {
+            series(p, AFTER_NAME, after, AFTER, MarkerShape::Circle);
+        });
+        if !distances.is_empty() {
+            let title = RichText::new("Fig. 6, after only (its own scale)").strong();
+            cols[1].label(title.color(AFTER));
+            let after = numbered(distances.iter().map(DistanceRecord::error_after));
+            compare_plot("fig6_after", AFTER_HEIGHT, FIG6_AXES).show(&mut cols[1], |p| {
+                zero_line(p);
+                series(p, AFTER_NAME, after, AFTER, MarkerShape::Circle);
+            });
         }
     });
     ui.columns(2, |cols| {
         cols[0].label(RichText::new("ε per iteration (paper eq. 20)").strong());
-        epsilon_plot_ui(
-            &mut cols[0],
-            "result_epsilon",
-            &view.epsilons,
-            view.threshold,
-            PLOT_HEIGHT,
-        );
+        let (epsilons, threshold) = (view.epsilons(), view.file.solver.threshold());
+        let height = PLOT_HEIGHT;
+        epsilon_plot_ui(&mut cols[0], "result_epsilon", &epsilons, threshold, height);
         let title = if view.hand_eye_only.is_some() {
             "Identified: the hand-eye only"
-        } else if view.singular_values.is_empty()
-            && !(view.fixed.is_empty() && view.estimated.is_empty())
-        {
+        } else if singular_values(view).is_empty() && !nothing_identified(view) {
             "Identifiable set"
         } else {
             "Singular values of the last update"
@@ -100,6 +73,33 @@ pub(super) fn plots_ui(ui: &mut egui::Ui, view: &ResultView) {
         cols[1].label(RichText::new(title).strong());
         singular_ui(&mut cols[1], view);
     });
+}
+
+/// The singular values of the paper's last update, descending (none for
+/// another method).
+fn singular_values(view: &ResultView) -> &[f64] {
+    let paper = view.file.solver.paper();
+    paper
+        .and_then(|p| p.singular_values.as_deref())
+        .unwrap_or_default()
+}
+
+/// The method neither estimated nor held fixed any parameter (no update
+/// was made).
+fn nothing_identified(view: &ResultView) -> bool {
+    view.file.solver.fixed().is_empty() && view.file.solver.estimated().is_empty()
+}
+
+/// What the method says about parameters the data cannot tell apart.
+fn caveats(view: &ResultView) -> Vec<String> {
+    let Some(ml) = view.file.solver.ml() else {
+        return Vec::new();
+    };
+    let inseparable = ml.inseparable.iter().map(ToString::to_string);
+    let strong = ml.strong_correlations.iter();
+    inseparable
+        .chain(strong.map(|c| format!("strongly correlated: {c}")))
+        .collect()
 }
 
 /// The colour key of the before/after plots (their legends would cover
@@ -114,75 +114,91 @@ fn key_ui(ui: &mut egui::Ui) {
     );
 }
 
-fn before_after_series(p: &mut egui_plot::PlotUi<'_>, before: Vec<[f64; 2]>, after: Vec<[f64; 2]>) {
-    p.line(
-        Line::new("before (nominal)", PlotPoints::from(before.clone()))
-            .color(BEFORE)
-            .width(1.0),
-    );
-    p.points(
-        Points::new("before (nominal)", PlotPoints::from(before))
-            .color(BEFORE)
-            .shape(MarkerShape::Square)
-            .radius(3.0),
-    );
-    p.line(
-        Line::new("after (calibrated)", PlotPoints::from(after.clone()))
-            .color(AFTER)
-            .width(1.0),
-    );
-    p.points(
-        Points::new("after (calibrated)", PlotPoints::from(after))
-            .color(AFTER)
-            .shape(MarkerShape::Circle)
-            .radius(3.0),
+/// The name of the after series.
+const AFTER_NAME: &str = "after (calibrated)";
+
+/// Fig. 5's axis labels.
+const FIG5_AXES: (&str, &str) = ("pair (station by station)", "distance (mm)");
+
+/// Fig. 6's axis labels.
+const FIG6_AXES: (&str, &str) = ("reference distance no.", "error (mm)");
+
+/// A series drawn as a line through its markers.
+fn series(
+    p: &mut egui_plot::PlotUi<'_>,
+    name: &str,
+    points: Vec<[f64; 2]>,
+    colour: egui::Color32,
+    shape: MarkerShape,
+) {
+    let line = Line::new(name, PlotPoints::from(points.clone()));
+    p.line(line.color(colour).width(1.0));
+    let points = Points::new(name, PlotPoints::from(points));
+    p.points(points.color(colour).shape(shape).radius(3.0));
+}
+
+/// The before (squares) and after (circles) series of `values`
+/// (before, after), numbered from 1.
+fn before_after_series(p: &mut egui_plot::PlotUi<'_>, values: impl Iterator<Item = (f64, f64)>) {
+    let (before, after): (Vec<f64>, Vec<f64>) = values.unzip();
+    let before = numbered(before.into_iter());
+    series(p, "before (nominal)", before, BEFORE, MarkerShape::Square);
+    series(
+        p,
+        AFTER_NAME,
+        numbered(after.into_iter()),
+        AFTER,
+        MarkerShape::Circle,
     );
 }
 
-fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
-    let before: Vec<[f64; 2]> = view
-        .shown
-        .within
-        .iter()
-        .enumerate()
-        .map(|(k, p)| [(k + 1) as f64, p.before])
-        .collect();
-    let after: Vec<[f64; 2]> = view
-        .shown
-        .within
-        .iter()
-        .enumerate()
-        .map(|(k, p)| [(k + 1) as f64, p.after])
-        .collect();
-    let top = view
-        .shown
-        .within
+/// The line at 0 of an error plot.
+fn zero_line(p: &mut egui_plot::PlotUi<'_>) {
+    p.hline(HLine::new("", 0.0).color(MUTED).width(1.0));
+}
+
+/// A plot of Fig. 5 or 6 (or its after-only panel) `height` points tall
+/// with its axes.
+fn compare_plot<'a>(id: &str, height: f32, (x, y): (&str, &str)) -> Plot<'a> {
+    readable(Plot::new(id), true)
+        .height(height)
+        // The wheel scrolls the page, not the plot (drag still pans).
+        .allow_scroll(false)
+        .x_axis_label(x.to_owned())
+        .y_axis_label(y.to_owned())
+}
+
+/// The hover text of a point: `text(its index, its value)` near one.
+fn hover<'a>(
+    text: impl Fn(usize, f64) -> Option<String> + 'a,
+) -> impl Fn(&egui_plot::HoverPosition<'_>) -> Option<String> + 'a {
+    move |pos| match pos {
+        egui_plot::HoverPosition::NearDataPoint {
+            index, position, ..
+        } => text(*index, position.y),
+        egui_plot::HoverPosition::Elsewhere { .. } => None,
+    }
+}
+
+fn fig5_ui(ui: &mut egui::Ui, within: &[PairDistance]) {
+    let top = within
         .iter()
         .map(|p| p.before.max(p.after))
         .fold(0.0, f64::max);
-    let within = &view.shown.within;
-    readable(Plot::new("fig5"), true)
-        .height(PLOT_HEIGHT)
-        // The wheel scrolls the page, not the plot (drag still pans).
-        .allow_scroll(false)
-        .x_axis_label("pair (station by station)")
-        .y_axis_label("distance (mm)")
+    let text = |k: usize, y: f64| {
+        let p = within.get(k)?;
+        Some(format!(
+            "{}: {} – {}\n{y:.4} mm",
+            p.station, p.ids.0, p.ids.1
+        ))
+    };
+    compare_plot("fig5", PLOT_HEIGHT, FIG5_AXES)
         .include_y(0.0)
         .include_y(top * 1.15)
-        .label_formatter(move |pos| match pos {
-            egui_plot::HoverPosition::NearDataPoint {
-                index, position, ..
-            } => within.get(*index).map(|p| {
-                format!(
-                    "{}: {} – {}\n{:.4} mm",
-                    p.station, p.ids.0, p.ids.1, position.y
-                )
-            }),
-            egui_plot::HoverPosition::Elsewhere { .. } => None,
-        })
+        .label_formatter(hover(text))
         .show(ui, |p| {
             station_bands_ui(p, within, top * 1.1);
-            before_after_series(p, before, after);
+            before_after_series(p, within.iter().map(|w| (w.before, w.after)));
         });
 }
 
@@ -190,46 +206,11 @@ fn fig5_ui(ui: &mut egui::Ui, view: &ResultView) {
 const AFTER_HEIGHT: f32 = PLOT_HEIGHT * 0.6;
 
 /// Values numbered from 1 for a plot.
-fn after_points(values: impl Iterator<Item = f64>) -> Vec<[f64; 2]> {
+fn numbered(values: impl Iterator<Item = f64>) -> Vec<[f64; 2]> {
     values
         .enumerate()
         .map(|(k, v)| [(k + 1) as f64, v])
         .collect()
-}
-
-/// One after series on its own scale (from 0 for distances, around 0
-/// for errors).
-fn after_only_ui(
-    ui: &mut egui::Ui,
-    id: &str,
-    after: Vec<[f64; 2]>,
-    (x_label, y_label): (&str, &str),
-    from_zero: bool,
-) {
-    let mut plot = readable(Plot::new(id), true)
-        .height(AFTER_HEIGHT)
-        .allow_scroll(false)
-        .x_axis_label(x_label)
-        .y_axis_label(y_label);
-    if from_zero {
-        plot = plot.include_y(0.0);
-    }
-    plot.show(ui, |p| {
-        if !from_zero {
-            p.hline(HLine::new("", 0.0).color(MUTED).width(1.0));
-        }
-        p.line(
-            Line::new("after (calibrated)", PlotPoints::from(after.clone()))
-                .color(AFTER)
-                .width(1.0),
-        );
-        p.points(
-            Points::new("after (calibrated)", PlotPoints::from(after))
-                .color(AFTER)
-                .shape(MarkerShape::Circle)
-                .radius(3.0),
-        );
-    });
 }
 
 /// Fig. 5's stations: a dotted line between two (under the names), and each one's name
@@ -280,54 +261,34 @@ fn station_bands_ui(p: &mut egui_plot::PlotUi<'_>, within: &[PairDistance], y: f
     }
 }
 
-fn fig6_ui(ui: &mut egui::Ui, view: &ResultView) {
-    if view.shown.distances.is_empty() {
+fn fig6_ui(ui: &mut egui::Ui, distances: &[DistanceRecord]) {
+    if distances.is_empty() {
         ui.allocate_ui(egui::vec2(ui.available_width(), PLOT_HEIGHT), |ui| {
             ui.label(RichText::new("No reference distances in this session.").color(MUTED));
         });
         return;
     }
-    let before: Vec<[f64; 2]> = view
-        .shown
-        .distances
+    let text = |k: usize, y: f64| {
+        let d = distances.get(k)?;
+        let (from, to, pose, reference) = (&d.from, &d.to, &d.pose, d.reference);
+        Some(format!(
+            "{from} → {to}, pose {pose}: reference {reference:.3} mm\nerror {y:+.4} mm"
+        ))
+    };
+    let errors = distances
         .iter()
-        .enumerate()
-        .map(|(k, d)| [(k + 1) as f64, d.error_before()])
-        .collect();
-    let after: Vec<[f64; 2]> = view
-        .shown
-        .distances
-        .iter()
-        .enumerate()
-        .map(|(k, d)| [(k + 1) as f64, d.error_after()])
-        .collect();
-    let distances = &view.shown.distances;
-    readable(Plot::new("fig6"), true)
-        .height(PLOT_HEIGHT)
-        // The wheel scrolls the page, not the plot (drag still pans).
-        .allow_scroll(false)
-        .x_axis_label("reference distance no.")
-        .y_axis_label("error (mm)")
-        .label_formatter(move |pos| match pos {
-            egui_plot::HoverPosition::NearDataPoint {
-                index, position, ..
-            } => distances.get(*index).map(|d| {
-                format!(
-                    "{} → {}, pose {}: reference {:.3} mm\nerror {:+.4} mm",
-                    d.from, d.to, d.pose, d.reference, position.y
-                )
-            }),
-            egui_plot::HoverPosition::Elsewhere { .. } => None,
-        })
+        .map(|d| (d.error_before(), d.error_after()));
+    compare_plot("fig6", PLOT_HEIGHT, FIG6_AXES)
+        .label_formatter(hover(text))
         .show(ui, |p| {
-            p.hline(HLine::new("", 0.0).color(MUTED).width(1.0));
-            before_after_series(p, before, after);
+            zero_line(p);
+            before_after_series(p, errors);
         });
 }
 
 fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
-    let values: Vec<(usize, f64)> = view
-        .singular_values
+    let all = singular_values(view);
+    let values: Vec<(usize, f64)> = all
         .iter()
         .copied()
         .enumerate()
@@ -342,28 +303,28 @@ fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
             ui.set_max_width(size.x);
             if view.hand_eye_only.is_some() {
                 pose_only_ui(ui, view);
-            } else if view.fixed.is_empty() && view.estimated.is_empty() {
-                ui.label(
-                    RichText::new("No update was made: ε started below the threshold.")
-                        .color(MUTED),
-                );
+            } else if nothing_identified(view) {
+                let text = "No update was made: ε started below the threshold.";
+                ui.label(RichText::new(text).color(MUTED));
             } else {
                 identifiable_set_ui(ui, view);
             }
         });
         return;
     }
+    let paper = view.file.solver.paper();
     let smax = values.iter().map(|v| v.1).fold(0.0, f64::max);
-    let cut = view.svd_tolerance.map(|t| t * smax);
+    let cut = paper.and_then(|p| p.svd_tolerance).map(|t| t * smax);
+    let kept = paper.and_then(|p| p.kept_directions);
     let (kept, dropped): (Indexed, Indexed) = values
         .iter()
-        .partition(|(k, s)| view.kept.map_or(cut.is_none_or(|c| *s >= c), |n| *k < n));
+        .partition(|(k, s)| kept.map_or(cut.is_none_or(|c| *s >= c), |n| *k < n));
     let pts = |v: &[(usize, f64)]| -> Vec<[f64; 2]> {
         v.iter()
             .map(|(k, s)| [(*k + 1) as f64, s.log10()])
             .collect()
     };
-    let zeros = view.singular_values.len() - values.len();
+    let zeros = all.len() - values.len();
     let mut key = vec![("● kept", AFTER)];
     if !dropped.is_empty() {
         key.push(("× dropped", BAD));
@@ -372,100 +333,81 @@ fn singular_ui(ui: &mut egui::Ui, view: &ResultView) {
         key.push(("- - truncation (tolerance × σ_max)", BEFORE));
     }
     crate::app::widgets::plot_key(ui, &key);
+    // Less the key line, and the zeros' note under the plot.
+    let height = PLOT_HEIGHT - if zeros > 0 { 36.0 } else { 18.0 };
     crate::app::widgets::plots::readable_log_y(Plot::new("singular"))
-        // Less the key line, and the zeros' note under the plot.
-        .height(if zeros > 0 {
-            PLOT_HEIGHT - 36.0
-        } else {
-            PLOT_HEIGHT - 18.0
-        })
+        .height(height)
         .x_axis_label("index")
         .y_axis_label("σ (log scale)")
         .show(ui, |p| {
-            p.points(
-                Points::new("kept", PlotPoints::from(pts(&kept)))
-                    .color(AFTER)
-                    .radius(3.5),
-            );
+            let kept = Points::new("kept", PlotPoints::from(pts(&kept)));
+            p.points(kept.color(AFTER).radius(3.5));
             if !dropped.is_empty() {
-                p.points(
-                    Points::new("dropped", PlotPoints::from(pts(&dropped)))
-                        .color(BAD)
-                        .shape(MarkerShape::Cross)
-                        .radius(5.0),
-                );
+                let dropped = Points::new("dropped", PlotPoints::from(pts(&dropped)));
+                p.points(dropped.color(BAD).shape(MarkerShape::Cross).radius(5.0));
             }
             if let Some(c) = cut {
-                p.hline(
-                    HLine::new("truncation (tolerance × σ_max)", c.log10())
-                        .color(BEFORE)
-                        .style(LineStyle::dashed_loose()),
-                );
+                let line = HLine::new("truncation (tolerance × σ_max)", c.log10());
+                p.hline(line.color(BEFORE).style(LineStyle::dashed_loose()));
             }
         });
     if zeros > 0 {
-        ui.label(
-            RichText::new(format!(
-                "{zeros} singular value(s) are 0 (not drawn on the log scale)"
-            ))
-            .small()
-            .weak(),
-        );
+        let text = format!("{zeros} singular value(s) are 0 (not drawn on the log scale)");
+        ui.label(RichText::new(text).small().weak());
     }
 }
 
 /// Room kept between a column's text and its right edge, points.
 const TEXT_MARGIN: f32 = 12.0;
 
+/// `text` wrapped in its column.
+fn wrapped(ui: &mut egui::Ui, text: impl Into<egui::WidgetText>) {
+    ui.add(egui::Label::new(text).wrap());
+}
+
 /// A pose-only result (flange poses, no joint readings): no kinematic
 /// parameter was identified, so there is no identifiable set to list.
 fn pose_only_ui(ui: &mut egui::Ui, view: &ResultView) {
-    ui.add(
-        egui::Label::new(format!(
+    wrapped(
+        ui,
+        format!(
             "A pose-only result: the session gives flange poses, no joint readings, so method {} identified the hand-eye (sensor on the flange) and the station centres and no kinematic parameter: there is no identifiable set of the model to show. How well the hand-eye is determined: under “Hand-eye only”.",
-            view.method
-        ))
-        .wrap(),
+            view.method()
+        ),
     );
-    for c in &view.caveats {
-        ui.add(egui::Label::new(RichText::new(c).small()).wrap());
+    for c in caveats(view) {
+        wrapped(ui, RichText::new(c).small());
     }
 }
 
 /// What a method that chooses its identifiable set (rather than truncating
 /// an SVD) estimated and held fixed (the list only when it held some).
 fn identifiable_set_ui(ui: &mut egui::Ui, view: &ResultView) {
-    let text = if view.fixed.is_empty() {
-        format!(
-            "Method {} estimated {} parameter(s) and held none fixed.",
-            view.method,
-            view.estimated.len()
-        )
+    let (method, solver) = (view.method(), &view.file.solver);
+    let (estimated, fixed) = (solver.estimated().len(), solver.fixed());
+    let text = if fixed.is_empty() {
+        format!("Method {method} estimated {estimated} parameter(s) and held none fixed.")
     } else {
         format!(
-            "Method {} estimated {} parameter(s) and held {} fixed (not identifiable from centre distances):",
-            view.method,
-            view.estimated.len(),
-            view.fixed.len()
+            "Method {method} estimated {estimated} parameter(s) and held {} fixed (not identifiable from centre distances):",
+            fixed.len()
         )
     };
     // Wrapped in its column: the text at the right edge was cut at
     // 1366 × 768.
-    ui.add(egui::Label::new(text).wrap());
+    wrapped(ui, text);
     egui::ScrollArea::vertical()
         .id_salt("identifiable_set")
         .max_height(PLOT_HEIGHT - 30.0)
         .show(ui, |ui| {
-            if !view.fixed.is_empty() {
-                ui.add(
-                    egui::Label::new(
-                        RichText::new(format!("fixed: {}", view.fixed.join(", "))).color(MUTED),
-                    )
-                    .wrap(),
+            if !fixed.is_empty() {
+                wrapped(
+                    ui,
+                    RichText::new(format!("fixed: {}", fixed.join(", "))).color(MUTED),
                 );
             }
-            for c in &view.caveats {
-                ui.add(egui::Label::new(RichText::new(c).small()).wrap());
+            for c in caveats(view) {
+                wrapped(ui, RichText::new(c).small());
             }
         });
 }

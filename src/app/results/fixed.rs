@@ -25,7 +25,7 @@ pub(super) fn fixed_ui(ui: &mut egui::Ui, view: &ResultView) {
     }
     ui.add_space(8.0);
     ui.label(RichText::new("Targets on the flange (flange frame, mm)").strong());
-    super::tables::table(ui, "fixed_targets", &["target", "x", "y", "z"], |ui| {
+    crate::app::widgets::table(ui, "fixed_targets", &["target", "x", "y", "z"], |ui| {
         for st in &view.file.stations {
             let [x, y, z] = st.point.map(|v| format!("{v:.3}"));
             super::tables::row(ui, [st.id.clone(), x, y, z]);

@@ -55,28 +55,6 @@ pub struct ResultView {
     pub origin: ResultOrigin,
     /// What every reader shows: headline, pairs, hand-eye, marks, σ.
     pub shown: Shown,
-    /// `solver.method`.
-    pub method: String,
-    /// Why the loop stopped, when the method says.
-    pub stop_reason: Option<String>,
-    /// The threshold on ε, mm, when the method says.
-    pub threshold: Option<f64>,
-    /// ε after 0, 1, … updates, mm.
-    pub epsilons: Vec<f64>,
-    /// Singular values of the last update, descending (paper's method).
-    pub singular_values: Vec<f64>,
-    /// SVD tolerance (fraction of σ_max), when given.
-    pub svd_tolerance: Option<f64>,
-    /// SVD directions kept, when given.
-    pub kept: Option<usize>,
-    /// The directions the SVD dropped.
-    pub dropped: Vec<String>,
-    /// Parameters a method held fixed.
-    pub fixed: Vec<String>,
-    /// Parameters a method estimated (when it says).
-    pub estimated: Vec<String>,
-    /// What the method says about parameters the data cannot tell apart.
-    pub caveats: Vec<String>,
     /// Base-frame centres before and after.
     pub centres: CentreSet,
     /// Warnings: e.g. the result names another session.
@@ -93,19 +71,6 @@ impl ResultView {
     /// (when there is one) by measurement id.
     #[must_use]
     pub fn new(file: ResultFile, origin: ResultOrigin, session: Option<&Session>) -> Self {
-        let solver = &file.solver;
-        let paper = solver.paper();
-        let mut caveats: Vec<String> = solver
-            .ml()
-            .map(|m| m.inseparable.iter().map(ToString::to_string).collect())
-            .unwrap_or_default();
-        caveats.extend(
-            solver
-                .ml()
-                .iter()
-                .flat_map(|m| &m.strong_correlations)
-                .map(|c| format!("strongly correlated: {c}")),
-        );
         let mut notes = Vec::new();
         let ids = session.map(crate::engine::tools::result_view::measurement_index);
         let index_of =
@@ -149,26 +114,31 @@ impl ResultView {
             origin,
             sets: ErrorSet::all_of(&file.centres, &shown.distances),
             shown,
-            method: solver.method().to_string(),
-            stop_reason: solver.stop_reason().map(str::to_string),
-            threshold: solver.threshold(),
-            epsilons: file.iterations.iter().map(|r| r.epsilon).collect(),
-            singular_values: paper
-                .and_then(|p| p.singular_values.clone())
-                .unwrap_or_default(),
-            svd_tolerance: paper.and_then(|p| p.svd_tolerance),
-            kept: paper.and_then(|p| p.kept_directions),
-            dropped: paper
-                .and_then(|p| p.dropped_directions.as_ref())
-                .map(|d| d.iter().map(ToString::to_string).collect())
-                .unwrap_or_default(),
-            fixed: solver.fixed().to_vec(),
-            estimated: solver.estimated().to_vec(),
-            caveats,
             centres: CentreSet::new(points),
             notes,
             hand_eye_only: crate::engine::tools::result_view::hand_eye_only_lines(&file, session),
             file,
+        }
+    }
+
+    /// `solver.method`.
+    #[must_use]
+    pub fn method(&self) -> &str {
+        self.file.solver.method()
+    }
+
+    /// ε after 0, 1, … updates, mm.
+    #[must_use]
+    pub fn epsilons(&self) -> Vec<f64> {
+        self.file.iterations.iter().map(|r| r.epsilon).collect()
+    }
+
+    /// Where the result came from, in words (the exports' `source`).
+    #[must_use]
+    pub fn source(&self) -> String {
+        match &self.origin {
+            ResultOrigin::Review(p) => p.display().to_string(),
+            ResultOrigin::Run { .. } => format!("a workbench run of {}", self.file.session),
         }
     }
 }
@@ -222,17 +192,12 @@ pub fn calibration(state: &AppState) -> Reading {
         None => "none".to_string(),
         Some(r) => match &r.origin {
             ResultOrigin::Run { .. } => {
-                format!("run #{} ({})", state.results_shown, r.method)
+                format!("run #{} ({})", state.results_shown, r.method())
             }
-            ResultOrigin::Review(p) => format!(
-                "{} (#{}, {})",
-                p.file_name().map_or_else(
-                    || p.display().to_string(),
-                    |n| n.to_string_lossy().into_owned()
-                ),
-                state.results_shown,
-                r.method
-            ),
+            ResultOrigin::Review(p) => {
+                let name = p.file_name().unwrap_or(p.as_os_str()).to_string_lossy();
+                format!("{name} (#{}, {})", state.results_shown, r.method())
+            }
         },
     };
     Reading::new(

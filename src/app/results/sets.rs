@@ -11,7 +11,7 @@ use egui_plot::{Bar, BarChart, Plot};
 
 use crate::app::results::{CALIBRATION_SET, ErrorSet, ResultView, Summary};
 use crate::app::widgets::plots::{nice_step, readable};
-use crate::app::widgets::{AFTER, BEFORE, MUTED, plot_key};
+use crate::app::widgets::{AFTER, BEFORE, MUTED, plot_key, table};
 
 /// Width of the histogram beside the table, points.
 const HISTOGRAM_WIDTH: f32 = 300.0;
@@ -29,11 +29,6 @@ pub const SETS_TITLE: &str = "Calibration set vs validation set";
 const CALIBRATION: egui::Color32 = AFTER;
 /// Colour of the validation set in the histogram.
 const VALIDATION: egui::Color32 = BEFORE;
-
-/// `before → after` of one statistic, mm.
-fn cell(before: f64, after: f64) -> String {
-    format!("{before:.3} → {after:.3}")
-}
 
 /// The table and the histogram, side by side.
 pub(super) fn sets_ui(ui: &mut egui::Ui, view: &ResultView) {
@@ -55,26 +50,20 @@ pub(super) fn sets_ui(ui: &mut egui::Ui, view: &ResultView) {
 }
 
 fn table_ui(ui: &mut egui::Ui, sets: &[ErrorSet]) {
-    egui::Grid::new("sets_table")
-        .striped(true)
-        .num_columns(6)
-        .spacing([10.0, 4.0])
-        .show(ui, |ui| {
-            for h in ["set", "errors", "n", "mean", "std", "max"] {
-                ui.strong(h);
+    ui.spacing_mut().item_spacing = egui::vec2(10.0, 4.0);
+    let header = ["set", "errors", "n", "mean", "std", "max"];
+    table(ui, "sets_table", &header, |ui| {
+        for s in sets {
+            let (b, a) = (Summary::of(&s.before), Summary::of(&s.after));
+            ui.label(s.set);
+            ui.add(egui::Label::new(&s.what).extend());
+            ui.label(a.n.to_string());
+            for (b, a) in [(b.mean, a.mean), (b.std, a.std), (b.max, a.max)] {
+                ui.label(format!("{b:.3} → {a:.3}"));
             }
             ui.end_row();
-            for s in sets {
-                let (b, a) = (Summary::of(&s.before), Summary::of(&s.after));
-                ui.label(s.set);
-                ui.add(egui::Label::new(&s.what).extend());
-                ui.label(a.n.to_string());
-                ui.label(cell(b.mean, a.mean));
-                ui.label(cell(b.std, a.std));
-                ui.label(cell(b.max, a.max));
-                ui.end_row();
-            }
-        });
+        }
+    });
     ui.add(
         egui::Label::new(
             RichText::new(
@@ -85,6 +74,15 @@ fn table_ui(ui: &mut egui::Ui, sets: &[ErrorSet]) {
         )
         .wrap(),
     );
+}
+
+/// The key entry of `set` in the histogram and its colour.
+fn key(set: &ErrorSet) -> (&'static str, egui::Color32) {
+    if set.set == CALIBRATION_SET {
+        ("■ calibration", CALIBRATION)
+    } else {
+        ("■ validation", VALIDATION)
+    }
 }
 
 /// The share (%) of `values` in each of `bins` bins of `width` from 0.
@@ -115,15 +113,8 @@ fn histogram_ui(ui: &mut egui::Ui, sets: &[ErrorSet]) {
     }
     let width = nice_step(largest / HISTOGRAM_BINS, false);
     let bins = ((largest / width).floor() as usize + 1).max(1);
-    let mut key = Vec::new();
-    for s in &within {
-        key.push(if s.set == CALIBRATION_SET {
-            ("■ calibration", CALIBRATION)
-        } else {
-            ("■ validation", VALIDATION)
-        });
-    }
-    plot_key(ui, &key);
+    let entries: Vec<_> = within.iter().map(|s| key(s)).collect();
+    plot_key(ui, &entries);
     readable(Plot::new("sets_histogram"), false)
         .height(HISTOGRAM_HEIGHT)
         .allow_scroll(false)
@@ -136,11 +127,7 @@ fn histogram_ui(ui: &mut egui::Ui, sets: &[ErrorSet]) {
         .show(ui, |p| {
             let n = within.len() as f64;
             for (k, s) in within.iter().enumerate() {
-                let colour = if s.set == CALIBRATION_SET {
-                    CALIBRATION
-                } else {
-                    VALIDATION
-                };
+                let colour = key(s).1;
                 // Side by side within each bin.
                 let bar_width = width / n;
                 let bars: Vec<Bar> = histogram(&s.after, width, bins)

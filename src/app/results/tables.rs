@@ -7,7 +7,7 @@
 use egui::RichText;
 
 use crate::app::results::{HandEyeView, ResultView};
-use crate::app::widgets::{MUTED, WARN};
+use crate::app::widgets::{MUTED, WARN, table};
 use crate::engine::base::geometry::{rows_from_isometry, wrap_deg};
 use crate::engine::base::robot::{PARAM_NAMES, PARAMS_PER_JOINT};
 use crate::engine::calibrate::solve::estimate::HAND_EYE_LABELS;
@@ -16,25 +16,6 @@ use crate::engine::files::format::result::solver_block;
 /// Longest solver-block value shown in full (longer ones are cut, the
 /// whole value is in the tooltip and the exported JSON).
 const SOLVER_ENTRY_CHARS: usize = 300;
-
-/// A striped grid `id` headed by `header` in bold; `body` adds the rows.
-pub(super) fn table(
-    ui: &mut egui::Ui,
-    id: &str,
-    header: &[&str],
-    body: impl FnOnce(&mut egui::Ui),
-) {
-    egui::Grid::new(id)
-        .striped(true)
-        .num_columns(header.len())
-        .show(ui, |ui| {
-            for h in header {
-                ui.strong(*h);
-            }
-            ui.end_row();
-            body(ui);
-        });
-}
 
 /// One row of plain cells.
 pub(super) fn row(ui: &mut egui::Ui, cells: impl IntoIterator<Item = impl Into<egui::WidgetText>>) {
@@ -57,44 +38,34 @@ pub(super) fn tables_ui(
         Some(lines) => hand_eye_only_ui(ui, lines),
         None => joint_errors_ui(ui, view),
     }
-    if !view.dropped.is_empty() {
+    let paper = view.file.solver.paper();
+    let dropped = paper.and_then(|p| p.dropped_directions.as_deref());
+    if let Some(dropped) = dropped.filter(|d| !d.is_empty()) {
         ui.add_space(6.0);
-        egui::CollapsingHeader::new(format!(
-            "Directions the SVD dropped ({})",
-            view.dropped.len()
-        ))
-        .show(ui, |ui| {
-            for d in &view.dropped {
-                ui.monospace(d);
+        let title = format!("Directions the SVD dropped ({})", dropped.len());
+        egui::CollapsingHeader::new(title).show(ui, |ui| {
+            for d in dropped {
+                ui.monospace(d.to_string());
             }
         });
     }
     ml_tables_ui(ui, view, tolerance);
-    egui::CollapsingHeader::new("Details: the solver block as written in the result file").show(
-        ui,
-        |ui| {
-            egui::Grid::new("solver_entries")
-                .striped(true)
-                .num_columns(2)
-                .show(ui, |ui| {
-                    for (k, v) in solver_block(&view.file.solver) {
-                        let v = match v {
-                            serde_json::Value::String(t) => t,
-                            other => other.to_string(),
-                        };
-                        ui.monospace(k);
-                        let short: String = v.chars().take(SOLVER_ENTRY_CHARS).collect();
-                        let shown = if short.len() < v.len() {
-                            format!("{short}…")
-                        } else {
-                            short
-                        };
-                        ui.add(egui::Label::new(shown).wrap()).on_hover_text(v);
-                        ui.end_row();
-                    }
-                });
-        },
-    );
+    let title = "Details: the solver block as written in the result file";
+    egui::CollapsingHeader::new(title).show(ui, |ui| {
+        let grid = egui::Grid::new("solver_entries").striped(true);
+        grid.num_columns(2).show(ui, |ui| {
+            for (k, v) in solver_block(&view.file.solver) {
+                let v = v.as_str().map_or_else(|| v.to_string(), str::to_owned);
+                ui.monospace(k);
+                let mut shown: String = v.chars().take(SOLVER_ENTRY_CHARS).collect();
+                if shown.len() < v.len() {
+                    shown.push('…');
+                }
+                ui.add(egui::Label::new(shown).wrap()).on_hover_text(v);
+                ui.end_row();
+            }
+        });
+    });
 }
 
 fn marked_cell(ui: &mut egui::Ui, view: &ResultView, label: &str, text: String) {
@@ -267,18 +238,11 @@ fn ml_tables_ui(
         });
     });
     if let Some(cv) = &ml.cross_validation {
-        egui::CollapsingHeader::new(format!(
-            "Leave-one-station-out: rms {:.4} mm over {} stations",
-            cv.rms,
-            cv.stations.len()
-        ))
-        .show(ui, |ui| {
-            ui.label(
-                RichText::new(
-                    "Each station's within-station centre distances predicted by the model fitted without it: an accuracy estimate without a tracker.",
-                )
-                .color(MUTED),
-            );
+        let (rms, n) = (cv.rms, cv.stations.len());
+        let title = format!("Leave-one-station-out: rms {rms:.4} mm over {n} stations");
+        egui::CollapsingHeader::new(title).show(ui, |ui| {
+            let text = "Each station's within-station centre distances predicted by the model fitted without it: an accuracy estimate without a tracker.";
+            ui.label(RichText::new(text).color(MUTED));
             let mut rows: Vec<_> = cv.stations.iter().collect();
             rows.sort_by(|a, b| b.rms.total_cmp(&a.rms));
             table(ui, "loso", &["station", "pairs", "rms (mm)"], |ui| {

@@ -81,18 +81,19 @@ fn origin_ui(ui: &mut egui::Ui, view: &ResultView) {
             };
             format!(
                 "Run of session \"{}\" in this window ({seconds:.2} s{left_out}), method {}.",
-                view.file.session, view.method
+                view.file.session,
+                view.method()
             )
         }
         ResultOrigin::Review(path) => format!(
             "Reviewing {} (session \"{}\", method {}): shown as it was computed, the solver was not run.",
             path.display(),
             view.file.session,
-            view.method
+            view.method()
         ),
     };
     ui.label(RichText::new(text).weak());
-    if let Some(stop) = &view.stop_reason {
+    if let Some(stop) = view.file.solver.stop_reason() {
         ui.label(RichText::new(stop).small());
     }
     for w in &view.shown.warnings {
@@ -114,26 +115,23 @@ fn headline_ui(
 ) {
     egui::Frame::group(ui.style()).show(ui, |ui| {
         ui.set_width(ui.available_width());
-        match &view.shown.headline {
-            Some(h) => {
-                ui.label(RichText::new(&h.what).strong());
-                let (b, a) = (h.stats.before, h.stats.after);
-                ui.horizontal_wrapped(|ui| {
-                    big(ui, format!("std {:.3} → {:.3} mm", b.std, a.std));
-                    ui.label(RichText::new(ratio_text(b.std, a.std)).size(16.0).color(AFTER));
-                    ui.add_space(24.0);
-                    big(ui, format!("max {:.3} → {:.3} mm", b.max, a.max));
-                    ui.label(RichText::new(ratio_text(b.max, a.max)).size(16.0).color(AFTER));
-                });
-            }
-            None => {
-                ui.label(
-                    RichText::new(
-                        "Validation skipped: no validate data (the session has no validate measurements), so accuracy is not checked; the report says so.",
-                    )
-                    .color(WARN),
-                );
-            }
+        if let Some(h) = &view.shown.headline {
+            ui.label(RichText::new(&h.what).strong());
+            let (b, a) = (h.stats.before, h.stats.after);
+            ui.horizontal_wrapped(|ui| {
+                for (what, b, a) in [("std", b.std, a.std), ("max", b.max, a.max)] {
+                    let text = format!("{what} {b:.3} → {a:.3} mm");
+                    ui.label(RichText::new(text).size(28.0).strong());
+                    ui.label(RichText::new(ratio_text(b, a)).size(16.0).color(AFTER));
+                    // The gap between the two, none after the last.
+                    if what == "std" {
+                        ui.add_space(24.0);
+                    }
+                }
+            });
+        } else {
+            let text = "Validation skipped: no validate data (the session has no validate measurements), so accuracy is not checked; the report says so.";
+            ui.label(RichText::new(text).color(WARN));
         }
         verdict_ui(ui, view, forms, stale, commands);
         let w = &view.shown.within_stats;
@@ -231,25 +229,14 @@ fn verdict_ui(
         // Typed, never dragged: a sideways drag must not turn a PASS
         // into a FAIL. A value takes effect on Enter or leaving the field.
         let mut edited = tolerance;
-        if let Some(v) = number_field(
-            ui,
-            "tolerance_std",
-            "tolerance: std ≤",
-            tolerance.std_mm,
-            TOLERANCE_MM,
-            "mm",
-        ) {
-            edited.std_mm = v;
-        }
-        if let Some(v) = number_field(
-            ui,
-            "tolerance_max",
-            "max ≤",
-            tolerance.max_mm,
-            TOLERANCE_MM,
-            "mm",
-        ) {
-            edited.max_mm = v;
+        let (std, max) = (&mut edited.std_mm, &mut edited.max_mm);
+        for (id, label, value) in [
+            ("tolerance_std", "tolerance: std ≤", std),
+            ("tolerance_max", "max ≤", max),
+        ] {
+            if let Some(v) = number_field(ui, id, label, *value, TOLERANCE_MM, "mm") {
+                *value = v;
+            }
         }
         if edited != tolerance {
             commands.push(Command::View(ViewCommand::SetTolerance(edited)));
@@ -265,10 +252,6 @@ pub const STALE_VERDICT: &str = "does not hold: the result is stale, run again";
 
 /// The tolerances one may type, mm.
 const TOLERANCE_MM: std::ops::RangeInclusive<f64> = 0.001..=100.0;
-
-fn big(ui: &mut egui::Ui, text: String) {
-    ui.label(RichText::new(text).size(28.0).strong());
-}
 
 fn export_ui(
     ui: &mut egui::Ui,

@@ -178,12 +178,17 @@ impl Core {
         let seconds = run.started.elapsed().as_secs_f64();
         match outcome {
             Ok(mut view) => {
-                let stop = view.stop_reason.clone().unwrap_or_default();
+                let stop = view
+                    .file
+                    .solver
+                    .stop_reason()
+                    .unwrap_or_default()
+                    .to_string();
                 // One wall time for the header and the status line.
                 if let ResultOrigin::Run { seconds: s, .. } = &mut view.origin {
                     *s = seconds;
                 }
-                let what = format!("method {}", view.method);
+                let what = format!("method {}", view.method());
                 self.show_result(view, run.stamp.clone(), what);
                 // The operator stays where they are; the status line and
                 // the Results tab say a result is ready.

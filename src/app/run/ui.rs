@@ -92,11 +92,11 @@ pub fn solver_ui(
         epsilon_plot_ui(
             ui,
             "last_epsilon",
-            &result.epsilons,
-            result.threshold,
+            &result.epsilons(),
+            result.file.solver.threshold(),
             SIDE_EPSILON_HEIGHT,
         );
-        if let Some(stop) = &result.stop_reason {
+        if let Some(stop) = result.file.solver.stop_reason() {
             ui.label(RichText::new(stop).small());
         }
     }

@@ -442,7 +442,7 @@ impl Core {
                 let notes = view.notes.join("; ");
                 // Made elsewhere: not with this window's solver settings.
                 let stamp = self.state.ledger.stamp(Artefact::Result);
-                let what = format!("method {} (reviewed)", view.method);
+                let what = format!("method {} (reviewed)", view.method());
                 self.show_result(*view, stamp.without(Input::Solver), what);
                 self.state.result_unseen = false;
                 self.forms.tab = Tab::Results;
