@@ -170,23 +170,25 @@ fn targets_are_compensated_largest_first_flagged_written_and_refused_when_stale(
     assert!(
         far.flags
             .iter()
-            .any(|f| f.contains("from every identify pose")),
+            .any(|f| f.describe().contains("from every identify pose")),
         "{far:?}"
     );
-    assert_eq!(view.flagged, 1);
+    assert_eq!(view.summary.flagged, 1);
     assert!(
         view.summary
+            .line()
             .starts_with("5 targets compensated: largest correction")
             && view
                 .summary
+                .line()
                 .contains("; 1 flagged outside what the calibration saw"),
         "{}",
-        view.summary
+        view.summary.line()
     );
     // On screen: the summary, the far row's reason in words, the tool
     // data in RAPID (an ABB table) with its Copy button.
     // The view's line and the status bar's.
-    assert_eq!(labels_with(&h, &view.summary).len(), 2);
+    assert_eq!(labels_with(&h, &view.summary.line()).len(), 2);
     let reasons = labels_with(&h, "outside what the calibration saw: joints");
     assert_eq!(reasons.len(), 1, "{reasons:?}");
     assert!(!labels_with(&h, "PERS tooldata tSpherecal := [TRUE,[[").is_empty());
@@ -346,7 +348,7 @@ fn the_flag_limits_are_set_in_the_view_and_mark_the_table_stale() {
     std::fs::write(&t_csv, table(&targets(&result))).unwrap();
     compensate_in_view(&mut h, &t_csv);
     let flagged = |h: &Harness<'_, WorkbenchApp>| match &h.state().state().compensate.outcome {
-        Some(Ok(v)) => v.flagged,
+        Some(Ok(v)) => v.summary.flagged,
         other => panic!("{other:?}"),
     };
     assert_eq!(flagged(&h), 1);
@@ -377,7 +379,7 @@ fn the_flag_limits_are_set_in_the_view_and_mark_the_table_stale() {
     assert!(
         view.rows
             .iter()
-            .all(|r| r.flags.iter().any(|f| f.contains("0.001"))),
+            .all(|r| r.flags.iter().any(|f| f.describe().contains("0.001"))),
         "{:?}",
         view.rows
     );
@@ -397,7 +399,7 @@ fn the_flag_limits_are_set_in_the_view_and_mark_the_table_stale() {
         other => panic!("{other:?}"),
     };
     let flags: Vec<_> = view.rows.iter().map(|r| (&r.name, &r.flags)).collect();
-    assert_eq!(view.flagged, 0, "{flags:?}");
+    assert_eq!(view.summary.flagged, 0, "{flags:?}");
 }
 
 /// The operator's defect (issue 30): after the targets changed, Write

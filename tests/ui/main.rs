@@ -23,4 +23,5 @@ mod scene_views;
 mod tabs;
 mod trust;
 mod use_exports;
+mod views34;
 mod workbench;

@@ -10,7 +10,6 @@ use std::path::{Path, PathBuf};
 use crate::app::error::JobError;
 use crate::app::job::Worker;
 use crate::engine::base::session::Session;
-use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format::ResultFile;
 use crate::engine::tools::plan::{Controller, Plan, PlanConfig, program_controller};
 use crate::engine::uses::check::{self, CheckRequest, CheckSource, Checked, choose_check_design};
@@ -106,11 +105,7 @@ pub fn check_session_file(
         alpha,
     };
     let (session, checked) = check::check_file(request, &mut |what, done| {
-        if w.progress(what, Some(done)) {
-            Control::Continue
-        } else {
-            Control::Cancel
-        }
+        crate::app::plan::job::report(w, what, Some(done))
     })
     .map_err(|e| e.to_string())?;
     let lines = check::verdict_lines(&checked, alpha);

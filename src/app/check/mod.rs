@@ -21,8 +21,7 @@ use super::job::{Job, Slot};
 use super::ledger::{Artefact, Reading, Stamp};
 use super::state::Level;
 use super::{Core, Forms, Write};
-use crate::engine::files::format::{ResultFile, check_record_path, write_atomic};
-use crate::engine::tools::plan;
+use crate::engine::files::format::{ResultFile, check_record_path};
 use crate::engine::uses::check::DEFAULT_ALPHA;
 use job::{CheckPlanView, CheckView};
 
@@ -83,9 +82,6 @@ pub fn form_reading(forms: &Forms) -> Reading {
 #[must_use]
 pub fn session_reading(form: &CheckForm) -> Reading {
     let path = form.session.trim();
-    let stamp = std::fs::metadata(path)
-        .ok()
-        .and_then(|m| Some((m.len(), m.modified().ok()?)));
     let fields = vec![
         (
             "file".to_string(),
@@ -93,7 +89,7 @@ pub fn session_reading(form: &CheckForm) -> Reading {
         ),
         ("α".to_string(), form.alpha.to_string()),
     ];
-    Reading::new(fields, stamp)
+    Reading::new(fields, super::compensate::file_stamp(path))
 }
 
 impl Core {
@@ -209,12 +205,7 @@ impl Core {
             again: Command::Check(CheckCommand::Export(kind)),
         };
         self.write(ctx, path, write, move |path| {
-            let text = match kind {
-                PlanExport::Csv => plan::plan_csv(&made),
-                PlanExport::Program(c) => plan::render_program(c, &made)?,
-            };
-            write_atomic(path, text.as_bytes())?;
-            Ok(None)
+            super::plan::write_plan(kind, &made, path)
         });
     }
 

@@ -13,7 +13,7 @@ use crate::app::job::Slot;
 use crate::app::ledger::Artefact;
 use crate::app::widgets::{
     BAD, GOOD, MUTED, WARN, boxed, coloured, command_button, dialog_note_ui, export_folder_ui,
-    job_ui, labelled_drag, labelled_field, stale_banner_ui, weak, written_ui,
+    job_ui, labelled_drag, path_row, stale_banner_ui, weak, written_ui,
 };
 use crate::app::{AppState, Forms};
 
@@ -149,15 +149,17 @@ fn run_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mut
     let busy = state.jobs.runs(&Slot::Dialog);
     let form = &mut forms.check;
     ui.horizontal(|ui| {
-        let hint = "the check's scan imported as a session (.json)";
-        labelled_field(ui, "Check session", &mut form.session, hint, 420.0);
-        let browse = Command::Browse(Purpose::CheckSession);
-        command_button(
+        let (hint, purpose) = (
+            "the check's scan imported as a session (.json)",
+            Purpose::CheckSession,
+        );
+        path_row(
             ui,
-            !busy,
-            "Browse…",
-            "choose the check's session",
-            browse,
+            "Check session",
+            &mut form.session,
+            hint,
+            busy,
+            purpose,
             commands,
         );
     });

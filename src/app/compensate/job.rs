@@ -8,25 +8,22 @@
 //! atomically, never over an input.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 
-use nalgebra::Isometry3;
-
+use crate::app::job::Worker;
+use crate::app::plan::job::report;
 use crate::engine::base::robot::controller::FlangeConvention;
-use crate::engine::calibrate::solve::Control;
 use crate::engine::files::format::{refuse_inputs, write_atomic};
 use crate::engine::files::program::PoseFile;
 use crate::engine::uses::compensate::{
     self, CompensateError, CompensateFileError, CompensateRequest, Compensation, Model,
-    TargetFailure, Tcp, report,
+    TargetFailure, TargetReport, Tcp, report, report::Summary,
 };
 
 /// Compensates the request's targets by the one engine entry `spherecal
 /// compensate` calls too ([`compensate::compensate_file`]; with
 /// `current_tool`, a pose-only result's targets for the controller's
 /// current tool, [`compensate::compensate_file_tool_only`]) and makes the
-/// view of it; `progress` hears of each target, `cancel` stops at the
-/// next one.
+/// view of it; `w` hears of each target, Cancel stops at the next one.
 ///
 /// # Errors
 /// The message, naming the file (and the target and line): a file that
@@ -35,21 +32,13 @@ use crate::engine::uses::compensate::{
 pub fn compensate_targets(
     request: CompensateRequest,
     current_tool: Option<PathBuf>,
-    cancel: &AtomicBool,
-    progress: &mut dyn FnMut(String, f64),
+    w: &Worker,
 ) -> Result<CompensationView, String> {
     let (targets, convention) = (request.targets.clone(), request.read.convention);
     let mut each = |p: &compensate::CompensateProgress| {
         let fraction = p.done as f64 / p.total.max(1) as f64;
-        progress(
-            format!("target {}: {} of {}", p.target, p.done, p.total),
-            fraction,
-        );
-        if cancel.load(Ordering::Relaxed) {
-            Control::Cancel
-        } else {
-            Control::Continue
-        }
+        let text = format!("target {}: {} of {}", p.target, p.done, p.total);
+        report(w, text, Some(fraction))
     };
     let fail = |e: CompensateFileError| match e {
         CompensateFileError::Model(e) => format!("{e} (the result on show)"),
@@ -74,13 +63,13 @@ pub fn compensate_targets(
         );
         return Ok(CompensationView::from_parts(
             done.compensation,
-            &done.file,
+            done.file,
             what,
             Vec::new(),
         ));
     }
     let done = compensate::compensate_file(request, &mut each).map_err(fail)?;
-    let mut view = CompensationView::new(done.compensation, &done.file, &done.model, convention);
+    let mut view = CompensationView::new(done.compensation, done.file, &done.model, convention);
     view.notes.extend(done.notes);
     Ok(view)
 }
@@ -124,61 +113,33 @@ pub fn write_compensated(
     Ok(write_atomic(path, text.as_bytes())?)
 }
 
-/// One target of the table.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TargetRow {
-    /// Its name (`P[3]`, `p10`, a table's id).
-    pub name: String,
-    /// Its 1-based line in the targets file.
-    pub line: usize,
-    /// TCP position correction `|commanded − wanted|`, mm.
-    pub correction_mm: f64,
-    /// Rotation correction, deg.
-    pub correction_deg: f64,
-    /// Largest joint change between the nominal and the calibrated
-    /// solution, deg.
-    pub joint_change_deg: f64,
-    /// Predicted 1σ residual of the TCP position after compensation, mm
-    /// (`ml` results only).
-    pub sigma_mm: Option<f64>,
-    /// Joint-space distance to the nearest identify pose, deg (when the
-    /// joints of the poses are known).
-    pub nearest_identify_deg: Option<f64>,
-    /// Why it lies outside what the calibration saw, in words (empty:
-    /// inside).
-    pub flags: Vec<String>,
-    /// A joint target left as written.
-    pub kept: bool,
-    /// What to know about it (a configuration kept or updated).
-    pub notes: Vec<String>,
-    /// The TCP pose wanted, base frame, mm.
-    pub wanted: Isometry3<f64>,
-    /// The TCP pose to command, base frame, mm.
-    pub commanded: Isometry3<f64>,
+/// Why a target is flagged, in words (empty: not flagged).
+#[must_use]
+pub fn flags_text(target: &TargetReport) -> String {
+    let why: Vec<String> = target
+        .flags
+        .iter()
+        .map(compensate::Flag::describe)
+        .collect();
+    why.join("; ")
 }
 
-/// A compensation as the view shows it.
+/// A compensation as the view shows it: the engine's reports as they
+/// came, the targets largest correction first.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompensationView {
-    /// The targets file.
-    pub targets: PathBuf,
-    /// What the file is and how it was read: "pose table T.csv: in file
-    /// order (layout detected)".
-    pub file_line: String,
-    /// The reader's warnings.
-    pub warnings: Vec<String>,
+    /// The targets as read (path, layout, warnings).
+    pub file: PoseFile,
     /// The TCP, for people.
     pub tcp: String,
     /// The tool data to set on the controller, per controller
     /// (description, text), when the TCP is the calibrated sensor.
     pub tool_data: Vec<(String, String)>,
-    /// Every target, largest position correction first.
-    pub rows: Vec<TargetRow>,
-    /// The command line's summary line (targets, largest correction,
-    /// flagged).
-    pub summary: String,
-    /// Targets flagged outside what the calibration saw.
-    pub flagged: usize,
+    /// Every target, largest position correction first (as the command
+    /// line's table).
+    pub rows: Vec<TargetReport>,
+    /// The command line's summary (targets, largest correction, flagged).
+    pub summary: Summary,
     /// What to know about the run as a whole.
     pub notes: Vec<String>,
     /// The compensated file: positions rewritten, every other byte kept.
@@ -192,12 +153,12 @@ impl CompensationView {
     #[must_use]
     pub fn new(
         done: Compensation,
-        file: &PoseFile,
+        file: PoseFile,
         model: &Model,
         convention: Option<FlangeConvention>,
     ) -> Self {
         let tool_data = if model.tcp == Tcp::Sensor {
-            report::tool_data(file, convention, &model.tool)
+            report::tool_data(&file, convention, &model.tool)
                 .into_iter()
                 .map(|(kind, text)| (kind.to_string(), text))
                 .collect()
@@ -212,56 +173,37 @@ impl CompensationView {
     #[must_use]
     pub fn from_parts(
         done: Compensation,
-        file: &PoseFile,
+        file: PoseFile,
         tcp: String,
         tool_data: Vec<(String, String)>,
     ) -> Self {
-        let file_line = report::file_line(file);
-        // Largest first, as the command line's table.
-        let rows = report::largest_first(&done.targets)
-            .into_iter()
-            .map(|t| TargetRow {
-                name: t.name.clone(),
-                line: t.line,
-                correction_mm: t.correction_mm,
-                correction_deg: t.correction_deg,
-                joint_change_deg: t.joint_change_deg,
-                sigma_mm: t.sigma_mm,
-                nearest_identify_deg: t.nearest_identify_deg,
-                flags: t
-                    .flags
-                    .iter()
-                    .map(crate::engine::uses::compensate::Flag::describe)
-                    .collect(),
-                kept: !t.written,
-                notes: t.notes.clone(),
-                wanted: t.wanted,
-                commanded: t.commanded,
-            })
-            .collect();
+        let rows = report::largest_first(&done.targets).into_iter().cloned();
         Self {
-            targets: file.path.clone(),
-            file_line,
-            warnings: file.warnings.clone(),
+            rows: rows.collect(),
+            file,
             tcp,
             tool_data,
-            rows,
-            summary: done.summary.line(),
-            flagged: done.summary.flagged,
+            summary: done.summary,
             notes: done.notes,
             text: done.text,
         }
+    }
+
+    /// The targets file.
+    #[must_use]
+    pub fn targets(&self) -> &Path {
+        &self.file.path
     }
 
     /// The default name of the compensated file: `<stem>-compensated`
     /// with the targets file's extension.
     #[must_use]
     pub fn default_file_name(&self) -> String {
-        let stem = self.targets.file_stem().map_or_else(
+        let stem = self.targets().file_stem().map_or_else(
             || "targets".to_string(),
             |s| s.to_string_lossy().into_owned(),
         );
-        match self.targets.extension() {
+        match self.targets().extension() {
             Some(e) => format!("{stem}-compensated.{}", e.to_string_lossy()),
             None => format!("{stem}-compensated"),
         }

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use super::command::{Command, CompensateCommand};
 use super::job::{Job, Slot};
 use super::ledger::{Artefact, Reading};
-use super::state::{Level, Notice};
+use super::state::Level;
 use super::{Core, Write};
 use crate::engine::files::program::ReadSpec;
 use crate::engine::uses::compensate::JointTargets;
@@ -79,11 +79,8 @@ impl Core {
         if let Err(e) =
             crate::engine::files::format::write_atomic(&path, EXAMPLE_TARGETS.as_bytes())
         {
-            self.state.notice = Some(Notice {
-                title: "Example targets not written".to_string(),
-                body: e.to_string(),
-            });
-            return;
+            let title = "Example targets not written";
+            return self.refuse(title, title, e.to_string());
         }
         self.forms.compensate.targets = path.display().to_string();
         self.forms.compensate.convention =
@@ -108,13 +105,8 @@ impl Core {
         // Targets are never compensated through a result that is out of
         // date.
         if let Err(why) = self.state.ledger.check(Artefact::Result) {
-            self.state
-                .say(Level::Warning, format!("not compensated: {why}"));
-            self.state.notice = Some(Notice {
-                title: "Not compensated".to_string(),
-                body: format!("{why}: run the calibration again, then compensate"),
-            });
-            return;
+            let again = format!("{why}: run the calibration again, then compensate");
+            return self.refuse("Not compensated", &format!("not compensated: {why}"), again);
         }
         let form = &self.forms.compensate;
         if form.targets.trim().is_empty() {
@@ -162,10 +154,7 @@ impl Core {
         };
         let stamp = self.state.ledger.stamp(Artefact::Compensation);
         if self.start(ctx, Slot::Compensate, stamp, move |w| {
-            compensate_targets(request, current_tool, w.flag(), &mut |text, fraction| {
-                w.progress(text, Some(fraction));
-            })
-            .map(Box::new)
+            compensate_targets(request, current_tool, w).map(Box::new)
         }) && let Some(job) = self.state.jobs.get_mut(&Slot::Compensate)
         {
             job.phase = "reading the targets…".to_string();
@@ -176,38 +165,20 @@ impl Core {
     /// The compensated text and its stamp when it may be written; `None`
     /// (with the reason in a notice) when it is stale, failed or not made.
     fn compensation_to_write(&mut self) -> Option<(String, PathBuf, crate::app::ledger::Stamp)> {
-        let refuse = |state: &mut crate::app::AppState, why: String| {
-            state.say(Level::Warning, format!("{WRITTEN_WHAT} not written: {why}"));
-            state.notice = Some(Notice {
-                title: format!("{WRITTEN_WHAT} not written"),
-                body: why,
-            });
+        let why = match (
+            &self.state.compensate.outcome,
+            self.state.ledger.check(Artefact::Compensation),
+        ) {
+            (Some(Ok(v)), Ok(stamp)) => {
+                return Some((v.text.clone(), v.targets().to_path_buf(), stamp));
+            }
+            (Some(Err(e)), _) => format!("the targets had errors, nothing is written: {e}"),
+            (None, _) => "compensate the targets first (press Compensate targets)".to_string(),
+            (Some(Ok(_)), Err(why)) => format!("{why}: press Compensate targets again"),
         };
-        let (text, targets) = match &self.state.compensate.outcome {
-            Some(Ok(v)) => (v.text.clone(), v.targets.clone()),
-            Some(Err(e)) => {
-                let why = format!("the targets had errors, nothing is written: {e}");
-                refuse(&mut self.state, why);
-                return None;
-            }
-            None => {
-                refuse(
-                    &mut self.state,
-                    "compensate the targets first (press Compensate targets)".to_string(),
-                );
-                return None;
-            }
-        };
-        match self.state.ledger.check(Artefact::Compensation) {
-            Ok(stamp) => Some((text, targets, stamp)),
-            Err(why) => {
-                refuse(
-                    &mut self.state,
-                    format!("{why}: press Compensate targets again"),
-                );
-                None
-            }
-        }
+        let title = format!("{WRITTEN_WHAT} not written");
+        self.refuse(&title, &format!("{title}: {why}"), why);
+        None
     }
 
     pub(super) fn compensate_write(&mut self, ctx: &egui::Context) {
@@ -265,21 +236,21 @@ impl Core {
     ) {
         match outcome {
             Ok(view) => {
-                let what = view.summary.clone();
+                let what = view.summary.line();
                 self.state
                     .ledger
-                    .record(Artefact::Compensation, job.stamp.clone(), what);
-                let level = if view.flagged > 0 {
+                    .record(Artefact::Compensation, job.stamp.clone(), what.clone());
+                let level = if view.summary.flagged > 0 {
                     Level::Warning
                 } else {
                     Level::Info
                 };
-                self.state.say(level, view.summary.clone());
+                self.state.say(level, what);
                 // Where the compensated file goes: beside the targets,
                 // named after them; the name follows the targets unless
                 // the operator typed another.
                 let derived = view
-                    .targets
+                    .targets()
                     .with_file_name(view.default_file_name())
                     .display()
                     .to_string();
@@ -306,7 +277,8 @@ impl Core {
 
 /// Size and modification time of a file, when it can be read: a file
 /// rewritten in place reads otherwise.
-fn file_stamp(path: &str) -> Option<(u64, std::time::SystemTime)> {
+#[must_use]
+pub fn file_stamp(path: &str) -> Option<(u64, std::time::SystemTime)> {
     let path = path.trim();
     if path.is_empty() {
         return None;
@@ -324,42 +296,27 @@ pub fn reading(f: &CompensateForm) -> Reading {
         TcpChoice::ToolFile => format!("tool {}", f.tool.trim()),
         other => other.key().to_string(),
     };
-    let fields = vec![
+    let (targets, o) = (f.targets.trim(), &f.options);
+    let joints = match o.joint_targets {
+        JointTargets::Compensate => "compensated",
+        JointTargets::Keep => "kept",
+    };
+    let fields = [
         (
-            "file".into(),
-            if f.targets.trim().is_empty() {
-                "none".to_string()
-            } else {
-                f.targets.trim().to_string()
-            },
+            "file",
+            if targets.is_empty() { "none" } else { targets }.to_string(),
         ),
         (
-            "pose convention".into(),
+            "pose convention",
             CompensateForm::convention_label(f.convention),
         ),
-        ("TCP".into(), tcp),
-        (
-            "joint targets".into(),
-            match f.options.joint_targets {
-                JointTargets::Compensate => "compensated",
-                JointTargets::Keep => "kept",
-            }
-            .to_string(),
-        ),
-        (
-            "σ tolerance".into(),
-            format!("{} mm", f.options.sigma_tolerance_mm),
-        ),
-        (
-            "far in joints".into(),
-            format!("{}°", f.options.far_joints_deg),
-        ),
-        (
-            "region margin".into(),
-            format!("{} mm", f.options.region_margin_mm),
-        ),
+        ("TCP", tcp),
+        ("joint targets", joints.to_string()),
+        ("σ tolerance", format!("{} mm", o.sigma_tolerance_mm)),
+        ("far in joints", format!("{}°", o.far_joints_deg)),
+        ("region margin", format!("{} mm", o.region_margin_mm)),
     ];
-    let mut fields = fields;
+    let mut fields = Vec::from(fields.map(|(k, v)| (k.to_string(), v)));
     if !f.current_tool.trim().is_empty() {
         fields.push(("current tool".into(), f.current_tool.trim().to_string()));
     }

@@ -8,13 +8,14 @@
 use egui::Stroke;
 use nalgebra::Isometry3;
 
-use super::job::{CompensationView, TargetRow};
+use super::job::{CompensationView, flags_text};
 use crate::app::AppState;
 use crate::app::Forms;
 use crate::app::scene::content::axes_lines;
 use crate::app::scene::{Line3, Mark, Scene};
 use crate::app::widgets::{AFTER, BEFORE, MUTED, WARN};
 use crate::engine::tools::scene::{FrameAxes, arrow_scale, bounds, frame_axes};
+use crate::engine::uses::compensate::TargetReport;
 
 /// Width the scene starts at beside the view, points.
 const SCENE_WIDTH: f32 = 400.0;
@@ -30,7 +31,7 @@ fn position(pose: &Isometry3<f64>) -> [f64; 3] {
 /// The target selected: `selected` when it is one, else the first row
 /// (the largest correction).
 #[must_use]
-pub fn shown_target(rows: &[TargetRow], selected: Option<usize>) -> Option<usize> {
+pub fn shown_target(rows: &[TargetReport], selected: Option<usize>) -> Option<usize> {
     selected
         .filter(|i| *i < rows.len())
         .or((!rows.is_empty()).then_some(0))
@@ -40,7 +41,7 @@ pub fn shown_target(rows: &[TargetRow], selected: Option<usize>) -> Option<usize
 /// highlighted, and the factor the moves are drawn enlarged by (1: to
 /// scale).
 #[must_use]
-pub fn compensation_scene(rows: &[TargetRow], selected: Option<usize>) -> (Scene, f64) {
+pub fn compensation_scene(rows: &[TargetReport], selected: Option<usize>) -> (Scene, f64) {
     let wanted: Vec<[f64; 3]> = rows.iter().map(|r| position(&r.wanted)).collect();
     let radius = bounds(&wanted).map_or(MIN_RADIUS_MM, |b| b.1.max(MIN_RADIUS_MM));
     let largest = rows.iter().map(|r| r.correction_mm).fold(0.0, f64::max);
@@ -141,7 +142,7 @@ pub fn caption(view: &CompensationView, shown: Option<usize>, scale: f64) -> Str
             if r.flags.is_empty() {
                 String::new()
             } else {
-                format!("; flagged: {}", r.flags.join("; "))
+                format!("; flagged: {}", flags_text(r))
             }
         ));
     }
@@ -149,15 +150,16 @@ pub fn caption(view: &CompensationView, shown: Option<usize>, scale: f64) -> Str
 }
 
 /// The scene beside the Compensate view, when a compensation is on show:
-/// a target picked there becomes the selected one.
-pub fn scene_panel_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms) {
+/// a target picked there becomes the selected one; at most `max_width`
+/// wide (the view's column keeps the rest).
+pub fn scene_panel_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, max_width: f32) {
     let Some(Ok(view)) = &state.compensate.outcome else {
         return;
     };
     egui::Panel::right("compensate_scene")
         .resizable(true)
-        .default_size(SCENE_WIDTH)
-        .size_range(260.0..=900.0)
+        .default_size(SCENE_WIDTH.min(max_width))
+        .size_range(260.0..=max_width.max(260.0))
         .show(ui, |ui| {
             let selected = forms.scene.compensate_target;
             let (scene, scale) = compensation_scene(&view.rows, selected);
@@ -180,23 +182,34 @@ pub fn scene_panel_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms) {
 mod tests {
     use super::*;
     use crate::engine::base::geometry::{rot_x, trans};
+    use crate::engine::files::program::{PoseFile, PoseFormat};
+    use crate::engine::uses::compensate::arms::BranchRule;
+    use crate::engine::uses::compensate::report::Summary;
 
-    fn row(name: &str, line: usize, at: [f64; 3], moved: [f64; 3]) -> TargetRow {
+    fn row(name: &str, line: usize, at: [f64; 3], moved: [f64; 3]) -> TargetReport {
         let wanted = trans(at[0], at[1], at[2]) * rot_x(0.2);
         let commanded = trans(at[0] + moved[0], at[1] + moved[1], at[2] + moved[2]) * rot_x(0.21);
-        TargetRow {
+        TargetReport {
+            index: line - 1,
             name: name.into(),
             line,
+            joints_target: false,
+            written: true,
+            nominal_joints: [0.0; 6],
+            joints: [0.0; 6],
+            branch: BranchRule::First,
+            wanted,
+            commanded,
             correction_mm: (moved[0].powi(2) + moved[1].powi(2) + moved[2].powi(2)).sqrt(),
             correction_deg: 0.573,
             joint_change_deg: 0.1,
             sigma_mm: None,
             nearest_identify_deg: None,
+            outside_mm: 0.0,
             flags: Vec::new(),
-            kept: false,
+            values: Vec::new(),
+            config_update: None,
             notes: Vec::new(),
-            wanted,
-            commanded,
         }
     }
 
@@ -247,15 +260,22 @@ mod tests {
         let drawn = a[0].points[1][0] - a[0].points[0][0];
         assert!((drawn - 0.02 * scale).abs() < 1e-9, "{drawn}");
         assert!(scene.marks[1].selected && !scene.marks[0].selected);
-        let view = CompensationView {
-            targets: "t.csv".into(),
-            file_line: String::new(),
+        let file = PoseFile {
+            path: "t.csv".into(),
+            format: PoseFormat::Json,
+            detected: true,
+            targets: Vec::new(),
+            order: Vec::new(),
+            order_note: String::new(),
             warnings: Vec::new(),
+            text: String::new(),
+        };
+        let view = CompensationView {
+            file,
             tcp: String::new(),
             tool_data: Vec::new(),
             rows,
-            summary: String::new(),
-            flagged: 0,
+            summary: Summary::default(),
             notes: Vec::new(),
             text: String::new(),
         };

@@ -14,13 +14,17 @@ use crate::app::AppState;
 use crate::app::Forms;
 use crate::app::command::{Command, CompensateCommand};
 use crate::app::compensate::form::{CompensateForm, TcpChoice};
-use crate::app::compensate::job::{CompensationView, TargetRow};
+use crate::app::compensate::job::{CompensationView, flags_text};
 use crate::app::dialog::Purpose;
 use crate::app::job::Slot;
 use crate::app::ledger::Artefact;
-use crate::app::widgets::{BAD, MUTED, WARN, dialog_note_ui, labelled_field, stale_banner_ui};
+use crate::app::session::Source;
+use crate::app::widgets::{
+    BAD, MUTED, WARN, choice, coloured, command_button, dialog_note_ui, labelled_drag,
+    labelled_field, stale_banner_ui,
+};
 use crate::engine::base::robot::controller::FlangeConvention;
-use crate::engine::uses::compensate::{JointTargets, Options};
+use crate::engine::uses::compensate::{JointTargets, Options, TargetReport, report};
 
 /// Most target rows drawn (largest corrections first); every target is
 /// compensated and written. A robot program has tens to a few hundred
@@ -28,8 +32,13 @@ use crate::engine::uses::compensate::{JointTargets, Options};
 const ROWS_SHOWN: usize = 1000;
 
 /// Width of the path fields, points: a whole path at 1366×768 beside the
-/// side panel.
-const PATH_WIDTH: f32 = 420.0;
+/// side panel and the scene.
+const PATH_WIDTH: f32 = 340.0;
+
+/// Narrowest the column of the form and the table gets beside the scene,
+/// points: every row of the form (wrapped) fits it, and the scene takes
+/// what is left (issue 34: at 1366×768 the scene clipped the column).
+const COLUMN_MIN: f32 = 600.0;
 
 /// The Compensate view.
 pub fn compensate_ui(
@@ -38,31 +47,21 @@ pub fn compensate_ui(
     forms: &mut Forms,
     commands: &mut Vec<Command>,
 ) {
-    super::scene::scene_panel_ui(ui, state, forms);
-    // Both ways: the rows wider than the view beside the scene scroll
-    // instead of running under it.
-    egui::ScrollArea::both()
+    let scene_max = (ui.available_width() - COLUMN_MIN).max(260.0);
+    super::scene::scene_panel_ui(ui, state, forms, scene_max);
+    // Vertical only: the rows wrap to the column's width; the table alone
+    // scrolls sideways ([`table_ui`]).
+    egui::ScrollArea::vertical()
         .id_salt("compensate_scroll")
         .auto_shrink([false, false])
         .show(ui, |ui| {
             ui.heading("Compensate targets through the calibration");
-            ui.label(
-                RichText::new(
-                    "The controller runs its nominal kinematics: each target (the TCP pose wanted, base frame) \
-                     is replaced by the pose to command so that the nominal controller drives the joints the \
-                     calibrated model needs for it. Positions are rewritten in place, every other byte kept.",
-                )
-                .small()
-                .color(MUTED),
-            );
+            let about = "The controller runs its nominal kinematics: each target (the TCP pose wanted, base frame) is replaced by the pose to command so that the nominal controller drives the joints the calibrated model needs for it. Positions are rewritten in place, every other byte kept.";
+            ui.label(RichText::new(about).small().color(MUTED));
             ui.add_space(4.0);
             if state.result.is_none() {
-                ui.label(
-                    RichText::new(
-                        "No calibration on show: run the calibration (step 4) or open a result file first.",
-                    )
-                    .color(WARN),
-                );
+                let text = "No calibration on show: run the calibration (step 4) or open a result file first.";
+                coloured(ui, WARN, text);
             }
             pose_only_ui(ui, state, &mut forms.compensate, commands);
             inputs_ui(ui, state, &mut forms.compensate, commands);
@@ -121,120 +120,75 @@ fn pose_only_ui(
     });
 }
 
-/// The targets file, the pose convention, the TCP, and Compensate.
+/// The targets file, the pose convention, the TCP, and Compensate; each
+/// row wraps to the column.
 fn inputs_ui(
     ui: &mut egui::Ui,
     state: &AppState,
     form: &mut CompensateForm,
     commands: &mut Vec<Command>,
 ) {
-    let dialog_busy = state.jobs.runs(&Slot::Dialog);
-    egui::Grid::new("compensate_inputs")
-        .num_columns(2)
-        .spacing([8.0, 6.0])
-        .show(ui, |ui| {
-            ui.label("Targets");
-            ui.horizontal(|ui| {
-                labelled_field(
-                    ui,
-                    "file",
-                    &mut form.targets,
-                    "a pose table (.csv) or a robot program (.mod, .src/.dat, .ls, .script)",
-                    PATH_WIDTH,
-                );
-                if ui
-                    .add_enabled(!dialog_busy, egui::Button::new("Open targets…"))
-                    .clicked()
-                {
-                    commands.push(Command::Browse(Purpose::CompensateTargets));
-                }
-                dialog_note_ui(ui, state, &[Purpose::CompensateTargets]);
-            });
-            ui.end_row();
-            let on_demo = state
-                .loaded
-                .as_ref()
-                .is_some_and(|l| l.source == crate::app::session::Source::Demo);
-            if on_demo && state.result.is_some() {
-                ui.label("");
-                if ui
-                    .button("Use the guide's example targets")
-                    .on_hover_text(format!(
-                        "the demo's cell: ten sensor poses along a scan path (examples/targets.csv of the guide), written to the export folder as {} and compensated",
-                        super::EXAMPLE_TARGETS_NAME
-                    ))
-                    .clicked()
-                {
-                    commands.push(Command::Compensate(CompensateCommand::ExampleTargets));
-                }
-                ui.end_row();
-            }
-
-            let l = ui.label("Pose convention");
-            ui.horizontal(|ui| {
-                egui::ComboBox::from_id_salt("compensate_convention")
-                    .selected_text(CompensateForm::convention_label(form.convention))
-                    .width(260.0)
-                    .show_ui(ui, |ui| {
-                        ui.selectable_value(
-                            &mut form.convention,
-                            None,
-                            CompensateForm::convention_label(None),
-                        );
-                        for c in FlangeConvention::ALL {
-                            ui.selectable_value(&mut form.convention, Some(c), c.key())
-                                .on_hover_text(c.describe());
-                        }
-                    })
-                    .response
-                    .labelled_by(l.id);
-                ui.label(
-                    RichText::new(form.convention.map_or(
-                        "a table or JSON list needs one; a program's language fixes its own",
-                        FlangeConvention::describe,
-                    ))
-                    .small()
-                    .color(MUTED),
-                );
-            });
-            ui.end_row();
-
-            ui.label("TCP");
-            ui.horizontal(|ui| {
-                for choice in TcpChoice::ALL {
-                    ui.radio_value(&mut form.tcp, choice, choice.label());
-                }
-            });
-            ui.end_row();
-            if form.tcp == TcpChoice::ToolFile {
-                ui.label("");
-                ui.horizontal(|ui| {
-                    labelled_field(
-                        ui,
-                        "tool",
-                        &mut form.tool,
-                        "JSON: flange_from_tcp, a 4×4 matrix (rows, mm)",
-                        PATH_WIDTH - 30.0,
-                    );
-                    if ui
-                        .add_enabled(!dialog_busy, egui::Button::new("Open tool…"))
-                        .clicked()
-                    {
-                        commands.push(Command::Browse(Purpose::CompensateTool));
-                    }
-                    dialog_note_ui(ui, state, &[Purpose::CompensateTool]);
-                });
-                ui.end_row();
-            }
-            options_rows_ui(ui, &mut form.options);
+    let idle = !state.jobs.runs(&Slot::Dialog);
+    ui.horizontal_wrapped(|ui| {
+        let hint = "a pose table (.csv) or a robot program (.mod, .src/.dat, .ls, .script)";
+        labelled_field(ui, "Targets file", &mut form.targets, hint, PATH_WIDTH);
+        let open = Command::Browse(Purpose::CompensateTargets);
+        let hover = "choose the targets file with the desktop's dialog";
+        command_button(ui, idle, "Open targets…", hover, open, commands);
+        dialog_note_ui(ui, state, &[Purpose::CompensateTargets]);
+    });
+    let on_demo = state
+        .loaded
+        .as_ref()
+        .is_some_and(|l| l.source == Source::Demo);
+    if on_demo && state.result.is_some() {
+        let hover = format!(
+            "the demo's cell: ten sensor poses along a scan path (examples/targets.csv of the guide), written to the export folder as {} and compensated",
+            super::EXAMPLE_TARGETS_NAME
+        );
+        let example = Command::Compensate(CompensateCommand::ExampleTargets);
+        command_button(
+            ui,
+            true,
+            "Use the guide's example targets",
+            &hover,
+            example,
+            commands,
+        );
+    }
+    ui.horizontal_wrapped(|ui| {
+        let conventions = FlangeConvention::ALL.map(|c| (Some(c), c.key().to_string()));
+        let none = (None, CompensateForm::convention_label(None));
+        let options = std::iter::once(none).chain(conventions);
+        let id = "compensate_convention";
+        choice(ui, "Pose convention", id, &mut form.convention, options);
+        let what = "a table or JSON list needs one; a program's language fixes its own";
+        let what = form.convention.map_or(what, FlangeConvention::describe);
+        ui.label(RichText::new(what).small().color(MUTED));
+    });
+    ui.horizontal_wrapped(|ui| {
+        ui.label("TCP");
+        for choice in TcpChoice::ALL {
+            ui.radio_value(&mut form.tcp, choice, choice.label());
+        }
+    });
+    if form.tcp == TcpChoice::ToolFile {
+        ui.horizontal_wrapped(|ui| {
+            let hint = "JSON: flange_from_tcp, a 4×4 matrix (rows, mm)";
+            labelled_field(ui, "Tool file", &mut form.tool, hint, PATH_WIDTH);
+            let open = Command::Browse(Purpose::CompensateTool);
+            let hover = "choose the tool file with the desktop's dialog";
+            command_button(ui, idle, "Open tool…", hover, open, commands);
+            dialog_note_ui(ui, state, &[Purpose::CompensateTool]);
         });
+    }
+    options_ui(ui, &mut form.options);
     ui.add_space(4.0);
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         if let Some(job) = state.jobs.get(&Slot::Compensate) {
             crate::app::widgets::job_ui(ui, job);
-            if ui.button("Cancel").clicked() {
-                commands.push(Command::Compensate(CompensateCommand::Cancel));
-            }
+            let cancel = Command::Compensate(CompensateCommand::Cancel);
+            command_button(ui, true, "Cancel", "stop compensating", cancel, commands);
             return;
         }
         let pose_only = state
@@ -250,14 +204,11 @@ fn inputs_ui(
         } else {
             None
         };
-        let button = egui::Button::new(RichText::new("Compensate targets").strong());
-        let response = ui
-            .add_enabled(why_not.is_none(), button)
-            .on_hover_text("compensate every target through the result on show")
+        let text = RichText::new("Compensate targets").strong();
+        let hover = "compensate every target through the result on show";
+        let run = Command::Compensate(CompensateCommand::Run);
+        command_button(ui, why_not.is_none(), text, hover, run, commands)
             .on_disabled_hover_text(why_not.unwrap_or_default());
-        if response.clicked() {
-            commands.push(Command::Compensate(CompensateCommand::Run));
-        }
         if let Some(w) = why_not {
             ui.label(RichText::new(w).small().color(MUTED));
         }
@@ -266,25 +217,22 @@ fn inputs_ui(
 
 /// What joint targets mean, and the three limits beyond which a target is
 /// flagged (`--joint-targets`, `--sigma-tolerance`, `--far-joints`,
-/// `--region-margin`); rows of the inputs grid.
-fn options_rows_ui(ui: &mut egui::Ui, options: &mut Options) {
-    ui.label("Joint targets");
-    ui.horizontal(|ui| {
+/// `--region-margin`).
+fn options_ui(ui: &mut egui::Ui, options: &mut Options) {
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Joint targets");
+        let value = &mut options.joint_targets;
+        let compensated =
+            "compensated (offline-programmed: the nominal pose of the joints is wanted)";
+        ui.radio_value(value, JointTargets::Compensate, compensated);
         ui.radio_value(
-            &mut options.joint_targets,
-            JointTargets::Compensate,
-            "compensated (offline-programmed: the nominal pose of the joints is wanted)",
-        );
-        ui.radio_value(
-            &mut options.joint_targets,
+            value,
             JointTargets::Keep,
             "kept as written (taught on the robot)",
         );
     });
-    ui.end_row();
-
-    ui.label("Flag a target");
     ui.horizontal_wrapped(|ui| {
+        ui.label("Flag a target:");
         let limits: [(&str, &mut f64, f64, &str, &str); 3] = [
             (
                 "σ tolerance",
@@ -309,19 +257,10 @@ fn options_rows_ui(ui: &mut egui::Ui, options: &mut Options) {
             ),
         ];
         for (label, value, max, unit, hint) in limits {
-            let l = ui.label(label);
-            ui.add(
-                egui::DragValue::new(value)
-                    .range(0.0..=max)
-                    .speed(0.05)
-                    .max_decimals(3)
-                    .suffix(unit),
-            )
-            .labelled_by(l.id)
-            .on_hover_text(hint);
+            let drag = egui::DragValue::new(value).range(0.0..=max).speed(0.05);
+            labelled_drag(ui, label, drag.max_decimals(3).suffix(unit)).on_hover_text(hint);
         }
     });
-    ui.end_row();
 }
 
 /// What the last compensation gave: its stale mark, the error naming the
@@ -366,17 +305,14 @@ fn outcome_ui(
                     "The table below is not what the targets give now; writing is refused: press Compensate targets again.",
                 );
             }
-            ui.label(RichText::new(&view.summary).strong());
-            ui.add(egui::Label::new(RichText::new(&view.file_line).small()).wrap());
+            ui.label(RichText::new(view.summary.line()).strong());
+            ui.label(RichText::new(report::file_line(&view.file)).small());
             ui.label(RichText::new(format!("TCP: {}", view.tcp)).small());
-            for w in &view.warnings {
+            for w in &view.file.warnings {
                 ui.label(RichText::new(format!("warning: {w}")).small().color(WARN));
             }
             for n in &view.notes {
-                ui.add(
-                    egui::Label::new(RichText::new(format!("note: {n}")).small().color(MUTED))
-                        .wrap(),
-                );
+                ui.label(RichText::new(format!("note: {n}")).small().color(MUTED));
             }
             let stale_why = stale.as_ref().map(ToString::to_string);
             tool_data_ui(ui, view, stale_why.as_deref());
@@ -437,33 +373,24 @@ fn write_ui(
     let busy = state.jobs.writing() || state.jobs.runs(&Slot::Dialog);
     let why_not = stale.then_some("the compensation is stale: press Compensate targets again");
     ui.horizontal_wrapped(|ui| {
-        labelled_field(
-            ui,
-            "Write to",
-            &mut form.out,
-            "where the compensated file goes",
-            PATH_WIDTH - 60.0,
-        );
-        let write = ui
-            .add_enabled(why_not.is_none() && !busy, egui::Button::new("Write"))
-            .on_hover_text("write the compensated file to this path (atomic: all or nothing)");
-        if let Some(w) = why_not {
-            write.clone().on_disabled_hover_text(w);
-        }
-        if write.clicked() {
-            commands.push(Command::Compensate(CompensateCommand::Write));
-        }
-        let dialog = ui
-            .add_enabled(
-                why_not.is_none() && !busy,
-                egui::Button::new("Write compensated program…"),
-            )
-            .on_hover_text("choose where to write the compensated file");
-        if let Some(w) = why_not {
-            dialog.clone().on_disabled_hover_text(w);
-        }
-        if dialog.clicked() {
-            commands.push(Command::Browse(Purpose::CompensateOut));
+        let hint = "where the compensated file goes";
+        labelled_field(ui, "Write to", &mut form.out, hint, PATH_WIDTH);
+        let idle = why_not.is_none() && !busy;
+        let buttons = [
+            (
+                "Write",
+                "write the compensated file to this path (atomic: all or nothing)",
+                Command::Compensate(CompensateCommand::Write),
+            ),
+            (
+                "Write compensated program…",
+                "choose where to write the compensated file",
+                Command::Browse(Purpose::CompensateOut),
+            ),
+        ];
+        for (text, hover, command) in buttons {
+            command_button(ui, idle, text, hover, command, commands)
+                .on_disabled_hover_text(why_not.unwrap_or("a file is being written"));
         }
         if let Some(w) = why_not {
             ui.label(RichText::new(w).small().color(WARN));
@@ -473,63 +400,82 @@ fn write_ui(
     crate::app::widgets::written_ui(ui, state, &[Artefact::Compensation]);
 }
 
-/// One row per target, largest correction first.
-fn table_ui(ui: &mut egui::Ui, rows: &[TargetRow]) {
+/// One row per target, largest correction first; the table alone scrolls
+/// sideways when it is wider than the column.
+fn table_ui(ui: &mut egui::Ui, rows: &[TargetReport]) {
     let shown = rows.len().min(ROWS_SHOWN);
     if shown < rows.len() {
-        ui.label(
-            RichText::new(format!(
-                "the {shown} largest corrections of {} targets (all are compensated and written)",
-                rows.len()
-            ))
-            .small()
-            .color(MUTED),
+        let text = format!(
+            "the {shown} largest corrections of {} targets (all are compensated and written)",
+            rows.len()
         );
+        ui.label(RichText::new(text).small().color(MUTED));
     }
-    egui::Grid::new("compensate_targets")
-        .striped(true)
-        .num_columns(8)
-        .spacing([14.0, 3.0])
+    let headers = [
+        ("target", "its name in the file"),
+        ("line", "its line in the file"),
+        (
+            "correction mm",
+            "how far the pose to command is from the target (TCP position)",
+        ),
+        (
+            "correction °",
+            "the rotation between the pose to command and the target",
+        ),
+        (
+            "Δq max °",
+            "the largest joint change between the nominal and the calibrated solution",
+        ),
+        (
+            "σ mm (1σ)",
+            "the predicted 1σ residual of the TCP position after compensation (ml's covariance)",
+        ),
+        (
+            "nearest pose °",
+            "joint-space distance to the nearest identify pose",
+        ),
+        (
+            "flag",
+            "why a target lies outside what the calibration saw (compensated and written all the same)",
+        ),
+    ];
+    let or_dash = |v: Option<f64>, decimals: usize| {
+        v.map_or_else(|| "–".to_string(), |v| format!("{v:.decimals$}"))
+    };
+    egui::ScrollArea::horizontal()
+        .id_salt("compensate_table")
         .show(ui, |ui| {
-            for (h, hover) in [
-                ("target", "its name in the file"),
-                ("line", "its line in the file"),
-                ("correction mm", "how far the pose to command is from the target (TCP position)"),
-                ("correction °", "the rotation between the pose to command and the target"),
-                ("Δq max °", "the largest joint change between the nominal and the calibrated solution"),
-                ("σ mm (1σ)", "the predicted 1σ residual of the TCP position after compensation (ml's covariance)"),
-                ("nearest pose °", "joint-space distance to the nearest identify pose"),
-                ("flag", "why a target lies outside what the calibration saw (compensated and written all the same)"),
-            ] {
-                ui.label(RichText::new(h).strong()).on_hover_text(hover);
-            }
-            ui.end_row();
-            for r in &rows[..shown] {
-                let flagged = !r.flags.is_empty();
-                let name = RichText::new(&r.name);
-                ui.label(if flagged { name.color(WARN) } else { name });
-                ui.label(r.line.to_string());
-                ui.label(format!("{:.3}", r.correction_mm));
-                ui.label(format!("{:.4}", r.correction_deg));
-                ui.label(format!("{:.3}", r.joint_change_deg));
-                ui.label(r.sigma_mm.map_or_else(|| "–".to_string(), |s| format!("{s:.3}")));
-                ui.label(
-                    r.nearest_identify_deg
-                        .map_or_else(|| "–".to_string(), |d| format!("{d:.1}")),
-                );
-                let flag = if flagged {
-                    RichText::new(format!("outside what the calibration saw: {}", r.flags.join("; ")))
-                        .color(WARN)
-                } else if r.kept {
-                    RichText::new("joint target kept").color(MUTED)
-                } else {
-                    RichText::new("")
-                };
-                let response = ui.add(egui::Label::new(flag).wrap());
-                if !r.notes.is_empty() {
-                    response.on_hover_text(r.notes.join("\n"));
+            let grid = egui::Grid::new("compensate_targets").striped(true);
+            grid.spacing([14.0, 3.0]).show(ui, |ui| {
+                for (h, hover) in headers {
+                    ui.label(RichText::new(h).strong()).on_hover_text(hover);
                 }
                 ui.end_row();
-            }
+                for r in &rows[..shown] {
+                    let flagged = !r.flags.is_empty();
+                    let name = RichText::new(&r.name);
+                    ui.label(if flagged { name.color(WARN) } else { name });
+                    ui.label(r.line.to_string());
+                    ui.label(format!("{:.3}", r.correction_mm));
+                    ui.label(format!("{:.4}", r.correction_deg));
+                    ui.label(format!("{:.3}", r.joint_change_deg));
+                    ui.label(or_dash(r.sigma_mm, 3));
+                    ui.label(or_dash(r.nearest_identify_deg, 1));
+                    let flag = if flagged {
+                        let why = flags_text(r);
+                        RichText::new(format!("outside what the calibration saw: {why}"))
+                            .color(WARN)
+                    } else if !r.written {
+                        RichText::new("joint target kept").color(MUTED)
+                    } else {
+                        RichText::new("")
+                    };
+                    let response = ui.label(flag);
+                    if !r.notes.is_empty() {
+                        response.on_hover_text(r.notes.join("\n"));
+                    }
+                    ui.end_row();
+                }
+            });
         });
 }

@@ -487,29 +487,21 @@ pub fn reading(f: &MeasureForm) -> Reading {
         ScanChoice::SessionFile => f.session_file.trim().to_string(),
         ScanChoice::RawScan => format!("{} + {}", f.log.trim(), f.profiles.trim()),
     };
-    let fields = vec![
-        ("scan".into(), scan),
+    let frame = f.frame_path();
+    let fields = [
+        ("scan", scan),
+        ("use", f.usage.map_or("all", |u| u.as_str()).to_string()),
         (
-            "use".into(),
-            f.usage.map_or("all", |u| u.as_str()).to_string(),
+            "frame",
+            frame.map_or_else(|| "base".to_string(), |p| p.display().to_string()),
         ),
-        (
-            "frame".into(),
-            f.frame_path()
-                .map_or_else(|| "base".to_string(), |p| p.display().to_string()),
-        ),
-        (
-            "sensor noise".into(),
-            format!("{} mm", f.options.sensor_noise_mm),
-        ),
-        (
-            "σ".into(),
-            if f.options.sigma { "yes" } else { "no" }.to_string(),
-        ),
+        ("sensor noise", format!("{} mm", f.options.sensor_noise_mm)),
+        ("σ", if f.options.sigma { "yes" } else { "no" }.to_string()),
     ];
     let mut unseen = f.clone();
     unseen.out.clear();
-    Reading::new(fields, format!("{unseen:?}"))
+    let fields = fields.map(|(k, v)| (k.to_string(), v));
+    Reading::new(fields.into(), format!("{unseen:?}"))
 }
 
 #[cfg(test)]

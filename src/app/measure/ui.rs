@@ -21,10 +21,10 @@ use crate::app::job::Slot;
 use crate::app::ledger::Artefact;
 use crate::app::measure::job::MeasuredCloud;
 use crate::app::measure::job::{DRAWN_MAX, group, has_covariance};
-use crate::app::measure::{RawLog, ScanChoice};
+use crate::app::measure::{MeasureForm, RawLog, ScanChoice};
 use crate::app::widgets::{
-    AFTER, BAD, GOOD, MUTED, WARN, choice, coloured, command_button, labelled_field, number_field,
-    path_row, stale_banner_ui, table,
+    AFTER, BAD, GOOD, MUTED, WARN, boxed, choice, coloured, command_button, labelled_field,
+    number_field, path_row, stale_banner_ui, table,
 };
 use crate::engine::base::session::Use;
 use crate::engine::files::import::{AngleUnit, LengthUnit};
@@ -108,19 +108,20 @@ pub fn measure_ui(
         .id_salt("measure_scroll")
         .auto_shrink(false)
         .show(ui, |ui| {
+            if state.measure.shown.is_none() {
+                to_do_ui(ui, state, &forms.measure);
+            }
             inputs_ui(ui, state, forms, commands);
             let Some(cloud) = &state.measure.shown else {
-                ui.label(
-                    RichText::new(
-                        "No cloud yet: choose the scan above and press ▶ Measure. The cloud is drawn in three projections coloured by each point's σ; the counts, the export and the self-validation come with it.",
-                    )
-                    .color(MUTED),
-                );
                 return;
             };
             ui.separator();
             if let Some(s) = state.ledger.stale(Artefact::Cloud) {
-                stale_banner_ui(ui, &s, "Press ▶ Measure again; its export is refused until then.");
+                stale_banner_ui(
+                    ui,
+                    &s,
+                    "Press ▶ Measure again; its export is refused until then.",
+                );
             }
             summary_ui(ui, cloud);
             export_ui(ui, state, forms, commands);
@@ -131,8 +132,54 @@ pub fn measure_ui(
         });
 }
 
-/// The result, the scan and the options, Measure and Cancel.
+/// With no cloud on show, what to do first, boxed at the top of the view
+/// (issue 34: Next's "Measure a scan" opened the view and nothing said
+/// where to start), and what comes with the cloud.
+fn to_do_ui(ui: &mut egui::Ui, state: &AppState, form: &MeasureForm) {
+    let press = "then press ▶ Measure";
+    let todo = match (&state.result, form.choice, &state.loaded) {
+        (None, ..) => {
+            "run the calibration (step 4) or open a result file: the scan is measured through it"
+                .to_string()
+        }
+        (Some(_), ScanChoice::OpenSession, Some(l)) => format!(
+            "press ▶ Measure to measure the open session \"{}\" through the result on show, or choose a session file or a raw scan below",
+            l.session.name
+        ),
+        (Some(_), ScanChoice::OpenSession, None) => {
+            "open a session, or choose a session file or a raw scan below".to_string()
+        }
+        (Some(_), ScanChoice::SessionFile, _) if form.session_file.trim().is_empty() => {
+            format!("type or browse the session file below, {press}")
+        }
+        (Some(_), ScanChoice::RawScan, _) => form
+            .scan_files(0)
+            .map_or_else(|why| format!("{why}, {press}"), |_| press.to_string()),
+        (Some(_), ScanChoice::SessionFile, _) => press.to_string(),
+    };
+    boxed(ui, AFTER, &format!("To do: {todo}"), |ui| {
+        let what = "The cloud is shown in the cell in 3-D and in three projections (XY, XZ, YZ), each point coloured by its σ; the counts, the export and the self-validation come with it.";
+        ui.label(RichText::new(what).small().color(MUTED));
+    });
+}
+
+/// Whether the view is drawn for the first time since it was last
+/// hidden (opened by its tab or by Next).
+fn newly_opened(ui: &egui::Ui) -> bool {
+    let (id, frame) = (
+        ui.make_persistent_id("measure_view_drawn"),
+        ui.ctx().cumulative_frame_nr(),
+    );
+    let last: Option<u64> = ui.data_mut(|d| d.get_temp(id));
+    ui.data_mut(|d| d.insert_temp(id, frame));
+    last.is_none_or(|l| l + 1 < frame)
+}
+
+/// The result, the scan and the options, Measure and Cancel; ▶ Measure
+/// takes the keyboard focus when the view opens with no cloud and a scan
+/// to measure (Enter measures).
 fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mut Vec<Command>) {
+    let opened = newly_opened(ui);
     let form = &mut forms.measure;
     ui.horizontal_wrapped(|ui| {
         ui.label(RichText::new("Result:").strong());
@@ -189,8 +236,11 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
         let text = RichText::new("▶ Measure").size(16.0);
         let hover = "measure the scan with the result on show, on a background thread";
         let idle = !running && state.result.is_some();
-        command_button(ui, idle, text, hover, Command::Measure(start), commands)
+        let measure = command_button(ui, idle, text, hover, Command::Measure(start), commands)
             .on_disabled_hover_text("a result is needed (and no measuring under way)");
+        if opened && idle && state.measure.shown.is_none() {
+            measure.request_focus();
+        }
         let hover = "stop the measuring job; the cloud on show stays";
         let cancel = Command::Measure(cancel);
         command_button(ui, running, "Cancel measuring", hover, cancel, commands);
@@ -208,7 +258,7 @@ fn inputs_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &
 fn scan_ui(
     ui: &mut egui::Ui,
     state: &AppState,
-    form: &mut crate::app::measure::MeasureForm,
+    form: &mut MeasureForm,
     commands: &mut Vec<Command>,
 ) {
     ui.horizontal_wrapped(|ui| {
@@ -289,7 +339,7 @@ fn scan_ui(
 
 /// The raw scan's units and readings: joint unit or pose convention,
 /// profile unit, axes, no-return value, the artefact's diameter.
-fn raw_units_ui(ui: &mut egui::Ui, form: &mut crate::app::measure::MeasureForm) {
+fn raw_units_ui(ui: &mut egui::Ui, form: &mut MeasureForm) {
     ui.horizontal_wrapped(|ui| {
         match form.raw_log {
             RawLog::Joints => {

@@ -4,8 +4,6 @@
 //! them, with progress and cancel; and a simulated session of a plan, to
 //! try the whole workflow without a robot.
 
-use std::sync::atomic::{AtomicBool, Ordering};
-
 use crate::engine::base::robot::RobotChoice;
 use crate::engine::base::session::Session;
 use crate::engine::calibrate::solve::Control;
@@ -16,21 +14,29 @@ use crate::engine::tools::plan::{
 use crate::engine::tools::simulate::{self, PlanExecution, SimConfig};
 
 use crate::app::error::JobError;
+use crate::app::job::Worker;
+
+/// Reports `phase` and `fraction` to `w`, and [`Control::Cancel`] once
+/// the job should stop (cancelled, or the workbench gone): the job-slot
+/// glue of the Plan, Compensate and Re-check jobs (it could be a method
+/// of the shared job slot's worker).
+pub fn report(w: &Worker, phase: impl Into<String>, fraction: Option<f64>) -> Control {
+    if w.progress(phase, fraction) {
+        Control::Continue
+    } else {
+        Control::Cancel
+    }
+}
 
 /// Plans and predicts ([`plan::plan_and_predict`], as `spherecal plan`),
-/// reporting each stage in words; `cancel` stops at the next stage or
-/// prediction run.
+/// reporting each stage in words to `w`; Cancel stops at the next stage
+/// or prediction run.
 ///
 /// # Errors
 /// The planner's error ([`PlanError::Cancelled`] after a cancel, also
 /// during the prediction). A failed prediction is not an error: the plan
 /// comes with the reason.
-pub fn make_plan(
-    config: &PlanConfig,
-    runs: usize,
-    cancel: &AtomicBool,
-    report: &mut dyn FnMut(String, Option<f64>),
-) -> Result<Planned, PlanError> {
+pub fn make_plan(config: &PlanConfig, runs: usize, w: &Worker) -> Result<Planned, PlanError> {
     // The candidates take most of the planning; a prediction, when
     // asked for, the second half of the bar.
     let share = if runs > 0 { 0.5 } else { 1.0 };
@@ -38,27 +44,22 @@ pub fn make_plan(
         runs,
         ..PredictConfig::default()
     });
-    plan::plan_and_predict(config, predict.as_ref(), &mut |progress| {
-        match progress {
-            PlanProgress::Stage(stage) => {
-                let done = match stage {
-                    PlanStage::Candidates { done, of } => 0.6 * done as f64 / of.max(1) as f64,
-                    PlanStage::Analysis { done, of } => 0.6 + 0.3 * done as f64 / of.max(1) as f64,
-                    _ => 0.9,
-                };
-                report(stage_text(stage), Some(share * done));
-            }
-            PlanProgress::Planned(_) => {}
-            PlanProgress::Predicting { done, of } => report(
-                format!("predicting the accuracy: {done} of {of} simulated calibrations"),
-                Some(0.5 + 0.5 * done as f64 / of.max(1) as f64),
-            ),
+    plan::plan_and_predict(config, predict.as_ref(), &mut |progress| match progress {
+        PlanProgress::Stage(stage) => {
+            let done = match stage {
+                PlanStage::Candidates { done, of } => 0.6 * done as f64 / of.max(1) as f64,
+                PlanStage::Analysis { done, of } => 0.6 + 0.3 * done as f64 / of.max(1) as f64,
+                _ => 0.9,
+            };
+            report(w, stage_text(stage), Some(share * done))
         }
-        if cancel.load(Ordering::Relaxed) {
-            Control::Cancel
-        } else {
-            Control::Continue
-        }
+        PlanProgress::Planned(_) if w.cancelled() => Control::Cancel,
+        PlanProgress::Planned(_) => Control::Continue,
+        PlanProgress::Predicting { done, of } => report(
+            w,
+            format!("predicting the accuracy: {done} of {of} simulated calibrations"),
+            Some(0.5 + 0.5 * done as f64 / of.max(1) as f64),
+        ),
     })
 }
 

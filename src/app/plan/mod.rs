@@ -94,10 +94,7 @@ impl Core {
         let runs = self.forms.plan.request.predict_runs;
         let stamp = self.state.ledger.stamp(Artefact::Plan);
         if self.start(ctx, Slot::Plan, stamp, move |w| {
-            make_plan(&config, runs, w.flag(), &mut |text, fraction| {
-                w.progress(text, fraction);
-            })
-            .map_err(JobError::from)
+            make_plan(&config, runs, w).map_err(JobError::from)
         }) {
             self.state.say(Level::Info, "planning the poses…");
         }
@@ -107,23 +104,19 @@ impl Core {
     /// `None`, and the operator is told why nothing is written (a stale
     /// plan is never written as another robot's program).
     fn current_plan(&mut self, what: &str) -> Option<(Plan, Stamp)> {
-        let plan = if let Some(Ok(o)) = &self.state.plan.outcome {
-            (*o.plan).clone()
-        } else {
+        let Some(Ok(o)) = &self.state.plan.outcome else {
             self.state.say(Level::Warning, "make a plan first");
             return None;
         };
-        if let Err(why) = self.state.ledger.check(Artefact::Plan) {
-            self.state
-                .say(Level::Warning, format!("{what} refused: {why}"));
-            self.state.notice = Some(Notice {
-                title: format!("{what} refused"),
-                body: format!("{why}: press Make plan again"),
-            });
-            return None;
+        let plan = (*o.plan).clone();
+        match self.state.ledger.check(Artefact::Plan) {
+            Ok(stamp) => Some((plan, stamp)),
+            Err(why) => {
+                let (title, status) = (format!("{what} refused"), format!("{what} refused: {why}"));
+                self.refuse(&title, &status, format!("{why}: press Make plan again"));
+                None
+            }
         }
-        let stamp = self.state.ledger.check(Artefact::Plan).ok()?;
-        Some((plan, stamp))
     }
 
     fn plan_export(&mut self, ctx: &egui::Context, kind: PlanExport) {
@@ -140,14 +133,7 @@ impl Core {
             stamp,
             again: Command::Plan(PlanCommand::Export(kind)),
         };
-        self.write(ctx, path, write, move |path| {
-            let text = match kind {
-                PlanExport::Csv => plan::plan_csv(&plan),
-                PlanExport::Program(c) => plan::render_program(c, &plan)?,
-            };
-            write_atomic(path, text.as_bytes())?;
-            Ok(None)
-        });
+        self.write(ctx, path, write, move |path| write_plan(kind, &plan, path));
     }
 
     fn plan_simulate(&mut self, ctx: &egui::Context) {
@@ -230,6 +216,24 @@ impl Core {
     }
 }
 
+/// Writes `plan` to `path` (atomically) as `kind`: the joint-log CSV or
+/// the controller's program (the Plan and Re-check views' exports).
+///
+/// # Errors
+/// The program cannot be rendered, or the file cannot be written.
+pub fn write_plan(
+    kind: PlanExport,
+    plan: &Plan,
+    path: &std::path::Path,
+) -> Result<Option<String>, JobError> {
+    let text = match kind {
+        PlanExport::Csv => plan::plan_csv(plan),
+        PlanExport::Program(c) => plan::render_program(c, plan)?,
+    };
+    write_atomic(path, text.as_bytes())?;
+    Ok(None)
+}
+
 /// The hand-eye guess "from the open calibration": the result's on show,
 /// else the open session's.
 #[must_use]
@@ -257,39 +261,29 @@ pub fn reading(f: &PlanForm, session_hand_eye: Option<Isometry3<f64>>) -> Readin
             )
         }
     };
-    let fields = vec![
-        ("robot".into(), f.robot.clone()),
+    let (d, sphere) = (&r.design, r.design.sphere);
+    let fields = [
+        ("robot", f.robot.clone()),
         (
-            "sphere".into(),
-            format!(
-                "({}, {}, {}) mm",
-                r.design.sphere[0], r.design.sphere[1], r.design.sphere[2]
-            ),
+            "sphere",
+            format!("({}, {}, {}) mm", sphere[0], sphere[1], sphere[2]),
         ),
-        ("translations".into(), r.design.n_translation.to_string()),
-        ("rotations".into(), r.design.n_rotation.to_string()),
-        ("identify stations".into(), r.design.n_identify.to_string()),
-        (
-            "poses per identify station".into(),
-            r.design.identify_poses.to_string(),
-        ),
-        ("validate stations".into(), r.design.n_validate.to_string()),
-        (
-            "poses per validate station".into(),
-            r.design.validate_poses.to_string(),
-        ),
-        ("candidates".into(), r.design.candidates.to_string()),
-        ("prediction runs".into(), r.predict_runs.to_string()),
-        ("cut angle".into(), format!("{}°", r.design.cut_angle)),
-        ("seed".into(), r.design.seed.to_string()),
-        (
-            "objective".into(),
-            objective_text(r.design.selection).into(),
-        ),
-        ("range".into(), range_text(r.range.as_ref())),
-        ("spread".into(), r.spread.to_string()),
-        ("hand-eye guess".into(), hand_eye),
+        ("translations", d.n_translation.to_string()),
+        ("rotations", d.n_rotation.to_string()),
+        ("identify stations", d.n_identify.to_string()),
+        ("poses per identify station", d.identify_poses.to_string()),
+        ("validate stations", d.n_validate.to_string()),
+        ("poses per validate station", d.validate_poses.to_string()),
+        ("candidates", d.candidates.to_string()),
+        ("prediction runs", r.predict_runs.to_string()),
+        ("cut angle", format!("{}°", d.cut_angle)),
+        ("seed", d.seed.to_string()),
+        ("objective", objective_text(d.selection).into()),
+        ("range", range_text(r.range.as_ref())),
+        ("spread", r.spread.to_string()),
+        ("hand-eye guess", hand_eye),
     ];
+    let fields = Vec::from(fields.map(|(k, v)| (k.to_string(), v)));
     // Fields the view does not show (cone, box, …) still count.
     let unseen = format!("{r:?}");
     Reading::new(fields, unseen)

@@ -10,7 +10,7 @@ use egui::{RichText, Stroke};
 use crate::app::Forms;
 use crate::app::scene::content::{LASER, LINK, axes_lines};
 use crate::app::scene::{Line3, Mark, Scene, Sphere3};
-use crate::app::widgets::{BAD, MUTED, station_style};
+use crate::app::widgets::{BAD, MUTED, coloured, station_style, table};
 use crate::engine::tools::plan::Plan;
 use crate::engine::tools::scene::{
     fan_around, frame_axes, laser_fan, link_polyline, planned_pose_problem,
@@ -152,12 +152,9 @@ pub fn plan_scene_ui(ui: &mut egui::Ui, forms: &mut Forms, plan: &Plan, stale: b
         ui.data_mut(|d| d.insert_temp(scroll_id(), i));
     }
     if crossed > 0 {
-        ui.label(
-            RichText::new(format!(
-                "{crossed} planned poses cannot be run as planned: press Make plan again"
-            ))
-            .color(BAD),
-        );
+        let text =
+            format!("{crossed} planned poses cannot be run as planned: press Make plan again");
+        coloured(ui, BAD, text);
     }
 }
 
@@ -176,40 +173,32 @@ pub fn poses_table_ui(ui: &mut egui::Ui, forms: &mut Forms, plan: &Plan) {
         .id_salt("plan_poses")
         .open(scroll_to.map(|_| true))
         .show(ui, |ui| {
-            egui::ScrollArea::vertical()
-                .id_salt("plan_pose_table")
-                .max_height(260.0)
-                .show(ui, |ui| {
-                    egui::Grid::new("plan_pose_grid")
-                        .striped(true)
-                        .num_columns(5)
-                        .show(ui, |ui| {
-                            for h in ["id", "station", "use", "side", "joints (deg)"] {
-                                ui.label(RichText::new(h).strong());
-                            }
-                            ui.end_row();
-                            for (i, p) in plan.poses.iter().enumerate() {
-                                let row = ui.selectable_label(selected == Some(i), &p.id);
-                                if row.clicked() {
-                                    forms.scene.plan_pose = Some(i);
-                                }
-                                if scroll_to == Some(i) {
-                                    // Just into sight (the scene above
-                                    // stays in view as far as it can),
-                                    // once the row is laid out.
-                                    row.scroll_to_me(None);
-                                    ui.data_mut(|d| d.remove::<usize>(scroll_id()));
-                                }
-                                ui.label(&p.station);
-                                ui.label(p.usage.as_str());
-                                ui.label(format!("{:+}", p.side));
-                                let joints: Vec<String> =
-                                    p.joints.iter().map(|q| format!("{q:8.3}")).collect();
-                                ui.label(RichText::new(joints.join(" ")).monospace());
-                                ui.end_row();
-                            }
-                        });
+            let scroll = egui::ScrollArea::vertical().id_salt("plan_pose_table");
+            scroll.max_height(260.0).show(ui, |ui| {
+                let headers = ["id", "station", "use", "side", "joints (deg)"];
+                table(ui, "plan_pose_grid", &headers, |ui| {
+                    for (i, p) in plan.poses.iter().enumerate() {
+                        let row = ui.selectable_label(selected == Some(i), &p.id);
+                        if row.clicked() {
+                            forms.scene.plan_pose = Some(i);
+                        }
+                        if scroll_to == Some(i) {
+                            // Just into sight (the scene above stays in
+                            // view as far as it can), once the row is
+                            // laid out.
+                            row.scroll_to_me(None);
+                            ui.data_mut(|d| d.remove::<usize>(scroll_id()));
+                        }
+                        ui.label(&p.station);
+                        ui.label(p.usage.as_str());
+                        ui.label(format!("{:+}", p.side));
+                        let joints: Vec<String> =
+                            p.joints.iter().map(|q| format!("{q:8.3}")).collect();
+                        ui.label(RichText::new(joints.join(" ")).monospace());
+                        ui.end_row();
+                    }
                 });
+            });
         });
     if plan.poses.is_empty() {
         ui.label(RichText::new("no poses").color(MUTED));

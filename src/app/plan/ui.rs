@@ -14,11 +14,13 @@ use crate::app::dialog::Purpose;
 use crate::app::job::Slot;
 use crate::app::ledger::{Artefact, Stale};
 use crate::app::widgets::{
-    AFTER, BAD, BEFORE, DEFAULT_RANGE, MUTED, export_folder_ui, preset_ui, range_fields, range_of,
-    range_values,
+    AFTER, BAD, BEFORE, DEFAULT_RANGE, MUTED, command_button, export_folder_ui, preset_ui,
+    range_fields, range_of, range_values,
 };
 use crate::app::{Forms, plan::form::default_sphere};
-use crate::engine::tools::plan::{MAX_PREDICT_RUNS, Plan, PlanStats, Planned, StationRole};
+use crate::engine::tools::plan::{
+    Controller, MAX_PREDICT_RUNS, Plan, PlanStats, Planned, StationRole,
+};
 
 /// Width of the settings column, points.
 const FORM_WIDTH: f32 = 330.0;
@@ -177,22 +179,20 @@ fn form_ui(ui: &mut egui::Ui, state: &AppState, forms: &mut Forms, commands: &mu
     ui.horizontal(|ui| {
         let running = state.jobs.runs(&Slot::Plan);
         let wrong = settings_error(f);
-        if ui
-            .add_enabled(
-                !running && wrong.is_none(),
-                egui::Button::new(RichText::new("Make plan").strong().size(16.0)),
-            )
-            .on_disabled_hover_text(wrong.unwrap_or_else(|| "a plan is being made".into()))
-            .clicked()
-        {
-            commands.push(Command::Plan(PlanCommand::Make));
-        }
-        if ui
-            .add_enabled(running, egui::Button::new("Cancel plan"))
-            .clicked()
-        {
-            commands.push(Command::Plan(PlanCommand::Cancel));
-        }
+        let make = Command::Plan(PlanCommand::Make);
+        let text = RichText::new("Make plan").strong().size(16.0);
+        let hover = "plan the poses on a background thread";
+        command_button(ui, !running && wrong.is_none(), text, hover, make, commands)
+            .on_disabled_hover_text(wrong.unwrap_or_else(|| "a plan is being made".into()));
+        let cancel = Command::Plan(PlanCommand::Cancel);
+        command_button(
+            ui,
+            running,
+            "Cancel plan",
+            "stop planning",
+            cancel,
+            commands,
+        );
     });
     crate::app::widgets::slot_ui(ui, state, &Slot::Plan);
 }
@@ -370,36 +370,27 @@ fn export_ui(
                 .color(MUTED),
             );
         }
-        for kind in std::iter::once(PlanExport::Csv).chain(controller.map(PlanExport::Program)) {
-            let hint = match kind {
-                PlanExport::Csv => "the joint-log CSV that `spherecal import` reads (id, station, use, side, joints, nominal ABB flange pose)",
-                PlanExport::Program(crate::engine::tools::plan::Controller::Abb) => "an ABB RAPID module: one jointtarget per pose, MoveAbsJ in plan order, a stop per measurement",
-                PlanExport::Program(crate::engine::tools::plan::Controller::Ur) => "a URScript program for a Universal Robots controller: one movej per pose (rad), a popup per station, a measure hook",
-                // Only the controllers of plan::PROGRAMS are offered.
-                PlanExport::Program(_) => "the controller's program",
-            };
-            if ui
-                .add_enabled(
-                    !busy && stale.is_none(),
-                    egui::Button::new(kind.label()),
-                )
-                .on_hover_text(hint)
-                .on_disabled_hover_text(&refused)
-                .clicked()
-            {
-                commands.push(Command::Plan(PlanCommand::Export(kind)));
-            }
-        }
-        if ui
-            .add_enabled(
-                !busy && stale.is_none(),
-                egui::Button::new("Simulate and open"),
-            )
-            .on_hover_text("a session of this plan on a simulated robot with kinematic errors, each pose touched up as when teaching: try the calibration before going to the cell")
-            .on_disabled_hover_text(&refused)
-            .clicked()
-        {
-            commands.push(Command::Plan(PlanCommand::Simulate));
+        let exports = std::iter::once(PlanExport::Csv).chain(controller.map(PlanExport::Program));
+        let mut buttons: Vec<(String, &str, Command)> = exports
+            .map(|kind| {
+                let hint = match kind {
+                    PlanExport::Csv => "the joint-log CSV that `spherecal import` reads (id, station, use, side, joints, nominal ABB flange pose)",
+                    PlanExport::Program(Controller::Abb) => "an ABB RAPID module: one jointtarget per pose, MoveAbsJ in plan order, a stop per measurement",
+                    PlanExport::Program(Controller::Ur) => "a URScript program for a Universal Robots controller: one movej per pose (rad), a popup per station, a measure hook",
+                    // Only the controllers of plan::PROGRAMS are offered.
+                    PlanExport::Program(_) => "the controller's program",
+                };
+                (kind.label().to_string(), hint, Command::Plan(PlanCommand::Export(kind)))
+            })
+            .collect();
+        buttons.push((
+            "Simulate and open".to_string(),
+            "a session of this plan on a simulated robot with kinematic errors, each pose touched up as when teaching: try the calibration before going to the cell",
+            Command::Plan(PlanCommand::Simulate),
+        ));
+        for (text, hint, command) in buttons {
+            command_button(ui, !busy && stale.is_none(), text, hint, command, commands)
+                .on_disabled_hover_text(&refused);
         }
     });
 }
@@ -444,17 +435,35 @@ fn map_ui(ui: &mut egui::Ui, plan: &Plan) {
             .collect()
     };
     let base = plan.robot.base.translation.vector;
+    let roles = [
+        (
+            "◆ P0 (hand-eye groups)",
+            BAD,
+            StationRole::HandEye,
+            MarkerShape::Diamond,
+            6.0,
+        ),
+        (
+            "● identify",
+            AFTER,
+            StationRole::Identify,
+            MarkerShape::Circle,
+            5.0,
+        ),
+        (
+            "■ validate",
+            BEFORE,
+            StationRole::Validate,
+            MarkerShape::Square,
+            5.0,
+        ),
+    ];
     // The key names only what is drawn.
-    let mut key = Vec::new();
-    for (text, colour, role) in [
-        ("◆ P0 (hand-eye groups)", BAD, StationRole::HandEye),
-        ("● identify", AFTER, StationRole::Identify),
-        ("■ validate", BEFORE, StationRole::Validate),
-    ] {
-        if !of(role).is_empty() {
-            key.push((text, colour));
-        }
-    }
+    let mut key: Vec<(&str, egui::Color32)> = roles
+        .iter()
+        .filter(|r| !of(r.2).is_empty())
+        .map(|r| (r.0, r.1))
+        .collect();
     key.push(("× robot base", MUTED));
     crate::app::widgets::plot_key(ui, &key);
     crate::app::widgets::plots::readable(Plot::new("plan_map"), false)
@@ -465,32 +474,13 @@ fn map_ui(ui: &mut egui::Ui, plan: &Plan) {
         .x_axis_label("x (mm)")
         .y_axis_label("y (mm)")
         .show(ui, |p| {
-            p.points(
-                Points::new("robot base", PlotPoints::from(vec![[base.x, base.y]]))
-                    .shape(MarkerShape::Cross)
-                    .radius(7.0)
-                    .color(MUTED),
-            );
-            p.points(
-                Points::new(
-                    "P0 (hand-eye groups)",
-                    PlotPoints::from(of(StationRole::HandEye)),
-                )
-                .shape(MarkerShape::Diamond)
-                .radius(6.0)
-                .color(BAD),
-            );
-            p.points(
-                Points::new("identify", PlotPoints::from(of(StationRole::Identify)))
-                    .shape(MarkerShape::Circle)
-                    .radius(5.0)
-                    .color(AFTER),
-            );
-            p.points(
-                Points::new("validate", PlotPoints::from(of(StationRole::Validate)))
-                    .shape(MarkerShape::Square)
-                    .radius(5.0)
-                    .color(BEFORE),
-            );
+            let base = PlotPoints::from(vec![[base.x, base.y]]);
+            let base = Points::new("robot base", base).shape(MarkerShape::Cross);
+            p.points(base.radius(7.0).color(MUTED));
+            for (name, colour, role, shape, radius) in roles {
+                let name = name.split_once(' ').map_or(name, |(_, n)| n);
+                let points = Points::new(name, PlotPoints::from(of(role))).shape(shape);
+                p.points(points.radius(radius).color(colour));
+            }
         });
 }
