@@ -8,7 +8,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use std::path::Path;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT as _, Queryable as _};
@@ -171,40 +171,22 @@ fn cancel_in_the_last_phase_keeps_the_previous_result() {
     let first = h.state().state().result.clone().expect("a first result");
     // A second run, cancelled once it has reached leave-one-station-out.
     h.get_by_label("▶ Run").click();
-    let mut reached = false;
-    for _ in 0..20_000 {
-        h.step();
-        let phase = h
-            .state()
-            .state()
-            .jobs
-            .get(&Slot::Run)
-            .map(|r| r.phase.clone());
-        if phase.is_some_and(|p| p.starts_with("leave-one-station-out")) {
-            reached = true;
-            break;
-        }
-        assert!(
-            h.state().state().jobs.get(&Slot::Run).is_some(),
-            "the run ended before its last phase"
-        );
-        std::thread::sleep(Duration::from_millis(1));
-    }
-    assert!(reached, "the run reached leave-one-station-out");
+    step_until_last_phase(&mut h);
     assert!(
         h.query_all_by_label_contains("leave-one-station-out")
             .count()
             > 0,
         "the phase is shown"
     );
-    let cancelled_at = std::time::Instant::now();
+    // No wall-clock bound: the phase itself takes about 0.4 s here, and a
+    // bound in seconds measured the machine's load (it failed at load 10
+    // with the cancel honoured). That the run stopped *inside* the phase
+    // is shown below: the status says it was cancelled (a run that ended
+    // says so instead) and the first run's result is still on show.
+    let cancelled_at = Instant::now();
     h.get_by_label("Cancel").click();
     settle(&mut h);
     eprintln!("TIMING cancel {:?}", cancelled_at.elapsed());
-    assert!(
-        cancelled_at.elapsed() < Duration::from_secs(1),
-        "stopped within a second"
-    );
     let state = h.state().state();
     assert!(state.jobs.get(&Slot::Run).is_none());
     let shown = state
@@ -218,6 +200,29 @@ fn cancel_in_the_last_phase_keeps_the_previous_result() {
         .map(|s| s.text.clone())
         .unwrap_or_default();
     assert!(status.contains("cancelled"), "status: {status}");
+}
+
+/// Steps the window until the run's phase is leave-one-station-out (the
+/// last), failing if the run ends before it.
+fn step_until_last_phase(h: &mut Harness<'_, WorkbenchApp>) {
+    for _ in 0..20_000 {
+        h.step();
+        let phase = h
+            .state()
+            .state()
+            .jobs
+            .get(&Slot::Run)
+            .map(|r| r.phase.clone());
+        if phase.is_some_and(|p| p.starts_with("leave-one-station-out")) {
+            return;
+        }
+        assert!(
+            h.state().state().jobs.get(&Slot::Run).is_some(),
+            "the run ended before its last phase"
+        );
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    panic!("the run did not reach leave-one-station-out");
 }
 
 /// Issue 13: the demo's one stripe warning was 60 rows down; the Session
