@@ -32,7 +32,7 @@ fn a_start_within_the_threshold_is_said_and_threshold_zero_refines_it() {
     let (code, _, err) = run(&["simulate", "--pose-only", "0.02", "--out", s, "-q"]);
     assert_eq!(code, 0, "{err}");
     let start = dir.path().join("start.result.json");
-    let (code, _, err) = run(&[
+    let (code, out, err) = run(&[
         "calibrate",
         s,
         "--method",
@@ -41,6 +41,14 @@ fn a_start_within_the_threshold_is_said_and_threshold_zero_refines_it() {
         start.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
+    // The stop line does not call an unrefined start "converged".
+    let console = format!("{out}{err}");
+    assert!(
+        console
+            .contains("no update: ε = 0.1068 mm was within the threshold 0.1500 mm at the start"),
+        "{console}"
+    );
+    assert!(!console.contains("converged"), "{console}");
     assert!(
         err.contains(
             "warning: no update: ε = 0.1068 mm started within the threshold 0.15 mm, so nothing was identified"

@@ -244,6 +244,15 @@ impl StopReason {
     #[must_use]
     pub fn describe(&self) -> String {
         match *self {
+            // Nothing converged when no update was made: the start was
+            // already within the threshold (no_update_warning says more).
+            Self::Converged {
+                epsilon,
+                threshold,
+                updates: 0,
+            } => format!(
+                "no update: ε = {epsilon:.4} mm was within the threshold {threshold:.4} mm at the start"
+            ),
             Self::Converged {
                 epsilon,
                 threshold,
