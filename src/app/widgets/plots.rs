@@ -330,7 +330,11 @@ pub fn epsilon_plot_ui(
             )),
             egui_plot::HoverPosition::Elsewhere { .. } => None,
         })
+        // Update 1 too: with a single point (a run without update) x = 0
+        // sat mid-plot and the threshold's name, written from it to the
+        // right, ran past the frame.
         .include_x(0.0)
+        .include_x(1.0)
         .allow_scroll(false)
         .show(ui, |p| {
             p.line(
