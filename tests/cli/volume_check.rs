@@ -617,11 +617,18 @@ fn seeds() -> Vec<u64> {
         .collect()
 }
 
-/// The check: the plan made by the command line, scored on the cells.
-#[test]
-#[ignore = "bench: the acceptance check of issue 32, a minute a cell"]
-fn issue_32_check() {
-    let dir = std::env::temp_dir().join(format!("spherecal-volume-check-{}", std::process::id()));
+/// The check's plan, made by the command line as the issue states it
+/// (`VOLUME_CHECK_PLAN` adds options), in a scratch folder of its own.
+struct CheckPlan {
+    dir: std::path::PathBuf,
+    poses: Vec<PlanPose>,
+    console: String,
+    seconds: f64,
+    extra: String,
+}
+
+fn check_plan(name: &str) -> CheckPlan {
+    let dir = std::env::temp_dir().join(format!("spherecal-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let csv = dir.join("P.csv");
     let extra = std::env::var("VOLUME_CHECK_PLAN").unwrap_or_default();
@@ -640,10 +647,30 @@ fn issue_32_check() {
     args.extend(extra.split_whitespace().map(str::to_owned));
     let t = Instant::now();
     let (code, out, err) = run(&args);
-    let plan_seconds = t.elapsed().as_secs_f64();
+    let seconds = t.elapsed().as_secs_f64();
     assert_eq!(code, 0, "plan: {out}{err}");
-    println!("{}", out.trim_end());
-    let plan = read_plan_csv(&std::fs::read_to_string(&csv).unwrap()).unwrap();
+    let poses = read_plan_csv(&std::fs::read_to_string(&csv).unwrap()).unwrap();
+    CheckPlan {
+        dir,
+        poses,
+        console: out,
+        seconds,
+        extra,
+    }
+}
+
+/// The check: the plan made by the command line, scored on the cells.
+#[test]
+#[ignore = "bench: the acceptance check of issue 32, a minute a cell"]
+fn issue_32_check() {
+    let CheckPlan {
+        dir,
+        poses: plan,
+        console,
+        seconds: plan_seconds,
+        extra,
+    } = check_plan("volume-check");
+    println!("{}", console.trim_end());
     println!(
         "plan {} ({plan_seconds:.1} s, this build)",
         if extra.is_empty() {
@@ -681,26 +708,9 @@ fn issue_32_check() {
 #[test]
 #[ignore = "bench: rows missed by the check's plan on the cells' true robots"]
 fn rows_missed() {
-    let dir = std::env::temp_dir().join(format!("spherecal-rows-missed-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let csv = dir.join("P.csv");
-    let extra = std::env::var("VOLUME_CHECK_PLAN").unwrap_or_default();
-    let mut args: Vec<String> = [
-        "plan",
-        "--sphere",
-        "1050,0,475",
-        "--identify-stations",
-        "20",
-        "--csv",
-    ]
-    .iter()
-    .map(|s| (*s).to_owned())
-    .collect();
-    args.push(csv.display().to_string());
-    args.extend(extra.split_whitespace().map(str::to_owned));
-    let (code, out, err) = run(&args);
-    assert_eq!(code, 0, "plan: {out}{err}");
-    let plan = read_plan_csv(&std::fs::read_to_string(&csv).unwrap()).unwrap();
+    let CheckPlan {
+        dir, poses: plan, ..
+    } = check_plan("rows-missed");
     let preset = robot::preset("irb2400").unwrap();
     let config = PlanConfig::for_preset(&preset, SPHERE);
     let hand_eye = simulated_true_hand_eye(&config.flange_from_sensor);
@@ -743,10 +753,9 @@ fn rows_missed() {
 #[test]
 #[ignore = "bench: the anatomy of the check's cells"]
 fn anatomy() {
-    let dir = std::env::temp_dir().join(format!("spherecal-volume-anatomy-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let csv = dir.join("P.csv");
-    let extra = std::env::var("VOLUME_CHECK_PLAN").unwrap_or_default();
+    let CheckPlan {
+        dir, poses: plan, ..
+    } = check_plan("volume-anatomy");
     let env = |k: &str, d: u64| {
         std::env::var(k)
             .ok()
@@ -757,22 +766,6 @@ fn anatomy() {
         env("VOLUME_ANATOMY_REPS", 3),
         env("VOLUME_ANATOMY_RESCORES", 20),
     );
-    let mut args: Vec<String> = [
-        "plan",
-        "--sphere",
-        "1050,0,475",
-        "--identify-stations",
-        "20",
-        "--csv",
-    ]
-    .iter()
-    .map(|s| (*s).to_owned())
-    .collect();
-    args.push(csv.display().to_string());
-    args.extend(extra.split_whitespace().map(str::to_owned));
-    let (code, out, err) = run(&args);
-    assert_eq!(code, 0, "plan: {out}{err}");
-    let plan = read_plan_csv(&std::fs::read_to_string(&csv).unwrap()).unwrap();
     println!(
         "| cell | noise | after / floor | floor, mm | parameters' part, mm | predicted, mm | part / predicted | rescored: ratio median [10 %, 90 %] worst, parameters' part mean |"
     );
@@ -838,29 +831,9 @@ fn anatomy() {
 #[test]
 #[ignore = "bench: the anatomy's rescorings one by one"]
 fn rescorings() {
-    let dir = std::env::temp_dir().join(format!(
-        "spherecal-volume-rescorings-{}",
-        std::process::id()
-    ));
-    std::fs::create_dir_all(&dir).unwrap();
-    let csv = dir.join("P.csv");
-    let extra = std::env::var("VOLUME_CHECK_PLAN").unwrap_or_default();
-    let mut args: Vec<String> = [
-        "plan",
-        "--sphere",
-        "1050,0,475",
-        "--identify-stations",
-        "20",
-        "--csv",
-    ]
-    .iter()
-    .map(|s| (*s).to_owned())
-    .collect();
-    args.push(csv.display().to_string());
-    args.extend(extra.split_whitespace().map(str::to_owned));
-    let (code, out, err) = run(&args);
-    assert_eq!(code, 0, "plan: {out}{err}");
-    let plan = read_plan_csv(&std::fs::read_to_string(&csv).unwrap()).unwrap();
+    let CheckPlan {
+        dir, poses: plan, ..
+    } = check_plan("volume-rescorings");
     let n: u64 = std::env::var("VOLUME_ANATOMY_RESCORES")
         .ok()
         .and_then(|v| v.parse().ok())
